@@ -1,0 +1,304 @@
+//! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
+
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+use tessera::criterion::Plan;
+use tessera::engine::{self, TessellateOptions};
+use tessera::mesh::Mesh;
+use tessera::pattern::uniform::Uniform;
+use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
+use tessera::topology::weld::Weld;
+use tessera::verify;
+
+/// The Utah teapot, public domain, embedded for `tessera demo`.
+const TEAPOT: &str = include_str!("../assets/teapot.patches");
+
+#[derive(Parser)]
+#[command(name = "tessera", version, about = "Crack-free tessellation of parametric surfaces", long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Tessellate a patch file (.patches, bicubic Bézier) or a triangle mesh (.obj, as PN
+    /// triangles) into one watertight indexed mesh.
+    Mesh(MeshArgs),
+    /// Check a mesh: watertightness, triangle quality and, with --against, the input's
+    /// topology and the approximation error.
+    Check(CheckArgs),
+    /// Tessellate the embedded Utah teapot, write teapot.obj and print the report.
+    Demo(DemoArgs),
+}
+
+#[derive(Args)]
+struct InputArgs {
+    /// Merge control points / mesh vertices closer than EPS (default: only bit-identical
+    /// positions are merged).
+    #[arg(long, value_name = "EPS")]
+    weld: Option<f64>,
+    /// Reverse the orientation (front side) of every patch after auto-orientation.
+    #[arg(long)]
+    flip_normals: bool,
+    /// Keep the input's orientation instead of orienting closed inputs outward.
+    #[arg(long)]
+    keep_orientation: bool,
+}
+
+#[derive(Args)]
+struct MeshArgs {
+    /// Input: .patches (Newell bicubic patch format) or .obj (triangle mesh → PN triangles).
+    input: PathBuf,
+    /// Output mesh; the format follows the extension: .obj, .ply, .stl or .glb.
+    #[arg(short, long, value_name = "OUT")]
+    output: Option<PathBuf>,
+    /// Uniform tessellation factor: every edge is cut into N segments.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    factor: u32,
+    /// Print one JSON object with counts, topology and timing on one stdout line.
+    #[arg(long)]
+    stats: bool,
+    /// Tessellate R times and report the median time (with --stats).
+    #[arg(long, value_name = "R", default_value_t = 1)]
+    repeat: u32,
+    /// Also measure the approximation error against the exact surface (with --stats).
+    #[arg(long)]
+    measure_error: bool,
+    #[command(flatten)]
+    input_args: InputArgs,
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    /// Mesh to check: .obj, .ply, .stl or .glb.
+    mesh: PathBuf,
+    /// The input the mesh was made from: compares topology and, for .ply meshes written by
+    /// tessera (they carry per-corner patch parameters), measures the error.
+    #[arg(long, value_name = "IN")]
+    against: Option<PathBuf>,
+    #[command(flatten)]
+    input_args: InputArgs,
+}
+
+#[derive(Args)]
+struct DemoArgs {
+    /// Where to write the teapot mesh.
+    #[arg(short, long, default_value = "teapot.obj")]
+    output: PathBuf,
+    /// Uniform tessellation factor.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    factor: u32,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Mesh(a) => run_mesh(a),
+        Command::Check(a) => run_check(a),
+        Command::Demo(a) => run_demo(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+type CliResult = Result<ExitCode, Box<dyn std::error::Error>>;
+
+/// A spinner on stderr for work that may take a while; hidden when stderr is not a terminal.
+fn spinner(message: &str) -> ProgressBar {
+    let pb = ProgressBar::new_spinner();
+    pb.set_style(ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("static template"));
+    pb.set_message(message.to_string());
+    pb.enable_steady_tick(Duration::from_millis(120));
+    pb
+}
+
+fn build_options(a: &InputArgs) -> Result<BuildOptions, Box<dyn std::error::Error>> {
+    let weld = match a.weld {
+        None => Weld::Exact,
+        Some(eps) if eps.is_finite() && eps >= 0.0 => Weld::Within(eps),
+        Some(eps) => return Err(format!("--weld {eps}: the distance must be finite and ≥ 0").into()),
+    };
+    Ok(BuildOptions {
+        weld,
+        orientation: if a.keep_orientation { Orientation::AsGiven } else { Orientation::Outward },
+        flip: a.flip_normals,
+    })
+}
+
+/// Loads a surface set from a patch file or an OBJ mesh, by extension.
+fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => {
+            let mesh = tessera::io::obj::read_obj(path)?;
+            SurfaceSet::pn_from_mesh(&mesh, path, options)
+        }
+        _ => {
+            let file = tessera::io::patches::read_patches(path)?;
+            Ok(SurfaceSet::from_patch_file(&file, options))
+        }
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn run_mesh(a: MeshArgs) -> CliResult {
+    let options = build_options(&a.input_args)?;
+    let pb = spinner(&format!("reading {}", a.input.display()));
+    let set = load_surfaces(&a.input, options)?;
+    let plan = Plan::uniform(&set, a.factor)?;
+    let wants_params = a.measure_error
+        || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
+    let opts = TessellateOptions { corner_params: wants_params };
+    pb.set_message(format!("tessellating {} patches at factor {}", set.patches.len(), a.factor));
+    let mut times = Vec::new();
+    let mut mesh = Mesh::default();
+    for _ in 0..a.repeat.max(1) {
+        let start = Instant::now();
+        mesh = engine::tessellate(&set, &plan, &Uniform, opts)?;
+        times.push(start.elapsed().as_secs_f64());
+    }
+    if let Some(out) = &a.output {
+        pb.set_message(format!("writing {}", out.display()));
+        tessera::mesh::write_mesh(&mesh, out)?;
+    }
+    pb.finish_and_clear();
+    if a.stats {
+        let w = verify::watertight(&mesh);
+        let seconds = median(times);
+        let mut stats = serde_json::json!({
+            "input": a.input.display().to_string(),
+            "factor": a.factor,
+            "patches": set.patches.len(),
+            "triangles": mesh.triangle_count(),
+            "vertices": mesh.vertex_count(),
+            "boundary_edges": w.boundary_edges,
+            "nonmanifold_edges": w.nonmanifold_edges,
+            "degenerate_triangles": w.degenerate_triangles(),
+            "euler_characteristic": w.euler_characteristic,
+            "input_euler_characteristic": set.topology.report.euler_characteristic,
+            "input_boundary_edges": set.topology.report.boundary_edges,
+            "seconds": seconds,
+            "repeat": a.repeat.max(1),
+            "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
+            "threads": rayon::current_num_threads(),
+        });
+        if a.measure_error {
+            let e = verify::approximation_error(&mesh, &set, 6)?;
+            stats["max_error"] = e.max.into();
+            stats["rms_error"] = e.rms.into();
+        }
+        println!("{stats}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn read_any_mesh(path: &Path) -> Result<Mesh, tessera::Error> {
+    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if !is_obj {
+        return tessera::mesh::read_mesh(path);
+    }
+    let obj = tessera::io::obj::read_obj(path)?;
+    let tris = obj.triangles(path)?;
+    let mut mesh = Mesh {
+        positions: obj.positions.iter().map(|p| p.as_vec3().to_array()).collect(),
+        indices: tris.iter().flatten().copied().collect(),
+        ..Default::default()
+    };
+    mesh.normals = vec![[0.0; 3]; mesh.positions.len()];
+    mesh.uvs = vec![[0.0; 2]; mesh.positions.len()];
+    mesh.vertex_patch = vec![0; mesh.positions.len()];
+    mesh.triangle_patch = vec![0; tris.len()];
+    Ok(mesh)
+}
+
+fn print_report(mesh: &Mesh, w: &verify::WatertightReport) {
+    let q = verify::quality(mesh);
+    println!("triangles            {}", w.triangles);
+    println!("vertices (welded)    {}", w.vertices);
+    println!("boundary edges       {}", w.boundary_edges);
+    println!("non-manifold edges   {}", w.nonmanifold_edges);
+    println!("misoriented edges    {}", w.misoriented_edges);
+    println!(
+        "degenerate triangles {} ({} collapsed, {} zero area)",
+        w.degenerate_triangles(),
+        w.collapsed_triangles,
+        w.zero_area_triangles
+    );
+    println!("Euler characteristic {}", w.euler_characteristic);
+    println!("watertight           {}", if w.is_closed() { "yes" } else { "no" });
+    println!("min angle            {:.2}°", q.min_angle);
+    println!("under 10°            {:.2} %", 100.0 * q.share_below_10_degrees);
+    let hist: Vec<String> = q.min_angle_histogram.iter().map(|c| c.to_string()).collect();
+    println!("min-angle histogram  {} (5° bins from 0° to 60°)", hist.join(" "));
+}
+
+fn run_check(a: CheckArgs) -> CliResult {
+    let pb = spinner(&format!("reading {}", a.mesh.display()));
+    let mesh = read_any_mesh(&a.mesh)?;
+    let w = verify::watertight(&mesh);
+    pb.finish_and_clear();
+    println!("mesh                 {}", a.mesh.display());
+    print_report(&mesh, &w);
+    let Some(input) = &a.against else { return Ok(ExitCode::SUCCESS) };
+    let set = load_surfaces(input, build_options(&a.input_args)?)?;
+    let t = set.topology.report;
+    println!("input                {} ({} patches)", input.display(), t.patches);
+    println!("input boundary edges {} (curves)", t.boundary_edges);
+    println!("input non-manifold   {}", t.nonmanifold_edges);
+    println!("input Euler char.    {}", t.euler_characteristic);
+    if mesh.corner_params.is_some() {
+        let e = verify::approximation_error(&mesh, &set, 6)?;
+        println!("max error            {:.6e}", e.max);
+        println!("rms error            {:.6e}", e.rms);
+    } else {
+        println!("max error            not measured: {} carries no per-corner patch parameters (write .ply with tessera mesh)", a.mesh.display());
+    }
+    if t.is_closed() && !w.is_closed() {
+        println!("FAIL: the input is closed but the mesh is open or non-manifold");
+        return Ok(ExitCode::from(1));
+    }
+    if w.euler_characteristic != t.euler_characteristic {
+        println!("note: the Euler characteristic differs from the input's");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_demo(a: DemoArgs) -> CliResult {
+    let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
+    let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
+    let plan = Plan::uniform(&set, a.factor)?;
+    let start = Instant::now();
+    let mesh = engine::tessellate(&set, &plan, &Uniform, TessellateOptions { corner_params: true })?;
+    let seconds = start.elapsed().as_secs_f64();
+    tessera::mesh::write_mesh(&mesh, &a.output)?;
+    let w = verify::watertight(&mesh);
+    let e = verify::approximation_error(&mesh, &set, 6)?;
+    println!("Utah teapot: {} bicubic patches, uniform factor {}", set.patches.len(), a.factor);
+    println!("wrote                {}", a.output.display());
+    println!("tessellation time    {:.3} ms", seconds * 1e3);
+    print_report(&mesh, &w);
+    println!(
+        "input boundary edges {} (curves: rim, lid, handle and spout ends)",
+        set.topology.report.boundary_edges
+    );
+    println!("input Euler char.    {}", set.topology.report.euler_characteristic);
+    println!("max error            {:.6e} (bounding-box diagonal {:.3})", e.max, {
+        let (lo, hi) = set.bounds();
+        lo.distance(hi)
+    });
+    println!("rms error            {:.6e}", e.rms);
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,36 @@
+//! Criteria: decide how finely each shared edge and each patch interior is sampled.
+//!
+//! A criterion's output is a [`Plan`]: one [`EdgeSampling`] per canonical edge of the
+//! topology and interior factors per patch. Crack-freeness rests on one rule: the sampling of
+//! an edge is decided once, from data all its patches agree on, and every patch reads it.
+
+use crate::error::{Error, Result};
+use crate::sampling::EdgeSampling;
+use crate::surface::SurfaceSet;
+
+/// Largest uniform factor accepted: past it a single patch would need more than 2³² indices.
+pub const MAX_FACTOR: u32 = 16_384;
+
+/// Samplings for every edge and interior factors for every patch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// One per `topology.edges` entry, in canonical orientation.
+    pub edges: Vec<EdgeSampling>,
+    /// Interior factors per patch (`[u, v]`; triangles use the first).
+    pub interior: Vec<[u32; 2]>,
+}
+
+impl Plan {
+    /// The uniform plan: factor `n` everywhere. Errors for `n = 0` or `n > MAX_FACTOR`.
+    pub fn uniform(set: &SurfaceSet, n: u32) -> Result<Plan> {
+        if n == 0 || n > MAX_FACTOR {
+            return Err(Error::InvalidArgument(format!(
+                "factor {n} is out of range: use an integer from 1 to {MAX_FACTOR}"
+            )));
+        }
+        Ok(Plan {
+            edges: vec![EdgeSampling::uniform(n); set.topology.edges.len()],
+            interior: vec![[n, n]; set.patches.len()],
+        })
+    }
+}

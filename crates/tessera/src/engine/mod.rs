@@ -1,0 +1,340 @@
+//! The CPU engine: count → exclusive scan → parallel write (rayon).
+//!
+//! Output vertex layout: the corner entries of the topology first (one per vertex and normal
+//! variant), then every edge's inner samples (`segments − 1` per normal variant), then every
+//! patch's interior vertices. Counts are known before anything is evaluated, so each task
+//! writes its own disjoint slice. A shared edge's inner vertices are evaluated once, by the
+//! edge's owner patch, and every patch on the edge indexes them: the mesh is watertight bit
+//! for bit without welding. Split-normal variants copy the owner's position bits and take
+//! their normal from a patch of their own variant.
+
+use crate::criterion::Plan;
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::pattern::{LocalTessellation, Pattern, PatternInput};
+use crate::surface::{Domain, SurfaceSet};
+use glam::DVec2;
+use rayon::prelude::*;
+
+/// Engine options.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TessellateOptions {
+    /// Fill [`Mesh::corner_params`] (needed to measure the approximation error).
+    pub corner_params: bool,
+}
+
+#[derive(Clone, Copy, Default)]
+struct VertexRecord {
+    position: [f32; 3],
+    normal: [f32; 3],
+    uv: [f32; 2],
+    patch: u32,
+}
+
+fn record(set: &SurfaceSet, patch: u32, uv: DVec2) -> VertexRecord {
+    let p = set.patches[patch as usize].eval(uv);
+    VertexRecord {
+        position: p.position.as_vec3().to_array(),
+        normal: p.normal.as_vec3().to_array(),
+        uv: uv.as_vec2().to_array(),
+        patch,
+    }
+}
+
+/// Splits `data` into consecutive slices of the given lengths.
+fn split_by_counts<'a, T>(mut data: &'a mut [T], counts: &[usize]) -> Vec<&'a mut [T]> {
+    let mut out = Vec::with_capacity(counts.len());
+    for &c in counts {
+        let (head, tail) = data.split_at_mut(c);
+        out.push(head);
+        data = tail;
+    }
+    out
+}
+
+fn exclusive_scan(counts: &[usize]) -> (Vec<usize>, usize) {
+    let mut offsets = Vec::with_capacity(counts.len());
+    let mut sum = 0usize;
+    for &c in counts {
+        offsets.push(sum);
+        sum += c;
+    }
+    (offsets, sum)
+}
+
+/// Per-patch mapping from local vertex indices to output vertices.
+struct LocalMap<'a> {
+    set: &'a SurfaceSet,
+    plan: &'a Plan,
+    input: PatternInput,
+    patch: usize,
+    edge_base: &'a [usize],
+    interior_base: usize,
+}
+
+impl LocalMap<'_> {
+    fn corner_vertex(&self, c: usize) -> u32 {
+        self.set.topology.patch_corner_entries[self.patch][c]
+    }
+
+    /// Output vertex of local index `l`.
+    fn vertex(&self, l: u32) -> u32 {
+        let nc = self.input.domain.corner_count();
+        if (l as usize) < nc {
+            return self.corner_vertex(l as usize);
+        }
+        let interior_start = self.input.interior_base();
+        if l >= interior_start {
+            return (self.interior_base + (l - interior_start) as usize) as u32;
+        }
+        let mut e = 0;
+        while l >= self.input.edge_base(e + 1) {
+            e += 1;
+        }
+        let k = l - self.input.edge_base(e) + 1; // 1..segments-1, local direction
+        let pe = self.set.topology.patch_edges[self.patch][e];
+        let edge = &self.set.topology.edges[pe.edge as usize];
+        if edge.collapsed {
+            // Every sample of a collapsed curve is its single point: the corner.
+            return self.corner_vertex(e);
+        }
+        let segments = self.plan.edges[pe.edge as usize].segments();
+        let kc = if pe.reversed { segments - k } else { k };
+        let base = self.edge_base[pe.edge as usize] + pe.variant as usize * (segments as usize - 1);
+        (base + kc as usize - 1) as u32
+    }
+
+    /// Parameters of local index `l` in this patch.
+    fn param(&self, l: u32, local: &LocalTessellation) -> DVec2 {
+        let d = self.input.domain;
+        let nc = d.corner_count();
+        if (l as usize) < nc {
+            return d.corner(l as usize);
+        }
+        let interior_start = self.input.interior_base();
+        if l >= interior_start {
+            return local.interior[(l - interior_start) as usize];
+        }
+        let mut e = 0;
+        while l >= self.input.edge_base(e + 1) {
+            e += 1;
+        }
+        let k = l - self.input.edge_base(e) + 1;
+        let pe = self.set.topology.patch_edges[self.patch][e];
+        let t = self.plan.edges[pe.edge as usize].local_param(k, pe.reversed);
+        d.edge_point(e, t)
+    }
+}
+
+fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
+    let domain = set.patches[p].domain();
+    let mut segments = [1; 4];
+    for (e, s) in segments.iter_mut().enumerate().take(domain.corner_count()) {
+        *s = plan.edges[set.topology.patch_edges[p][e].edge as usize].segments();
+    }
+    PatternInput { domain, segments, interior: plan.interior[p] }
+}
+
+/// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
+/// starts and ends at one point): only then can a pattern triangle degenerate.
+fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
+    let n = set.patches[p].domain().corner_count();
+    let c = &set.topology.patch_corners[p][..n];
+    (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))
+}
+
+/// Tessellates `set` with `pattern` following `plan`.
+///
+/// Preconditions: `plan` was made for `set` (one sampling per edge, one interior entry per
+/// patch) and fits the pattern's requirements. Cost: O(output) work, parallel over corners,
+/// edges and patches; memory O(output).
+pub fn tessellate(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    options: TessellateOptions,
+) -> Result<Mesh> {
+    let topo = &set.topology;
+    if plan.edges.len() != topo.edges.len() || plan.interior.len() != set.patches.len() {
+        return Err(Error::InvalidArgument("plan does not match the surface set".into()));
+    }
+
+    // Count.
+    let edge_counts: Vec<usize> = topo
+        .edges
+        .iter()
+        .zip(&plan.edges)
+        .map(|(e, s)| if e.collapsed { 0 } else { (s.segments() as usize - 1) * e.variants as usize })
+        .collect();
+    let patch_counts: Vec<(usize, usize)> = (0..set.patches.len())
+        .into_par_iter()
+        .map_init(LocalTessellation::default, |scratch, p| {
+            let input = pattern_input(set, plan, p);
+            let (vi, t) = pattern.counts(&input);
+            if !has_repeated_corner(set, p) {
+                return (vi as usize, t as usize);
+            }
+            // Triangles with two corners on one vertex degenerate; count the ones that remain.
+            pattern.build(&input, scratch);
+            let map = LocalMap { set, plan, input, patch: p, edge_base: &[], interior_base: 0 };
+            let kept = scratch.triangles.iter().filter(|t| !degenerate_after_collapse(&map, t)).count();
+            (vi as usize, kept)
+        })
+        .collect();
+
+    // Scan.
+    let corner_count = topo.corner_entries.len();
+    let (edge_offsets, edge_total) = exclusive_scan(&edge_counts);
+    let interior_counts: Vec<usize> = patch_counts.iter().map(|c| c.0).collect();
+    let tri_counts: Vec<usize> = patch_counts.iter().map(|c| c.1).collect();
+    let (interior_offsets, interior_total) = exclusive_scan(&interior_counts);
+    let (tri_offsets, tri_total) = exclusive_scan(&tri_counts);
+    let vertex_total = corner_count + edge_total + interior_total;
+    if vertex_total > u32::MAX as usize || tri_total.saturating_mul(3) > isize::MAX as usize / 8 {
+        return Err(Error::InvalidArgument(format!(
+            "output too large: {vertex_total} vertices, {tri_total} triangles; lower the factor"
+        )));
+    }
+    let edge_base: Vec<usize> = edge_offsets.iter().map(|o| corner_count + o).collect();
+    let interior_base: Vec<usize> = interior_offsets.iter().map(|o| corner_count + edge_total + o).collect();
+    let _ = tri_offsets;
+
+    // Write vertices: corners, edges, interiors, each a disjoint range.
+    let mut records = vec![VertexRecord::default(); vertex_total];
+    let (corner_part, rest) = records.split_at_mut(corner_count);
+    let (edge_part, interior_part) = rest.split_at_mut(edge_total);
+
+    corner_part.par_iter_mut().enumerate().for_each(|(i, r)| {
+        let e = &topo.corner_entries[i];
+        let d = set.patches[e.owner_patch as usize].domain();
+        *r = record(set, e.owner_patch, d.corner(e.owner_corner as usize));
+    });
+    // Split-normal entries take the position bits of their vertex's first entry.
+    for i in 0..corner_count {
+        let src = topo.corner_entries[i].position_entry as usize;
+        if src != i {
+            corner_part[i].position = corner_part[src].position;
+        }
+    }
+
+    split_by_counts(edge_part, &edge_counts).into_par_iter().enumerate().for_each(|(e, out)| {
+        if out.is_empty() {
+            return;
+        }
+        let sampling = &plan.edges[e];
+        let inner = sampling.segments() as usize - 1;
+        let uses = topo.edge_uses(e);
+        for variant in 0..topo.edges[e].variants as usize {
+            let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
+            let d = set.patches[u.patch as usize].domain();
+            for k in 1..=inner {
+                let t = sampling.param(k as u32);
+                let local_t = if u.reversed { 1.0 - t } else { t };
+                let uv = d.edge_point(u.local as usize, local_t);
+                let mut r = record(set, u.patch, uv);
+                if variant > 0 {
+                    r.position = out[k - 1].position;
+                }
+                out[variant * inner + k - 1] = r;
+            }
+        }
+    });
+
+    // Interiors and triangles, one task per patch.
+    let mut indices = vec![0u32; tri_total * 3];
+    let mut triangle_patch = vec![0u32; tri_total];
+    let mut corner_params = if options.corner_params { vec![[0f32; 2]; tri_total * 3] } else { Vec::new() };
+    let tri3: Vec<usize> = tri_counts.iter().map(|c| c * 3).collect();
+    let param_counts: Vec<usize> = if options.corner_params { tri3.clone() } else { vec![0; tri3.len()] };
+    let interior_slices = split_by_counts(interior_part, &interior_counts);
+    let index_slices = split_by_counts(&mut indices, &tri3);
+    let patch_slices = split_by_counts(&mut triangle_patch, &tri_counts);
+    let param_slices = split_by_counts(&mut corner_params, &param_counts);
+    interior_slices
+        .into_par_iter()
+        .zip(index_slices)
+        .zip(patch_slices)
+        .zip(param_slices)
+        .enumerate()
+        .for_each_init(LocalTessellation::default, |scratch, (p, (((verts, idx), tp), params))| {
+            let input = pattern_input(set, plan, p);
+            pattern.build(&input, scratch);
+            for (r, &uv) in verts.iter_mut().zip(&scratch.interior) {
+                *r = record(set, p as u32, uv);
+            }
+            let map = LocalMap {
+                set,
+                plan,
+                input,
+                patch: p,
+                edge_base: &edge_base,
+                interior_base: interior_base[p],
+            };
+            let collapsed = has_repeated_corner(set, p);
+            let mut t = 0;
+            for tri in &scratch.triangles {
+                if collapsed && degenerate_after_collapse(&map, tri) {
+                    continue;
+                }
+                for c in 0..3 {
+                    idx[3 * t + c] = map.vertex(tri[c]);
+                    if !params.is_empty() {
+                        params[3 * t + c] = map.param(tri[c], scratch).as_vec2().to_array();
+                    }
+                }
+                tp[t] = p as u32;
+                t += 1;
+            }
+            debug_assert_eq!(t, tp.len());
+        });
+
+    let mut mesh = Mesh {
+        positions: records.par_iter().map(|r| r.position).collect(),
+        normals: records.par_iter().map(|r| r.normal).collect(),
+        uvs: records.par_iter().map(|r| r.uv).collect(),
+        vertex_patch: records.par_iter().map(|r| r.patch).collect(),
+        indices,
+        triangle_patch,
+        corner_params: None,
+    };
+    if options.corner_params {
+        mesh.corner_params = Some(corner_params);
+    }
+    Ok(mesh)
+}
+
+/// True when two corners of a pattern triangle land on the same output vertex because they lie
+/// on a collapsed boundary curve (or at its ends). Decided from local indices only, so the
+/// count pass and the write pass agree.
+fn degenerate_after_collapse(map: &LocalMap<'_>, tri: &[u32; 3]) -> bool {
+    let id = |l: u32| -> (u8, u32) {
+        // Identify collapsed-curve samples with their corner; others stay distinct.
+        let nc = map.input.domain.corner_count();
+        if (l as usize) < nc || l >= map.input.interior_base() {
+            if (l as usize) < nc {
+                return (0, map.corner_vertex(l as usize));
+            }
+            return (1, l);
+        }
+        let mut e = 0;
+        while l >= map.input.edge_base(e + 1) {
+            e += 1;
+        }
+        let pe = map.set.topology.patch_edges[map.patch][e];
+        if map.set.topology.edges[pe.edge as usize].collapsed {
+            (0, map.corner_vertex(e))
+        } else {
+            (1, l)
+        }
+    };
+    let [a, b, c] = tri.map(id);
+    a == b || b == c || a == c
+}
+
+/// Number of triangles the uniform pattern gives a domain at factor `n` (for reports).
+pub fn uniform_triangles(domain: Domain, n: u32) -> u64 {
+    match domain {
+        Domain::Quad => 2 * n as u64 * n as u64,
+        Domain::Tri => n as u64 * n as u64,
+    }
+}

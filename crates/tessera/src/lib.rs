@@ -1,0 +1,53 @@
+//! # tessera
+//!
+//! Crack-free adaptive tessellation of parametric surfaces — PN triangles, cubic Bézier
+//! triangles and bicubic rational Bézier patches — into one watertight indexed triangle mesh.
+//!
+//! ## The pipeline
+//!
+//! ```text
+//! input ─► SurfaceSet ─► Criterion ─► EdgeSampling per edge ─► Pattern per patch ─► Engine ─► Mesh
+//! ```
+//!
+//! 1. [`io`] parses OBJ meshes and Newell patch files, with errors naming file, line and reason.
+//! 2. [`surface::SurfaceSet`] holds the patches and their [`topology`]: shared boundary curves
+//!    found by index and by welding coincident control points.
+//! 3. A [`criterion`] decides, per shared edge, how it is sampled — from data both neighbours
+//!    agree on, which is what makes the output crack-free.
+//! 4. A [`pattern`] triangulates each patch's domain given its edges' samplings; patterns never
+//!    evaluate surfaces.
+//! 5. The [`engine`] counts, scans and writes in parallel; each shared edge vertex is evaluated
+//!    once and referenced by every patch on it.
+//! 6. [`mesh`] writes OBJ, PLY, STL or glTF; [`verify`] checks watertightness, error and quality.
+//!
+//! ## Example
+//!
+//! ```
+//! use tessera::{criterion::Plan, engine, pattern::uniform::Uniform, surface::SurfaceSet};
+//! use tessera::io::patches::parse_patches;
+//! use std::path::Path;
+//!
+//! // One flat bicubic patch (the Newell format: counts, 1-based indices, points).
+//! let mut text = String::from("1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n16\n");
+//! for i in 0..4 { for j in 0..4 { text += &format!("{i},{j},0\n"); } }
+//! let file = parse_patches(&text, Path::new("<example>"))?;
+//! let set = SurfaceSet::from_patch_file(&file, Default::default());
+//! let plan = Plan::uniform(&set, 8)?;
+//! let mesh = engine::tessellate(&set, &plan, &Uniform, Default::default())?;
+//! assert_eq!(mesh.triangle_count(), 2 * 8 * 8);
+//! assert_eq!(mesh.vertex_count(), 9 * 9);
+//! # Ok::<(), tessera::Error>(())
+//! ```
+
+pub mod criterion;
+pub mod engine;
+pub mod error;
+pub mod io;
+pub mod mesh;
+pub mod pattern;
+pub mod sampling;
+pub mod surface;
+pub mod topology;
+pub mod verify;
+
+pub use error::{Error, Result};

@@ -1,0 +1,50 @@
+//! Output mesh buffers and the writers for OBJ, binary PLY, binary STL and glTF binary.
+//!
+//! The engine writes one indexed triangle mesh. Vertices shared by several patches carry the
+//! patch id and (u, v) of the patch that evaluated them (the edge's or corner's *owner*).
+//! Where a triangle needs the parameters of its corners in its own patch (error measurement),
+//! the engine fills [`Mesh::corner_params`] on request.
+
+/// One indexed triangle mesh, in plain buffers (meshoptimizer style).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit vertex normals, one per position.
+    pub normals: Vec<[f32; 3]>,
+    /// Parameters of each vertex in the patch given by `vertex_patch`.
+    pub uvs: Vec<[f32; 2]>,
+    /// The patch that evaluated each vertex.
+    pub vertex_patch: Vec<u32>,
+    /// Triangle list, counter-clockwise seen from the normal side; 3 indices a triangle.
+    pub indices: Vec<u32>,
+    /// The patch each triangle belongs to.
+    pub triangle_patch: Vec<u32>,
+    /// Optional: for every triangle corner (parallel to `indices`), its parameters in the
+    /// triangle's own patch. Filled by the engine when asked; needed to measure the
+    /// approximation error against the exact surface.
+    pub corner_params: Option<Vec<[f32; 2]>>,
+}
+
+impl Mesh {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// The vertex indices of triangle `t`.
+    pub fn triangle(&self, t: usize) -> [u32; 3] {
+        [self.indices[3 * t], self.indices[3 * t + 1], self.indices[3 * t + 2]]
+    }
+}
+
+pub mod read;
+pub mod write;
+
+pub use read::read_mesh;
+pub use write::write_mesh;

@@ -1,0 +1,52 @@
+//! Tessellation patterns: the triangulation of one patch's domain, given how its edges are
+//! sampled. Patterns never evaluate surfaces; one pattern serves every surface kind and both
+//! engines.
+//!
+//! Local vertex numbering, shared by every pattern: corners first (`0..corner_count`), then
+//! the inner samples of edge 0, edge 1, … in the patch's own edge direction (corner `e` →
+//! `e+1`), then the pattern's interior vertices. Triangles are counter-clockwise in the
+//! `(u, v)` domain.
+
+pub mod uniform;
+
+use crate::surface::Domain;
+use glam::DVec2;
+
+/// What a pattern needs to know about a patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PatternInput {
+    pub domain: Domain,
+    /// Segments on each edge (`segments[e] ≥ 1`; entries past the corner count are ignored).
+    pub segments: [u32; 4],
+    /// Interior factors along u and v (triangles use `interior[0]`).
+    pub interior: [u32; 2],
+}
+
+impl PatternInput {
+    /// Index of the first local vertex of edge `e`'s inner samples.
+    pub fn edge_base(&self, e: usize) -> u32 {
+        let n = self.domain.corner_count();
+        n as u32 + self.segments[..e].iter().map(|s| s - 1).sum::<u32>()
+    }
+
+    /// Index of the first interior vertex.
+    pub fn interior_base(&self) -> u32 {
+        self.edge_base(self.domain.corner_count())
+    }
+}
+
+/// Interior parameters and triangles of one patch, over local vertex indices.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LocalTessellation {
+    pub interior: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A tessellation pattern.
+pub trait Pattern: Sync {
+    /// Number of interior vertices and of triangles. Must agree with [`Pattern::build`].
+    fn counts(&self, input: &PatternInput) -> (u32, u32);
+
+    /// Writes interior parameters and triangles into `out` (cleared first).
+    fn build(&self, input: &PatternInput, out: &mut LocalTessellation);
+}

@@ -1,0 +1,187 @@
+//! Surfaces: evaluation of one patch at domain parameters.
+//!
+//! Two domains exist. A [`Domain::Quad`] patch is parametrised over `[0,1]²` with corners
+//! `c0=(0,0)`, `c1=(1,0)`, `c2=(1,1)`, `c3=(0,1)`; a [`Domain::Tri`] patch over the triangle
+//! `u,v ≥ 0, u+v ≤ 1` with corners `c0=(0,0)`, `c1=(1,0)`, `c2=(0,1)` (barycentric
+//! `(1-u-v, u, v)`). In both, corners run counter-clockwise and edge `i` goes from corner `i`
+//! to corner `i+1`; the front side of the patch is the side `∂S/∂u × ∂S/∂v` points to.
+//!
+//! Patterns never evaluate surfaces (the OpenSubdiv Bfr separation): the engine asks a
+//! [`Patch`] for points at the parameters a pattern chose.
+
+mod bezier_triangle;
+mod bicubic;
+mod pn_triangle;
+mod set;
+
+pub use bezier_triangle::BezierTriangle;
+pub use bicubic::RationalBicubic;
+pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
+pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
+
+use glam::{DVec2, DVec3};
+
+/// The parameter domain of a patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Domain {
+    /// Triangle `u,v ≥ 0, u+v ≤ 1`; 3 corners, 3 edges.
+    Tri,
+    /// Unit square; 4 corners, 4 edges.
+    Quad,
+}
+
+impl Domain {
+    /// Number of corners (and of edges).
+    pub fn corner_count(self) -> usize {
+        match self {
+            Domain::Tri => 3,
+            Domain::Quad => 4,
+        }
+    }
+
+    /// Parameters of corner `i`.
+    pub fn corner(self, i: usize) -> DVec2 {
+        match self {
+            Domain::Tri => [DVec2::ZERO, DVec2::X, DVec2::Y][i],
+            Domain::Quad => [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y][i],
+        }
+    }
+
+    /// Parameters of the point at `t ∈ [0,1]` along edge `e` (from corner `e` to `e+1`).
+    pub fn edge_point(self, e: usize, t: f64) -> DVec2 {
+        let n = self.corner_count();
+        let a = self.corner(e);
+        let b = self.corner((e + 1) % n);
+        // Written as a convex combination so t=0 and t=1 give the corners exactly.
+        a * (1.0 - t) + b * t
+    }
+}
+
+/// A point on a surface with its unit normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub position: DVec3,
+    /// Unit normal on the front side; never zero or NaN for a patch that is not collapsed to
+    /// a point or a curve.
+    pub normal: DVec3,
+}
+
+/// Position and first derivatives at one parameter point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceDerivatives {
+    pub position: DVec3,
+    pub du: DVec3,
+    pub dv: DVec3,
+}
+
+/// One patch of any supported kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Patch {
+    /// A bicubic rational Bézier tensor-product patch over the unit square.
+    Bicubic(RationalBicubic),
+    /// A cubic Bézier triangle (normal from its derivatives).
+    BezierTriangle(BezierTriangle),
+    /// A PN triangle: cubic Bézier triangle geometry and a quadratic normal field.
+    Pn(PnTriangle),
+}
+
+impl Patch {
+    /// The patch's domain.
+    pub fn domain(&self) -> Domain {
+        match self {
+            Patch::Bicubic(_) => Domain::Quad,
+            Patch::BezierTriangle(_) | Patch::Pn(_) => Domain::Tri,
+        }
+    }
+
+    /// Position and unit normal at `uv`. Cost: O(1), a few hundred flops.
+    pub fn eval(&self, uv: DVec2) -> SurfacePoint {
+        match self {
+            Patch::Bicubic(p) => p.eval(uv),
+            Patch::BezierTriangle(p) => p.eval(uv),
+            Patch::Pn(p) => p.eval(uv),
+        }
+    }
+
+    /// Position only. Cost: O(1), cheaper than [`Patch::eval`].
+    pub fn position(&self, uv: DVec2) -> DVec3 {
+        match self {
+            Patch::Bicubic(p) => p.position(uv),
+            Patch::BezierTriangle(p) => p.position(uv),
+            Patch::Pn(p) => p.geometry.position(uv),
+        }
+    }
+
+    /// Position and first partial derivatives at `uv`.
+    pub fn derivatives(&self, uv: DVec2) -> SurfaceDerivatives {
+        match self {
+            Patch::Bicubic(p) => p.derivatives(uv),
+            Patch::BezierTriangle(p) => p.derivatives(uv),
+            Patch::Pn(p) => p.geometry.derivatives(uv),
+        }
+    }
+
+    /// The same surface with the opposite front side (reverses the parametrisation's
+    /// orientation, so triangles emitted counter-clockwise in the domain flip too).
+    pub fn flipped(&self) -> Patch {
+        match self {
+            Patch::Bicubic(p) => Patch::Bicubic(p.transposed()),
+            Patch::BezierTriangle(p) => Patch::BezierTriangle(p.swapped_uv()),
+            Patch::Pn(p) => Patch::Pn(p.flipped()),
+        }
+    }
+
+    /// The control points (for bounding boxes and bounds); the surface lies in their convex hull.
+    pub fn control_points(&self) -> &[DVec3] {
+        match self {
+            Patch::Bicubic(p) => &p.points,
+            Patch::BezierTriangle(p) => &p.points,
+            Patch::Pn(p) => &p.geometry.points,
+        }
+    }
+}
+
+/// A unit normal from the first derivatives, falling back to the limit normal where they are
+/// parallel (a boundary curve collapsed to a point, as at the teapot's lid apex).
+///
+/// `second` supplies the mixed derivative `S_uv` used by the limit: near a collapsed `u = u0`
+/// boundary `S_v ≈ (u-u0)·S_uv`, so the normal tends to `±S_u × S_uv`, with the sign that
+/// points the same way as the normals just inside the domain (and likewise for `v`).
+/// `inside` gives the direction towards the domain's interior at `uv` (used for those signs
+/// and for the last-resort nudge).
+pub(crate) fn robust_normal(
+    du: DVec3,
+    dv: DVec3,
+    uv: DVec2,
+    inside: DVec2,
+    second: impl Fn() -> DVec3,
+    nudged: impl Fn(DVec2) -> DVec3,
+) -> DVec3 {
+    let n = du.cross(dv);
+    let scale = du.length_squared().max(dv.length_squared());
+    if n.length_squared() > 1e-20 * scale * scale && n.is_finite() {
+        return n.normalize();
+    }
+    let suv = second();
+    let candidate = if dv.length_squared() <= du.length_squared() {
+        // S_v vanished: a u-boundary collapsed; moving inside changes u by inside.x.
+        du.cross(suv) * inside.x.signum()
+    } else {
+        suv.cross(dv) * inside.y.signum()
+    };
+    let s2 = candidate.length_squared();
+    if s2 > 1e-30 && candidate.is_finite() {
+        return candidate / s2.sqrt();
+    }
+    // Both derivatives vanish (a corner where two boundaries collapse): take the normal a
+    // small step inside, which converges to the limit normal for smooth patches.
+    for step in [1e-6, 1e-4, 1e-2] {
+        let n = nudged(uv + inside * step);
+        if n.length_squared() > 0.0 && n.is_finite() {
+            return n.normalize();
+        }
+    }
+    // The patch is collapsed to a curve or point: no normal exists. Keep the contract of
+    // never returning zero; topology reports such patches.
+    DVec3::Z
+}

@@ -1,0 +1,261 @@
+//! Topology: which patches share which boundary curves and corners.
+//!
+//! Patches are matched by *keys* computed from welded ids (see [`weld`]): a corner's key is its
+//! welded vertex id, a boundary curve's key the welded ids of its control points (bicubic) or
+//! of its end vertices (triangle meshes). Two patches share an edge exactly when their keys
+//! agree, read forwards or backwards. Each edge gets a canonical orientation — the direction in
+//! which its key is lexicographically smaller, so from the lower vertex id to the higher — and
+//! every later decision about an edge (its sampling) is made in that orientation, from data
+//! all its patches agree on. Boundary and non-manifold edges are counted, never rejected.
+
+pub mod weld;
+
+use crate::surface::Domain;
+use std::collections::HashMap;
+
+/// Marks an unused key slot (the fourth corner of a triangle, inner ids of a mesh edge).
+pub const NONE: u32 = u32::MAX;
+
+/// The keys of one patch, from which the topology is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PatchKeys {
+    pub domain: Domain,
+    /// Welded vertex id of each corner (`NONE` past the domain's corner count).
+    pub corners: [u32; 4],
+    /// Key of each boundary curve, read from corner `e` to corner `e+1`.
+    pub edges: [[u32; 4]; 4],
+    /// Which normal each corner uses; corners of one vertex with different keys get separate
+    /// output vertices with the same position (split normals). 0 for surfaces whose normals
+    /// come from their geometry.
+    pub normals: [u32; 4],
+}
+
+/// One use of an edge by a patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EdgeUse {
+    pub patch: u32,
+    /// Local edge index in the patch.
+    pub local: u8,
+    /// True when the patch runs along the edge against its canonical orientation.
+    pub reversed: bool,
+    /// Which normal variant of the edge this use takes (0 = the owner's).
+    pub variant: u8,
+}
+
+/// A canonical edge (boundary curve) shared by one or more patches.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Edge {
+    /// Key in canonical orientation.
+    pub key: [u32; 4],
+    /// Compacted vertex ids of the canonical start and end corners.
+    pub ends: [u32; 2],
+    /// The curve is a single point (all control points welded together): its samples all
+    /// coincide with the corner, as at the teapot's lid apex.
+    pub collapsed: bool,
+    /// Range into [`Topology::uses`]; the first use is the edge's owner.
+    pub uses: std::ops::Range<u32>,
+    /// Number of normal variants (1 unless the edge is a crease with split normals).
+    pub variants: u8,
+}
+
+/// Reference from a patch's local edge to its canonical edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PatchEdge {
+    pub edge: u32,
+    pub reversed: bool,
+    pub variant: u8,
+}
+
+/// An output vertex at a corner: one per (vertex, normal key) pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CornerEntry {
+    pub vertex: u32,
+    /// The first patch corner that uses this entry; it evaluates the vertex.
+    pub owner_patch: u32,
+    pub owner_corner: u8,
+    /// The entry of the same vertex that evaluates the position (positions are computed once
+    /// per vertex and copied to split-normal entries).
+    pub position_entry: u32,
+}
+
+/// Counts that describe an input's topology.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TopologyReport {
+    pub patches: usize,
+    pub vertices: usize,
+    pub edges: usize,
+    pub boundary_edges: usize,
+    pub nonmanifold_edges: usize,
+    pub collapsed_edges: usize,
+    /// Manifold edges whose two patches run along them in the same direction.
+    pub inconsistently_oriented_edges: usize,
+    pub euler_characteristic: i64,
+}
+
+impl TopologyReport {
+    /// No boundary and no non-manifold edge.
+    pub fn is_closed(&self) -> bool {
+        self.boundary_edges == 0 && self.nonmanifold_edges == 0
+    }
+}
+
+/// The shared-edge structure of a set of patches.
+#[derive(Debug, Clone, Default)]
+pub struct Topology {
+    pub vertex_count: u32,
+    pub edges: Vec<Edge>,
+    pub uses: Vec<EdgeUse>,
+    /// Per patch, per local edge.
+    pub patch_edges: Vec<[PatchEdge; 4]>,
+    /// Compacted vertex id of each patch corner.
+    pub patch_corners: Vec<[u32; 4]>,
+    /// Output corner entry of each patch corner.
+    pub patch_corner_entries: Vec<[u32; 4]>,
+    pub corner_entries: Vec<CornerEntry>,
+    pub report: TopologyReport,
+}
+
+fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
+    let rev = [key[3], key[2], key[1], key[0]];
+    if rev < key {
+        (rev, true)
+    } else {
+        (key, false)
+    }
+}
+
+impl Topology {
+    /// Builds the topology. Cost: O(P) hashing, P = number of patches.
+    pub fn build(keys: &[PatchKeys]) -> Topology {
+        let mut vertex_ids: HashMap<u32, u32> = HashMap::new();
+        let mut patch_corners = Vec::with_capacity(keys.len());
+        for k in keys {
+            let mut c = [NONE; 4];
+            for (i, slot) in c.iter_mut().enumerate().take(k.domain.corner_count()) {
+                let next = vertex_ids.len() as u32;
+                *slot = *vertex_ids.entry(k.corners[i]).or_insert(next);
+            }
+            patch_corners.push(c);
+        }
+
+        // Edges, with their uses gathered per canonical key.
+        let mut edge_index: HashMap<[u32; 4], u32> = HashMap::new();
+        let mut edge_uses: Vec<Vec<(u32, u8, bool)>> = Vec::new();
+        let mut edge_keys: Vec<[u32; 4]> = Vec::new();
+        let mut edge_ends: Vec<[u32; 2]> = Vec::new();
+        for (p, k) in keys.iter().enumerate() {
+            let n = k.domain.corner_count();
+            for e in 0..n {
+                let (key, reversed) = canonical(k.edges[e]);
+                let id = *edge_index.entry(key).or_insert_with(|| {
+                    edge_keys.push(key);
+                    edge_uses.push(Vec::new());
+                    let (a, b) = (patch_corners[p][e], patch_corners[p][(e + 1) % n]);
+                    edge_ends.push(if reversed { [b, a] } else { [a, b] });
+                    (edge_keys.len() - 1) as u32
+                });
+                edge_uses[id as usize].push((p as u32, e as u8, reversed));
+            }
+        }
+
+        let mut edges = Vec::with_capacity(edge_keys.len());
+        let mut uses = Vec::with_capacity(keys.len() * 4);
+        let mut patch_edges = vec![[PatchEdge::default(); 4]; keys.len()];
+        let mut report = TopologyReport { patches: keys.len(), ..Default::default() };
+        for (id, list) in edge_uses.iter().enumerate() {
+            let key = edge_keys[id];
+            let collapsed = key.iter().all(|&x| x == key[0]);
+            // Normal signature of a use: the normal keys at the canonical start and end.
+            let signature = |&(p, e, rev): &(u32, u8, bool)| {
+                let k = &keys[p as usize];
+                let n = k.domain.corner_count();
+                let (a, b) = (k.normals[e as usize], k.normals[(e as usize + 1) % n]);
+                if rev {
+                    (b, a)
+                } else {
+                    (a, b)
+                }
+            };
+            let mut signatures: Vec<(u32, u32)> = Vec::new();
+            let start = uses.len() as u32;
+            for u in list {
+                let s = signature(u);
+                let variant = match signatures.iter().position(|&x| x == s) {
+                    Some(v) => v,
+                    None => {
+                        signatures.push(s);
+                        signatures.len() - 1
+                    }
+                };
+                let variant = variant.min(u8::MAX as usize) as u8;
+                uses.push(EdgeUse { patch: u.0, local: u.1, reversed: u.2, variant });
+                patch_edges[u.0 as usize][u.1 as usize] =
+                    PatchEdge { edge: id as u32, reversed: u.2, variant };
+            }
+            if collapsed {
+                report.collapsed_edges += 1;
+            } else {
+                report.edges += 1;
+                match list.len() {
+                    1 => report.boundary_edges += 1,
+                    2 => {
+                        if list[0].2 == list[1].2 {
+                            report.inconsistently_oriented_edges += 1
+                        }
+                    }
+                    _ => report.nonmanifold_edges += 1,
+                }
+            }
+            edges.push(Edge {
+                key,
+                ends: edge_ends[id],
+                collapsed,
+                uses: start..uses.len() as u32,
+                variants: signatures.len().min(u8::MAX as usize) as u8,
+            });
+        }
+
+        // Corner entries: one per (vertex, normal key); the position is evaluated once per
+        // vertex by the first entry of that vertex.
+        let mut entry_index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut first_entry_of_vertex: HashMap<u32, u32> = HashMap::new();
+        let mut corner_entries = Vec::new();
+        let mut patch_corner_entries = vec![[NONE; 4]; keys.len()];
+        for (p, k) in keys.iter().enumerate() {
+            for c in 0..k.domain.corner_count() {
+                let v = patch_corners[p][c];
+                let next = corner_entries.len() as u32;
+                let id = *entry_index.entry((v, k.normals[c])).or_insert_with(|| {
+                    let position_entry = *first_entry_of_vertex.entry(v).or_insert(next);
+                    corner_entries.push(CornerEntry {
+                        vertex: v,
+                        owner_patch: p as u32,
+                        owner_corner: c as u8,
+                        position_entry,
+                    });
+                    next
+                });
+                patch_corner_entries[p][c] = id;
+            }
+        }
+
+        report.vertices = vertex_ids.len();
+        report.euler_characteristic = report.vertices as i64 - report.edges as i64 + report.patches as i64;
+        Topology {
+            vertex_count: vertex_ids.len() as u32,
+            edges,
+            uses,
+            patch_edges,
+            patch_corners,
+            patch_corner_entries,
+            corner_entries,
+            report,
+        }
+    }
+
+    /// The uses of edge `e`; the first is the owner.
+    pub fn edge_uses(&self, e: usize) -> &[EdgeUse] {
+        let r = &self.edges[e].uses;
+        &self.uses[r.start as usize..r.end as usize]
+    }
+}
