@@ -238,7 +238,10 @@ fn print_report(mesh: &Mesh, w: &verify::WatertightReport) {
         w.zero_area_triangles
     );
     println!("Euler characteristic {}", w.euler_characteristic);
-    println!("watertight           {}", if w.is_closed() { "yes" } else { "no" });
+    println!(
+        "closed               {}",
+        if w.is_closed() { "yes (no boundary or non-manifold edge)" } else { "no" }
+    );
     println!("min angle            {:.2}°", q.min_angle);
     println!("under 10°            {:.2} %", 100.0 * q.share_below_10_degrees);
     let hist: Vec<String> = q.min_angle_histogram.iter().map(|c| c.to_string()).collect();
@@ -290,15 +293,26 @@ fn run_demo(a: DemoArgs) -> CliResult {
     println!("wrote                {}", a.output.display());
     println!("tessellation time    {:.3} ms", seconds * 1e3);
     print_report(&mesh, &w);
-    println!(
-        "input boundary edges {} (curves: rim, lid, handle and spout ends)",
-        set.topology.report.boundary_edges
-    );
-    println!("input Euler char.    {}", set.topology.report.euler_characteristic);
-    println!("max error            {:.6e} (bounding-box diagonal {:.3})", e.max, {
-        let (lo, hi) = set.bounds();
-        lo.distance(hi)
-    });
+    let t = set.topology.report;
+    println!("input boundary edges {} (curves: rim, lid, handle and spout ends)", t.boundary_edges);
+    println!("input Euler char.    {}", t.euler_characteristic);
+    let (lo, hi) = set.bounds();
+    println!("max error            {:.6e} (bounding-box diagonal {:.3})", e.max, lo.distance(hi));
     println!("rms error            {:.6e}", e.rms);
+    let crack_free = w.boundary_edges == t.boundary_edges * a.factor as usize
+        && w.nonmanifold_edges == 0
+        && w.euler_characteristic == t.euler_characteristic;
+    if a.factor < 3 {
+        // At factors 1 and 2 distinct curves with common corners can share output edges.
+        println!("crack-free           not judged below factor 3");
+    } else if crack_free {
+        println!(
+            "crack-free           yes: every boundary edge lies on a free input curve ({} × {})",
+            t.boundary_edges, a.factor
+        );
+    } else {
+        println!("crack-free           NO: the output has boundary edges inside the surface");
+        return Ok(ExitCode::from(1));
+    }
     Ok(ExitCode::SUCCESS)
 }

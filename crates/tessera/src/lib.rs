@@ -51,3 +51,8 @@ pub mod topology;
 pub mod verify;
 
 pub use error::{Error, Result};
+
+/// The README's examples, compiled as doctests so they cannot go stale.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

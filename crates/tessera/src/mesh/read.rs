@@ -1171,7 +1171,7 @@ impl<'a> Glb<'a> {
         let start = view.byte_offset.map_or(0, |o| o.0);
         let len = view.byte_length.0;
         let end = start.checked_add(len);
-        if buffer.byte_length.0 > bin.len() as u64 || end.map_or(true, |e| e > buffer.byte_length.0) {
+        if buffer.byte_length.0 > bin.len() as u64 || end.is_none_or(|e| e > buffer.byte_length.0) {
             return Err(self.err(format!(
                 "buffer view {index} spans bytes {start}..{} of a {}-byte buffer (BIN chunk of {} \
                  bytes at byte offset {bin_offset})",
@@ -1232,7 +1232,7 @@ impl<'a> Glb<'a> {
                 .and_then(|s| s.checked_add(element))
                 .and_then(|s| s.checked_add(offset)),
         };
-        if needed.map_or(true, |end| end > bytes.len() as u64) {
+        if needed.is_none_or(|end| end > bytes.len() as u64) {
             return Err(self.err(format!(
                 "{what}: {count} elements of {element} bytes from offset {offset} with stride \
                  {stride} do not fit in the {}-byte buffer view {view_index}",

@@ -47,6 +47,8 @@ impl RationalBicubic {
         self.weights.iter().all(|&w| w == 1.0)
     }
 
+    // Index loops mirror the double sum of the formula.
+    #[allow(clippy::needless_range_loop)]
     fn sums(&self, uv: DVec2) -> Sums {
         let (bu, du, _) = bernstein3(uv.x);
         let (bv, dv, _) = bernstein3(uv.y);
@@ -79,6 +81,7 @@ impl RationalBicubic {
     }
 
     /// Position at `uv`. Cost: 16 weighted control points.
+    #[allow(clippy::needless_range_loop)]
     pub fn position(&self, uv: DVec2) -> DVec3 {
         let (bu, _, _) = bernstein3(uv.x);
         let (bv, _, _) = bernstein3(uv.y);

@@ -1,0 +1,176 @@
+//! End-to-end tests of the `tessera` binary: the commands README.md shows, and bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn data(rel: &str) -> PathBuf {
+    let base = std::env::var("TESSERA_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    let p = base.join(rel);
+    assert!(p.exists(), "{} missing: set TESSERA_DATA to the shared data folder", p.display());
+    p
+}
+
+fn tessera(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tessera")).args(args).current_dir(dir).output().expect("run tessera")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tessera-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn demo_writes_a_watertight_teapot() {
+    let dir = scratch("demo");
+    let out = tessera(&["demo"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("non-manifold edges   0"), "{stdout}");
+    assert!(stdout.contains("max error"), "{stdout}");
+    let obj = dir.join("teapot.obj");
+    assert!(obj.exists());
+    // The demo's own output checks as it reports: 16 free curves × 8 = 128 boundary edges.
+    let check = tessera(&["check", obj.to_str().unwrap()], &dir);
+    assert!(check.status.success(), "{}", text(&check.stderr));
+    assert!(text(&check.stdout).contains("boundary edges       128"), "{}", text(&check.stdout));
+}
+
+#[test]
+fn mesh_stats_is_one_json_line_with_the_required_keys() {
+    let dir = scratch("stats");
+    let input = data("bench/torus_64x32.patches");
+    let out = tessera(
+        &["mesh", input.to_str().unwrap(), "-o", "t.glb", "--factor", "2", "--stats", "--repeat", "3"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(v["patches"], 2048);
+    assert_eq!(v["triangles"], 2 * 4 * 2048);
+    assert_eq!(v["vertices"], 4 * 2048);
+    assert_eq!(v["boundary_edges"], 0);
+    assert_eq!(v["nonmanifold_edges"], 0);
+    assert!(v["seconds"].as_f64().unwrap() > 0.0);
+    assert!(dir.join("t.glb").metadata().unwrap().len() > 0);
+}
+
+#[test]
+fn every_output_format_checks_watertight_against_the_input() {
+    let dir = scratch("formats");
+    let input = data("patches/teacup.patches");
+    for ext in ["obj", "ply", "stl", "glb"] {
+        let name = format!("cup.{ext}");
+        let out = tessera(&["mesh", input.to_str().unwrap(), "-o", &name, "--factor", "3"], &dir);
+        assert!(out.status.success(), "{ext}: {}", text(&out.stderr));
+        let check = tessera(&["check", &name, "--against", input.to_str().unwrap()], &dir);
+        assert!(check.status.success(), "{ext}: {}", text(&check.stdout));
+        let s = text(&check.stdout);
+        assert!(s.contains("boundary edges       36"), "{ext}: 12 free curves × 3\n{s}");
+        if ext == "ply" {
+            // PLY carries per-corner patch parameters, so the error is measured, and it is the
+            // error measured in memory by `mesh --measure-error`.
+            let line = s.lines().find(|l| l.starts_with("max error")).unwrap();
+            let from_file: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+            let stats = tessera(
+                &["mesh", input.to_str().unwrap(), "--factor", "3", "--stats", "--measure-error"],
+                &dir,
+            );
+            let v: serde_json::Value = serde_json::from_str(text(&stats.stdout).trim()).unwrap();
+            let in_memory = v["max_error"].as_f64().unwrap();
+            assert!(in_memory > 0.0);
+            assert!((from_file - in_memory).abs() <= 1e-6 * in_memory.max(1.0), "{from_file} vs {in_memory}");
+        }
+    }
+}
+
+#[test]
+fn check_fails_when_a_closed_input_gives_an_open_mesh() {
+    let dir = scratch("open");
+    let input = data("bench/torus_64x32.patches");
+    let out = tessera(&["mesh", input.to_str().unwrap(), "-o", "t.obj", "--factor", "1"], &dir);
+    assert!(out.status.success());
+    // Remove one face: the mesh is now open.
+    let obj = std::fs::read_to_string(dir.join("t.obj")).unwrap();
+    let mut removed = false;
+    let cut: String = obj
+        .lines()
+        .filter(|l| {
+            if !removed && l.starts_with("f ") {
+                removed = true;
+                return false;
+            }
+            true
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(dir.join("open.obj"), cut).unwrap();
+    let check = tessera(&["check", "open.obj", "--against", input.to_str().unwrap()], &dir);
+    assert_eq!(check.status.code(), Some(1), "{}", text(&check.stdout));
+    let intact = tessera(&["check", "t.obj", "--against", input.to_str().unwrap()], &dir);
+    assert_eq!(intact.status.code(), Some(0), "{}", text(&intact.stdout));
+}
+
+/// Each bad input gives exit status 2 and one stderr line naming the file, the line and the
+/// reason; never a panic.
+#[test]
+fn bad_input_gives_one_clear_line() {
+    let dir = scratch("bad");
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "truncated.patches",
+            "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n16\n0,0,0\n",
+            "truncated.patches:4",
+        ),
+        ("range.patches", "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,99\n1\n0,0,0\n", "truncated.patches"),
+        ("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", "nan.obj:3"),
+        ("inf.obj", "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n", "inf.obj:2"),
+        ("empty.obj", "", "empty.obj"),
+        ("empty.patches", "", "empty.patches"),
+        ("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", "index.obj:4"),
+        ("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", "quad.obj:5"),
+    ];
+    for (name, content, expect) in cases {
+        std::fs::write(dir.join(name), content).unwrap();
+        let out = tessera(&["mesh", name, "-o", "x.obj"], &dir);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: one line expected:\n{err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        let expect = if *name == "range.patches" { "range.patches:2" } else { expect };
+        assert!(err.contains(expect), "{name}: expected `{expect}` in `{err}`");
+    }
+    let quad = text(&tessera(&["mesh", "quad.obj"], &dir).stderr);
+    assert!(quad.contains("triangle"), "{quad}");
+    let missing = tessera(&["mesh", "does-not-exist.patches"], &dir);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(text(&missing.stderr).contains("does-not-exist.patches"));
+    for factor in ["0", "100000"] {
+        let out =
+            tessera(&["mesh", data("patches/teapot.patches").to_str().unwrap(), "--factor", factor], &dir);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(text(&out.stderr).contains("factor"), "{}", text(&out.stderr));
+    }
+    let out = tessera(&["mesh", data("patches/teapot.patches").to_str().unwrap(), "-o", "x.xyz"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("xyz"), "{}", text(&out.stderr));
+}
+
+#[test]
+fn help_is_there_for_every_command() {
+    let dir = scratch("help");
+    for cmd in [vec!["--help"], vec!["mesh", "--help"], vec!["check", "--help"], vec!["demo", "--help"]] {
+        let out = tessera(&cmd, &dir);
+        assert!(out.status.success());
+        assert!(text(&out.stdout).contains("Usage"));
+    }
+}
