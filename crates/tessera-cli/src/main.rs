@@ -149,6 +149,16 @@ fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tesse
     }
 }
 
+/// Output buffers may use up to 3/4 of the memory available now (Linux `MemAvailable`), or
+/// 8 GiB where that cannot be read, so an absurd factor is refused instead of thrashing.
+fn memory_limit() -> u64 {
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
+    });
+    available.map_or(8 << 30, |b| b / 4 * 3)
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
@@ -156,12 +166,15 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn run_mesh(a: MeshArgs) -> CliResult {
     let options = build_options(&a.input_args)?;
+    if let Some(out) = &a.output {
+        tessera::mesh::check_output_path(out)?;
+    }
     let pb = spinner(&format!("reading {}", a.input.display()));
     let set = load_surfaces(&a.input, options)?;
     let plan = Plan::uniform(&set, a.factor)?;
     let wants_params = a.measure_error
         || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
-    let opts = TessellateOptions { corner_params: wants_params };
+    let opts = TessellateOptions { corner_params: wants_params, memory_limit: Some(memory_limit()) };
     pb.set_message(format!("tessellating {} patches at factor {}", set.patches.len(), a.factor));
     let mut times = Vec::new();
     let mut mesh = Mesh::default();
@@ -280,11 +293,13 @@ fn run_check(a: CheckArgs) -> CliResult {
 }
 
 fn run_demo(a: DemoArgs) -> CliResult {
+    tessera::mesh::check_output_path(&a.output)?;
     let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
     let plan = Plan::uniform(&set, a.factor)?;
     let start = Instant::now();
-    let mesh = engine::tessellate(&set, &plan, &Uniform, TessellateOptions { corner_params: true })?;
+    let opts = TessellateOptions { corner_params: true, memory_limit: Some(memory_limit()) };
+    let mesh = engine::tessellate(&set, &plan, &Uniform, opts)?;
     let seconds = start.elapsed().as_secs_f64();
     tessera::mesh::write_mesh(&mesh, &a.output)?;
     let w = verify::watertight(&mesh);

@@ -160,6 +160,11 @@ fn bad_input_gives_one_clear_line() {
         assert_eq!(out.status.code(), Some(2));
         assert!(text(&out.stderr).contains("factor"), "{}", text(&out.stderr));
     }
+    // Within the factor range but far beyond memory: refused before allocating.
+    let torus = data("bench/torus_64x32.patches");
+    let out = tessera(&["mesh", torus.to_str().unwrap(), "--factor", "16000"], &dir);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("too large"), "{}", text(&out.stderr));
     let out = tessera(&["mesh", data("patches/teapot.patches").to_str().unwrap(), "-o", "x.xyz"], &dir);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("xyz"), "{}", text(&out.stderr));

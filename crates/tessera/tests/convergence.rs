@@ -9,7 +9,9 @@ use tessera::verify;
 
 fn max_error(set: &tessera::surface::SurfaceSet, n: u32) -> f64 {
     let plan = Plan::uniform(set, n).unwrap();
-    let mesh = tessellate(set, &plan, &Uniform, TessellateOptions { corner_params: true }).unwrap();
+    let mesh =
+        tessellate(set, &plan, &Uniform, TessellateOptions { corner_params: true, ..Default::default() })
+            .unwrap();
     verify::approximation_error(&mesh, set, 6).unwrap().max
 }
 

@@ -21,6 +21,16 @@ use rayon::prelude::*;
 pub struct TessellateOptions {
     /// Fill [`Mesh::corner_params`] (needed to measure the approximation error).
     pub corner_params: bool,
+    /// Refuse (with [`Error::InvalidArgument`]) an output whose buffers would take more bytes
+    /// than this, before allocating anything. `None`: no limit beyond the u32 index range.
+    pub memory_limit: Option<u64>,
+}
+
+/// Bytes the engine allocates for an output of this size (records, buffers, parameters).
+pub fn output_bytes(vertices: u64, triangles: u64, corner_params: bool) -> u64 {
+    let per_vertex = 2 * std::mem::size_of::<VertexRecord>() as u64; // records + final buffers
+    let per_triangle = 12 + 4 + if corner_params { 24 } else { 0 };
+    vertices.saturating_mul(per_vertex).saturating_add(triangles.saturating_mul(per_triangle))
 }
 
 #[derive(Clone, Copy, Default)]
@@ -190,9 +200,14 @@ pub fn tessellate(
     let (interior_offsets, interior_total) = exclusive_scan(&interior_counts);
     let (tri_offsets, tri_total) = exclusive_scan(&tri_counts);
     let vertex_total = corner_count + edge_total + interior_total;
-    if vertex_total > u32::MAX as usize || tri_total.saturating_mul(3) > isize::MAX as usize / 8 {
+    let bytes = output_bytes(vertex_total as u64, tri_total as u64, options.corner_params);
+    if vertex_total > u32::MAX as usize
+        || tri_total.saturating_mul(3) > isize::MAX as usize / 8
+        || options.memory_limit.is_some_and(|limit| bytes > limit)
+    {
         return Err(Error::InvalidArgument(format!(
-            "output too large: {vertex_total} vertices, {tri_total} triangles; lower the factor"
+            "output too large: {vertex_total} vertices and {tri_total} triangles would take {:.1} GiB; lower the factor",
+            bytes as f64 / (1u64 << 30) as f64
         )));
     }
     let edge_base: Vec<usize> = edge_offsets.iter().map(|o| corner_count + o).collect();

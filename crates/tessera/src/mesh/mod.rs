@@ -47,4 +47,4 @@ pub mod read;
 pub mod write;
 
 pub use read::read_mesh;
-pub use write::write_mesh;
+pub use write::{check_output_path, write_mesh};

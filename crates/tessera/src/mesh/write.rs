@@ -85,6 +85,12 @@ impl Format {
     }
 }
 
+/// Checks that `path` names a supported output format, so a caller can refuse a bad output
+/// name before doing the work. Cost: O(1).
+pub fn check_output_path(path: &Path) -> Result<()> {
+    Format::from_path(path).map(|_| ())
+}
+
 /// Writes `mesh` to `path`, choosing the format by the extension (case-insensitive): `.obj`,
 /// `.ply` (binary little-endian), `.stl` (binary) or `.glb`. See the module documentation for
 /// what each format keeps.
