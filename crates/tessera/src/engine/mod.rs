@@ -11,7 +11,7 @@
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::pattern::{LocalTessellation, Pattern, PatternInput};
+use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
@@ -89,50 +89,34 @@ impl LocalMap<'_> {
 
     /// Output vertex of local index `l`.
     fn vertex(&self, l: u32) -> u32 {
-        let nc = self.input.domain.corner_count();
-        if (l as usize) < nc {
-            return self.corner_vertex(l as usize);
+        match self.input.slot(l) {
+            Slot::Corner(c) => self.corner_vertex(c),
+            Slot::Interior(j) => (self.interior_base + j as usize) as u32,
+            Slot::Edge(e, k) => {
+                let pe = self.set.topology.patch_edges[self.patch][e];
+                if self.set.topology.edges[pe.edge as usize].collapsed {
+                    // Every sample of a collapsed curve is its single point: the corner.
+                    return self.corner_vertex(e);
+                }
+                let segments = self.plan.edges[pe.edge as usize].segments();
+                let kc = if pe.reversed { segments - k } else { k };
+                let base = self.edge_base[pe.edge as usize] + pe.variant as usize * (segments as usize - 1);
+                (base + kc as usize - 1) as u32
+            }
         }
-        let interior_start = self.input.interior_base();
-        if l >= interior_start {
-            return (self.interior_base + (l - interior_start) as usize) as u32;
-        }
-        let mut e = 0;
-        while l >= self.input.edge_base(e + 1) {
-            e += 1;
-        }
-        let k = l - self.input.edge_base(e) + 1; // 1..segments-1, local direction
-        let pe = self.set.topology.patch_edges[self.patch][e];
-        let edge = &self.set.topology.edges[pe.edge as usize];
-        if edge.collapsed {
-            // Every sample of a collapsed curve is its single point: the corner.
-            return self.corner_vertex(e);
-        }
-        let segments = self.plan.edges[pe.edge as usize].segments();
-        let kc = if pe.reversed { segments - k } else { k };
-        let base = self.edge_base[pe.edge as usize] + pe.variant as usize * (segments as usize - 1);
-        (base + kc as usize - 1) as u32
     }
 
     /// Parameters of local index `l` in this patch.
     fn param(&self, l: u32, local: &LocalTessellation) -> DVec2 {
         let d = self.input.domain;
-        let nc = d.corner_count();
-        if (l as usize) < nc {
-            return d.corner(l as usize);
+        match self.input.slot(l) {
+            Slot::Corner(c) => d.corner(c),
+            Slot::Interior(j) => local.interior[j as usize],
+            Slot::Edge(e, k) => {
+                let pe = self.set.topology.patch_edges[self.patch][e];
+                d.edge_point(e, self.plan.edges[pe.edge as usize].local_param(k, pe.reversed))
+            }
         }
-        let interior_start = self.input.interior_base();
-        if l >= interior_start {
-            return local.interior[(l - interior_start) as usize];
-        }
-        let mut e = 0;
-        while l >= self.input.edge_base(e + 1) {
-            e += 1;
-        }
-        let k = l - self.input.edge_base(e) + 1;
-        let pe = self.set.topology.patch_edges[self.patch][e];
-        let t = self.plan.edges[pe.edge as usize].local_param(k, pe.reversed);
-        d.edge_point(e, t)
     }
 }
 
@@ -322,24 +306,18 @@ pub fn tessellate(
 /// on a collapsed boundary curve (or at its ends). Decided from local indices only, so the
 /// count pass and the write pass agree.
 fn degenerate_after_collapse(map: &LocalMap<'_>, tri: &[u32; 3]) -> bool {
-    let id = |l: u32| -> (u8, u32) {
-        // Identify collapsed-curve samples with their corner; others stay distinct.
-        let nc = map.input.domain.corner_count();
-        if (l as usize) < nc || l >= map.input.interior_base() {
-            if (l as usize) < nc {
-                return (0, map.corner_vertex(l as usize));
+    // Corners and samples of collapsed curves are identified by their vertex; every other
+    // local index is a distinct vertex of its own.
+    let id = |l: u32| -> (bool, u32) {
+        match map.input.slot(l) {
+            Slot::Corner(c) => (true, map.corner_vertex(c)),
+            Slot::Edge(e, _)
+                if map.set.topology.edges[map.set.topology.patch_edges[map.patch][e].edge as usize]
+                    .collapsed =>
+            {
+                (true, map.corner_vertex(e))
             }
-            return (1, l);
-        }
-        let mut e = 0;
-        while l >= map.input.edge_base(e + 1) {
-            e += 1;
-        }
-        let pe = map.set.topology.patch_edges[map.patch][e];
-        if map.set.topology.edges[pe.edge as usize].collapsed {
-            (0, map.corner_vertex(e))
-        } else {
-            (1, l)
+            _ => (false, l),
         }
     };
     let [a, b, c] = tri.map(id);

@@ -35,6 +35,36 @@ impl PatternInput {
     }
 }
 
+/// What a local vertex index refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slot {
+    /// Corner `c`.
+    Corner(usize),
+    /// Inner sample `k` (`1 ≤ k < segments`) of edge `e`, counted in the patch's own direction.
+    Edge(usize, u32),
+    /// Interior vertex `j` of the pattern.
+    Interior(u32),
+}
+
+impl PatternInput {
+    /// Decodes a local vertex index. Cost: O(corner count).
+    pub fn slot(&self, l: u32) -> Slot {
+        let nc = self.domain.corner_count();
+        if (l as usize) < nc {
+            return Slot::Corner(l as usize);
+        }
+        let mut base = nc as u32;
+        for e in 0..nc {
+            let inner = self.segments[e] - 1;
+            if l < base + inner {
+                return Slot::Edge(e, l - base + 1);
+            }
+            base += inner;
+        }
+        Slot::Interior(l - base)
+    }
+}
+
 /// Interior parameters and triangles of one patch, over local vertex indices.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LocalTessellation {
@@ -49,4 +79,27 @@ pub trait Pattern: Sync {
 
     /// Writes interior parameters and triangles into `out` (cleared first).
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slots_follow_the_local_numbering() {
+        let input = PatternInput { domain: Domain::Quad, segments: [2, 3, 1, 5], interior: [4, 4] };
+        let mut expected = vec![Slot::Corner(0), Slot::Corner(1), Slot::Corner(2), Slot::Corner(3)];
+        for e in 0..4 {
+            assert_eq!(input.edge_base(e) as usize, expected.len());
+            for k in 1..input.segments[e] {
+                expected.push(Slot::Edge(e, k));
+            }
+        }
+        assert_eq!(input.interior_base() as usize, expected.len());
+        expected.push(Slot::Interior(0));
+        expected.push(Slot::Interior(1));
+        for (l, s) in expected.iter().enumerate() {
+            assert_eq!(input.slot(l as u32), *s, "local {l}");
+        }
+    }
 }
