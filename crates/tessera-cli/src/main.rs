@@ -1,5 +1,7 @@
 //! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
 
+mod plan;
+
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -56,13 +58,12 @@ struct MeshArgs {
     /// Output mesh; the format follows the extension: .obj, .ply, .stl or .glb.
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
-    /// Uniform tessellation factor: every edge is cut into N segments.
-    #[arg(long, value_name = "N", default_value_t = 8)]
-    factor: u32,
+    #[command(flatten)]
+    criterion: plan::CriterionArgs,
     /// Print one JSON object with counts, topology and timing on one stdout line.
     #[arg(long)]
     stats: bool,
-    /// Tessellate R times and report the median time (with --stats).
+    /// Tessellate R times (reusing the output buffers) and report the median time (--stats).
     #[arg(long, value_name = "R", default_value_t = 1)]
     repeat: u32,
     /// Also measure the approximation error against the exact surface (with --stats).
@@ -171,16 +172,27 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     let pb = spinner(&format!("reading {}", a.input.display()));
     let set = load_surfaces(&a.input, options)?;
-    let plan = Plan::uniform(&set, a.factor)?;
+    pb.set_message("choosing factors");
+    let chosen = plan::choose(&a.criterion, &set)?;
+    if let Some(r) = &chosen.report {
+        if r.capped_patches > 0 {
+            eprintln!(
+                "warning: --max-factor {} stopped the error bound on {} patches: the guaranteed bound there is up to {:.3e}, {:.2}× the request; raise --max-factor",
+                a.criterion.max_factor, r.capped_patches, r.worst_bound, r.worst_ratio
+            );
+        }
+    }
     let wants_params = a.measure_error
         || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
     let opts = TessellateOptions { corner_params: wants_params, memory_limit: Some(memory_limit()) };
-    pb.set_message(format!("tessellating {} patches at factor {}", set.patches.len(), a.factor));
+    pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
     let mut times = Vec::new();
     let mut mesh = Mesh::default();
     for _ in 0..a.repeat.max(1) {
         let start = Instant::now();
-        mesh = engine::tessellate(&set, &plan, &Uniform, opts)?;
+        // Buffers are reused across repeats, as an application re-tessellating every frame
+        // would: the median then measures tessellation, not page faults.
+        engine::tessellate_into(&set, &chosen.plan, chosen.pattern.as_ref(), opts, &mut mesh)?;
         times.push(start.elapsed().as_secs_f64());
     }
     if let Some(out) = &a.output {
@@ -193,7 +205,8 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         let seconds = median(times);
         let mut stats = serde_json::json!({
             "input": a.input.display().to_string(),
-            "factor": a.factor,
+            "scheme": chosen.description,
+            "culled_patches": chosen.plan.visible.iter().filter(|v| !**v).count(),
             "patches": set.patches.len(),
             "triangles": mesh.triangle_count(),
             "vertices": mesh.vertex_count(),
@@ -208,6 +221,14 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
             "threads": rayon::current_num_threads(),
         });
+        if let Some(r) = &chosen.report {
+            stats["guaranteed_bound"] = r.worst_bound.into();
+            stats["bound_met"] = (r.capped_patches == 0).into();
+            stats["capped_patches"] = r.capped_patches.into();
+        }
+        if let Some(t) = chosen.tolerance {
+            stats["tolerance"] = t.into();
+        }
         if a.measure_error {
             let e = verify::approximation_error(&mesh, &set, 6)?;
             stats["max_error"] = e.max.into();

@@ -1,10 +1,15 @@
 //! Uniform factor 16 on the 64×32 bicubic torus (1,048,576 triangles). Criterion reports
 //! the throughput in triangles per second (elements/s).
+//!
+//! `reuse`: one output mesh for every iteration ([`tessellate_into`]), the steady state of an
+//! application that re-tessellates; `fresh`: a new mesh each time ([`tessellate`]), which also
+//! pays for faulting in new memory.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::path::PathBuf;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, tessellate_into, TessellateOptions};
+use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::SurfaceSet;
 
@@ -24,7 +29,13 @@ fn uniform_torus(c: &mut Criterion) {
         let plan = Plan::uniform(&set, n).unwrap();
         let triangles = 2 * (n * n) as u64 * set.patches.len() as u64;
         group.throughput(Throughput::Elements(triangles));
-        group.bench_function(format!("torus_64x32/factor_{n}"), |b| {
+        let mut mesh = Mesh::default();
+        group.bench_function(format!("torus_64x32/factor_{n}/reuse"), |b| {
+            b.iter(|| {
+                tessellate_into(&set, &plan, &Uniform, TessellateOptions::default(), &mut mesh).unwrap()
+            })
+        });
+        group.bench_function(format!("torus_64x32/factor_{n}/fresh"), |b| {
             b.iter(|| tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap())
         });
     }

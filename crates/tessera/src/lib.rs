@@ -39,6 +39,7 @@
 //! # Ok::<(), tessera::Error>(())
 //! ```
 
+pub mod camera;
 pub mod criterion;
 pub mod engine;
 pub mod error;

@@ -4,6 +4,11 @@
 //! topology and interior factors per patch. Crack-freeness rests on one rule: the sampling of
 //! an edge is decided once, from data all its patches agree on, and every patch reads it.
 
+pub mod bounds;
+pub mod screen;
+pub mod tolerance;
+pub mod view;
+
 use crate::error::{Error, Result};
 use crate::sampling::EdgeSampling;
 use crate::surface::SurfaceSet;
@@ -18,6 +23,9 @@ pub struct Plan {
     pub edges: Vec<EdgeSampling>,
     /// Interior factors per patch (`[u, v]`; triangles use the first).
     pub interior: Vec<[u32; 2]>,
+    /// Patches to tessellate; culled patches emit nothing (their edges with visible
+    /// neighbours are still sampled as those neighbours need).
+    pub visible: Vec<bool>,
 }
 
 impl Plan {
@@ -31,6 +39,7 @@ impl Plan {
         Ok(Plan {
             edges: vec![EdgeSampling::uniform(n); set.topology.edges.len()],
             interior: vec![[n, n]; set.patches.len()],
+            visible: vec![true; set.patches.len()],
         })
     }
 }

@@ -16,6 +16,8 @@ use crate::surface::{Domain, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
+mod uniform_quads;
+
 /// Engine options.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TessellateOptions {
@@ -148,8 +150,42 @@ pub fn tessellate(
     pattern: &dyn Pattern,
     options: TessellateOptions,
 ) -> Result<Mesh> {
+    let mut mesh = Mesh::default();
+    tessellate_into(set, plan, pattern, options, &mut mesh)?;
+    Ok(mesh)
+}
+
+/// [`tessellate`] into an existing mesh, whose buffers are reused where the engine can (the
+/// uniform bicubic fast path): repeated calls then avoid faulting in fresh memory.
+/// `out` is overwritten; on error its contents are unspecified.
+pub fn tessellate_into(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    options: TessellateOptions,
+    out: &mut Mesh,
+) -> Result<()> {
+    if pattern.is_uniform() {
+        if let Some(result) = uniform_quads::try_tessellate(set, plan, options, out) {
+            return result;
+        }
+    }
+    *out = tessellate_generic(set, plan, pattern, options)?;
+    Ok(())
+}
+
+/// The generic engine, for any pattern and surface kind.
+fn tessellate_generic(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    options: TessellateOptions,
+) -> Result<Mesh> {
     let topo = &set.topology;
-    if plan.edges.len() != topo.edges.len() || plan.interior.len() != set.patches.len() {
+    if plan.edges.len() != topo.edges.len()
+        || plan.interior.len() != set.patches.len()
+        || plan.visible.len() != set.patches.len()
+    {
         return Err(Error::InvalidArgument("plan does not match the surface set".into()));
     }
 
@@ -158,11 +194,23 @@ pub fn tessellate(
         .edges
         .iter()
         .zip(&plan.edges)
-        .map(|(e, s)| if e.collapsed { 0 } else { (s.segments() as usize - 1) * e.variants as usize })
+        .enumerate()
+        .map(|(i, (e, s))| {
+            // Edges of culled patches only are not written: nothing refers to them.
+            let seen = topo.edge_uses(i).iter().any(|u| plan.visible[u.patch as usize]);
+            if e.collapsed || !seen {
+                0
+            } else {
+                (s.segments() as usize - 1) * e.variants as usize
+            }
+        })
         .collect();
     let patch_counts: Vec<(usize, usize)> = (0..set.patches.len())
         .into_par_iter()
         .map_init(LocalTessellation::default, |scratch, p| {
+            if !plan.visible[p] {
+                return (0, 0);
+            }
             let input = pattern_input(set, plan, p);
             let (vi, t) = pattern.counts(&input);
             if !has_repeated_corner(set, p) {
@@ -256,6 +304,9 @@ pub fn tessellate(
         .zip(param_slices)
         .enumerate()
         .for_each_init(LocalTessellation::default, |scratch, (p, (((verts, idx), tp), params))| {
+            if !plan.visible[p] {
+                return;
+            }
             let input = pattern_input(set, plan, p);
             pattern.build(&input, scratch);
             for (r, &uv) in verts.iter_mut().zip(&scratch.interior) {

@@ -7,6 +7,7 @@
 //! `e+1`), then the pattern's interior vertices. Triangles are counter-clockwise in the
 //! `(u, v)` domain.
 
+pub mod transition;
 pub mod uniform;
 
 use crate::surface::Domain;
@@ -79,6 +80,11 @@ pub trait Pattern: Sync {
 
     /// Writes interior parameters and triangles into `out` (cleared first).
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation);
+
+    /// True for [`uniform::Uniform`], for which the engine has a fast path.
+    fn is_uniform(&self) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]

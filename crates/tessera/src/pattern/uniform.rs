@@ -51,6 +51,10 @@ pub fn tri_local(n: u32, i: u32, j: u32) -> u32 {
 }
 
 impl Pattern for Uniform {
+    fn is_uniform(&self) -> bool {
+        true
+    }
+
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let n = input.interior[0];
         match input.domain {

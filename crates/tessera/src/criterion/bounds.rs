@@ -1,0 +1,340 @@
+//! Bounds on second derivatives, and the approximation-error bounds built on them.
+//!
+//! For a triangle `T` in the parameter domain and the linear interpolant `L` of the surface at
+//! its corners, `|S − L| ≤ Λ·R²/2` everywhere on `T`, where `R` is the radius of the smallest
+//! disc containing `T` and `Λ` bounds every second directional derivative `|dᵀ·D²S·d|`,
+//! `|d| = 1`. (Proof: with `c` the disc's centre, `e = w·(S − L) − Λ/2·(R² − |x − c|²)` is
+//! convex for every unit vector `w` and `≤ 0` at the corners, hence on `T`.) With
+//! `|S_uu| ≤ Muu`, `|S_uv| ≤ Muv`, `|S_vv| ≤ Mvv`, `Λ` is the largest eigenvalue of
+//! `[[Muu, Muv], [Muv, Mvv]]`. Measuring the domain in the scaled coordinates
+//! `(a·u, b·v)` makes the bound direction-aware; with `(a, b) = (√Muu, √Mvv)` and grid cells
+//! with `√Muu·hu = √Mvv·hv` it equals the bound of Filip, Magedson & Markot (1986):
+//! `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8`.
+//!
+//! `Muu`, `Muv`, `Mvv` come from the control net: `m(m−1)·max|Δ²b|` and `m·n·max|ΔuΔv b|` for
+//! polynomial patches; rational patches bound the homogeneous numerator and the weight
+//! separately and divide by the smallest weight (in the spirit of Zheng & Sederberg 2000; the
+//! quotient-rule expansion is in [`bicubic_hessian`]).
+
+use crate::surface::{BezierTriangle, Patch, RationalBicubic};
+use glam::{DVec2, DVec3};
+
+/// Bounds on the second partial derivatives of a patch over its whole domain.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HessianBound {
+    pub uu: f64,
+    pub uv: f64,
+    pub vv: f64,
+}
+
+impl HessianBound {
+    /// Largest eigenvalue of `[[uu, uv], [uv, vv]]`: a bound on every unit second directional
+    /// derivative.
+    pub fn lambda(&self) -> f64 {
+        let (a, b, c) = (self.uu, self.uv, self.vv);
+        0.5 * ((a + c) + ((a - c) * (a - c) + 4.0 * b * b).sqrt())
+    }
+
+    /// Bound over one triangle with the domain measured in coordinates `(a·u, b·v)`.
+    fn scaled_error(&self, t: [DVec2; 3], s: DVec2) -> f64 {
+        let scaled =
+            HessianBound { uu: self.uu / (s.x * s.x), uv: self.uv / (s.x * s.y), vv: self.vv / (s.y * s.y) };
+        let r = enclosing_radius(t.map(|p| p * s));
+        scaled.lambda() * r * r / 2.0
+    }
+
+    /// Guaranteed bound on `|S − L|` over the parameter triangle `t`: the smallest of the bounds
+    /// for three scalings of the domain (each is valid; `(√Muu, √Mvv)` matches Filip's bound on
+    /// grid cells whose sides follow `√Muu·hu = √Mvv·hv`). Cost: O(1).
+    pub fn triangle_error(&self, t: [DVec2; 3]) -> f64 {
+        let tiny = 1e-300 + 1e-12 * (self.uu + self.uv + self.vv);
+        let scales = [
+            DVec2::new((self.uu + tiny).sqrt(), (self.vv + tiny).sqrt()),
+            DVec2::new((self.uu + self.uv + tiny).sqrt(), (self.vv + self.uv + tiny).sqrt()),
+            DVec2::ONE,
+        ];
+        let general = scales.iter().map(|&s| self.scaled_error(t, s)).fold(f64::INFINITY, f64::min);
+        general.min(self.axis_aligned_error(t).unwrap_or(f64::INFINITY))
+    }
+
+    /// Filip's bound `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8` for a right triangle whose legs
+    /// run along the `u` and `v` axes (the cells of a grid); None for other triangles.
+    fn axis_aligned_error(&self, t: [DVec2; 3]) -> Option<f64> {
+        // Parameters computed as k/n along an edge and as i·(1/n) inside differ in the last
+        // bits; a skew of 1e-12 of the side changes the bound by less than that.
+        let flat = |x: f64, side: f64| x.abs() <= 1e-12 * side.abs();
+        for c in 0..3 {
+            let (a, b) = (t[(c + 1) % 3] - t[c], t[(c + 2) % 3] - t[c]);
+            let (du, dv) = if flat(a.y, a.x) && flat(b.x, b.y) {
+                (a.x, b.y)
+            } else if flat(a.x, a.y) && flat(b.y, b.x) {
+                (b.x, a.y)
+            } else {
+                continue;
+            };
+            let (hu, hv) = (du.abs(), dv.abs());
+            return Some((hu * hu * self.uu + 2.0 * hu * hv * self.uv + hv * hv * self.vv) / 8.0);
+        }
+        None
+    }
+}
+
+/// Radius of the smallest disc containing a triangle: half the longest side when the triangle
+/// is right or obtuse, else its circumradius.
+pub fn enclosing_radius(t: [DVec2; 3]) -> f64 {
+    let (a, b, c) =
+        ((t[1] - t[2]).length_squared(), (t[2] - t[0]).length_squared(), (t[0] - t[1]).length_squared());
+    let longest = a.max(b).max(c);
+    if 2.0 * longest >= a + b + c {
+        return longest.sqrt() / 2.0;
+    }
+    let area2 = (t[1] - t[0]).perp_dot(t[2] - t[0]).abs();
+    (a * b * c).sqrt() / (2.0 * area2)
+}
+
+fn max_norm(it: impl Iterator<Item = DVec3>) -> f64 {
+    it.map(|v| v.length()).fold(0.0, f64::max)
+}
+
+/// Second-derivative bounds of a bicubic (rational) patch.
+///
+/// With `H = Σ w_ij (P_ij − c) B B` (`c` the control points' bounding-box centre, which makes
+/// `r = max|P_ij − c|` small) and `S − c = H/w`: `S_u = (H_u − (S−c)·w_u)/w`,
+/// `S_uu = (H_uu − 2·S_u·w_u − (S−c)·w_uu)/w`, `S_uv = (H_uv − S_u·w_v − S_v·w_u − (S−c)·w_uv)/w`;
+/// each term is bounded through the control-net differences of `H` and `w` and `w ≥ min w_ij`.
+/// For polynomial patches this is exactly `6·max|Δ²b|`, `9·max|ΔuΔv b|`.
+pub fn bicubic_hessian(p: &RationalBicubic) -> HessianBound {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for q in &p.points {
+        lo = lo.min(*q);
+        hi = hi.max(*q);
+    }
+    let c = (lo + hi) * 0.5;
+    let h = |i: usize, j: usize| (p.points[4 * i + j] - c) * p.weights[4 * i + j];
+    let w = |i: usize, j: usize| p.weights[4 * i + j];
+    let r = max_norm(p.points.iter().map(|q| *q - c));
+    let wmin = p.weights.iter().copied().fold(f64::INFINITY, f64::min);
+
+    let pairs = |f: &dyn Fn(usize, usize) -> f64| -> f64 {
+        let mut m = 0.0f64;
+        for i in 0..4 {
+            for j in 0..4 {
+                m = m.max(f(i, j));
+            }
+        }
+        m
+    };
+    let d1u_h = 3.0 * pairs(&|i, j| if i < 3 { (h(i + 1, j) - h(i, j)).length() } else { 0.0 });
+    let d1v_h = 3.0 * pairs(&|i, j| if j < 3 { (h(i, j + 1) - h(i, j)).length() } else { 0.0 });
+    let d2u_h =
+        6.0 * pairs(&|i, j| if i < 2 { (h(i + 2, j) - 2.0 * h(i + 1, j) + h(i, j)).length() } else { 0.0 });
+    let d2v_h =
+        6.0 * pairs(&|i, j| if j < 2 { (h(i, j + 2) - 2.0 * h(i, j + 1) + h(i, j)).length() } else { 0.0 });
+    let duv_h = 9.0
+        * pairs(&|i, j| {
+            if i < 3 && j < 3 {
+                (h(i + 1, j + 1) - h(i + 1, j) - h(i, j + 1) + h(i, j)).length()
+            } else {
+                0.0
+            }
+        });
+    if p.is_polynomial() {
+        return polynomial_bicubic_hessian(p);
+    }
+    let w1u = 3.0 * pairs(&|i, j| if i < 3 { (w(i + 1, j) - w(i, j)).abs() } else { 0.0 });
+    let w1v = 3.0 * pairs(&|i, j| if j < 3 { (w(i, j + 1) - w(i, j)).abs() } else { 0.0 });
+    let w2u =
+        6.0 * pairs(&|i, j| if i < 2 { (w(i + 2, j) - 2.0 * w(i + 1, j) + w(i, j)).abs() } else { 0.0 });
+    let w2v =
+        6.0 * pairs(&|i, j| if j < 2 { (w(i, j + 2) - 2.0 * w(i, j + 1) + w(i, j)).abs() } else { 0.0 });
+    let wuv = 9.0
+        * pairs(&|i, j| {
+            if i < 3 && j < 3 {
+                (w(i + 1, j + 1) - w(i + 1, j) - w(i, j + 1) + w(i, j)).abs()
+            } else {
+                0.0
+            }
+        });
+    let gu = (d1u_h + r * w1u) / wmin;
+    let gv = (d1v_h + r * w1v) / wmin;
+    HessianBound {
+        uu: (d2u_h + 2.0 * gu * w1u + r * w2u) / wmin,
+        uv: (duv_h + gu * w1v + gv * w1u + r * wuv) / wmin,
+        vv: (d2v_h + 2.0 * gv * w1v + r * w2v) / wmin,
+    }
+}
+
+/// Sub-intervals a bound is refined over: each second derivative of a polynomial bicubic is
+/// itself a Bézier patch (degrees (1,3), (2,2), (3,1)); the control points of its pieces over
+/// a `SPLIT × SPLIT` grid of sub-rectangles bound it more tightly than its own net, and
+/// converge to its true maximum as the pieces shrink.
+const SPLIT: usize = 4;
+
+/// De Casteljau split of a Bézier curve at `t`: the control points of `[0, t]` and `[t, 1]`.
+fn split<const N: usize>(c: [DVec3; N], t: f64) -> ([DVec3; N], [DVec3; N]) {
+    let (mut left, mut right) = ([DVec3::ZERO; N], [DVec3::ZERO; N]);
+    let mut level = c;
+    for r in 0..N {
+        left[r] = level[0];
+        right[N - 1 - r] = level[N - 1 - r];
+        for i in 0..N - 1 - r {
+            level[i] = level[i] * (1.0 - t) + level[i + 1] * t;
+        }
+    }
+    (left, right)
+}
+
+/// Control points of the piece of a Bézier curve over `[a, b] ⊂ [0, 1]`.
+fn sub_curve<const N: usize>(c: [DVec3; N], a: f64, b: f64) -> [DVec3; N] {
+    let right = split(c, a).1;
+    let t = if a < 1.0 { ((b - a) / (1.0 - a)).clamp(0.0, 1.0) } else { 0.0 };
+    split(right, t).0
+}
+
+/// Largest control-point norm over the `SPLIT × SPLIT` pieces of a tensor Bézier patch with
+/// `M × N` control points `net[i][j]` (`i` along u).
+fn split_max<const M: usize, const N: usize>(net: [[DVec3; N]; M]) -> f64 {
+    let mut worst = 0.0f64;
+    for pu in 0..SPLIT {
+        let (ua, ub) = (pu as f64 / SPLIT as f64, (pu + 1) as f64 / SPLIT as f64);
+        // Rows restricted in u: for each column j, the curve over i.
+        let mut cols = [[DVec3::ZERO; M]; N];
+        for (j, col) in cols.iter_mut().enumerate() {
+            *col = sub_curve(std::array::from_fn(|i| net[i][j]), ua, ub);
+        }
+        for pv in 0..SPLIT {
+            let (va, vb) = (pv as f64 / SPLIT as f64, (pv + 1) as f64 / SPLIT as f64);
+            for i in 0..M {
+                let row: [DVec3; N] = sub_curve(std::array::from_fn(|j| cols[j][i]), va, vb);
+                worst = row.iter().map(|p| p.length()).fold(worst, f64::max);
+            }
+        }
+    }
+    worst
+}
+
+/// Tight second-derivative bounds of a polynomial bicubic: the nets of `S_uu`
+/// (`6·Δ²_u b`, 2×4), `S_uv` (`9·ΔuΔv b`, 3×3) and `S_vv` (`6·Δ²_v b`, 4×2), each bounded
+/// over `SPLIT × SPLIT` pieces.
+fn polynomial_bicubic_hessian(p: &RationalBicubic) -> HessianBound {
+    let b = |i: usize, j: usize| p.points[4 * i + j];
+    let uu: [[DVec3; 4]; 2] =
+        std::array::from_fn(|i| std::array::from_fn(|j| (b(i + 2, j) - 2.0 * b(i + 1, j) + b(i, j)) * 6.0));
+    let vv: [[DVec3; 2]; 4] =
+        std::array::from_fn(|i| std::array::from_fn(|j| (b(i, j + 2) - 2.0 * b(i, j + 1) + b(i, j)) * 6.0));
+    let uv: [[DVec3; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| (b(i + 1, j + 1) - b(i + 1, j) - b(i, j + 1) + b(i, j)) * 9.0)
+    });
+    HessianBound { uu: split_max(uu), uv: split_max(uv), vv: split_max(vv) }
+}
+
+/// Second-derivative bounds of a cubic Bézier triangle in its `(u, v)` parameters:
+/// `S_uu = 6 Σ (b_{i,j+2,k} − 2b_{i+1,j+1,k} + b_{i+2,j,k}) B¹`, likewise for `vv` and `uv`.
+pub fn triangle_hessian(t: &BezierTriangle) -> HessianBound {
+    let mut m = HessianBound::default();
+    for (i, j, k) in [(1, 0, 0), (0, 1, 0), (0, 0, 1)] {
+        let b = |di: usize, dj: usize, dk: usize| t.b(i + di, j + dj, k + dk);
+        m.uu = m.uu.max(6.0 * (b(0, 2, 0) - 2.0 * b(1, 1, 0) + b(2, 0, 0)).length());
+        m.vv = m.vv.max(6.0 * (b(0, 0, 2) - 2.0 * b(1, 0, 1) + b(2, 0, 0)).length());
+        m.uv = m.uv.max(6.0 * (b(0, 1, 1) - b(1, 0, 1) - b(1, 1, 0) + b(2, 0, 0)).length());
+    }
+    m
+}
+
+/// Second-derivative bounds of any patch (PN triangles: their cubic geometry).
+pub fn hessian(p: &Patch) -> HessianBound {
+    match p {
+        Patch::Bicubic(b) => bicubic_hessian(b),
+        Patch::BezierTriangle(t) => triangle_hessian(t),
+        Patch::Pn(pn) => triangle_hessian(&pn.geometry),
+    }
+}
+
+/// Bound on the second derivative of a cubic (rational) curve from its own four control
+/// points and weights — the data both patches of an edge agree on.
+pub fn curve_second_derivative(points: [DVec3; 4], weights: [f64; 4]) -> f64 {
+    let c = (points.iter().fold(DVec3::splat(f64::INFINITY), |a, &b| a.min(b))
+        + points.iter().fold(DVec3::splat(f64::NEG_INFINITY), |a, &b| a.max(b)))
+        * 0.5;
+    let h = points.map(|p| p - c);
+    let hw: Vec<DVec3> = h.iter().zip(weights).map(|(p, w)| *p * w).collect();
+    let d2 = 6.0 * max_norm((0..2).map(|i| hw[i + 2] - 2.0 * hw[i + 1] + hw[i]));
+    if weights.iter().all(|&w| w == 1.0) {
+        return d2;
+    }
+    let r = max_norm(h.iter().copied());
+    let wmin = weights.iter().copied().fold(f64::INFINITY, f64::min);
+    let d1 = 3.0 * max_norm((0..3).map(|i| hw[i + 1] - hw[i]));
+    let w1 = 3.0 * (0..3).map(|i| (weights[i + 1] - weights[i]).abs()).fold(0.0, f64::max);
+    let w2 =
+        6.0 * (0..2).map(|i| (weights[i + 2] - 2.0 * weights[i + 1] + weights[i]).abs()).fold(0.0, f64::max);
+    let g = (d1 + r * w1) / wmin;
+    (d2 + 2.0 * g * w1 + r * w2) / wmin
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_bounds_are_valid_and_tighter() {
+        // A wavy polynomial patch: the refined bound is still ≥ every sampled |S_uu|, |S_vv|,
+        // |S_uv| (by finite differences) and no looser than the plain net bound.
+        let mut pts = [DVec3::ZERO; 16];
+        for i in 0..4 {
+            for j in 0..4 {
+                let (x, y) = (i as f64, j as f64);
+                pts[4 * i + j] = DVec3::new(x, y, ((x * 1.7).sin() + (y * 2.3).cos()) * (1.0 + x * y * 0.3));
+            }
+        }
+        let p = RationalBicubic::polynomial(pts);
+        let tight = polynomial_bicubic_hessian(&p);
+        let b = |i: usize, j: usize| p.points[4 * i + j];
+        let mut loose = 0.0f64;
+        for i in 0..2 {
+            for j in 0..4 {
+                loose = loose.max(6.0 * (b(i + 2, j) - 2.0 * b(i + 1, j) + b(i, j)).length());
+            }
+        }
+        assert!(tight.uu <= loose + 1e-12);
+        let h = 1e-4;
+        for k in 0..=20 {
+            for l in 0..=20 {
+                let (u, v) = (0.05 + 0.9 * k as f64 / 20.0, 0.05 + 0.9 * l as f64 / 20.0);
+                let at = |du: f64, dv: f64| p.position(DVec2::new(u + du, v + dv));
+                let suu = (at(h, 0.0) - 2.0 * at(0.0, 0.0) + at(-h, 0.0)) / (h * h);
+                let svv = (at(0.0, h) - 2.0 * at(0.0, 0.0) + at(0.0, -h)) / (h * h);
+                let suv = (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4.0 * h * h);
+                assert!(suu.length() <= tight.uu * (1.0 + 1e-4) + 1e-6);
+                assert!(svv.length() <= tight.vv * (1.0 + 1e-4) + 1e-6);
+                assert!(suv.length() <= tight.uv * (1.0 + 1e-4) + 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn enclosing_radius_of_right_and_equilateral_triangles() {
+        let right = [DVec2::ZERO, DVec2::X, DVec2::Y];
+        assert!((enclosing_radius(right) - 2f64.sqrt() / 2.0).abs() < 1e-12);
+        let eq = [DVec2::ZERO, DVec2::X, DVec2::new(0.5, 3f64.sqrt() / 2.0)];
+        assert!((enclosing_radius(eq) - 1.0 / 3f64.sqrt()).abs() < 1e-12);
+        let obtuse = [DVec2::ZERO, DVec2::new(2.0, 0.0), DVec2::new(1.0, 0.1)];
+        assert!((enclosing_radius(obtuse) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn grid_cell_bound_equals_filip() {
+        let m = HessianBound { uu: 3.0, uv: 1.0, vv: 0.5 };
+        let (hu, hv) = (0.1, 0.25);
+        let tri = [DVec2::ZERO, DVec2::new(hu, 0.0), DVec2::new(hu, hv)];
+        let filip = (hu * hu * m.uu + 2.0 * hu * hv * m.uv + hv * hv * m.vv) / 8.0;
+        let ours = m.triangle_error(tri);
+        // Never tighter than Filip's (which is sharp for such cells), and close to it.
+        assert!(ours >= filip * (1.0 - 1e-12) && ours <= 1.5 * filip, "{ours} vs {filip}");
+        // Equal to Filip's when the cell follows √Muu·hu = √Mvv·hv.
+        let hv = hu * (m.uu / m.vv).sqrt();
+        let tri = [DVec2::ZERO, DVec2::new(hu, 0.0), DVec2::new(hu, hv)];
+        let filip = (hu * hu * m.uu + 2.0 * hu * hv * m.uv + hv * hv * m.vv) / 8.0;
+        assert!((m.triangle_error(tri) - filip).abs() < 1e-12 * filip);
+    }
+}

@@ -1,0 +1,395 @@
+//! Error-bounded plans: every visible patch gets an object-space tolerance `ε_p` (given
+//! directly, or converted from pixels by [`super::screen`]), and the plan guarantees that the
+//! mesh stays within `ε_p` of the surface on that patch (bounds in [`super::bounds`]).
+//!
+//! Crack-freeness: an edge's sampling is the *maximum* of what its visible patches ask for
+//! (the CudaTess rule), computed once per edge here and read by every patch. Each patch's
+//! proposal already covers the edge curve's own bound, so the maximum satisfies all of them.
+//! Interior factors are private to a patch and may be raised freely.
+
+use super::bounds::{self, HessianBound};
+use super::Plan;
+use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
+use crate::sampling::EdgeSampling;
+use crate::surface::{Domain, Patch, SurfaceSet};
+use rayon::prelude::*;
+
+/// Which pattern the plan is for: it decides how interior factors follow from edges.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// One factor for the whole mesh (the uniform baseline at the same guarantee).
+    Uniform,
+    /// Per-edge factors, core factors as in CudaTess: quads take the smaller factor of the two
+    /// edges along each direction, triangles the largest edge factor; transition strips
+    /// connect the core to finer edges.
+    Transition,
+}
+
+/// What an error-bounded plan achieved.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlanReport {
+    /// Patches culled (not tessellated).
+    pub culled: usize,
+    /// Visible patches whose guarantee the factor cap prevented.
+    pub capped_patches: usize,
+    /// Largest ratio of guaranteed bound to requested tolerance over visible patches
+    /// (≤ 1 when every bound is met).
+    pub worst_ratio: f64,
+    /// Largest guaranteed object-space bound over visible patches.
+    pub worst_bound: f64,
+}
+
+/// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
+/// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
+fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
+    let mut best: Option<(u32, u32)> = None;
+    for nu in 1..=cap {
+        let hu = 1.0 / nu as f64;
+        let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
+        if c > 0.0 {
+            continue;
+        }
+        let hv = if a > 0.0 {
+            (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a)
+        } else if b > 0.0 {
+            -c / b
+        } else {
+            1.0
+        };
+        let nv = if hv >= 1.0 { 1 } else { (1.0 / hv).ceil() as u64 };
+        if nv > cap as u64 {
+            continue;
+        }
+        let nv = nv as u32;
+        if best.is_none_or(|(bu, bv)| (nu as u64 * nv as u64) < (bu as u64 * bv as u64)) {
+            best = Some((nu, nv));
+        }
+        if nv == 1 {
+            break; // larger nu only adds cells
+        }
+    }
+    best
+}
+
+/// Smallest factor `n` whose uniform triangle grid meets the bound (`hu = hv = 1/n`).
+fn uniform_factor(m: &HessianBound, eps: f64) -> f64 {
+    ((m.uu + 2.0 * m.uv + m.vv) / (8.0 * eps)).sqrt().ceil().max(1.0)
+}
+
+/// Segments a boundary curve needs on its own: `sqrt(M_edge / 8ε)` from its four control
+/// points — data both neighbours share.
+fn curve_factor(patch: &Patch, local: usize, eps: f64) -> f64 {
+    let (points, weights) = edge_control_points(patch, local);
+    (bounds::curve_second_derivative(points, weights) / (8.0 * eps)).sqrt().ceil().max(1.0)
+}
+
+/// The four control points (and weights) of a patch's boundary curve `local`, from corner
+/// `local` to corner `local + 1`.
+pub fn edge_control_points(patch: &Patch, local: usize) -> ([glam::DVec3; 4], [f64; 4]) {
+    use crate::surface::BezierTriangle as B;
+    match patch {
+        Patch::Bicubic(b) => {
+            let idx = [[0, 4, 8, 12], [12, 13, 14, 15], [15, 11, 7, 3], [3, 2, 1, 0]][local];
+            (idx.map(|i| b.points[i]), idx.map(|i| b.weights[i]))
+        }
+        Patch::BezierTriangle(_) | Patch::Pn(_) => {
+            let t = match patch {
+                Patch::BezierTriangle(t) => t,
+                Patch::Pn(p) => &p.geometry,
+                Patch::Bicubic(_) => unreachable!(),
+            };
+            let idx = [
+                [B::index(3, 0, 0), B::index(2, 1, 0), B::index(1, 2, 0), B::index(0, 3, 0)],
+                [B::index(0, 3, 0), B::index(0, 2, 1), B::index(0, 1, 2), B::index(0, 0, 3)],
+                [B::index(0, 0, 3), B::index(1, 0, 2), B::index(2, 0, 1), B::index(3, 0, 0)],
+            ][local];
+            (idx.map(|i| t.points[i]), [1.0; 4])
+        }
+    }
+}
+
+/// Guaranteed error bound of one patch under `input`, from its pattern's triangles.
+pub fn patch_bound(
+    m: &HessianBound,
+    input: &PatternInput,
+    pattern: &dyn Pattern,
+    scratch: &mut LocalTessellation,
+) -> f64 {
+    pattern.build(input, scratch);
+    let d = input.domain;
+    let param = |l: u32| match input.slot(l) {
+        Slot::Corner(c) => d.corner(c),
+        Slot::Edge(e, k) => d.edge_point(e, k as f64 / input.segments[e] as f64),
+        Slot::Interior(j) => scratch.interior[j as usize],
+    };
+    scratch.triangles.iter().map(|t| m.triangle_error(t.map(param))).fold(0.0, f64::max)
+}
+
+/// Minimum segments for edges whose samples could otherwise coincide with another edge's:
+/// two distinct curves between the same two corners need 2 (else both become the same chord),
+/// a curve that starts and ends at one point needs 3.
+pub fn minimum_segments(set: &SurfaceSet) -> Vec<u32> {
+    let topo = &set.topology;
+    let mut pairs: std::collections::HashMap<(u32, u32), u32> = Default::default();
+    for e in topo.edges.iter().filter(|e| !e.collapsed) {
+        let [a, b] = e.ends;
+        *pairs.entry((a.min(b), a.max(b))).or_default() += 1;
+    }
+    topo.edges
+        .iter()
+        .map(|e| {
+            let [a, b] = e.ends;
+            if e.collapsed {
+                1
+            } else if a == b {
+                3
+            } else if pairs[&(a.min(b), a.max(b))] > 1 {
+                2
+            } else {
+                1
+            }
+        })
+        .collect()
+}
+
+/// Minimum interior factors `[u, v]` per patch, so that no two triangles of the output share
+/// an edge by accident of coarse sampling:
+/// - a quad whose opposite corners are also corners of another patch (the two halves of the
+///   teacup's handle share all four) needs an interior vertex, or at factor 1 both could
+///   triangulate with the same diagonal chord: 2 in both directions;
+/// - a quad with a curve that starts and ends at one point (teapot_teasetorig's lid top)
+///   needs 3 along that curve, or the core vertices next to its two ends coincide and both
+///   ends, one vertex, connect to it twice.
+pub fn minimum_interior(set: &SurfaceSet) -> Vec<[u32; 2]> {
+    let mut pairs: std::collections::HashMap<(u32, u32), u32> = Default::default();
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let corners = &set.topology.patch_corners;
+    for (p, patch) in set.patches.iter().enumerate() {
+        if patch.domain() == Domain::Quad {
+            let c = corners[p];
+            *pairs.entry(key(c[0], c[2])).or_default() += 1;
+            *pairs.entry(key(c[1], c[3])).or_default() += 1;
+        }
+    }
+    for e in &set.topology.edges {
+        *pairs.entry(key(e.ends[0], e.ends[1])).or_default() += 1;
+    }
+    set.patches
+        .iter()
+        .enumerate()
+        .map(|(p, patch)| {
+            if patch.domain() != Domain::Quad {
+                return [1, 1];
+            }
+            let c = corners[p];
+            let shared = pairs[&key(c[0], c[2])] > 1 || pairs[&key(c[1], c[3])] > 1;
+            let mut m = if shared { [2, 2] } else { [1, 1] };
+            for l in 0..4 {
+                let edge = &set.topology.edges[set.topology.patch_edges[p][l].edge as usize];
+                if !edge.collapsed && edge.ends[0] == edge.ends[1] {
+                    m[l % 2] = 3; // edges 0 and 2 run along u, 1 and 3 along v
+                }
+            }
+            m
+        })
+        .collect()
+}
+
+/// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
+/// for `pattern` laid out as `layout`, with factors capped at `max_factor`. Cost: O(P) bound
+/// computations plus one pattern build per patch for the a-posteriori check.
+pub fn plan(
+    set: &SurfaceSet,
+    eps: &[Option<f64>],
+    layout: Layout,
+    pattern: &dyn Pattern,
+    max_factor: u32,
+) -> (Plan, PlanReport) {
+    let cap = max_factor.max(1);
+    let topo = &set.topology;
+    let hessians: Vec<HessianBound> = set.patches.par_iter().map(bounds::hessian).collect();
+    let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
+
+    // Each visible patch's proposal per local edge.
+    let proposals: Vec<[f64; 4]> = (0..set.patches.len())
+        .into_par_iter()
+        .map(|p| {
+            let Some(e) = eps[p] else { return [0.0; 4] };
+            let patch = &set.patches[p];
+            let m = &hessians[p];
+            let mut out = [0.0; 4];
+            match (layout, patch.domain()) {
+                (Layout::Transition, Domain::Quad) => {
+                    let (nu, nv) = quad_grid(m, e, cap).unwrap_or((cap, cap));
+                    out = [nu as f64, nv as f64, nu as f64, nv as f64];
+                }
+                _ => {
+                    let n = uniform_factor(m, e);
+                    out[..patch.domain().corner_count()].fill(n);
+                }
+            }
+            for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
+                *o = o.max(curve_factor(patch, l, e));
+            }
+            out
+        })
+        .collect();
+
+    let minimum = minimum_segments(set);
+    let visible: Vec<bool> = eps.iter().map(|e| e.is_some()).collect();
+    let mut proposals = proposals;
+    let edge_segments = |proposals: &[[f64; 4]]| -> Vec<u32> {
+        let mut segments: Vec<u32> = (0..topo.edges.len())
+            .map(|e| {
+                let wanted = topo
+                    .edge_uses(e)
+                    .iter()
+                    .map(|u| proposals[u.patch as usize][u.local as usize])
+                    .fold(0.0, f64::max);
+                (wanted.min(cap as f64) as u32).max(minimum[e]).max(1)
+            })
+            .collect();
+        if layout == Layout::Uniform {
+            let n = segments.iter().copied().max().unwrap_or(1);
+            segments.iter_mut().for_each(|s| *s = n);
+        }
+        segments
+    };
+    let all: Vec<usize> = (0..set.patches.len()).collect();
+    let mut segments = edge_segments(&proposals);
+    let mut results = check_patches(set, eps, layout, pattern, cap, &hessians, &proposals, &segments, &all);
+    // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
+    // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
+    // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
+    // Errors shrink as h², hence the square root.
+    for _round in 0..256 {
+        let failing: Vec<usize> = (0..set.patches.len()).filter(|&p| results[p].2).collect();
+        if failing.is_empty() || layout == Layout::Uniform {
+            break;
+        }
+        for &p in &failing {
+            let (e, bound) = (eps[p].unwrap_or(f64::INFINITY), results[p].1);
+            let grow = (bound / e).sqrt().max(1.2);
+            for v in proposals[p].iter_mut() {
+                *v = (*v * grow).ceil().min(cap as f64);
+            }
+        }
+        let next = edge_segments(&proposals);
+        let mut affected: Vec<usize> = failing.clone();
+        for (e, (&a, &b)) in segments.iter().zip(&next).enumerate() {
+            if a != b {
+                affected.extend(topo.edge_uses(e).iter().map(|u| u.patch as usize));
+            }
+        }
+        affected.sort_unstable();
+        affected.dedup();
+        if next == segments {
+            break; // every failing patch is at the cap
+        }
+        segments = next;
+        let rechecked =
+            check_patches(set, eps, layout, pattern, cap, &hessians, &proposals, &segments, &affected);
+        for (i, &p) in affected.iter().enumerate() {
+            results[p] = rechecked[i];
+        }
+    }
+    for (p, r) in results.iter().enumerate() {
+        if let Some(e) = eps[p] {
+            report.worst_bound = report.worst_bound.max(r.1);
+            report.worst_ratio = report.worst_ratio.max(r.1 / e);
+            if r.2 {
+                report.capped_patches += 1;
+            }
+        }
+    }
+    let plan = Plan {
+        edges: segments.iter().map(|&s| EdgeSampling::uniform(s)).collect(),
+        interior: results.iter().map(|r| r.0).collect(),
+        visible,
+    };
+    (plan, report)
+}
+
+/// Interior factors for every patch and the a-posteriori check: the interior is raised until
+/// the pattern's own triangles meet the bound (interior vertices are private, so this never
+/// opens a crack), growing like the square root of the excess since errors shrink as h².
+/// Returns, for each patch of `which`, (interior, guaranteed bound, bound not met).
+#[allow(clippy::too_many_arguments)]
+fn check_patches(
+    set: &SurfaceSet,
+    eps: &[Option<f64>],
+    layout: Layout,
+    pattern: &dyn Pattern,
+    cap: u32,
+    hessians: &[HessianBound],
+    proposals: &[[f64; 4]],
+    segments: &[u32],
+    which: &[usize],
+) -> Vec<([u32; 2], f64, bool)> {
+    let topo = &set.topology;
+    let global = segments.iter().copied().max().unwrap_or(1);
+    let minimum = minimum_interior(set);
+    which
+        .par_iter()
+        .map_init(LocalTessellation::default, |scratch, &p| {
+            let domain = set.patches[p].domain();
+            let nc = domain.corner_count();
+            let mut seg = [1u32; 4];
+            for (l, s) in seg.iter_mut().enumerate().take(nc) {
+                *s = segments[topo.patch_edges[p][l].edge as usize];
+            }
+            let mut interior = match (layout, domain) {
+                (Layout::Uniform, _) => [global, global],
+                (Layout::Transition, Domain::Quad) => {
+                    // The patch's own grid is enough for the core; CudaTess's min of the two
+                    // edges is never smaller, and neighbours' finer needs reach the core
+                    // through the transition strips instead of refining the whole patch.
+                    let own = |l: usize| (proposals[p][l].min(cap as f64) as u32).max(1);
+                    [own(0).min(seg[0].min(seg[2])), own(1).min(seg[1].min(seg[3]))]
+                }
+                (Layout::Transition, Domain::Tri) => {
+                    let n = seg[..3].iter().copied().max().unwrap_or(1);
+                    [n, n]
+                }
+            };
+            if layout == Layout::Transition {
+                interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
+            }
+            let Some(e) = eps[p] else { return (interior, 0.0, false) };
+            let mut previous = f64::INFINITY;
+            loop {
+                let input = PatternInput { domain, segments: seg, interior };
+                let bound = patch_bound(&hessians[p], &input, pattern, scratch);
+                if bound <= e * (1.0 + 1e-9) {
+                    return (interior, bound, false);
+                }
+                // No progress means the worst triangles follow the edges, not the core.
+                let stuck = bound >= previous * (1.0 - 1e-9);
+                if layout == Layout::Uniform || interior[0].max(interior[1]) >= cap || stuck {
+                    return (interior, bound, true);
+                }
+                previous = bound;
+                let grow = (bound / e).sqrt().max(1.05);
+                interior = interior.map(|n| ((n as f64 * grow).ceil() as u32).clamp(n + 1, cap));
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_grid_meets_filip_with_few_cells() {
+        let m = HessianBound { uu: 10.0, uv: 1.0, vv: 0.1 };
+        let eps = 1e-3;
+        let (nu, nv) = quad_grid(&m, eps, 1000).unwrap();
+        let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+        assert!((hu * hu * m.uu + 2.0 * hu * hv * m.uv + hv * hv * m.vv) / 8.0 <= eps);
+        assert!(nu > nv, "anisotropic bounds give anisotropic grids: {nu}×{nv}");
+        assert!(quad_grid(&m, eps, 3).is_none());
+        let flat = HessianBound::default();
+        assert_eq!(quad_grid(&flat, eps, 10), Some((1, 1)));
+    }
+}
