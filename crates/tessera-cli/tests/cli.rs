@@ -179,3 +179,82 @@ fn help_is_there_for_every_command() {
         assert!(text(&out.stdout).contains("Usage"));
     }
 }
+
+fn stats(args: &[&str], dir: &Path) -> (serde_json::Value, String) {
+    let out = tessera(args, dir);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    (serde_json::from_str(text(&out.stdout).trim()).unwrap(), text(&out.stderr))
+}
+
+#[test]
+fn tolerance_is_met_and_the_cap_is_reported() {
+    let dir = scratch("tolerance");
+    let teapot = data("patches/teapot.patches");
+    let t = teapot.to_str().unwrap();
+    let (v, _) = stats(&["mesh", t, "--tolerance", "0.1%", "--stats", "--measure-error"], &dir);
+    assert_eq!(v["bound_met"], true);
+    let (tol, measured) = (v["tolerance"].as_f64().unwrap(), v["max_error"].as_f64().unwrap());
+    assert!(measured <= tol && v["guaranteed_bound"].as_f64().unwrap() <= tol, "{v}");
+    assert_eq!(v["nonmanifold_edges"], 0);
+    // An absolute tolerance works the same way.
+    let (v, _) = stats(&["mesh", t, "--tolerance", &format!("{tol}"), "--stats"], &dir);
+    assert_eq!(v["bound_met"], true);
+    // The cap stops a very tight bound: the command says so and by how much.
+    let (v, err) = stats(&["mesh", t, "--tolerance", "0.001%", "--max-factor", "16", "--stats"], &dir);
+    assert_eq!(v["bound_met"], false);
+    assert!(
+        err.contains("--max-factor 16 stopped the error bound") && err.contains("× the request"),
+        "{err}"
+    );
+}
+
+#[test]
+fn pixel_error_with_camera_and_no_cull_keeps_closed_inputs_closed() {
+    let dir = scratch("pixels");
+    let torus = data("bench/torus_64x32.patches");
+    let cam = "eye=0,-3,1.5,target=0,0,0,fov=50,size=800x600";
+    let (v, _) = stats(
+        &["mesh", torus.to_str().unwrap(), "--pixel-error", "1", "--camera", cam, "--no-cull", "--stats"],
+        &dir,
+    );
+    assert_eq!((v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()), (Some(0), Some(0)), "{v}");
+    assert_eq!(v["culled_patches"], 0);
+    assert_eq!(v["euler_characteristic"], 0);
+    let (v, _) =
+        stats(&["mesh", torus.to_str().unwrap(), "--pixel-error", "1", "--camera", cam, "--stats"], &dir);
+    assert!(v["culled_patches"].as_u64().unwrap() > 0, "back faces of the torus are culled: {v}");
+    // The default camera frames the model.
+    let (v, _) = stats(&["mesh", torus.to_str().unwrap(), "--pixel-error", "2", "--stats"], &dir);
+    assert!(v["triangles"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn view_criteria_and_bad_criteria_arguments() {
+    let dir = scratch("view");
+    let spot = data("meshes/spot.obj");
+    let s = spot.to_str().unwrap();
+    for args in [
+        vec!["mesh", s, "--silhouette", "1:7", "--no-cull", "--stats"],
+        vec!["mesh", s, "--silhouette", "1:7", "--silhouette-mode", "vertices", "--no-cull", "--stats"],
+        vec!["mesh", s, "--distance", "1:7", "--mapping", "quadratic", "--no-cull", "--stats"],
+    ] {
+        let (v, _) = stats(&args, &dir);
+        assert_eq!(
+            (v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()),
+            (Some(0), Some(0)),
+            "{args:?}: {v}"
+        );
+    }
+    for bad in [
+        vec!["mesh", s, "--pixel-error", "1", "--camera", "fov=500"],
+        vec!["mesh", s, "--pixel-error", "1", "--camera", "eye=1,2"],
+        vec!["mesh", s, "--pixel-error", "-1"],
+        vec!["mesh", s, "--tolerance", "abc"],
+        vec!["mesh", s, "--silhouette", "7:1"],
+        vec!["mesh", s, "--factor", "4", "--tolerance", "1%"],
+    ] {
+        let out = tessera(&bad, &dir);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(!text(&out.stderr).contains("panicked"), "{bad:?}");
+    }
+}

@@ -193,6 +193,7 @@ fn sub_curve<const N: usize>(c: [DVec3; N], a: f64, b: f64) -> [DVec3; N] {
 
 /// Largest control-point norm over the `SPLIT × SPLIT` pieces of a tensor Bézier patch with
 /// `M × N` control points `net[i][j]` (`i` along u).
+#[allow(clippy::needless_range_loop)] // i indexes the second axis of cols
 fn split_max<const M: usize, const N: usize>(net: [[DVec3; N]; M]) -> f64 {
     let mut worst = 0.0f64;
     for pu in 0..SPLIT {
