@@ -86,25 +86,11 @@ fn curve_factor(patch: &Patch, local: usize, eps: f64) -> f64 {
 /// The four control points (and weights) of a patch's boundary curve `local`, from corner
 /// `local` to corner `local + 1`.
 pub fn edge_control_points(patch: &Patch, local: usize) -> ([glam::DVec3; 4], [f64; 4]) {
-    use crate::surface::BezierTriangle as B;
+    let idx = crate::surface::corner_and_edge_points(patch.domain()).1[local];
+    let points = patch.control_points();
     match patch {
-        Patch::Bicubic(b) => {
-            let idx = [[0, 4, 8, 12], [12, 13, 14, 15], [15, 11, 7, 3], [3, 2, 1, 0]][local];
-            (idx.map(|i| b.points[i]), idx.map(|i| b.weights[i]))
-        }
-        Patch::BezierTriangle(_) | Patch::Pn(_) => {
-            let t = match patch {
-                Patch::BezierTriangle(t) => t,
-                Patch::Pn(p) => &p.geometry,
-                Patch::Bicubic(_) => unreachable!(),
-            };
-            let idx = [
-                [B::index(3, 0, 0), B::index(2, 1, 0), B::index(1, 2, 0), B::index(0, 3, 0)],
-                [B::index(0, 3, 0), B::index(0, 2, 1), B::index(0, 1, 2), B::index(0, 0, 3)],
-                [B::index(0, 0, 3), B::index(1, 0, 2), B::index(2, 0, 1), B::index(3, 0, 0)],
-            ][local];
-            (idx.map(|i| t.points[i]), [1.0; 4])
-        }
+        Patch::Bicubic(b) => (idx.map(|i| points[i]), idx.map(|i| b.weights[i])),
+        Patch::BezierTriangle(_) | Patch::Pn(_) => (idx.map(|i| points[i]), [1.0; 4]),
     }
 }
 

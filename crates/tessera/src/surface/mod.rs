@@ -17,6 +17,7 @@ mod set;
 pub use bezier_triangle::BezierTriangle;
 pub use bicubic::RationalBicubic;
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
+pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 
 use glam::{DVec2, DVec3};

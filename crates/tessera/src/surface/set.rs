@@ -57,7 +57,7 @@ pub struct SurfaceSet {
 }
 
 /// Control-point indices of each corner and each edge (corner `e` → `e+1`) of a patch kind.
-fn corner_and_edge_points(domain: Domain) -> (&'static [usize], &'static [[usize; 4]]) {
+pub(crate) fn corner_and_edge_points(domain: Domain) -> (&'static [usize], &'static [[usize; 4]]) {
     use BezierTriangle as B;
     const QUAD_CORNERS: [usize; 4] = [0, 12, 15, 3];
     const QUAD_EDGES: [[usize; 4]; 4] = [[0, 4, 8, 12], [12, 13, 14, 15], [15, 11, 7, 3], [3, 2, 1, 0]];
