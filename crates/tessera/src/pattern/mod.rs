@@ -7,6 +7,7 @@
 //! `e+1`), then the pattern's interior vertices. Triangles are counter-clockwise in the
 //! `(u, v)` domain.
 
+pub mod semi_uniform;
 pub mod transition;
 pub mod uniform;
 
