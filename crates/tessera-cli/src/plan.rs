@@ -7,6 +7,7 @@ use tessera::camera::Camera;
 use tessera::criterion::tolerance::{self, Layout, PlanReport};
 use tessera::criterion::view::{self, Mapping, ViewCriterion};
 use tessera::criterion::{screen, Plan};
+use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
@@ -18,6 +19,9 @@ pub enum SchemeArg {
     Uniform,
     /// CudaTess: uniform core with Bresenham-like transition strips to each edge's factor.
     Transition,
+    /// Semi-uniform (paper 000): power-of-two edge factors, the dyadic pattern of the patch's
+    /// level with coarser edges snapped.
+    SemiUniform,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -125,15 +129,23 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
     let (layout, pattern): (Layout, Box<dyn Pattern>) = match scheme {
         SchemeArg::Uniform => (Layout::Uniform, Box::new(Uniform)),
         SchemeArg::Transition => (Layout::Transition, Box::new(Transition)),
+        SchemeArg::SemiUniform => (Layout::Dyadic, Box::new(SemiUniform)),
     };
     if args.max_factor == 0 || args.max_factor > tessera::criterion::MAX_FACTOR {
         return Err(
             format!("--max-factor {}: use 1 to {}", args.max_factor, tessera::criterion::MAX_FACTOR).into()
         );
     }
-    let scheme_name = if scheme == SchemeArg::Uniform { "uniform" } else { "transition" };
+    let scheme_name = match scheme {
+        SchemeArg::Uniform => "uniform",
+        SchemeArg::Transition => "transition",
+        SchemeArg::SemiUniform => "semi-uniform",
+    };
     if !adaptive {
         let n = args.factor.unwrap_or(8);
+        if scheme == SchemeArg::SemiUniform && !n.is_power_of_two() {
+            return Err(format!("--factor {n} with --scheme semi-uniform: use a power of two").into());
+        }
         let plan = Plan::uniform(set, n)?;
         return Ok(Chosen {
             plan,

@@ -234,6 +234,8 @@ fn view_criteria_and_bad_criteria_arguments() {
     let spot = data("meshes/spot.obj");
     let s = spot.to_str().unwrap();
     for args in [
+        vec!["mesh", s, "--silhouette", "1:8", "--scheme", "semi-uniform", "--no-cull", "--stats"],
+        vec!["mesh", s, "--tolerance", "0.1%", "--scheme", "semi-uniform", "--stats"],
         vec!["mesh", s, "--silhouette", "1:7", "--no-cull", "--stats"],
         vec!["mesh", s, "--silhouette", "1:7", "--silhouette-mode", "vertices", "--no-cull", "--stats"],
         vec!["mesh", s, "--distance", "1:7", "--mapping", "quadratic", "--no-cull", "--stats"],
@@ -252,6 +254,7 @@ fn view_criteria_and_bad_criteria_arguments() {
         vec!["mesh", s, "--tolerance", "abc"],
         vec!["mesh", s, "--silhouette", "7:1"],
         vec!["mesh", s, "--factor", "4", "--tolerance", "1%"],
+        vec!["mesh", s, "--factor", "6", "--scheme", "semi-uniform"],
     ] {
         let out = tessera(&bad, &dir);
         assert_eq!(out.status.code(), Some(2), "{bad:?}");

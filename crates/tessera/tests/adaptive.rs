@@ -11,6 +11,7 @@ use tessera::criterion::tolerance::{self, Layout};
 use tessera::criterion::{screen, Plan};
 use tessera::engine::{tessellate, TessellateOptions};
 use tessera::mesh::Mesh;
+use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
@@ -59,11 +60,13 @@ fn tolerance_bounds_hold_on_every_model() {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         for share in [1e-2, 1e-3, 1e-4] {
             let eps = share * diagonal(&set);
-            for (layout, pattern) in
-                [(Layout::Transition, &Transition as &dyn Pattern), (Layout::Uniform, &Uniform)]
-            {
-                if layout == Layout::Uniform && share < 1e-3 {
-                    continue; // the uniform baseline at 0.01% is large; 1% and 0.1% cover it
+            for (layout, pattern) in [
+                (Layout::Transition, &Transition as &dyn Pattern),
+                (Layout::Uniform, &Uniform),
+                (Layout::Dyadic, &SemiUniform),
+            ] {
+                if layout != Layout::Transition && share < 1e-3 {
+                    continue; // uniform and dyadic outputs at 0.01% are large; 1% and 0.1% cover them
                 }
                 let (plan, report) =
                     tolerance::plan(&set, &vec![Some(eps); set.patches.len()], layout, pattern, 4096);
@@ -149,9 +152,12 @@ fn screen_space_bounds_hold_for_random_cameras() {
             TestRng::deterministic_rng(RngAlgorithm::ChaCha),
         );
         runner
-            .run(&(random_camera(&set), any::<bool>()), |((camera, px), cull)| {
+            .run(&(random_camera(&set), any::<bool>(), any::<bool>()), |((camera, px), cull, dyadic)| {
                 let eps = screen::tolerances(&set, &camera, px, cull);
-                let (plan, report) = tolerance::plan(&set, &eps, Layout::Transition, &Transition, 4096);
+                // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic).
+                let (layout, pattern): (Layout, &dyn Pattern) =
+                    if dyadic { (Layout::Dyadic, &SemiUniform) } else { (Layout::Transition, &Transition) };
+                let (plan, report) = tolerance::plan(&set, &eps, layout, pattern, 4096);
                 prop_assert_eq!(
                     report.capped_patches,
                     0,
@@ -161,7 +167,7 @@ fn screen_space_bounds_hold_for_random_cameras() {
                     cull,
                     report
                 );
-                let mesh = run(&set, &plan, &Transition);
+                let mesh = run(&set, &plan, pattern);
                 expect_topology(&set, &plan, &mesh, &name);
                 let err = projected_error(&mesh, &set, &camera);
                 prop_assert!(err <= px, "{}: {:.3} px > {:.3} px", name, err, px);

@@ -23,7 +23,13 @@ pub enum Layout {
     /// edges along each direction, triangles the largest edge factor; transition strips
     /// connect the core to finer edges.
     Transition,
+    /// Semi-uniform (paper 000): every edge factor a power of two `2^l` (level `l ≤ 8`), the
+    /// patch drawn as the dyadic pattern of its largest level with coarser edges snapped.
+    Dyadic,
 }
+
+/// Highest level of the semi-uniform pattern (paper 000 uses M ≤ 8).
+pub const MAX_DYADIC_LEVEL: u32 = 8;
 
 /// What an error-bounded plan achieved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -191,7 +197,11 @@ pub fn plan(
     pattern: &dyn Pattern,
     max_factor: u32,
 ) -> (Plan, PlanReport) {
-    let cap = max_factor.max(1);
+    let mut cap = max_factor.max(1);
+    if layout == Layout::Dyadic {
+        // Largest power of two within the cap and the pattern's highest level.
+        cap = 1 << (31 - cap.min(1 << MAX_DYADIC_LEVEL).leading_zeros());
+    }
     let topo = &set.topology;
     let hessians: Vec<HessianBound> = set.patches.par_iter().map(bounds::hessian).collect();
     let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
@@ -232,7 +242,12 @@ pub fn plan(
                     .iter()
                     .map(|u| proposals[u.patch as usize][u.local as usize])
                     .fold(0.0, f64::max);
-                (wanted.min(cap as f64) as u32).max(minimum[e]).max(1)
+                let s = (wanted.min(cap as f64) as u32).max(minimum[e]).max(1);
+                if layout == Layout::Dyadic {
+                    s.next_power_of_two().min(cap)
+                } else {
+                    s
+                }
             })
             .collect();
         if layout == Layout::Uniform {
@@ -333,13 +348,20 @@ fn check_patches(
                     let own = |l: usize| (proposals[p][l].min(cap as f64) as u32).max(1);
                     [own(0).min(seg[0].min(seg[2])), own(1).min(seg[1].min(seg[3]))]
                 }
-                (Layout::Transition, Domain::Tri) => {
-                    let n = seg[..3].iter().copied().max().unwrap_or(1);
+                (Layout::Transition, Domain::Tri) | (Layout::Dyadic, _) => {
+                    let n = seg[..nc].iter().copied().max().unwrap_or(1);
                     [n, n]
                 }
             };
-            if layout == Layout::Transition {
-                interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
+            match layout {
+                Layout::Transition => {
+                    interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
+                }
+                Layout::Dyadic => {
+                    let n = interior[0].max(minimum[p][0]).max(minimum[p][1]).next_power_of_two().min(cap);
+                    interior = [n, n];
+                }
+                Layout::Uniform => {}
             }
             let Some(e) = eps[p] else { return (interior, 0.0, false) };
             let mut previous = f64::INFINITY;
@@ -357,6 +379,9 @@ fn check_patches(
                 previous = bound;
                 let grow = (bound / e).sqrt().max(1.05);
                 interior = interior.map(|n| ((n as f64 * grow).ceil() as u32).clamp(n + 1, cap));
+                if layout == Layout::Dyadic {
+                    interior = interior.map(|n| n.next_power_of_two().min(cap));
+                }
             }
         })
         .collect()

@@ -115,6 +115,10 @@ pub fn plan(
         let n = segments.iter().copied().max().unwrap_or(1);
         segments.iter_mut().for_each(|s| *s = n);
     }
+    if layout == Layout::Dyadic {
+        let top = 1 << super::tolerance::MAX_DYADIC_LEVEL;
+        segments.iter_mut().for_each(|s| *s = s.next_power_of_two().min(top));
+    }
     let min_interior = minimum_interior(set);
     let interior = (0..set.patches.len())
         .map(|p| {
