@@ -37,7 +37,6 @@
 
 use super::{LocalTessellation, Pattern, PatternInput};
 use crate::surface::Domain;
-use glam::DVec2;
 
 /// The semi-uniform pattern for triangles and quads.
 ///
@@ -206,50 +205,16 @@ impl Pattern for SemiUniform {
     }
 
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
-        out.interior.clear();
-        out.triangles.clear();
         let layout = Layout::new(input);
-        let n = layout.n;
-        let step = 1.0 / n as f64;
         // The same grid and triangle order as the uniform pattern, with every vertex mapped
         // through φ; only the boundary vertices can move.
-        match input.domain {
-            Domain::Quad => {
-                for j in 1..n {
-                    for i in 1..n {
-                        out.interior.push(DVec2::new(i as f64 * step, j as f64 * step));
-                    }
-                }
-                for j in 0..n {
-                    for i in 0..n {
-                        let a = layout.local(i, j);
-                        let b = layout.local(i + 1, j);
-                        let c = layout.local(i + 1, j + 1);
-                        let d = layout.local(i, j + 1);
-                        push(&mut out.triangles, a, b, c);
-                        push(&mut out.triangles, a, c, d);
-                    }
-                }
-            }
-            Domain::Tri => {
-                for j in 1..n {
-                    for i in 1..n.saturating_sub(j) {
-                        out.interior.push(DVec2::new(i as f64 * step, j as f64 * step));
-                    }
-                }
-                for j in 0..n {
-                    for i in 0..n - j {
-                        let a = layout.local(i, j);
-                        let b = layout.local(i + 1, j);
-                        let d = layout.local(i, j + 1);
-                        push(&mut out.triangles, a, b, d);
-                        if i + j + 2 <= n {
-                            push(&mut out.triangles, b, layout.local(i + 1, j + 1), d);
-                        }
-                    }
-                }
-            }
-        }
+        crate::pattern::uniform::grid(
+            input.domain,
+            layout.n,
+            |i, j| layout.local(i, j),
+            out,
+            |t, [a, b, c]| push(t, a, b, c),
+        );
     }
 }
 
@@ -258,6 +223,7 @@ mod tests {
     use super::*;
     use crate::pattern::uniform::Uniform;
     use crate::pattern::Slot;
+    use glam::DVec2;
     use std::collections::{HashMap, HashSet};
 
     fn input(domain: Domain, p: [u32; 4], m: u32) -> PatternInput {

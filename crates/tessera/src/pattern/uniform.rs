@@ -64,45 +64,48 @@ impl Pattern for Uniform {
     }
 
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
-        out.interior.clear();
-        out.triangles.clear();
         let n = input.interior[0];
-        let step = 1.0 / n as f64;
-        match input.domain {
-            Domain::Quad => {
-                for j in 1..n {
-                    for i in 1..n {
-                        out.interior.push(DVec2::new(i as f64 * step, j as f64 * step));
-                    }
+        let local = |i, j| match input.domain {
+            Domain::Quad => quad_local(n, i, j),
+            Domain::Tri => tri_local(n, i, j),
+        };
+        grid(input.domain, n, local, out, |t, tri| t.push(tri));
+    }
+}
+
+/// Walks the uniform `n`-grid of a domain: pushes the interior parameters (rows of `j`, then
+/// `i`) and hands every grid triangle, in a fixed order and counter-clockwise, to `emit` with
+/// its corners mapped by `local(i, j)`. The uniform pattern emits them as they are; the
+/// semi-uniform pattern maps boundary points through its snap first and drops collapsed ones.
+pub(crate) fn grid(
+    domain: Domain,
+    n: u32,
+    local: impl Fn(u32, u32) -> u32,
+    out: &mut LocalTessellation,
+    mut emit: impl FnMut(&mut Vec<[u32; 3]>, [u32; 3]),
+) {
+    out.interior.clear();
+    out.triangles.clear();
+    let step = 1.0 / n as f64;
+    let tri = domain == Domain::Tri;
+    for j in 1..n {
+        let end = if tri { n.saturating_sub(j) } else { n };
+        for i in 1..end {
+            out.interior.push(DVec2::new(i as f64 * step, j as f64 * step));
+        }
+    }
+    for j in 0..n {
+        for i in 0..if tri { n - j } else { n } {
+            let (a, b, d) = (local(i, j), local(i + 1, j), local(i, j + 1));
+            if tri {
+                emit(&mut out.triangles, [a, b, d]);
+                if i + j + 2 <= n {
+                    emit(&mut out.triangles, [b, local(i + 1, j + 1), d]);
                 }
-                for j in 0..n {
-                    for i in 0..n {
-                        let a = quad_local(n, i, j);
-                        let b = quad_local(n, i + 1, j);
-                        let c = quad_local(n, i + 1, j + 1);
-                        let d = quad_local(n, i, j + 1);
-                        out.triangles.push([a, b, c]);
-                        out.triangles.push([a, c, d]);
-                    }
-                }
-            }
-            Domain::Tri => {
-                for j in 1..n {
-                    for i in 1..n.saturating_sub(j) {
-                        out.interior.push(DVec2::new(i as f64 * step, j as f64 * step));
-                    }
-                }
-                for j in 0..n {
-                    for i in 0..n - j {
-                        let a = tri_local(n, i, j);
-                        let b = tri_local(n, i + 1, j);
-                        let d = tri_local(n, i, j + 1);
-                        out.triangles.push([a, b, d]);
-                        if i + j + 2 <= n {
-                            out.triangles.push([b, tri_local(n, i + 1, j + 1), d]);
-                        }
-                    }
-                }
+            } else {
+                let c = local(i + 1, j + 1);
+                emit(&mut out.triangles, [a, b, c]);
+                emit(&mut out.triangles, [a, c, d]);
             }
         }
     }
