@@ -14,6 +14,27 @@ pub enum EdgeSampling {
     Uniform { segments: u32 },
     /// Explicit increasing parameters, starting with 0 and ending with 1.
     Params(Arc<[f64]>),
+    /// A real factor `factor ≥ 1` cut by a fractional rule. Every rule here is symmetric
+    /// about the edge midpoint (`param(n − k) = 1 − param(k)`), so the sampling needs no
+    /// direction: both neighbours get the same points whichever way they run.
+    Fractional { factor: f64, spacing: Spacing },
+    /// The SD-2 symmetric cut of `factor`, reverse-projected with the depths of the edge's
+    /// canonical start and end vertices (`pattern::sd2::warped_param`). The warp depends
+    /// only on the edge's own ends, so both neighbours get the same points.
+    Warped { factor: f64, depths: [f64; 2] },
+}
+
+/// How a real factor cuts an edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Spacing {
+    /// SD-2 (paper 001, Fig. 4): `⌈f⌉` segments, the inner ones `1/f` long, the remainder
+    /// shared equally by the first and the last.
+    Symmetric,
+    /// Direct3D 11 `fractional_odd`: odd segment counts, two short segments that grow
+    /// continuously from zero around the middle.
+    FractionalOdd,
+    /// Direct3D 11 `fractional_even`: even segment counts, likewise.
+    FractionalEven,
 }
 
 impl EdgeSampling {
@@ -27,6 +48,16 @@ impl EdgeSampling {
         match self {
             EdgeSampling::Uniform { segments } => *segments,
             EdgeSampling::Params(p) => p.len().saturating_sub(1) as u32,
+            EdgeSampling::Fractional { factor, spacing } => spacing_segments(*factor, *spacing),
+            EdgeSampling::Warped { factor, .. } => crate::pattern::sd2::symmetric_segments(*factor),
+        }
+    }
+
+    /// The real factor: the segment count for integer samplings.
+    pub fn factor(&self) -> f64 {
+        match self {
+            EdgeSampling::Fractional { factor, .. } | EdgeSampling::Warped { factor, .. } => *factor,
+            other => other.segments() as f64,
         }
     }
 
@@ -42,6 +73,11 @@ impl EdgeSampling {
                 }
             }
             EdgeSampling::Params(p) => p[k as usize],
+            EdgeSampling::Fractional { factor, spacing } => spacing_param(*factor, *spacing, k),
+            EdgeSampling::Warped { factor, depths } => {
+                let t = crate::pattern::sd2::symmetric_param(*factor, k);
+                crate::pattern::sd2::warped_param(t, depths[0], depths[1])
+            }
         }
     }
 
@@ -55,3 +91,23 @@ impl EdgeSampling {
         }
     }
 }
+
+/// Segments of a real factor under `spacing`.
+pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
+    match spacing {
+        Spacing::Symmetric => crate::pattern::sd2::symmetric_segments(factor),
+        Spacing::FractionalOdd => crate::pattern::fractional::segments(factor, Parity::Odd),
+        Spacing::FractionalEven => crate::pattern::fractional::segments(factor, Parity::Even),
+    }
+}
+
+/// Parameter `k` (`0 ≤ k ≤ segments`) of a real factor under `spacing`.
+pub fn spacing_param(factor: f64, spacing: Spacing, k: u32) -> f64 {
+    match spacing {
+        Spacing::Symmetric => crate::pattern::sd2::symmetric_param(factor, k),
+        Spacing::FractionalOdd => crate::pattern::fractional::param(factor, Parity::Odd, k),
+        Spacing::FractionalEven => crate::pattern::fractional::param(factor, Parity::Even, k),
+    }
+}
+
+pub use crate::pattern::fractional::Parity;

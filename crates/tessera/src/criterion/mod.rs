@@ -5,7 +5,9 @@
 //! an edge is decided once, from data all its patches agree on, and every patch reads it.
 
 pub mod bounds;
+pub mod esc;
 pub mod screen;
+pub mod sd2;
 pub mod tolerance;
 pub mod view;
 

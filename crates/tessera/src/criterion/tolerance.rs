@@ -366,7 +366,7 @@ fn check_patches(
             let Some(e) = eps[p] else { return (interior, 0.0, false) };
             let mut previous = f64::INFINITY;
             loop {
-                let input = PatternInput { domain, segments: seg, interior };
+                let input = PatternInput::new(domain, seg, interior);
                 let bound = patch_bound(&hessians[p], &input, pattern, scratch);
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);

@@ -10,7 +10,8 @@ use super::screen;
 use super::tolerance::{minimum_interior, minimum_segments, Layout};
 use super::Plan;
 use crate::camera::Camera;
-use crate::sampling::EdgeSampling;
+use crate::pattern::fractional::{settled_factor, Parity, OUTPUT_GAP};
+use crate::sampling::{EdgeSampling, Spacing};
 use crate::surface::{Domain, SurfaceSet};
 use glam::DVec3;
 
@@ -37,7 +38,7 @@ pub enum ViewCriterion {
     Silhouetteness,
 }
 
-fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
+pub(crate) fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
     // Position and normal of each vertex, from the first patch corner at it.
     let topo = &set.topology;
     let mut out = vec![(DVec3::ZERO, DVec3::Z); topo.vertex_count as usize];
@@ -49,18 +50,16 @@ fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
     out
 }
 
-/// Builds a plan from a view criterion with factors in `[fmin, fmax]` (integers ≥ 1),
-/// culling invisible patches when `cull`. Cost: O(P + E) evaluations.
-pub fn plan(
+/// The real factor of every edge under a view criterion, in `[fmin, fmax]` (reals,
+/// `1 ≤ fmin ≤ fmax`), before rounding or minimums. Cost: O(V + E) evaluations.
+pub fn edge_factors(
     set: &SurfaceSet,
     camera: &Camera,
     criterion: ViewCriterion,
-    fmin: u32,
-    fmax: u32,
-    layout: Layout,
-    cull: bool,
-) -> Plan {
-    let (fmin, fmax) = (fmin.max(1), fmax.max(fmin.max(1)));
+    fmin: f64,
+    fmax: f64,
+) -> Vec<f64> {
+    let (lo, hi) = (fmin.max(1.0), fmax.max(fmin.max(1.0)));
     let topo = &set.topology;
     let verts = vertex_data(set);
     let (_, _, forward) = camera.basis();
@@ -69,8 +68,6 @@ pub fn plan(
         .map(depth)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
     let span = (dmax - dmin).max(1e-300);
-    let (lo, hi) = (fmin as f64, fmax as f64);
-    let minimum = minimum_segments(set);
     let factor = |e: usize| -> f64 {
         let edge = &topo.edges[e];
         let [a, b] = edge.ends;
@@ -109,15 +106,43 @@ pub fn plan(
             }
         }
     };
+    (0..topo.edges.len()).map(|e| factor(e).clamp(lo, hi)).collect()
+}
+
+/// Builds a plan from a view criterion with factors in `[fmin, fmax]` (integers ≥ 1),
+/// culling invisible patches when `cull`. Cost: O(P + E) evaluations.
+pub fn plan(
+    set: &SurfaceSet,
+    camera: &Camera,
+    criterion: ViewCriterion,
+    fmin: u32,
+    fmax: u32,
+    layout: Layout,
+    cull: bool,
+) -> Plan {
+    let (fmin, fmax) = (fmin.max(1), fmax.max(fmin.max(1)));
+    let topo = &set.topology;
+    let minimum = minimum_segments(set);
+    let factors = edge_factors(set, camera, criterion, fmin as f64, fmax as f64);
     let mut segments: Vec<u32> =
-        (0..topo.edges.len()).map(|e| (factor(e).round().clamp(lo, hi) as u32).max(minimum[e])).collect();
+        factors.iter().zip(&minimum).map(|(&f, &m)| (f.round() as u32).clamp(fmin, fmax).max(m)).collect();
     if layout == Layout::Uniform {
         let n = segments.iter().copied().max().unwrap_or(1);
         segments.iter_mut().for_each(|s| *s = n);
     }
     if layout == Layout::Dyadic {
-        let top = 1 << super::tolerance::MAX_DYADIC_LEVEL;
-        segments.iter_mut().for_each(|s| *s = s.next_power_of_two().min(top));
+        // Levels, not factors, are interpolated (paper 000 / DRS08: level ⌈s·M⌉ for
+        // silhouetteness s): the criterion's value t ∈ [0, 1] maps to the level
+        // ⌈log2 fmin + t·(log2 fmax − log2 fmin)⌉, so half-way is half the levels, not a
+        // factor of fmax/2 that rounds up to the top level.
+        let top = super::tolerance::MAX_DYADIC_LEVEL;
+        let (lmin, lmax) = ((fmin as f64).log2(), (fmax as f64).log2());
+        let span = (fmax - fmin) as f64;
+        for (s, (&f, &m)) in segments.iter_mut().zip(factors.iter().zip(&minimum)) {
+            let t = if span > 0.0 { ((f - fmin as f64) / span).clamp(0.0, 1.0) } else { 1.0 };
+            let level = ((lmin + t * (lmax - lmin)) - 1e-9).ceil().clamp(0.0, top as f64) as u32;
+            *s = (1u32 << level).max(m.next_power_of_two()).min(1 << top);
+        }
     }
     let min_interior = minimum_interior(set);
     let interior = (0..set.patches.len())
@@ -125,6 +150,11 @@ pub fn plan(
             let domain = set.patches[p].domain();
             let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
             match domain {
+                // P^m with the patch level m = max of its edge levels (paper 000).
+                _ if layout == Layout::Dyadic => {
+                    let n = (0..domain.corner_count()).map(s).max().unwrap_or(1);
+                    [n, n]
+                }
                 Domain::Quad => {
                     [s(0).min(s(2)).max(min_interior[p][0]), s(1).min(s(3)).max(min_interior[p][1])]
                 }
@@ -137,4 +167,56 @@ pub fn plan(
         .collect();
     let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
     Plan { edges: segments.into_iter().map(EdgeSampling::uniform).collect(), interior, visible }
+}
+
+/// A plan of real factors cut by a fractional rule (`spacing`): `factor` on every edge, or
+/// the view criterion's factors in `[fmin, fmax]` (`None` for a fixed factor), never below
+/// the topology's minimum segments. Crack-free as [`plan`]: each factor comes from the
+/// edge's own data, and the fractional cuts are symmetric. Cost: O(V + E + P) evaluations.
+pub fn fractional_plan(
+    set: &SurfaceSet,
+    camera: &Camera,
+    factors: FractionalFactors,
+    spacing: Spacing,
+    cull: bool,
+) -> Plan {
+    let topo = &set.topology;
+    let minimum = minimum_segments(set);
+    let real = match factors {
+        FractionalFactors::Fixed(f) => vec![f; topo.edges.len()],
+        FractionalFactors::View { criterion, fmin, fmax } => edge_factors(set, camera, criterion, fmin, fmax),
+    };
+    let edges: Vec<EdgeSampling> = real
+        .iter()
+        .zip(&minimum)
+        .map(|(&f, &m)| {
+            let f = f.max(m as f64);
+            // D3D11 partitions settle factors just above a count boundary to the boundary, so
+            // no output segment falls below f32 resolution (`pattern::fractional::OUTPUT_GAP`).
+            let f = match spacing {
+                Spacing::FractionalOdd => settled_factor(f, Parity::Odd, OUTPUT_GAP),
+                Spacing::FractionalEven => settled_factor(f, Parity::Even, OUTPUT_GAP),
+                Spacing::Symmetric => f,
+            };
+            EdgeSampling::Fractional { factor: f, spacing }
+        })
+        .collect();
+    let interior = (0..set.patches.len())
+        .map(|p| {
+            let n = (0..set.patches[p].domain().corner_count())
+                .map(|l| edges[topo.patch_edges[p][l].edge as usize].segments())
+                .max()
+                .unwrap_or(1);
+            [n, n]
+        })
+        .collect();
+    let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
+    Plan { edges, interior, visible }
+}
+
+/// Where the factors of [`fractional_plan`] come from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FractionalFactors {
+    Fixed(f64),
+    View { criterion: ViewCriterion, fmin: f64, fmax: f64 },
 }

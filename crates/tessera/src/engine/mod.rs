@@ -10,12 +10,14 @@
 
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
+use crate::mesh::strips::RESTART;
 use crate::mesh::Mesh;
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
+pub mod render_queues;
 mod uniform_quads;
 
 /// Engine options.
@@ -26,6 +28,9 @@ pub struct TessellateOptions {
     /// Refuse (with [`Error::InvalidArgument`]) an output whose buffers would take more bytes
     /// than this, before allocating anything. `None`: no limit beyond the u32 index range.
     pub memory_limit: Option<u64>,
+    /// Also fill [`Mesh::strips`], for patterns with a strip form ([`Pattern::strips`]);
+    /// an error for the others.
+    pub strips: bool,
 }
 
 /// Bytes the engine allocates for an output of this size (records, buffers, parameters).
@@ -125,10 +130,13 @@ impl LocalMap<'_> {
 fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.patches[p].domain();
     let mut segments = [1; 4];
-    for (e, s) in segments.iter_mut().enumerate().take(domain.corner_count()) {
-        *s = plan.edges[set.topology.patch_edges[p][e].edge as usize].segments();
+    let mut factors = [1.0; 4];
+    for e in 0..domain.corner_count() {
+        let sampling = &plan.edges[set.topology.patch_edges[p][e].edge as usize];
+        segments[e] = sampling.segments();
+        factors[e] = sampling.factor();
     }
-    PatternInput { domain, segments, interior: plan.interior[p] }
+    PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32 }
 }
 
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
@@ -165,8 +173,9 @@ pub fn tessellate_into(
     options: TessellateOptions,
     out: &mut Mesh,
 ) -> Result<()> {
-    if pattern.is_uniform() {
+    if pattern.is_uniform() && !options.strips {
         if let Some(result) = uniform_quads::try_tessellate(set, plan, options, out) {
+            out.strips = None;
             return result;
         }
     }
@@ -338,6 +347,8 @@ fn tessellate_generic(
             debug_assert_eq!(t, tp.len());
         });
 
+    let strips =
+        if options.strips { Some(strips_of(set, plan, pattern, &edge_base, &interior_base)?) } else { None };
     let mut mesh = Mesh {
         positions: records.par_iter().map(|r| r.position).collect(),
         normals: records.par_iter().map(|r| r.normal).collect(),
@@ -346,11 +357,58 @@ fn tessellate_generic(
         indices,
         triangle_patch,
         corner_params: None,
+        strips,
     };
     if options.corner_params {
         mesh.corner_params = Some(corner_params);
     }
     Ok(mesh)
+}
+
+/// The strip form of every visible patch, over output vertices, one [`RESTART`] between
+/// patches. Triangles that degenerate at collapsed corners get a repeated index, so the
+/// decoder drops them just as the list writer does.
+fn strips_of(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    edge_base: &[usize],
+    interior_base: &[usize],
+) -> Result<Vec<u32>> {
+    let per_patch: Vec<Option<Vec<u32>>> = (0..set.patches.len())
+        .into_par_iter()
+        .map(|p| {
+            if !plan.visible[p] {
+                return Some(Vec::new());
+            }
+            let input = pattern_input(set, plan, p);
+            let mut local = Vec::new();
+            if !pattern.strips(&input, &mut local) {
+                return None;
+            }
+            let map = LocalMap { set, plan, input, patch: p, edge_base, interior_base: interior_base[p] };
+            for l in &mut local {
+                if *l != RESTART {
+                    *l = map.vertex(*l);
+                }
+            }
+            Some(local)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for strips in per_patch {
+        let Some(strips) = strips else {
+            return Err(Error::InvalidArgument("this scheme has no triangle-strip form".into()));
+        };
+        if strips.is_empty() {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push(RESTART);
+        }
+        out.extend_from_slice(&strips);
+    }
+    Ok(out)
 }
 
 /// True when two corners of a pattern triangle land on the same output vertex because they lie

@@ -24,6 +24,10 @@ pub struct Mesh {
     /// triangle's own patch. Filled by the engine when asked; needed to measure the
     /// approximation error against the exact surface.
     pub corner_params: Option<Vec<[f32; 2]>>,
+    /// Optional: the same triangles as triangle strips ([`strips`]), when asked for and
+    /// the scheme has a strip form. `indices` always holds the decoded list, so a writer
+    /// that cannot store strips loses nothing.
+    pub strips: Option<Vec<u32>>,
 }
 
 impl Mesh {
@@ -44,6 +48,7 @@ impl Mesh {
 }
 
 pub mod read;
+pub mod strips;
 pub mod write;
 
 pub use read::read_mesh;

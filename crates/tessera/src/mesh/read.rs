@@ -507,6 +507,7 @@ fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path) -> Resu
             "face" => {
                 corner_params = read_ply_faces(element, header.encoding, vertex_count, src, file, &mut mesh)?;
             }
+            "tristrips" => read_ply_strips(element, vertex_count, src, &mut mesh)?,
             _ => {
                 for i in 0..element.count {
                     for p in &element.props {
@@ -518,8 +519,59 @@ fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path) -> Resu
         }
     }
     mesh.corner_params = corner_params;
+    if let Some(strips) = &mesh.strips {
+        if !header.elements.iter().any(|e| e.name == "face") {
+            // Strips only: the decoded list becomes the triangles.
+            let tris = crate::mesh::strips::decode(strips);
+            mesh.indices = tris.iter().flatten().copied().collect();
+            mesh.triangle_patch = vec![0; tris.len()];
+        }
+    }
     fill_missing(&mut mesh);
     Ok(mesh)
+}
+
+/// Reads the Stanford `tristrips` element (`vertex_indices` lists, `-1` between strips) into
+/// [`Mesh::strips`], records joined by a restart.
+fn read_ply_strips(
+    element: &Element,
+    vertex_count: u64,
+    src: &mut impl Source,
+    mesh: &mut Mesh,
+) -> Result<()> {
+    let restart = crate::mesh::strips::RESTART;
+    let mut strips: Vec<u32> = Vec::new();
+    for i in 0..element.count {
+        let what = format!("tristrips {i}");
+        for prop in &element.props {
+            match (prop.name.as_str(), prop.kind) {
+                ("vertex_indices", PropKind::List { count, item }) => {
+                    if !strips.is_empty() && strips.last() != Some(&restart) {
+                        strips.push(restart);
+                    }
+                    for _ in 0..list_len(src, count, item, &what)? {
+                        let v = src.value(item)?;
+                        if v == -1.0 {
+                            strips.push(restart);
+                            continue;
+                        }
+                        match to_u32(v) {
+                            Some(k) if u64::from(k) < vertex_count => strips.push(k),
+                            _ => {
+                                return Err(src.error(format!(
+                                "tristrips {i} refers to vertex {v}, but there are {vertex_count} vertices"
+                            )))
+                            }
+                        }
+                    }
+                }
+                _ => skip_property(src, prop.kind, &what)?,
+            }
+        }
+        src.end_record(&what)?;
+    }
+    mesh.strips = Some(strips);
+    Ok(())
 }
 
 fn read_ply_vertices(

@@ -12,6 +12,10 @@
 //! |--------|-----------|---------|-----|--------------|----------------|---------------|
 //! | OBJ    | yes       | yes     | yes | no           | `g patch_<id>` | no            |
 //! | PLY    | yes       | yes     | yes | yes          | yes            | `texcoord`    |
+//!
+//! Triangle strips ([`Mesh::strips`]) go to PLY only, as a `tristrips` element (one `int`
+//! list, `-1` between strips) after the face list; the other formats, which cannot store
+//! strips, keep the decoded triangle list that `indices` always holds.
 //! | STL    | yes       | facet   | no  | no           | no             | no            |
 //! | GLB    | yes       | yes     | yes | `_PATCH`     | extras         | extras        |
 //!
@@ -240,6 +244,15 @@ fn check_mesh(mesh: &Mesh) -> Result<()> {
             ));
         }
     }
+    if let Some(strips) = &mesh.strips {
+        let restart = super::strips::RESTART;
+        if let Some(&i) = strips.iter().find(|&&i| i != restart && (i as usize >= n || i > i32::MAX as u32)) {
+            return invalid(format!("strips refer to vertex {i} but the mesh has {n} vertices"));
+        }
+        if u32::try_from(strips.len()).is_err() {
+            return invalid(format!("{} strip indices exceed the PLY list limit", strips.len()));
+        }
+    }
     if let Some(k) = mesh.indices.iter().position(|&i| i as usize >= n) {
         return invalid(format!(
             "triangle {} refers to vertex {} but the mesh has {n} vertices",
@@ -337,6 +350,10 @@ fn emit_ply<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
     if mesh.corner_params.is_some() {
         writeln!(w, "property list uchar float texcoord")?;
     }
+    if mesh.strips.is_some() {
+        // The Stanford `tristrips` convention: one list, strips separated by -1.
+        writeln!(w, "element tristrips 1\nproperty list uint int vertex_indices")?;
+    }
     writeln!(w, "end_header")?;
     for (((p, n), uv), &patch) in
         mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&mesh.vertex_patch)
@@ -357,6 +374,13 @@ fn emit_ply<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
             for uv in &params[3 * t..3 * t + 3] {
                 put_f32s(w, uv)?;
             }
+        }
+    }
+    if let Some(strips) = &mesh.strips {
+        put_u32(w, strips.len() as u32)?;
+        for &i in strips {
+            let v = if i == super::strips::RESTART { -1 } else { i as i32 };
+            w.write_all(&v.to_le_bytes())?;
         }
     }
     Ok(())

@@ -7,6 +7,9 @@
 //! `e+1`), then the pattern's interior vertices. Triangles are counter-clockwise in the
 //! `(u, v)` domain.
 
+pub mod esc;
+pub mod fractional;
+pub mod sd2;
 pub mod semi_uniform;
 pub mod transition;
 pub mod uniform;
@@ -15,16 +18,26 @@ use crate::surface::Domain;
 use glam::DVec2;
 
 /// What a pattern needs to know about a patch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PatternInput {
     pub domain: Domain,
     /// Segments on each edge (`segments[e] ≥ 1`; entries past the corner count are ignored).
     pub segments: [u32; 4],
     /// Interior factors along u and v (triangles use `interior[0]`).
     pub interior: [u32; 2],
+    /// The real (possibly fractional) factor of each edge, for the fractional patterns
+    /// (`sd2`, `fractional`); equal to `segments` as `f64` for integer samplings.
+    pub factors: [f64; 4],
+    /// The patch's index in its set, for patterns that hold per-patch decisions (`esc`).
+    pub patch: u32,
 }
 
 impl PatternInput {
+    /// An integer input: `factors` equal to `segments`, patch 0.
+    pub fn new(domain: Domain, segments: [u32; 4], interior: [u32; 2]) -> Self {
+        PatternInput { domain, segments, interior, factors: segments.map(f64::from), patch: 0 }
+    }
+
     /// Index of the first local vertex of edge `e`'s inner samples.
     pub fn edge_base(&self, e: usize) -> u32 {
         let n = self.domain.corner_count();
@@ -86,6 +99,15 @@ pub trait Pattern: Sync {
     fn is_uniform(&self) -> bool {
         false
     }
+
+    /// Appends the pattern's triangles as triangle strips over local indices, strips
+    /// separated by [`crate::mesh::strips::RESTART`], and returns true; a pattern without a
+    /// strip form returns false and appends nothing. Contract: decoding the strips
+    /// ([`crate::mesh::strips::decode`], which drops triangles with a repeated index) gives
+    /// exactly [`Pattern::build`]'s triangles, in order, with the same winding.
+    fn strips(&self, _input: &PatternInput, _out: &mut Vec<u32>) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]
@@ -94,7 +116,7 @@ mod tests {
 
     #[test]
     fn slots_follow_the_local_numbering() {
-        let input = PatternInput { domain: Domain::Quad, segments: [2, 3, 1, 5], interior: [4, 4] };
+        let input = PatternInput::new(Domain::Quad, [2, 3, 1, 5], [4, 4]);
         let mut expected = vec![Slot::Corner(0), Slot::Corner(1), Slot::Corner(2), Slot::Corner(3)];
         for e in 0..4 {
             assert_eq!(input.edge_base(e) as usize, expected.len());

@@ -227,7 +227,7 @@ mod tests {
     use std::collections::{HashMap, HashSet};
 
     fn input(domain: Domain, p: [u32; 4], m: u32) -> PatternInput {
-        PatternInput { domain, segments: p.map(|p| 1 << p), interior: [1 << m, 1 << m] }
+        PatternInput::new(domain, p.map(|p| 1 << p), [1 << m, 1 << m])
     }
 
     /// Domain parameters of every local vertex.

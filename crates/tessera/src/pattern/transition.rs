@@ -527,11 +527,11 @@ mod tests {
     }
 
     fn quad(segments: [u32; 4], interior: [u32; 2]) -> PatternInput {
-        PatternInput { domain: Domain::Quad, segments, interior }
+        PatternInput::new(Domain::Quad, segments, interior)
     }
 
     fn tri(s: [u32; 3], n: u32) -> PatternInput {
-        PatternInput { domain: Domain::Tri, segments: [s[0], s[1], s[2], 1], interior: [n, n] }
+        PatternInput::new(Domain::Tri, [s[0], s[1], s[2], 1], [n, n])
     }
 
     #[test]
@@ -617,7 +617,7 @@ mod tests {
     fn matches_uniform_when_all_factors_agree() {
         for n in 1..=20 {
             for domain in [Domain::Quad, Domain::Tri] {
-                let input = PatternInput { domain, segments: [n; 4], interior: [n, n] };
+                let input = PatternInput::new(domain, [n; 4], [n, n]);
                 assert_eq!(Transition.counts(&input), Uniform.counts(&input));
                 let (mut a, mut b) = (LocalTessellation::default(), LocalTessellation::default());
                 Transition.build(&input, &mut a);
@@ -673,7 +673,7 @@ mod tests {
             let (min, mean) = min_angle_stats(&Transition, &input);
             // The uniform pattern at the core factor, the baseline the strips are added to.
             let n = input.interior[0];
-            let uniform = PatternInput { segments: [n; 4], interior: [n, n], ..input };
+            let uniform = PatternInput::new(input.domain, [n; 4], [n, n]);
             let (umin, umean) = min_angle_stats(&Uniform, &uniform);
             println!("{name:30} transition {min:6.2} {mean:6.2}   uniform {umin:6.2} {umean:6.2}");
             assert!(min > 0.0 && mean <= umean + 1e-9, "{name}: {min} {mean}");

@@ -116,7 +116,7 @@ mod tests {
     use super::*;
 
     fn check(domain: Domain, n: u32) {
-        let input = PatternInput { domain, segments: [n; 4], interior: [n, n] };
+        let input = PatternInput::new(domain, [n; 4], [n, n]);
         let mut out = LocalTessellation::default();
         Uniform.build(&input, &mut out);
         let (vi, t) = Uniform.counts(&input);

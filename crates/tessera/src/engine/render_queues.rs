@@ -1,0 +1,350 @@
+//! The instanced form of the semi-uniform scheme (paper 000, §4): the `M + 1` static
+//! patterns `P^m` and the per-level *render queues*.
+//!
+//! On a GPU, every patch of level `m` is drawn by one instanced draw of the static `P^m`; a
+//! vertex shader fetches the instance's queue entry (patch id and the levels of its edges),
+//! snaps the pattern's boundary vertices with `φ` and evaluates the patch. Degenerate
+//! triangles are left in and discarded by the rasteriser. This module builds that form and
+//! draws it on the CPU exactly as the shader would, as the reference the GPU engine is
+//! tested against; the compacted indexed mesh comes from the engine with
+//! [`SemiUniform`](crate::pattern::semi_uniform::SemiUniform).
+//!
+//! **Static patterns.** `P^m` holds the `2^m` grid of the domain, triangulated as the
+//! uniform pattern does, in grid order. Like the paper's `gl_Vertex.w` (Listing 1), every
+//! vertex carries a tag: the edge it lies on (corners and interior points are not snapped,
+//! since `σ_p` keeps corners), its parameter `t` along that edge in the patch's direction,
+//! and the tie offset: `½` from the midpoint on, `½ − ε` before it, so that
+//! `⌊2^p·t + offset⌋ / 2^p` is `σ_p(t)` of equation (1) without a branch.
+//!
+//! **Render queues** are built by counting and an exclusive scan per level, the prefix-sum
+//! alternative to the HistoPyramid that §4.1 mentions: each patch's level is computed, a
+//! parallel histogram counts the patches per level, an exclusive scan of the counts gives
+//! each queue's range in one buffer, and a second, chunked pass writes every patch at its
+//! level's offset plus its rank among the earlier patches of that level (itself an exclusive
+//! scan, over chunks). The queues come out sorted by patch id, whatever the thread count.
+
+use crate::criterion::Plan;
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::surface::{Domain, SurfaceSet};
+use glam::DVec2;
+use rayon::prelude::*;
+
+/// Largest level a static pattern may have (`2^8 = 256` segments per side).
+pub const MAX_LEVEL: u32 = 8;
+
+/// `ε` of the tie offset `½ − ε`. Grid parameters are multiples of `2^-MAX_LEVEL`, so
+/// `2^p·t + ½` is either an integer (a tie) or at least `2^-MAX_LEVEL` past one; any smaller
+/// `ε` turns ties down and changes nothing else.
+const TIE_EPSILON: f32 = 1.0 / (4 << MAX_LEVEL) as f32;
+
+/// One vertex of a static pattern.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatternVertex {
+    /// Domain parameters before snapping.
+    pub uv: [f32; 2],
+    /// The edge the vertex lies on, or `None` for corners and interior vertices.
+    pub edge: Option<u8>,
+    /// Parameter along `edge` in the patch's own edge direction (0 when `edge` is `None`).
+    pub t: f32,
+    /// `½` or `½ − ε`: the tie-breaking offset of the snap.
+    pub offset: f32,
+}
+
+/// The static pattern `P^m` of one domain: `2^m` segments per side, uniform triangulation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticPattern {
+    pub domain: Domain,
+    pub level: u32,
+    pub vertices: Vec<PatternVertex>,
+    /// Counter-clockwise triangles over `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// One render-queue entry: a patch and the levels of its edges (in the patch's edge order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct QueueEntry {
+    pub patch: u32,
+    pub edge_levels: [u8; 4],
+}
+
+/// The render queues: for each level `m = 0..=M`, the patches of level `m`, stored as one
+/// buffer with per-level ranges (`offsets[m]..offsets[m + 1]`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RenderQueues {
+    pub entries: Vec<QueueEntry>,
+    /// `M + 2` offsets: the exclusive scan of the per-level counts, then the total.
+    pub offsets: Vec<usize>,
+}
+
+impl RenderQueues {
+    /// The queue of level `m`.
+    pub fn level(&self, m: u32) -> &[QueueEntry] {
+        &self.entries[self.offsets[m as usize]..self.offsets[m as usize + 1]]
+    }
+
+    /// The highest level `M` the queues were built for.
+    pub fn max_level(&self) -> u32 {
+        (self.offsets.len() - 2) as u32
+    }
+}
+
+impl StaticPattern {
+    /// Builds `P^m` for `domain`. Precondition: `m ≤ MAX_LEVEL`. Cost: O(4^m).
+    pub fn new(domain: Domain, m: u32) -> StaticPattern {
+        assert!(m <= MAX_LEVEL, "static pattern level {m} beyond {MAX_LEVEL}");
+        let n = 1u32 << m;
+        let tri = domain == Domain::Tri;
+        let row = |j: u32| if tri { n - j + 1 } else { n + 1 };
+        let mut first = Vec::with_capacity(n as usize + 2);
+        let mut vertices = Vec::new();
+        for j in 0..=n {
+            first.push(vertices.len() as u32);
+            for i in 0..row(j) {
+                vertices.push(pattern_vertex(domain, n, i, j));
+            }
+        }
+        let id = |i: u32, j: u32| first[j as usize] + i;
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..if tri { n - j } else { n } {
+                let (a, b, d) = (id(i, j), id(i + 1, j), id(i, j + 1));
+                if tri {
+                    triangles.push([a, b, d]);
+                    if i + j + 2 <= n {
+                        triangles.push([b, id(i + 1, j + 1), d]);
+                    }
+                } else {
+                    let c = id(i + 1, j + 1);
+                    triangles.push([a, b, c]);
+                    triangles.push([a, c, d]);
+                }
+            }
+        }
+        StaticPattern { domain, level: m, vertices, triangles }
+    }
+
+    /// The `M + 1` patterns `P^0 … P^M` of a domain. Cost: O(4^M).
+    pub fn all(domain: Domain, max_level: u32) -> Vec<StaticPattern> {
+        (0..=max_level).map(|m| StaticPattern::new(domain, m)).collect()
+    }
+}
+
+fn pattern_vertex(domain: Domain, n: u32, i: u32, j: u32) -> PatternVertex {
+    let uv = [i as f32 / n as f32, j as f32 / n as f32];
+    // Which edge, and the grid index along it in the patch's direction.
+    let on_edge = match domain {
+        Domain::Tri => match (i, j) {
+            _ if (i == 0 || i == n) && j == 0 || (i == 0 && j == n) => None,
+            (i, 0) => Some((0, i)),
+            (i, j) if i + j == n => Some((1, j)),
+            (0, j) => Some((2, n - j)),
+            _ => None,
+        },
+        Domain::Quad => match (i, j) {
+            _ if (i == 0 || i == n) && (j == 0 || j == n) => None,
+            (i, 0) => Some((0, i)),
+            (i, j) if i == n => Some((1, j)),
+            (i, j) if j == n => Some((2, n - i)),
+            (0, j) => Some((3, n - j)),
+            _ => None,
+        },
+    };
+    match on_edge {
+        Some((e, k)) => PatternVertex {
+            uv,
+            edge: Some(e),
+            t: k as f32 / n as f32,
+            offset: if 2 * k >= n { 0.5 } else { 0.5 - TIE_EPSILON },
+        },
+        None => PatternVertex { uv, edge: None, t: 0.0, offset: 0.5 },
+    }
+}
+
+/// `φ` as the vertex shader applies it: the domain point a pattern vertex goes to for a
+/// patch whose edges have the given levels. Cost: O(1).
+pub fn snap(domain: Domain, v: &PatternVertex, edge_levels: [u8; 4]) -> DVec2 {
+    match v.edge {
+        None => DVec2::new(v.uv[0] as f64, v.uv[1] as f64),
+        Some(e) => {
+            let s = (1u32 << edge_levels[e as usize]) as f32;
+            let t = (s * v.t + v.offset).floor() / s;
+            domain.edge_point(e as usize, t as f64)
+        }
+    }
+}
+
+/// The level of every patch: `log2` of its interior factor (the paper's `m = max_e p_e`, or
+/// more where a tolerance plan raised the interior). Errors for a plan that is not dyadic.
+fn patch_levels(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<Vec<Option<u8>>> {
+    let topo = &set.topology;
+    (0..set.patches.len())
+        .map(|p| {
+            if !plan.visible[p] {
+                return Ok(None);
+            }
+            let n = plan.interior[p][0];
+            let nc = set.patches[p].domain().corner_count();
+            let edges_ok = (0..nc).all(|e| {
+                let s = plan.edges[topo.patch_edges[p][e].edge as usize].segments();
+                s.is_power_of_two() && s <= n
+            });
+            if !n.is_power_of_two() || n.trailing_zeros() > max_level || !edges_ok {
+                return Err(Error::InvalidArgument(format!(
+                    "patch {p}: the render queues need a dyadic plan with levels up to {max_level} \
+                     (interior {n}); use the semi-uniform scheme"
+                )));
+            }
+            Ok(Some(n.trailing_zeros() as u8))
+        })
+        .collect()
+}
+
+/// Builds the render queues of a dyadic plan (`Layout::Dyadic`, the semi-uniform scheme)
+/// for levels `0..=max_level`; culled patches are in no queue. Cost: O(P) work in parallel.
+pub fn build(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<RenderQueues> {
+    if max_level > MAX_LEVEL {
+        return Err(Error::InvalidArgument(format!("render queues: level {max_level} beyond {MAX_LEVEL}")));
+    }
+    let levels = patch_levels(set, plan, max_level)?;
+    let buckets = max_level as usize + 1;
+    const CHUNK: usize = 4096;
+    // Count: a histogram per chunk of patches.
+    let chunk_counts: Vec<Vec<usize>> = levels
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut c = vec![0usize; buckets];
+            for m in chunk.iter().flatten() {
+                c[*m as usize] += 1;
+            }
+            c
+        })
+        .collect();
+    // Scan: per level over the chunks, and the levels over each other.
+    let mut offsets = Vec::with_capacity(buckets + 1);
+    let mut chunk_starts = vec![vec![0usize; buckets]; chunk_counts.len()];
+    let mut total = 0usize;
+    for m in 0..buckets {
+        offsets.push(total);
+        for (c, counts) in chunk_counts.iter().enumerate() {
+            chunk_starts[c][m] = total;
+            total += counts[m];
+        }
+    }
+    offsets.push(total);
+    // Write: each chunk at its own positions.
+    let topo = &set.topology;
+    let mut entries = vec![QueueEntry { patch: 0, edge_levels: [0; 4] }; total];
+    let placed: Vec<Vec<(usize, QueueEntry)>> = levels
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut next = chunk_starts[c].clone();
+            let mut out = Vec::new();
+            for (i, m) in chunk.iter().enumerate() {
+                let Some(m) = m else { continue };
+                let p = c * CHUNK + i;
+                let mut edge_levels = [0u8; 4];
+                for (e, l) in edge_levels.iter_mut().enumerate().take(set.patches[p].domain().corner_count())
+                {
+                    *l = plan.edges[topo.patch_edges[p][e].edge as usize].segments().trailing_zeros() as u8;
+                }
+                out.push((next[*m as usize], QueueEntry { patch: p as u32, edge_levels }));
+                next[*m as usize] += 1;
+            }
+            out
+        })
+        .collect();
+    for (slot, entry) in placed.into_iter().flatten() {
+        entries[slot] = entry;
+    }
+    Ok(RenderQueues { entries, offsets })
+}
+
+/// Draws the instanced form on the CPU as the GPU does: for every level and every queue
+/// entry, all of `P^m`'s vertices through `F ∘ φ` and all its triangles, degenerate ones
+/// included. `patterns[d][m]` must be `P^m` of domain `d` (`0` = triangles, `1` = quads;
+/// see [`StaticPattern::all`]). Each instance evaluates its own vertices, so positions on a
+/// shared edge agree to rounding, not bit for bit; the compacted engine output is the
+/// bit-exact one. Cost: O(Σ 4^m) evaluations.
+pub fn draw(set: &SurfaceSet, queues: &RenderQueues, patterns: &[Vec<StaticPattern>; 2]) -> Mesh {
+    let max = queues.max_level();
+    let instances: Vec<(u32, QueueEntry)> =
+        (0..=max).flat_map(|m| queues.level(m).iter().map(move |e| (m, *e))).collect();
+    let parts: Vec<Mesh> = instances
+        .par_iter()
+        .map(|&(m, entry)| {
+            let patch = &set.patches[entry.patch as usize];
+            let domain = patch.domain();
+            let pattern = &patterns[usize::from(domain == Domain::Quad)][m as usize];
+            let mut part = Mesh::default();
+            for v in &pattern.vertices {
+                let uv = snap(domain, v, entry.edge_levels);
+                let point = patch.eval(uv);
+                part.positions.push(point.position.as_vec3().to_array());
+                part.normals.push(point.normal.as_vec3().to_array());
+                part.uvs.push(uv.as_vec2().to_array());
+                part.vertex_patch.push(entry.patch);
+            }
+            part.indices = pattern.triangles.iter().flatten().copied().collect();
+            part.triangle_patch = vec![entry.patch; pattern.triangles.len()];
+            part
+        })
+        .collect();
+    let mut mesh = Mesh::default();
+    for part in parts {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(part.positions);
+        mesh.normals.extend(part.normals);
+        mesh.uvs.extend(part.uvs);
+        mesh.vertex_patch.extend(part.vertex_patch);
+        mesh.indices.extend(part.indices.iter().map(|i| i + base));
+        mesh.triangle_patch.extend(part.triangle_patch);
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pattern::semi_uniform::snap_index;
+
+    #[test]
+    fn shader_snap_equals_the_exact_snap() {
+        for domain in [Domain::Tri, Domain::Quad] {
+            for m in 0..=6 {
+                let pattern = StaticPattern::new(domain, m);
+                let n = 1u32 << m;
+                for v in &pattern.vertices {
+                    let Some(e) = v.edge else { continue };
+                    let k = (v.t * n as f32).round() as u32;
+                    for p in 0..=m {
+                        let mut levels = [0u8; 4];
+                        levels[e as usize] = p as u8;
+                        let got = snap(domain, v, levels);
+                        let t = snap_index(p, m, k) as f64 / (1u64 << p) as f64;
+                        let want = domain.edge_point(e as usize, t);
+                        assert_eq!(got, want, "{domain:?} m={m} p={p} k={k}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn static_patterns_have_uniform_counts() {
+        for m in 0..=5 {
+            let n = 1usize << m;
+            let t = StaticPattern::new(Domain::Tri, m);
+            assert_eq!((t.vertices.len(), t.triangles.len()), ((n + 1) * (n + 2) / 2, n * n));
+            let q = StaticPattern::new(Domain::Quad, m);
+            assert_eq!((q.vertices.len(), q.triangles.len()), ((n + 1) * (n + 1), 2 * n * n));
+            // Corners and interior points are never tagged; the others are, on their edge.
+            for v in &q.vertices {
+                let on_boundary = v.uv.iter().any(|&x| x == 0.0 || x == 1.0);
+                let corner = v.uv.iter().all(|&x| x == 0.0 || x == 1.0);
+                assert_eq!(v.edge.is_some(), on_boundary && !corner, "{v:?}");
+            }
+        }
+    }
+}
