@@ -22,32 +22,6 @@ fn run(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Mesh {
     tessellate(set, plan, pattern, TessellateOptions { corner_params: true, ..Default::default() }).unwrap()
 }
 
-/// The topology the output must have: an edge used by exactly one visible patch contributes
-/// its segments as boundary edges, one used by more than two as non-manifold edges.
-fn expect_topology(set: &SurfaceSet, plan: &Plan, mesh: &Mesh, name: &str) {
-    let topo = &set.topology;
-    let (mut boundary, mut nonmanifold) = (0, 0);
-    for (e, edge) in topo.edges.iter().enumerate() {
-        if edge.collapsed {
-            continue;
-        }
-        let visible = topo.edge_uses(e).iter().filter(|u| plan.visible[u.patch as usize]).count();
-        let s = plan.edges[e].segments() as usize;
-        match visible {
-            1 => boundary += s,
-            0 | 2 => {}
-            _ => nonmanifold += s,
-        }
-    }
-    let w = verify::watertight(mesh);
-    assert_eq!(w.boundary_edges, boundary, "{name}: boundary edges ({w:?})");
-    assert_eq!(w.nonmanifold_edges, nonmanifold, "{name}: non-manifold edges ({w:?})");
-    assert_eq!(w.collapsed_triangles, 0, "{name}");
-    if plan.visible.iter().all(|&v| v) {
-        assert_eq!(w.euler_characteristic, topo.report.euler_characteristic, "{name}: Euler characteristic");
-    }
-}
-
 fn diagonal(set: &SurfaceSet) -> f64 {
     let (lo, hi) = set.bounds();
     lo.distance(hi)
@@ -75,7 +49,7 @@ fn tolerance_bounds_hold_on_every_model() {
                 let mesh = run(&set, &plan, pattern);
                 let err = verify::approximation_error(&mesh, &set, 5).unwrap();
                 assert!(err.max <= eps, "{name} {layout:?} {share}: measured {:.3e} > {eps:.3e}", err.max);
-                expect_topology(&set, &plan, &mesh, &name);
+                common::expect_topology(&set, &plan, &mesh, &name);
             }
         }
     }
@@ -105,37 +79,6 @@ fn projected_error(mesh: &Mesh, set: &SurfaceSet, camera: &Camera) -> f64 {
     worst
 }
 
-fn random_camera(set: &SurfaceSet) -> impl Strategy<Value = (Camera, f64)> {
-    let (lo, hi) = set.bounds();
-    let (centre, diag) = ((lo + hi) * 0.5, lo.distance(hi));
-    (
-        (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64),
-        0.6..3.0f64, // outside the bounding sphere: the eye never touches the surface
-        (-0.3..0.3f64, -0.3..0.3f64, -0.3..0.3f64),
-        15.0..90.0f64,
-        (160u32..1920, 120u32..1080),
-        0.5..4.0f64,
-    )
-        .prop_filter_map("degenerate direction", move |(d, dist, off, fov, (w, h), px)| {
-            let dir = DVec3::new(d.0, d.1, d.2).try_normalize()?;
-            let eye = centre + dir * dist * diag;
-            let target = centre + DVec3::new(off.0, off.1, off.2) * diag;
-            let up = if dir.cross(DVec3::Z).length() > 0.1 { DVec3::Z } else { DVec3::Y };
-            let cam = Camera {
-                eye,
-                target,
-                up,
-                fov_y_degrees: fov,
-                width: w,
-                height: h,
-                near: diag * 1e-3,
-                far: diag * 10.0,
-            };
-            cam.validate().ok()?;
-            Some((cam, px))
-        })
-}
-
 /// For seeded random cameras: the output is watertight (exactly the input's topology with
 /// `--no-cull`; with culling, open only along culled neighbours), and the measured projected
 /// error of visible patches stays under the requested pixels.
@@ -152,27 +95,33 @@ fn screen_space_bounds_hold_for_random_cameras() {
             TestRng::deterministic_rng(RngAlgorithm::ChaCha),
         );
         runner
-            .run(&(random_camera(&set), any::<bool>(), any::<bool>()), |((camera, px), cull, dyadic)| {
-                let eps = screen::tolerances(&set, &camera, px, cull);
-                // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic).
-                let (layout, pattern): (Layout, &dyn Pattern) =
-                    if dyadic { (Layout::Dyadic, &SemiUniform) } else { (Layout::Transition, &Transition) };
-                let (plan, report) = tolerance::plan(&set, &eps, layout, pattern, 4096);
-                prop_assert_eq!(
-                    report.capped_patches,
-                    0,
-                    "{:?} px {} cull {} {:?}",
-                    camera,
-                    px,
-                    cull,
-                    report
-                );
-                let mesh = run(&set, &plan, pattern);
-                expect_topology(&set, &plan, &mesh, &name);
-                let err = projected_error(&mesh, &set, &camera);
-                prop_assert!(err <= px, "{}: {:.3} px > {:.3} px", name, err, px);
-                Ok(())
-            })
+            .run(
+                &(common::random_camera(&set), any::<bool>(), any::<bool>()),
+                |((camera, px), cull, dyadic)| {
+                    let eps = screen::tolerances(&set, &camera, px, cull);
+                    // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic).
+                    let (layout, pattern): (Layout, &dyn Pattern) = if dyadic {
+                        (Layout::Dyadic, &SemiUniform)
+                    } else {
+                        (Layout::Transition, &Transition)
+                    };
+                    let (plan, report) = tolerance::plan(&set, &eps, layout, pattern, 4096);
+                    prop_assert_eq!(
+                        report.capped_patches,
+                        0,
+                        "{:?} px {} cull {} {:?}",
+                        camera,
+                        px,
+                        cull,
+                        report
+                    );
+                    let mesh = run(&set, &plan, pattern);
+                    common::expect_topology(&set, &plan, &mesh, &name);
+                    let err = projected_error(&mesh, &set, &camera);
+                    prop_assert!(err <= px, "{}: {:.3} px > {:.3} px", name, err, px);
+                    Ok(())
+                },
+            )
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         println!("{name}: {cases} cameras in {:.1} s", start.elapsed().as_secs_f64());
     }

@@ -1,8 +1,14 @@
 //! Shared helpers for the integration tests: where the models are, and loading them.
 #![allow(dead_code)]
 
+use glam::DVec3;
+use proptest::prelude::*;
 use std::path::{Path, PathBuf};
+use tessera::camera::Camera;
+use tessera::criterion::Plan;
+use tessera::mesh::Mesh;
 use tessera::surface::{BuildOptions, SurfaceSet};
+use tessera::verify;
 
 /// The shared model folder: `$TESSERA_DATA`, else `../shared/data` beside the checkout.
 pub fn data_dir() -> PathBuf {
@@ -55,4 +61,62 @@ pub fn all_surface_models() -> Vec<PathBuf> {
     v.extend(models_in("meshes", "obj"));
     v.extend(models_in("awkward", "obj"));
     v
+}
+
+/// The topology the output must have: an edge used by exactly one visible patch contributes
+/// its segments as boundary edges, one used by more than two as non-manifold edges.
+pub fn expect_topology(set: &SurfaceSet, plan: &Plan, mesh: &Mesh, name: &str) {
+    let topo = &set.topology;
+    let (mut boundary, mut nonmanifold) = (0, 0);
+    for (e, edge) in topo.edges.iter().enumerate() {
+        if edge.collapsed {
+            continue;
+        }
+        let visible = topo.edge_uses(e).iter().filter(|u| plan.visible[u.patch as usize]).count();
+        let s = plan.edges[e].segments() as usize;
+        match visible {
+            1 => boundary += s,
+            0 | 2 => {}
+            _ => nonmanifold += s,
+        }
+    }
+    let w = verify::watertight(mesh);
+    assert_eq!(w.boundary_edges, boundary, "{name}: boundary edges ({w:?})");
+    assert_eq!(w.nonmanifold_edges, nonmanifold, "{name}: non-manifold edges ({w:?})");
+    assert_eq!(w.collapsed_triangles, 0, "{name}");
+    if plan.visible.iter().all(|&v| v) {
+        assert_eq!(w.euler_characteristic, topo.report.euler_characteristic, "{name}: Euler characteristic");
+    }
+}
+
+/// A random camera outside the model's bounding sphere, and a pixel tolerance.
+pub fn random_camera(set: &SurfaceSet) -> impl Strategy<Value = (Camera, f64)> {
+    let (lo, hi) = set.bounds();
+    let (centre, diag) = ((lo + hi) * 0.5, lo.distance(hi));
+    (
+        (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64),
+        0.6..3.0f64, // outside the bounding sphere: the eye never touches the surface
+        (-0.3..0.3f64, -0.3..0.3f64, -0.3..0.3f64),
+        15.0..90.0f64,
+        (160u32..1920, 120u32..1080),
+        0.5..4.0f64,
+    )
+        .prop_filter_map("degenerate direction", move |(d, dist, off, fov, (w, h), px)| {
+            let dir = DVec3::new(d.0, d.1, d.2).try_normalize()?;
+            let eye = centre + dir * dist * diag;
+            let target = centre + DVec3::new(off.0, off.1, off.2) * diag;
+            let up = if dir.cross(DVec3::Z).length() > 0.1 { DVec3::Z } else { DVec3::Y };
+            let cam = Camera {
+                eye,
+                target,
+                up,
+                fov_y_degrees: fov,
+                width: w,
+                height: h,
+                near: diag * 1e-3,
+                far: diag * 10.0,
+            };
+            cam.validate().ok()?;
+            Some((cam, px))
+        })
 }
