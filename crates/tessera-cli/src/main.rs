@@ -8,9 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tessera::criterion::Plan;
+use tessera::engine::render_queues::{self, RenderQueues, StaticPattern};
 use tessera::engine::{self, TessellateOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
+use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
 use tessera::topology::weld::Weld;
 use tessera::verify;
@@ -25,6 +27,8 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run, so the size of the `mesh` arguments does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Tessellate a patch file (.patches, bicubic Bézier) or a triangle mesh (.obj, as PN
@@ -69,6 +73,15 @@ struct MeshArgs {
     /// Also measure the approximation error against the exact surface (with --stats).
     #[arg(long)]
     measure_error: bool,
+    /// Also produce triangle strips (schemes sd2 and esc): stored in .ply as a `tristrips`
+    /// element; the other formats keep the decoded triangle list.
+    #[arg(long)]
+    strips: bool,
+    /// Semi-uniform: also write the instanced form as JSON — the static patterns P^0..P^M
+    /// (vertices u, v, tag: edge + snap offset, or 4 for unsnapped) and the render queues
+    /// (per level: patch id and edge levels).
+    #[arg(long, value_name = "JSON")]
+    instanced: Option<PathBuf>,
     #[command(flatten)]
     input_args: InputArgs,
 }
@@ -184,7 +197,28 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     let wants_params = a.measure_error
         || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
-    let opts = TessellateOptions { corner_params: wants_params, memory_limit: Some(memory_limit()) };
+    let opts = TessellateOptions {
+        corner_params: wants_params,
+        memory_limit: Some(memory_limit()),
+        strips: a.strips,
+    };
+    if a.strips
+        && a.output.as_ref().is_some_and(|o| !o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
+    {
+        eprintln!("note: only .ply stores triangle strips; the output gets the decoded triangle list");
+    }
+    let queues = match &a.instanced {
+        Some(path) => {
+            if a.criterion.scheme != Some(plan::SchemeArg::SemiUniform) {
+                return Err("--instanced needs --scheme semi-uniform".into());
+            }
+            let max_level = a.criterion.max_level.unwrap_or(plan::DEFAULT_MAX_LEVEL);
+            let queues = render_queues::build(&set, &chosen.plan, max_level)?;
+            write_instanced(path, &set, &queues)?;
+            Some(queues)
+        }
+        None => None,
+    };
     pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
     let mut times = Vec::new();
     let mut mesh = Mesh::default();
@@ -229,6 +263,15 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         if let Some(t) = chosen.tolerance {
             stats["tolerance"] = t.into();
         }
+        if let Some(strips) = &mesh.strips {
+            stats["strip_indices"] = strips.len().into();
+            stats["strips"] =
+                (strips.iter().filter(|&&i| i == tessera::mesh::strips::RESTART).count() + 1).into();
+        }
+        if let Some(q) = &queues {
+            let sizes: Vec<usize> = (0..=q.max_level()).map(|m| q.level(m).len()).collect();
+            stats["render_queues"] = sizes.into();
+        }
         if a.measure_error {
             let e = verify::approximation_error(&mesh, &set, 6)?;
             stats["max_error"] = e.max.into();
@@ -237,6 +280,53 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         println!("{stats}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes the instanced form of a semi-uniform plan (see `--instanced`).
+fn write_instanced(
+    path: &Path,
+    set: &SurfaceSet,
+    queues: &RenderQueues,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let max = queues.max_level();
+    let mut domains = Vec::new();
+    for (name, domain) in [("tri", Domain::Tri), ("quad", Domain::Quad)] {
+        if !set.patches.iter().any(|p| p.domain() == domain) {
+            continue;
+        }
+        let patterns: Vec<serde_json::Value> = StaticPattern::all(domain, max)
+            .iter()
+            .map(|p| {
+                let vertices: Vec<[f32; 3]> = p
+                    .vertices
+                    .iter()
+                    .map(|v| [v.uv[0], v.uv[1], v.edge.map_or(4.0, |e| e as f32 + v.offset)])
+                    .collect();
+                serde_json::json!({ "level": p.level, "vertices": vertices, "triangles": p.triangles })
+            })
+            .collect();
+        domains.push((name, patterns));
+    }
+    let levels: Vec<serde_json::Value> = (0..=max)
+        .map(|m| {
+            let entries: Vec<[u32; 5]> = queues
+                .level(m)
+                .iter()
+                .map(|e| {
+                    let l = e.edge_levels.map(u32::from);
+                    [e.patch, l[0], l[1], l[2], l[3]]
+                })
+                .collect();
+            serde_json::json!({ "level": m, "entries": entries })
+        })
+        .collect();
+    let mut json = serde_json::json!({ "max_level": max, "queues": levels });
+    for (name, patterns) in domains {
+        json[name] = patterns.into();
+    }
+    let text = serde_json::to_string(&json)?;
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(())
 }
 
 fn read_any_mesh(path: &Path) -> Result<Mesh, tessera::Error> {
@@ -319,7 +409,7 @@ fn run_demo(a: DemoArgs) -> CliResult {
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
     let plan = Plan::uniform(&set, a.factor)?;
     let start = Instant::now();
-    let opts = TessellateOptions { corner_params: true, memory_limit: Some(memory_limit()) };
+    let opts = TessellateOptions { corner_params: true, memory_limit: Some(memory_limit()), strips: false };
     let mesh = engine::tessellate(&set, &plan, &Uniform, opts)?;
     let seconds = start.elapsed().as_secs_f64();
     tessera::mesh::write_mesh(&mesh, &a.output)?;

@@ -4,16 +4,21 @@
 
 use clap::{Args, ValueEnum};
 use tessera::camera::Camera;
+use tessera::criterion::esc::{self, EscOptions, Threshold};
+use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
 use tessera::criterion::tolerance::{self, Layout, PlanReport};
-use tessera::criterion::view::{self, Mapping, ViewCriterion};
+use tessera::criterion::view::{self, FractionalFactors, Mapping, ViewCriterion};
 use tessera::criterion::{screen, Plan};
+use tessera::engine::render_queues::MAX_LEVEL;
+use tessera::pattern::fractional::{Fractional, Parity};
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
+use tessera::sampling::Spacing;
 use tessera::surface::SurfaceSet;
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, Debug, ValueEnum)]
 pub enum SchemeArg {
     /// One factor everywhere.
     Uniform,
@@ -22,6 +27,26 @@ pub enum SchemeArg {
     /// Semi-uniform (paper 000): power-of-two edge factors, the dyadic pattern of the patch's
     /// level with coarser edges snapped.
     SemiUniform,
+    /// SD-2 (paper 001): at most two different fractional factors per triangle from a level
+    /// function (--distance or --silhouette), parallel × radial lines, strips. Triangles only.
+    Sd2,
+    /// Direct3D 11 fractional_odd partitioning: real factors, points move continuously.
+    FractionalOdd,
+    /// Direct3D 11 fractional_even partitioning.
+    FractionalEven,
+    /// ESC (paper 002): bicubic patches only; 18 coarse triangles per patch, a level per
+    /// object from the camera, candidates inserted by the distance test (--quality,
+    /// --threshold), strips with virtual vertices.
+    Esc,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum QualityArg {
+    /// Threshold 0.4 % of each object's bounding-box diagonal (≈ 94 % of the non-adaptive
+    /// triangles on the paper's Teacups scene).
+    High,
+    /// Threshold 2.2 % of the diagonal (≈ 53 %).
+    Medium,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -41,9 +66,10 @@ pub enum SilhouetteMode {
 #[derive(Args)]
 #[group(skip)]
 pub struct CriterionArgs {
-    /// Uniform factor: every edge is cut into N segments (the default criterion, N = 8).
+    /// Uniform factor: every edge is cut into N segments (the default criterion, N = 8); a
+    /// real number for the fractional schemes and SD-2.
     #[arg(long, value_name = "N", conflicts_with_all = ["tolerance", "pixel_error", "distance", "silhouette"])]
-    pub factor: Option<u32>,
+    pub factor: Option<f64>,
     /// Guaranteed object-space error: a distance, or a share of the bounding-box diagonal
     /// written with % (e.g. 0.1%).
     #[arg(long, value_name = "E", conflicts_with_all = ["factor", "pixel_error", "distance", "silhouette"])]
@@ -52,7 +78,8 @@ pub struct CriterionArgs {
     /// the view or facing away are culled unless --no-cull.
     #[arg(long, value_name = "P", conflicts_with_all = ["factor", "tolerance", "distance", "silhouette"])]
     pub pixel_error: Option<f64>,
-    /// Factors from the distance to the eye plane, FMIN:FMAX (near edges get FMAX).
+    /// Factors from the distance to the eye plane, FMIN:FMAX (near edges get FMAX; reals for
+    /// SD-2 and the fractional schemes).
     #[arg(long, value_name = "FMIN:FMAX", conflicts_with_all = ["factor", "tolerance", "pixel_error", "silhouette"])]
     pub distance: Option<String>,
     /// Refine silhouettes: FMIN:FMAX (silhouette edges get FMAX).
@@ -61,9 +88,10 @@ pub struct CriterionArgs {
     /// The mapping g of --distance.
     #[arg(long, value_enum, default_value = "linear")]
     pub mapping: MappingArg,
-    /// How --silhouette finds silhouette edges.
-    #[arg(long, value_enum, default_value = "silhouetteness")]
-    pub silhouette_mode: SilhouetteMode,
+    /// How --silhouette finds silhouette edges (default: vertices for SD-2, which needs a
+    /// level function, silhouetteness otherwise).
+    #[arg(long, value_enum)]
+    pub silhouette_mode: Option<SilhouetteMode>,
     /// The camera: eye=X,Y,Z,target=X,Y,Z,fov=DEG,size=WxH with optional up=X,Y,Z, near=D,
     /// far=D (any subset; the rest from the default camera, which frames the model's
     /// bounding box at 1280x720 with a 45° vertical field of view).
@@ -75,6 +103,23 @@ pub struct CriterionArgs {
     /// Largest factor an adaptive criterion may use; when it stops a bound, tessera says so.
     #[arg(long, value_name = "N", default_value_t = 64)]
     pub max_factor: u32,
+    /// The highest level: semi-uniform M (edge factors up to 2^M; 0 to 8, default 5), ESC
+    /// Lmax (0 to 6, default 3).
+    #[arg(long, value_name = "M")]
+    pub max_level: Option<u32>,
+    /// ESC: one level L (0 to 6) for every patch instead of the camera's.
+    #[arg(long, value_name = "L")]
+    pub level: Option<u32>,
+    /// ESC: the distance-test preset.
+    #[arg(long, value_enum, conflicts_with = "threshold")]
+    pub quality: Option<QualityArg>,
+    /// ESC: the distance-test threshold ρ in model units (instead of --quality).
+    #[arg(long, value_name = "D")]
+    pub threshold: Option<f64>,
+    /// SD-2: reverse-project the pattern with the vertex depths (paper 001, §3.3), so it is
+    /// uniform on screen rather than in the domain.
+    #[arg(long)]
+    pub warp: bool,
     /// Keep every patch (no view-frustum or back-face culling), so a closed input stays closed.
     #[arg(long)]
     pub no_cull: bool,
@@ -119,6 +164,50 @@ pub fn camera(args: &CriterionArgs, set: &SurfaceSet) -> Result<Camera, tessera:
     }
 }
 
+fn range_f64(text: &str, flag: &str) -> Result<(f64, f64), String> {
+    let parse = |s: &str| s.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v >= 1.0);
+    match text.split_once(':').map(|(a, b)| (parse(a), parse(b))) {
+        Some((Some(a), Some(b))) if a <= b => Ok((a, b)),
+        _ => Err(format!("{flag} {text}: expected FMIN:FMAX, numbers with 1 ≤ FMIN ≤ FMAX")),
+    }
+}
+
+fn scheme_name(scheme: SchemeArg) -> &'static str {
+    match scheme {
+        SchemeArg::Uniform => "uniform",
+        SchemeArg::Transition => "transition",
+        SchemeArg::SemiUniform => "semi-uniform",
+        SchemeArg::Sd2 => "sd2",
+        SchemeArg::FractionalOdd => "fractional-odd",
+        SchemeArg::FractionalEven => "fractional-even",
+        SchemeArg::Esc => "esc",
+    }
+}
+
+/// The view criterion of --distance / --silhouette, its text and flag.
+fn view_criterion(args: &CriterionArgs, scheme: SchemeArg) -> Option<(ViewCriterion, &str, &'static str)> {
+    match (&args.distance, &args.silhouette) {
+        (Some(d), _) => {
+            let mapping =
+                if args.mapping == MappingArg::Linear { Mapping::Linear } else { Mapping::Quadratic };
+            Some((ViewCriterion::Distance(mapping), d.as_str(), "--distance"))
+        }
+        (None, Some(s)) => {
+            let default = if scheme == SchemeArg::Sd2 {
+                SilhouetteMode::Vertices
+            } else {
+                SilhouetteMode::Silhouetteness
+            };
+            let c = match args.silhouette_mode.unwrap_or(default) {
+                SilhouetteMode::Silhouetteness => ViewCriterion::Silhouetteness,
+                SilhouetteMode::Vertices => ViewCriterion::SilhouetteVertices,
+            };
+            Some((c, s.as_str(), "--silhouette"))
+        }
+        (None, None) => None,
+    }
+}
+
 pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn std::error::Error>> {
     let adaptive = args.factor.is_none()
         && (args.tolerance.is_some()
@@ -126,31 +215,66 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
             || args.distance.is_some()
             || args.silhouette.is_some());
     let scheme = args.scheme.unwrap_or(if adaptive { SchemeArg::Transition } else { SchemeArg::Uniform });
-    let (layout, pattern): (Layout, Box<dyn Pattern>) = match scheme {
-        SchemeArg::Uniform => (Layout::Uniform, Box::new(Uniform)),
-        SchemeArg::Transition => (Layout::Transition, Box::new(Transition)),
-        SchemeArg::SemiUniform => (Layout::Dyadic, Box::new(SemiUniform)),
-    };
+    let name = scheme_name(scheme);
     if args.max_factor == 0 || args.max_factor > tessera::criterion::MAX_FACTOR {
         return Err(
             format!("--max-factor {}: use 1 to {}", args.max_factor, tessera::criterion::MAX_FACTOR).into()
         );
     }
-    let scheme_name = match scheme {
-        SchemeArg::Uniform => "uniform",
-        SchemeArg::Transition => "transition",
-        SchemeArg::SemiUniform => "semi-uniform",
+    if args.warp && scheme != SchemeArg::Sd2 {
+        return Err("--warp applies to --scheme sd2 only".into());
+    }
+    if scheme != SchemeArg::Esc
+        && (args.level.is_some() || args.quality.is_some() || args.threshold.is_some())
+    {
+        return Err("--level, --quality and --threshold apply to --scheme esc only".into());
+    }
+    if scheme == SchemeArg::Esc {
+        return choose_esc(args, set);
+    }
+    let max_level = args.max_level.unwrap_or(DEFAULT_MAX_LEVEL);
+    if max_level > MAX_LEVEL {
+        return Err(format!("--max-level {max_level}: use 0 to {MAX_LEVEL}").into());
+    }
+    match scheme {
+        SchemeArg::Sd2 | SchemeArg::FractionalOdd | SchemeArg::FractionalEven => {
+            return choose_fractional(args, set, scheme);
+        }
+        _ => {}
+    }
+    let (layout, pattern): (Layout, Box<dyn Pattern>) = match scheme {
+        SchemeArg::Transition => (Layout::Transition, Box::new(Transition)),
+        SchemeArg::SemiUniform => (Layout::Dyadic, Box::new(SemiUniform)),
+        _ => (Layout::Uniform, Box::new(Uniform)),
+    };
+    // Semi-uniform: edge levels 0..=M, so factors up to 2^M.
+    let max_factor = if scheme == SchemeArg::SemiUniform {
+        args.max_factor.min(1 << max_level)
+    } else {
+        args.max_factor
     };
     if !adaptive {
-        let n = args.factor.unwrap_or(8);
-        if scheme == SchemeArg::SemiUniform && !n.is_power_of_two() {
-            return Err(format!("--factor {n} with --scheme semi-uniform: use a power of two").into());
+        let f = args.factor.unwrap_or(8.0);
+        if f.fract() != 0.0 || !(1.0..=tessera::criterion::MAX_FACTOR as f64).contains(&f) {
+            return Err(format!(
+                "--factor {f} with --scheme {name}: use an integer from 1 to {} (real factors need \
+                 --scheme fractional-odd, fractional-even or sd2)",
+                tessera::criterion::MAX_FACTOR
+            )
+            .into());
+        }
+        let n = f as u32;
+        if scheme == SchemeArg::SemiUniform && (!n.is_power_of_two() || n > 1 << max_level) {
+            return Err(format!(
+                "--factor {n} with --scheme semi-uniform: use a power of two up to 2^{max_level} (--max-level)"
+            )
+            .into());
         }
         let plan = Plan::uniform(set, n)?;
         return Ok(Chosen {
             plan,
             pattern,
-            description: format!("{scheme_name}, factor {n}"),
+            description: format!("{name}, factor {n}"),
             report: None,
             tolerance: None,
         });
@@ -159,17 +283,12 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
     if let Some(t) = &args.tolerance {
         let (lo, hi) = set.bounds();
         let eps = parse_tolerance(t, lo.distance(hi))?;
-        let (plan, report) = tolerance::plan(
-            set,
-            &vec![Some(eps); set.patches.len()],
-            layout,
-            pattern.as_ref(),
-            args.max_factor,
-        );
+        let (plan, report) =
+            tolerance::plan(set, &vec![Some(eps); set.patches.len()], layout, pattern.as_ref(), max_factor);
         return Ok(Chosen {
             plan,
             pattern,
-            description: format!("{scheme_name}, tolerance {eps:.4e}"),
+            description: format!("{name}, tolerance {eps:.4e}"),
             report: Some(report),
             tolerance: Some(eps),
         });
@@ -180,37 +299,140 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
             return Err(format!("--pixel-error {px}: must be a positive number of pixels").into());
         }
         let eps = screen::tolerances(set, &cam, px, cull);
-        let (plan, report) = tolerance::plan(set, &eps, layout, pattern.as_ref(), args.max_factor);
+        let (plan, report) = tolerance::plan(set, &eps, layout, pattern.as_ref(), max_factor);
         return Ok(Chosen {
             plan,
             pattern,
-            description: format!("{scheme_name}, {px} px screen-space error"),
+            description: format!("{name}, {px} px screen-space error"),
             report: Some(report),
             tolerance: None,
         });
     }
-    let (criterion, text, flag) = match (&args.distance, &args.silhouette) {
-        (Some(d), _) => {
-            let mapping =
-                if args.mapping == MappingArg::Linear { Mapping::Linear } else { Mapping::Quadratic };
-            (ViewCriterion::Distance(mapping), d, "--distance")
-        }
-        (None, Some(s)) => {
-            let c = match args.silhouette_mode {
-                SilhouetteMode::Silhouetteness => ViewCriterion::Silhouetteness,
-                SilhouetteMode::Vertices => ViewCriterion::SilhouetteVertices,
-            };
-            (c, s, "--silhouette")
-        }
-        (None, None) => unreachable!("adaptive implies a criterion"),
-    };
+    let (criterion, text, flag) = view_criterion(args, scheme).expect("adaptive implies a criterion");
     let (fmin, fmax) = range(text, flag)?;
-    let fmax = fmax.min(args.max_factor);
+    let fmax = fmax.min(max_factor);
     let plan = view::plan(set, &cam, criterion, fmin.min(fmax), fmax, layout, cull);
+    Ok(Chosen { plan, pattern, description: format!("{name}, {flag} {text}"), report: None, tolerance: None })
+}
+
+/// SD-2 and the fractional schemes: real factors, no error guarantee.
+fn choose_fractional(
+    args: &CriterionArgs,
+    set: &SurfaceSet,
+    scheme: SchemeArg,
+) -> Result<Chosen, Box<dyn std::error::Error>> {
+    let name = scheme_name(scheme);
+    if args.tolerance.is_some() || args.pixel_error.is_some() {
+        return Err(format!(
+            "--scheme {name} gives no error guarantee: use --factor, --distance or --silhouette with it, \
+             or --tolerance / --pixel-error with uniform, transition or semi-uniform"
+        )
+        .into());
+    }
+    let cam = camera(args, set)?;
+    let cull = !args.no_cull;
+    let view = view_criterion(args, scheme);
+    let (factors, description) = match (args.factor, view) {
+        (Some(_), _) | (None, None) => {
+            let f = args.factor.unwrap_or(8.0);
+            if !(f.is_finite() && f >= 1.0 && f <= args.max_factor as f64) {
+                return Err(
+                    format!("--factor {f}: use a number from 1 to --max-factor {}", args.max_factor).into()
+                );
+            }
+            (FractionalFactors::Fixed(f), format!("{name}, factor {f}"))
+        }
+        (None, Some((criterion, text, flag))) => {
+            let (fmin, fmax) = range_f64(text, flag)?;
+            let fmax = fmax.min(args.max_factor as f64);
+            (
+                FractionalFactors::View { criterion, fmin: fmin.min(fmax), fmax },
+                format!("{name}, {flag} {text}"),
+            )
+        }
+    };
+    if scheme == SchemeArg::Sd2 {
+        let level = match factors {
+            FractionalFactors::Fixed(_) => LevelFunction::Distance(Mapping::Linear),
+            FractionalFactors::View { criterion: ViewCriterion::Distance(m), .. } => {
+                LevelFunction::Distance(m)
+            }
+            FractionalFactors::View { criterion: ViewCriterion::SilhouetteVertices, .. } => {
+                LevelFunction::Silhouette
+            }
+            FractionalFactors::View { criterion: ViewCriterion::Silhouetteness, .. } => {
+                return Err(
+                    "--scheme sd2 needs a level function: use --silhouette-mode vertices (the default \
+                            for sd2) or --distance"
+                        .into(),
+                )
+            }
+        };
+        let (fmin, fmax) = match factors {
+            FractionalFactors::Fixed(f) => (f, f),
+            FractionalFactors::View { fmin, fmax, .. } => (fmin, fmax),
+        };
+        let options = Sd2Options { level, fmin, fmax, warp: args.warp, cull };
+        let (plan, pattern) = sd2::plan(set, &cam, &options)?;
+        let warp = if args.warp { ", warped" } else { "" };
+        return Ok(Chosen {
+            plan,
+            pattern: Box::new(pattern),
+            description: format!("{description}{warp}"),
+            report: None,
+            tolerance: None,
+        });
+    }
+    let (spacing, parity) = if scheme == SchemeArg::FractionalOdd {
+        (Spacing::FractionalOdd, Parity::Odd)
+    } else {
+        (Spacing::FractionalEven, Parity::Even)
+    };
+    let plan = view::fractional_plan(set, &cam, factors, spacing, cull);
+    Ok(Chosen { plan, pattern: Box::new(Fractional { parity }), description, report: None, tolerance: None })
+}
+
+/// Semi-uniform's default highest level M (paper 000's benchmarks use 3 and 5).
+pub const DEFAULT_MAX_LEVEL: u32 = 5;
+
+/// ESC: its own criterion (level per object from the camera, distance test).
+fn choose_esc(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn std::error::Error>> {
+    if args.factor.is_some()
+        || args.tolerance.is_some()
+        || args.pixel_error.is_some()
+        || args.distance.is_some()
+        || args.silhouette.is_some()
+    {
+        return Err("--scheme esc has its own criterion: use --quality high|medium or --threshold D, with \
+                    --camera, --max-level or --level"
+            .into());
+    }
+    let threshold = match (args.threshold, args.quality) {
+        (Some(d), _) => Threshold::Absolute(d),
+        (None, Some(QualityArg::High)) => Threshold::High,
+        (None, _) => Threshold::Medium,
+    };
+    let options = EscOptions {
+        max_level: args.max_level.unwrap_or(3),
+        level: args.level,
+        threshold,
+        ..EscOptions::default()
+    };
+    let cam = camera(args, set)?;
+    let (plan, pattern) = esc::plan(set, &cam, &options)?;
+    let what = match threshold {
+        Threshold::High => "high quality".to_string(),
+        Threshold::Medium => "medium quality".to_string(),
+        Threshold::Absolute(d) => format!("threshold {d}"),
+    };
+    let level = match args.level {
+        Some(l) => format!("level {l}"),
+        None => format!("Lmax {}", options.max_level),
+    };
     Ok(Chosen {
         plan,
-        pattern,
-        description: format!("{scheme_name}, {flag} {text}"),
+        pattern: Box::new(pattern),
+        description: format!("esc, {what}, {level}"),
         report: None,
         tolerance: None,
     })

@@ -261,3 +261,134 @@ fn view_criteria_and_bad_criteria_arguments() {
         assert!(!text(&out.stderr).contains("panicked"), "{bad:?}");
     }
 }
+
+fn stats_of(out: &Output) -> serde_json::Value {
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    serde_json::from_str(text(&out.stdout).trim()).unwrap()
+}
+
+#[test]
+fn sd2_with_strips_writes_a_closed_ply_whose_strips_decode_to_its_faces() {
+    let dir = scratch("sd2");
+    let input = data("meshes/cow.obj");
+    let out = tessera(
+        &[
+            "mesh",
+            input.to_str().unwrap(),
+            "--scheme",
+            "sd2",
+            "--silhouette",
+            "1:7",
+            "--no-cull",
+            "--strips",
+            "-o",
+            "cow.ply",
+            "--stats",
+        ],
+        &dir,
+    );
+    let v = stats_of(&out);
+    assert_eq!(v["boundary_edges"], 0);
+    assert!(v["strips"].as_u64().unwrap() > 0);
+    let mesh = tessera::mesh::read_mesh(&dir.join("cow.ply")).unwrap();
+    let strips = mesh.strips.as_ref().expect("tristrips element");
+    let decoded: Vec<u32> = tessera::mesh::strips::decode(strips).into_iter().flatten().collect();
+    assert_eq!(decoded, mesh.indices);
+    assert_eq!(mesh.triangle_count() as u64, v["triangles"].as_u64().unwrap());
+}
+
+#[test]
+fn semi_uniform_writes_the_instanced_form() {
+    let dir = scratch("instanced");
+    let input = data("patches/teapot.patches");
+    let out = tessera(
+        &[
+            "mesh",
+            input.to_str().unwrap(),
+            "--scheme",
+            "semi-uniform",
+            "--silhouette",
+            "1:8",
+            "--max-level",
+            "3",
+            "--instanced",
+            "q.json",
+            "--stats",
+        ],
+        &dir,
+    );
+    let v = stats_of(&out);
+    let queues: Vec<u64> =
+        v["render_queues"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect();
+    assert_eq!(queues.len(), 4, "levels 0..=3");
+    let culled = v["culled_patches"].as_u64().unwrap();
+    assert_eq!(queues.iter().sum::<u64>() + culled, 32);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("q.json")).unwrap()).unwrap();
+    let patterns = json["quad"].as_array().unwrap();
+    assert_eq!(patterns.len(), 4);
+    assert_eq!(patterns[3]["vertices"].as_array().unwrap().len(), 81);
+    assert_eq!(patterns[3]["triangles"].as_array().unwrap().len(), 128);
+    for (m, q) in json["queues"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(q["entries"].as_array().unwrap().len() as u64, queues[m]);
+    }
+}
+
+#[test]
+fn fractional_schemes_take_real_factors() {
+    let dir = scratch("fractional");
+    let input = data("patches/teacup.patches");
+    for scheme in ["fractional-odd", "fractional-even"] {
+        let out = tessera(
+            &["mesh", input.to_str().unwrap(), "--scheme", scheme, "--factor", "5.3", "--stats"],
+            &dir,
+        );
+        let v = stats_of(&out);
+        assert_eq!(v["nonmanifold_edges"], 0);
+        assert!(v["triangles"].as_u64().unwrap() > 0);
+    }
+}
+
+#[test]
+fn scheme_misuse_is_a_clear_error() {
+    let dir = scratch("misuse");
+    let teapot = data("patches/teapot.patches");
+    let teapot = teapot.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["mesh", teapot, "--scheme", "sd2", "--silhouette", "1:7"], "triangular"),
+        (vec!["mesh", teapot, "--factor", "5.5"], "integer"),
+        (vec!["mesh", teapot, "--scheme", "sd2", "--tolerance", "1%"], "no error guarantee"),
+        (vec!["mesh", teapot, "--strips"], "strip"),
+        (vec!["mesh", teapot, "--instanced", "q.json"], "semi-uniform"),
+        (vec!["mesh", teapot, "--scheme", "semi-uniform", "--factor", "6"], "power of two"),
+    ] {
+        let out = tessera(&args, &dir);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = text(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn esc_presets_give_closed_meshes_with_strips() {
+    let dir = scratch("esc");
+    let input = data("patches/teacup.patches");
+    let mut counts = Vec::new();
+    for quality in ["high", "medium"] {
+        let out = tessera(
+            &["mesh", input.to_str().unwrap(), "--scheme", "esc", "--quality", quality, "--strips", "--stats"],
+            &dir,
+        );
+        let v = stats_of(&out);
+        assert_eq!(v["nonmanifold_edges"], 0);
+        assert_eq!(v["euler_characteristic"], v["input_euler_characteristic"]);
+        assert!(v["strips"].as_u64().unwrap() > 0);
+        counts.push(v["triangles"].as_u64().unwrap());
+    }
+    assert!(counts[1] < counts[0], "medium keeps fewer triangles than high: {counts:?}");
+    let spool = data("meshes/spool.obj");
+    let out = tessera(&["mesh", spool.to_str().unwrap(), "--scheme", "esc"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("bicubic"), "{}", text(&out.stderr));
+}
