@@ -248,11 +248,8 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
         _ => (Layout::Uniform, Box::new(Uniform)),
     };
     // Semi-uniform: edge levels 0..=M, so factors up to 2^M.
-    let max_factor = if scheme == SchemeArg::SemiUniform {
-        args.max_factor.min(1 << max_level)
-    } else {
-        args.max_factor
-    };
+    let max_factor =
+        if scheme == SchemeArg::SemiUniform { args.max_factor.min(1 << max_level) } else { args.max_factor };
     if !adaptive {
         let f = args.factor.unwrap_or(8.0);
         if f.fract() != 0.0 || !(1.0..=tessera::criterion::MAX_FACTOR as f64).contains(&f) {

@@ -377,7 +377,16 @@ fn esc_presets_give_closed_meshes_with_strips() {
     let mut counts = Vec::new();
     for quality in ["high", "medium"] {
         let out = tessera(
-            &["mesh", input.to_str().unwrap(), "--scheme", "esc", "--quality", quality, "--strips", "--stats"],
+            &[
+                "mesh",
+                input.to_str().unwrap(),
+                "--scheme",
+                "esc",
+                "--quality",
+                quality,
+                "--strips",
+                "--stats",
+            ],
             &dir,
         );
         let v = stats_of(&out);

@@ -20,6 +20,23 @@
 //!    once and referenced by every patch on it.
 //! 6. [`mesh`] writes OBJ, PLY, STL or glTF; [`verify`] checks watertightness, error and quality.
 //!
+//! ## Schemes
+//!
+//! Each published scheme is a pattern plus the criterion that feeds it:
+//!
+//! | pattern | criterion | paper |
+//! | --- | --- | --- |
+//! | [`pattern::uniform`] | [`criterion::Plan::uniform`] | the baseline |
+//! | [`pattern::transition`] | [`criterion::tolerance`], [`criterion::screen`], [`criterion::view`] | CudaTess (003) |
+//! | [`pattern::semi_uniform`] (+ [`engine::render_queues`] for the instanced form) | the same, `Layout::Dyadic` | Dyken et al. (000) |
+//! | [`pattern::sd2`] (strips) | [`criterion::sd2`] | Amresh & Fünfzig (001) |
+//! | [`pattern::fractional`] | [`criterion::view::fractional_plan`] | Direct3D 11 |
+//! | [`pattern::esc`] (strips) | [`criterion::esc`] | Concheiro et al. (002) |
+//!
+//! Patterns with a strip form fill [`mesh::Mesh::strips`] when
+//! [`engine::TessellateOptions::strips`] is set; [`mesh::strips::decode`] turns strips back
+//! into the triangle list.
+//!
 //! ## Example
 //!
 //! ```

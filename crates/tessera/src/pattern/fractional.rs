@@ -212,19 +212,6 @@ pub struct Fractional {
     pub parity: Parity,
 }
 
-/// Local index of outer point `k` (`0 ≤ k ≤ s`) of edge `e` with `s` segments.
-#[inline]
-fn outer(input: &PatternInput, e: usize, k: u32) -> u32 {
-    let nc = input.domain.corner_count();
-    if k == 0 {
-        e as u32
-    } else if k == input.segments[e] {
-        ((e + 1) % nc) as u32
-    } else {
-        input.edge_base(e) + k - 1
-    }
-}
-
 /// Triangulates the band between an outer row of `no` segments and a parallel inner row of
 /// `ni ≥ 0` segments, both running in the outer edge's (counter-clockwise) direction with the
 /// inner row on its left. `o(k)` / `i(k)` give a point's local index and its coordinate along
@@ -394,7 +381,7 @@ impl Fractional {
         }
         for e in 0..4 {
             let f = input.factors[e];
-            let o = |k: u32| (outer(input, e, k), param(f, self.parity, k));
+            let o = |k: u32| (input.boundary_vertex(e, k), param(f, self.parity, k));
             let s = input.segments[e];
             // Inner row: the grid side facing edge e, in the edge's direction; its coordinate
             // along the edge is pu(k) (resp. pv(k)) on all four sides by the partition's symmetry.
@@ -442,7 +429,7 @@ impl Fractional {
             stitch(
                 input.segments[e],
                 n - 2,
-                |k| (outer(input, e, k), param(f, self.parity, k)),
+                |k| (input.boundary_vertex(e, k), param(f, self.parity, k)),
                 |k| (ring(1, e, k + 1), p[k as usize + 1]),
                 &mut out.triangles,
             );
@@ -509,14 +496,7 @@ mod tests {
     /// Domain coordinates of every local vertex: corners, edge points (from `param`, as the
     /// engine evaluates them), interior.
     fn positions(input: &PatternInput, parity: Parity, out: &LocalTessellation, p: &mut Vec<DVec2>) {
-        let d = input.domain;
-        p.clear();
-        p.extend((0..d.corner_count()).map(|c| d.corner(c)));
-        for e in 0..d.corner_count() {
-            let f = input.factors[e];
-            p.extend((1..input.segments[e]).map(|k| d.edge_point(e, param(f, parity, k))));
-        }
-        p.extend_from_slice(&out.interior);
+        *p = input.local_positions(&out.interior, |e, k| param(input.factors[e], parity, k));
     }
 
     /// A small deterministic generator (xorshift64*), so failures reproduce.
@@ -610,44 +590,7 @@ mod tests {
         assert_eq!(out.triangles.len() as u32, t, "{input:?}: triangle count");
         let mut p = Vec::new();
         positions(input, parity, &out, &mut p);
-        let total = p.len();
-        for q in &out.interior {
-            let inside = match input.domain {
-                Domain::Quad => q.x > 0.0 && q.x < 1.0 && q.y > 0.0 && q.y < 1.0,
-                Domain::Tri => q.x > 0.0 && q.y > 0.0 && q.x + q.y < 1.0,
-            };
-            assert!(inside, "{input:?}: interior vertex {q} not strictly inside");
-        }
-        let mut used = vec![false; total];
-        let mut area = 0.0;
-        for tri in &out.triangles {
-            for &v in tri {
-                assert!((v as usize) < total, "{input:?}: index {v} out of range");
-                used[v as usize] = true;
-            }
-            let [a, b, c] = tri.map(|v| p[v as usize]);
-            let s = (b - a).perp_dot(c - a) / 2.0;
-            assert!(s > 0.0, "{input:?}: triangle {tri:?} has signed area {s}");
-            area += s;
-        }
-        assert!(used.iter().all(|&u| u), "{input:?}: unused local vertex");
-        let domain_area = match input.domain {
-            Domain::Quad => 1.0,
-            Domain::Tri => 0.5,
-        };
-        assert!((area - domain_area).abs() < 1e-9, "{input:?}: area {area}");
-        let mut directed: Vec<(u32, u32)> =
-            out.triangles.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
-        directed.sort_unstable();
-        assert!(directed.windows(2).all(|w| w[0] != w[1]), "{input:?}: repeated directed edge");
-        let mut boundary: Vec<(u32, u32)> =
-            directed.iter().filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err()).copied().collect();
-        boundary.sort_unstable();
-        let mut expected: Vec<(u32, u32)> = (0..input.domain.corner_count())
-            .flat_map(|e| (0..input.segments[e]).map(move |k| (outer(input, e, k), outer(input, e, k + 1))))
-            .collect();
-        expected.sort_unstable();
-        assert_eq!(boundary, expected, "{input:?}: boundary edges");
+        crate::pattern::assert_tiles(input, &out, &p, 0.0);
     }
 
     #[test]
@@ -763,7 +706,7 @@ mod tests {
         for e in 0..nc {
             let (so, sn) = (oi.segments[e], ni.segments[e]);
             for k in 1..sn {
-                pairs.push((outer(ni, e, k), outer(oi, e, map1(parity, so, sn, k))));
+                pairs.push((ni.boundary_vertex(e, k), oi.boundary_vertex(e, map1(parity, so, sn, k))));
             }
         }
         let (ob, nb) = (oi.interior_base(), ni.interior_base());

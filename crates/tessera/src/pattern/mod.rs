@@ -48,6 +48,32 @@ impl PatternInput {
     pub fn interior_base(&self) -> u32 {
         self.edge_base(self.domain.corner_count())
     }
+
+    /// Local index of boundary point `k` (`0 ≤ k ≤ segments[e]`) of edge `e`, counted in the
+    /// patch's own direction: corner `e`, an inner sample, or corner `e + 1`. Cost: O(1).
+    pub fn boundary_vertex(&self, e: usize, k: u32) -> u32 {
+        let nc = self.domain.corner_count();
+        if k == 0 {
+            e as u32
+        } else if k == self.segments[e] {
+            ((e + 1) % nc) as u32
+        } else {
+            self.edge_base(e) + k - 1
+        }
+    }
+
+    /// Domain position of every local vertex: corners, edge `e`'s inner samples at parameter
+    /// `edge_t(e, k)` along the edge, then `interior`. For tests and diagnostics. Cost: O(V).
+    pub fn local_positions(&self, interior: &[DVec2], edge_t: impl Fn(usize, u32) -> f64) -> Vec<DVec2> {
+        let d = self.domain;
+        let nc = d.corner_count();
+        let mut p: Vec<DVec2> = (0..nc).map(|c| d.corner(c)).collect();
+        for e in 0..nc {
+            p.extend((1..self.segments[e]).map(|k| d.edge_point(e, edge_t(e, k))));
+        }
+        p.extend_from_slice(interior);
+        p
+    }
 }
 
 /// What a local vertex index refers to.
@@ -108,6 +134,59 @@ pub trait Pattern: Sync {
     fn strips(&self, _input: &PatternInput, _out: &mut Vec<u32>) -> bool {
         false
     }
+}
+
+/// The check every pattern's tests share: `out` is a valid conforming triangulation of the
+/// domain given the vertex positions `p` (from [`PatternInput::local_positions`]) — indices
+/// in range, every vertex used, interior vertices strictly inside, every triangle of signed
+/// area above `min_area`, areas summing to the domain's, each directed edge used once, and
+/// the edges without a reversed twin exactly the boundary segments in counter-clockwise
+/// order. Positive orientation plus that boundary means every point of the domain is covered
+/// exactly once: no fold-over, no gap, no T-junction.
+#[cfg(test)]
+pub(crate) fn assert_tiles(input: &PatternInput, out: &LocalTessellation, p: &[DVec2], min_area: f64) {
+    let total = p.len();
+    assert_eq!(total as u32, input.interior_base() + out.interior.len() as u32, "{input:?}: vertex count");
+    for q in &out.interior {
+        let inside = match input.domain {
+            Domain::Quad => q.x > 0.0 && q.x < 1.0 && q.y > 0.0 && q.y < 1.0,
+            Domain::Tri => q.x > 0.0 && q.y > 0.0 && q.x + q.y < 1.0,
+        };
+        assert!(inside, "{input:?}: interior vertex {q} not strictly inside");
+    }
+    let mut used = vec![false; total];
+    let mut area = 0.0;
+    for tri in &out.triangles {
+        for &v in tri {
+            assert!((v as usize) < total, "{input:?}: index {v} out of range");
+            used[v as usize] = true;
+        }
+        let [a, b, c] = tri.map(|v| p[v as usize]);
+        let s = (b - a).perp_dot(c - a) / 2.0;
+        assert!(s > min_area, "{input:?}: triangle {tri:?} has signed area {s}");
+        area += s;
+    }
+    assert!(used.iter().all(|&u| u), "{input:?}: unused local vertex");
+    let domain_area = match input.domain {
+        Domain::Quad => 1.0,
+        Domain::Tri => 0.5,
+    };
+    assert!((area - domain_area).abs() < 1e-9, "{input:?}: area {area}");
+    let mut directed: Vec<(u32, u32)> =
+        out.triangles.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+    directed.sort_unstable();
+    assert!(directed.windows(2).all(|w| w[0] != w[1]), "{input:?}: repeated directed edge");
+    let mut boundary: Vec<(u32, u32)> =
+        directed.iter().filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err()).copied().collect();
+    boundary.sort_unstable();
+    let mut expected: Vec<(u32, u32)> = (0..input.domain.corner_count())
+        .flat_map(|e| {
+            (0..input.segments[e])
+                .map(move |k| (input.boundary_vertex(e, k), input.boundary_vertex(e, k + 1)))
+        })
+        .collect();
+    expected.sort_unstable();
+    assert_eq!(boundary, expected, "{input:?}: boundary does not match the edge sampling");
 }
 
 #[cfg(test)]

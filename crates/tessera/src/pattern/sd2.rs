@@ -133,7 +133,7 @@ struct Layout {
     nd: u32,
     fs: f64,
     fd: f64,
-    edge_base: [u32; 3],
+    input: PatternInput,
     interior_base: u32,
 }
 
@@ -144,26 +144,15 @@ impl Layout {
         }
         let d = diff_edge(&input.factors)?;
         let same = (d + 1) % 3;
-        let edge_base = [input.edge_base(0), input.edge_base(1), input.edge_base(2)];
         Some(Layout {
             d,
             ns: input.segments[same],
             nd: input.segments[d],
             fs: input.factors[same],
             fd: input.factors[d],
-            edge_base,
+            input: *input,
             interior_base: input.interior_base(),
         })
-    }
-
-    fn edge_vertex(&self, e: usize, k: u32, n: u32) -> u32 {
-        if k == 0 {
-            e as u32
-        } else if k == n {
-            ((e + 1) % 3) as u32
-        } else {
-            self.edge_base[e] + k - 1
-        }
     }
 
     /// Local index of the vertex on row `i` (from the tip) and radial line `j`.
@@ -173,15 +162,15 @@ impl Layout {
             return ((d + 2) % 3) as u32;
         }
         if i == ns {
-            return self.edge_vertex(d, j, nd); // diff edge runs corner d → d+1 with j
+            return self.input.boundary_vertex(d, j); // diff edge runs corner d → d+1 with j
         }
         if j == 0 {
             // Edge d+2 runs from the tip to corner d: its sample i is row i.
-            return self.edge_vertex((d + 2) % 3, i, ns);
+            return self.input.boundary_vertex((d + 2) % 3, i);
         }
         if j == nd {
             // Edge d+1 runs from corner d+1 to the tip: row i is its sample ns − i.
-            return self.edge_vertex((d + 1) % 3, ns - i, ns);
+            return self.input.boundary_vertex((d + 1) % 3, ns - i);
         }
         self.interior_base + (i - 1) * (nd - 1) + (j - 1)
     }
@@ -277,7 +266,6 @@ fn fallback(input: &PatternInput) -> PatternInput {
 mod tests {
     use super::*;
     use crate::mesh::strips::decode;
-    use std::collections::HashMap;
 
     fn input(f: [f64; 3]) -> PatternInput {
         let segments = [symmetric_segments(f[0]), symmetric_segments(f[1]), symmetric_segments(f[2]), 1];
@@ -292,48 +280,14 @@ mod tests {
 
     /// Domain position of every local index (edge samples from the symmetric cut).
     fn positions(input: &PatternInput, local: &LocalTessellation, warp: Option<[f64; 3]>) -> Vec<DVec2> {
-        let mut out: Vec<DVec2> = (0..3).map(|c| Domain::Tri.corner(c)).collect();
-        for e in 0..3 {
-            for k in 1..input.segments[e] {
-                let mut t = symmetric_param(input.factors[e], k);
-                if let Some(z) = warp {
-                    t = warped_param(t, z[e], z[(e + 1) % 3]);
-                }
-                out.push(Domain::Tri.edge_point(e, t));
-            }
-        }
-        out.extend_from_slice(&local.interior);
-        out
+        input.local_positions(&local.interior, |e, k| {
+            let t = symmetric_param(input.factors[e], k);
+            warp.map_or(t, |z| warped_param(t, z[e], z[(e + 1) % 3]))
+        })
     }
 
-    /// Asserts the triangles tile the domain: positive areas summing to ½, every inner edge
-    /// used twice in opposite directions, the boundary exactly the edge samples.
     fn assert_tiles(input: &PatternInput, local: &LocalTessellation, pos: &[DVec2]) {
-        let mut area = 0.0;
-        let mut edges: HashMap<(u32, u32), i32> = HashMap::new();
-        for t in &local.triangles {
-            let [a, b, c] = t.map(|i| pos[i as usize]);
-            let doubled = (b - a).perp_dot(c - a);
-            assert!(doubled > 0.0, "{:?}: triangle {t:?} has area {doubled}", input.factors);
-            area += doubled / 2.0;
-            for k in 0..3 {
-                *edges.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
-            }
-        }
-        assert!((area - 0.5).abs() < 1e-12, "{:?}: area {area}", input.factors);
-        let mut boundary = 0;
-        for (&(a, b), &n) in &edges {
-            assert_eq!(n, 1, "directed edge used twice");
-            if !edges.contains_key(&(b, a)) {
-                boundary += 1;
-                let (pa, pb) = (pos[a as usize], pos[b as usize]);
-                let on_boundary =
-                    |p: DVec2| p.x.abs() < 1e-15 || p.y.abs() < 1e-15 || (p.x + p.y - 1.0).abs() < 1e-12;
-                assert!(on_boundary(pa) && on_boundary(pb), "open edge inside the domain");
-            }
-        }
-        let expected: u32 = input.segments[..3].iter().sum();
-        assert_eq!(boundary, expected as usize, "{:?}", input.factors);
+        crate::pattern::assert_tiles(input, local, pos, 0.0);
     }
 
     #[test]

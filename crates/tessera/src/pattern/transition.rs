@@ -424,15 +424,7 @@ impl Pattern for Transition {
 /// Domain parameters of every local vertex of `local` (built for `input`), assuming uniform
 /// edge samples `t_k = k / segments[e]`.
 fn local_params(input: &PatternInput, local: &LocalTessellation) -> Vec<DVec2> {
-    let d = input.domain;
-    let nc = d.corner_count();
-    let mut p: Vec<DVec2> = (0..nc).map(|c| d.corner(c)).collect();
-    for e in 0..nc {
-        let s = input.segments[e];
-        p.extend((1..s).map(|k| d.edge_point(e, k as f64 / s as f64)));
-    }
-    p.extend_from_slice(&local.interior);
-    p
+    input.local_positions(&local.interior, |e, k| k as f64 / input.segments[e] as f64)
 }
 
 /// Minimum angle statistics of `pattern` on `input`, in degrees, measured in the `(u, v)`
@@ -461,10 +453,6 @@ mod tests {
     use super::super::uniform::Uniform;
     use super::*;
 
-    fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-        (b - a).perp_dot(c - a)
-    }
-
     /// Checks every structural property of one configuration; returns the triangle count.
     fn check(input: &PatternInput) -> usize {
         let mut out = LocalTessellation::default();
@@ -472,57 +460,7 @@ mod tests {
         let (vi, t) = Transition.counts(input);
         assert_eq!(out.interior.len() as u32, vi, "{input:?}: interior count");
         assert_eq!(out.triangles.len() as u32, t, "{input:?}: triangle count");
-        let p = local_params(input, &out);
-        let total = p.len();
-        assert_eq!(total as u32, input.interior_base() + vi);
-
-        // Interior vertices strictly inside the domain.
-        for q in &out.interior {
-            let inside = match input.domain {
-                Domain::Quad => q.x > 0.0 && q.x < 1.0 && q.y > 0.0 && q.y < 1.0,
-                Domain::Tri => q.x > 0.0 && q.y > 0.0 && q.x + q.y < 1.0,
-            };
-            assert!(inside, "{input:?}: interior vertex {q} not strictly inside");
-        }
-
-        // Indices in range, every vertex used, positive areas summing to the domain's area.
-        let mut used = vec![false; total];
-        let mut area = 0.0;
-        for tri in &out.triangles {
-            for &v in tri {
-                assert!((v as usize) < total, "{input:?}: index {v} out of range");
-                used[v as usize] = true;
-            }
-            let a = cross(p[tri[0] as usize], p[tri[1] as usize], p[tri[2] as usize]) / 2.0;
-            assert!(a > 1e-12, "{input:?}: triangle {tri:?} has area {a}");
-            area += a;
-        }
-        assert!(used.iter().all(|&u| u), "{input:?}: unused local vertex");
-        let domain_area = match input.domain {
-            Domain::Quad => 1.0,
-            Domain::Tri => 0.5,
-        };
-        assert!((area - domain_area).abs() < 1e-9, "{input:?}: area {area}");
-
-        // Each directed edge at most once; the edges without a reversed twin are exactly the
-        // boundary segments of the edge sampling, each in its counter-clockwise direction.
-        let mut directed: Vec<(u32, u32)> =
-            out.triangles.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
-        directed.sort_unstable();
-        assert!(directed.windows(2).all(|w| w[0] != w[1]), "{input:?}: repeated directed edge");
-        let mut boundary: Vec<(u32, u32)> =
-            directed.iter().filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err()).copied().collect();
-        boundary.sort_unstable();
-        let nc = input.domain.corner_count();
-        let b = Bases::new(input);
-        let mut expected: Vec<(u32, u32)> = (0..nc)
-            .flat_map(|e| {
-                let s = input.segments[e];
-                (0..s).map(move |k| (b.outer(nc, e, s, k), b.outer(nc, e, s, k + 1)))
-            })
-            .collect();
-        expected.sort_unstable();
-        assert_eq!(boundary, expected, "{input:?}: boundary does not match the edge sampling");
+        super::super::assert_tiles(input, &out, &local_params(input, &out), 1e-12);
         out.triangles.len()
     }
 
