@@ -224,7 +224,6 @@ mod tests {
     use crate::pattern::uniform::Uniform;
     use crate::pattern::Slot;
     use glam::DVec2;
-    use std::collections::{HashMap, HashSet};
 
     fn input(domain: Domain, p: [u32; 4], m: u32) -> PatternInput {
         PatternInput::new(domain, p.map(|p| 1 << p), [1 << m, 1 << m])
@@ -242,10 +241,6 @@ mod tests {
             .collect()
     }
 
-    fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-        (b - a).perp_dot(c - a)
-    }
-
     /// Checks that the output tiles the domain and matches the edges' samplings; returns the
     /// triangle count.
     fn check(input: &PatternInput) -> usize {
@@ -254,55 +249,8 @@ mod tests {
         let (vi, t) = SemiUniform.counts(input);
         assert_eq!(out.interior.len() as u32, vi, "{input:?}");
         assert_eq!(out.triangles.len() as u32, t, "{input:?}");
-        let uv = params(input, &out);
-        let mut area = 0.0;
-        let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-        for tri in &out.triangles {
-            let [a, b, c] = tri.map(|l| uv[l as usize]);
-            let twice = cross(a, b, c);
-            // Grid triangles have twice-area ≥ 1/n², so anything near 0 is degenerate.
-            assert!(twice > 1e-9, "{input:?}: triangle {tri:?} has signed area {}", twice / 2.0);
-            area += twice / 2.0;
-            for k in 0..3 {
-                *edges.entry((tri[k], tri[(k + 1) % 3])).or_default() += 1;
-            }
-        }
-        let expected = match input.domain {
-            Domain::Tri => 0.5,
-            Domain::Quad => 1.0,
-        };
-        assert!((area - expected).abs() < 1e-12, "{input:?}: area {area}");
-        // The boundary cycle: corner e, edge e's samples, corner e+1, …
-        let nc = input.domain.corner_count();
-        let mut boundary = Vec::new();
-        for e in 0..nc {
-            let mut prev = e as u32;
-            for k in 1..input.segments[e] {
-                let l = input.edge_base(e) + k - 1;
-                boundary.push((prev, l));
-                prev = l;
-            }
-            boundary.push((prev, ((e + 1) % nc) as u32));
-        }
-        let boundary: HashSet<(u32, u32)> = boundary.into_iter().collect();
-        for &(a, b) in &boundary {
-            assert_eq!(edges.get(&(a, b)), Some(&1), "{input:?}: boundary segment {a}->{b}");
-            assert_eq!(edges.get(&(b, a)), None, "{input:?}: boundary segment {b}->{a} reversed");
-        }
-        for (&(a, b), &count) in &edges {
-            assert_eq!(count, 1, "{input:?}: edge {a}->{b} used {count} times");
-            if !boundary.contains(&(a, b)) {
-                assert_eq!(edges.get(&(b, a)), Some(&1), "{input:?}: inner edge {a}->{b} unpaired");
-            }
-        }
-        // Every local vertex is used.
-        let mut used = vec![false; uv.len()];
-        for tri in &out.triangles {
-            for &l in tri {
-                used[l as usize] = true;
-            }
-        }
-        assert!(used.iter().all(|&u| u), "{input:?}: unused local vertex");
+        // Grid triangles have area ≥ 1/(2n²), so anything near 0 is degenerate.
+        crate::pattern::assert_tiles(input, &out, &params(input, &out), 5e-10);
         out.triangles.len()
     }
 
