@@ -222,7 +222,6 @@ impl Pattern for SemiUniform {
 mod tests {
     use super::*;
     use crate::pattern::uniform::Uniform;
-    use crate::pattern::Slot;
     use glam::DVec2;
 
     fn input(domain: Domain, p: [u32; 4], m: u32) -> PatternInput {
@@ -231,14 +230,7 @@ mod tests {
 
     /// Domain parameters of every local vertex.
     fn params(input: &PatternInput, out: &LocalTessellation) -> Vec<DVec2> {
-        let total = input.interior_base() + out.interior.len() as u32;
-        (0..total)
-            .map(|l| match input.slot(l) {
-                Slot::Corner(c) => input.domain.corner(c),
-                Slot::Edge(e, k) => input.domain.edge_point(e, k as f64 / input.segments[e] as f64),
-                Slot::Interior(j) => out.interior[j as usize],
-            })
-            .collect()
+        input.local_positions(&out.interior, |e, k| k as f64 / input.segments[e] as f64)
     }
 
     /// Checks that the output tiles the domain and matches the edges' samplings; returns the

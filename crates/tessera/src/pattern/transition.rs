@@ -82,19 +82,6 @@ impl Bases {
         }
         Bases { edge, interior: input.interior_base() }
     }
-
-    /// Local index of outer point `k` (`0 ≤ k ≤ s`) of edge `e` with `s` segments, in the
-    /// edge's own direction.
-    #[inline]
-    fn outer(&self, nc: usize, e: usize, s: u32, k: u32) -> u32 {
-        if k == 0 {
-            e as u32
-        } else if k == s {
-            ((e + 1) % nc) as u32
-        } else {
-            self.edge[e] + k - 1
-        }
-    }
 }
 
 /// The core grid and strips of a quad patch.
@@ -211,7 +198,7 @@ impl QuadLayout {
                 m,
                 lead,
                 trail,
-                |k| (b.outer(4, e, s, k), Domain::Quad.edge_point(e, k as f64 / s as f64)),
+                |k| (input.boundary_vertex(e, k), Domain::Quad.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
                     (self.local(&b, i, j), DVec2::new(i as f64 * su, j as f64 * sv))
@@ -315,7 +302,7 @@ impl TriLayout {
                 m,
                 lead,
                 trail,
-                |k| (b.outer(3, e, s, k), Domain::Tri.edge_point(e, k as f64 / s as f64)),
+                |k| (input.boundary_vertex(e, k), Domain::Tri.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
                     (self.local(&b, i, j), DVec2::new(i as f64 * step, j as f64 * step))
