@@ -10,7 +10,7 @@ use tessera::criterion::tolerance::{self, Layout, PlanReport};
 use tessera::criterion::view::{self, FractionalFactors, Mapping, ViewCriterion};
 use tessera::criterion::{screen, Plan};
 use tessera::engine::render_queues::MAX_LEVEL;
-use tessera::pattern::fractional::{Fractional, Parity};
+use tessera::pattern::hardware::{Hardware, Partitioning};
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
@@ -30,9 +30,15 @@ pub enum SchemeArg {
     /// SD-2 (paper 001): at most two different fractional factors per triangle from a level
     /// function (--distance or --silhouette), parallel × radial lines, strips. Triangles only.
     Sd2,
-    /// Direct3D 11 fractional_odd partitioning: real factors, points move continuously.
+    /// The Direct3D 11 hardware tessellator, integer partitioning: factors rounded up, the
+    /// exact points and triangles of the D3D11 reference tessellator.
+    Integer,
+    /// The hardware tessellator with factors rounded up to powers of two (pow2).
+    Pow2,
+    /// The hardware tessellator's fractional_odd partitioning: real factors, points move
+    /// continuously.
     FractionalOdd,
-    /// Direct3D 11 fractional_even partitioning.
+    /// The hardware tessellator's fractional_even partitioning.
     FractionalEven,
     /// ESC (paper 002): bicubic patches only; 18 coarse triangles per patch, a level per
     /// object from the camera, candidates inserted by the distance test (--quality,
@@ -178,6 +184,8 @@ fn scheme_name(scheme: SchemeArg) -> &'static str {
         SchemeArg::Transition => "transition",
         SchemeArg::SemiUniform => "semi-uniform",
         SchemeArg::Sd2 => "sd2",
+        SchemeArg::Integer => "integer",
+        SchemeArg::Pow2 => "pow2",
         SchemeArg::FractionalOdd => "fractional-odd",
         SchemeArg::FractionalEven => "fractional-even",
         SchemeArg::Esc => "esc",
@@ -237,7 +245,11 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
         return Err(format!("--max-level {max_level}: use 0 to {MAX_LEVEL}").into());
     }
     match scheme {
-        SchemeArg::Sd2 | SchemeArg::FractionalOdd | SchemeArg::FractionalEven => {
+        SchemeArg::Sd2
+        | SchemeArg::Integer
+        | SchemeArg::Pow2
+        | SchemeArg::FractionalOdd
+        | SchemeArg::FractionalEven => {
             return choose_fractional(args, set, scheme);
         }
         _ => {}
@@ -380,13 +392,26 @@ fn choose_fractional(
             tolerance: None,
         });
     }
-    let (spacing, parity) = if scheme == SchemeArg::FractionalOdd {
-        (Spacing::FractionalOdd, Parity::Odd)
-    } else {
-        (Spacing::FractionalEven, Parity::Even)
-    };
-    let plan = view::fractional_plan(set, &cam, factors, spacing, cull);
-    Ok(Chosen { plan, pattern: Box::new(Fractional { parity }), description, report: None, tolerance: None })
+    let partitioning = partitioning(scheme).expect("a hardware scheme");
+    let plan = view::fractional_plan(set, &cam, factors, Spacing::Hardware(partitioning), cull);
+    Ok(Chosen {
+        plan,
+        pattern: Box::new(Hardware { partitioning }),
+        description,
+        report: None,
+        tolerance: None,
+    })
+}
+
+/// The hardware tessellator's partitioning of a scheme, if it is one of the four.
+pub fn partitioning(scheme: SchemeArg) -> Option<Partitioning> {
+    match scheme {
+        SchemeArg::Integer => Some(Partitioning::Integer),
+        SchemeArg::Pow2 => Some(Partitioning::Pow2),
+        SchemeArg::FractionalOdd => Some(Partitioning::FractionalOdd),
+        SchemeArg::FractionalEven => Some(Partitioning::FractionalEven),
+        _ => None,
+    }
 }
 
 /// Semi-uniform's default highest level M (paper 000's benchmarks use 3 and 5).

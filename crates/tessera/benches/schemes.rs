@@ -12,7 +12,7 @@ use tessera::criterion::tolerance::Layout;
 use tessera::criterion::view::{self, FractionalFactors, ViewCriterion};
 use tessera::criterion::Plan;
 use tessera::engine::{tessellate, TessellateOptions};
-use tessera::pattern::fractional::{Fractional, Parity};
+use tessera::pattern::hardware::{Hardware, Partitioning};
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::Pattern;
@@ -74,11 +74,9 @@ fn schemes(c: &mut Criterion) {
     bench_engine(c, "cow_silhouette_4_7", "sd2", &cow, &plan, &pattern);
 
     let factors = FractionalFactors::Fixed(6.4);
-    for (name, spacing, parity) in
-        [("odd", Spacing::FractionalOdd, Parity::Odd), ("even", Spacing::FractionalEven, Parity::Even)]
-    {
-        let plan = view::fractional_plan(&cow, &camera, factors, spacing, false);
-        bench_engine(c, "cow_factor_6_4", &format!("fractional_{name}"), &cow, &plan, &Fractional { parity });
+    for partitioning in [Partitioning::Integer, Partitioning::FractionalOdd, Partitioning::FractionalEven] {
+        let plan = view::fractional_plan(&cow, &camera, factors, Spacing::Hardware(partitioning), false);
+        bench_engine(c, "cow_factor_6_4", partitioning.name(), &cow, &plan, &Hardware { partitioning });
     }
 
     let teapot = load("patches/teapot.patches");

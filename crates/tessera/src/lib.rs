@@ -30,7 +30,7 @@
 //! | [`pattern::transition`] | [`criterion::tolerance`], [`criterion::screen`], [`criterion::view`] | CudaTess (003) |
 //! | [`pattern::semi_uniform`] (+ [`engine::render_queues`] for the instanced form) | the same, `Layout::Dyadic` | Dyken et al. (000) |
 //! | [`pattern::sd2`] (strips) | [`criterion::sd2`] | Amresh & Fünfzig (001) |
-//! | [`pattern::fractional`] | [`criterion::view::fractional_plan`] | Direct3D 11 |
+//! | [`pattern::hardware`] (integer, pow2, fractional odd/even) | [`criterion::view::fractional_plan`] | the Direct3D 11 tessellator |
 //! | [`pattern::esc`] (strips) | [`criterion::esc`] | Concheiro et al. (002) |
 //!
 //! Patterns with a strip form fill [`mesh::Mesh::strips`] when

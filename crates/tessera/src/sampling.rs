@@ -30,11 +30,9 @@ pub enum Spacing {
     /// SD-2 (paper 001, Fig. 4): `⌈f⌉` segments, the inner ones `1/f` long, the remainder
     /// shared equally by the first and the last.
     Symmetric,
-    /// Direct3D 11 `fractional_odd`: odd segment counts, two short segments that grow
-    /// continuously from zero around the middle.
-    FractionalOdd,
-    /// Direct3D 11 `fractional_even`: even segment counts, likewise.
-    FractionalEven,
+    /// The Direct3D 11 hardware tessellator's edge partition (`pattern::hardware`): integer,
+    /// pow2, fractional_odd or fractional_even, in its 16.16 fixed point.
+    Hardware(Partitioning),
 }
 
 impl EdgeSampling {
@@ -96,8 +94,7 @@ impl EdgeSampling {
 pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
     match spacing {
         Spacing::Symmetric => crate::pattern::sd2::symmetric_segments(factor),
-        Spacing::FractionalOdd => crate::pattern::fractional::segments(factor, Parity::Odd),
-        Spacing::FractionalEven => crate::pattern::fractional::segments(factor, Parity::Even),
+        Spacing::Hardware(p) => crate::pattern::hardware::edge_segments(factor, p),
     }
 }
 
@@ -105,9 +102,8 @@ pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
 pub fn spacing_param(factor: f64, spacing: Spacing, k: u32) -> f64 {
     match spacing {
         Spacing::Symmetric => crate::pattern::sd2::symmetric_param(factor, k),
-        Spacing::FractionalOdd => crate::pattern::fractional::param(factor, Parity::Odd, k),
-        Spacing::FractionalEven => crate::pattern::fractional::param(factor, Parity::Even, k),
+        Spacing::Hardware(p) => crate::pattern::hardware::edge_param(factor, p, k),
     }
 }
 
-pub use crate::pattern::fractional::Parity;
+pub use crate::pattern::hardware::Partitioning;

@@ -1,5 +1,5 @@
 //! The view-dependent schemes of issue 4 — semi-uniform (paper 000), SD-2 (paper 001) and the
-//! D3D11 fractional partitionings — on every model and 50 seeded random cameras each:
+//! Direct3D 11 hardware partitionings (integer, pow2, fractional odd and even) — on every model and 50 seeded random cameras each:
 //! watertight, SD-2 never three different factors, strips decode to the triangle list, and
 //! the render queues of the instanced form agree with the compacted mesh.
 
@@ -17,7 +17,7 @@ use tessera::engine::render_queues::{self, StaticPattern};
 use tessera::engine::{tessellate, TessellateOptions};
 use tessera::mesh::strips;
 use tessera::mesh::Mesh;
-use tessera::pattern::fractional::{Fractional, Parity};
+use tessera::pattern::hardware::{Hardware, Partitioning};
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::Pattern;
 use tessera::sampling::Spacing;
@@ -209,13 +209,13 @@ fn sd2_is_two_different_watertight_and_strips_decode() {
     });
 }
 
-/// The fractional partitionings on every model: real factors from the view criteria, both
-/// parities, watertight.
+/// The hardware partitionings on every model: real factors from the view criteria, all four
+/// modes, watertight.
 #[test]
-fn fractional_is_watertight() {
+fn hardware_partitionings_are_watertight() {
     let models = common::all_surface_models();
-    let extra = (any::<u8>(), 0.0..1.0f64, 0.0..1.0f64, any::<bool>(), any::<bool>());
-    for_cameras(&models, extra, |set, name, camera, (kind, a, b, odd, cull)| {
+    let extra = (any::<u8>(), 0.0..1.0f64, 0.0..1.0f64, 0..4usize, any::<bool>());
+    for_cameras(&models, extra, |set, name, camera, (kind, a, b, mode, cull)| {
         let top = top_factor(set);
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
         let factors = FractionalFactors::View {
@@ -223,10 +223,14 @@ fn fractional_is_watertight() {
             fmin: fmin.min(fmax),
             fmax: fmin.max(fmax),
         };
-        let (spacing, parity) =
-            if odd { (Spacing::FractionalOdd, Parity::Odd) } else { (Spacing::FractionalEven, Parity::Even) };
-        let plan = view::fractional_plan(set, &camera, factors, spacing, cull);
-        let mesh = tessellate(set, &plan, &Fractional { parity }, options(false)).unwrap();
+        let partitioning = [
+            Partitioning::Integer,
+            Partitioning::Pow2,
+            Partitioning::FractionalOdd,
+            Partitioning::FractionalEven,
+        ][mode];
+        let plan = view::fractional_plan(set, &camera, factors, Spacing::Hardware(partitioning), cull);
+        let mesh = tessellate(set, &plan, &Hardware { partitioning }, options(false)).unwrap();
         common::expect_topology(set, &plan, &mesh, name);
         Ok(())
     });

@@ -10,7 +10,7 @@ use super::screen;
 use super::tolerance::{minimum_interior, minimum_segments, Layout};
 use super::Plan;
 use crate::camera::Camera;
-use crate::pattern::fractional::{settled_factor, Parity, OUTPUT_GAP};
+use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
 use crate::sampling::{EdgeSampling, Spacing};
 use crate::surface::{Domain, SurfaceSet};
 use glam::DVec3;
@@ -191,11 +191,11 @@ pub fn fractional_plan(
         .zip(&minimum)
         .map(|(&f, &m)| {
             let f = f.max(m as f64);
-            // D3D11 partitions settle factors just above a count boundary to the boundary, so
-            // no output segment falls below f32 resolution (`pattern::fractional::OUTPUT_GAP`).
             let f = match spacing {
-                Spacing::FractionalOdd => settled_factor(f, Parity::Odd, OUTPUT_GAP),
-                Spacing::FractionalEven => settled_factor(f, Parity::Even, OUTPUT_GAP),
+                // The hull-shader side: pow2 rounds up to a power of two; fractional factors
+                // just above a count boundary settle to it, so no output segment falls below
+                // f32 resolution (`pattern::hardware::OUTPUT_GAP`).
+                Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
                 Spacing::Symmetric => f,
             };
             EdgeSampling::Fractional { factor: f, spacing }

@@ -8,7 +8,7 @@
 //! `(u, v)` domain.
 
 pub mod esc;
-pub mod fractional;
+pub mod hardware;
 pub mod sd2;
 pub mod semi_uniform;
 pub mod transition;
@@ -26,7 +26,7 @@ pub struct PatternInput {
     /// Interior factors along u and v (triangles use `interior[0]`).
     pub interior: [u32; 2],
     /// The real (possibly fractional) factor of each edge, for the fractional patterns
-    /// (`sd2`, `fractional`); equal to `segments` as `f64` for integer samplings.
+    /// (`sd2`, `hardware`); equal to `segments` as `f64` for integer samplings.
     pub factors: [f64; 4],
     /// The patch's index in its set, for patterns that hold per-patch decisions (`esc`).
     pub patch: u32,

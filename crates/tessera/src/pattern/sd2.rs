@@ -21,7 +21,7 @@
 //! remainder") gives `(k + 1)/f − inc` with the remainder `f − (n − 1) ∈ (0, 1]`, which is
 //! what we use. With it, integer factors give the uniform cut. As `f` crosses an integer `m`
 //! upwards a new segment appears and every inner point shifts by up to `1/(2m)`: the SD-2
-//! cut is continuous in `f` except at integers. (`fractional` is the continuous one.)
+//! cut is continuous in `f` except at integers. (`hardware`'s fractional modes are the continuous ones.)
 //!
 //! **Reverse projection (§3.3, after Munkberg et al.).** Optionally, the pattern's
 //! barycentric coordinates `b` are warped to `b'_i = (b_i/z_i) / Σ_k (b_k/z_k)` with the
