@@ -1,5 +1,6 @@
 //! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
 
+mod pattern_file;
 mod plan;
 
 use clap::{Args, Parser, Subcommand};
@@ -39,6 +40,11 @@ enum Command {
     Check(CheckArgs),
     /// Tessellate the embedded Utah teapot, write teapot.obj and print the report.
     Demo(DemoArgs),
+    /// Draw the domain pattern of any scheme for given edge and inside factors, as an SVG
+    /// picture or as JSON in the Direct3D 11 reference tessellator's conventions (points
+    /// [u, v]; triangles in D3D's triangle_ccw order; edges in D3D's order: quad
+    /// U==0,V==0,U==1,V==1, tri U==0,V==0,W==0).
+    Pattern(pattern_file::PatternArgs),
 }
 
 #[derive(Args)]
@@ -114,6 +120,7 @@ fn main() -> ExitCode {
         Command::Mesh(a) => run_mesh(a),
         Command::Check(a) => run_check(a),
         Command::Demo(a) => run_demo(a),
+        Command::Pattern(a) => pattern_file::run(a).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

@@ -178,7 +178,7 @@ fn range_f64(text: &str, flag: &str) -> Result<(f64, f64), String> {
     }
 }
 
-fn scheme_name(scheme: SchemeArg) -> &'static str {
+pub fn scheme_name(scheme: SchemeArg) -> &'static str {
     match scheme {
         SchemeArg::Uniform => "uniform",
         SchemeArg::Transition => "transition",
@@ -349,11 +349,22 @@ fn choose_fractional(
                     format!("--factor {f}: use a number from 1 to --max-factor {}", args.max_factor).into()
                 );
             }
+            // The hardware clamps larger factors; say so rather than tessellate another factor.
+            if let Some(p) = partitioning(scheme) {
+                let hi = p.range().1 as f64;
+                if f > hi {
+                    return Err(
+                        format!("--factor {f}: the hardware's {} range is 1 to {hi}", p.name()).into()
+                    );
+                }
+            }
             (FractionalFactors::Fixed(f), format!("{name}, factor {f}"))
         }
         (None, Some((criterion, text, flag))) => {
             let (fmin, fmax) = range_f64(text, flag)?;
-            let fmax = fmax.min(args.max_factor as f64);
+            // Hardware schemes: the top of the range is the hardware's largest factor.
+            let hardware_top = partitioning(scheme).map_or(f64::INFINITY, |p| p.range().1 as f64);
+            let fmax = fmax.min(args.max_factor as f64).min(hardware_top);
             (
                 FractionalFactors::View { criterion, fmin: fmin.min(fmax), fmax },
                 format!("{name}, {flag} {text}"),

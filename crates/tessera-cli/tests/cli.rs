@@ -335,18 +335,23 @@ fn semi_uniform_writes_the_instanced_form() {
 }
 
 #[test]
-fn fractional_schemes_take_real_factors() {
+fn hardware_schemes_take_real_factors() {
     let dir = scratch("fractional");
     let input = data("patches/teacup.patches");
+    let triangles = |args: &[&str]| {
+        let mut all = vec!["mesh", input.to_str().unwrap(), "--stats"];
+        all.extend_from_slice(args);
+        let v = stats_of(&tessera(&all, &dir));
+        assert_eq!(v["nonmanifold_edges"], 0, "{args:?}");
+        v["triangles"].as_u64().unwrap()
+    };
     for scheme in ["fractional-odd", "fractional-even"] {
-        let out = tessera(
-            &["mesh", input.to_str().unwrap(), "--scheme", scheme, "--factor", "5.3", "--stats"],
-            &dir,
-        );
-        let v = stats_of(&out);
-        assert_eq!(v["nonmanifold_edges"], 0);
-        assert!(v["triangles"].as_u64().unwrap() > 0);
+        assert!(triangles(&["--scheme", scheme, "--factor", "5.3"]) > 0);
     }
+    // The hardware's integer pattern of a uniform factor has the uniform grid's triangle
+    // count; integer rounds 5.3 up to 6, pow2 up to 8.
+    assert_eq!(triangles(&["--scheme", "integer", "--factor", "5.3"]), triangles(&["--factor", "6"]));
+    assert_eq!(triangles(&["--scheme", "pow2", "--factor", "5.3"]), triangles(&["--factor", "8"]));
 }
 
 #[test]
@@ -361,6 +366,7 @@ fn scheme_misuse_is_a_clear_error() {
         (vec!["mesh", teapot, "--strips"], "strip"),
         (vec!["mesh", teapot, "--instanced", "q.json"], "semi-uniform"),
         (vec!["mesh", teapot, "--scheme", "semi-uniform", "--factor", "6"], "power of two"),
+        (vec!["mesh", teapot, "--scheme", "fractional-odd", "--factor", "64"], "1 to 63"),
     ] {
         let out = tessera(&args, &dir);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -400,4 +406,116 @@ fn esc_presets_give_closed_meshes_with_strips() {
     let out = tessera(&["mesh", spool.to_str().unwrap(), "--scheme", "esc"], &dir);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("bicubic"), "{}", text(&out.stderr));
+}
+
+/// `tessera pattern` writes a picture and a JSON for every scheme, and the JSON's points and
+/// triangles follow the domain's conventions (counter-clockwise in (u, v) once reversed from
+/// Direct3D's triangle_ccw, covering the domain).
+#[test]
+fn pattern_writes_svg_and_json_for_every_scheme() {
+    let dir = scratch("pattern");
+    let cases: [(&str, &str, &[&str]); 10] = [
+        ("uniform", "quad", &["--edges", "4,4,4,4"]),
+        ("transition", "quad", &["--edges", "5,3,7,3", "--inside", "5,4"]),
+        ("semi-uniform", "tri", &["--edges", "2,8,4"]),
+        ("sd2", "tri", &["--edges", "3.5,5.2,5.2"]),
+        ("integer", "quad", &["--edges", "3,5,2,7"]),
+        ("pow2", "tri", &["--edges", "2,4,8"]),
+        ("fractional-odd", "quad", &["--edges", "5.3,3.2,6.7,2.5", "--inside", "5.3,4.1"]),
+        ("fractional-even", "tri", &["--edges", "3.5,9.1,2.4"]),
+        ("esc", "quad", &["--level", "2", "--mask", "110"]),
+        ("esc", "quad", &["--level", "1", "--mask", "1"]),
+    ];
+    for (scheme, domain, extra) in cases {
+        let mut triangles = None;
+        for ext in ["svg", "json"] {
+            let out_name = format!("{scheme}.{ext}");
+            let mut args = vec!["pattern", "--scheme", scheme, "--domain", domain, "-o", &out_name];
+            args.extend_from_slice(extra);
+            let out = tessera(&args, &dir);
+            assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+            let written = std::fs::read_to_string(dir.join(&out_name)).unwrap();
+            if ext == "svg" {
+                assert!(written.starts_with("<svg") && written.trim_end().ends_with("</svg>"), "{scheme}");
+                triangles = Some(written.matches("<polygon").count());
+                continue;
+            }
+            let v: serde_json::Value = serde_json::from_str(&written).unwrap();
+            let points: Vec<[f64; 2]> = v["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+                .collect();
+            let tris = v["triangles"].as_array().unwrap();
+            assert_eq!(Some(tris.len()), triangles, "{scheme}: SVG and JSON disagree");
+            let mut area = 0.0;
+            for t in tris {
+                let [a, b, c] = [0, 1, 2].map(|k| points[t[k].as_u64().unwrap() as usize]);
+                let s = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2.0;
+                assert!(s < 0.0, "{scheme}: a triangle_ccw triangle with signed area {s}");
+                area -= s;
+            }
+            let want = if domain == "quad" { 1.0 } else { 0.5 };
+            assert!((area - want).abs() < 1e-9, "{scheme}: triangles cover {area} of the domain");
+        }
+    }
+    // The scheme's constraints are errors naming the flag.
+    for (args, needle) in [
+        (vec!["--scheme", "uniform", "--domain", "quad", "--edges", "4,4,5,4"], "one factor"),
+        (vec!["--scheme", "semi-uniform", "--domain", "quad", "--edges", "3,4,4,4"], "powers of two"),
+        (vec!["--scheme", "sd2", "--domain", "quad", "--edges", "3,4,4,4"], "triangles"),
+        (vec!["--scheme", "integer", "--domain", "tri", "--edges", "3,4"], "3 edge factors"),
+        (vec!["--scheme", "integer", "--domain", "tri", "--edges", "3,4,0"], "culls"),
+        (vec!["--scheme", "transition", "--domain", "tri", "--edges", "3,4.5,4"], "integer"),
+        (vec!["--scheme", "esc", "--domain", "quad", "--mask", "12"], "0s and 1s"),
+    ] {
+        let mut all = vec!["pattern", "-o", "x.svg"];
+        all.extend(args.iter().copied());
+        let out = tessera(&all, &dir);
+        assert_eq!(out.status.code(), Some(2), "{all:?}");
+        let err = text(&out.stderr);
+        assert!(err.contains(needle), "{all:?}: {err}");
+    }
+}
+
+/// The JSON of a hardware scheme can be compared with the Direct3D 11 reference file
+/// directly: for every reference case, `tessera pattern` gives the reference's points (within
+/// the file's 7-decimal rounding) and its triangles, index for index.
+#[test]
+fn pattern_json_matches_the_d3d11_reference_file() {
+    let dir = scratch("pattern-reference");
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("reference/d3d11_tessellator.json")).unwrap())
+            .unwrap();
+    let list = |v: &serde_json::Value| {
+        v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap().to_string()).collect::<Vec<_>>().join(",")
+    };
+    for (n, case) in reference["cases"].as_array().unwrap().iter().enumerate() {
+        let scheme = match case["partitioning"].as_str().unwrap() {
+            "odd" => "fractional-odd",
+            "even" => "fractional-even",
+            other => other,
+        };
+        let (edges, inside) = (list(&case["edge_factors"]), list(&case["inside_factors"]));
+        let domain = case["domain"].as_str().unwrap();
+        let args = [
+            "pattern", "--scheme", scheme, "--domain", domain, "--edges", &edges, "--inside", &inside, "-o",
+            "p.json",
+        ];
+        let out = tessera(&args, &dir);
+        assert!(out.status.success(), "case {n}: {}", text(&out.stderr));
+        let ours: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("p.json")).unwrap()).unwrap();
+        assert_eq!(ours["triangles"], case["triangles"], "case {n}: triangles");
+        assert_eq!(ours["partitioning"], case["partitioning"], "case {n}");
+        let (a, b) = (ours["points"].as_array().unwrap(), case["points"].as_array().unwrap());
+        assert_eq!(a.len(), b.len(), "case {n}: points");
+        for (p, q) in a.iter().zip(b) {
+            for k in 0..2 {
+                let d = (p[k].as_f64().unwrap() - q[k].as_f64().unwrap()).abs();
+                assert!(d <= 1e-7, "case {n}: point {p} against {q}");
+            }
+        }
+    }
 }
