@@ -76,6 +76,10 @@ struct MeshArgs {
     /// Tessellate R times (reusing the output buffers) and report the median time (--stats).
     #[arg(long, value_name = "R", default_value_t = 1)]
     repeat: u32,
+    /// Refuse, before allocating anything, an output of more triangles than this. Default:
+    /// what three quarters of the memory available now can hold.
+    #[arg(long, value_name = "N")]
+    max_triangles: Option<u64>,
     /// Also measure the approximation error against the exact surface (with --stats).
     #[arg(long)]
     measure_error: bool,
@@ -180,6 +184,71 @@ fn memory_limit() -> u64 {
     available.map_or(8 << 30, |b| b / 4 * 3)
 }
 
+/// The engine limits for a run: the memory limit and the triangle limit (`--max-triangles`,
+/// else what the memory limit holds at a typical vertex-to-triangle ratio of 1:2).
+fn limits(max_triangles: Option<u64>, corner_params: bool) -> TessellateOptions {
+    let memory = memory_limit();
+    let per_two_triangles = engine::output_bytes(1, 2, corner_params);
+    TessellateOptions {
+        corner_params,
+        memory_limit: Some(memory),
+        max_triangles: Some(max_triangles.unwrap_or(memory / per_two_triangles * 2)),
+        strips: false,
+    }
+}
+
+/// The CLI's line for an output the engine refused: the estimate, the memory, and the flag.
+fn explain_limit(e: tessera::Error, options: &TessellateOptions) -> Box<dyn std::error::Error> {
+    match e {
+        tessera::Error::OutputTooLarge { vertices, triangles, bytes } => format!(
+            "output too large: {vertices} vertices and {triangles} triangles would need {:.1} GiB; the limit is \
+             --max-triangles {} (from the memory available): lower the factor or the criterion, or raise --max-triangles",
+            bytes as f64 / (1u64 << 30) as f64,
+            options.max_triangles.unwrap_or(u64::MAX)
+        )
+        .into(),
+        other => other.into(),
+    }
+}
+
+/// A ratio for a message: fixed-point when small, scientific when huge.
+fn ratio(x: f64) -> String {
+    if x.abs() < 1e4 {
+        format!("{x:.2}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// One line per kind of repair the input needed, on stderr, and the same as JSON for --stats.
+fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
+    let r = &set.repairs;
+    let lines = [
+        (r.welded_points, "input points merged into coincident ones by welding"),
+        (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
+        (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
+        (
+            mesh.collapsed_triangles,
+            "triangles not emitted: they collapse where a boundary curve is a single point",
+        ),
+    ];
+    for (n, what) in lines {
+        if n > 0 {
+            eprintln!("repair: {n} {what}");
+        }
+    }
+    if r.flipped {
+        eprintln!("repair: the orientation was reversed so that normals point outward");
+    }
+    serde_json::json!({
+        "welded_points": r.welded_points,
+        "dropped_degenerate_faces": r.dropped_degenerate_faces,
+        "dropped_duplicate_faces": r.dropped_duplicate_faces,
+        "collapsed_triangles": mesh.collapsed_triangles,
+        "flipped": r.flipped,
+    })
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
@@ -187,28 +256,45 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn run_mesh(a: MeshArgs) -> CliResult {
     let options = build_options(&a.input_args)?;
+    if a.repeat == 0 {
+        return Err("--repeat 0: use 1 or more".into());
+    }
+    if a.max_triangles == Some(0) {
+        return Err("--max-triangles 0: use 1 or more".into());
+    }
     if let Some(out) = &a.output {
         tessera::mesh::check_output_path(out)?;
     }
     let pb = spinner(&format!("reading {}", a.input.display()));
     let set = load_surfaces(&a.input, options)?;
     pb.set_message("choosing factors");
-    let chosen = plan::choose(&a.criterion, &set)?;
+    let wants_params = a.measure_error
+        || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
+    let opts = TessellateOptions { strips: a.strips, ..limits(a.max_triangles, wants_params) };
+    let max_triangles = opts.max_triangles.unwrap_or(u64::MAX);
+    let chosen = plan::choose(&a.criterion, &set, &a.input, max_triangles).map_err(|e| match e
+        .downcast::<tessera::Error>()
+    {
+        Ok(e) => explain_limit(*e, &opts),
+        Err(e) => e,
+    })?;
     if let Some(r) = &chosen.report {
         if r.capped_patches > 0 {
+            // Semi-uniform's cap is its highest level, 2^M, not --max-factor.
+            let (cap, flag) = if a.criterion.scheme == Some(plan::SchemeArg::SemiUniform) {
+                let m = a.criterion.max_level.unwrap_or(plan::DEFAULT_MAX_LEVEL);
+                (format!("--max-level {m} (factor {})", a.criterion.max_factor.min(1 << m)), "--max-level")
+            } else {
+                (format!("--max-factor {}", a.criterion.max_factor), "--max-factor")
+            };
             eprintln!(
-                "warning: --max-factor {} stopped the error bound on {} patches: the guaranteed bound there is up to {:.3e}, {:.2}× the request; raise --max-factor",
-                a.criterion.max_factor, r.capped_patches, r.worst_bound, r.worst_ratio
+                "warning: {cap} stopped the error bound on {} patches: the guaranteed bound there is up to {:.3e}, {}× the request; raise {flag}",
+                r.capped_patches,
+                r.worst_bound,
+                ratio(r.worst_ratio)
             );
         }
     }
-    let wants_params = a.measure_error
-        || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
-    let opts = TessellateOptions {
-        corner_params: wants_params,
-        memory_limit: Some(memory_limit()),
-        strips: a.strips,
-    };
     if a.strips
         && a.output.as_ref().is_some_and(|o| !o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
     {
@@ -233,7 +319,8 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         let start = Instant::now();
         // Buffers are reused across repeats, as an application re-tessellating every frame
         // would: the median then measures tessellation, not page faults.
-        engine::tessellate_into(&set, &chosen.plan, chosen.pattern.as_ref(), opts, &mut mesh)?;
+        engine::tessellate_into(&set, &chosen.plan, chosen.pattern.as_ref(), opts, &mut mesh)
+            .map_err(|e| explain_limit(e, &opts))?;
         times.push(start.elapsed().as_secs_f64());
     }
     if let Some(out) = &a.output {
@@ -241,13 +328,29 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         tessera::mesh::write_mesh(&mesh, out)?;
     }
     pb.finish_and_clear();
+    let repairs = report_repairs(&set, &mesh);
+    if a.output.is_none() && !a.stats {
+        eprintln!(
+            "tessellated {} patches into {} triangles and {} vertices; nothing written: give -o OUT to write the mesh, or --stats for the figures",
+            set.patches.len(),
+            mesh.triangle_count(),
+            mesh.vertex_count()
+        );
+    }
+    let culled = chosen.plan.visible.iter().filter(|v| !**v).count();
+    if culled > 0 {
+        eprintln!(
+            "note: --cull left out {culled} of {} patches (outside the view or facing away): the mesh is open there",
+            set.patches.len()
+        );
+    }
     if a.stats {
         let w = verify::watertight(&mesh);
         let seconds = median(times);
         let mut stats = serde_json::json!({
             "input": a.input.display().to_string(),
             "scheme": chosen.description,
-            "culled_patches": chosen.plan.visible.iter().filter(|v| !**v).count(),
+            "culled_patches": culled,
             "patches": set.patches.len(),
             "triangles": mesh.triangle_count(),
             "vertices": mesh.vertex_count(),
@@ -261,6 +364,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             "repeat": a.repeat.max(1),
             "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
             "threads": rayon::current_num_threads(),
+            "repairs": repairs,
         });
         if let Some(r) = &chosen.report {
             stats["guaranteed_bound"] = r.worst_bound.into();
@@ -336,10 +440,25 @@ fn write_instanced(
     Ok(())
 }
 
-fn read_any_mesh(path: &Path) -> Result<Mesh, tessera::Error> {
-    let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    if !is_obj {
-        return tessera::mesh::read_mesh(path);
+fn read_any_mesh(path: &Path) -> Result<Mesh, Box<dyn std::error::Error>> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("obj") => {}
+        Some("ply" | "stl" | "glb") => return Ok(tessera::mesh::read_mesh(path)?),
+        Some(other) => {
+            return Err(format!(
+                "{}: unsupported mesh extension \".{other}\"; supported: .obj, .ply, .stl, .glb",
+                path.display()
+            )
+            .into())
+        }
+        None => {
+            return Err(format!(
+                "{}: the mesh file has no extension; supported: .obj, .ply, .stl, .glb",
+                path.display()
+            )
+            .into())
+        }
     }
     let obj = tessera::io::obj::read_obj(path)?;
     let tris = obj.triangles(path)?;
@@ -380,6 +499,8 @@ fn print_report(mesh: &Mesh, w: &verify::WatertightReport) {
 }
 
 fn run_check(a: CheckArgs) -> CliResult {
+    // Checked even without --against, so a bad option never passes unnoticed.
+    let build = build_options(&a.input_args)?;
     let pb = spinner(&format!("reading {}", a.mesh.display()));
     let mesh = read_any_mesh(&a.mesh)?;
     let w = verify::watertight(&mesh);
@@ -387,16 +508,36 @@ fn run_check(a: CheckArgs) -> CliResult {
     println!("mesh                 {}", a.mesh.display());
     print_report(&mesh, &w);
     let Some(input) = &a.against else { return Ok(ExitCode::SUCCESS) };
-    let set = load_surfaces(input, build_options(&a.input_args)?)?;
+    let set = load_surfaces(input, build)?;
     let t = set.topology.report;
     println!("input                {} ({} patches)", input.display(), t.patches);
     println!("input boundary edges {} (curves)", t.boundary_edges);
     println!("input non-manifold   {}", t.nonmanifold_edges);
     println!("input Euler char.    {}", t.euler_characteristic);
-    if mesh.corner_params.is_some() {
+    // A mesh made from another input refers to patches the input does not have, or lies far
+    // from its surface: say so instead of printing a meaningless error.
+    let foreign = mesh.triangle_patch.iter().copied().max().is_some_and(|p| p as usize >= set.patches.len());
+    if mesh.corner_params.is_some() && foreign {
+        println!(
+            "max error            not measured: the mesh refers to patch {} but {} has {} patches: it was not made from this input",
+            mesh.triangle_patch.iter().max().unwrap(),
+            input.display(),
+            set.patches.len()
+        );
+        return Ok(ExitCode::from(1));
+    } else if mesh.corner_params.is_some() {
         let e = verify::approximation_error(&mesh, &set, 6)?;
         println!("max error            {:.6e}", e.max);
         println!("rms error            {:.6e}", e.rms);
+        let (lo, hi) = set.bounds();
+        let diagonal = lo.distance(hi);
+        if e.max > 0.05 * diagonal {
+            println!(
+                "note: the max error is {:.0}% of the input's bounding-box diagonal: the mesh was probably not made from {}",
+                100.0 * e.max / diagonal,
+                input.display()
+            );
+        }
     } else {
         println!("max error            not measured: {} carries no per-corner patch parameters (write .ply with tessera mesh)", a.mesh.display());
     }
@@ -416,8 +557,8 @@ fn run_demo(a: DemoArgs) -> CliResult {
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
     let plan = Plan::uniform(&set, a.factor)?;
     let start = Instant::now();
-    let opts = TessellateOptions { corner_params: true, memory_limit: Some(memory_limit()), strips: false };
-    let mesh = engine::tessellate(&set, &plan, &Uniform, opts)?;
+    let opts = limits(None, true);
+    let mesh = engine::tessellate(&set, &plan, &Uniform, opts).map_err(|e| explain_limit(e, &opts))?;
     let seconds = start.elapsed().as_secs_f64();
     tessera::mesh::write_mesh(&mesh, &a.output)?;
     let w = verify::watertight(&mesh);

@@ -1,8 +1,9 @@
 //! Command-line criteria: turn `--factor`, `--tolerance`, `--pixel-error`, `--distance` or
-//! `--silhouette` (with `--camera`, `--scheme`, `--max-factor`, `--no-cull`) into a plan and
+//! `--silhouette` (with `--camera`, `--scheme`, `--max-factor`, `--cull`) into a plan and
 //! the pattern that draws it.
 
 use clap::{Args, ValueEnum};
+use std::path::Path;
 use tessera::camera::Camera;
 use tessera::criterion::esc::{self, EscOptions, Threshold};
 use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
@@ -80,8 +81,8 @@ pub struct CriterionArgs {
     /// written with % (e.g. 0.1%).
     #[arg(long, value_name = "E", conflicts_with_all = ["factor", "pixel_error", "distance", "silhouette"])]
     pub tolerance: Option<String>,
-    /// Guaranteed screen-space error in pixels for the camera (--camera); patches outside
-    /// the view or facing away are culled unless --no-cull.
+    /// Guaranteed screen-space error in pixels for the camera (--camera); with --cull,
+    /// patches outside the view or facing away are left out.
     #[arg(long, value_name = "P", conflicts_with_all = ["factor", "tolerance", "distance", "silhouette"])]
     pub pixel_error: Option<f64>,
     /// Factors from the distance to the eye plane, FMIN:FMAX (near edges get FMAX; reals for
@@ -126,8 +127,14 @@ pub struct CriterionArgs {
     /// uniform on screen rather than in the domain.
     #[arg(long)]
     pub warp: bool,
-    /// Keep every patch (no view-frustum or back-face culling), so a closed input stays closed.
+    /// Leave out patches outside the camera's view frustum or facing away from it
+    /// (conservative normal cone), as a renderer would: the mesh is then open where they
+    /// were, and tessera says how many it culled. Off by default, so a closed input gives a
+    /// closed mesh.
     #[arg(long)]
+    pub cull: bool,
+    /// Keep every patch: the default (kept so that older command lines still run).
+    #[arg(long, hide = true, conflicts_with = "cull")]
     pub no_cull: bool,
 }
 
@@ -216,7 +223,15 @@ fn view_criterion(args: &CriterionArgs, scheme: SchemeArg) -> Option<(ViewCriter
     }
 }
 
-pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn std::error::Error>> {
+/// Chooses the plan and pattern; `input` names the file in errors about its contents.
+/// `max_triangles` bounds what the error-bounded criteria may build while they check their
+/// bounds (they refuse with `Error::OutputTooLarge` beyond it).
+pub fn choose(
+    args: &CriterionArgs,
+    set: &SurfaceSet,
+    input: &Path,
+    max_triangles: u64,
+) -> Result<Chosen, Box<dyn std::error::Error>> {
     let adaptive = args.factor.is_none()
         && (args.tolerance.is_some()
             || args.pixel_error.is_some()
@@ -238,7 +253,7 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
         return Err("--level, --quality and --threshold apply to --scheme esc only".into());
     }
     if scheme == SchemeArg::Esc {
-        return choose_esc(args, set);
+        return choose_esc(args, set, input);
     }
     let max_level = args.max_level.unwrap_or(DEFAULT_MAX_LEVEL);
     if max_level > MAX_LEVEL {
@@ -288,12 +303,18 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
             tolerance: None,
         });
     }
-    let cull = !args.no_cull;
+    let cull = args.cull;
     if let Some(t) = &args.tolerance {
         let (lo, hi) = set.bounds();
         let eps = parse_tolerance(t, lo.distance(hi))?;
-        let (plan, report) =
-            tolerance::plan(set, &vec![Some(eps); set.patches.len()], layout, pattern.as_ref(), max_factor);
+        let (plan, report) = tolerance::plan_limited(
+            set,
+            &vec![Some(eps); set.patches.len()],
+            layout,
+            pattern.as_ref(),
+            max_factor,
+            max_triangles,
+        )?;
         return Ok(Chosen {
             plan,
             pattern,
@@ -308,7 +329,8 @@ pub fn choose(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn 
             return Err(format!("--pixel-error {px}: must be a positive number of pixels").into());
         }
         let eps = screen::tolerances(set, &cam, px, cull);
-        let (plan, report) = tolerance::plan(set, &eps, layout, pattern.as_ref(), max_factor);
+        let (plan, report) =
+            tolerance::plan_limited(set, &eps, layout, pattern.as_ref(), max_factor, max_triangles)?;
         return Ok(Chosen {
             plan,
             pattern,
@@ -339,7 +361,7 @@ fn choose_fractional(
         .into());
     }
     let cam = camera(args, set)?;
-    let cull = !args.no_cull;
+    let cull = args.cull;
     let view = view_criterion(args, scheme);
     let (factors, description) = match (args.factor, view) {
         (Some(_), _) | (None, None) => {
@@ -429,7 +451,18 @@ pub fn partitioning(scheme: SchemeArg) -> Option<Partitioning> {
 pub const DEFAULT_MAX_LEVEL: u32 = 5;
 
 /// ESC: its own criterion (level per object from the camera, distance test).
-fn choose_esc(args: &CriterionArgs, set: &SurfaceSet) -> Result<Chosen, Box<dyn std::error::Error>> {
+fn choose_esc(
+    args: &CriterionArgs,
+    set: &SurfaceSet,
+    input: &Path,
+) -> Result<Chosen, Box<dyn std::error::Error>> {
+    if let Some(p) = set.patches.iter().position(|p| p.domain() != tessera::surface::Domain::Quad) {
+        return Err(format!(
+            "{}: patch {p} is a triangle patch (a mesh gives PN triangles); --scheme esc tessellates bicubic Bézier patches only",
+            input.display()
+        )
+        .into());
+    }
     if args.factor.is_some()
         || args.tolerance.is_some()
         || args.pixel_error.is_some()

@@ -209,23 +209,53 @@ fn tolerance_is_met_and_the_cap_is_reported() {
 }
 
 #[test]
-fn pixel_error_with_camera_and_no_cull_keeps_closed_inputs_closed() {
+fn pixel_error_keeps_closed_inputs_closed_unless_asked_to_cull() {
     let dir = scratch("pixels");
     let torus = data("bench/torus_64x32.patches");
     let cam = "eye=0,-3,1.5,target=0,0,0,fov=50,size=800x600";
-    let (v, _) = stats(
-        &["mesh", torus.to_str().unwrap(), "--pixel-error", "1", "--camera", cam, "--no-cull", "--stats"],
-        &dir,
-    );
-    assert_eq!((v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()), (Some(0), Some(0)), "{v}");
-    assert_eq!(v["culled_patches"], 0);
-    assert_eq!(v["euler_characteristic"], 0);
-    let (v, _) =
-        stats(&["mesh", torus.to_str().unwrap(), "--pixel-error", "1", "--camera", cam, "--stats"], &dir);
-    assert!(v["culled_patches"].as_u64().unwrap() > 0, "back faces of the torus are culled: {v}");
+    let t = torus.to_str().unwrap();
+    for extra in [&[][..], &["--no-cull"][..]] {
+        let mut args = vec!["mesh", t, "--pixel-error", "1", "--camera", cam, "--stats"];
+        args.extend_from_slice(extra);
+        let (v, err) = stats(&args, &dir);
+        assert_eq!(
+            (v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()),
+            (Some(0), Some(0)),
+            "{v}"
+        );
+        assert_eq!(v["culled_patches"], 0);
+        assert_eq!(v["euler_characteristic"], 0);
+        assert!(!err.contains("cull"), "{err}");
+    }
+    let (v, err) = stats(&["mesh", t, "--pixel-error", "1", "--camera", cam, "--cull", "--stats"], &dir);
+    let culled = v["culled_patches"].as_u64().unwrap();
+    assert!(culled > 0, "back faces of the torus are culled: {v}");
+    assert!(err.contains(&format!("--cull left out {culled} of 2048 patches")), "{err}");
     // The default camera frames the model.
-    let (v, _) = stats(&["mesh", torus.to_str().unwrap(), "--pixel-error", "2", "--stats"], &dir);
+    let (v, _) = stats(&["mesh", t, "--pixel-error", "2", "--stats"], &dir);
     assert!(v["triangles"].as_u64().unwrap() > 0);
+}
+
+/// Issue 10, item 2: the view criteria and the real-factor schemes used to cull by default,
+/// writing closed meshes open (spot --silhouette 1:7 had 1,956 boundary edges).
+#[test]
+fn view_dependent_schemes_write_closed_meshes_by_default() {
+    let dir = scratch("no-cull-default");
+    let spot = data("meshes/spot.obj");
+    let s = spot.to_str().unwrap();
+    for args in [
+        vec!["mesh", s, "--silhouette", "1:7", "--stats"],
+        vec!["mesh", s, "--distance", "1:5", "--stats"],
+        vec!["mesh", s, "--scheme", "sd2", "--silhouette", "1:5", "--stats"],
+        vec!["mesh", s, "--scheme", "fractional-odd", "--factor", "3.5", "--stats"],
+        vec!["mesh", s, "--scheme", "semi-uniform", "--silhouette", "1:4", "--stats"],
+    ] {
+        let (v, err) = stats(&args, &dir);
+        assert_eq!(v["culled_patches"], 0, "{args:?}");
+        assert_eq!(v["boundary_edges"], v["input_boundary_edges"], "{args:?}: {v}");
+        assert_eq!(v["nonmanifold_edges"], 0, "{args:?}");
+        assert!(!err.contains("cull"), "{args:?}: {err}");
+    }
 }
 
 #[test]
@@ -234,11 +264,11 @@ fn view_criteria_and_bad_criteria_arguments() {
     let spot = data("meshes/spot.obj");
     let s = spot.to_str().unwrap();
     for args in [
-        vec!["mesh", s, "--silhouette", "1:8", "--scheme", "semi-uniform", "--no-cull", "--stats"],
+        vec!["mesh", s, "--silhouette", "1:8", "--scheme", "semi-uniform", "--stats"],
         vec!["mesh", s, "--tolerance", "0.1%", "--scheme", "semi-uniform", "--stats"],
-        vec!["mesh", s, "--silhouette", "1:7", "--no-cull", "--stats"],
-        vec!["mesh", s, "--silhouette", "1:7", "--silhouette-mode", "vertices", "--no-cull", "--stats"],
-        vec!["mesh", s, "--distance", "1:7", "--mapping", "quadratic", "--no-cull", "--stats"],
+        vec!["mesh", s, "--silhouette", "1:7", "--stats"],
+        vec!["mesh", s, "--silhouette", "1:7", "--silhouette-mode", "vertices", "--stats"],
+        vec!["mesh", s, "--distance", "1:7", "--mapping", "quadratic", "--stats"],
     ] {
         let (v, _) = stats(&args, &dir);
         assert_eq!(

@@ -42,6 +42,13 @@ pub enum Error {
     /// An argument is out of range (factor 0, negative tolerance, ...).
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// The output would exceed a limit (memory, triangle count or the u32 index range); it
+    /// was refused before anything of its size was allocated.
+    #[error(
+        "output too large: {vertices} vertices and {triangles} triangles would need {:.1} GiB",
+        *bytes as f64 / (1u64 << 30) as f64
+    )]
+    OutputTooLarge { vertices: u64, triangles: u64, bytes: u64 },
     /// Writing an output failed.
     #[error("{path}: cannot write: {source}")]
     Write {

@@ -9,10 +9,12 @@
 
 use super::bounds::{self, HessianBound};
 use super::Plan;
+use crate::error::{Error, Result};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::sampling::EdgeSampling;
 use crate::surface::{Domain, Patch, SurfaceSet};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Which pattern the plan is for: it decides how interior factors follow from edges.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -197,6 +199,23 @@ pub fn plan(
     pattern: &dyn Pattern,
     max_factor: u32,
 ) -> (Plan, PlanReport) {
+    plan_limited(set, eps, layout, pattern, max_factor, u64::MAX).expect("no triangle limit")
+}
+
+/// [`plan`] for an output of at most `max_triangles`: before each round of a-posteriori checks
+/// (which build patterns), the output the current factors give is counted, and a plan that
+/// would exceed the limit is refused with [`Error::OutputTooLarge`] instead of building
+/// patterns of that size; a single patch whose check would build more than `max_triangles`
+/// stops refining and counts as capped. Cost: that of [`plan`] plus O(P) pattern counts per
+/// round.
+pub fn plan_limited(
+    set: &SurfaceSet,
+    eps: &[Option<f64>],
+    layout: Layout,
+    pattern: &dyn Pattern,
+    max_factor: u32,
+    max_triangles: u64,
+) -> Result<(Plan, PlanReport)> {
     let mut cap = max_factor.max(1);
     if layout == Layout::Dyadic {
         // Largest power of two within the cap and the pattern's highest level.
@@ -258,7 +277,8 @@ pub fn plan(
     };
     let all: Vec<usize> = (0..set.patches.len()).collect();
     let mut segments = edge_segments(&proposals);
-    let mut results = check_patches(set, eps, layout, pattern, cap, &hessians, &proposals, &segments, &all);
+    let limit = Limit::new(pattern, max_triangles, set.patches.len());
+    let mut results = check_patches(set, eps, layout, &limit, cap, &hessians, &proposals, &segments, &all);
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
@@ -289,7 +309,7 @@ pub fn plan(
         }
         segments = next;
         let rechecked =
-            check_patches(set, eps, layout, pattern, cap, &hessians, &proposals, &segments, &affected);
+            check_patches(set, eps, layout, &limit, cap, &hessians, &proposals, &segments, &affected);
         for (i, &p) in affected.iter().enumerate() {
             results[p] = rechecked[i];
         }
@@ -303,12 +323,96 @@ pub fn plan(
             }
         }
     }
+    limit.result()?;
     let plan = Plan {
         edges: segments.iter().map(|&s| EdgeSampling::uniform(s)).collect(),
         interior: results.iter().map(|r| r.0).collect(),
         visible,
     };
-    (plan, report)
+    Ok((plan, report))
+}
+
+/// The output budget of [`plan_limited`]: the triangles of each patch's latest checked
+/// pattern, counted (O(1)) before the pattern is built, so that no check builds a pattern the
+/// output could not hold.
+struct Limit<'a> {
+    pattern: &'a dyn Pattern,
+    max_triangles: u64,
+    used: AtomicU64,
+    per_patch: Vec<AtomicU64>,
+    /// The total a refused check would have reached (0: none refused).
+    exceeded: AtomicU64,
+}
+
+impl<'a> Limit<'a> {
+    fn new(pattern: &'a dyn Pattern, max_triangles: u64, patches: usize) -> Self {
+        Limit {
+            pattern,
+            max_triangles,
+            used: AtomicU64::new(0),
+            per_patch: (0..patches).map(|_| AtomicU64::new(0)).collect(),
+            exceeded: AtomicU64::new(0),
+        }
+    }
+
+    /// Whether patch `p` may build a pattern of `input`; records its count if so.
+    fn admit(&self, p: usize, input: &PatternInput) -> bool {
+        let t = self.pattern.counts(input).1 as u64;
+        let previous = self.per_patch[p].load(Ordering::Relaxed);
+        let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
+            let n = u - previous + t;
+            (n <= self.max_triangles).then_some(n)
+        });
+        match update {
+            Ok(_) => {
+                self.per_patch[p].store(t, Ordering::Relaxed);
+                true
+            }
+            Err(u) => {
+                self.exceeded.fetch_max(u - previous + t, Ordering::SeqCst);
+                false
+            }
+        }
+    }
+
+    /// [`Limit::admit`] for many patches at once, all or none: when their patterns together
+    /// would exceed the limit, the whole total is what the refusal reports.
+    fn reserve(&self, inputs: &[(usize, PatternInput)]) -> bool {
+        let (mut add, mut remove) = (0u64, 0u64);
+        let counts: Vec<u64> =
+            inputs.par_iter().map(|(_, input)| self.pattern.counts(input).1 as u64).collect();
+        for ((p, _), &t) in inputs.iter().zip(&counts) {
+            add += t;
+            remove += self.per_patch[*p].load(Ordering::Relaxed);
+        }
+        let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
+            let n = u - remove + add;
+            (n <= self.max_triangles).then_some(n)
+        });
+        match update {
+            Ok(_) => {
+                for ((p, _), &t) in inputs.iter().zip(&counts) {
+                    self.per_patch[*p].store(t, Ordering::Relaxed);
+                }
+                true
+            }
+            Err(u) => {
+                self.exceeded.fetch_max(u - remove + add, Ordering::SeqCst);
+                false
+            }
+        }
+    }
+
+    fn result(&self) -> Result<()> {
+        match self.exceeded.load(Ordering::SeqCst) {
+            0 => Ok(()),
+            triangles => Err(Error::OutputTooLarge {
+                vertices: triangles / 2,
+                triangles,
+                bytes: crate::engine::output_bytes(triangles / 2, triangles, false),
+            }),
+        }
+    }
 }
 
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
@@ -320,7 +424,7 @@ fn check_patches(
     set: &SurfaceSet,
     eps: &[Option<f64>],
     layout: Layout,
-    pattern: &dyn Pattern,
+    limit: &Limit,
     cap: u32,
     hessians: &[HessianBound],
     proposals: &[[f64; 4]],
@@ -330,44 +434,66 @@ fn check_patches(
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
     let minimum = minimum_interior(set);
+    // Each patch's first pattern: its edges and the smallest interior the layout gives it.
+    let first = |p: usize| {
+        let domain = set.patches[p].domain();
+        let nc = domain.corner_count();
+        let mut seg = [1u32; 4];
+        for (l, s) in seg.iter_mut().enumerate().take(nc) {
+            *s = segments[topo.patch_edges[p][l].edge as usize];
+        }
+        let mut interior = match (layout, domain) {
+            (Layout::Uniform, _) => [global, global],
+            (Layout::Transition, Domain::Quad) => {
+                // The patch's own grid is enough for the core; CudaTess's min of the two
+                // edges is never smaller, and neighbours' finer needs reach the core
+                // through the transition strips instead of refining the whole patch.
+                let own = |l: usize| (proposals[p][l].min(cap as f64) as u32).max(1);
+                [own(0).min(seg[0].min(seg[2])), own(1).min(seg[1].min(seg[3]))]
+            }
+            (Layout::Transition, Domain::Tri) | (Layout::Dyadic, _) => {
+                let n = seg[..nc].iter().copied().max().unwrap_or(1);
+                [n, n]
+            }
+        };
+        match layout {
+            Layout::Transition => {
+                interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
+            }
+            Layout::Dyadic => {
+                let n = interior[0].max(minimum[p][0]).max(minimum[p][1]).next_power_of_two().min(cap);
+                interior = [n, n];
+            }
+            Layout::Uniform => {}
+        }
+        (domain, seg, interior)
+    };
+    // Interiors only grow, so the first patterns' triangles are a lower bound of the output:
+    // count them all before building any, and build nothing when they already exceed the limit.
+    let firsts: Vec<_> = which.par_iter().map(|&p| first(p)).collect();
+    let visible: Vec<(usize, PatternInput)> = which
+        .iter()
+        .zip(&firsts)
+        .filter(|(&p, _)| eps[p].is_some())
+        .map(|(&p, &(domain, seg, interior))| (p, PatternInput::new(domain, seg, interior)))
+        .collect();
+    let admitted = limit.reserve(&visible);
     which
         .par_iter()
-        .map_init(LocalTessellation::default, |scratch, &p| {
-            let domain = set.patches[p].domain();
-            let nc = domain.corner_count();
-            let mut seg = [1u32; 4];
-            for (l, s) in seg.iter_mut().enumerate().take(nc) {
-                *s = segments[topo.patch_edges[p][l].edge as usize];
-            }
-            let mut interior = match (layout, domain) {
-                (Layout::Uniform, _) => [global, global],
-                (Layout::Transition, Domain::Quad) => {
-                    // The patch's own grid is enough for the core; CudaTess's min of the two
-                    // edges is never smaller, and neighbours' finer needs reach the core
-                    // through the transition strips instead of refining the whole patch.
-                    let own = |l: usize| (proposals[p][l].min(cap as f64) as u32).max(1);
-                    [own(0).min(seg[0].min(seg[2])), own(1).min(seg[1].min(seg[3]))]
-                }
-                (Layout::Transition, Domain::Tri) | (Layout::Dyadic, _) => {
-                    let n = seg[..nc].iter().copied().max().unwrap_or(1);
-                    [n, n]
-                }
-            };
-            match layout {
-                Layout::Transition => {
-                    interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
-                }
-                Layout::Dyadic => {
-                    let n = interior[0].max(minimum[p][0]).max(minimum[p][1]).next_power_of_two().min(cap);
-                    interior = [n, n];
-                }
-                Layout::Uniform => {}
+        .zip(firsts)
+        .map_init(LocalTessellation::default, |scratch, (&p, (domain, seg, mut interior))| {
+            if !admitted {
+                return (interior, f64::INFINITY, true);
             }
             let Some(e) = eps[p] else { return (interior, 0.0, false) };
             let mut previous = f64::INFINITY;
             loop {
                 let input = PatternInput::new(domain, seg, interior);
-                let bound = patch_bound(&hessians[p], &input, pattern, scratch);
+                if !limit.admit(p, &input) {
+                    // The output could not hold this pattern; the plan is refused at the end.
+                    return (interior, f64::INFINITY, true);
+                }
+                let bound = patch_bound(&hessians[p], &input, limit.pattern, scratch);
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
                 }

@@ -25,9 +25,12 @@ mod uniform_quads;
 pub struct TessellateOptions {
     /// Fill [`Mesh::corner_params`] (needed to measure the approximation error).
     pub corner_params: bool,
-    /// Refuse (with [`Error::InvalidArgument`]) an output whose buffers would take more bytes
+    /// Refuse (with [`Error::OutputTooLarge`]) an output whose buffers would take more bytes
     /// than this, before allocating anything. `None`: no limit beyond the u32 index range.
     pub memory_limit: Option<u64>,
+    /// Refuse (with [`Error::OutputTooLarge`]) an output of more triangles than this, before
+    /// allocating anything. `None`: no limit.
+    pub max_triangles: Option<u64>,
     /// Also fill [`Mesh::strips`], for patterns with a strip form ([`Pattern::strips`]);
     /// an error for the others.
     pub strips: bool,
@@ -147,6 +150,20 @@ fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
     (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))
 }
 
+/// Refuses an output of `vertices` and `triangles` that does not fit the index range, the
+/// address space or the limits in `options`. Cost: O(1).
+pub(crate) fn check_size(vertices: u64, triangles: u64, options: &TessellateOptions) -> Result<()> {
+    let bytes = output_bytes(vertices, triangles, options.corner_params);
+    if vertices > u32::MAX as u64
+        || triangles.saturating_mul(3) > isize::MAX as u64 / 8
+        || options.memory_limit.is_some_and(|limit| bytes > limit)
+        || options.max_triangles.is_some_and(|limit| triangles > limit)
+    {
+        return Err(Error::OutputTooLarge { vertices, triangles, bytes });
+    }
+    Ok(())
+}
+
 /// Tessellates `set` with `pattern` following `plan`.
 ///
 /// Preconditions: `plan` was made for `set` (one sampling per edge, one interior entry per
@@ -176,6 +193,7 @@ pub fn tessellate_into(
     if pattern.is_uniform() && !options.strips {
         if let Some(result) = uniform_quads::try_tessellate(set, plan, options, out) {
             out.strips = None;
+            out.collapsed_triangles = 0;
             return result;
         }
     }
@@ -214,43 +232,47 @@ fn tessellate_generic(
             }
         })
         .collect();
-    let patch_counts: Vec<(usize, usize)> = (0..set.patches.len())
+    // Pattern counts first, without building anything: a triangle count is an upper bound
+    // (triangles collapsed at a repeated corner are dropped below), so an output that is too
+    // large is refused here, before any pattern or buffer of its size exists.
+    let upper: Vec<(usize, usize)> = (0..set.patches.len())
         .into_par_iter()
-        .map_init(LocalTessellation::default, |scratch, p| {
+        .map(|p| {
             if !plan.visible[p] {
                 return (0, 0);
             }
-            let input = pattern_input(set, plan, p);
-            let (vi, t) = pattern.counts(&input);
-            if !has_repeated_corner(set, p) {
-                return (vi as usize, t as usize);
+            let (vi, t) = pattern.counts(&pattern_input(set, plan, p));
+            (vi as usize, t as usize)
+        })
+        .collect();
+    let corner_count = topo.corner_entries.len();
+    let edge_total: usize = edge_counts.iter().sum();
+    let interior_total: usize = upper.iter().map(|c| c.0).sum();
+    let upper_triangles: usize = upper.iter().map(|c| c.1).sum();
+    check_size((corner_count + edge_total + interior_total) as u64, upper_triangles as u64, &options)?;
+    let patch_counts: Vec<(usize, usize)> = upper
+        .par_iter()
+        .enumerate()
+        .map_init(LocalTessellation::default, |scratch, (p, &(vi, t))| {
+            if t == 0 || !has_repeated_corner(set, p) {
+                return (vi, t);
             }
             // Triangles with two corners on one vertex degenerate; count the ones that remain.
+            let input = pattern_input(set, plan, p);
             pattern.build(&input, scratch);
             let map = LocalMap { set, plan, input, patch: p, edge_base: &[], interior_base: 0 };
             let kept = scratch.triangles.iter().filter(|t| !degenerate_after_collapse(&map, t)).count();
-            (vi as usize, kept)
+            (vi, kept)
         })
         .collect();
 
     // Scan.
-    let corner_count = topo.corner_entries.len();
     let (edge_offsets, edge_total) = exclusive_scan(&edge_counts);
     let interior_counts: Vec<usize> = patch_counts.iter().map(|c| c.0).collect();
     let tri_counts: Vec<usize> = patch_counts.iter().map(|c| c.1).collect();
     let (interior_offsets, interior_total) = exclusive_scan(&interior_counts);
     let (tri_offsets, tri_total) = exclusive_scan(&tri_counts);
     let vertex_total = corner_count + edge_total + interior_total;
-    let bytes = output_bytes(vertex_total as u64, tri_total as u64, options.corner_params);
-    if vertex_total > u32::MAX as usize
-        || tri_total.saturating_mul(3) > isize::MAX as usize / 8
-        || options.memory_limit.is_some_and(|limit| bytes > limit)
-    {
-        return Err(Error::InvalidArgument(format!(
-            "output too large: {vertex_total} vertices and {tri_total} triangles would take {:.1} GiB; lower the factor",
-            bytes as f64 / (1u64 << 30) as f64
-        )));
-    }
     let edge_base: Vec<usize> = edge_offsets.iter().map(|o| corner_count + o).collect();
     let interior_base: Vec<usize> = interior_offsets.iter().map(|o| corner_count + edge_total + o).collect();
     let _ = tri_offsets;
@@ -358,6 +380,7 @@ fn tessellate_generic(
         triangle_patch,
         corner_params: None,
         strips,
+        collapsed_triangles: upper_triangles - tri_total,
     };
     if options.corner_params {
         mesh.corner_params = Some(corner_params);

@@ -186,11 +186,8 @@ impl Sizes {
         let interior_vertices = (set.patches.len() as u64).checked_mul(m.checked_mul(m)?)?;
         let triangles = (set.patches.len() as u64).checked_mul(n.checked_mul(2 * n)?)?;
         let vertices = corners.checked_add(edge_vertices)?.checked_add(interior_vertices)?;
-        let bytes = super::output_bytes(vertices, triangles, options.corner_params);
-        let fits = vertices <= u32::MAX as u64
-            && triangles.checked_mul(3)? <= isize::MAX as u64 / 8
-            && options.memory_limit.is_none_or(|limit| bytes <= limit);
-        fits.then_some(Sizes {
+        super::check_size(vertices, triangles, &options).ok()?;
+        Some(Sizes {
             corners: corners as usize,
             edge_vertices: edge_vertices as usize,
             interior_vertices: interior_vertices as usize,

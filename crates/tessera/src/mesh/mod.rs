@@ -28,6 +28,10 @@ pub struct Mesh {
     /// the scheme has a strip form. `indices` always holds the decoded list, so a writer
     /// that cannot store strips loses nothing.
     pub strips: Option<Vec<u32>>,
+    /// Pattern triangles the engine did not emit because two of their corners are one vertex
+    /// (at a boundary curve collapsed to a point, such as the teapot's lid apex): a
+    /// documented repair, reported by the CLI.
+    pub collapsed_triangles: usize,
 }
 
 impl Mesh {

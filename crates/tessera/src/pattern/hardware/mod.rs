@@ -1,0 +1,516 @@
+//! The Direct3D 11 hardware tessellator's patterns: `integer`, `pow2`, `fractional_odd` and
+//! `fractional_even` partitioning of triangle and quad domains, point for point and triangle
+//! for triangle what a Direct3D 11 or Vulkan GPU's fixed-function tessellator emits.
+//!
+//! **Why exact.** Users porting hull/domain-shader code to compute expect the mesh their
+//! hardware made, and every such GPU follows the D3D11 reference tessellator. This module is
+//! written from that tessellator's documented behaviour and checked against its output on 200
+//! random factor sets (`../shared/data/reference/d3d11_tessellator.json`, test
+//! `tests/hardware_reference.rs`); it is structured our own way (rings as point cycles rather
+//! than index patching).
+//!
+//! **Factors.** Edge factors are clamped to the partitioning's range (`integer`/`pow2`
+//! `[1, 64]`, `fractional_odd` `[1, 63]`, `fractional_even` `[2, 64]`; NaN reads as the
+//! minimum), rounded up for `integer`/`pow2`, then converted to 16.16 fixed point; the
+//! hardware makes no `pow2` distinction (rounding to powers of two is the hull shader's job,
+//! done by tessera's criterion). An edge factor `≤ 0` culls the patch. Inside factors get the
+//! same treatment, except that `fractional_odd` raises an inside factor of 1 to `1 + 2⁻¹⁶`
+//! when any factor exceeds 1, so the patch gets a "picture frame" of interior points.
+//! `integer` picks each factor's parity from its rounded value (an inside factor of 1 counts
+//! as even); the fractional partitionings use their own parity everywhere.
+//!
+//! **1-D partition** ([`Axis`]). A factor `f` with parity cuts `[0, 1]` symmetrically; half the
+//! factor, `h = f/2` (plus ½ for odd), lies between `⌊h⌋` and `⌈h⌉`, and each point of the half
+//! edge is the blend, by `h − ⌊h⌋`, of its place in the uniform partitions with `2⌊h⌋` and
+//! `2⌈h⌉` segments (less one for odd). Which point is the new one on the floor partition is
+//! decided by a bit-pattern rule (the "ruler function"): the split point is
+//! `2·removeMSB(⌊h⌋ − [odd]) + 1`. The other half mirrors the first exactly (`1 − x` in fixed
+//! point), so an edge's points depend only on its factor and partitioning: two patches
+//! sharing an edge get the same points whichever way they run along it.
+//!
+//! **Rings.** The outer ring is the four (three) edges' points, clockwise in Direct3D's
+//! picture (v down); inner rings follow, each from the inside factors with the factor reduced
+//! by two per ring; an even inside partition ends in a degenerate ring (a row of points, or
+//! the centre point). The band between the outer ring and ring 1 is stitched by the
+//! ruler-function transition ([`FINAL_POINT_POSITION`]), inner bands by trapezoids with mirrored
+//! diagonals, and what is left in the middle by a strip of quads (quads) or one triangle.
+//!
+//! **Orientation.** Triangles here are counter-clockwise in the `(u, v)` plane, tessera's
+//! convention — Direct3D's `triangle_cw` output order; its `triangle_ccw` is the reverse.
+//!
+//! **Costs.** [`edge_segments`] and [`edge_param`] are O(1); [`counts`] is O(rings); building
+//! ([`tessellate`]) is linear in the output.
+
+use super::{LocalTessellation, Pattern, PatternInput};
+use crate::surface::Domain;
+use glam::DVec2;
+use partition::{
+    clamp, parity_odd, to_f64, to_fixed, Fixed, EPSILON, FRACTION_BITS, HALF, ONE, ONE_THIRD, TWO_THIRDS,
+};
+use stitch::{Diagonals, Emit};
+
+mod partition;
+mod stitch;
+#[cfg(test)]
+mod tests;
+
+pub use partition::{edge_param, edge_segments, settled_factor, Axis, Partitioning, OUTPUT_GAP};
+
+/// Factors processed for one patch.
+#[derive(Debug, Clone, Copy)]
+struct Processed {
+    domain: Domain,
+    /// All factors 1 (integer and odd modes): the bare domain, 2 (1) triangles.
+    minimum: bool,
+    /// Edge partitions in Direct3D's edge order (quad `U==0, V==0, U==1, V==1`; tri
+    /// `U==0, V==0, W==0`).
+    outer: [Axis; 4],
+    /// Inside partitions (quad `U, V`; tri `[inside, inside]`), at least 4 points (odd) or 3
+    /// (even).
+    inside: [Axis; 2],
+}
+
+impl Processed {
+    /// `None` when an edge factor is not positive (Direct3D culls the patch).
+    fn new(domain: Domain, partitioning: Partitioning, edges: [f32; 4], inside: [f32; 2]) -> Option<Self> {
+        let n = domain.corner_count();
+        let edges = &edges[..n];
+        let inside = &inside[..if domain == Domain::Quad { 2 } else { 1 }];
+        if edges.iter().any(|f| !(*f > 0.0)) {
+            return None;
+        }
+        let (lo, hi) = partitioning.range();
+        let e: Vec<f32> = edges.iter().map(|&f| clamp(f, lo, hi, partitioning)).collect();
+        let frame_threshold = 1.0 + EPSILON / 2.0;
+        // Quads also look at the raw inside factors; triangles have only one.
+        let frame = partitioning == Partitioning::FractionalOdd
+            && (e.iter().any(|&f| f > frame_threshold)
+                || (domain == Domain::Quad && inside.iter().any(|&f| f > frame_threshold)));
+        let inside_lo = if frame { 1.0 + EPSILON } else { lo };
+        let i: Vec<f32> = inside.iter().map(|&f| clamp(f, inside_lo, hi, partitioning)).collect();
+        let e_fixed: Vec<Fixed> = e.iter().map(|&f| to_fixed(f)).collect();
+        let i_fixed: Vec<Fixed> = i.iter().map(|&f| to_fixed(f)).collect();
+        let minimum = (partitioning.is_integer() || partitioning == Partitioning::FractionalOdd)
+            && e_fixed.iter().chain(&i_fixed).all(|&f| f == ONE);
+        let mut outer = [Axis::new(ONE, true); 4];
+        for k in 0..n {
+            outer[k] = Axis::new(e_fixed[k], parity_odd(e[k], partitioning, false));
+        }
+        let mut inner = [Axis::new(ONE, true); 2];
+        for k in 0..2 {
+            let j = k.min(i.len() - 1);
+            let mut a = Axis::new(i_fixed[j], parity_odd(i[j], partitioning, true));
+            // Fewer points would leave no interior: the transition regions degenerate instead.
+            a.points = a.points.max(if a.odd { 4 } else { 3 });
+            inner[k] = a;
+        }
+        Some(Processed { domain, minimum, outer, inside: inner })
+    }
+
+    fn outer_points(&self) -> i64 {
+        (0..self.domain.corner_count()).map(|e| self.outer[e].points - 1).sum()
+    }
+
+    /// Number of points and triangles. Cost: O(rings).
+    fn counts(&self) -> (u32, u32) {
+        let nc = self.domain.corner_count();
+        if self.minimum {
+            return (nc as u32, nc as u32 - 2);
+        }
+        let outer = self.outer_points();
+        match self.domain {
+            Domain::Quad => {
+                let n = [self.inside[0].points, self.inside[1].points];
+                let interior = (n[0] - 2) * (n[1] - 2);
+                let rings = ((n[0] + 1) >> 1).min((n[1] + 1) >> 1);
+                // Side e of ring r has n[axis(e)] − 2r points; axis(e) = (e + 1) & 1.
+                let side = |e: usize, r: i64| n[(e + 1) & 1] - 2 * r;
+                let mut tris = 0;
+                for r in 1..rings {
+                    for e in 0..4 {
+                        let out = if r == 1 { self.outer[e].points } else { side(e, r - 1) };
+                        tris += side(e, r) + out - 2;
+                    }
+                }
+                if let Some((quads, ..)) = self.centre_strip() {
+                    tris += 2 * quads;
+                }
+                ((outer + interior) as u32, tris as u32)
+            }
+            Domain::Tri => {
+                let n = self.inside[0].points;
+                let k = (n >> 1) - 1;
+                let interior = if self.inside[0].odd { 3 * (k * (k + 1) - k) } else { 3 * k * (k + 1) + 1 };
+                let rings = (n + 1) >> 1;
+                let mut tris = 0;
+                for r in 1..rings {
+                    for e in 0..3 {
+                        let out = if r == 1 { self.outer[e].points } else { n - 2 * (r - 1) };
+                        tris += n - 2 * r + out - 2;
+                    }
+                }
+                if self.inside[0].odd {
+                    tris += 1;
+                }
+                ((outer + interior) as u32, tris as u32)
+            }
+        }
+    }
+
+    /// The strip of quads left in the middle of a quad whose smaller inside partition is odd:
+    /// `(quads, horizontal)` — along u when the u partition has more points.
+    fn centre_strip(&self) -> Option<(i64, bool)> {
+        let [u, v] = self.inside;
+        if u.points > v.points && v.odd {
+            Some((((u.points >> 1) - (v.points >> 1)) * 2 + if u.odd { 1 } else { 2 }, true))
+        } else if v.points >= u.points && u.odd {
+            Some((((v.points >> 1) - (u.points >> 1)) * 2 + if v.odd { 1 } else { 2 }, false))
+        } else {
+            None
+        }
+    }
+}
+
+/// One ring of points as a cycle, split into sides that share their end points.
+#[derive(Debug, Clone, Default)]
+struct Ring {
+    points: Vec<u32>,
+    side_points: [u32; 4],
+}
+
+impl Ring {
+    /// Point `j` of side `e`, following the cycle (the last side wraps to the first point).
+    fn at(&self, e: usize, j: u32) -> u32 {
+        let offset: u32 = self.side_points[..e].iter().map(|n| n - 1).sum();
+        self.points[((offset + j) as usize) % self.points.len()]
+    }
+
+    fn side(&self, e: usize) -> Vec<u32> {
+        (0..self.side_points[e]).map(|j| self.at(e, j)).collect()
+    }
+}
+
+/// The Direct3D 11 tessellation of one domain.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct HardwareTessellation {
+    /// Domain points `(u, v)` in the hardware's output order (tri: `w = 1 − u − v`).
+    pub points: Vec<DVec2>,
+    /// Triangles, counter-clockwise in `(u, v)`, in the hardware's output order.
+    pub triangles: Vec<[u32; 3]>,
+    /// The band each triangle belongs to: 1 the transition from the outer edges, `r` the band
+    /// between rings `r − 1` and `r`, and one more than the last ring for the centre.
+    pub regions: Vec<u32>,
+    /// Points on each edge (ends included), in Direct3D's edge order.
+    pub edge_points: [u32; 4],
+}
+
+/// The Direct3D 11 tessellation of `domain` for edge factors in Direct3D's edge order (quad
+/// `[U==0, V==0, U==1, V==1]`, tri `[U==0, V==0, W==0]`; entries past the edge count are
+/// ignored) and inside factors (quad `[U, V]`, tri `[inside]`), given as the hardware gets them
+/// (no reduction). `None` when an edge factor is not positive or is NaN-free and `≤ 0` —
+/// Direct3D culls such a patch. Cost: linear in the output.
+pub fn tessellate(
+    domain: Domain,
+    partitioning: Partitioning,
+    edges: [f32; 4],
+    inside: [f32; 2],
+) -> Option<HardwareTessellation> {
+    let pre = Processed::new(domain, partitioning, edges, inside)?;
+    let mut out = HardwareTessellation::default();
+    for e in 0..domain.corner_count() {
+        out.edge_points[e] = pre.outer[e].points as u32;
+    }
+    if pre.minimum {
+        match domain {
+            Domain::Quad => {
+                out.points.extend([DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]);
+                let mut emit = Emit { out: &mut out, region: 1 };
+                emit.tri(0, 1, 3);
+                emit.tri(1, 2, 3);
+            }
+            Domain::Tri => {
+                out.points.extend([DVec2::Y, DVec2::ZERO, DVec2::X]);
+                Emit { out: &mut out, region: 1 }.tri(0, 1, 2);
+            }
+        }
+        return Some(out);
+    }
+    let (points, triangles) = pre.counts();
+    out.points.reserve(points as usize);
+    out.triangles.reserve(triangles as usize);
+    match domain {
+        Domain::Quad => quad(&pre, &mut out),
+        Domain::Tri => tri(&pre, &mut out),
+    }
+    debug_assert_eq!((out.points.len() as u32, out.triangles.len() as u32), (points, triangles));
+    Some(out)
+}
+
+fn push(out: &mut HardwareTessellation, u: Fixed, v: Fixed) -> u32 {
+    out.points.push(DVec2::new(to_f64(u), to_f64(v)));
+    out.points.len() as u32 - 1
+}
+
+/// The outer ring: each edge's points but its last, clockwise in Direct3D's picture.
+fn outer_ring(
+    pre: &Processed,
+    out: &mut HardwareTessellation,
+    point: impl Fn(usize, Fixed) -> (Fixed, Fixed),
+) -> Ring {
+    let mut ring = Ring::default();
+    for e in 0..pre.domain.corner_count() {
+        let axis = &pre.outer[e];
+        let end = axis.points - 1;
+        for p in 0..end {
+            let q = if reversed(pre.domain, e) { end - p } else { p };
+            let (u, v) = point(e, axis.place(q));
+            ring.points.push(push(out, u, v));
+        }
+        ring.side_points[e] = axis.points as u32;
+    }
+    ring
+}
+
+/// Whether edge `e`'s points run against its 1-D partition (the outer ring and the rings are
+/// written clockwise in Direct3D's picture).
+fn reversed(domain: Domain, e: usize) -> bool {
+    match domain {
+        Domain::Quad => !(e == 1 || e == 2),
+        Domain::Tri => e % 2 == 0,
+    }
+}
+
+fn quad(pre: &Processed, out: &mut HardwareTessellation) {
+    let [iu, iv] = pre.inside;
+    let n = [iu.points, iv.points];
+    let mut rings = vec![outer_ring(pre, out, |e, x| match e {
+        0 => (0, x),
+        1 => (x, 0),
+        2 => (ONE, x),
+        _ => (x, ONE),
+    })];
+    // Inner rings; side e runs along axis (e + 1) & 1 at a fixed coordinate of the other.
+    let point_rings = n[0].min(n[1]) >> 1;
+    for r in 1..point_rings {
+        let end = [n[0] - 1 - r, n[1] - 1 - r];
+        let mut ring = Ring::default();
+        for e in 0..4 {
+            let (across, along) = (e & 1, (e + 1) & 1);
+            let perp_point = if e < 2 { r } else { end[across] };
+            let perp = pre.inside[across].place(perp_point);
+            for p in r..end[along] {
+                let q = if e == 1 || e == 2 { p } else { end[along] - (p - r) };
+                let x = pre.inside[along].place(q);
+                let id = if along == 1 { push(out, perp, x) } else { push(out, x, perp) };
+                ring.points.push(id);
+            }
+            ring.side_points[e] = (n[along] - 2 * r) as u32;
+        }
+        rings.push(ring);
+    }
+    // An even inside partition ends in a degenerate ring: a row (or column, or one point)
+    // through the middle, its sides running along it and back.
+    let degenerate = if n[0] > n[1] && !iv.odd {
+        let r = point_rings;
+        let row: Vec<u32> = (r..=n[0] - 1 - r).map(|p| push(out, iu.place(p), HALF)).collect();
+        let m = row.len() as u32;
+        Some((row, [1, m, 1, m]))
+    } else if n[1] >= n[0] && !iu.odd {
+        let r = point_rings;
+        let column: Vec<u32> = (r..=n[1] - 1 - r).rev().map(|p| push(out, HALF, iv.place(p))).collect();
+        let m = column.len() as u32;
+        Some((column, [m, 1, m, 1]))
+    } else {
+        None
+    };
+    if let Some((line, side_points)) = degenerate {
+        let mut points = line.clone();
+        if line.len() > 1 {
+            points.extend(line[1..line.len() - 1].iter().rev());
+        }
+        rings.push(Ring { points, side_points: if line.len() == 1 { [1; 4] } else { side_points } });
+    }
+    let band_rings = ((n[0] + 1) >> 1).min((n[1] + 1) >> 1) as usize;
+    debug_assert_eq!(band_rings, rings.len());
+    for r in 1..band_rings {
+        let mut emit = Emit { out, region: r as u32 };
+        for e in 0..4 {
+            let (outer, inner) = (rings[r - 1].side(e), rings[r].side(e));
+            if r == 1 {
+                emit.transition(&inner, &pre.inside[(e + 1) & 1], &outer, &pre.outer[e]);
+            } else {
+                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
+            }
+        }
+    }
+    // A strip of quads in the middle when the smaller inside partition is odd.
+    if let Some((quads, horizontal)) = pre.centre_strip() {
+        let last = rings.last().expect("at least the outer ring");
+        let mut emit = Emit { out, region: band_rings as u32 };
+        if horizontal {
+            let (outer, mut inner) = (last.side(1), last.side(3));
+            inner.reverse();
+            debug_assert_eq!(inner.len() as i64, quads + 1);
+            emit.regular(false, Diagonals::InsideToOutside, &inner, &outer);
+        } else {
+            let (outer, mut inner) = (last.side(0), last.side(2));
+            inner.reverse();
+            debug_assert_eq!(inner.len() as i64, quads + 1);
+            let diagonals =
+                if iv.odd { Diagonals::InsideToOutsideExceptMiddle } else { Diagonals::InsideToOutside };
+            emit.regular(false, diagonals, &inner, &outer);
+        }
+    }
+}
+
+fn tri(pre: &Processed, out: &mut HardwareTessellation) {
+    let axis = pre.inside[0];
+    let n = axis.points;
+    let mut rings = vec![outer_ring(pre, out, |e, x| match e {
+        0 => (0, x),
+        1 => (x, 0),
+        _ => (x, ONE - x),
+    })];
+    for r in 1..n >> 1 {
+        let end = n - 1 - r;
+        // The ring's distance from each side, scaled to barycentric size (2/3 of the 1-D
+        // position), and the along-side parameters pushed in by half of it.
+        let perp = (axis.place(r) * TWO_THIRDS + HALF) >> FRACTION_BITS;
+        let shift = (perp + 1) / 2;
+        let mut ring = Ring::default();
+        for e in 0..3 {
+            for p in r..end {
+                let q = if e % 2 == 1 { p } else { end - (p - r) };
+                let x = axis.place(q) - shift;
+                let id = match e {
+                    0 => push(out, perp, x),
+                    1 => push(out, x, perp),
+                    _ => push(out, x, ONE - x - perp),
+                };
+                ring.points.push(id);
+            }
+            ring.side_points[e] = (n - 2 * r) as u32;
+        }
+        rings.push(ring);
+    }
+    if !axis.odd {
+        let centre = push(out, ONE_THIRD, ONE_THIRD);
+        rings.push(Ring { points: vec![centre], side_points: [1; 4] });
+    }
+    let band_rings = ((n + 1) >> 1) as usize;
+    debug_assert_eq!(band_rings, rings.len());
+    for r in 1..band_rings {
+        let mut emit = Emit { out, region: r as u32 };
+        for e in 0..3 {
+            let (outer, inner) = (rings[r - 1].side(e), rings[r].side(e));
+            if r == 1 {
+                emit.transition(&inner, &axis, &outer, &pre.outer[e]);
+            } else {
+                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
+            }
+        }
+    }
+    if axis.odd {
+        let last = &rings[band_rings - 1].points;
+        Emit { out, region: band_rings as u32 }.tri(last[0], last[1], last[2]);
+    }
+}
+
+/// Direct3D's edge order from tessera's: quad `U==0, V==0, U==1, V==1` are tessera's edges
+/// 3, 0, 1, 2; tri `U==0, V==0, W==0` are edges 2, 0, 1 (with `(u, v)` the same in both).
+pub fn d3d_edge(domain: Domain, tessera_edge: usize) -> usize {
+    match domain {
+        Domain::Quad => (tessera_edge + 1) % 4,
+        Domain::Tri => (tessera_edge + 1) % 3,
+    }
+}
+
+/// Tessera's edge of Direct3D edge `d`, and whether tessera runs along it against the 1-D
+/// partition's direction (so that 1-D point `q` is tessera's point `segments − q`).
+fn tessera_edge(domain: Domain, d: usize) -> (usize, bool) {
+    match domain {
+        // Edges 0 (v = 0) and 1 (u = 1) run with u and v; 2 and 3 against them.
+        Domain::Quad => {
+            let e = (d + 3) % 4;
+            (e, e >= 2)
+        }
+        // Edge 0 (v = 0) runs with u; edge 1 (from (1,0) to (0,1)) with v = 1 − u against
+        // the partition of u; edge 2 (u = 0, from (0,1) to (0,0)) against v.
+        Domain::Tri => {
+            let e = (d + 2) % 3;
+            (e, e >= 1)
+        }
+    }
+}
+
+/// The hardware pattern, fed by tessera's criteria.
+///
+/// Preconditions: every edge's `input.segments[e]` is [`edge_segments`] of `input.factors[e]`
+/// (the engine guarantees it for [`crate::sampling::Spacing::Hardware`] samplings);
+/// `input.interior` is ignored: the inside factors come from the edge factors by Direct3D's
+/// `max` reduction (triangle: the largest edge factor; quad: inside-u the larger of the two
+/// edges along u, inside-v likewise). Cost: linear in the output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Hardware {
+    pub partitioning: Partitioning,
+}
+
+impl Hardware {
+    /// Direct3D edge and inside factors of a patch, in Direct3D's order.
+    fn factors(&self, input: &PatternInput) -> ([f32; 4], [f32; 2]) {
+        let d = input.domain;
+        let mut edges = [1.0f32; 4];
+        for e in 0..d.corner_count() {
+            edges[d3d_edge(d, e)] = input.factors[e] as f32;
+        }
+        let inside = match d {
+            Domain::Quad => [edges[1].max(edges[3]), edges[0].max(edges[2])],
+            Domain::Tri => [edges[0].max(edges[1]).max(edges[2]); 2],
+        };
+        (edges, inside)
+    }
+
+    fn processed(&self, input: &PatternInput) -> Processed {
+        let (edges, inside) = self.factors(input);
+        // Tessera's factors are at least 1, so the hardware never culls here.
+        Processed::new(input.domain, self.partitioning, edges, inside).expect("edge factors are positive")
+    }
+}
+
+impl Pattern for Hardware {
+    /// O(rings).
+    fn counts(&self, input: &PatternInput) -> (u32, u32) {
+        let pre = self.processed(input);
+        let (points, triangles) = pre.counts();
+        (points - pre.outer_points() as u32, triangles)
+    }
+
+    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        out.interior.clear();
+        out.triangles.clear();
+        let d = input.domain;
+        let (edges, inside) = self.factors(input);
+        let hw = tessellate(d, self.partitioning, edges, inside).expect("edge factors are positive");
+        debug_assert!(
+            (0..d.corner_count()).all(|e| input.segments[e] + 1 == hw.edge_points[d3d_edge(d, e)]),
+            "hardware pattern: segments do not match factors: {input:?}"
+        );
+        // Local index of every hardware point: the outer ring's points are tessera's boundary
+        // points, the rest interior in the hardware's order.
+        let mut local = Vec::with_capacity(hw.points.len());
+        for dd in 0..d.corner_count() {
+            let (e, against) = tessera_edge(d, dd);
+            let end = hw.edge_points[dd] - 1;
+            for p in 0..end {
+                let q = if reversed(d, dd) { end - p } else { p };
+                let k = if against { end - q } else { q };
+                local.push(input.boundary_vertex(e, k));
+            }
+        }
+        let outer = local.len();
+        let base = input.interior_base();
+        local.extend((0..(hw.points.len() - outer) as u32).map(|j| base + j));
+        out.interior.extend_from_slice(&hw.points[outer..]);
+        out.triangles.extend(hw.triangles.iter().map(|t| t.map(|v| local[v as usize])));
+    }
+}
