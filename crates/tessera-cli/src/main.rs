@@ -159,8 +159,26 @@ fn build_options(a: &InputArgs) -> Result<BuildOptions, Box<dyn std::error::Erro
     })
 }
 
-/// Loads a surface set from a patch file or an OBJ mesh, by extension.
-fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
+/// Loads a surface set from a patch file or an OBJ mesh, by extension; a set left without a
+/// patch by its repairs is an error naming the file.
+fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, Box<dyn std::error::Error>> {
+    let set = load_surfaces_as_given(path, options)?;
+    if set.patches.is_empty() {
+        let weld = match options.weld {
+            Weld::Within(eps) => format!(" (--weld {eps} merged them: use a smaller distance)"),
+            _ => String::new(),
+        };
+        return Err(format!(
+            "{}: no usable patch: all {} collapsed to a single point{weld}",
+            path.display(),
+            set.repairs.dropped_collapsed_patches
+        )
+        .into());
+    }
+    Ok(set)
+}
+
+fn load_surfaces_as_given(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
         "obj" => {
@@ -227,6 +245,8 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
         (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
+        (r.dropped_zero_area_faces, "input faces dropped: zero area (three collinear vertices)"),
+        (r.dropped_collapsed_patches, "input patches dropped: all their control points are one point"),
         (
             mesh.collapsed_triangles,
             "triangles not emitted: they collapse where a boundary curve is a single point",
@@ -244,6 +264,8 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         "welded_points": r.welded_points,
         "dropped_degenerate_faces": r.dropped_degenerate_faces,
         "dropped_duplicate_faces": r.dropped_duplicate_faces,
+        "dropped_zero_area_faces": r.dropped_zero_area_faces,
+        "dropped_collapsed_patches": r.dropped_collapsed_patches,
         "collapsed_triangles": mesh.collapsed_triangles,
         "flipped": r.flipped,
     })
@@ -344,8 +366,11 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             set.patches.len()
         );
     }
+    // Checked on every run: a mesh that is open, non-manifold or degenerate where the input
+    // was not never leaves without a warning and exit status 1.
+    let w = verify::watertight(&mesh);
+    let problems = output_problems(&set, &w, culled);
     if a.stats {
-        let w = verify::watertight(&mesh);
         let seconds = median(times);
         let mut stats = serde_json::json!({
             "input": a.input.display().to_string(),
@@ -360,6 +385,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             "euler_characteristic": w.euler_characteristic,
             "input_euler_characteristic": set.topology.report.euler_characteristic,
             "input_boundary_edges": set.topology.report.boundary_edges,
+            "input_nonmanifold_edges": set.topology.report.nonmanifold_edges,
             "seconds": seconds,
             "repeat": a.repeat.max(1),
             "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
@@ -388,9 +414,54 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             stats["max_error"] = e.max.into();
             stats["rms_error"] = e.rms.into();
         }
+        stats["problems"] = problems.clone().into();
         println!("{stats}");
     }
-    Ok(ExitCode::SUCCESS)
+    for p in &problems {
+        eprintln!("warning: {p}");
+    }
+    Ok(if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// What is wrong with the output that was not wrong with the input. Culled patches leave
+/// holes by request, so with culling only the degeneracies count.
+fn output_problems(set: &SurfaceSet, w: &verify::WatertightReport, culled: usize) -> Vec<String> {
+    let t = set.topology.report;
+    let mut problems = Vec::new();
+    if w.degenerate_triangles() > 0 {
+        problems.push(format!(
+            "the mesh has {} degenerate triangles ({} with two corners at one position, {} of zero area)",
+            w.degenerate_triangles(),
+            w.collapsed_triangles,
+            w.zero_area_triangles
+        ));
+    }
+    // A non-manifold input curve legitimately gives non-manifold output edges, one per segment.
+    if w.nonmanifold_edges > 0 && t.nonmanifold_edges == 0 {
+        problems.push(format!(
+            "the input is manifold but the mesh has {} non-manifold edges",
+            w.nonmanifold_edges
+        ));
+    }
+    if w.misoriented_edges > 0 && t.inconsistently_oriented_edges == 0 {
+        problems.push(format!("the mesh has {} edges used twice in the same direction", w.misoriented_edges));
+    }
+    if culled == 0 {
+        if t.boundary_edges == 0 && w.boundary_edges > 0 {
+            problems
+                .push(format!("the input is closed but the mesh has {} boundary edges", w.boundary_edges));
+        }
+        if t.nonmanifold_edges == 0
+            && w.nonmanifold_edges == 0
+            && w.euler_characteristic != t.euler_characteristic
+        {
+            problems.push(format!(
+                "the mesh's Euler characteristic is {}, the input's {}: its topology changed (a pinch or a hole)",
+                w.euler_characteristic, t.euler_characteristic
+            ));
+        }
+    }
+    problems
 }
 
 /// Writes the instanced form of a semi-uniform plan (see `--instanced`).

@@ -34,7 +34,9 @@ pub struct PatternArgs {
     domain: DomainArg,
     /// Edge factors in Direct3D's order: quad U==0,V==0,U==1,V==1 (the edges u = 0, v = 0,
     /// u = 1, v = 1); tri U==0,V==0,W==0. Integers for uniform and transition, powers of two
-    /// for semi-uniform, real factors for sd2 and the hardware schemes. Not used by esc.
+    /// for semi-uniform, real factors for sd2 and the hardware schemes (pow2 as the hardware
+    /// takes them: rounded up to integers; rounding to powers of two is the hull shader's
+    /// part, which `tessera mesh` does). Not used by esc.
     #[arg(long, value_name = "F0,F1,F2[,F3]", value_delimiter = ',')]
     edges: Vec<f64>,
     /// Inside factors: quad U,V; tri one. Hardware schemes take them as the hardware does;

@@ -294,7 +294,13 @@ pub fn choose(
             )
             .into());
         }
-        let plan = Plan::uniform(set, n)?;
+        let mut plan = Plan::uniform(set, n)?;
+        if args.cull {
+            // A fixed factor has no camera of its own; --cull culls against --camera (or the
+            // default camera) all the same.
+            let cam = camera(args, set)?;
+            plan.visible = set.patches.iter().map(|p| !screen::culled(p, &cam)).collect();
+        }
         return Ok(Chosen {
             plan,
             pattern,

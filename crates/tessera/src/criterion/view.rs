@@ -126,9 +126,15 @@ pub fn plan(
     let factors = edge_factors(set, camera, criterion, fmin as f64, fmax as f64);
     let mut segments: Vec<u32> =
         factors.iter().zip(&minimum).map(|(&f, &m)| (f.round() as u32).clamp(fmin, fmax).max(m)).collect();
+    let min_interior = minimum_interior(set);
     if layout == Layout::Uniform {
-        let n = segments.iter().copied().max().unwrap_or(1);
+        // One factor everywhere, edges and interiors alike (the uniform pattern's
+        // precondition), at least what every patch's interior needs.
+        let n = segments.iter().copied().chain(min_interior.iter().flatten().copied()).max().unwrap_or(1);
         segments.iter_mut().for_each(|s| *s = n);
+        let interior = vec![[n, n]; set.patches.len()];
+        let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
+        return Plan { edges: segments.into_iter().map(EdgeSampling::uniform).collect(), interior, visible };
     }
     if layout == Layout::Dyadic {
         // Levels, not factors, are interpolated (paper 000 / DRS08: level ⌈s·M⌉ for
@@ -144,7 +150,6 @@ pub fn plan(
             *s = (1u32 << level).max(m.next_power_of_two()).min(1 << top);
         }
     }
-    let min_interior = minimum_interior(set);
     let interior = (0..set.patches.len())
         .map(|p| {
             let domain = set.patches[p].domain();

@@ -43,6 +43,12 @@ pub struct Repairs {
     /// Faces dropped because an earlier face has the same three vertices (in any order or
     /// winding): a copy adds no surface, only coincident triangles.
     pub dropped_duplicate_faces: usize,
+    /// Faces dropped because their three (distinct) vertices are collinear: a face of zero
+    /// area has no normal and no surface.
+    pub dropped_zero_area_faces: usize,
+    /// Patches dropped because all their control points are one point (after welding): they
+    /// have no surface, and their triangles would all degenerate.
+    pub dropped_collapsed_patches: usize,
     /// The orientation was reversed (by `Outward` or by `flip`).
     pub flipped: bool,
 }
@@ -149,14 +155,20 @@ impl SurfaceSet {
         let welded = weld(&points, &weights, options.weld);
         repairs.welded_points = welded.merged;
         let mut keys = Vec::with_capacity(patches.len());
+        let mut kept = Vec::with_capacity(patches.len());
         let mut base = 0;
-        for p in patches.iter_mut() {
+        for mut p in patches {
             let count = p.control_points().len();
             let ids = &welded.ids[base..base + count];
+            base += count;
+            if ids.iter().all(|&i| i == ids[0]) {
+                repairs.dropped_collapsed_patches += 1;
+                continue;
+            }
             if matches!(options.weld, Weld::Within(_)) {
                 // Snap to the cluster representative so both neighbours get the same curve.
                 let snapped: Vec<DVec3> = ids.iter().map(|&i| points[i as usize]).collect();
-                match p {
+                match &mut p {
                     Patch::Bicubic(b) => b.points.copy_from_slice(&snapped),
                     Patch::BezierTriangle(b) => b.points.copy_from_slice(&snapped),
                     Patch::Pn(b) => b.geometry.points.copy_from_slice(&snapped),
@@ -172,8 +184,9 @@ impl SurfaceSet {
                 k.edges[e] = edge.map(|c| ids[c]);
             }
             keys.push(k);
-            base += count;
+            kept.push(p);
         }
+        let patches = kept;
         let topology = Topology::build(&keys);
         SurfaceSet { patches, keys, topology, repairs }
     }
@@ -195,7 +208,7 @@ impl SurfaceSet {
 
     /// Builds PN triangles from a triangle mesh.
     ///
-    /// Vertices with bit-identical positions are welded (or within `options.weld`); faces that
+    /// Vertices with identical positions at f32 precision are welded (or within `options.weld`); faces that
     /// then repeat a vertex, and faces that repeat an earlier face's vertices, are dropped and
     /// counted in [`Repairs`]. Normals: the file's when
     /// every corner of a face has one, else angle-weighted averages of the face normals.
@@ -227,6 +240,11 @@ impl SurfaceSet {
             sorted.sort_unstable();
             if !seen.insert(sorted) {
                 repairs.dropped_duplicate_faces += 1;
+                continue;
+            }
+            let [a, b, c] = v.map(pos);
+            if (b - a).cross(c - a) == DVec3::ZERO {
+                repairs.dropped_zero_area_faces += 1;
                 continue;
             }
             let n = f.normals.as_ref().and_then(|n| {

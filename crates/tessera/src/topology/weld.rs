@@ -7,8 +7,11 @@ use std::collections::HashMap;
 /// How coincident points are merged.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Weld {
-    /// Merge points with bit-identical coordinates (`-0.0` equals `0.0`). The default: it never
-    /// merges points the author kept apart.
+    /// Merge points whose coordinates (and weights) are identical at `f32` precision, the
+    /// precision of the output (`-0.0` equals `0.0`). The default: it merges only points that
+    /// would become one output position anyway — a boundary curve shorter than `f32` can
+    /// resolve then collapses to a point (and is handled as one) instead of giving degenerate
+    /// triangles and a pinched mesh.
     #[default]
     Exact,
     /// Merge points closer than this distance (per axis grid cells, then Euclidean test); each
@@ -27,9 +30,9 @@ pub struct Welded {
     pub merged: usize,
 }
 
-fn bits(p: DVec3, w: f64) -> [u64; 4] {
+fn bits(p: DVec3, w: f64) -> [u32; 4] {
     // Adding 0.0 turns -0.0 into +0.0, so the two zeros hash alike.
-    [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits(), (w + 0.0).to_bits()]
+    [p.x, p.y, p.z, w].map(|x| (x as f32 + 0.0).to_bits())
 }
 
 /// Welds `points` (with their `weights`; points of different weight never merge).
@@ -41,7 +44,7 @@ pub fn weld(points: &[DVec3], weights: &[f64], mode: Weld) -> Welded {
     match mode {
         Weld::Off => {}
         Weld::Exact => {
-            let mut seen: HashMap<[u64; 4], u32> = HashMap::with_capacity(n);
+            let mut seen: HashMap<[u32; 4], u32> = HashMap::with_capacity(n);
             for i in 0..n {
                 let r = *seen.entry(bits(points[i], weights[i])).or_insert(i as u32);
                 if r != i as u32 {
@@ -91,11 +94,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn exact_weld_merges_bit_equal_points_and_signed_zeros() {
-        let p = [DVec3::new(0.0, 1.0, 2.0), DVec3::new(-0.0, 1.0, 2.0), DVec3::new(0.0, 1.0, 2.0000001)];
-        let w = weld(&p, &[1.0; 3], Weld::Exact);
-        assert_eq!(w.ids, vec![0, 0, 2]);
-        assert_eq!(w.merged, 1);
+    fn exact_weld_merges_points_equal_at_f32_precision_and_signed_zeros() {
+        let p = [
+            DVec3::new(0.0, 1.0, 2.0),
+            DVec3::new(-0.0, 1.0, 2.0),
+            // 1e-8 apart: one f32 position, so one point.
+            DVec3::new(0.0, 1.0, 2.00000001),
+            // 1e-6 apart: four f32 steps, kept apart.
+            DVec3::new(0.0, 1.0, 2.000001),
+        ];
+        let w = weld(&p, &[1.0; 4], Weld::Exact);
+        assert_eq!(w.ids, vec![0, 0, 0, 3]);
+        assert_eq!(w.merged, 2);
     }
 
     #[test]

@@ -80,26 +80,32 @@ impl Processed {
             return None;
         }
         let (lo, hi) = partitioning.range();
-        let e: Vec<f32> = edges.iter().map(|&f| clamp(f, lo, hi, partitioning)).collect();
+        let mut e = [0f32; 4];
+        for (k, &f) in edges.iter().enumerate() {
+            e[k] = clamp(f, lo, hi, partitioning);
+        }
+        let e = &e[..n];
         let frame_threshold = 1.0 + EPSILON / 2.0;
         // Quads also look at the raw inside factors; triangles have only one.
         let frame = partitioning == Partitioning::FractionalOdd
             && (e.iter().any(|&f| f > frame_threshold)
                 || (domain == Domain::Quad && inside.iter().any(|&f| f > frame_threshold)));
         let inside_lo = if frame { 1.0 + EPSILON } else { lo };
-        let i: Vec<f32> = inside.iter().map(|&f| clamp(f, inside_lo, hi, partitioning)).collect();
-        let e_fixed: Vec<Fixed> = e.iter().map(|&f| to_fixed(f)).collect();
-        let i_fixed: Vec<Fixed> = i.iter().map(|&f| to_fixed(f)).collect();
+        let mut i = [0f32; 2];
+        for (k, &f) in inside.iter().enumerate() {
+            i[k] = clamp(f, inside_lo, hi, partitioning);
+        }
+        let i = &i[..inside.len()];
         let minimum = (partitioning.is_integer() || partitioning == Partitioning::FractionalOdd)
-            && e_fixed.iter().chain(&i_fixed).all(|&f| f == ONE);
+            && e.iter().chain(i).all(|&f| to_fixed(f) == ONE);
         let mut outer = [Axis::new(ONE, true); 4];
         for k in 0..n {
-            outer[k] = Axis::new(e_fixed[k], parity_odd(e[k], partitioning, false));
+            outer[k] = Axis::new(to_fixed(e[k]), parity_odd(e[k], partitioning, false));
         }
         let mut inner = [Axis::new(ONE, true); 2];
         for k in 0..2 {
             let j = k.min(i.len() - 1);
-            let mut a = Axis::new(i_fixed[j], parity_odd(i[j], partitioning, true));
+            let mut a = Axis::new(to_fixed(i[j]), parity_odd(i[j], partitioning, true));
             // Fewer points would leave no interior: the transition regions degenerate instead.
             a.points = a.points.max(if a.odd { 4 } else { 3 });
             inner[k] = a;
@@ -171,22 +177,58 @@ impl Processed {
     }
 }
 
-/// One ring of points as a cycle, split into sides that share their end points.
+/// One ring of points as a cycle, split into sides that share their end points. Most rings
+/// are a run of consecutive point indices, kept as `start..start + len` without a vector.
 #[derive(Debug, Clone, Default)]
 struct Ring {
-    points: Vec<u32>,
+    start: u32,
+    len: u32,
+    /// The cycle when it is not a run of consecutive indices (the degenerate ring).
+    cycle: Vec<u32>,
     side_points: [u32; 4],
 }
 
 impl Ring {
-    /// Point `j` of side `e`, following the cycle (the last side wraps to the first point).
-    fn at(&self, e: usize, j: u32) -> u32 {
+    fn from_cycle(cycle: Vec<u32>, side_points: [u32; 4]) -> Ring {
+        Ring { start: 0, len: cycle.len() as u32, cycle, side_points }
+    }
+
+    /// Appends point `id` to the cycle.
+    fn push(&mut self, id: u32) {
+        if self.cycle.is_empty() && (self.len == 0 || id == self.start + self.len) {
+            if self.len == 0 {
+                self.start = id;
+            }
+        } else {
+            if self.cycle.is_empty() {
+                self.cycle.extend(self.start..self.start + self.len);
+            }
+            self.cycle.push(id);
+        }
+        self.len += 1;
+    }
+
+    /// Point `i` of the cycle (wrapping).
+    fn point(&self, i: u32) -> u32 {
+        let i = i % self.len;
+        if self.cycle.is_empty() {
+            self.start + i
+        } else {
+            self.cycle[i as usize]
+        }
+    }
+
+    /// The points of side `e` into `out` (the last side wraps to the first point).
+    fn side_into(&self, e: usize, out: &mut Vec<u32>) {
         let offset: u32 = self.side_points[..e].iter().map(|n| n - 1).sum();
-        self.points[((offset + j) as usize) % self.points.len()]
+        out.clear();
+        out.extend((0..self.side_points[e]).map(|j| self.point(offset + j)));
     }
 
     fn side(&self, e: usize) -> Vec<u32> {
-        (0..self.side_points[e]).map(|j| self.at(e, j)).collect()
+        let mut out = Vec::new();
+        self.side_into(e, &mut out);
+        out
     }
 }
 
@@ -264,7 +306,7 @@ fn outer_ring(
         for p in 0..end {
             let q = if reversed(pre.domain, e) { end - p } else { p };
             let (u, v) = point(e, axis.place(q));
-            ring.points.push(push(out, u, v));
+            ring.push(push(out, u, v));
         }
         ring.side_points[e] = axis.points as u32;
     }
@@ -302,7 +344,7 @@ fn quad(pre: &Processed, out: &mut HardwareTessellation) {
                 let q = if e == 1 || e == 2 { p } else { end[along] - (p - r) };
                 let x = pre.inside[along].place(q);
                 let id = if along == 1 { push(out, perp, x) } else { push(out, x, perp) };
-                ring.points.push(id);
+                ring.push(id);
             }
             ring.side_points[e] = (n[along] - 2 * r) as u32;
         }
@@ -328,14 +370,16 @@ fn quad(pre: &Processed, out: &mut HardwareTessellation) {
         if line.len() > 1 {
             points.extend(line[1..line.len() - 1].iter().rev());
         }
-        rings.push(Ring { points, side_points: if line.len() == 1 { [1; 4] } else { side_points } });
+        rings.push(Ring::from_cycle(points, if line.len() == 1 { [1; 4] } else { side_points }));
     }
     let band_rings = ((n[0] + 1) >> 1).min((n[1] + 1) >> 1) as usize;
     debug_assert_eq!(band_rings, rings.len());
+    let (mut outer, mut inner) = (Vec::new(), Vec::new());
     for r in 1..band_rings {
         let mut emit = Emit { out, region: r as u32 };
         for e in 0..4 {
-            let (outer, inner) = (rings[r - 1].side(e), rings[r].side(e));
+            rings[r - 1].side_into(e, &mut outer);
+            rings[r].side_into(e, &mut inner);
             if r == 1 {
                 emit.transition(&inner, &pre.inside[(e + 1) & 1], &outer, &pre.outer[e]);
             } else {
@@ -387,7 +431,7 @@ fn tri(pre: &Processed, out: &mut HardwareTessellation) {
                     1 => push(out, x, perp),
                     _ => push(out, x, ONE - x - perp),
                 };
-                ring.points.push(id);
+                ring.push(id);
             }
             ring.side_points[e] = (n - 2 * r) as u32;
         }
@@ -395,14 +439,16 @@ fn tri(pre: &Processed, out: &mut HardwareTessellation) {
     }
     if !axis.odd {
         let centre = push(out, ONE_THIRD, ONE_THIRD);
-        rings.push(Ring { points: vec![centre], side_points: [1; 4] });
+        rings.push(Ring::from_cycle(vec![centre], [1; 4]));
     }
     let band_rings = ((n + 1) >> 1) as usize;
     debug_assert_eq!(band_rings, rings.len());
+    let (mut outer, mut inner) = (Vec::new(), Vec::new());
     for r in 1..band_rings {
         let mut emit = Emit { out, region: r as u32 };
         for e in 0..3 {
-            let (outer, inner) = (rings[r - 1].side(e), rings[r].side(e));
+            rings[r - 1].side_into(e, &mut outer);
+            rings[r].side_into(e, &mut inner);
             if r == 1 {
                 emit.transition(&inner, &axis, &outer, &pre.outer[e]);
             } else {
@@ -411,8 +457,8 @@ fn tri(pre: &Processed, out: &mut HardwareTessellation) {
         }
     }
     if axis.odd {
-        let last = &rings[band_rings - 1].points;
-        Emit { out, region: band_rings as u32 }.tri(last[0], last[1], last[2]);
+        let last = &rings[band_rings - 1];
+        Emit { out, region: band_rings as u32 }.tri(last.point(0), last.point(1), last.point(2));
     }
 }
 
