@@ -1,31 +1,10 @@
 //! End-to-end tests of the `tessera` binary: the commands README.md shows, and bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn data(rel: &str) -> PathBuf {
-    let base = std::env::var("TESSERA_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let p = base.join(rel);
-    assert!(p.exists(), "{} missing: set TESSERA_DATA to the shared data folder", p.display());
-    p
-}
-
-fn tessera(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tessera")).args(args).current_dir(dir).output().expect("run tessera")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tessera-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+use common::{data, scratch, tessera, text};
+use std::path::Path;
+use std::process::Output;
 
 #[test]
 fn demo_writes_a_watertight_teapot() {

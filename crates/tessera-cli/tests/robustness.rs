@@ -2,32 +2,13 @@
 //! nothing on stderr (or crashed) before; now it is refused with a clear line, repaired and
 //! reported, or warned about with exit status 1.
 
+mod common;
+
+use common::{data, scratch, tessera, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn data(rel: &str) -> PathBuf {
-    let base = std::env::var("TESSERA_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let p = base.join(rel);
-    assert!(p.exists(), "{} missing: set TESSERA_DATA to the shared data folder", p.display());
-    p
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tessera-robust-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn run(args: &[&str], dir: &Path) -> (Option<i32>, String, String) {
-    let out: Output = Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tessera");
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    let out = tessera(args, dir);
     let err = text(&out.stderr);
     assert!(!err.contains("panicked"), "{args:?}: {err}");
     (out.status.code(), text(&out.stdout), err)

@@ -322,6 +322,32 @@ fn reversed(domain: Domain, e: usize) -> bool {
     }
 }
 
+/// Stitches the band between each pair of consecutive rings, side by side: the ruler-function
+/// transition from the outer edges to ring 1 (`inside(e)` is the partition along side `e`),
+/// trapezoids with mirrored diagonals further in.
+fn stitch_bands<'a>(
+    pre: &'a Processed,
+    rings: &[Ring],
+    band_rings: usize,
+    inside: impl Fn(usize) -> &'a Axis,
+    out: &mut HardwareTessellation,
+) {
+    debug_assert_eq!(band_rings, rings.len());
+    let (mut outer, mut inner) = (Vec::new(), Vec::new());
+    for r in 1..band_rings {
+        let mut emit = Emit { out, region: r as u32 };
+        for e in 0..pre.domain.corner_count() {
+            rings[r - 1].side_into(e, &mut outer);
+            rings[r].side_into(e, &mut inner);
+            if r == 1 {
+                emit.transition(&inner, inside(e), &outer, &pre.outer[e]);
+            } else {
+                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
+            }
+        }
+    }
+}
+
 fn quad(pre: &Processed, out: &mut HardwareTessellation) {
     let [iu, iv] = pre.inside;
     let n = [iu.points, iv.points];
@@ -373,20 +399,7 @@ fn quad(pre: &Processed, out: &mut HardwareTessellation) {
         rings.push(Ring::from_cycle(points, if line.len() == 1 { [1; 4] } else { side_points }));
     }
     let band_rings = ((n[0] + 1) >> 1).min((n[1] + 1) >> 1) as usize;
-    debug_assert_eq!(band_rings, rings.len());
-    let (mut outer, mut inner) = (Vec::new(), Vec::new());
-    for r in 1..band_rings {
-        let mut emit = Emit { out, region: r as u32 };
-        for e in 0..4 {
-            rings[r - 1].side_into(e, &mut outer);
-            rings[r].side_into(e, &mut inner);
-            if r == 1 {
-                emit.transition(&inner, &pre.inside[(e + 1) & 1], &outer, &pre.outer[e]);
-            } else {
-                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
-            }
-        }
-    }
+    stitch_bands(pre, &rings, band_rings, |e| &pre.inside[(e + 1) & 1], out);
     // A strip of quads in the middle when the smaller inside partition is odd.
     if let Some((quads, horizontal)) = pre.centre_strip() {
         let last = rings.last().expect("at least the outer ring");
@@ -442,20 +455,7 @@ fn tri(pre: &Processed, out: &mut HardwareTessellation) {
         rings.push(Ring::from_cycle(vec![centre], [1; 4]));
     }
     let band_rings = ((n + 1) >> 1) as usize;
-    debug_assert_eq!(band_rings, rings.len());
-    let (mut outer, mut inner) = (Vec::new(), Vec::new());
-    for r in 1..band_rings {
-        let mut emit = Emit { out, region: r as u32 };
-        for e in 0..3 {
-            rings[r - 1].side_into(e, &mut outer);
-            rings[r].side_into(e, &mut inner);
-            if r == 1 {
-                emit.transition(&inner, &axis, &outer, &pre.outer[e]);
-            } else {
-                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
-            }
-        }
-    }
+    stitch_bands(pre, &rings, band_rings, |_| &axis, out);
     if axis.odd {
         let last = &rings[band_rings - 1];
         Emit { out, region: band_rings as u32 }.tri(last.point(0), last.point(1), last.point(2));
