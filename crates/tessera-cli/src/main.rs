@@ -215,18 +215,27 @@ fn limits(max_triangles: Option<u64>, corner_params: bool) -> TessellateOptions 
     }
 }
 
-/// The CLI's line for an output the engine refused: the estimate, the memory, and the flag.
+/// The CLI's line for an output the engine refused: the estimate, the memory, and which limit
+/// (and flag) stopped it.
 fn explain_limit(e: tessera::Error, options: &TessellateOptions) -> Box<dyn std::error::Error> {
-    match e {
-        tessera::Error::OutputTooLarge { vertices, triangles, bytes } => format!(
-            "output too large: {vertices} vertices and {triangles} triangles would need {:.1} GiB; the limit is \
-             --max-triangles {} (from the memory available): lower the factor or the criterion, or raise --max-triangles",
-            bytes as f64 / (1u64 << 30) as f64,
-            options.max_triangles.unwrap_or(u64::MAX)
+    let tessera::Error::OutputTooLarge { vertices, triangles, bytes } = e else { return e.into() };
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    let max_triangles = options.max_triangles.unwrap_or(u64::MAX);
+    let why = if triangles > max_triangles {
+        format!("the limit is --max-triangles {max_triangles}: lower the factor or the criterion, or raise --max-triangles")
+    } else if options.memory_limit.is_some_and(|m| bytes > m) {
+        format!(
+            "more than three quarters of the memory available ({:.1} GiB): lower the factor or the criterion",
+            gib(options.memory_limit.unwrap_or(0))
         )
-        .into(),
-        other => other.into(),
-    }
+    } else {
+        "beyond the 32-bit vertex index range: lower the factor or the criterion".to_string()
+    };
+    format!(
+        "output too large: {vertices} vertices and {triangles} triangles would need {:.1} GiB; {why}",
+        gib(bytes)
+    )
+    .into()
 }
 
 /// A ratio for a message: fixed-point when small, scientific when huge.

@@ -246,7 +246,7 @@ fn tessellate_generic(
         })
         .collect();
     let corner_count = topo.corner_entries.len();
-    let edge_total: usize = edge_counts.iter().sum();
+    let (edge_offsets, edge_total) = exclusive_scan(&edge_counts);
     let interior_total: usize = upper.iter().map(|c| c.0).sum();
     let upper_triangles: usize = upper.iter().map(|c| c.1).sum();
     check_size((corner_count + edge_total + interior_total) as u64, upper_triangles as u64, &options)?;
@@ -267,7 +267,6 @@ fn tessellate_generic(
         .collect();
 
     // Scan.
-    let (edge_offsets, edge_total) = exclusive_scan(&edge_counts);
     let interior_counts: Vec<usize> = patch_counts.iter().map(|c| c.0).collect();
     let tri_counts: Vec<usize> = patch_counts.iter().map(|c| c.1).collect();
     let (interior_offsets, interior_total) = exclusive_scan(&interior_counts);
