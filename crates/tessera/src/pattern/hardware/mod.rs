@@ -47,6 +47,7 @@ use glam::DVec2;
 use partition::{
     clamp, parity_odd, to_f64, to_fixed, Fixed, EPSILON, FRACTION_BITS, HALF, ONE, ONE_THIRD, TWO_THIRDS,
 };
+use std::cell::RefCell;
 use stitch::{Diagonals, Emit};
 
 mod partition;
@@ -257,8 +258,24 @@ pub fn tessellate(
     edges: [f32; 4],
     inside: [f32; 2],
 ) -> Option<HardwareTessellation> {
-    let pre = Processed::new(domain, partitioning, edges, inside)?;
     let mut out = HardwareTessellation::default();
+    tessellate_into(domain, partitioning, edges, inside, &mut out).then_some(out)
+}
+
+/// [`tessellate`] into `out`, reusing its buffers; false (and `out` emptied) when the hardware
+/// culls the patch. Cost: linear in the output, no allocation once `out` has grown.
+pub fn tessellate_into(
+    domain: Domain,
+    partitioning: Partitioning,
+    edges: [f32; 4],
+    inside: [f32; 2],
+    out: &mut HardwareTessellation,
+) -> bool {
+    out.points.clear();
+    out.triangles.clear();
+    out.regions.clear();
+    out.edge_points = [0; 4];
+    let Some(pre) = Processed::new(domain, partitioning, edges, inside) else { return false };
     for e in 0..domain.corner_count() {
         out.edge_points[e] = pre.outer[e].points as u32;
     }
@@ -266,26 +283,26 @@ pub fn tessellate(
         match domain {
             Domain::Quad => {
                 out.points.extend([DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]);
-                let mut emit = Emit { out: &mut out, region: 1 };
+                let mut emit = Emit { out, region: 1 };
                 emit.tri(0, 1, 3);
                 emit.tri(1, 2, 3);
             }
             Domain::Tri => {
                 out.points.extend([DVec2::Y, DVec2::ZERO, DVec2::X]);
-                Emit { out: &mut out, region: 1 }.tri(0, 1, 2);
+                Emit { out, region: 1 }.tri(0, 1, 2);
             }
         }
-        return Some(out);
+        return true;
     }
     let (points, triangles) = pre.counts();
     out.points.reserve(points as usize);
     out.triangles.reserve(triangles as usize);
     match domain {
-        Domain::Quad => quad(&pre, &mut out),
-        Domain::Tri => tri(&pre, &mut out),
+        Domain::Quad => quad(&pre, out),
+        Domain::Tri => tri(&pre, out),
     }
     debug_assert_eq!((out.points.len() as u32, out.triangles.len() as u32), (points, triangles));
-    Some(out)
+    true
 }
 
 fn push(out: &mut HardwareTessellation, u: Fixed, v: Fixed) -> u32 {
@@ -536,27 +553,34 @@ impl Pattern for Hardware {
         out.triangles.clear();
         let d = input.domain;
         let (edges, inside) = self.factors(input);
-        let hw = tessellate(d, self.partitioning, edges, inside).expect("edge factors are positive");
-        debug_assert!(
-            (0..d.corner_count()).all(|e| input.segments[e] + 1 == hw.edge_points[d3d_edge(d, e)]),
-            "hardware pattern: segments do not match factors: {input:?}"
-        );
-        // Local index of every hardware point: the outer ring's points are tessera's boundary
-        // points, the rest interior in the hardware's order.
-        let mut local = Vec::with_capacity(hw.points.len());
-        for dd in 0..d.corner_count() {
-            let (e, against) = tessera_edge(d, dd);
-            let end = hw.edge_points[dd] - 1;
-            for p in 0..end {
-                let q = if reversed(d, dd) { end - p } else { p };
-                let k = if against { end - q } else { q };
-                local.push(input.boundary_vertex(e, k));
-            }
+        // One scratch per thread: the engine builds many patches on each.
+        thread_local! {
+            static SCRATCH: RefCell<(HardwareTessellation, Vec<u32>)> = RefCell::default();
         }
-        let outer = local.len();
-        let base = input.interior_base();
-        local.extend((0..(hw.points.len() - outer) as u32).map(|j| base + j));
-        out.interior.extend_from_slice(&hw.points[outer..]);
-        out.triangles.extend(hw.triangles.iter().map(|t| t.map(|v| local[v as usize])));
+        SCRATCH.with_borrow_mut(|(hw, local)| {
+            let positive = tessellate_into(d, self.partitioning, edges, inside, hw);
+            assert!(positive, "edge factors are positive");
+            debug_assert!(
+                (0..d.corner_count()).all(|e| input.segments[e] + 1 == hw.edge_points[d3d_edge(d, e)]),
+                "hardware pattern: segments do not match factors: {input:?}"
+            );
+            // Local index of every hardware point: the outer ring's points are tessera's
+            // boundary points, the rest interior in the hardware's order.
+            local.clear();
+            for dd in 0..d.corner_count() {
+                let (e, against) = tessera_edge(d, dd);
+                let end = hw.edge_points[dd] - 1;
+                for p in 0..end {
+                    let q = if reversed(d, dd) { end - p } else { p };
+                    let k = if against { end - q } else { q };
+                    local.push(input.boundary_vertex(e, k));
+                }
+            }
+            let outer = local.len();
+            let base = input.interior_base();
+            local.extend((0..(hw.points.len() - outer) as u32).map(|j| base + j));
+            out.interior.extend_from_slice(&hw.points[outer..]);
+            out.triangles.extend(hw.triangles.iter().map(|t| t.map(|v| local[v as usize])));
+        });
     }
 }
