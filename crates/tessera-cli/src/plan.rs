@@ -462,6 +462,9 @@ fn choose_esc(
     set: &SurfaceSet,
     input: &Path,
 ) -> Result<Chosen, Box<dyn std::error::Error>> {
+    if args.cull {
+        return Err("--scheme esc chooses one level per object and culls nothing: leave out --cull".into());
+    }
     if let Some(p) = set.patches.iter().position(|p| p.domain() != tessera::surface::Domain::Quad) {
         return Err(format!(
             "{}: patch {p} is a triangle patch (a mesh gives PN triangles); --scheme esc tessellates bicubic Bézier patches only",

@@ -376,6 +376,7 @@ fn scheme_misuse_is_a_clear_error() {
         (vec!["mesh", teapot, "--instanced", "q.json"], "semi-uniform"),
         (vec!["mesh", teapot, "--scheme", "semi-uniform", "--factor", "6"], "power of two"),
         (vec!["mesh", teapot, "--scheme", "fractional-odd", "--factor", "64"], "1 to 63"),
+        (vec!["mesh", teapot, "--scheme", "esc", "--cull"], "culls nothing"),
     ] {
         let out = tessera(&args, &dir);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
