@@ -32,13 +32,13 @@
 //! picture (v down); inner rings follow, each from the inside factors with the factor reduced
 //! by two per ring; an even inside partition ends in a degenerate ring (a row of points, or
 //! the centre point). The band between the outer ring and ring 1 is stitched by the
-//! ruler-function transition ([`FINAL_POINT_POSITION`]), inner bands by trapezoids with mirrored
+//! ruler-function transition (the final-point-position table in `stitch.rs`), inner bands by trapezoids with mirrored
 //! diagonals, and what is left in the middle by a strip of quads (quads) or one triangle.
 //!
 //! **Orientation.** Triangles here are counter-clockwise in the `(u, v)` plane, tessera's
 //! convention — Direct3D's `triangle_cw` output order; its `triangle_ccw` is the reverse.
 //!
-//! **Costs.** [`edge_segments`] and [`edge_param`] are O(1); [`counts`] is O(rings); building
+//! **Costs.** [`edge_segments`] and [`edge_param`] are O(1); counting (`Pattern::counts`) is O(rings); building
 //! ([`tessellate`]) is linear in the output.
 
 use super::{LocalTessellation, Pattern, PatternInput};
