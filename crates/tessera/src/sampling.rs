@@ -7,6 +7,9 @@
 
 use std::sync::Arc;
 
+/// Largest uniform factor accepted: past it a single patch would need more than 2³² indices.
+pub const MAX_FACTOR: u32 = 16_384;
+
 /// The parameters on one edge, in `[0, 1]`, endpoints included.
 #[derive(Debug, Clone, PartialEq)]
 pub enum EdgeSampling {

@@ -15,8 +15,7 @@ use crate::error::{Error, Result};
 use crate::sampling::EdgeSampling;
 use crate::surface::SurfaceSet;
 
-/// Largest uniform factor accepted: past it a single patch would need more than 2³² indices.
-pub const MAX_FACTOR: u32 = 16_384;
+pub use crate::sampling::MAX_FACTOR;
 
 /// Samplings for every edge and interior factors for every patch.
 #[derive(Debug, Clone, PartialEq)]

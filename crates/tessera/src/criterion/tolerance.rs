@@ -30,9 +30,6 @@ pub enum Layout {
     Dyadic,
 }
 
-/// Highest level of the semi-uniform pattern (paper 000 uses M ≤ 8).
-pub const MAX_DYADIC_LEVEL: u32 = 8;
-
 /// What an error-bounded plan achieved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PlanReport {
@@ -219,7 +216,7 @@ pub fn plan_limited(
     let mut cap = max_factor.max(1);
     if layout == Layout::Dyadic {
         // Largest power of two within the cap and the pattern's highest level.
-        cap = 1 << (31 - cap.min(1 << MAX_DYADIC_LEVEL).leading_zeros());
+        cap = 1 << (31 - cap.min(1 << crate::pattern::semi_uniform::MAX_LEVEL).leading_zeros());
     }
     let topo = &set.topology;
     let hessians: Vec<HessianBound> = set.patches.par_iter().map(bounds::hessian).collect();

@@ -141,7 +141,7 @@ pub fn plan(
         // silhouetteness s): the criterion's value t ∈ [0, 1] maps to the level
         // ⌈log2 fmin + t·(log2 fmax − log2 fmin)⌉, so half-way is half the levels, not a
         // factor of fmax/2 that rounds up to the top level.
-        let top = super::tolerance::MAX_DYADIC_LEVEL;
+        let top = crate::pattern::semi_uniform::MAX_LEVEL;
         let (lmin, lmax) = ((fmin as f64).log2(), (fmax as f64).log2());
         let span = (fmax - fmin) as f64;
         for (s, (&f, &m)) in segments.iter_mut().zip(factors.iter().zip(&minimum)) {

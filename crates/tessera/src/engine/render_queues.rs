@@ -30,8 +30,7 @@ use crate::surface::{Domain, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
-/// Largest level a static pattern may have (`2^8 = 256` segments per side).
-pub const MAX_LEVEL: u32 = 8;
+pub use crate::pattern::semi_uniform::MAX_LEVEL;
 
 /// `ε` of the tie offset `½ − ε`. Grid parameters are multiples of `2^-MAX_LEVEL`, so
 /// `2^p·t + ½` is either an integer (a tie) or at least `2^-MAX_LEVEL` past one; any smaller

@@ -45,8 +45,8 @@ use crate::surface::Domain;
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
 
-/// Largest SD-2 factor accepted (segments per edge).
-pub const MAX_FACTOR: f64 = 1024.0;
+/// Largest SD-2 factor accepted: the one edge-segment cap, [`crate::sampling::MAX_FACTOR`].
+pub const MAX_FACTOR: f64 = crate::sampling::MAX_FACTOR as f64;
 
 /// Segments of an edge with real factor `factor` under the symmetric remainder: `⌈f⌉`,
 /// with `f` clamped to `[1, MAX_FACTOR]` (NaN reads as 1). Cost: O(1).

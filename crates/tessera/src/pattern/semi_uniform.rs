@@ -38,6 +38,11 @@
 use super::{LocalTessellation, Pattern, PatternInput};
 use crate::surface::Domain;
 
+/// Highest level `M` of the semi-uniform pattern and its static patterns `P^0…P^M`: edge
+/// factors up to `2^8 = 256` (paper 000 uses `M ≤ 8`). The one cap every user of the scheme
+/// reads.
+pub const MAX_LEVEL: u32 = 8;
+
 /// The semi-uniform pattern for triangles and quads.
 ///
 /// Preconditions (checked by `debug_assert!`): every `segments[e]` is a power of two, and
