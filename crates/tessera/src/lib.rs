@@ -58,6 +58,7 @@
 
 pub mod camera;
 pub mod criterion;
+pub mod domain;
 pub mod engine;
 pub mod error;
 pub mod io;

@@ -661,7 +661,7 @@ mod tests {
                 }
             }
             let esc = Esc::new(vec![g]);
-            let input = PatternInput::new(crate::surface::Domain::Quad, [side; 4], [side; 2]);
+            let input = PatternInput::new(crate::domain::Domain::Quad, [side; 4], [side; 2]);
             let mut out = LocalTessellation::default();
             esc.build(&input, &mut out);
             assert_eq!(esc.counts(&input), ((side - 1) * (side - 1), 2 * side * side));

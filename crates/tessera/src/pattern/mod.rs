@@ -14,7 +14,7 @@ pub mod semi_uniform;
 pub mod transition;
 pub mod uniform;
 
-use crate::surface::Domain;
+use crate::domain::Domain;
 use glam::DVec2;
 
 /// What a pattern needs to know about a patch.

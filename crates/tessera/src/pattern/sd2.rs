@@ -40,8 +40,8 @@
 
 use super::transition::Transition;
 use super::{LocalTessellation, Pattern, PatternInput};
+use crate::domain::Domain;
 use crate::mesh::strips::RESTART;
-use crate::surface::Domain;
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
 

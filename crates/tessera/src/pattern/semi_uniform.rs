@@ -36,7 +36,7 @@
 //! at `2^m`, triangle for triangle.
 
 use super::{LocalTessellation, Pattern, PatternInput};
-use crate::surface::Domain;
+use crate::domain::Domain;
 
 /// Highest level `M` of the semi-uniform pattern and its static patterns `P^0…P^M`: edge
 /// factors up to `2^8 = 256` (paper 000 uses `M ≤ 8`). The one cap every user of the scheme

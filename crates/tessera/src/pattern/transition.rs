@@ -53,7 +53,7 @@
 //! its triangles have positive area for those positions.
 
 use super::{LocalTessellation, Pattern, PatternInput};
-use crate::surface::Domain;
+use crate::domain::Domain;
 use glam::DVec2;
 
 /// The CudaTess transition pattern: uniform core plus Bresenham-like transition strips.

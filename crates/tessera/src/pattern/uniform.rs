@@ -6,7 +6,7 @@
 //! grid: `n²` triangles, `(n+1)(n+2)/2` vertices.
 
 use super::{LocalTessellation, Pattern, PatternInput};
-use crate::surface::Domain;
+use crate::domain::Domain;
 use glam::DVec2;
 
 /// The uniform pattern. Precondition: all edges of a patch have `interior[0]` segments.

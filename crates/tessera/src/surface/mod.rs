@@ -14,6 +14,8 @@ mod bicubic;
 mod pn_triangle;
 mod set;
 
+/// The parameter domains live in [`crate::domain`]; re-exported here for the surfaces' users.
+pub use crate::domain::Domain;
 pub use bezier_triangle::BezierTriangle;
 pub use bicubic::RationalBicubic;
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
@@ -21,42 +23,6 @@ pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 
 use glam::{DVec2, DVec3};
-
-/// The parameter domain of a patch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Domain {
-    /// Triangle `u,v ≥ 0, u+v ≤ 1`; 3 corners, 3 edges.
-    Tri,
-    /// Unit square; 4 corners, 4 edges.
-    Quad,
-}
-
-impl Domain {
-    /// Number of corners (and of edges).
-    pub fn corner_count(self) -> usize {
-        match self {
-            Domain::Tri => 3,
-            Domain::Quad => 4,
-        }
-    }
-
-    /// Parameters of corner `i`.
-    pub fn corner(self, i: usize) -> DVec2 {
-        match self {
-            Domain::Tri => [DVec2::ZERO, DVec2::X, DVec2::Y][i],
-            Domain::Quad => [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y][i],
-        }
-    }
-
-    /// Parameters of the point at `t ∈ [0,1]` along edge `e` (from corner `e` to `e+1`).
-    pub fn edge_point(self, e: usize, t: f64) -> DVec2 {
-        let n = self.corner_count();
-        let a = self.corner(e);
-        let b = self.corner((e + 1) % n);
-        // Written as a convex combination so t=0 and t=1 give the corners exactly.
-        a * (1.0 - t) + b * t
-    }
-}
 
 /// A point on a surface with its unit normal.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -42,7 +42,7 @@
 //! ([`tessellate`]) is linear in the output.
 
 use super::{LocalTessellation, Pattern, PatternInput};
-use crate::surface::Domain;
+use crate::domain::Domain;
 use glam::DVec2;
 use partition::{
     clamp, parity_odd, to_f64, to_fixed, Fixed, EPSILON, FRACTION_BITS, HALF, ONE, ONE_THIRD, TWO_THIRDS,
