@@ -512,7 +512,8 @@ fn tessera_edge(domain: Domain, d: usize) -> (usize, bool) {
 /// (the engine guarantees it for [`crate::sampling::Spacing::Hardware`] samplings);
 /// `input.interior` is ignored: the inside factors come from the edge factors by Direct3D's
 /// `max` reduction (triangle: the largest edge factor; quad: inside-u the larger of the two
-/// edges along u, inside-v likewise). Cost: linear in the output.
+/// edges along u, inside-v likewise; for `fractional_odd` quads each raised to at least the
+/// other's, capped at 3, so that no ring lies on the boundary). Cost: linear in the output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Hardware {
     pub partitioning: Partitioning,
@@ -526,10 +527,20 @@ impl Hardware {
         for e in 0..d.corner_count() {
             edges[d3d_edge(d, e)] = input.factors[e] as f32;
         }
-        let inside = match d {
+        let mut inside = match d {
             Domain::Quad => [edges[1].max(edges[3]), edges[0].max(edges[2])],
             Domain::Tri => [edges[0].max(edges[1]).max(edges[2]); 2],
         };
+        // fractional_odd with an inside factor of 1 beside a larger one: the hardware forces a
+        // "picture frame" of factor 1 + 2⁻¹⁶, whose ring lies exactly on the boundary, and its
+        // transition then emits zero-area triangles along the edges — fins on a shared curve,
+        // emitted by both neighbours (found by fuzzing). Like HLSL's rule for small odd inside
+        // factors, raise it to the other one, at most 3; the edges are untouched, so
+        // neighbours still agree.
+        if d == Domain::Quad && self.partitioning == Partitioning::FractionalOdd {
+            let [u, v] = inside;
+            inside = [u.max(v.min(3.0)), v.max(u.min(3.0))];
+        }
         (edges, inside)
     }
 
