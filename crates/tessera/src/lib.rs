@@ -61,6 +61,8 @@ pub mod criterion;
 pub mod domain;
 pub mod engine;
 pub mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod io;
 pub mod mesh;
 pub mod pattern;

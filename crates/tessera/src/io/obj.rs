@@ -97,9 +97,10 @@ pub fn read_obj(path: &Path) -> Result<ObjMesh> {
 /// # Errors
 ///
 /// [`Error::Parse`] with `file` and the 1-based line for a `v`/`vn` with fewer than 3
-/// numbers, a non-number, a NaN or infinite coordinate, a face with fewer than 3 corners, a
-/// malformed corner, or an index that is 0 or refers to an element not defined before that
-/// line; [`Error::Unsupported`] (line 0) when the file has no faces.
+/// numbers, a non-number, a NaN or infinite coordinate, a `v` coordinate beyond the f32 range
+/// of the output mesh, a face with fewer than 3 corners, a malformed corner, or an index that
+/// is 0 or refers to an element not defined before that line; [`Error::Unsupported`] (line 0)
+/// when the file has no faces.
 ///
 /// Cost: O(text length) time; memory O(mesh size).
 pub fn parse_obj(text: &str, file: &Path) -> Result<ObjMesh> {
@@ -189,6 +190,14 @@ impl At<'_> {
             if !value.is_finite() {
                 let kind = if value.is_nan() { "NaN" } else { "infinite" };
                 return Err(self.err(format!("`{kw}` coordinate {name} is {kind} ({})", quote(token))));
+            }
+            // Output meshes store f32, so a position past its range would come out infinite
+            // (normals are only directions and are normalised in f64).
+            if kw == "v" && value.abs() > f64::from(f32::MAX) {
+                return Err(self.err(format!(
+                    "`v` coordinate {name} is {}, beyond the f32 range (±3.4e38) of the output mesh",
+                    quote(token)
+                )));
             }
             *slot = value;
         }
@@ -523,6 +532,8 @@ mod tests {
         assert_parse_err(&e("v inf 2 3\n"), 5, "`v` coordinate x is infinite");
         assert_parse_err(&e("v 1 -1e999 3\n"), 5, "coordinate y is infinite");
         assert_parse_err(&e("vn 0 NaN 1\n"), 5, "`vn` coordinate y is NaN");
+        // Positions the f32 output cannot hold (found by fuzzing: they came out infinite).
+        assert_parse_err(&e("v 1e39 2 3\n"), 5, "`v` coordinate x is `1e39`, beyond the f32 range");
         // CRLF line numbers.
         assert_parse_err(&e("\n\nf 1 2 7\n").replace('\n', "\r\n"), 7, "index 7");
     }

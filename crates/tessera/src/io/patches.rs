@@ -14,9 +14,10 @@
 //! endings, a UTF-8 byte-order mark, blank lines (anywhere; the counts drive the parse), a
 //! missing final newline and exponent notation. Rejected, with the file and the 1-based line:
 //! an empty file, a bad count, a patch line without exactly 16 indices, an index that is 0 or
-//! greater than the point count, a non-number, a NaN or infinite coordinate, a weight that is
-//! not finite and positive, a file with fewer data lines than its counts promise, and
-//! non-blank lines after the last point.
+//! greater than the point count, a non-number, a NaN or infinite coordinate, a coordinate
+//! beyond the f32 range of the output meshes, a weight that is not finite and positive, a
+//! file with fewer data lines than its counts promise, and non-blank lines after the last
+//! point.
 
 use std::path::Path;
 
@@ -281,6 +282,18 @@ fn parse_point_line(body: &str, line: usize, file: &Path, what: &dyn Fn() -> Str
             let kind = if value.is_nan() { "NaN" } else { "infinite" };
             return Err(Error::parse(file, line, format!("{}: {name} is {kind} ({})", what(), quote(field))));
         }
+        // Output meshes store f32, so a coordinate past its range would come out infinite.
+        if k < 3 && value.abs() > f64::from(f32::MAX) {
+            return Err(Error::parse(
+                file,
+                line,
+                format!(
+                    "{}: {name} is {}, beyond the f32 range (±3.4e38) of the output mesh",
+                    what(),
+                    quote(field)
+                ),
+            ));
+        }
         if k == 3 && !(value.is_finite() && value > 0.0) {
             return Err(Error::parse(
                 file,
@@ -518,6 +531,9 @@ mod tests {
             let t = good.replace("2.5,2,-0\n", &format!("2.5,2,{bad}\n"));
             assert_parse_err(&t, 6, &format!("point 3 of 16: z is {kind}"));
         }
+        // Coordinates the f32 output cannot hold (found by fuzzing: they came out infinite).
+        let t = good.replace("2.5,2,-0\n", "2.5,2,-1e39\n");
+        assert_parse_err(&t, 6, "point 3 of 16: z is `-1e39`, beyond the f32 range");
         // Extra content after the data.
         let t = format!("{good}\n0,0,0\n");
         assert_parse_err(&t, 21, "unexpected content after the last point");
