@@ -40,6 +40,24 @@ impl WatertightReport {
     pub fn degenerate_triangles(&self) -> usize {
         self.collapsed_triangles + self.zero_area_triangles
     }
+
+    /// Counts one undirected edge used `forward` times one way and `backward` times the other.
+    fn count_edge(&mut self, forward: u32, backward: u32) {
+        self.edges += 1;
+        match forward + backward {
+            1 => self.boundary_edges += 1,
+            2 if forward == 2 || backward == 2 => self.misoriented_edges += 1,
+            2 => {}
+            _ => self.nonmanifold_edges += 1,
+        }
+    }
+
+    /// The Euler characteristic, once vertices, edges and triangles are counted.
+    fn finish(mut self) -> Self {
+        let faces = (self.triangles - self.collapsed_triangles) as i64;
+        self.euler_characteristic = self.vertices as i64 - self.edges as i64 + faces;
+        self
+    }
 }
 
 fn position_key(p: [f32; 3]) -> [u32; 3] {
@@ -128,17 +146,9 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
             }
             k += 1;
         }
-        report.edges += 1;
-        match forward + backward {
-            1 => report.boundary_edges += 1,
-            2 if forward == 2 || backward == 2 => report.misoriented_edges += 1,
-            2 => {}
-            _ => report.nonmanifold_edges += 1,
-        }
+        report.count_edge(forward, backward);
     }
-    let faces = (report.triangles - report.collapsed_triangles) as i64;
-    report.euler_characteristic = report.vertices as i64 - report.edges as i64 + faces;
-    report
+    report.finish()
 }
 
 /// [`watertight`] with hash maps: for meshes of 2³¹ vertices or more, which the packed
@@ -180,18 +190,10 @@ fn watertight_hashed(mesh: &Mesh) -> WatertightReport {
         }
     }
     report.vertices = used.iter().filter(|&&u| u).count();
-    report.edges = edges.len();
     for &(f, b) in edges.values() {
-        match f + b {
-            1 => report.boundary_edges += 1,
-            2 if f == 2 || b == 2 => report.misoriented_edges += 1,
-            2 => {}
-            _ => report.nonmanifold_edges += 1,
-        }
+        report.count_edge(f, b);
     }
-    let faces = (report.triangles - report.collapsed_triangles) as i64;
-    report.euler_characteristic = report.vertices as i64 - report.edges as i64 + faces;
-    report
+    report.finish()
 }
 
 /// Distance between the mesh and the exact surface.
