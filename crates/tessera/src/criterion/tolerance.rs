@@ -143,22 +143,6 @@ pub fn minimum_segments(set: &SurfaceSet) -> Vec<u32> {
         .collect()
 }
 
-/// The transition layout samples a curve collapsed to a point once: its samples are all that
-/// point, and more of them would make the transition strip fan from the point over several
-/// samples of the neighbouring shared curve, a fan the neighbour across that curve emits too
-/// (non-manifold edges; found by fuzzing a spindle with `--silhouette`). The uniform and dyadic
-/// layouts keep their own counts, whose collapsed triangles the engine drops. Cost: O(E).
-pub(crate) fn one_segment_on_collapsed_curves(set: &SurfaceSet, layout: Layout, segments: &mut [u32]) {
-    if layout != Layout::Transition {
-        return;
-    }
-    for (s, e) in segments.iter_mut().zip(&set.topology.edges) {
-        if e.collapsed {
-            *s = 1;
-        }
-    }
-}
-
 /// Minimum interior factors `[u, v]` per patch, so that no two triangles of the output share
 /// an edge by accident of coarse sampling:
 /// - a quad whose opposite corners are also corners of another patch (the two halves of the
@@ -286,7 +270,6 @@ pub fn plan_limited(
             let n = segments.iter().copied().max().unwrap_or(1);
             segments.iter_mut().for_each(|s| *s = n);
         }
-        one_segment_on_collapsed_curves(set, layout, &mut segments);
         segments
     };
     let all: Vec<usize> = (0..set.patches.len()).collect();

@@ -126,7 +126,6 @@ pub fn plan(
     let factors = edge_factors(set, camera, criterion, fmin as f64, fmax as f64);
     let mut segments: Vec<u32> =
         factors.iter().zip(&minimum).map(|(&f, &m)| (f.round() as u32).clamp(fmin, fmax).max(m)).collect();
-    super::tolerance::one_segment_on_collapsed_curves(set, layout, &mut segments);
     let min_interior = minimum_interior(set);
     if layout == Layout::Uniform {
         // One factor everywhere, edges and interiors alike (the uniform pattern's
