@@ -13,6 +13,7 @@ use tessera::engine::render_queues::{self, RenderQueues, StaticPattern};
 use tessera::engine::{self, TessellateOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
+use tessera::scheme::Scheme;
 use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
 use tessera::topology::weld::Weld;
@@ -312,8 +313,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     if let Some(r) = &chosen.report {
         if r.capped_patches > 0 {
             // Semi-uniform's cap is its highest level, 2^M, not --max-factor.
-            let (cap, flag) = if a.criterion.scheme == Some(plan::SchemeArg::SemiUniform) {
-                let m = a.criterion.max_level.unwrap_or(plan::DEFAULT_MAX_LEVEL);
+            let (cap, flag) = if let Scheme::SemiUniform { max_level: m } = chosen.scheme {
                 (format!("--max-level {m} (factor {})", a.criterion.max_factor.min(1 << m)), "--max-level")
             } else {
                 (format!("--max-factor {}", a.criterion.max_factor), "--max-factor")
@@ -333,10 +333,9 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     let queues = match &a.instanced {
         Some(path) => {
-            if a.criterion.scheme != Some(plan::SchemeArg::SemiUniform) {
+            let Scheme::SemiUniform { max_level } = chosen.scheme else {
                 return Err("--instanced needs --scheme semi-uniform".into());
-            }
-            let max_level = a.criterion.max_level.unwrap_or(plan::DEFAULT_MAX_LEVEL);
+            };
             let queues = render_queues::build(&set, &chosen.plan, max_level)?;
             write_instanced(path, &set, &queues)?;
             Some(queues)
@@ -350,7 +349,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         let start = Instant::now();
         // Buffers are reused across repeats, as an application re-tessellating every frame
         // would: the median then measures tessellation, not page faults.
-        engine::tessellate_into(&set, &chosen.plan, chosen.pattern.as_ref(), opts, &mut mesh)
+        engine::tessellate_into(&set, &chosen.plan, &chosen.pattern, opts, &mut mesh)
             .map_err(|e| explain_limit(e, &opts))?;
         times.push(start.elapsed().as_secs_f64());
     }
@@ -368,7 +367,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             mesh.vertex_count()
         );
     }
-    let culled = chosen.plan.visible.iter().filter(|v| !**v).count();
+    let culled = chosen.plan.visible.iter().filter(|&&v| v == 0).count();
     if culled > 0 {
         eprintln!(
             "note: --cull left out {culled} of {} patches (outside the view or facing away): the mesh is open there",

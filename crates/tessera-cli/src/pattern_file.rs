@@ -4,18 +4,19 @@
 //! triples in Direct3D's `triangle_ccw` order (negative signed area in the `(u, v)` plane),
 //! edge factors in Direct3D's order (quad `U==0, V==0, U==1, V==1`; tri `U==0, V==0, W==0`).
 
-use crate::plan::{partitioning, SchemeArg};
+use crate::plan::SchemeArg;
 use clap::{Args, ValueEnum};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use tessera::mesh::strips::{decode, RESTART};
 use tessera::pattern::esc::{Esc, PatchGrid, MAX_LEVEL as ESC_MAX_LEVEL};
 use tessera::pattern::hardware::{self, d3d_edge, Partitioning};
-use tessera::pattern::sd2::{self, Sd2};
+use tessera::pattern::sd2::Sd2;
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::{LocalTessellation, Pattern, PatternInput};
+use tessera::scheme::Scheme;
 use tessera::surface::Domain;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -162,7 +163,7 @@ pub fn build(a: &PatternArgs) -> CmdResult<DomainPattern> {
     // Tessera's patterns: edge e of tessera's numbering is Direct3D edge d3d_edge(e).
     let nc = domain.corner_count();
     let edge = |e: usize| a.edges[d3d_edge(domain, e)];
-    let scheme = crate::plan::scheme_name(a.scheme);
+    let scheme = a.scheme.name();
     let mut out = LocalTessellation::default();
     let mut strips = Vec::new();
     let (input, params, has_strips): (PatternInput, Vec<Vec<f64>>, bool) = match a.scheme {
@@ -216,13 +217,17 @@ pub fn build(a: &PatternArgs) -> CmdResult<DomainPattern> {
             }
             let input = PatternInput {
                 domain,
-                segments: factors.map(sd2::symmetric_segments),
+                segments: factors.map(tessera::sampling::symmetric_segments),
                 interior: [1, 1],
                 factors,
                 patch: 0,
             };
             let params = (0..nc)
-                .map(|e| (0..=input.segments[e]).map(|k| sd2::symmetric_param(factors[e], k)).collect())
+                .map(|e| {
+                    (0..=input.segments[e])
+                        .map(|k| tessera::sampling::symmetric_param(factors[e], k))
+                        .collect()
+                })
                 .collect();
             let pattern = Sd2 { corner_depths: None };
             pattern.build(&input, &mut out);
@@ -352,7 +357,7 @@ fn strip_regions(strips: &[u32]) -> Vec<u32> {
 /// The JSON form: the reference file's case layout.
 pub fn to_json(a: &PatternArgs, p: &DomainPattern) -> serde_json::Value {
     let mut case = serde_json::json!({
-        "scheme": crate::plan::scheme_name(a.scheme),
+        "scheme": a.scheme.name(),
         "domain": match p.domain { Domain::Tri => "tri", Domain::Quad => "quad" },
         "edge_factors": p.edge_factors,
         "inside_factors": p.inside_factors,
@@ -412,7 +417,7 @@ pub fn to_svg(a: &PatternArgs, p: &DomainPattern) -> String {
         let _ = writeln!(s, r##"<circle cx="{x:.2}" cy="{y:.2}" r="2.2" fill="#000000"/>"##);
     }
     let factors = |f: &[f64]| f.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ");
-    let scheme = crate::plan::scheme_name(a.scheme);
+    let scheme = a.scheme.name();
     let order = match p.domain {
         Domain::Quad => "U==0, V==0, U==1, V==1",
         Domain::Tri => "U==0, V==0, W==0",
@@ -463,10 +468,18 @@ pub fn run(a: PatternArgs) -> CmdResult<()> {
     eprintln!(
         "{}: {} {} pattern, {} points, {} triangles",
         a.output.display(),
-        crate::plan::scheme_name(a.scheme),
+        a.scheme.name(),
         name(p.domain),
         p.points.len(),
         p.triangles.len()
     );
     Ok(())
+}
+
+/// The hardware tessellator's partitioning of a scheme, if it is one of the four.
+fn partitioning(scheme: SchemeArg) -> Option<tessera::pattern::hardware::Partitioning> {
+    match scheme.scheme(None, false) {
+        Scheme::Hardware(p) => Some(p),
+        _ => None,
+    }
 }

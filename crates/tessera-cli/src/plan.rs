@@ -1,22 +1,16 @@
-//! Command-line criteria: turn `--factor`, `--tolerance`, `--pixel-error`, `--distance` or
-//! `--silhouette` (with `--camera`, `--scheme`, `--max-factor`, `--cull`) into a plan and
-//! the pattern that draws it.
+//! Command-line criteria: map `--factor`, `--tolerance`, `--pixel-error`, `--distance`,
+//! `--silhouette` or ESC's flags (with `--camera`, `--scheme`, `--max-factor`, `--cull`) to
+//! the library's [`Scheme`], [`Criterion`] and [`PlanOptions`]. No scheme rule lives here.
 
 use clap::{Args, ValueEnum};
 use std::path::Path;
 use tessera::camera::Camera;
-use tessera::criterion::esc::{self, EscOptions, Threshold};
-use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
-use tessera::criterion::tolerance::{self, Layout, PlanReport};
-use tessera::criterion::view::{self, FractionalFactors, Mapping, ViewCriterion};
-use tessera::criterion::{screen, Plan};
-use tessera::pattern::hardware::{Hardware, Partitioning};
-use tessera::pattern::semi_uniform::SemiUniform;
-use tessera::pattern::semi_uniform::MAX_LEVEL;
-use tessera::pattern::transition::Transition;
-use tessera::pattern::uniform::Uniform;
-use tessera::pattern::Pattern;
-use tessera::sampling::Spacing;
+use tessera::criterion::esc::Threshold;
+use tessera::criterion::tolerance::PlanReport;
+use tessera::criterion::view::{Mapping, ViewCriterion};
+use tessera::criterion::Plan;
+use tessera::pattern::hardware::Partitioning;
+use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePattern};
 use tessera::surface::SurfaceSet;
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug, ValueEnum)]
@@ -138,20 +132,23 @@ pub struct CriterionArgs {
     pub no_cull: bool,
 }
 
-/// A plan, its pattern, a one-line description, and the guarantee report where one applies.
+/// A plan, its scheme and pattern, a one-line description, and the guarantee report where
+/// one applies.
 pub struct Chosen {
+    pub scheme: Scheme,
     pub plan: Plan,
-    pub pattern: Box<dyn Pattern>,
+    pub pattern: SchemePattern,
     pub description: String,
     pub report: Option<PlanReport>,
     pub tolerance: Option<f64>,
 }
 
-fn range(text: &str, flag: &str) -> Result<(u32, u32), String> {
-    let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|&v| v >= 1);
+/// Parses `FMIN:FMAX` (any numbers; the scheme checks their range).
+fn range(text: &str, flag: &str) -> Result<(f64, f64), String> {
+    let parse = |s: &str| s.trim().parse::<f64>().ok().filter(|v| v.is_finite());
     match text.split_once(':').map(|(a, b)| (parse(a), parse(b))) {
-        Some((Some(a), Some(b))) if a <= b => Ok((a, b)),
-        _ => Err(format!("{flag} {text}: expected FMIN:FMAX, integers with 1 ≤ FMIN ≤ FMAX")),
+        Some((Some(a), Some(b))) => Ok((a, b)),
+        _ => Err(format!("{flag} {text}: expected FMIN:FMAX, two numbers")),
     }
 }
 
@@ -177,338 +174,130 @@ pub fn camera(args: &CriterionArgs, set: &SurfaceSet) -> Result<Camera, tessera:
     }
 }
 
-fn range_f64(text: &str, flag: &str) -> Result<(f64, f64), String> {
-    let parse = |s: &str| s.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v >= 1.0);
-    match text.split_once(':').map(|(a, b)| (parse(a), parse(b))) {
-        Some((Some(a), Some(b))) if a <= b => Ok((a, b)),
-        _ => Err(format!("{flag} {text}: expected FMIN:FMAX, numbers with 1 ≤ FMIN ≤ FMAX")),
-    }
-}
-
-pub fn scheme_name(scheme: SchemeArg) -> &'static str {
-    match scheme {
-        SchemeArg::Uniform => "uniform",
-        SchemeArg::Transition => "transition",
-        SchemeArg::SemiUniform => "semi-uniform",
-        SchemeArg::Sd2 => "sd2",
-        SchemeArg::Integer => "integer",
-        SchemeArg::Pow2 => "pow2",
-        SchemeArg::FractionalOdd => "fractional-odd",
-        SchemeArg::FractionalEven => "fractional-even",
-        SchemeArg::Esc => "esc",
-    }
-}
-
-/// The view criterion of --distance / --silhouette, its text and flag.
-fn view_criterion(args: &CriterionArgs, scheme: SchemeArg) -> Option<(ViewCriterion, &str, &'static str)> {
-    match (&args.distance, &args.silhouette) {
-        (Some(d), _) => {
-            let mapping =
-                if args.mapping == MappingArg::Linear { Mapping::Linear } else { Mapping::Quadratic };
-            Some((ViewCriterion::Distance(mapping), d.as_str(), "--distance"))
+impl SchemeArg {
+    /// The library scheme, with `--max-level` and `--warp`.
+    pub fn scheme(self, max_level: Option<u32>, warp: bool) -> Scheme {
+        match self {
+            SchemeArg::Uniform => Scheme::Uniform,
+            SchemeArg::Transition => Scheme::Transition,
+            SchemeArg::SemiUniform => {
+                Scheme::SemiUniform { max_level: max_level.unwrap_or(Scheme::DEFAULT_SEMI_UNIFORM_LEVEL) }
+            }
+            SchemeArg::Sd2 => Scheme::Sd2 { warp },
+            SchemeArg::Integer => Scheme::Hardware(Partitioning::Integer),
+            SchemeArg::Pow2 => Scheme::Hardware(Partitioning::Pow2),
+            SchemeArg::FractionalOdd => Scheme::Hardware(Partitioning::FractionalOdd),
+            SchemeArg::FractionalEven => Scheme::Hardware(Partitioning::FractionalEven),
+            SchemeArg::Esc => Scheme::Esc { max_level: max_level.unwrap_or(Scheme::DEFAULT_ESC_LEVEL) },
         }
-        (None, Some(s)) => {
-            let default = if scheme == SchemeArg::Sd2 {
-                SilhouetteMode::Vertices
-            } else {
-                SilhouetteMode::Silhouetteness
-            };
-            let c = match args.silhouette_mode.unwrap_or(default) {
-                SilhouetteMode::Silhouetteness => ViewCriterion::Silhouetteness,
-                SilhouetteMode::Vertices => ViewCriterion::SilhouetteVertices,
-            };
-            Some((c, s.as_str(), "--silhouette"))
-        }
-        (None, None) => None,
+    }
+
+    /// The command-line name (the library's).
+    pub fn name(self) -> &'static str {
+        self.scheme(None, false).name()
     }
 }
 
-/// Chooses the plan and pattern; `input` names the file in errors about its contents.
-/// `max_triangles` bounds what the error-bounded criteria may build while they check their
-/// bounds (they refuse with `Error::OutputTooLarge` beyond it).
+/// The criterion the flags name (`scheme` only picks the default silhouette test), and its
+/// text for the description.
+fn criterion(
+    args: &CriterionArgs,
+    set: &SurfaceSet,
+    scheme: Option<Scheme>,
+) -> Result<(Criterion, String), String> {
+    if let Some(f) = args.factor {
+        return Ok((Criterion::Factor(f), format!("factor {f}")));
+    }
+    if let Some(t) = &args.tolerance {
+        let (lo, hi) = set.bounds();
+        let eps = parse_tolerance(t, lo.distance(hi))?;
+        return Ok((Criterion::Tolerance(eps), format!("tolerance {eps:.4e}")));
+    }
+    if let Some(px) = args.pixel_error {
+        return Ok((Criterion::PixelError(px), format!("{px} px screen-space error")));
+    }
+    if let Some(text) = &args.distance {
+        let (fmin, fmax) = range(text, "--distance")?;
+        let mapping = if args.mapping == MappingArg::Linear { Mapping::Linear } else { Mapping::Quadratic };
+        return Ok((
+            Criterion::View { criterion: ViewCriterion::Distance(mapping), fmin, fmax },
+            format!("--distance {text}"),
+        ));
+    }
+    if let Some(text) = &args.silhouette {
+        let (fmin, fmax) = range(text, "--silhouette")?;
+        let criterion = match args.silhouette_mode {
+            Some(SilhouetteMode::Silhouetteness) => ViewCriterion::Silhouetteness,
+            Some(SilhouetteMode::Vertices) => ViewCriterion::SilhouetteVertices,
+            None => scheme.unwrap_or(Scheme::Transition).default_silhouette(),
+        };
+        return Ok((Criterion::View { criterion, fmin, fmax }, format!("--silhouette {text}")));
+    }
+    let esc_flags = args.level.is_some() || args.quality.is_some() || args.threshold.is_some();
+    if esc_flags || matches!(scheme, Some(Scheme::Esc { .. })) {
+        let threshold = match (args.threshold, args.quality) {
+            (Some(d), _) => Threshold::Absolute(d),
+            (None, Some(QualityArg::High)) => Threshold::High,
+            (None, _) => Threshold::Medium,
+        };
+        let what = match threshold {
+            Threshold::High => "high quality".to_string(),
+            Threshold::Medium => "medium quality".to_string(),
+            Threshold::Absolute(d) => format!("threshold {d}"),
+        };
+        return Ok((Criterion::Esc { threshold, level: args.level }, what));
+    }
+    Ok((Criterion::Factor(8.0), "factor 8".into()))
+}
+
+/// Maps the flags to a scheme, a criterion and plan options, and plans: every rule, cap and
+/// compatibility check is the library's ([`Scheme::plan`]). `input` names the file in errors
+/// about its patches. `max_triangles` bounds what the error-bounded criteria may build while
+/// they check their bounds.
 pub fn choose(
     args: &CriterionArgs,
     set: &SurfaceSet,
     input: &Path,
     max_triangles: u64,
 ) -> Result<Chosen, Box<dyn std::error::Error>> {
-    let adaptive = args.factor.is_none()
-        && (args.tolerance.is_some()
-            || args.pixel_error.is_some()
-            || args.distance.is_some()
-            || args.silhouette.is_some());
-    let scheme = args.scheme.unwrap_or(if adaptive { SchemeArg::Transition } else { SchemeArg::Uniform });
-    let name = scheme_name(scheme);
-    if args.max_factor == 0 || args.max_factor > tessera::criterion::MAX_FACTOR {
-        return Err(
-            format!("--max-factor {}: use 1 to {}", args.max_factor, tessera::criterion::MAX_FACTOR).into()
-        );
-    }
-    if args.warp && scheme != SchemeArg::Sd2 {
+    if args.warp && args.scheme != Some(SchemeArg::Sd2) {
         return Err("--warp applies to --scheme sd2 only".into());
     }
-    if scheme != SchemeArg::Esc
-        && (args.level.is_some() || args.quality.is_some() || args.threshold.is_some())
-    {
-        return Err("--level, --quality and --threshold apply to --scheme esc only".into());
-    }
-    if scheme == SchemeArg::Esc {
-        return choose_esc(args, set, input);
-    }
-    let max_level = args.max_level.unwrap_or(DEFAULT_MAX_LEVEL);
-    if max_level > MAX_LEVEL {
-        return Err(format!("--max-level {max_level}: use 0 to {MAX_LEVEL}").into());
-    }
+    let named = args.scheme.map(|s| s.scheme(args.max_level, args.warp));
+    let (criterion, text) = criterion(args, set, named)?;
+    let scheme = named.unwrap_or_else(|| Scheme::default_for(&criterion));
+    let options = PlanOptions {
+        camera: Some(camera(args, set)?),
+        cull: args.cull,
+        max_factor: args.max_factor,
+        max_triangles,
+    };
+    let planned = scheme.plan(set, &criterion, &options).map_err(|e| -> Box<dyn std::error::Error> {
+        match e {
+            tessera::Error::PatchKindNotAccepted { .. } => format!("{}: {e}", input.display()).into(),
+            e => Box::new(e),
+        }
+    })?;
+    let mut description = format!("{}, {text}", scheme.name());
     match scheme {
-        SchemeArg::Sd2
-        | SchemeArg::Integer
-        | SchemeArg::Pow2
-        | SchemeArg::FractionalOdd
-        | SchemeArg::FractionalEven => {
-            return choose_fractional(args, set, scheme);
+        Scheme::Sd2 { warp: true } => description += ", warped",
+        Scheme::Esc { max_level } => {
+            description += &match args.level {
+                Some(l) => format!(", level {l}"),
+                None => format!(", Lmax {max_level}"),
+            }
         }
         _ => {}
     }
-    let (layout, pattern): (Layout, Box<dyn Pattern>) = match scheme {
-        SchemeArg::Transition => (Layout::Transition, Box::new(Transition)),
-        SchemeArg::SemiUniform => (Layout::Dyadic, Box::new(SemiUniform)),
-        _ => (Layout::Uniform, Box::new(Uniform)),
-    };
-    // Semi-uniform: edge levels 0..=M, so factors up to 2^M.
-    let max_factor =
-        if scheme == SchemeArg::SemiUniform { args.max_factor.min(1 << max_level) } else { args.max_factor };
-    if !adaptive {
-        let f = args.factor.unwrap_or(8.0);
-        if f.fract() != 0.0 || !(1.0..=tessera::criterion::MAX_FACTOR as f64).contains(&f) {
-            return Err(format!(
-                "--factor {f} with --scheme {name}: use an integer from 1 to {} (real factors need \
-                 --scheme fractional-odd, fractional-even or sd2)",
-                tessera::criterion::MAX_FACTOR
-            )
-            .into());
-        }
-        let n = f as u32;
-        if scheme == SchemeArg::SemiUniform && (!n.is_power_of_two() || n > 1 << max_level) {
-            return Err(format!(
-                "--factor {n} with --scheme semi-uniform: use a power of two up to 2^{max_level} (--max-level)"
-            )
-            .into());
-        }
-        let mut plan = Plan::uniform(set, n)?;
-        if args.cull {
-            // A fixed factor has no camera of its own; --cull culls against --camera (or the
-            // default camera) all the same.
-            let cam = camera(args, set)?;
-            plan.visible = set.patches.iter().map(|p| !screen::culled(p, &cam)).collect();
-        }
-        return Ok(Chosen {
-            plan,
-            pattern,
-            description: format!("{name}, factor {n}"),
-            report: None,
-            tolerance: None,
-        });
-    }
-    let cull = args.cull;
-    if let Some(t) = &args.tolerance {
-        let (lo, hi) = set.bounds();
-        let eps = parse_tolerance(t, lo.distance(hi))?;
-        let (plan, report) = tolerance::plan_limited(
-            set,
-            &vec![Some(eps); set.patches.len()],
-            layout,
-            pattern.as_ref(),
-            max_factor,
-            max_triangles,
-        )?;
-        return Ok(Chosen {
-            plan,
-            pattern,
-            description: format!("{name}, tolerance {eps:.4e}"),
-            report: Some(report),
-            tolerance: Some(eps),
-        });
-    }
-    let cam = camera(args, set)?;
-    if let Some(px) = args.pixel_error {
-        if !(px.is_finite() && px > 0.0) {
-            return Err(format!("--pixel-error {px}: must be a positive number of pixels").into());
-        }
-        let eps = screen::tolerances(set, &cam, px, cull);
-        let (plan, report) =
-            tolerance::plan_limited(set, &eps, layout, pattern.as_ref(), max_factor, max_triangles)?;
-        return Ok(Chosen {
-            plan,
-            pattern,
-            description: format!("{name}, {px} px screen-space error"),
-            report: Some(report),
-            tolerance: None,
-        });
-    }
-    let (criterion, text, flag) = view_criterion(args, scheme).expect("adaptive implies a criterion");
-    let (fmin, fmax) = range(text, flag)?;
-    let fmax = fmax.min(max_factor);
-    let plan = view::plan(set, &cam, criterion, fmin.min(fmax), fmax, layout, cull);
-    Ok(Chosen { plan, pattern, description: format!("{name}, {flag} {text}"), report: None, tolerance: None })
-}
-
-/// SD-2 and the fractional schemes: real factors, no error guarantee.
-fn choose_fractional(
-    args: &CriterionArgs,
-    set: &SurfaceSet,
-    scheme: SchemeArg,
-) -> Result<Chosen, Box<dyn std::error::Error>> {
-    let name = scheme_name(scheme);
-    if args.tolerance.is_some() || args.pixel_error.is_some() {
-        return Err(format!(
-            "--scheme {name} gives no error guarantee: use --factor, --distance or --silhouette with it, \
-             or --tolerance / --pixel-error with uniform, transition or semi-uniform"
-        )
-        .into());
-    }
-    let cam = camera(args, set)?;
-    let cull = args.cull;
-    let view = view_criterion(args, scheme);
-    let (factors, description) = match (args.factor, view) {
-        (Some(_), _) | (None, None) => {
-            let f = args.factor.unwrap_or(8.0);
-            if !(f.is_finite() && f >= 1.0 && f <= args.max_factor as f64) {
-                return Err(
-                    format!("--factor {f}: use a number from 1 to --max-factor {}", args.max_factor).into()
-                );
-            }
-            // The hardware clamps larger factors; say so rather than tessellate another factor.
-            if let Some(p) = partitioning(scheme) {
-                let hi = p.range().1 as f64;
-                if f > hi {
-                    return Err(
-                        format!("--factor {f}: the hardware's {} range is 1 to {hi}", p.name()).into()
-                    );
-                }
-            }
-            (FractionalFactors::Fixed(f), format!("{name}, factor {f}"))
-        }
-        (None, Some((criterion, text, flag))) => {
-            let (fmin, fmax) = range_f64(text, flag)?;
-            // Hardware schemes: the top of the range is the hardware's largest factor.
-            let hardware_top = partitioning(scheme).map_or(f64::INFINITY, |p| p.range().1 as f64);
-            let fmax = fmax.min(args.max_factor as f64).min(hardware_top);
-            (
-                FractionalFactors::View { criterion, fmin: fmin.min(fmax), fmax },
-                format!("{name}, {flag} {text}"),
-            )
-        }
-    };
-    if scheme == SchemeArg::Sd2 {
-        let level = match factors {
-            FractionalFactors::Fixed(_) => LevelFunction::Distance(Mapping::Linear),
-            FractionalFactors::View { criterion: ViewCriterion::Distance(m), .. } => {
-                LevelFunction::Distance(m)
-            }
-            FractionalFactors::View { criterion: ViewCriterion::SilhouetteVertices, .. } => {
-                LevelFunction::Silhouette
-            }
-            FractionalFactors::View { criterion: ViewCriterion::Silhouetteness, .. } => {
-                return Err(
-                    "--scheme sd2 needs a level function: use --silhouette-mode vertices (the default \
-                            for sd2) or --distance"
-                        .into(),
-                )
-            }
-        };
-        let (fmin, fmax) = match factors {
-            FractionalFactors::Fixed(f) => (f, f),
-            FractionalFactors::View { fmin, fmax, .. } => (fmin, fmax),
-        };
-        let options = Sd2Options { level, fmin, fmax, warp: args.warp, cull };
-        let (plan, pattern) = sd2::plan(set, &cam, &options)?;
-        let warp = if args.warp { ", warped" } else { "" };
-        return Ok(Chosen {
-            plan,
-            pattern: Box::new(pattern),
-            description: format!("{description}{warp}"),
-            report: None,
-            tolerance: None,
-        });
-    }
-    let partitioning = partitioning(scheme).expect("a hardware scheme");
-    let plan = view::fractional_plan(set, &cam, factors, Spacing::Hardware(partitioning), cull);
     Ok(Chosen {
-        plan,
-        pattern: Box::new(Hardware { partitioning }),
+        scheme,
+        plan: planned.plan,
+        pattern: planned.pattern,
         description,
-        report: None,
-        tolerance: None,
-    })
-}
-
-/// The hardware tessellator's partitioning of a scheme, if it is one of the four.
-pub fn partitioning(scheme: SchemeArg) -> Option<Partitioning> {
-    match scheme {
-        SchemeArg::Integer => Some(Partitioning::Integer),
-        SchemeArg::Pow2 => Some(Partitioning::Pow2),
-        SchemeArg::FractionalOdd => Some(Partitioning::FractionalOdd),
-        SchemeArg::FractionalEven => Some(Partitioning::FractionalEven),
-        _ => None,
-    }
-}
-
-/// Semi-uniform's default highest level M (paper 000's benchmarks use 3 and 5).
-pub const DEFAULT_MAX_LEVEL: u32 = 5;
-
-/// ESC: its own criterion (level per object from the camera, distance test).
-fn choose_esc(
-    args: &CriterionArgs,
-    set: &SurfaceSet,
-    input: &Path,
-) -> Result<Chosen, Box<dyn std::error::Error>> {
-    if args.cull {
-        return Err("--scheme esc chooses one level per object and culls nothing: leave out --cull".into());
-    }
-    if let Some(p) = set.patches.iter().position(|p| p.domain() != tessera::surface::Domain::Quad) {
-        return Err(format!(
-            "{}: patch {p} is a triangle patch (a mesh gives PN triangles); --scheme esc tessellates bicubic Bézier patches only",
-            input.display()
-        )
-        .into());
-    }
-    if args.factor.is_some()
-        || args.tolerance.is_some()
-        || args.pixel_error.is_some()
-        || args.distance.is_some()
-        || args.silhouette.is_some()
-    {
-        return Err("--scheme esc has its own criterion: use --quality high|medium or --threshold D, with \
-                    --camera, --max-level or --level"
-            .into());
-    }
-    let threshold = match (args.threshold, args.quality) {
-        (Some(d), _) => Threshold::Absolute(d),
-        (None, Some(QualityArg::High)) => Threshold::High,
-        (None, _) => Threshold::Medium,
-    };
-    let options = EscOptions {
-        max_level: args.max_level.unwrap_or(3),
-        level: args.level,
-        threshold,
-        ..EscOptions::default()
-    };
-    let cam = camera(args, set)?;
-    let (plan, pattern) = esc::plan(set, &cam, &options)?;
-    let what = match threshold {
-        Threshold::High => "high quality".to_string(),
-        Threshold::Medium => "medium quality".to_string(),
-        Threshold::Absolute(d) => format!("threshold {d}"),
-    };
-    let level = match args.level {
-        Some(l) => format!("level {l}"),
-        None => format!("Lmax {}", options.max_level),
-    };
-    Ok(Chosen {
-        plan,
-        pattern: Box::new(pattern),
-        description: format!("esc, {what}, {level}"),
-        report: None,
-        tolerance: None,
+        report: planned.report,
+        tolerance: match criterion {
+            Criterion::Tolerance(eps) => Some(eps),
+            _ => None,
+        },
     })
 }

@@ -6,17 +6,13 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::path::PathBuf;
 use tessera::camera::Camera;
-use tessera::criterion::esc::{self, EscOptions, Threshold};
-use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
-use tessera::criterion::tolerance::Layout;
-use tessera::criterion::view::{self, FractionalFactors, ViewCriterion};
+use tessera::criterion::esc::Threshold;
+use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::engine::{tessellate, TessellateOptions};
-use tessera::pattern::hardware::{Hardware, Partitioning};
-use tessera::pattern::semi_uniform::SemiUniform;
-use tessera::pattern::transition::Transition;
+use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::Pattern;
-use tessera::sampling::Spacing;
+use tessera::scheme::{self, PlanOptions, Planned, Scheme};
 use tessera::surface::SurfaceSet;
 
 fn data_dir() -> PathBuf {
@@ -58,37 +54,40 @@ fn schemes(c: &mut Criterion) {
     let cow = load("meshes/cow.obj");
     let (lo, hi) = cow.bounds();
     let camera = Camera::framing(lo, hi, 1280, 720);
-    let silhouette = ViewCriterion::SilhouetteVertices;
+    let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+    let plan = |set: &SurfaceSet, scheme: Scheme, criterion: scheme::Criterion| -> Planned {
+        scheme.plan(set, &criterion, &options).unwrap()
+    };
+    let silhouette = |criterion, fmin, fmax| scheme::Criterion::View { criterion, fmin, fmax };
+    let vertices = silhouette(ViewCriterion::SilhouetteVertices, 4.0, 7.0);
 
-    let plan = view::plan(&cow, &camera, silhouette, 4, 7, Layout::Transition, false);
-    bench_engine(c, "cow_silhouette_4_7", "transition", &cow, &plan, &Transition);
-    let plan = view::plan(&cow, &camera, ViewCriterion::Silhouetteness, 1, 8, Layout::Dyadic, false);
-    bench_engine(c, "cow_silhouette_1_8", "semi_uniform_m3", &cow, &plan, &SemiUniform);
+    let p = plan(&cow, Scheme::Transition, vertices);
+    bench_engine(c, "cow_silhouette_4_7", "transition", &cow, &p.plan, &p.pattern);
+    let p =
+        plan(&cow, Scheme::SemiUniform { max_level: 3 }, silhouette(ViewCriterion::Silhouetteness, 1.0, 8.0));
+    bench_engine(c, "cow_silhouette_1_8", "semi_uniform_m3", &cow, &p.plan, &p.pattern);
 
-    let options =
-        Sd2Options { level: LevelFunction::Silhouette, fmin: 4.0, fmax: 7.0, warp: false, cull: false };
-    c.bench_function("cow_silhouette_4_7/sd2/plan", |b| {
-        b.iter(|| sd2::plan(&cow, &camera, &options).unwrap())
-    });
-    let (plan, pattern) = sd2::plan(&cow, &camera, &options).unwrap();
-    bench_engine(c, "cow_silhouette_4_7", "sd2", &cow, &plan, &pattern);
+    let sd2 = Scheme::Sd2 { warp: false };
+    c.bench_function("cow_silhouette_4_7/sd2/plan", |b| b.iter(|| plan(&cow, sd2, vertices)));
+    let p = plan(&cow, sd2, vertices);
+    bench_engine(c, "cow_silhouette_4_7", "sd2", &cow, &p.plan, &p.pattern);
 
-    let factors = FractionalFactors::Fixed(6.4);
     for partitioning in [Partitioning::Integer, Partitioning::FractionalOdd, Partitioning::FractionalEven] {
-        let plan = view::fractional_plan(&cow, &camera, factors, Spacing::Hardware(partitioning), false);
-        bench_engine(c, "cow_factor_6_4", partitioning.name(), &cow, &plan, &Hardware { partitioning });
+        let p = plan(&cow, Scheme::Hardware(partitioning), scheme::Criterion::Factor(6.4));
+        bench_engine(c, "cow_factor_6_4", partitioning.name(), &cow, &p.plan, &p.pattern);
     }
 
     let teapot = load("patches/teapot.patches");
     let (lo, hi) = teapot.bounds();
-    let camera = Camera::framing(lo, hi, 1280, 720);
+    let options = PlanOptions { camera: Some(Camera::framing(lo, hi, 1280, 720)), ..PlanOptions::default() };
+    let esc = Scheme::Esc { max_level: Scheme::DEFAULT_ESC_LEVEL };
     for (name, threshold) in [("high", Threshold::High), ("medium", Threshold::Medium)] {
-        let options = EscOptions { threshold, ..Default::default() };
+        let criterion = scheme::Criterion::Esc { threshold, level: None };
         c.bench_function(&format!("teapot_esc/{name}/plan"), |b| {
-            b.iter(|| esc::plan(&teapot, &camera, &options).unwrap())
+            b.iter(|| esc.plan(&teapot, &criterion, &options).unwrap())
         });
-        let (plan, pattern) = esc::plan(&teapot, &camera, &options).unwrap();
-        bench_engine(c, "teapot_esc", name, &teapot, &plan, &pattern);
+        let p = esc.plan(&teapot, &criterion, &options).unwrap();
+        bench_engine(c, "teapot_esc", name, &teapot, &p.plan, &p.pattern);
     }
 }
 

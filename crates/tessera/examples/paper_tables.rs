@@ -13,15 +13,27 @@
 use glam::DVec3;
 use std::path::PathBuf;
 use tessera::camera::Camera;
-use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
-use tessera::criterion::tolerance::Layout;
-use tessera::criterion::view::{self, ViewCriterion};
+use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::engine::{tessellate, TessellateOptions};
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::Pattern;
+use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
+
+/// Triangles of `scheme` under the view criterion `criterion` in `[fmin, fmax]` from `camera`.
+fn view_triangles(
+    set: &SurfaceSet,
+    scheme: Scheme,
+    criterion: ViewCriterion,
+    (fmin, fmax): (f64, f64),
+    camera: &Camera,
+) -> tessera::Result<usize> {
+    let options = PlanOptions { camera: Some(*camera), ..PlanOptions::default() };
+    let planned = scheme.plan(set, &Criterion::View { criterion, fmin, fmax }, &options)?;
+    Ok(triangles(set, &planned.plan, &planned.pattern))
+}
 
 fn data_dir() -> PathBuf {
     std::env::var("TESSERA_DATA")
@@ -93,13 +105,12 @@ fn main() -> tessera::Result<()> {
         for m in [3u32, 5] {
             let top = 1 << m;
             let uniform = triangles(set, &Plan::uniform(set, top)?, &SemiUniform);
+            let scheme = Scheme::SemiUniform { max_level: m };
             let count = |camera: &Camera| {
-                let plan =
-                    view::plan(set, camera, ViewCriterion::Silhouetteness, 1, top, Layout::Dyadic, false);
-                triangles(set, &plan, &SemiUniform)
+                view_triangles(set, scheme, ViewCriterion::Silhouetteness, (1.0, top as f64), camera)
             };
-            let mean = views.iter().map(count).sum::<usize>() as f64 / views.len() as f64;
-            let here = count(&default);
+            let mean = views.iter().map(count).sum::<tessera::Result<usize>>()? as f64 / views.len() as f64;
+            let here = count(&default)?;
             println!(
                 "{:<20} {:>2} {:>10} {:>14.0} ({:>4.1} %) {:>14} ({:>4.1} %)",
                 rel,
@@ -130,19 +141,13 @@ fn main() -> tessera::Result<()> {
         let uniform = triangles(set, &Plan::uniform(set, 7)?, &Transition);
         let mut row = format!("{rel:<20} {uniform:>10}");
         for fmin in 1..=5 {
-            let options = Sd2Options {
-                level: LevelFunction::Silhouette,
-                fmin: fmin as f64,
-                fmax: 7.0,
-                warp: false,
-                cull: false,
-            };
-            let (plan, pattern) = sd2::plan(set, &camera, &options)?;
-            row += &format!(" {:>9}", triangles(set, &plan, &pattern));
+            let sd2 = Scheme::Sd2 { warp: false };
+            let t = view_triangles(set, sd2, ViewCriterion::SilhouetteVertices, (fmin as f64, 7.0), &camera)?;
+            row += &format!(" {t:>9}");
         }
-        let plan =
-            view::plan(set, &camera, ViewCriterion::SilhouetteVertices, 4, 7, Layout::Transition, false);
-        row += &format!(" {:>16}", triangles(set, &plan, &Transition));
+        let t =
+            view_triangles(set, Scheme::Transition, ViewCriterion::SilhouetteVertices, (4.0, 7.0), &camera)?;
+        row += &format!(" {t:>16}");
         println!("{row}");
     }
     println!("paper, cow (5,804): uniform 284,396, SD-2 222,586, stitch 200,383 (f_min not stated)");

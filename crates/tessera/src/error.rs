@@ -42,6 +42,29 @@ pub enum Error {
     /// An argument is out of range (factor 0, negative tolerance, ...).
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// A parameter is out of its range or malformed: `name` says which (`camera`,
+    /// `tolerance`, `esc threshold`, ...).
+    #[error("{name}: {reason}")]
+    InvalidParameter { name: &'static str, reason: String },
+    /// A factor the scheme cannot tessellate; `expected` says what it accepts.
+    #[error("factor {factor} is out of range for the {scheme} scheme: use {expected}")]
+    FactorOutOfRange { scheme: &'static str, factor: f64, expected: String },
+    /// The scheme does not accept the criterion (e.g. an error tolerance for a scheme without
+    /// error bounds); `hint` names what it accepts.
+    #[error("the {scheme} scheme does not accept {criterion}: {hint}")]
+    CriterionNotAccepted { scheme: &'static str, criterion: &'static str, hint: String },
+    /// The scheme cannot tessellate this kind of patch (`patch` is the first such patch).
+    #[error("the {scheme} scheme does not tessellate {kind} patches (patch {patch} is one): {hint}")]
+    PatchKindNotAccepted { scheme: &'static str, kind: &'static str, patch: usize, hint: &'static str },
+    /// The criterion (or culling) needs a camera and none was given.
+    #[error("{what} needs a camera")]
+    NeedsCamera { what: &'static str },
+    /// A plan used with a surface set it was not made for.
+    #[error("the plan does not match the surface set: {what}")]
+    PlanMismatch { what: String },
+    /// Triangle strips were asked of a pattern that has no strip form.
+    #[error("the {pattern} pattern has no triangle-strip form")]
+    NoStripForm { pattern: &'static str },
     /// The output would exceed a limit (memory, triangle count or the u32 index range); it
     /// was refused before anything of its size was allocated.
     #[error(

@@ -15,11 +15,9 @@ use std::path::Path;
 use glam::DVec3;
 
 use crate::camera::Camera;
-use crate::criterion::esc::{self, EscOptions, Threshold};
-use crate::criterion::sd2::{self, LevelFunction, Sd2Options};
-use crate::criterion::tolerance::{self, Layout};
-use crate::criterion::view::{self, FractionalFactors, Mapping, ViewCriterion};
-use crate::criterion::{screen, Plan};
+use crate::criterion::esc::Threshold;
+use crate::criterion::view::{Mapping, ViewCriterion};
+use crate::criterion::Plan;
 use crate::engine::{self, TessellateOptions};
 use crate::error::Result;
 use crate::io::obj::{self, ObjMesh};
@@ -28,12 +26,10 @@ use crate::mesh::read::{parse_glb, parse_ply, parse_stl};
 use crate::mesh::strips;
 use crate::mesh::write::{write_glb, write_obj, write_ply, write_stl};
 use crate::mesh::Mesh;
-use crate::pattern::hardware::{Hardware, Partitioning};
-use crate::pattern::semi_uniform::SemiUniform;
+use crate::pattern::hardware::Partitioning;
 use crate::pattern::transition::Transition;
 use crate::pattern::uniform::Uniform;
 use crate::pattern::Pattern;
-use crate::sampling::Spacing;
 use crate::surface::{BuildOptions, Orientation, SurfaceSet};
 use crate::topology::weld::Weld;
 use crate::verify;
@@ -816,99 +812,50 @@ fn build_set(case: &EngineCase) -> Option<SurfaceSet> {
     }
 }
 
-/// The plan and pattern for a case, the way `tessera-cli`'s `plan.rs` makes them with
-/// `--no-cull`; None where the CLI would refuse the combination or the criterion errs.
+/// The plan and pattern for a case, through [`crate::scheme::Scheme::plan`] as the CLI makes
+/// them without `--cull`; None where the library refuses the combination or the criterion
+/// errs.
 fn plan_case(case: &EngineCase, set: &SurfaceSet, camera: &Camera) -> Option<(Plan, Box<dyn Pattern>)> {
-    const CULL: bool = false;
+    use crate::scheme::{self, PlanOptions};
     let top = f64::from(MAX_CASE_FACTOR);
-    match case.scheme {
-        Scheme::Uniform | Scheme::Transition | Scheme::SemiUniform => {
-            let (layout, pattern): (Layout, Box<dyn Pattern>) = match case.scheme {
-                Scheme::Transition => (Layout::Transition, Box::new(Transition)),
-                Scheme::SemiUniform => (Layout::Dyadic, Box::new(SemiUniform)),
-                _ => (Layout::Uniform, Box::new(Uniform)),
-            };
-            let max_factor = if case.scheme == Scheme::SemiUniform {
-                MAX_CASE_FACTOR.min(1 << case.max_level)
-            } else {
-                MAX_CASE_FACTOR
-            };
-            let plan = match case.criterion {
-                Criterion::Factor(f) => {
-                    // Integer factors only; semi-uniform also needs a power of two.
-                    let n = f.round() as u32;
-                    let n = if case.scheme == Scheme::SemiUniform {
-                        1 << n.ilog2().min(case.max_level)
-                    } else {
-                        n
-                    };
-                    Plan::uniform(set, n).ok()?
-                }
-                Criterion::Tolerance(share) => {
-                    let (lo, hi) = set.bounds();
-                    let eps = share * lo.distance(hi);
-                    if !(eps.is_finite() && eps > 0.0) {
-                        return None;
-                    }
-                    tolerance::plan(
-                        set,
-                        &vec![Some(eps); set.patches.len()],
-                        layout,
-                        pattern.as_ref(),
-                        max_factor,
-                    )
-                    .0
-                }
-                Criterion::PixelError(px) => {
-                    let eps = screen::tolerances(set, camera, px, CULL);
-                    tolerance::plan(set, &eps, layout, pattern.as_ref(), max_factor).0
-                }
-                Criterion::View(criterion, fmin, fmax) => {
-                    // The CLI's integer FMIN:FMAX for these schemes.
-                    let (fmin, fmax) = (fmin.round() as u32, (fmax.round() as u32).min(max_factor));
-                    view::plan(set, camera, criterion, fmin.min(fmax), fmax, layout, CULL)
-                }
-            };
-            Some((plan, pattern))
+    let library_scheme = match case.scheme {
+        Scheme::Uniform => scheme::Scheme::Uniform,
+        Scheme::Transition => scheme::Scheme::Transition,
+        Scheme::SemiUniform => scheme::Scheme::SemiUniform { max_level: case.max_level },
+        Scheme::Sd2 => scheme::Scheme::Sd2 { warp: case.variant },
+        Scheme::Hardware(p) => scheme::Scheme::Hardware(p),
+        Scheme::Esc => scheme::Scheme::Esc { max_level: case.max_level.min(3) },
+    };
+    let integer = matches!(case.scheme, Scheme::Uniform | Scheme::Transition | Scheme::SemiUniform);
+    let criterion = match (case.scheme, case.criterion) {
+        (Scheme::Esc, _) => scheme::Criterion::Esc {
+            threshold: case.esc_threshold,
+            level: case.variant.then_some(case.max_level.min(3)),
+        },
+        // Integer factors only; semi-uniform also needs a power of two.
+        (Scheme::SemiUniform, Criterion::Factor(f)) => scheme::Criterion::Factor(f64::from(
+            1u32 << (f.round() as u32).max(1).ilog2().min(case.max_level),
+        )),
+        (_, Criterion::Factor(f)) if integer => scheme::Criterion::Factor(f.round()),
+        (Scheme::Hardware(p), Criterion::Factor(f)) => {
+            scheme::Criterion::Factor(f.min(top.min(f64::from(p.range().1))))
         }
-        Scheme::Sd2 => {
-            let (level, fmin, fmax) = match case.criterion {
-                Criterion::View(ViewCriterion::Distance(m), a, b) => (LevelFunction::Distance(m), a, b),
-                Criterion::View(ViewCriterion::SilhouetteVertices, a, b) => (LevelFunction::Silhouette, a, b),
-                Criterion::Factor(f) => (LevelFunction::Distance(Mapping::Linear), f, f),
-                // The CLI refuses silhouetteness and the error-bounded criteria for SD-2.
-                _ => return None,
-            };
-            let options = Sd2Options { level, fmin, fmax, warp: case.variant, cull: CULL };
-            let (plan, pattern) = sd2::plan(set, camera, &options).ok()?;
-            Some((plan, Box::new(pattern)))
+        (_, Criterion::Factor(f)) => scheme::Criterion::Factor(f),
+        (_, Criterion::Tolerance(share)) => {
+            let (lo, hi) = set.bounds();
+            scheme::Criterion::Tolerance(share * lo.distance(hi))
         }
-        Scheme::Hardware(partitioning) => {
-            let hardware_top = top.min(f64::from(partitioning.range().1));
-            let factors = match case.criterion {
-                Criterion::Factor(f) => FractionalFactors::Fixed(f.min(hardware_top)),
-                Criterion::View(criterion, fmin, fmax) => {
-                    let fmax = fmax.min(hardware_top);
-                    FractionalFactors::View { criterion, fmin: fmin.min(fmax), fmax }
-                }
-                // No error guarantee: the CLI refuses --tolerance and --pixel-error here.
-                _ => return None,
-            };
-            let plan = view::fractional_plan(set, camera, factors, Spacing::Hardware(partitioning), CULL);
-            Some((plan, Box::new(Hardware { partitioning })))
+        (_, Criterion::PixelError(px)) => scheme::Criterion::PixelError(px),
+        // The CLI's integer FMIN:FMAX for the integer schemes.
+        (_, Criterion::View(criterion, fmin, fmax)) if integer => {
+            scheme::Criterion::View { criterion, fmin: fmin.round(), fmax: fmax.round() }
         }
-        Scheme::Esc => {
-            let max_level = case.max_level.min(3);
-            let options = EscOptions {
-                max_level,
-                level: case.variant.then_some(max_level),
-                threshold: case.esc_threshold,
-                ..EscOptions::default()
-            };
-            let (plan, pattern) = esc::plan(set, camera, &options).ok()?;
-            Some((plan, Box::new(pattern)))
-        }
-    }
+        (_, Criterion::View(criterion, fmin, fmax)) => scheme::Criterion::View { criterion, fmin, fmax },
+    };
+    let options =
+        PlanOptions { camera: Some(*camera), max_factor: MAX_CASE_FACTOR, ..PlanOptions::default() };
+    let planned = library_scheme.plan(set, &criterion, &options).ok()?;
+    Some((planned.plan, Box::new(planned.pattern)))
 }
 
 /// Runs a decoded case through the builder, the criterion and the engine, asserting what
@@ -938,7 +885,7 @@ pub fn run_engine_case(case: &EngineCase) -> EngineOutcome {
             panic!("{why}\n{case:#?}");
         }
     }
-    assert!(plan.visible.iter().all(|&v| v), "a plan made without culling hides patches\n{case:#?}");
+    assert!(plan.visible.iter().all(|&v| v != 0), "a plan made without culling hides patches\n{case:#?}");
     let Ok(mesh) = engine::tessellate(&set, &plan, pattern.as_ref(), case.options) else {
         return EngineOutcome::Refused;
     };
@@ -987,7 +934,7 @@ fn open_watertight_finding(case: &EngineCase, set: &SurfaceSet, plan: &Plan) -> 
         // across that curve emits the same fan. (Sampling such curves once fixes the fan but
         // breaks the error bounds next to the teapot's lid apex, so the fix belongs in the
         // transition pattern.)
-        Scheme::Transition if (0..plan.edges.len()).any(|e| collapsed(e) && plan.edges[e].segments() > 1) => {
+        Scheme::Transition if (0..plan.edge_count()).any(|e| collapsed(e) && plan.segments(e) > 1) => {
             Some("transition-fan-at-collapsed-edge")
         }
         _ => None,
@@ -1008,9 +955,8 @@ const SKIP_OPEN_FINDINGS: bool = cfg!(fuzzing);
 fn uniform_precondition_broken(set: &SurfaceSet, plan: &Plan) -> Option<String> {
     (0..set.patches.len()).find_map(|p| {
         let corners = set.patches[p].domain().corner_count();
-        let segments: Vec<u32> = (0..corners)
-            .map(|l| plan.edges[set.topology.patch_edges[p][l].edge as usize].segments())
-            .collect();
+        let segments: Vec<u32> =
+            (0..corners).map(|l| plan.segments(set.topology.patch_edges[p][l].edge as usize)).collect();
         let n = plan.interior[p][0];
         segments.iter().any(|&s| s != n).then(|| {
             format!(

@@ -6,14 +6,16 @@
 //! ## The pipeline
 //!
 //! ```text
-//! input ─► SurfaceSet ─► Criterion ─► EdgeSampling per edge ─► Pattern per patch ─► Engine ─► Mesh
+//! input ─► SurfaceSet ─► Criterion ─► resolve ─► Plan (edge samplings) ─► Pattern per patch ─► Engine ─► Mesh
 //! ```
 //!
 //! 1. [`io`] parses OBJ meshes and Newell patch files, with errors naming file, line and reason.
 //! 2. [`surface::SurfaceSet`] holds the patches and their [`topology`]: shared boundary curves
 //!    found by index and by welding coincident control points.
-//! 3. A [`criterion`] decides, per shared edge, how it is sampled — from data both neighbours
-//!    agree on, which is what makes the output crack-free.
+//! 3. A [`criterion`] proposes factors per use of each shared edge; one resolver
+//!    ([`criterion::resolve`]) decides each edge's sampling from data all its patches agree on,
+//!    which is what makes the output crack-free. The [`criterion::Plan`] is plain arrays that
+//!    every engine reads as they are.
 //! 4. A [`pattern`] triangulates each patch's domain given its edges' samplings; patterns never
 //!    evaluate surfaces.
 //! 5. The [`engine`] counts, scans and writes in parallel; each shared edge vertex is evaluated
@@ -22,16 +24,18 @@
 //!
 //! ## Schemes
 //!
-//! Each published scheme is a pattern plus the criterion that feeds it:
+//! Each published scheme is one [`scheme::Scheme`]: a pattern with its edge rule, interior
+//! rule, caps and the criteria it accepts. [`scheme::Scheme::plan`] is the way in; a scheme
+//! refuses a criterion it cannot honour with a typed error.
 //!
-//! | pattern | criterion | paper |
-//! | --- | --- | --- |
-//! | [`pattern::uniform`] | [`criterion::Plan::uniform`] | the baseline |
-//! | [`pattern::transition`] | [`criterion::tolerance`], [`criterion::screen`], [`criterion::view`] | CudaTess (003) |
-//! | [`pattern::semi_uniform`] (+ [`engine::render_queues`] for the instanced form) | the same, `Layout::Dyadic` | Dyken et al. (000) |
-//! | [`pattern::sd2`] (strips) | [`criterion::sd2`] | Amresh & Fünfzig (001) |
-//! | [`pattern::hardware`] (integer, pow2, fractional odd/even) | [`criterion::view::fractional_plan`] | the Direct3D 11 tessellator |
-//! | [`pattern::esc`] (strips) | [`criterion::esc`] | Concheiro et al. (002) |
+//! | scheme | pattern | criteria | paper |
+//! | --- | --- | --- | --- |
+//! | `Uniform` | [`pattern::uniform`] | factor, [`criterion::tolerance`], [`criterion::screen`], [`criterion::view`] | the baseline |
+//! | `Transition` | [`pattern::transition`] | the same | CudaTess (003) |
+//! | `SemiUniform` | [`pattern::semi_uniform`] (+ [`engine::render_queues`] for the instanced form) | the same | Dyken et al. (000) |
+//! | `Sd2` | [`pattern::sd2`] (strips) | factor, distance, vertex silhouettes ([`criterion::sd2`]) | Amresh & Fünfzig (001) |
+//! | `Hardware` | [`pattern::hardware`] (integer, pow2, fractional odd/even) | factor, view | the Direct3D 11 tessellator |
+//! | `Esc` | [`pattern::esc`] (strips) | its own ([`criterion::esc`]) | Concheiro et al. (002) |
 //!
 //! Patterns with a strip form fill [`mesh::Mesh::strips`] when
 //! [`engine::TessellateOptions::strips`] is set; [`mesh::strips::decode`] turns strips back
@@ -67,6 +71,7 @@ pub mod io;
 pub mod mesh;
 pub mod pattern;
 pub mod sampling;
+pub mod scheme;
 pub mod surface;
 pub mod topology;
 pub mod verify;

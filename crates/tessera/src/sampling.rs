@@ -4,27 +4,30 @@
 //! that runs along the edge the other way reads it mirrored (`t → 1 − t`, index `k → n − k`).
 //! Because every patch of an edge reads the same sampling and the engine evaluates each edge
 //! vertex once, neighbours meet exactly.
-
-use std::sync::Arc;
+//!
+//! A [`crate::criterion::Plan`] stores samplings as plain per-edge arrays (segments, `f32`
+//! factors, depths, lattice points); [`SamplingKind`] says how they turn into parameters, and
+//! [`param`] is that rule, the one every engine calls.
 
 /// Largest uniform factor accepted: past it a single patch would need more than 2³² indices.
 pub const MAX_FACTOR: u32 = 16_384;
 
-/// The parameters on one edge, in `[0, 1]`, endpoints included.
-#[derive(Debug, Clone, PartialEq)]
-pub enum EdgeSampling {
+/// How a plan's per-edge arrays give the parameters of an edge. One kind per plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SamplingKind {
     /// `segments` equal steps: parameters `k / segments`.
-    Uniform { segments: u32 },
-    /// Explicit increasing parameters, starting with 0 and ending with 1.
-    Params(Arc<[f64]>),
+    Uniform,
     /// A real factor `factor ≥ 1` cut by a fractional rule. Every rule here is symmetric
     /// about the edge midpoint (`param(n − k) = 1 − param(k)`), so the sampling needs no
     /// direction: both neighbours get the same points whichever way they run.
-    Fractional { factor: f64, spacing: Spacing },
+    Fractional(Spacing),
     /// The SD-2 symmetric cut of `factor`, reverse-projected with the depths of the edge's
     /// canonical start and end vertices (`pattern::sd2::warped_param`). The warp depends
     /// only on the edge's own ends, so both neighbours get the same points.
-    Warped { factor: f64, depths: [f64; 2] },
+    Warped,
+    /// Points of a lattice (ESC): point `k` is `lattice[k] / factor`, the numerators listed
+    /// in the plan, increasing from 0 to `factor`.
+    Lattice,
 }
 
 /// How a real factor cuts an edge.
@@ -38,65 +41,52 @@ pub enum Spacing {
     Hardware(Partitioning),
 }
 
-impl EdgeSampling {
-    /// Uniform sampling with `segments ≥ 1` steps.
-    pub fn uniform(segments: u32) -> Self {
-        EdgeSampling::Uniform { segments: segments.max(1) }
-    }
+/// One edge's row of a plan: what [`param`] reads.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeRow<'a> {
+    pub segments: u32,
+    pub factor: f32,
+    /// Depths of the canonical start and end (warped samplings only).
+    pub depths: [f32; 2],
+    /// Lattice numerators, `segments + 1` of them (lattice samplings only).
+    pub lattice: &'a [u32],
+}
 
-    /// Number of segments (points minus one).
-    pub fn segments(&self) -> u32 {
-        match self {
-            EdgeSampling::Uniform { segments } => *segments,
-            EdgeSampling::Params(p) => p.len().saturating_sub(1) as u32,
-            EdgeSampling::Fractional { factor, spacing } => spacing_segments(*factor, *spacing),
-            EdgeSampling::Warped { factor, .. } => crate::pattern::sd2::symmetric_segments(*factor),
+/// The `k`-th parameter (`0 ≤ k ≤ segments`) of an edge in canonical orientation: the one
+/// rule every engine reads edge points by. Cost: O(1).
+#[inline]
+pub fn param(kind: SamplingKind, row: &EdgeRow<'_>, k: u32) -> f64 {
+    match kind {
+        SamplingKind::Uniform => uniform_param(row.segments, k),
+        SamplingKind::Fractional(spacing) => spacing_param(row.factor as f64, spacing, k),
+        SamplingKind::Warped => {
+            let t = symmetric_param(row.factor as f64, k);
+            warped_param(t, row.depths[0] as f64, row.depths[1] as f64)
         }
-    }
-
-    /// The real factor: the segment count for integer samplings.
-    pub fn factor(&self) -> f64 {
-        match self {
-            EdgeSampling::Fractional { factor, .. } | EdgeSampling::Warped { factor, .. } => *factor,
-            other => other.segments() as f64,
-        }
-    }
-
-    /// The `k`-th parameter in canonical orientation, `0 ≤ k ≤ segments`.
-    #[inline]
-    pub fn param(&self, k: u32) -> f64 {
-        match self {
-            EdgeSampling::Uniform { segments } => {
-                if k == *segments {
-                    1.0
-                } else {
-                    k as f64 / *segments as f64
-                }
-            }
-            EdgeSampling::Params(p) => p[k as usize],
-            EdgeSampling::Fractional { factor, spacing } => spacing_param(*factor, *spacing, k),
-            EdgeSampling::Warped { factor, depths } => {
-                let t = crate::pattern::sd2::symmetric_param(*factor, k);
-                crate::pattern::sd2::warped_param(t, depths[0], depths[1])
+        SamplingKind::Lattice => {
+            if k == row.segments {
+                1.0
+            } else {
+                row.lattice[k as usize] as f64 / row.factor as f64
             }
         }
     }
+}
 
-    /// The `k`-th parameter as seen by a patch that runs along the edge reversed or not.
-    #[inline]
-    pub fn local_param(&self, k: u32, reversed: bool) -> f64 {
-        if reversed {
-            1.0 - self.param(self.segments() - k)
-        } else {
-            self.param(k)
-        }
+/// Parameter `k` of `segments` equal steps: `k / segments`, exactly 1 at the end. Cost: O(1).
+#[inline]
+pub fn uniform_param(segments: u32, k: u32) -> f64 {
+    if k == segments {
+        1.0
+    } else {
+        k as f64 / segments as f64
     }
 }
 
 /// Segments of a real factor under `spacing`.
 pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
     match spacing {
-        Spacing::Symmetric => crate::pattern::sd2::symmetric_segments(factor),
+        Spacing::Symmetric => symmetric_segments(factor),
         Spacing::Hardware(p) => crate::pattern::hardware::edge_segments(factor, p),
     }
 }
@@ -104,9 +94,64 @@ pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
 /// Parameter `k` (`0 ≤ k ≤ segments`) of a real factor under `spacing`.
 pub fn spacing_param(factor: f64, spacing: Spacing, k: u32) -> f64 {
     match spacing {
-        Spacing::Symmetric => crate::pattern::sd2::symmetric_param(factor, k),
+        Spacing::Symmetric => symmetric_param(factor, k),
         Spacing::Hardware(p) => crate::pattern::hardware::edge_param(factor, p, k),
     }
+}
+
+// The SD-2 cut (paper 001, Fig. 4) and its reverse projection: 1-D partitions, like the
+// hardware's (`pattern::hardware::partition`), that every engine reads edges by.
+
+/// Segments of an edge with real factor `factor` under the symmetric remainder: `⌈f⌉`,
+/// with `f` clamped to `[1, MAX_FACTOR]` (NaN reads as 1). Cost: O(1).
+pub fn symmetric_segments(factor: f64) -> u32 {
+    clamp_factor(factor).ceil() as u32
+}
+
+fn clamp_factor(factor: f64) -> f64 {
+    if factor.is_nan() {
+        1.0
+    } else {
+        factor.clamp(1.0, MAX_FACTOR as f64)
+    }
+}
+
+/// Point `k` (`0 ≤ k ≤ n`, `n = symmetric_segments(f)`) of the symmetric-remainder cut, in
+/// `[0, 1]`. The second half is computed as the mirror of the first, `1 − param(n − k)`, so
+/// the cut is symmetric to rounding and needs no direction. (Watertightness does not rest on
+/// it: the engine evaluates each edge's samples once.) Cost: O(1).
+pub fn symmetric_param(factor: f64, k: u32) -> f64 {
+    let f = clamp_factor(factor);
+    let n = f.ceil() as u32;
+    if k == 0 {
+        return 0.0;
+    }
+    if k >= n {
+        return 1.0;
+    }
+    if 2 * k == n {
+        return 0.5; // exact, so the mirror holds bit for bit
+    }
+    if 2 * k > n {
+        return 1.0 - symmetric_param(f, n - k);
+    }
+    let remainder = f - (n - 1) as f64; // in (0, 1]; 1 for integer factors
+    let shift = 0.5 * (1.0 - remainder) / f;
+    k as f64 / f - shift
+}
+
+/// An edge parameter `t` (from the end with depth `za` to the end with depth `zb`) warped by
+/// reverse projection: `t' = (t/zb) / ((1 − t)/za + t/zb)`. Depths must be positive (the
+/// criterion clamps them to the near plane). Cost: O(1).
+pub fn warped_param(t: f64, za: f64, zb: f64) -> f64 {
+    if t <= 0.0 {
+        return 0.0;
+    }
+    if t >= 1.0 {
+        return 1.0;
+    }
+    let (a, b) = ((1.0 - t) / za, t / zb);
+    b / (a + b)
 }
 
 pub use crate::pattern::hardware::Partitioning;

@@ -7,16 +7,31 @@ use glam::{DVec2, DVec3, Vec3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use tessera::camera::Camera;
-use tessera::criterion::tolerance::{self, Layout};
-use tessera::criterion::{screen, Plan};
+use tessera::criterion::tolerance::PlanReport;
+use tessera::criterion::Plan;
 use tessera::engine::{tessellate, TessellateOptions};
 use tessera::mesh::Mesh;
-use tessera::pattern::semi_uniform::SemiUniform;
-use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
+use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePattern};
 use tessera::surface::SurfaceSet;
 use tessera::verify;
+
+/// Semi-uniform at its highest level, so that the factor cap rarely stops a bound.
+const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 8 };
+
+/// The plan, pattern and report of an error-bounded criterion, factors up to 4096.
+fn plan(
+    set: &SurfaceSet,
+    scheme: Scheme,
+    criterion: Criterion,
+    camera: Option<Camera>,
+    cull: bool,
+) -> (Plan, SchemePattern, PlanReport) {
+    let options = PlanOptions { camera, cull, max_factor: 4096, ..PlanOptions::default() };
+    let planned = scheme.plan(set, &criterion, &options).unwrap();
+    (planned.plan, planned.pattern, planned.report.expect("an error-bounded criterion reports"))
+}
 
 fn run(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Mesh {
     tessellate(set, plan, pattern, TessellateOptions { corner_params: true, ..Default::default() }).unwrap()
@@ -34,21 +49,16 @@ fn tolerance_bounds_hold_on_every_model() {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         for share in [1e-2, 1e-3, 1e-4] {
             let eps = share * diagonal(&set);
-            for (layout, pattern) in [
-                (Layout::Transition, &Transition as &dyn Pattern),
-                (Layout::Uniform, &Uniform),
-                (Layout::Dyadic, &SemiUniform),
-            ] {
-                if layout != Layout::Transition && share < 1e-3 {
+            for scheme in [Scheme::Transition, Scheme::Uniform, SEMI_UNIFORM] {
+                if scheme != Scheme::Transition && share < 1e-3 {
                     continue; // uniform and dyadic outputs at 0.01% are large; 1% and 0.1% cover them
                 }
-                let (plan, report) =
-                    tolerance::plan(&set, &vec![Some(eps); set.patches.len()], layout, pattern, 4096);
+                let (plan, pattern, report) = plan(&set, scheme, Criterion::Tolerance(eps), None, false);
                 assert_eq!(report.capped_patches, 0, "{name}");
                 assert!(report.worst_bound <= eps * (1.0 + 1e-9));
-                let mesh = run(&set, &plan, pattern);
+                let mesh = run(&set, &plan, &pattern);
                 let err = verify::approximation_error(&mesh, &set, 5).unwrap();
-                assert!(err.max <= eps, "{name} {layout:?} {share}: measured {:.3e} > {eps:.3e}", err.max);
+                assert!(err.max <= eps, "{name} {scheme:?} {share}: measured {:.3e} > {eps:.3e}", err.max);
                 common::expect_topology(&set, &plan, &mesh, &name);
             }
         }
@@ -98,14 +108,10 @@ fn screen_space_bounds_hold_for_random_cameras() {
             .run(
                 &(common::random_camera(&set), any::<bool>(), any::<bool>()),
                 |((camera, px), cull, dyadic)| {
-                    let eps = screen::tolerances(&set, &camera, px, cull);
                     // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic).
-                    let (layout, pattern): (Layout, &dyn Pattern) = if dyadic {
-                        (Layout::Dyadic, &SemiUniform)
-                    } else {
-                        (Layout::Transition, &Transition)
-                    };
-                    let (plan, report) = tolerance::plan(&set, &eps, layout, pattern, 4096);
+                    let scheme = if dyadic { SEMI_UNIFORM } else { Scheme::Transition };
+                    let (plan, pattern, report) =
+                        plan(&set, scheme, Criterion::PixelError(px), Some(camera), cull);
                     prop_assert_eq!(
                         report.capped_patches,
                         0,
@@ -115,7 +121,7 @@ fn screen_space_bounds_hold_for_random_cameras() {
                         cull,
                         report
                     );
-                    let mesh = run(&set, &plan, pattern);
+                    let mesh = run(&set, &plan, &pattern);
                     common::expect_topology(&set, &plan, &mesh, &name);
                     let err = projected_error(&mesh, &set, &camera);
                     prop_assert!(err <= px, "{}: {:.3} px > {:.3} px", name, err, px);
@@ -146,9 +152,8 @@ fn adaptive_triangles_for(set: &SurfaceSet, target: f64) -> (usize, f64, f64) {
     let mut best = None;
     let mut eps = target;
     while eps < 8.0 * target {
-        let (plan, _) =
-            tolerance::plan(set, &vec![Some(eps); set.patches.len()], Layout::Transition, &Transition, 4096);
-        let mesh = run(set, &plan, &Transition);
+        let (plan, pattern, _) = plan(set, Scheme::Transition, Criterion::Tolerance(eps), None, false);
+        let mesh = run(set, &plan, &pattern);
         let e = verify::approximation_error(&mesh, set, 5).unwrap().max;
         if e <= target {
             best = Some((mesh.triangle_count(), e, eps));

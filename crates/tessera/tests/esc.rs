@@ -80,11 +80,11 @@ fn check(set: &SurfaceSet, plan: &Plan, pattern: &Esc, open: (usize, usize), wha
         let side = grid.side() as f64;
         for e in 0..4 {
             let pe = set.topology.patch_edges[p][e];
-            let sampling = &plan.edges[pe.edge as usize];
+            let edge = pe.edge as usize;
             let pts = grid.edge_points(e);
-            assert_eq!(pts.len() + 1, sampling.segments() as usize, "{what}: patch {p} edge {e}");
+            assert_eq!(pts.len() + 1, plan.segments(edge) as usize, "{what}: patch {p} edge {e}");
             for (k, &(i, j)) in pts.iter().enumerate() {
-                let t = sampling.local_param(k as u32 + 1, pe.reversed);
+                let t = plan.local_param(edge, k as u32 + 1, pe.reversed);
                 let lattice = [i as f64 / side, j as f64 / side];
                 let uv = tessera::surface::Domain::Quad.edge_point(e, t);
                 assert!(
@@ -101,7 +101,7 @@ fn check(set: &SurfaceSet, plan: &Plan, pattern: &Esc, open: (usize, usize), wha
         if edge.collapsed {
             continue;
         }
-        let s = plan.edges[e].segments() as usize;
+        let s = plan.segments(e) as usize;
         match topo.edge_uses(e).len() {
             1 => boundary += s,
             2 => {}

@@ -9,19 +9,30 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::collections::HashMap;
 use tessera::camera::Camera;
-use tessera::criterion::sd2::{self, LevelFunction, Sd2Options};
-use tessera::criterion::tolerance::Layout;
-use tessera::criterion::view::{self, FractionalFactors, Mapping, ViewCriterion};
-use tessera::criterion::Plan;
+use tessera::criterion::sd2;
+use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::render_queues::{self, StaticPattern};
 use tessera::engine::{tessellate, TessellateOptions};
 use tessera::mesh::strips;
 use tessera::mesh::Mesh;
-use tessera::pattern::hardware::{Hardware, Partitioning};
-use tessera::pattern::semi_uniform::SemiUniform;
-use tessera::pattern::Pattern;
-use tessera::sampling::Spacing;
+use tessera::pattern::hardware::Partitioning;
+use tessera::scheme::{Criterion, PlanOptions, Planned, Scheme};
 use tessera::surface::{Domain, SurfaceSet};
+use tessera::Error;
+
+/// Semi-uniform with the render queues' highest level.
+const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 5 };
+
+/// Plans through the library's front door, factors up to 64.
+fn planned(set: &SurfaceSet, scheme: Scheme, criterion: Criterion, camera: Camera, cull: bool) -> Planned {
+    let options = PlanOptions { camera: Some(camera), cull, ..PlanOptions::default() };
+    scheme.plan(set, &criterion, &options).unwrap()
+}
+
+/// A view criterion with factors in `[fmin, fmax]`.
+fn view(kind: u8, fmin: f64, fmax: f64) -> Criterion {
+    Criterion::View { criterion: view_criterion(kind), fmin, fmax }
+}
 
 const CAMERAS: u32 = 50;
 
@@ -81,8 +92,9 @@ fn semi_uniform_is_watertight_and_its_render_queues_match() {
     for_cameras(&models, (any::<u8>(), 0.0..1.0f64, any::<bool>()), |set, name, camera, (kind, lo, cull)| {
         let top = top_factor(set) as u32;
         let fmin = 1 + (lo * (top - 1) as f64) as u32;
-        let plan = view::plan(set, &camera, view_criterion(kind), fmin, top, Layout::Dyadic, cull);
-        let mesh = tessellate(set, &plan, &SemiUniform, options(false)).unwrap();
+        let Planned { plan, pattern, .. } =
+            planned(set, SEMI_UNIFORM, view(kind, fmin as f64, top as f64), camera, cull);
+        let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
         common::expect_topology(set, &plan, &mesh, name);
         let w = tessera::verify::watertight(&mesh);
         prop_assert_eq!(w.degenerate_triangles(), 0, "compacted mesh has degenerate triangles");
@@ -93,18 +105,21 @@ fn semi_uniform_is_watertight_and_its_render_queues_match() {
             let mut last = None;
             for e in queues.level(m) {
                 let p = e.patch as usize;
-                prop_assert!(plan.visible[p] && !seen[p]);
+                prop_assert!(plan.is_visible(p) && !seen[p]);
                 prop_assert!(last < Some(e.patch), "queue not sorted by patch id");
                 last = Some(e.patch);
                 seen[p] = true;
                 prop_assert_eq!(plan.interior[p][0], 1 << m);
                 for l in 0..set.patches[p].domain().corner_count() {
-                    let s = plan.edges[set.topology.patch_edges[p][l].edge as usize].segments();
+                    let s = plan.segments(set.topology.patch_edges[p][l].edge as usize);
                     prop_assert_eq!(1u32 << e.edge_levels[l], s);
                 }
             }
         }
-        prop_assert!(seen.iter().zip(&plan.visible).all(|(s, v)| s == v), "a visible patch is in no queue");
+        prop_assert!(
+            seen.iter().zip(&plan.visible).all(|(&s, &v)| s == (v != 0)),
+            "a visible patch is in no queue"
+        );
         Ok(())
     });
 }
@@ -122,11 +137,12 @@ fn instanced_draw_equals_the_compacted_mesh() {
         let (lo, hi) = set.bounds();
         let camera = Camera::framing(lo, hi, 1280, 720);
         for kind in 0..4 {
-            let plan = view::plan(&set, &camera, view_criterion(kind), 1, 32, Layout::Dyadic, kind % 2 == 0);
+            let Planned { plan, pattern, .. } =
+                planned(&set, SEMI_UNIFORM, view(kind, 1.0, 32.0), camera, kind % 2 == 0);
             let compact = tessellate(
                 &set,
                 &plan,
-                &SemiUniform,
+                &pattern,
                 TessellateOptions { corner_params: true, ..Default::default() },
             )
             .unwrap();
@@ -190,9 +206,9 @@ fn sd2_is_two_different_watertight_and_strips_decode() {
         let top = top_factor(set);
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
         let (fmin, fmax) = (fmin.min(fmax), fmin.max(fmax));
-        let level =
-            if silhouette { LevelFunction::Silhouette } else { LevelFunction::Distance(Mapping::Linear) };
-        let (plan, pattern) = sd2::plan(set, &camera, &Sd2Options { level, fmin, fmax, warp, cull }).unwrap();
+        let kind = if silhouette { 3 } else { 0 };
+        let Planned { plan, pattern, .. } =
+            planned(set, Scheme::Sd2 { warp }, view(kind, fmin, fmax), camera, cull);
         prop_assert_eq!(sd2::three_different(set, &plan), 0, "{}: three different factors", name);
         let mesh = tessellate(set, &plan, &pattern, options(true)).unwrap();
         common::expect_topology(set, &plan, &mesh, name);
@@ -218,19 +234,16 @@ fn hardware_partitionings_are_watertight() {
     for_cameras(&models, extra, |set, name, camera, (kind, a, b, mode, cull)| {
         let top = top_factor(set);
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
-        let factors = FractionalFactors::View {
-            criterion: view_criterion(kind),
-            fmin: fmin.min(fmax),
-            fmax: fmin.max(fmax),
-        };
+        let criterion = view(kind, fmin.min(fmax), fmin.max(fmax));
         let partitioning = [
             Partitioning::Integer,
             Partitioning::Pow2,
             Partitioning::FractionalOdd,
             Partitioning::FractionalEven,
         ][mode];
-        let plan = view::fractional_plan(set, &camera, factors, Spacing::Hardware(partitioning), cull);
-        let mesh = tessellate(set, &plan, &Hardware { partitioning }, options(false)).unwrap();
+        let Planned { plan, pattern, .. } =
+            planned(set, Scheme::Hardware(partitioning), criterion, camera, cull);
+        let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
         common::expect_topology(set, &plan, &mesh, name);
         Ok(())
     });
@@ -242,9 +255,8 @@ fn strips_round_trip_through_ply() {
     let set = common::load(&common::model("meshes/spool.obj")).unwrap();
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, 800, 600);
-    let options_sd2 =
-        Sd2Options { level: LevelFunction::Silhouette, fmin: 1.0, fmax: 4.5, warp: false, cull: false };
-    let (plan, pattern) = sd2::plan(&set, &camera, &options_sd2).unwrap();
+    let Planned { plan, pattern, .. } =
+        planned(&set, Scheme::Sd2 { warp: false }, view(3, 1.0, 4.5), camera, false);
     let mesh: Mesh = tessellate(&set, &plan, &pattern, options(true)).unwrap();
     let dir = std::env::temp_dir().join(format!("tessera-strips-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -255,9 +267,9 @@ fn strips_round_trip_through_ply() {
     assert_eq!(back.indices, mesh.indices);
     std::fs::remove_dir_all(&dir).ok();
     // A pattern without a strip form refuses strips instead of writing half of them.
-    let dyadic = view::plan(&set, &camera, ViewCriterion::Silhouetteness, 1, 4, Layout::Dyadic, false);
-    assert!(tessellate(&set, &dyadic, &SemiUniform as &dyn Pattern, options(true)).is_err());
-    let _: &Plan = &dyadic;
+    let dyadic = planned(&set, SEMI_UNIFORM, view(2, 1.0, 4.0), camera, false);
+    let err = tessellate(&set, &dyadic.plan, &dyadic.pattern, options(true)).unwrap_err();
+    assert!(matches!(err, Error::NoStripForm { pattern: "semi-uniform" }), "{err}");
 }
 
 /// SD-2 refuses quads with a clear error instead of tessellating them wrongly.
@@ -266,7 +278,10 @@ fn sd2_refuses_quad_patches() {
     let set = common::load(&common::model("patches/teapot.patches")).unwrap();
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, 800, 600);
-    let o = Sd2Options { level: LevelFunction::Silhouette, fmin: 1.0, fmax: 7.0, warp: false, cull: false };
-    let err = sd2::plan(&set, &camera, &o).unwrap_err().to_string();
-    assert!(err.contains("triangular"), "{err}");
+    let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+    let err = Scheme::Sd2 { warp: false }.plan(&set, &view(3, 1.0, 7.0), &options).unwrap_err();
+    assert!(
+        matches!(err, Error::PatchKindNotAccepted { scheme: "sd2", kind: "quad", patch: 0, .. }),
+        "{err}"
+    );
 }

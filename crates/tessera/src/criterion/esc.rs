@@ -31,7 +31,8 @@
 //! surface along it. A patch boundary curve is decided once per topology edge (from its owner
 //! patch, in canonical orientation; on the boundary the patch's value depends only on the
 //! curve's four control points) and the decision becomes the edge's
-//! [`EdgeSampling::Params`], which every patch on the curve reads; an inner cell edge or a
+//! lattice row of the plan ([`crate::sampling::SamplingKind::Lattice`]), which every patch on
+//! the curve reads; an inner cell edge or a
 //! cell diagonal is decided once and stored in the patch's grid, which both its coarse
 //! triangles read. So neighbours always agree, and the engine's once-per-edge evaluation
 //! makes the mesh watertight bit for bit.
@@ -40,11 +41,10 @@ use super::Plan;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::pattern::esc::{segments_for_level, Esc, PatchGrid, MAX_LEVEL};
-use crate::sampling::EdgeSampling;
+use crate::sampling::SamplingKind;
 use crate::surface::{corner_and_edge_points, BuildOptions, Domain, Patch, RationalBicubic, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-use std::sync::Arc;
 
 /// The quality threshold `ρ` of the distance test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,7 +100,7 @@ impl Default for EscOptions {
 impl EscOptions {
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
-        let bad = |why: String| Err(Error::InvalidArgument(format!("esc: {why}")));
+        let bad = |reason: String| Err(Error::InvalidParameter { name: "esc", reason });
         if self.max_level > MAX_LEVEL {
             return bad(format!("max level {} is above {MAX_LEVEL}", self.max_level));
         }
@@ -319,23 +319,24 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &EscOptions) -> Result<(
         })
         .collect();
 
-    let plan = Plan {
-        edges: edges
-            .iter()
-            .map(|flags| {
-                let side = (flags.len() - 1) as f64;
-                let params: Vec<f64> = flags
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, &f)| f)
-                    .map(|(k, _)| if k + 1 == flags.len() { 1.0 } else { k as f64 / side })
-                    .collect();
-                EdgeSampling::Params(Arc::from(params))
-            })
-            .collect(),
+    // Each edge's inserted lattice points, as numerators over the lattice size `3n`.
+    let mut plan = Plan {
+        kind: SamplingKind::Lattice,
+        segments: Vec::with_capacity(edges.len()),
+        factors: Vec::with_capacity(edges.len()),
+        depths: Vec::new(),
+        lattice_offsets: Vec::with_capacity(edges.len()),
+        lattice: Vec::new(),
         interior: levels.iter().map(|&l| [3 * segments_for_level(l); 2]).collect(),
-        visible: vec![true; set.patches.len()],
+        visible: vec![1; set.patches.len()],
     };
+    for flags in &edges {
+        plan.lattice_offsets.push(plan.lattice.len() as u32);
+        let before = plan.lattice.len();
+        plan.lattice.extend(flags.iter().enumerate().filter(|(_, &f)| f).map(|(k, _)| k as u32));
+        plan.segments.push((plan.lattice.len() - before - 1) as u32);
+        plan.factors.push((flags.len() - 1) as f32);
+    }
     Ok((plan, Esc::new(grids)))
 }
 
@@ -385,7 +386,10 @@ pub fn teacups_scene(cup: &SurfaceSet) -> Result<(SurfaceSet, Vec<Camera>)> {
     let (lo, hi) = cup.bounds();
     let size = hi - lo;
     if !(size.x > 0.0 && size.y > 0.0 && size.z > 0.0 && size.is_finite()) {
-        return Err(Error::InvalidArgument("teacups scene: the cup has no extent".into()));
+        return Err(Error::InvalidParameter {
+            name: "teacups scene",
+            reason: "the cup has no extent".into(),
+        });
     }
     let spacing = 1.5 * size.x.max(size.z);
     let mut patches = Vec::with_capacity(cup.patches.len() * TEACUPS_PER_SIDE * TEACUPS_PER_SIDE);
@@ -476,7 +480,7 @@ mod tests {
                 EscOptions { level: Some(level), threshold: Threshold::Absolute(1e-9), ..Default::default() };
             let (plan, esc) = plan(&set, &camera(), &options).unwrap();
             assert_eq!(esc.triangles(0), 18, "level {level}");
-            assert!(plan.edges.iter().all(|e| e.segments() == 3));
+            assert!(plan.segments.iter().all(|&s| s == 3));
         }
     }
 
@@ -488,7 +492,7 @@ mod tests {
         let options =
             EscOptions { level: Some(2), threshold: Threshold::Absolute(1e-3), ..Default::default() };
         let (plan, esc) = plan(&set, &camera(), &options).unwrap();
-        assert!(plan.edges.iter().all(|e| e.segments() == 3));
+        assert!(plan.segments.iter().all(|&s| s == 3));
         assert!(esc.triangles(0) > 18);
         let input = PatternInput { patch: 0, ..PatternInput::new(Domain::Quad, [3; 4], [9, 9]) };
         let (vi, t) = esc.counts(&input);
@@ -525,7 +529,7 @@ mod tests {
     #[test]
     fn bad_inputs_are_typed_errors() {
         let set = flat_patch(0.0);
-        let bad = |o: EscOptions| matches!(plan(&set, &camera(), &o), Err(Error::InvalidArgument(_)));
+        let bad = |o: EscOptions| matches!(plan(&set, &camera(), &o), Err(Error::InvalidParameter { .. }));
         assert!(bad(EscOptions { max_level: 7, ..Default::default() }));
         assert!(bad(EscOptions { level: Some(9), ..Default::default() }));
         assert!(bad(EscOptions { threshold: Threshold::Absolute(-1.0), ..Default::default() }));

@@ -1,46 +1,175 @@
 //! Criteria: decide how finely each shared edge and each patch interior is sampled.
 //!
-//! A criterion's output is a [`Plan`]: one [`EdgeSampling`] per canonical edge of the
-//! topology and interior factors per patch. Crack-freeness rests on one rule: the sampling of
-//! an edge is decided once, from data all its patches agree on, and every patch reads it.
+//! A criterion *proposes* — per use of an edge (a patch side), a real factor — and
+//! [`resolve`] *decides*: the maximum over the patches sharing the edge (the CudaTess rule),
+//! then the scheme's edge rule (integer, power of two, fractional spacing) and its caps. The
+//! result is a [`Plan`]: plain arrays, one row per canonical edge of the topology and one per
+//! patch, that every engine reads as they are. Crack-freeness rests on one rule: the sampling
+//! of an edge is decided once, from data all its patches agree on, and every patch reads it.
+//!
+//! Which criteria go with which pattern is [`crate::scheme::Scheme`]'s business.
 
 pub mod bounds;
 pub mod esc;
+pub mod resolve;
 pub mod screen;
 pub mod sd2;
 pub mod tolerance;
 pub mod view;
 
 use crate::error::{Error, Result};
-use crate::sampling::EdgeSampling;
+use crate::sampling::{EdgeRow, SamplingKind};
 use crate::surface::SurfaceSet;
 
 pub use crate::sampling::MAX_FACTOR;
 
-/// Samplings for every edge and interior factors for every patch.
+/// Samplings for every edge and interior factors for every patch, as plain arrays a GPU can
+/// upload as they are.
+///
+/// Per edge `e` (in `topology.edges` order, canonical orientation): `segments[e]` and
+/// `factors[e]` always; `depths[e]` for [`SamplingKind::Warped`] plans (empty otherwise);
+/// `lattice[lattice_offsets[e]..][..segments[e] + 1]` for [`SamplingKind::Lattice`] plans
+/// (both empty otherwise). Per patch `p`: `interior[p]` and `visible[p]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
-    /// One per `topology.edges` entry, in canonical orientation.
-    pub edges: Vec<EdgeSampling>,
+    /// How the per-edge arrays turn into parameters ([`crate::sampling::param`]).
+    pub kind: SamplingKind,
+    /// Segments of each edge (`≥ 1`).
+    pub segments: Vec<u32>,
+    /// The real factor of each edge; equal to `segments` for uniform samplings, the lattice
+    /// size for lattice samplings.
+    pub factors: Vec<f32>,
+    /// Depths of each edge's canonical start and end vertex (warped plans).
+    pub depths: Vec<[f32; 2]>,
+    /// Start of each edge's numerators in `lattice` (lattice plans).
+    pub lattice_offsets: Vec<u32>,
+    /// Lattice numerators of every edge, edge after edge (lattice plans).
+    pub lattice: Vec<u32>,
     /// Interior factors per patch (`[u, v]`; triangles use the first).
     pub interior: Vec<[u32; 2]>,
-    /// Patches to tessellate; culled patches emit nothing (their edges with visible
-    /// neighbours are still sampled as those neighbours need).
-    pub visible: Vec<bool>,
+    /// 1 for patches to tessellate, 0 for culled ones, which emit nothing (their edges with
+    /// visible neighbours are still sampled as those neighbours need).
+    pub visible: Vec<u32>,
 }
 
 impl Plan {
     /// The uniform plan: factor `n` everywhere. Errors for `n = 0` or `n > MAX_FACTOR`.
     pub fn uniform(set: &SurfaceSet, n: u32) -> Result<Plan> {
         if n == 0 || n > MAX_FACTOR {
-            return Err(Error::InvalidArgument(format!(
-                "factor {n} is out of range: use an integer from 1 to {MAX_FACTOR}"
-            )));
+            return Err(Error::FactorOutOfRange {
+                scheme: "uniform",
+                factor: n as f64,
+                expected: format!("an integer from 1 to {MAX_FACTOR}"),
+            });
         }
-        Ok(Plan {
-            edges: vec![EdgeSampling::uniform(n); set.topology.edges.len()],
-            interior: vec![[n, n]; set.patches.len()],
-            visible: vec![true; set.patches.len()],
-        })
+        Ok(Plan::integer(
+            vec![n; set.topology.edges.len()],
+            vec![[n, n]; set.patches.len()],
+            set.patches.len(),
+        ))
+    }
+
+    /// A plan of uniform samplings with the given segments and interiors, every patch
+    /// visible.
+    pub fn integer(segments: Vec<u32>, interior: Vec<[u32; 2]>, patches: usize) -> Plan {
+        Plan {
+            kind: SamplingKind::Uniform,
+            factors: segments.iter().map(|&s| s as f32).collect(),
+            segments,
+            depths: Vec::new(),
+            lattice_offsets: Vec::new(),
+            lattice: Vec::new(),
+            interior,
+            visible: vec![1; patches],
+        }
+    }
+
+    /// Number of edges the plan covers.
+    pub fn edge_count(&self) -> usize {
+        self.segments.len()
+    }
+
+    /// Whether patch `p` is tessellated.
+    #[inline]
+    pub fn is_visible(&self, p: usize) -> bool {
+        self.visible[p] != 0
+    }
+
+    /// Segments of edge `e`.
+    #[inline]
+    pub fn segments(&self, e: usize) -> u32 {
+        self.segments[e]
+    }
+
+    /// The real factor of edge `e`: the segment count for integer samplings.
+    #[inline]
+    pub fn factor(&self, e: usize) -> f64 {
+        match self.kind {
+            SamplingKind::Uniform | SamplingKind::Lattice => self.segments[e] as f64,
+            _ => self.factors[e] as f64,
+        }
+    }
+
+    /// Edge `e`'s row, as [`crate::sampling::param`] reads it.
+    #[inline]
+    pub fn row(&self, e: usize) -> EdgeRow<'_> {
+        EdgeRow {
+            segments: self.segments[e],
+            factor: self.factors[e],
+            depths: self.depths.get(e).copied().unwrap_or([1.0; 2]),
+            lattice: match self.kind {
+                SamplingKind::Lattice => &self.lattice[self.lattice_offsets[e] as usize..],
+                _ => &[],
+            },
+        }
+    }
+
+    /// The `k`-th parameter of edge `e` in canonical orientation, `0 ≤ k ≤ segments`.
+    #[inline]
+    pub fn param(&self, e: usize, k: u32) -> f64 {
+        crate::sampling::param(self.kind, &self.row(e), k)
+    }
+
+    /// The `k`-th parameter of edge `e` as seen by a patch that runs along it reversed or not.
+    #[inline]
+    pub fn local_param(&self, e: usize, k: u32, reversed: bool) -> f64 {
+        if reversed {
+            1.0 - self.param(e, self.segments[e] - k)
+        } else {
+            self.param(e, k)
+        }
+    }
+
+    /// Checks that the plan was made for `set`: one row per edge and per patch, every array
+    /// of its kind present, segments ≥ 1. Errors with [`Error::PlanMismatch`]. Cost: O(E + P).
+    pub fn check(&self, set: &SurfaceSet) -> Result<()> {
+        let (edges, patches) = (set.topology.edges.len(), set.patches.len());
+        let mismatch = |what: String| Err(Error::PlanMismatch { what });
+        if self.segments.len() != edges || self.factors.len() != edges {
+            return mismatch(format!("{} edge rows for {edges} edges", self.segments.len()));
+        }
+        if self.interior.len() != patches || self.visible.len() != patches {
+            return mismatch(format!("{} patch rows for {patches} patches", self.interior.len()));
+        }
+        if let Some(e) = self.segments.iter().position(|&s| s == 0) {
+            return mismatch(format!("edge {e} has 0 segments"));
+        }
+        match self.kind {
+            SamplingKind::Warped if self.depths.len() != edges => {
+                mismatch(format!("{} depth rows for {edges} edges", self.depths.len()))
+            }
+            SamplingKind::Lattice => {
+                let fits = self.lattice_offsets.len() == edges
+                    && (0..edges).all(|e| {
+                        self.lattice.len() as u64 > self.lattice_offsets[e] as u64 + self.segments[e] as u64
+                    });
+                if fits {
+                    Ok(())
+                } else {
+                    mismatch("lattice rows do not cover every edge".into())
+                }
+            }
+            _ => Ok(()),
+        }
     }
 }

@@ -141,3 +141,12 @@ pub fn back_facing(patch: &Patch, eye: DVec3) -> bool {
 pub fn tolerances(set: &SurfaceSet, camera: &Camera, pixels: f64, cull: bool) -> Vec<Option<f64>> {
     set.patches.par_iter().map(|p| patch_tolerance(p, camera, pixels, cull)).collect()
 }
+
+/// The plan's visibility row: 1 for every patch, or, with `cull`, 0 for the patches
+/// [`culled`] for `camera`. Cost: O(P) cone tests.
+pub fn visibility(set: &SurfaceSet, camera: &Camera, cull: bool) -> Vec<u32> {
+    if !cull {
+        return vec![1; set.patches.len()];
+    }
+    set.patches.par_iter().map(|p| u32::from(!culled(p, camera))).collect()
+}

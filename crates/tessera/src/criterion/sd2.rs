@@ -14,14 +14,16 @@
 //! Crack-freeness: an edge's factor depends only on its two end vertices, which its patches
 //! share, and the symmetric cut needs no direction.
 
+use super::resolve::{self, Caps, EdgeRule, InteriorRule};
 use super::screen;
-use super::tolerance::minimum_segments;
+use super::tolerance::{minimum_interior, minimum_segments};
 use super::view::{vertex_data, Mapping};
 use super::Plan;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::pattern::sd2::{Sd2, MAX_FACTOR};
-use crate::sampling::{EdgeSampling, Spacing};
+use crate::pattern::sd2::Sd2;
+use crate::sampling::MAX_FACTOR;
+use crate::sampling::{SamplingKind, Spacing};
 use crate::surface::{Domain, SurfaceSet};
 use std::sync::Arc;
 
@@ -51,16 +53,20 @@ pub struct Sd2Options {
 /// triangles) and for a bad factor range. Cost: O(V + E + P) evaluations.
 pub fn plan(set: &SurfaceSet, camera: &Camera, options: &Sd2Options) -> Result<(Plan, Sd2)> {
     if let Some(p) = set.patches.iter().position(|p| p.domain() != Domain::Tri) {
-        return Err(Error::InvalidArgument(format!(
-            "SD-2 is defined for triangular patches (paper 001) and patch {p} is a quad; use the \
-             semi-uniform, fractional or transition scheme"
-        )));
+        return Err(Error::PatchKindNotAccepted {
+            scheme: "sd2",
+            kind: "quad",
+            patch: p,
+            hint: "SD-2 is defined for triangles (paper 001); use the semi-uniform, hardware or transition scheme",
+        });
     }
     let (fmin, fmax) = (options.fmin, options.fmax);
-    if !(fmin.is_finite() && fmax.is_finite() && 1.0 <= fmin && fmin <= fmax && fmax <= MAX_FACTOR) {
-        return Err(Error::InvalidArgument(format!(
-            "SD-2 factors {fmin}:{fmax}: use 1 ≤ FMIN ≤ FMAX ≤ {MAX_FACTOR}"
-        )));
+    if !(fmin.is_finite() && fmax.is_finite() && 1.0 <= fmin && fmin <= fmax && fmax <= MAX_FACTOR as f64) {
+        return Err(Error::FactorOutOfRange {
+            scheme: "sd2",
+            factor: if (1.0..=MAX_FACTOR as f64).contains(&fmin) { fmax } else { fmin },
+            expected: format!("a range 1 ≤ FMIN ≤ FMAX ≤ {MAX_FACTOR}"),
+        });
     }
     let topo = &set.topology;
     let verts = vertex_data(set);
@@ -86,16 +92,14 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &Sd2Options) -> Result<(
         LevelFunction::Silhouette => Vec::new(),
     };
     let front = |v: u32| verts[v as usize].1.dot(camera.eye - verts[v as usize].0) >= 0.0;
-    let minimum = minimum_segments(set);
     // Near clamp for the warp: depths at or behind the eye would flip the projection.
     let near = camera.near.max(1e-9);
-    let edges: Vec<EdgeSampling> = topo
+    let per_edge: Vec<f64> = topo
         .edges
         .iter()
-        .enumerate()
-        .map(|(e, edge)| {
+        .map(|edge| {
             let [a, b] = edge.ends;
-            let f = match options.level {
+            match options.level {
                 // g is monotone decreasing in d, so g(min(d(a), d(b))) = max(g(d(a)), g(d(b))).
                 LevelFunction::Distance(_) => vertex_factor[a as usize].max(vertex_factor[b as usize]),
                 LevelFunction::Silhouette => {
@@ -105,32 +109,50 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &Sd2Options) -> Result<(
                         fmin
                     }
                 }
-            };
-            let f = f.max(minimum[e] as f64);
-            if options.warp {
-                EdgeSampling::Warped { factor: f, depths: [depth(a).max(near), depth(b).max(near)] }
-            } else {
-                EdgeSampling::Fractional { factor: f, spacing: Spacing::Symmetric }
             }
         })
         .collect();
-    let interior = (0..set.patches.len())
-        .map(|p| {
-            let n = (0..3).map(|l| edges[topo.patch_edges[p][l].edge as usize].segments()).max().unwrap_or(1);
-            [n, n]
-        })
-        .collect();
-    let visible = set.patches.iter().map(|p| !(options.cull && screen::culled(p, camera))).collect();
+    let minimum = minimum_segments(set);
+    let minimum_interior = minimum_interior(set);
+    let caps = Caps {
+        max_factor: MAX_FACTOR as f64,
+        minimum_segments: &minimum,
+        minimum_interior: &minimum_interior,
+    };
+    let mut proposals = Vec::new();
+    resolve::from_edge_factors(set, &per_edge, &mut proposals);
+    let (mut segments, mut factors) = (Vec::new(), Vec::new());
+    let rule = EdgeRule::Fractional(Spacing::Symmetric);
+    resolve::edges(set, &proposals, rule, InteriorRule::MaxEdge, &caps, &mut segments, &mut factors);
+    let mut interior = Vec::new();
+    resolve::interiors(set, &segments, InteriorRule::MaxEdge, &caps, &mut interior);
+    let (kind, depths) = if options.warp {
+        let depths = topo.edges.iter().map(|edge| edge.ends.map(|v| depth(v).max(near) as f32)).collect();
+        (SamplingKind::Warped, depths)
+    } else {
+        (SamplingKind::Fractional(Spacing::Symmetric), Vec::new())
+    };
+    let plan = Plan {
+        kind,
+        segments,
+        factors,
+        depths,
+        lattice_offsets: Vec::new(),
+        lattice: Vec::new(),
+        interior,
+        visible: screen::visibility(set, camera, options.cull),
+    };
     let corner_depths = options.warp.then(|| {
         let depths: Vec<[f64; 3]> = (0..set.patches.len())
             .map(|p| {
                 let c = &topo.patch_corners[p];
-                [depth(c[0]).max(near), depth(c[1]).max(near), depth(c[2]).max(near)]
+                // The f32 depths the edge rows hold, so the interior warp matches the edges'.
+                [0, 1, 2].map(|i| depth(c[i]).max(near) as f32 as f64)
             })
             .collect();
         Arc::from(depths)
     });
-    Ok((Plan { edges, interior, visible }, Sd2 { corner_depths }))
+    Ok((plan, Sd2 { corner_depths }))
 }
 
 /// Number of patches whose three edges carry three different factors (0 for every plan of
@@ -138,7 +160,7 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &Sd2Options) -> Result<(
 pub fn three_different(set: &SurfaceSet, plan: &Plan) -> usize {
     (0..set.patches.len())
         .filter(|&p| {
-            let f = |l: usize| plan.edges[set.topology.patch_edges[p][l].edge as usize].factor();
+            let f = |l: usize| plan.factor(set.topology.patch_edges[p][l].edge as usize);
             let (a, b, c) = (f(0), f(1), f(2));
             a != b && b != c && a != c
         })

@@ -8,27 +8,13 @@
 //! Interior factors are private to a patch and may be raised freely.
 
 use super::bounds::{self, HessianBound};
+use super::resolve::{self, Caps, EdgeRule, InteriorRule};
 use super::Plan;
 use crate::error::{Error, Result};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
-use crate::sampling::EdgeSampling;
 use crate::surface::{Domain, Patch, SurfaceSet};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Which pattern the plan is for: it decides how interior factors follow from edges.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Layout {
-    /// One factor for the whole mesh (the uniform baseline at the same guarantee).
-    Uniform,
-    /// Per-edge factors, core factors as in CudaTess: quads take the smaller factor of the two
-    /// edges along each direction, triangles the largest edge factor; transition strips
-    /// connect the core to finer edges.
-    Transition,
-    /// Semi-uniform (paper 000): every edge factor a power of two `2^l` (level `l ≤ 8`), the
-    /// patch drawn as the dyadic pattern of its largest level with coarser edges snapped.
-    Dyadic,
-}
 
 /// What an error-bounded plan achieved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -187,37 +173,27 @@ pub fn minimum_interior(set: &SurfaceSet) -> Vec<[u32; 2]> {
 }
 
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
-/// for `pattern` laid out as `layout`, with factors capped at `max_factor`. Cost: O(P) bound
-/// computations plus one pattern build per patch for the a-posteriori check.
-pub fn plan(
+/// for `pattern` with the scheme's `rule` and `interior` rule, factors capped at `max_factor`
+/// (a power of two for [`EdgeRule::PowerOfTwo`]), for an output of at most `max_triangles`.
+/// [`crate::scheme::Scheme::plan`] is the public door: it pairs the pattern with its rules.
+///
+/// Before each round of a-posteriori checks (which build patterns), the output the current
+/// factors give is counted, and a plan that would exceed the limit is refused with
+/// [`Error::OutputTooLarge`] instead of building patterns of that size; a single patch whose
+/// check would build more than `max_triangles` stops refining and counts as capped.
+/// Cost: O(P) bound computations plus one pattern build per patch and round for the
+/// a-posteriori check, and O(P) pattern counts per round.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn plan_limited(
     set: &SurfaceSet,
     eps: &[Option<f64>],
-    layout: Layout,
-    pattern: &dyn Pattern,
-    max_factor: u32,
-) -> (Plan, PlanReport) {
-    plan_limited(set, eps, layout, pattern, max_factor, u64::MAX).expect("no triangle limit")
-}
-
-/// [`plan`] for an output of at most `max_triangles`: before each round of a-posteriori checks
-/// (which build patterns), the output the current factors give is counted, and a plan that
-/// would exceed the limit is refused with [`Error::OutputTooLarge`] instead of building
-/// patterns of that size; a single patch whose check would build more than `max_triangles`
-/// stops refining and counts as capped. Cost: that of [`plan`] plus O(P) pattern counts per
-/// round.
-pub fn plan_limited(
-    set: &SurfaceSet,
-    eps: &[Option<f64>],
-    layout: Layout,
+    rule: EdgeRule,
+    interior: InteriorRule,
     pattern: &dyn Pattern,
     max_factor: u32,
     max_triangles: u64,
 ) -> Result<(Plan, PlanReport)> {
-    let mut cap = max_factor.max(1);
-    if layout == Layout::Dyadic {
-        // Largest power of two within the cap and the pattern's highest level.
-        cap = 1 << (31 - cap.min(1 << crate::pattern::semi_uniform::MAX_LEVEL).leading_zeros());
-    }
+    let cap = max_factor.max(1);
     let topo = &set.topology;
     let hessians: Vec<HessianBound> = set.patches.par_iter().map(bounds::hessian).collect();
     let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
@@ -230,8 +206,8 @@ pub fn plan_limited(
             let patch = &set.patches[p];
             let m = &hessians[p];
             let mut out = [0.0; 4];
-            match (layout, patch.domain()) {
-                (Layout::Transition, Domain::Quad) => {
+            match (interior, patch.domain()) {
+                (InteriorRule::Core, Domain::Quad) => {
                     let (nu, nv) = quad_grid(m, e, cap).unwrap_or((cap, cap));
                     out = [nu as f64, nv as f64, nu as f64, nv as f64];
                 }
@@ -248,41 +224,38 @@ pub fn plan_limited(
         .collect();
 
     let minimum = minimum_segments(set);
-    let visible: Vec<bool> = eps.iter().map(|e| e.is_some()).collect();
+    let minimum_inner = minimum_interior(set);
+    let caps = Caps { max_factor: cap as f64, minimum_segments: &minimum, minimum_interior: &minimum_inner };
+    let visible: Vec<u32> = eps.iter().map(|e| u32::from(e.is_some())).collect();
     let mut proposals = proposals;
-    let edge_segments = |proposals: &[[f64; 4]]| -> Vec<u32> {
-        let mut segments: Vec<u32> = (0..topo.edges.len())
-            .map(|e| {
-                let wanted = topo
-                    .edge_uses(e)
-                    .iter()
-                    .map(|u| proposals[u.patch as usize][u.local as usize])
-                    .fold(0.0, f64::max);
-                let s = (wanted.min(cap as f64) as u32).max(minimum[e]).max(1);
-                if layout == Layout::Dyadic {
-                    s.next_power_of_two().min(cap)
-                } else {
-                    s
-                }
-            })
-            .collect();
-        if layout == Layout::Uniform {
-            let n = segments.iter().copied().max().unwrap_or(1);
-            segments.iter_mut().for_each(|s| *s = n);
-        }
+    let mut factors = Vec::new();
+    let mut edge_segments = |proposals: &[[f64; 4]]| -> Vec<u32> {
+        let mut segments = Vec::new();
+        resolve::edges(set, proposals, rule, interior, &caps, &mut segments, &mut factors);
         segments
     };
     let all: Vec<usize> = (0..set.patches.len()).collect();
     let mut segments = edge_segments(&proposals);
     let limit = Limit::new(pattern, max_triangles, set.patches.len());
-    let mut results = check_patches(set, eps, layout, &limit, cap, &hessians, &proposals, &segments, &all);
+    let mut results = check_patches(
+        set,
+        eps,
+        interior,
+        &limit,
+        cap,
+        &minimum_inner,
+        &hessians,
+        &proposals,
+        &segments,
+        &all,
+    );
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
     // Errors shrink as h², hence the square root.
     for _round in 0..256 {
         let failing: Vec<usize> = (0..set.patches.len()).filter(|&p| results[p].2).collect();
-        if failing.is_empty() || layout == Layout::Uniform {
+        if failing.is_empty() || interior == InteriorRule::Global {
             break;
         }
         for &p in &failing {
@@ -305,8 +278,18 @@ pub fn plan_limited(
             break; // every failing patch is at the cap
         }
         segments = next;
-        let rechecked =
-            check_patches(set, eps, layout, &limit, cap, &hessians, &proposals, &segments, &affected);
+        let rechecked = check_patches(
+            set,
+            eps,
+            interior,
+            &limit,
+            cap,
+            &minimum_inner,
+            &hessians,
+            &proposals,
+            &segments,
+            &affected,
+        );
         for (i, &p) in affected.iter().enumerate() {
             results[p] = rechecked[i];
         }
@@ -321,11 +304,8 @@ pub fn plan_limited(
         }
     }
     limit.result()?;
-    let plan = Plan {
-        edges: segments.iter().map(|&s| EdgeSampling::uniform(s)).collect(),
-        interior: results.iter().map(|r| r.0).collect(),
-        visible,
-    };
+    let mut plan = Plan::integer(segments, results.iter().map(|r| r.0).collect(), set.patches.len());
+    plan.visible = visible;
     Ok((plan, report))
 }
 
@@ -420,9 +400,10 @@ impl<'a> Limit<'a> {
 fn check_patches(
     set: &SurfaceSet,
     eps: &[Option<f64>],
-    layout: Layout,
+    layout: InteriorRule,
     limit: &Limit,
     cap: u32,
+    minimum: &[[u32; 2]],
     hessians: &[HessianBound],
     proposals: &[[f64; 4]],
     segments: &[u32],
@@ -430,7 +411,6 @@ fn check_patches(
 ) -> Vec<([u32; 2], f64, bool)> {
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
-    let minimum = minimum_interior(set);
     // Each patch's first pattern: its edges and the smallest interior the layout gives it.
     let first = |p: usize| {
         let domain = set.patches[p].domain();
@@ -440,28 +420,28 @@ fn check_patches(
             *s = segments[topo.patch_edges[p][l].edge as usize];
         }
         let mut interior = match (layout, domain) {
-            (Layout::Uniform, _) => [global, global],
-            (Layout::Transition, Domain::Quad) => {
+            (InteriorRule::Global, _) => [global, global],
+            (InteriorRule::Core, Domain::Quad) => {
                 // The patch's own grid is enough for the core; CudaTess's min of the two
                 // edges is never smaller, and neighbours' finer needs reach the core
                 // through the transition strips instead of refining the whole patch.
                 let own = |l: usize| (proposals[p][l].min(cap as f64) as u32).max(1);
                 [own(0).min(seg[0].min(seg[2])), own(1).min(seg[1].min(seg[3]))]
             }
-            (Layout::Transition, Domain::Tri) | (Layout::Dyadic, _) => {
+            (InteriorRule::Core, Domain::Tri) | (InteriorRule::Level | InteriorRule::MaxEdge, _) => {
                 let n = seg[..nc].iter().copied().max().unwrap_or(1);
                 [n, n]
             }
         };
         match layout {
-            Layout::Transition => {
+            InteriorRule::Core | InteriorRule::MaxEdge => {
                 interior = [interior[0].max(minimum[p][0]), interior[1].max(minimum[p][1])];
             }
-            Layout::Dyadic => {
+            InteriorRule::Level => {
                 let n = interior[0].max(minimum[p][0]).max(minimum[p][1]).next_power_of_two().min(cap);
                 interior = [n, n];
             }
-            Layout::Uniform => {}
+            InteriorRule::Global => {}
         }
         (domain, seg, interior)
     };
@@ -496,13 +476,13 @@ fn check_patches(
                 }
                 // No progress means the worst triangles follow the edges, not the core.
                 let stuck = bound >= previous * (1.0 - 1e-9);
-                if layout == Layout::Uniform || interior[0].max(interior[1]) >= cap || stuck {
+                if layout == InteriorRule::Global || interior[0].max(interior[1]) >= cap || stuck {
                     return (interior, bound, true);
                 }
                 previous = bound;
                 let grow = (bound / e).sqrt().max(1.05);
                 interior = interior.map(|n| ((n as f64 * grow).ceil() as u32).clamp(n + 1, cap));
-                if layout == Layout::Dyadic {
+                if layout == InteriorRule::Level {
                     interior = interior.map(|n| n.next_power_of_two().min(cap));
                 }
             }

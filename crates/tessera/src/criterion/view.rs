@@ -6,13 +6,12 @@
 //! end vertices (distance, classification) or the normals of all its patches at the edge
 //! midpoint (silhouetteness) — computed once per edge.
 
+use super::resolve::{self, Caps, EdgeRule, InteriorRule};
 use super::screen;
-use super::tolerance::{minimum_interior, minimum_segments, Layout};
 use super::Plan;
 use crate::camera::Camera;
-use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
-use crate::sampling::{EdgeSampling, Spacing};
-use crate::surface::{Domain, SurfaceSet};
+use crate::sampling::SamplingKind;
+use crate::surface::SurfaceSet;
 use glam::DVec3;
 
 /// The mapping `g` from a level value to a factor (paper 001, section 3.2).
@@ -109,119 +108,69 @@ pub fn edge_factors(
     (0..topo.edges.len()).map(|e| factor(e).clamp(lo, hi)).collect()
 }
 
-/// Builds a plan from a view criterion with factors in `[fmin, fmax]` (integers ≥ 1),
-/// culling invisible patches when `cull`. Cost: O(P + E) evaluations.
-pub fn plan(
-    set: &SurfaceSet,
-    camera: &Camera,
-    criterion: ViewCriterion,
-    fmin: u32,
-    fmax: u32,
-    layout: Layout,
-    cull: bool,
-) -> Plan {
-    let (fmin, fmax) = (fmin.max(1), fmax.max(fmin.max(1)));
-    let topo = &set.topology;
-    let minimum = minimum_segments(set);
-    let factors = edge_factors(set, camera, criterion, fmin as f64, fmax as f64);
-    let mut segments: Vec<u32> =
-        factors.iter().zip(&minimum).map(|(&f, &m)| (f.round() as u32).clamp(fmin, fmax).max(m)).collect();
-    let min_interior = minimum_interior(set);
-    if layout == Layout::Uniform {
-        // One factor everywhere, edges and interiors alike (the uniform pattern's
-        // precondition), at least what every patch's interior needs.
-        let n = segments.iter().copied().chain(min_interior.iter().flatten().copied()).max().unwrap_or(1);
-        segments.iter_mut().for_each(|s| *s = n);
-        let interior = vec![[n, n]; set.patches.len()];
-        let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
-        return Plan { edges: segments.into_iter().map(EdgeSampling::uniform).collect(), interior, visible };
-    }
-    if layout == Layout::Dyadic {
-        // Levels, not factors, are interpolated (paper 000 / DRS08: level ⌈s·M⌉ for
-        // silhouetteness s): the criterion's value t ∈ [0, 1] maps to the level
-        // ⌈log2 fmin + t·(log2 fmax − log2 fmin)⌉, so half-way is half the levels, not a
-        // factor of fmax/2 that rounds up to the top level.
-        let top = crate::pattern::semi_uniform::MAX_LEVEL;
-        let (lmin, lmax) = ((fmin as f64).log2(), (fmax as f64).log2());
-        let span = (fmax - fmin) as f64;
-        for (s, (&f, &m)) in segments.iter_mut().zip(factors.iter().zip(&minimum)) {
-            let t = if span > 0.0 { ((f - fmin as f64) / span).clamp(0.0, 1.0) } else { 1.0 };
-            let level = ((lmin + t * (lmax - lmin)) - 1e-9).ceil().clamp(0.0, top as f64) as u32;
-            *s = (1u32 << level).max(m.next_power_of_two()).min(1 << top);
-        }
-    }
-    let interior = (0..set.patches.len())
-        .map(|p| {
-            let domain = set.patches[p].domain();
-            let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
-            match domain {
-                // P^m with the patch level m = max of its edge levels (paper 000).
-                _ if layout == Layout::Dyadic => {
-                    let n = (0..domain.corner_count()).map(s).max().unwrap_or(1);
-                    [n, n]
-                }
-                Domain::Quad => {
-                    [s(0).min(s(2)).max(min_interior[p][0]), s(1).min(s(3)).max(min_interior[p][1])]
-                }
-                Domain::Tri => {
-                    let n = s(0).max(s(1)).max(s(2));
-                    [n, n]
-                }
-            }
-        })
-        .collect();
-    let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
-    Plan { edges: segments.into_iter().map(EdgeSampling::uniform).collect(), interior, visible }
-}
-
-/// A plan of real factors cut by a fractional rule (`spacing`): `factor` on every edge, or
-/// the view criterion's factors in `[fmin, fmax]` (`None` for a fixed factor), never below
-/// the topology's minimum segments. Crack-free as [`plan`]: each factor comes from the
-/// edge's own data, and the fractional cuts are symmetric. Cost: O(V + E + P) evaluations.
-pub fn fractional_plan(
-    set: &SurfaceSet,
-    camera: &Camera,
-    factors: FractionalFactors,
-    spacing: Spacing,
-    cull: bool,
-) -> Plan {
-    let topo = &set.topology;
-    let minimum = minimum_segments(set);
-    let real = match factors {
-        FractionalFactors::Fixed(f) => vec![f; topo.edges.len()],
-        FractionalFactors::View { criterion, fmin, fmax } => edge_factors(set, camera, criterion, fmin, fmax),
-    };
-    let edges: Vec<EdgeSampling> = real
-        .iter()
-        .zip(&minimum)
-        .map(|(&f, &m)| {
-            let f = f.max(m as f64);
-            let f = match spacing {
-                // The hull-shader side: pow2 rounds up to a power of two; fractional factors
-                // just above a count boundary settle to it, so no output segment falls below
-                // f32 resolution (`pattern::hardware::OUTPUT_GAP`).
-                Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
-                Spacing::Symmetric => f,
-            };
-            EdgeSampling::Fractional { factor: f, spacing }
-        })
-        .collect();
-    let interior = (0..set.patches.len())
-        .map(|p| {
-            let n = (0..set.patches[p].domain().corner_count())
-                .map(|l| edges[topo.patch_edges[p][l].edge as usize].segments())
-                .max()
-                .unwrap_or(1);
-            [n, n]
-        })
-        .collect();
-    let visible = set.patches.iter().map(|p| !(cull && screen::culled(p, camera))).collect();
-    Plan { edges, interior, visible }
-}
-
-/// Where the factors of [`fractional_plan`] come from.
+/// Where the edge factors of [`plan`] come from.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum FractionalFactors {
+pub enum EdgeFactors {
+    /// One factor on every edge.
     Fixed(f64),
+    /// A view criterion's factors in `[fmin, fmax]`.
     View { criterion: ViewCriterion, fmin: f64, fmax: f64 },
+}
+
+/// Builds a plan from per-edge factors — fixed, or a view criterion's in `[fmin, fmax]` —
+/// resolved by `rule` and `interior` within `caps`, culling invisible patches when `cull`.
+/// For [`EdgeRule::PowerOfTwo`] the criterion's value is interpolated between the levels of
+/// `fmin` and `fmax`, not between the factors (paper 000 / DRS08: level `⌈s·M⌉` for
+/// silhouetteness `s`), so half-way is half the levels, not a factor of `fmax/2` that rounds
+/// up to the top level. Crack-free: each factor comes from the edge's own data.
+/// Cost: O(V + E + P) evaluations.
+pub(crate) fn plan(
+    set: &SurfaceSet,
+    camera: &Camera,
+    factors: EdgeFactors,
+    rule: EdgeRule,
+    interior: InteriorRule,
+    caps: &Caps<'_>,
+    cull: bool,
+) -> Plan {
+    let per_edge: Vec<f64> = match factors {
+        EdgeFactors::Fixed(f) => vec![f; set.topology.edges.len()],
+        EdgeFactors::View { criterion, fmin, fmax } => {
+            let factors = edge_factors(set, camera, criterion, fmin, fmax);
+            if rule != EdgeRule::PowerOfTwo {
+                factors
+            } else {
+                let (fmin, fmax) = (fmin.max(1.0), fmax.max(fmin.max(1.0)));
+                let (lmin, lmax) = (fmin.log2(), fmax.log2());
+                let span = fmax - fmin;
+                factors
+                    .iter()
+                    .map(|&f| {
+                        let t = if span > 0.0 { ((f - fmin) / span).clamp(0.0, 1.0) } else { 1.0 };
+                        (lmin + t * (lmax - lmin)).exp2()
+                    })
+                    .collect()
+            }
+        }
+    };
+    let mut proposals = Vec::new();
+    resolve::from_edge_factors(set, &per_edge, &mut proposals);
+    let (mut segments, mut edge_factors) = (Vec::new(), Vec::new());
+    resolve::edges(set, &proposals, rule, interior, caps, &mut segments, &mut edge_factors);
+    let mut interiors = Vec::new();
+    resolve::interiors(set, &segments, interior, caps, &mut interiors);
+    let kind = match rule {
+        EdgeRule::Fractional(spacing) => SamplingKind::Fractional(spacing),
+        EdgeRule::Integer | EdgeRule::PowerOfTwo => SamplingKind::Uniform,
+    };
+    Plan {
+        kind,
+        segments,
+        factors: edge_factors,
+        depths: Vec::new(),
+        lattice_offsets: Vec::new(),
+        lattice: Vec::new(),
+        interior: interiors,
+        visible: screen::visibility(set, camera, cull),
+    }
 }

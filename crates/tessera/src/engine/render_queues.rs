@@ -179,31 +179,36 @@ fn patch_levels(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<Vec<Opt
     let topo = &set.topology;
     (0..set.patches.len())
         .map(|p| {
-            if !plan.visible[p] {
+            if !plan.is_visible(p) {
                 return Ok(None);
             }
             let n = plan.interior[p][0];
             let nc = set.patches[p].domain().corner_count();
             let edges_ok = (0..nc).all(|e| {
-                let s = plan.edges[topo.patch_edges[p][e].edge as usize].segments();
+                let s = plan.segments(topo.patch_edges[p][e].edge as usize);
                 s.is_power_of_two() && s <= n
             });
             if !n.is_power_of_two() || n.trailing_zeros() > max_level || !edges_ok {
-                return Err(Error::InvalidArgument(format!(
-                    "patch {p}: the render queues need a dyadic plan with levels up to {max_level} \
-                     (interior {n}); use the semi-uniform scheme"
-                )));
+                return Err(Error::PlanMismatch {
+                    what: format!(
+                        "patch {p}: the render queues need a dyadic plan with levels up to {max_level} \
+                         (interior {n}); use the semi-uniform scheme"
+                    ),
+                });
             }
             Ok(Some(n.trailing_zeros() as u8))
         })
         .collect()
 }
 
-/// Builds the render queues of a dyadic plan (`Layout::Dyadic`, the semi-uniform scheme)
+/// Builds the render queues of a dyadic plan (from [`crate::scheme::Scheme::SemiUniform`])
 /// for levels `0..=max_level`; culled patches are in no queue. Cost: O(P) work in parallel.
 pub fn build(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<RenderQueues> {
     if max_level > MAX_LEVEL {
-        return Err(Error::InvalidArgument(format!("render queues: level {max_level} beyond {MAX_LEVEL}")));
+        return Err(Error::InvalidParameter {
+            name: "render queues",
+            reason: format!("level {max_level} beyond {MAX_LEVEL}"),
+        });
     }
     let levels = patch_levels(set, plan, max_level)?;
     let buckets = max_level as usize + 1;
@@ -246,7 +251,7 @@ pub fn build(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<RenderQueu
                 let mut edge_levels = [0u8; 4];
                 for (e, l) in edge_levels.iter_mut().enumerate().take(set.patches[p].domain().corner_count())
                 {
-                    *l = plan.edges[topo.patch_edges[p][e].edge as usize].segments().trailing_zeros() as u8;
+                    *l = plan.segments(topo.patch_edges[p][e].edge as usize).trailing_zeros() as u8;
                 }
                 out.push((next[*m as usize], QueueEntry { patch: p as u32, edge_levels }));
                 next[*m as usize] += 1;

@@ -1,63 +1,38 @@
-//! Fast path of the CPU engine: polynomial bicubic patches at one uniform factor `n`.
+//! A specialisation of *evaluation*: polynomial bicubic patches on a uniform grid, evaluated
+//! row by row in f32 with tabulated Bernstein bases, vectorized.
 //!
-//! This is the engine's heaviest common job (a dense uniform mesh of a patch model), and the
-//! generic path pays for its generality at every vertex: a pattern builds local triangles, each
-//! local index is decoded into a corner, edge or interior slot, every vertex is evaluated on
-//! its own in f64 with the rational formula, and the vertices go through a record buffer that
-//! is scattered into the mesh in a second pass. Here the layout is known in closed form, so
-//! none of that is needed.
-//!
-//! **Same mesh.** The output is the generic engine's, element for element: the corner entries
-//! first, then each edge's `n − 1` inner samples in topology order and canonical orientation,
-//! then each patch's `(n − 1)²` interior vertices row by row; two triangles per grid cell, split
-//! along the `(i, j) → (i+1, j+1)` diagonal, in the uniform pattern's order. Every count and
-//! offset follows from `n` and the topology's sizes, so each task writes its own disjoint slice
-//! of the final buffers directly. Vertex and triangle indices come from a few arithmetic cases
-//! (corner, one of four edges read forwards or backwards, interior) instead of per-triangle
-//! slot decoding. `uvs`, `vertex_patch`, `triangle_patch` and `corner_params` are computed
-//! with the generic path's own f64 formulas and rounded the same way, so they are identical.
+//! The engine ([`super::write`]) decides every vertex and triangle with the one numbering rule
+//! of [`super::layout`]; this module only computes positions and normals, faster, for the
+//! vertices where it applies: every corner entry, the inner samples of edges cut into the
+//! plan's factor `n`, and the interior of patches whose pattern promises a uniform `n × n` grid
+//! ([`crate::pattern::Pattern::interior_grid`]). Parameters (`uvs`) and patch ids are the
+//! generic evaluation's own f64 formulas rounded the same way, so only positions and normals
+//! differ, by rounding.
 //!
 //! **Watertight by construction, as in the generic path.** Each corner and each edge sample is
 //! evaluated once, by its owner patch, and every patch on it refers to it by index; no
 //! position is ever computed twice, so neighbours meet bit for bit.
 //!
-//! **Positions and normals** differ from the generic f64 evaluation only by rounding. The
-//! Bernstein basis of the `n + 1` parameters `i / n` is the same for every patch, so it is
-//! tabulated once. A patch is moved to a local frame (its control points minus their bounding
-//! box centre, divided by a power of two) and rounded to f32 there: f32 then carries the
-//! patch's own detail at full relative precision, whatever the model's size or offset, and the
-//! final `origin + scale · local` only adds rounding at the output's own magnitude. A row (or,
-//! for edges along `v`, a column) is reduced to a cubic curve and its cross derivative once;
-//! its points are then evaluated [`LANES`] at a time in structure-of-arrays form, which the
-//! compiler vectorizes. Where the derivatives are nearly parallel (a pole, or a pinched
-//! corner), f32 would lose the normal's direction, so such points take the generic f64
-//! evaluation instead ([`MIN_SIN2`]).
+//! **Positions and normals.** The Bernstein basis of the `n + 1` parameters `i / n` is the
+//! same for every patch, so it is tabulated once. A patch is moved to a local frame (its
+//! control points minus their bounding box centre, divided by a power of two) and rounded to
+//! f32 there: f32 then carries the patch's own detail at full relative precision, whatever the
+//! model's size or offset, and the final `origin + scale · local` only adds rounding at the
+//! output's own magnitude. A row (or, for edges along `v`, a column) is reduced to a cubic
+//! curve and its cross derivative once; its points are then evaluated [`LANES`] at a time in
+//! structure-of-arrays form, which the compiler vectorizes. Where the derivatives are nearly
+//! parallel (a pole, or a pinched corner), f32 would lose the normal's direction, so such
+//! points take the generic f64 evaluation instead ([`MIN_SIN2`]).
 //!
-//! **Kernels.** The evaluation and index kernels are written once, generic over whether
-//! multiply-adds are fused, and compiled twice: for the baseline target (SSE2 on x86-64) and,
-//! on x86-64 CPUs that have them, for AVX2 and FMA, chosen at run time. The wider registers
-//! hold a whole block of lanes and remove the spills of the baseline build (about 1.5× less
-//! time per vertex on one core). Calling the AVX2 build is the module's only `unsafe`.
-//!
-//! **Work split.** Everything is written in one parallel pass without barriers: the corners
-//! and edges beside tasks of whole grid rows of about [`TASK_TRIANGLES`] triangles (a few
-//! patches each at moderate factors, part of a patch at large ones), so both cores stay busy
-//! whatever the patch count. A task's rows are one contiguous range of every output buffer,
-//! split off the final `Mesh` buffers before the pass: no intermediate records, no second
-//! scatter pass, no allocation per patch or vertex.
-//!
-//! The path applies when every patch is a visible polynomial bicubic (culling leaves gaps in
-//! the layout), every edge is sampled `Uniform { n }` and every interior factor is `[n, n]`,
-//! no edge is collapsed, no patch repeats a corner (so no triangle degenerates and none is
-//! dropped), and every edge has one normal variant. Otherwise, and also when the generic path
-//! would refuse the output's size (so that it reports the error), it declines and the generic
-//! path runs.
+//! **Kernels.** The evaluation kernels are written once, generic over whether multiply-adds
+//! are fused, and compiled twice: for the baseline target (SSE2 on x86-64) and, on x86-64 CPUs
+//! that have them, for AVX2 and FMA, chosen at run time. Calling the AVX2 build is the
+//! module's only `unsafe`.
 
-use super::TessellateOptions;
+use super::VertexSlices;
 use crate::criterion::Plan;
-use crate::error::Result;
-use crate::mesh::Mesh;
-use crate::sampling::EdgeSampling;
+use crate::pattern::{Pattern, PatternInput};
+use crate::sampling::{uniform_param, SamplingKind};
 use crate::surface::{Domain, Patch, RationalBicubic, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -68,174 +43,6 @@ const LANES: usize = 8;
 /// Below this squared sine of the angle between `∂S/∂u` and `∂S/∂v`, the f32 cross product
 /// no longer gives the normal to about 1e-5, and the point is evaluated in f64.
 const MIN_SIN2: f32 = 1e-4;
-
-/// Aim for tasks of about this many triangles: small enough for both cores to share the work
-/// of a few patches, large enough that scheduling costs nothing.
-const TASK_TRIANGLES: usize = 4096;
-
-/// Tessellates `set` with the uniform pattern, or returns `None` when the fast path does not
-/// apply (see the module doc), leaving `out` untouched.
-///
-/// `out` is overwritten; its allocations are reused, so a caller that tessellates repeatedly
-/// into the same mesh avoids page faults on fresh memory. Cost: O(output), parallel.
-pub(crate) fn try_tessellate(
-    set: &SurfaceSet,
-    plan: &Plan,
-    options: TessellateOptions,
-    out: &mut Mesh,
-) -> Option<Result<()>> {
-    tessellate_with(set, plan, options, out, has_avx2_fma())
-}
-
-/// [`try_tessellate`] with the kernels chosen by the caller (`avx2_fma` only where the CPU
-/// has both).
-fn tessellate_with(
-    set: &SurfaceSet,
-    plan: &Plan,
-    options: TessellateOptions,
-    out: &mut Mesh,
-    avx2_fma: bool,
-) -> Option<Result<()>> {
-    let n = uniform_factor(set, plan)?;
-    let sizes = Sizes::new(set, n, options)?;
-    let ctx = Context::new(set, n, options.corner_params, avx2_fma);
-    let Sizes { corners, edge_vertices, interior_vertices, triangles } = sizes;
-    let vertices = corners + edge_vertices + interior_vertices;
-
-    reuse(&mut out.positions, vertices, [0.0; 3]);
-    reuse(&mut out.normals, vertices, [0.0; 3]);
-    reuse(&mut out.uvs, vertices, [0.0; 2]);
-    reuse(&mut out.vertex_patch, vertices, 0);
-    reuse(&mut out.indices, 3 * triangles, 0);
-    reuse(&mut out.triangle_patch, triangles, 0);
-    let mut no_params = Vec::new();
-    let params = if options.corner_params {
-        let params = out.corner_params.get_or_insert_with(Vec::new);
-        reuse(params, 3 * triangles, [0.0; 2]);
-        params
-    } else {
-        out.corner_params = None;
-        &mut no_params
-    };
-
-    let (corner_pos, rest) = out.positions.split_at_mut(corners);
-    let (edge_pos, interior_pos) = rest.split_at_mut(edge_vertices);
-    let (corner_nrm, rest) = out.normals.split_at_mut(corners);
-    let (edge_nrm, interior_nrm) = rest.split_at_mut(edge_vertices);
-    let (corner_uv, rest) = out.uvs.split_at_mut(corners);
-    let (edge_uv, interior_uv) = rest.split_at_mut(edge_vertices);
-    let (corner_vp, rest) = out.vertex_patch.split_at_mut(corners);
-    let (edge_vp, interior_vp) = rest.split_at_mut(edge_vertices);
-    let corner_part = VertexSlices { pos: corner_pos, nrm: corner_nrm, uv: corner_uv, patch: corner_vp };
-    let edge_part = VertexSlices { pos: edge_pos, nrm: edge_nrm, uv: edge_uv, patch: edge_vp };
-    let row_tasks = ctx.row_tasks(
-        VertexSlices { pos: interior_pos, nrm: interior_nrm, uv: interior_uv, patch: interior_vp },
-        &mut out.indices,
-        &mut out.triangle_patch,
-        params,
-    );
-
-    // Corners and edges are small; running them beside the patch rows lets the two cores
-    // share one pool of work instead of waiting for each other at a barrier in between.
-    rayon::join(
-        || {
-            ctx.corners(corner_part);
-            ctx.edges(edge_part);
-        },
-        || {
-            row_tasks.into_par_iter().for_each_init(|| Scratch::new(ctx.n), |s, task| ctx.rows(task, s));
-        },
-    );
-    Some(Ok(()))
-}
-
-/// The factor `n` when the fast path applies to `set` and `plan` (see the module doc).
-fn uniform_factor(set: &SurfaceSet, plan: &Plan) -> Option<u32> {
-    let topo = &set.topology;
-    if plan.edges.len() != topo.edges.len()
-        || plan.interior.len() != set.patches.len()
-        || plan.visible.len() != set.patches.len()
-    {
-        return None; // The generic path reports the mismatch.
-    }
-    let n = plan.interior.first()?[0];
-    let applies = n >= 1
-        && plan.visible.iter().all(|&v| v)
-        && plan.interior.iter().all(|&f| f == [n, n])
-        && plan.edges.iter().all(|s| *s == EdgeSampling::Uniform { segments: n })
-        && topo.edges.iter().all(|e| !e.collapsed && e.variants == 1)
-        && set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if b.is_polynomial()))
-        && (0..set.patches.len()).all(|p| !super::has_repeated_corner(set, p));
-    applies.then_some(n)
-}
-
-/// Element counts of the output.
-struct Sizes {
-    corners: usize,
-    edge_vertices: usize,
-    interior_vertices: usize,
-    triangles: usize,
-}
-
-impl Sizes {
-    /// `None` when the generic path would refuse the output, so that it reports why.
-    fn new(set: &SurfaceSet, n: u32, options: TessellateOptions) -> Option<Sizes> {
-        let (n, m) = (n as u64, n as u64 - 1);
-        let corners = set.topology.corner_entries.len() as u64;
-        let edge_vertices = (set.topology.edges.len() as u64).checked_mul(m)?;
-        let interior_vertices = (set.patches.len() as u64).checked_mul(m.checked_mul(m)?)?;
-        let triangles = (set.patches.len() as u64).checked_mul(n.checked_mul(2 * n)?)?;
-        let vertices = corners.checked_add(edge_vertices)?.checked_add(interior_vertices)?;
-        super::check_size(vertices, triangles, &options).ok()?;
-        Some(Sizes {
-            corners: corners as usize,
-            edge_vertices: edge_vertices as usize,
-            interior_vertices: interior_vertices as usize,
-            triangles: triangles as usize,
-        })
-    }
-}
-
-/// Makes `v` hold `len` elements, every one of which the caller then overwrites.
-fn reuse<T: Copy>(v: &mut Vec<T>, len: usize, zero: T) {
-    if v.capacity() < len {
-        // A fresh zeroed allocation arrives as lazily zeroed pages: nothing is written here,
-        // and the parallel pass faults the pages in; growing in place would first fill the
-        // whole buffer on one thread.
-        *v = Vec::new();
-        *v = vec![zero; len];
-    } else {
-        // Only a grown tail is written here; a buffer of the right length is left as is.
-        v.resize(len, zero);
-    }
-}
-
-/// Parallel vertex buffers of one part of the output.
-struct VertexSlices<'a> {
-    pos: &'a mut [[f32; 3]],
-    nrm: &'a mut [[f32; 3]],
-    uv: &'a mut [[f32; 2]],
-    patch: &'a mut [u32],
-}
-
-impl<'a> VertexSlices<'a> {
-    /// Splits off the first `k` vertices.
-    fn take_front(&mut self, k: usize) -> VertexSlices<'a> {
-        VertexSlices {
-            pos: take_front(&mut self.pos, k),
-            nrm: take_front(&mut self.nrm, k),
-            uv: take_front(&mut self.uv, k),
-            patch: take_front(&mut self.patch, k),
-        }
-    }
-}
-
-/// Splits off the first `k` elements of `s`, leaving the rest in `s`.
-fn take_front<'a, T>(s: &mut &'a mut [T], k: usize) -> &'a mut [T] {
-    let (head, tail) = std::mem::take(s).split_at_mut(k);
-    *s = tail;
-    head
-}
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -266,7 +73,7 @@ impl Basis {
         };
         for i in 0..len {
             // The edge sampling's parameters: exactly 1 at the end.
-            let (b, d) = bernstein3(EdgeSampling::Uniform { segments: n as u32 }.param(i.min(n) as u32));
+            let (b, d) = bernstein3(uniform_param(n as u32, i.min(n) as u32));
             for k in 0..4 {
                 basis.b[k][i] = b[k] as f32;
                 basis.d[k][i] = d[k] as f32;
@@ -492,45 +299,6 @@ fn edge_line(patch: &LocalPatch, basis: &Basis, n: usize, e: usize) -> Line {
     }
 }
 
-/// A range of grid rows with the output slices they fill. Row `r` is row `r % n` of patch
-/// `r / n`: its `2n` triangles and, for rows `j ≥ 1`, interior vertex row `j`.
-struct RowTask<'a> {
-    rows: std::ops::Range<usize>,
-    verts: VertexSlices<'a>,
-    indices: &'a mut [u32],
-    triangle_patch: &'a mut [u32],
-    /// Empty unless corner parameters were asked for.
-    params: &'a mut [[f32; 2]],
-}
-
-/// Per-task buffers for one grid row's output indices and parameters.
-struct Scratch {
-    lo: Vec<u32>,
-    hi: Vec<u32>,
-    lo_uv: Vec<[f32; 2]>,
-    hi_uv: Vec<[f32; 2]>,
-}
-
-impl Scratch {
-    fn new(n: usize) -> Scratch {
-        Scratch {
-            lo: vec![0; n + 1],
-            hi: vec![0; n + 1],
-            lo_uv: vec![[0.0; 2]; n + 1],
-            hi_uv: vec![[0.0; 2]; n + 1],
-        }
-    }
-}
-
-/// Where a patch's grid points are in the output.
-struct PatchMap {
-    corners: [u32; 4],
-    /// Per local edge: output index of its canonical sample 1, and whether the patch runs
-    /// along it reversed.
-    edges: [(u32, bool); 4],
-    interior: u32,
-}
-
 /// True when the CPU has AVX2 and FMA, so the kernels compiled for them may run.
 fn has_avx2_fma() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -541,18 +309,8 @@ fn has_avx2_fma() -> bool {
     false
 }
 
-impl PatchMap {
-    /// Output index of the patch's own sample `kp` (`1 ≤ kp < n`) of local edge `e`; the edge
-    /// stores its samples in canonical order.
-    #[inline(always)]
-    fn edge(&self, n: usize, e: usize, kp: usize) -> u32 {
-        let (base, rev) = self.edges[e];
-        base + (if rev { n - kp } else { kp }) as u32 - 1
-    }
-}
-
-/// Everything the tasks share.
-struct Context<'a> {
+/// The evaluator: everything its tasks share.
+pub(crate) struct FastEvaluator<'a> {
     set: &'a SurfaceSet,
     n: usize,
     basis: Basis,
@@ -563,25 +321,51 @@ struct Context<'a> {
     /// Per local edge and reversed flag, the f64 parameters of canonical sample `k` in the
     /// owner's domain, as the generic engine evaluates edge vertices.
     edge_uv: [[Vec<DVec2>; 2]; 4],
-    /// Per local edge and reversed flag, the f32 parameters of the patch's own sample `k` (its
-    /// corner parameters); empty unless asked for.
-    edge_params: [[Vec<[f32; 2]>; 2]; 4],
-    corner_count: usize,
     /// Every patch in its local frame; each is needed by several tasks (its corners, edges
     /// and rows), so it is made once.
     locals: Vec<LocalPatch>,
-    /// Triangles of the inner cells `i = 1..n-1` of a row between interior rows, relative to
-    /// the row's first interior vertex (see `triangle_row`).
-    cells: Vec<u32>,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
 }
 
-impl<'a> Context<'a> {
+impl<'a> FastEvaluator<'a> {
+    /// The evaluator for `set` and `plan`, or None where it cannot help: a plan of real
+    /// factors, or a patch that is not a polynomial bicubic. Its factor `n` is the first
+    /// patch's interior factor; vertices of other factors take the generic evaluation.
+    /// Cost: O(P) (each patch moved to its local frame).
+    pub(crate) fn new(set: &'a SurfaceSet, plan: &Plan) -> Option<FastEvaluator<'a>> {
+        Self::with_kernels(set, plan, has_avx2_fma())
+    }
+
+    /// [`FastEvaluator::new`] with the kernels chosen by the caller (`avx2_fma` is ignored
+    /// where the CPU lacks either).
+    pub(crate) fn with_kernels(
+        set: &'a SurfaceSet,
+        plan: &Plan,
+        avx2_fma: bool,
+    ) -> Option<FastEvaluator<'a>> {
+        let n = plan.interior.first()?[0];
+        let applies = n >= 1
+            && plan.kind == SamplingKind::Uniform
+            && set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if b.is_polynomial()));
+        applies.then(|| FastEvaluator::build(set, n, avx2_fma))
+    }
+
+    /// Whether edge `e`'s samples are this evaluator's: `n` segments, one normal variant.
+    pub(crate) fn covers_edge(&self, plan: &Plan, e: usize) -> bool {
+        let edge = &self.set.topology.edges[e];
+        plan.segments(e) as usize == self.n && edge.variants == 1 && !edge.collapsed
+    }
+
+    /// Whether the interior of the patch with `input` is this evaluator's: a quad whose
+    /// pattern promises the uniform `n × n` grid.
+    pub(crate) fn covers_patch(&self, pattern: &dyn Pattern, input: &PatternInput) -> bool {
+        input.domain == Domain::Quad && pattern.interior_grid(input) == Some([self.n as u32; 2])
+    }
+
     /// Precondition: `avx2_fma` only where [`has_avx2_fma`].
-    fn new(set: &'a SurfaceSet, n: u32, corner_params: bool, avx2_fma: bool) -> Context<'a> {
-        let sampling = EdgeSampling::Uniform { segments: n };
+    fn build(set: &'a SurfaceSet, n: u32, avx2_fma: bool) -> FastEvaluator<'a> {
         let step = 1.0 / n as f64;
         let nu = n as usize;
         let d = Domain::Quad;
@@ -589,44 +373,26 @@ impl<'a> Context<'a> {
             std::array::from_fn(|rev| {
                 (0..=n)
                     .map(|k| {
-                        let t = sampling.param(k);
+                        let t = uniform_param(n, k);
                         d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
                     })
                     .collect()
             })
         });
-        let edge_params = std::array::from_fn(|e| {
-            std::array::from_fn(|rev| {
-                if !corner_params {
-                    return Vec::new();
-                }
-                (0..=n)
-                    .map(|k| d.edge_point(e, sampling.local_param(k, rev == 1)).as_vec2().to_array())
-                    .collect()
-            })
-        });
-        Context {
+        FastEvaluator {
             set,
             n: nu,
             basis: Basis::new(nu),
             grid: (0..=nu).map(|i| i as f64 * step).collect(),
             grid32: (0..=nu).map(|i| (i as f64 * step) as f32).collect(),
             edge_uv,
-            edge_params,
-            corner_count: set.topology.corner_entries.len(),
             locals: set
                 .patches
                 .par_iter()
                 .with_min_len(64)
                 .map(|p| match p {
                     Patch::Bicubic(b) => LocalPatch::new(b),
-                    _ => unreachable!("the fast path checked that every patch is bicubic"),
-                })
-                .collect(),
-            cells: (1..nu.saturating_sub(1) as u32)
-                .flat_map(|i| {
-                    let m = n - 1;
-                    [i - 1, i, m + i, i - 1, m + i, m + i - 1]
+                    _ => unreachable!("the evaluator checked that every patch is bicubic"),
                 })
                 .collect(),
             avx2_fma: avx2_fma && has_avx2_fma(),
@@ -645,7 +411,7 @@ impl<'a> Context<'a> {
     }
 
     /// Evaluates every corner entry at its owner's corner.
-    fn corners(&self, out: VertexSlices<'_>) {
+    pub(crate) fn corners(&self, out: VertexSlices<'_>) {
         let topo = &self.set.topology;
         let n = self.n;
         out.pos
@@ -666,41 +432,20 @@ impl<'a> Context<'a> {
                 *uv = corner.as_vec2().to_array();
                 *vp = p as u32;
             });
-        // Split-normal entries take the position bits of their vertex's first entry (for
-        // bicubic patches every vertex has one entry; kept for the layout's contract).
-        for (i, e) in topo.corner_entries.iter().enumerate() {
-            if e.position_entry as usize != i {
-                out.pos[i] = out.pos[e.position_entry as usize];
-            }
-        }
     }
 
-    /// Evaluates every edge's inner samples with its owner patch, in canonical order.
-    fn edges(&self, out: VertexSlices<'_>) {
-        let m = self.n - 1;
-        if m == 0 {
-            return;
-        }
-        out.pos
-            .par_chunks_mut(m)
-            .zip(out.nrm.par_chunks_mut(m))
-            .zip(out.uv.par_chunks_mut(m))
-            .zip(out.patch.par_chunks_mut(m))
-            .enumerate()
-            .with_min_len(16)
-            .for_each(|(e, (((pos, nrm), uv), vp))| self.edge(e, VertexSlices { pos, nrm, uv, patch: vp }));
-    }
-
-    fn edge(&self, e: usize, out: VertexSlices<'_>) {
+    /// Evaluates the inner samples of edge `e` (precondition: [`FastEvaluator::covers_edge`])
+    /// with its owner patch, in canonical order.
+    pub(crate) fn edge(&self, e: usize, out: VertexSlices<'_>) {
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`Context::new`).
+            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
             return unsafe { self.edge_avx2_fma(e, out) };
         }
         self.edge_with::<false>(e, out)
     }
 
-    /// [`Context::edge_with`] compiled for AVX2 and FMA (everything it calls is inlined).
+    /// [`FastEvaluator::edge_with`] compiled for AVX2 and FMA (everything it calls is inlined).
     ///
     /// # Safety
     /// The CPU must support AVX2 and FMA.
@@ -733,170 +478,38 @@ impl<'a> Context<'a> {
         out.patch.fill(p as u32);
     }
 
-    /// Splits the interior and triangle buffers into tasks of whole grid rows.
-    fn row_tasks<'b>(
-        &self,
-        mut verts: VertexSlices<'b>,
-        mut indices: &'b mut [u32],
-        mut triangle_patch: &'b mut [u32],
-        mut params: &'b mut [[f32; 2]],
-    ) -> Vec<RowTask<'b>> {
-        let (n, m) = (self.n, self.n - 1);
-        let total = self.set.patches.len() * n;
-        let per_task = TASK_TRIANGLES.div_ceil(2 * n).max(1);
-        // Interior vertices before row r: whole patches, then rows 1..j of this one.
-        let vertex_offset = |r: usize| (r / n) * m * m + (r % n).saturating_sub(1) * m;
-        let mut tasks = Vec::with_capacity(total.div_ceil(per_task));
-        let mut r0 = 0;
-        while r0 < total {
-            let r1 = (r0 + per_task).min(total);
-            let triangles = (r1 - r0) * 2 * n;
-            tasks.push(RowTask {
-                rows: r0..r1,
-                verts: verts.take_front(vertex_offset(r1) - vertex_offset(r0)),
-                indices: take_front(&mut indices, 3 * triangles),
-                triangle_patch: take_front(&mut triangle_patch, triangles),
-                params: if params.is_empty() { &mut [] } else { take_front(&mut params, 3 * triangles) },
-            });
-            r0 = r1;
-        }
-        tasks
-    }
-
-    fn patch_map(&self, p: usize) -> PatchMap {
-        let topo = &self.set.topology;
-        let m = self.n - 1;
-        PatchMap {
-            corners: topo.patch_corner_entries[p],
-            edges: std::array::from_fn(|e| {
-                let pe = topo.patch_edges[p][e];
-                ((self.corner_count + pe.edge as usize * m) as u32, pe.reversed)
-            }),
-            interior: (self.corner_count + topo.edges.len() * m + p * m * m) as u32,
-        }
-    }
-
-    /// Output indices of grid row `j` (`i = 0..=n`) of a patch.
-    fn index_row(&self, map: &PatchMap, j: usize, row: &mut [u32]) {
-        let n = self.n;
-        // Patch-direction sample kp of local edge e; the edge stores canonical order.
-        let edge = |e: usize, kp: usize| map.edge(n, e, kp);
-        let last = row.len() - 1;
-        let inner = &mut row[1..last];
-        if j == 0 {
-            inner.iter_mut().enumerate().for_each(|(i, x)| *x = edge(0, i + 1));
-            (row[0], row[last]) = (map.corners[0], map.corners[1]);
-        } else if j == n {
-            inner.iter_mut().enumerate().for_each(|(i, x)| *x = edge(2, n - 1 - i));
-            (row[0], row[last]) = (map.corners[3], map.corners[2]);
-        } else {
-            let base = map.interior + ((j - 1) * (n - 1)) as u32;
-            inner.iter_mut().enumerate().for_each(|(i, x)| *x = base + i as u32);
-            (row[0], row[last]) = (edge(3, n - j), edge(1, j));
-        }
-    }
-
-    /// Parameters of grid row `j` in the patch's own domain, as the generic path computes a
-    /// triangle corner's parameters.
-    fn param_row(&self, map: &PatchMap, j: usize, row: &mut [[f32; 2]]) {
-        let n = self.n;
-        let edge = |e: usize, kp: usize| self.edge_params[e][map.edges[e].1 as usize][kp];
-        let last = row.len() - 1;
-        let inner = &mut row[1..last];
-        if j == 0 {
-            inner.iter_mut().enumerate().for_each(|(i, x)| *x = edge(0, i + 1));
-            (row[0], row[last]) = ([0.0, 0.0], [1.0, 0.0]);
-        } else if j == n {
-            inner.iter_mut().enumerate().for_each(|(i, x)| *x = edge(2, n - 1 - i));
-            (row[0], row[last]) = ([0.0, 1.0], [1.0, 1.0]);
-        } else {
-            let v = self.grid32[j];
-            inner.iter_mut().zip(&self.grid32[1..n]).for_each(|(x, &u)| *x = [u, v]);
-            (row[0], row[last]) = (edge(3, n - j), edge(1, j));
-        }
-    }
-
-    /// Fills one task: interior vertices and triangles of its rows.
-    fn rows(&self, task: RowTask<'_>, s: &mut Scratch) {
+    /// Evaluates the interior of patch `p` (precondition: [`FastEvaluator::covers_patch`]):
+    /// the uniform pattern's `(n − 1)²` grid points, row after row.
+    pub(crate) fn interior(&self, p: usize, out: VertexSlices<'_>) {
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`Context::new`).
-            return unsafe { self.rows_avx2_fma(task, s) };
+            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
+            return unsafe { self.interior_avx2_fma(p, out) };
         }
-        self.rows_with::<false>(task, s)
+        self.interior_with::<false>(p, out)
     }
 
-    /// [`Context::rows_with`] compiled for AVX2 and FMA (everything it calls is inlined).
+    /// [`FastEvaluator::interior_with`] compiled for AVX2 and FMA (everything it calls is
+    /// inlined).
     ///
     /// # Safety
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn rows_avx2_fma(&self, task: RowTask<'_>, s: &mut Scratch) {
-        self.rows_with::<true>(task, s)
+    unsafe fn interior_avx2_fma(&self, p: usize, out: VertexSlices<'_>) {
+        self.interior_with::<true>(p, out)
     }
 
-    /// The body of [`Context::rows`]. Inlined into both builds; so are the kernels it calls,
-    /// which is what compiles them for AVX2 in the fast build (a kernel left out of line
-    /// would be baseline code, and its `mul_add` a library call).
+    /// The body of [`FastEvaluator::interior`]. Inlined into both builds; so are the kernels
+    /// it calls, which is what compiles them for AVX2 in the fast build (a kernel left out of
+    /// line would be baseline code, and its `mul_add` a library call).
     #[inline(always)]
-    fn rows_with<const FMA: bool>(&self, task: RowTask<'_>, s: &mut Scratch) {
-        let (n, m) = (self.n, self.n - 1);
-        let RowTask { rows, mut verts, mut indices, mut triangle_patch, mut params } = task;
-        let mut r = rows.start;
-        while r < rows.end {
-            let p = r / n;
-            let j_range = r % n..(r % n + rows.end - r).min(n);
-            r += j_range.len();
-            let local = self.local(p);
-            let map = self.patch_map(p);
-            for j in j_range {
-                if j >= 1 {
-                    self.interior_row::<FMA>(p, local, j, verts.take_front(m));
-                }
-                self.triangle_row(&map, j, take_front(&mut indices, 6 * n), s);
-                take_front(&mut triangle_patch, 2 * n).fill(p as u32);
-                if !params.is_empty() {
-                    self.param_row(&map, j, &mut s.lo_uv);
-                    self.param_row(&map, j + 1, &mut s.hi_uv);
-                    let out = take_front(&mut params, 6 * n);
-                    for ((t, lo), hi) in
-                        out.chunks_exact_mut(6).zip(s.lo_uv.windows(2)).zip(s.hi_uv.windows(2))
-                    {
-                        t.copy_from_slice(&[lo[0], lo[1], hi[1], lo[0], hi[1], hi[0]]);
-                    }
-                }
-            }
+    fn interior_with<const FMA: bool>(&self, p: usize, mut out: VertexSlices<'_>) {
+        let m = self.n - 1;
+        let local = self.local(p);
+        for j in 1..self.n {
+            self.interior_row::<FMA>(p, local, j, out.take_front(m));
         }
-    }
-
-    /// The `2n` triangles of grid row `j` (cells `(i, j)`, `i = 0..n`).
-    #[inline(always)]
-    fn triangle_row(&self, map: &PatchMap, j: usize, idx: &mut [u32], s: &mut Scratch) {
-        let n = self.n;
-        let cell = |t: &mut [u32], lo: [u32; 2], hi: [u32; 2]| {
-            t.copy_from_slice(&[lo[0], lo[1], hi[1], lo[0], hi[1], hi[0]]);
-        };
-        if j == 0 || j + 1 == n {
-            // Along an edge: the general form.
-            self.index_row(map, j, &mut s.lo);
-            self.index_row(map, j + 1, &mut s.hi);
-            for ((t, lo), hi) in idx.chunks_exact_mut(6).zip(s.lo.windows(2)).zip(s.hi.windows(2)) {
-                cell(t, [lo[0], lo[1]], [hi[0], hi[1]]);
-            }
-            return;
-        }
-        // Between two interior rows, cells 1..n-1 use only interior vertices: the row's first
-        // interior index plus a fixed pattern (a vector add); the end cells touch edges 3 and 1.
-        let m = (n - 1) as u32;
-        let base = map.interior + (j as u32 - 1) * m;
-        let (first, rest) = idx.split_at_mut(6);
-        let (middle, last) = rest.split_at_mut(6 * (n - 2));
-        for (x, &t) in middle.iter_mut().zip(&self.cells) {
-            *x = base + t;
-        }
-        cell(first, [map.edge(n, 3, n - j), base], [map.edge(n, 3, n - j - 1), base + m]);
-        cell(last, [base + m - 1, map.edge(n, 1, j)], [base + 2 * m - 1, map.edge(n, 1, j + 1)]);
     }
 
     /// Interior vertices `i = 1..n` of grid row `j` (`1 ≤ j < n`) of patch `p`.
@@ -919,6 +532,8 @@ impl<'a> Context<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::{write_with, Layout, TessellateOptions};
+    use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
     use crate::surface::{BuildOptions, Orientation};
     use crate::verify;
@@ -933,14 +548,21 @@ mod tests {
     /// Both builds of the kernels where the CPU has AVX2 and FMA, else the baseline twice.
     const KERNELS: [bool; 2] = [false, true];
 
+    /// The engine's writer with the evaluator, with the chosen kernels.
     fn fast(set: &SurfaceSet, plan: &Plan, options: TessellateOptions, out: &mut Mesh, avx2_fma: bool) {
-        tessellate_with(set, plan, options, out, avx2_fma)
-            .expect("the fast path applies")
-            .expect("fast path");
+        let mut layout = Layout::default();
+        layout.build(set, plan, &Uniform, &options).expect("layout");
+        let evaluator = FastEvaluator::with_kernels(set, plan, avx2_fma).expect("the evaluator applies");
+        write_with(set, plan, &Uniform, &layout, options, out, Some(evaluator)).expect("fast evaluation");
     }
 
+    /// The engine's writer with the generic f64 evaluation everywhere.
     fn generic(set: &SurfaceSet, plan: &Plan, options: TessellateOptions) -> Mesh {
-        super::super::tessellate_generic(set, plan, &Uniform, options).expect("generic path")
+        let mut layout = Layout::default();
+        layout.build(set, plan, &Uniform, &options).expect("layout");
+        let mut mesh = Mesh::default();
+        write_with(set, plan, &Uniform, &layout, options, &mut mesh, None).expect("generic evaluation");
+        mesh
     }
 
     /// Layout, topology and parameters equal; positions within 1e-5 of the model's size and
@@ -1036,39 +658,49 @@ mod tests {
         }
     }
 
+    /// Collapsed curves and culled patches change the layout, not the evaluation: the
+    /// evaluator still covers the rest, and the mesh is the generic one.
     #[test]
-    fn fast_path_declines_what_it_does_not_cover() {
-        let opts = TessellateOptions::default();
-        let mut mesh = Mesh::default();
-
-        // The teapot's lid apex is a collapsed curve: its triangles degenerate and are dropped.
+    fn evaluation_matches_around_collapsed_curves_and_culled_patches() {
         let teapot = load("patches/teapot.patches");
         assert!(teapot.topology.edges.iter().any(|e| e.collapsed));
-        assert!(try_tessellate(&teapot, &Plan::uniform(&teapot, 4).unwrap(), opts, &mut mesh).is_none());
+        let set = load("bench/torus_64x32.patches");
+        let mut culled = Plan::uniform(&set, 4).unwrap();
+        culled.visible[3] = 0;
+        for avx2_fma in KERNELS {
+            for corner_params in [false, true] {
+                let options = TessellateOptions { corner_params, ..Default::default() };
+                let mut mesh = Mesh::default();
+                let plan = Plan::uniform(&teapot, 5).unwrap();
+                fast(&teapot, &plan, options, &mut mesh, avx2_fma);
+                assert!(mesh.collapsed_triangles > 0);
+                assert_same_mesh(&mesh, &generic(&teapot, &plan, options), "teapot n=5");
+                fast(&set, &culled, options, &mut mesh, avx2_fma);
+                assert_same_mesh(&mesh, &generic(&set, &culled, options), "torus, one patch culled");
+            }
+        }
+    }
 
+    #[test]
+    fn the_evaluator_covers_only_what_it_can_evaluate() {
         let set = load("bench/torus_64x32.patches");
         let plan = Plan::uniform(&set, 4).unwrap();
-        let mut one_edge = plan.clone();
-        one_edge.edges[7] = EdgeSampling::uniform(5);
-        assert!(try_tessellate(&set, &one_edge, opts, &mut mesh).is_none());
-        let mut one_interior = plan.clone();
-        one_interior.interior[3] = [4, 5];
-        assert!(try_tessellate(&set, &one_interior, opts, &mut mesh).is_none());
-        let mut culled = plan.clone();
-        culled.visible[3] = false;
-        assert!(try_tessellate(&set, &culled, opts, &mut mesh).is_none());
-        let mut explicit = plan.clone();
-        explicit.edges[0] = EdgeSampling::Params(vec![0.0, 0.25, 0.5, 0.75, 1.0].into());
-        assert!(try_tessellate(&set, &explicit, opts, &mut mesh).is_none());
+        let f = FastEvaluator::new(&set, &plan).expect("a uniform polynomial bicubic plan");
+        let mut other = plan.clone();
+        other.segments[7] = 5;
+        assert!(f.covers_edge(&plan, 7) && !f.covers_edge(&other, 7));
+        let input = |interior| PatternInput::new(Domain::Quad, [4; 4], interior);
+        assert!(f.covers_patch(&Uniform, &input([4, 4])));
+        assert!(!f.covers_patch(&Uniform, &input([5, 5])), "another factor");
+        assert!(!f.covers_patch(&crate::pattern::transition::Transition, &input([4, 4])), "no grid promise");
+        let mut fractional = plan.clone();
+        fractional.kind = SamplingKind::Fractional(crate::sampling::Spacing::Symmetric);
+        assert!(FastEvaluator::new(&set, &fractional).is_none());
         let mut rational = set.clone();
         if let Patch::Bicubic(b) = &mut rational.patches[5] {
             b.weights[5] = 2.0;
         }
-        assert!(try_tessellate(&rational, &plan, opts, &mut mesh).is_none());
-        // An output the generic path refuses: it reports the error, so the fast path declines.
-        let tiny = TessellateOptions { memory_limit: Some(1000), ..Default::default() };
-        assert!(try_tessellate(&set, &plan, tiny, &mut mesh).is_none());
-        assert_eq!(mesh, Mesh::default(), "declining leaves the output untouched");
+        assert!(FastEvaluator::new(&rational, &plan).is_none());
     }
 
     #[test]

@@ -424,6 +424,10 @@ impl Esc {
 }
 
 impl Pattern for Esc {
+    fn depends_on_patch(&self) -> bool {
+        true // each patch's own insertion grid
+    }
+
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let l = self.patch(input);
         (l.interior.len() as u32, l.triangles)

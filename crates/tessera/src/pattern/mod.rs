@@ -121,8 +121,23 @@ pub trait Pattern: Sync {
     /// Writes interior parameters and triangles into `out` (cleared first).
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation);
 
-    /// True for [`uniform::Uniform`], for which the engine has a fast path.
-    fn is_uniform(&self) -> bool {
+    /// A short name for messages (`uniform`, `transition`, ...).
+    fn name(&self) -> &'static str {
+        "given"
+    }
+
+    /// `Some([nu, nv])` when the interior vertices [`Pattern::build`] gives for `input` are
+    /// exactly the grid points `(i·(1/nu), j·(1/nv))`, `0 < i < nu`, `0 < j < nv`, row after
+    /// row (`j` outer): a promise an evaluator may use to evaluate them row by row
+    /// (`engine`'s vectorized bicubic evaluation). None (the default) promises nothing.
+    fn interior_grid(&self, _input: &PatternInput) -> Option<[u32; 2]> {
+        None
+    }
+
+    /// True when [`Pattern::build`] depends on `input.patch` (patterns holding per-patch
+    /// decisions); false lets the engine reuse one build for every patch with the same
+    /// input otherwise.
+    fn depends_on_patch(&self) -> bool {
         false
     }
 

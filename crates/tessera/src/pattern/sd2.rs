@@ -28,7 +28,7 @@
 //! corner depths `z_i`, so the pattern is uniform on screen rather than in the domain. The
 //! warp is projective, so lines stay lines and no triangle folds. On an edge it depends only
 //! on the edge's two end depths, so the criterion can warp the edge samplings identically
-//! for both neighbours ([`warped_param`]); the pattern warps its interior points itself from
+//! for both neighbours ([`crate::sampling::warped_param`]); the pattern warps its interior points itself from
 //! the per-patch corner depths it holds.
 //!
 //! **Three different factors** never come from the SD-2 criterion, which derives factors
@@ -45,65 +45,12 @@ use crate::mesh::strips::RESTART;
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
 
-/// Largest SD-2 factor accepted: the one edge-segment cap, [`crate::sampling::MAX_FACTOR`].
-pub const MAX_FACTOR: f64 = crate::sampling::MAX_FACTOR as f64;
-
-/// Segments of an edge with real factor `factor` under the symmetric remainder: `⌈f⌉`,
-/// with `f` clamped to `[1, MAX_FACTOR]` (NaN reads as 1). Cost: O(1).
-pub fn symmetric_segments(factor: f64) -> u32 {
-    clamp_factor(factor).ceil() as u32
-}
-
-fn clamp_factor(factor: f64) -> f64 {
-    if factor.is_nan() {
-        1.0
-    } else {
-        factor.clamp(1.0, MAX_FACTOR)
-    }
-}
-
-/// Point `k` (`0 ≤ k ≤ n`, `n = symmetric_segments(f)`) of the symmetric-remainder cut, in
-/// `[0, 1]`. The second half is computed as the mirror of the first, `1 − param(n − k)`, so
-/// the cut is symmetric to rounding and needs no direction. (Watertightness does not rest on
-/// it: the engine evaluates each edge's samples once.) Cost: O(1).
-pub fn symmetric_param(factor: f64, k: u32) -> f64 {
-    let f = clamp_factor(factor);
-    let n = f.ceil() as u32;
-    if k == 0 {
-        return 0.0;
-    }
-    if k >= n {
-        return 1.0;
-    }
-    if 2 * k == n {
-        return 0.5; // exact, so the mirror holds bit for bit
-    }
-    if 2 * k > n {
-        return 1.0 - symmetric_param(f, n - k);
-    }
-    let remainder = f - (n - 1) as f64; // in (0, 1]; 1 for integer factors
-    let shift = 0.5 * (1.0 - remainder) / f;
-    k as f64 / f - shift
-}
-
-/// An edge parameter `t` (from the end with depth `za` to the end with depth `zb`) warped by
-/// reverse projection: `t' = (t/zb) / ((1 − t)/za + t/zb)`. Depths must be positive (the
-/// criterion clamps them to the near plane). Cost: O(1).
-pub fn warped_param(t: f64, za: f64, zb: f64) -> f64 {
-    if t <= 0.0 {
-        return 0.0;
-    }
-    if t >= 1.0 {
-        return 1.0;
-    }
-    let (a, b) = ((1.0 - t) / za, t / zb);
-    b / (a + b)
-}
+use crate::sampling::symmetric_param;
 
 /// The SD-2 pattern.
 ///
 /// Preconditions: triangle domains (quads are refused by the criterion; given one, the
-/// pattern falls back to [`Transition`]); `segments[e] = symmetric_segments(factors[e])`.
+/// pattern falls back to [`Transition`]); `segments[e] = crate::sampling::symmetric_segments(factors[e])`.
 /// With `corner_depths`, entry `p` holds patch `p`'s corner depths (all > 0) and the
 /// interior is reverse-projected; the edge samplings must then be warped the same way.
 #[derive(Debug, Clone, Default)]
@@ -208,6 +155,10 @@ impl Sd2 {
 }
 
 impl Pattern for Sd2 {
+    fn depends_on_patch(&self) -> bool {
+        self.corner_depths.is_some() // the warp reads the patch's corner depths
+    }
+
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         match Layout::new(input) {
             Some(l) => ((l.ns - 1) * (l.nd - 1), l.nd * (2 * l.ns - 1)),
@@ -266,6 +217,7 @@ fn fallback(input: &PatternInput) -> PatternInput {
 mod tests {
     use super::*;
     use crate::mesh::strips::decode;
+    use crate::sampling::{symmetric_segments, warped_param};
 
     fn input(f: [f64; 3]) -> PatternInput {
         let segments = [symmetric_segments(f[0]), symmetric_segments(f[1]), symmetric_segments(f[2]), 1];
@@ -319,7 +271,7 @@ mod tests {
         // Bad factors do not panic.
         assert_eq!(symmetric_segments(f64::NAN), 1);
         assert_eq!(symmetric_segments(-3.0), 1);
-        assert_eq!(symmetric_segments(1e300), MAX_FACTOR as u32);
+        assert_eq!(symmetric_segments(1e300), crate::sampling::MAX_FACTOR);
     }
 
     #[test]

@@ -199,6 +199,16 @@ fn push(out: &mut Vec<[u32; 3]>, a: u32, b: u32, c: u32) {
 }
 
 impl Pattern for SemiUniform {
+    fn name(&self) -> &'static str {
+        "semi-uniform"
+    }
+
+    /// Quads: the interior of `P^m` is the `n × n` grid (`uniform::grid`); only boundary
+    /// points snap.
+    fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        (input.domain == Domain::Quad).then(|| [Layout::new(input).n; 2])
+    }
+
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let layout = Layout::new(input);
         let nc = input.domain.corner_count();

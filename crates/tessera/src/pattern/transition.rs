@@ -49,7 +49,7 @@
 //! cause cracks: interior vertices belong to one patch, and edges keep their sampling. A core
 //! of zero width (a line or a single point) is allowed; the strips then meet along it.
 //!
-//! The pattern assumes uniform edge samples (`t_k = k / segments`, `EdgeSampling::Uniform`):
+//! The pattern assumes uniform edge samples (`t_k = k / segments`, `SamplingKind::Uniform`):
 //! its triangles have positive area for those positions.
 
 use super::{LocalTessellation, Pattern, PatternInput};

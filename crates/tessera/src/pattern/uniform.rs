@@ -51,8 +51,13 @@ pub fn tri_local(n: u32, i: u32, j: u32) -> u32 {
 }
 
 impl Pattern for Uniform {
-    fn is_uniform(&self) -> bool {
-        true
+    fn name(&self) -> &'static str {
+        "uniform"
+    }
+
+    /// Quads: the `n × n` grid, built by [`grid`] row after row.
+    fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        (input.domain == Domain::Quad).then_some(input.interior)
     }
 
     fn counts(&self, input: &PatternInput) -> (u32, u32) {

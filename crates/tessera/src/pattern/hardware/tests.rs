@@ -113,12 +113,9 @@ fn tiles_the_domain_for_many_factor_combinations() {
                     (out.interior.len() as u32, out.triangles.len() as u32),
                     "{partitioning:?} {input:?}"
                 );
+                let spacing = crate::sampling::Spacing::Hardware(partitioning);
                 let p = input.local_positions(&out.interior, |e, k| {
-                    crate::sampling::EdgeSampling::Fractional {
-                        factor: input.factors[e],
-                        spacing: crate::sampling::Spacing::Hardware(partitioning),
-                    }
-                    .local_param(k, false)
+                    crate::sampling::spacing_param(input.factors[e], spacing, k)
                 });
                 assert_tiles(&input, &out, &p, 0.0);
             }

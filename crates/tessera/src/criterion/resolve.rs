@@ -1,0 +1,265 @@
+//! The one resolver: criteria propose, this decides.
+//!
+//! Every criterion states, for each use of an edge (a patch side), the real factor it would
+//! like ([`Proposals`]). [`edges`] turns those into the plan's per-edge rows with one rule:
+//! the **maximum** over the patches sharing the edge (the CudaTess consistency rule: each
+//! patch's proposal already covers what it needs, so the maximum satisfies all of them),
+//! then the scheme's [`EdgeRule`], then the caps and the topology's minimum segments.
+//! [`interiors`] then gives every patch its interior factors by the scheme's
+//! [`InteriorRule`]. Both read only data every patch agrees on, so the plan is crack-free by
+//! construction, and every engine (CPU or GPU) reads the same rows.
+
+use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
+use crate::sampling::{spacing_segments, Spacing};
+use crate::surface::{Domain, SurfaceSet};
+
+/// What each patch proposes for its local edges (`[0..corner_count]`; 0 = no wish, as for
+/// culled patches).
+pub type Proposals = [f64; 4];
+
+/// How a resolved real factor becomes an edge sampling.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EdgeRule {
+    /// Whole segments: the factor rounded to the nearest integer.
+    Integer,
+    /// Powers of two (semi-uniform's edge levels): the factor's level rounded up.
+    PowerOfTwo,
+    /// A real factor cut by `spacing`. The hardware spacings first round as the hull shader
+    /// does (pow2 to a power of two) and settle factors just above a count boundary onto it
+    /// (`pattern::hardware::settled_factor`), so no output segment falls below `f32`
+    /// resolution.
+    Fractional(Spacing),
+}
+
+/// How interior factors follow from a patch's edges.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InteriorRule {
+    /// One factor for the whole mesh, edges included (the uniform pattern's precondition).
+    Global,
+    /// CudaTess's core: a quad takes the smaller segments of the two edges along each
+    /// direction, a triangle its largest edge; transition strips reach finer edges.
+    Core,
+    /// Semi-uniform's patch level: the largest edge, a power of two.
+    Level,
+    /// The hardware tessellator's `max` reduction of the edge factors (also SD-2's).
+    MaxEdge,
+}
+
+/// Limits every resolved edge obeys.
+#[derive(Debug, Clone, Copy)]
+pub struct Caps<'a> {
+    /// Largest factor; a power of two for [`EdgeRule::PowerOfTwo`].
+    pub max_factor: f64,
+    /// Minimum segments per edge ([`super::tolerance::minimum_segments`]).
+    pub minimum_segments: &'a [u32],
+    /// Minimum interior factors per patch ([`super::tolerance::minimum_interior`]).
+    pub minimum_interior: &'a [[u32; 2]],
+}
+
+/// Resolves per-use proposals into per-edge segments and factors (written into `segments`
+/// and `factors`, cleared first). Cost: O(E) plus the edge uses.
+pub fn edges(
+    set: &SurfaceSet,
+    proposals: &[Proposals],
+    rule: EdgeRule,
+    interior: InteriorRule,
+    caps: &Caps<'_>,
+    segments: &mut Vec<u32>,
+    factors: &mut Vec<f32>,
+) {
+    let topo = &set.topology;
+    segments.clear();
+    factors.clear();
+    let cap = caps.max_factor.max(1.0);
+    for e in 0..topo.edges.len() {
+        let wanted = topo
+            .edge_uses(e)
+            .iter()
+            .map(|u| proposals[u.patch as usize][u.local as usize])
+            .fold(0.0, f64::max)
+            .min(cap);
+        let minimum = caps.minimum_segments[e].max(1);
+        let (s, f) = match rule {
+            EdgeRule::Integer => {
+                let s = (wanted.round() as u32).max(minimum);
+                (s, s as f32)
+            }
+            EdgeRule::PowerOfTwo => {
+                // Level ⌈log2 f⌉, with a margin for factors that are powers of two up to
+                // rounding (the view criteria interpolate levels, not factors).
+                let level = (wanted.max(1.0).log2() - 1e-9).ceil().max(0.0) as u32;
+                let s = (1u32 << level.min(31)).max(minimum).next_power_of_two().min(cap as u32);
+                (s, s as f32)
+            }
+            EdgeRule::Fractional(spacing) => {
+                let f = wanted.max(minimum as f64);
+                let f = match spacing {
+                    Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
+                    Spacing::Symmetric => f,
+                };
+                // Segments follow from the stored f32 factor, the one every engine reads.
+                let f = f as f32;
+                (spacing_segments(f as f64, spacing), f)
+            }
+        };
+        segments.push(s);
+        factors.push(f);
+    }
+    if interior == InteriorRule::Global {
+        let n = segments
+            .iter()
+            .copied()
+            .chain(caps.minimum_interior.iter().flatten().copied())
+            .max()
+            .unwrap_or(1);
+        segments.iter_mut().for_each(|s| *s = n);
+        factors.iter_mut().for_each(|f| *f = n as f32);
+    }
+}
+
+/// Interior factors of every patch from its edges' segments by `rule` (into `out`, cleared
+/// first). Cost: O(P).
+pub fn interiors(
+    set: &SurfaceSet,
+    segments: &[u32],
+    rule: InteriorRule,
+    caps: &Caps<'_>,
+    out: &mut Vec<[u32; 2]>,
+) {
+    let topo = &set.topology;
+    out.clear();
+    out.extend((0..set.patches.len()).map(|p| {
+        let domain = set.patches[p].domain();
+        let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
+        let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
+        let minimum = caps.minimum_interior[p];
+        match (rule, domain) {
+            (InteriorRule::Global, _) => [largest, largest],
+            (InteriorRule::Core, Domain::Quad) => {
+                [s(0).min(s(2)).max(minimum[0]), s(1).min(s(3)).max(minimum[1])]
+            }
+            (InteriorRule::Core, Domain::Tri) | (InteriorRule::MaxEdge, _) => [largest, largest],
+            (InteriorRule::Level, _) => {
+                let n =
+                    largest.max(minimum[0]).max(minimum[1]).next_power_of_two().min(caps.max_factor as u32);
+                [n, n]
+            }
+        }
+    }));
+}
+
+/// Per-use proposals from one factor per edge (criteria that judge an edge by its own data,
+/// such as the view criteria): every use of edge `e` proposes `per_edge[e]`. Cost: O(P).
+pub fn from_edge_factors(set: &SurfaceSet, per_edge: &[f64], out: &mut Vec<Proposals>) {
+    let topo = &set.topology;
+    out.clear();
+    out.extend((0..set.patches.len()).map(|p| {
+        let mut row = [0.0; 4];
+        for (l, r) in row.iter_mut().enumerate().take(set.patches[p].domain().corner_count()) {
+            *r = per_edge[topo.patch_edges[p][l].edge as usize];
+        }
+        row
+    }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::{Patch, RationalBicubic};
+    use glam::DVec3;
+
+    /// Two flat bicubic patches side by side, sharing the curve `x = 3`.
+    fn pair() -> SurfaceSet {
+        let quad = |x0: f64| {
+            Patch::Bicubic(RationalBicubic {
+                points: std::array::from_fn(|k| DVec3::new(x0 + (k / 4) as f64, (k % 4) as f64, 0.0)),
+                weights: [1.0; 16],
+            })
+        };
+        SurfaceSet::from_patches(vec![quad(0.0), quad(3.0)], Default::default())
+    }
+
+    fn shared_edge(set: &SurfaceSet) -> usize {
+        (0..set.topology.edges.len()).find(|&e| set.topology.edge_uses(e).len() == 2).expect("a shared curve")
+    }
+
+    fn resolve(
+        set: &SurfaceSet,
+        proposals: &[Proposals],
+        rule: EdgeRule,
+        interior: InteriorRule,
+        cap: f64,
+    ) -> (Vec<u32>, Vec<f32>) {
+        let minimum = vec![1; set.topology.edges.len()];
+        let minimum_interior = vec![[1, 1]; set.patches.len()];
+        let caps = Caps { max_factor: cap, minimum_segments: &minimum, minimum_interior: &minimum_interior };
+        let (mut s, mut f) = (Vec::new(), Vec::new());
+        edges(set, proposals, rule, interior, &caps, &mut s, &mut f);
+        (s, f)
+    }
+
+    #[test]
+    fn an_edge_takes_the_maximum_of_its_patches_proposals() {
+        let set = pair();
+        let shared = shared_edge(&set);
+        let (s, _) = resolve(&set, &[[2.0; 4], [5.0; 4]], EdgeRule::Integer, InteriorRule::Core, 64.0);
+        assert_eq!(s[shared], 5);
+        for u in set.topology.edge_uses(shared) {
+            assert_eq!(set.topology.patch_edges[u.patch as usize][u.local as usize].edge as usize, shared);
+        }
+        // Every other edge has one patch, and keeps its proposal.
+        for (e, &n) in s.iter().enumerate().filter(|&(e, _)| e != shared) {
+            let owner = set.topology.edge_uses(e)[0].patch;
+            assert_eq!(n, if owner == 0 { 2 } else { 5 }, "edge {e}");
+        }
+        // Order of the patches does not matter.
+        let (t, _) = resolve(&set, &[[5.0; 4], [2.0; 4]], EdgeRule::Integer, InteriorRule::Core, 64.0);
+        assert_eq!(t[shared], 5);
+    }
+
+    #[test]
+    fn rules_round_and_cap() {
+        let set = pair();
+        let shared = shared_edge(&set);
+        let (s, _) = resolve(&set, &[[3.0; 4], [1.0; 4]], EdgeRule::PowerOfTwo, InteriorRule::Level, 64.0);
+        assert_eq!(s[shared], 4, "3 rounds up to the next level");
+        let (s, _) = resolve(&set, &[[9.0; 4], [1.0; 4]], EdgeRule::PowerOfTwo, InteriorRule::Level, 8.0);
+        assert_eq!(s[shared], 8, "the cap stops the level");
+        let (s, _) = resolve(&set, &[[2.6; 4], [1.0; 4]], EdgeRule::Integer, InteriorRule::Core, 64.0);
+        assert_eq!(s[shared], 3, "integer factors round to the nearest");
+        let (s, _) = resolve(&set, &[[100.0; 4], [1.0; 4]], EdgeRule::Integer, InteriorRule::Core, 10.0);
+        assert_eq!(s[shared], 10);
+        let odd = Spacing::Hardware(crate::sampling::Partitioning::FractionalOdd);
+        let (s, f) =
+            resolve(&set, &[[2.5; 4], [1.0; 4]], EdgeRule::Fractional(odd), InteriorRule::MaxEdge, 64.0);
+        assert_eq!((s[shared], f[shared]), (spacing_segments(2.5, odd), 2.5));
+    }
+
+    #[test]
+    fn the_global_rule_gives_every_edge_the_largest() {
+        let set = pair();
+        let (s, f) = resolve(&set, &[[2.0; 4], [5.0; 4]], EdgeRule::Integer, InteriorRule::Global, 64.0);
+        assert!(s.iter().all(|&n| n == 5) && f.iter().all(|&x| x == 5.0), "{s:?}");
+    }
+
+    #[test]
+    fn minimums_hold_and_interiors_follow_the_rule() {
+        let set = pair();
+        let minimum = vec![3; set.topology.edges.len()];
+        let minimum_interior = vec![[1, 1]; set.patches.len()];
+        let caps = Caps { max_factor: 64.0, minimum_segments: &minimum, minimum_interior: &minimum_interior };
+        let (mut s, mut f) = (Vec::new(), Vec::new());
+        edges(&set, &[[1.0; 4], [1.0; 4]], EdgeRule::Integer, InteriorRule::Core, &caps, &mut s, &mut f);
+        assert!(s.iter().all(|&n| n == 3));
+        // Core: each direction takes the smaller of its two opposite edges.
+        let topo = &set.topology;
+        s[topo.patch_edges[0][0].edge as usize] = 7;
+        let mut interior = Vec::new();
+        interiors(&set, &s, InteriorRule::Core, &caps, &mut interior);
+        assert_eq!(interior[0], [3, 3]);
+        interiors(&set, &s, InteriorRule::MaxEdge, &caps, &mut interior);
+        assert_eq!(interior[0], [7, 7]);
+        interiors(&set, &s, InteriorRule::Level, &caps, &mut interior);
+        assert_eq!(interior[0], [8, 8]);
+    }
+}

@@ -1,0 +1,190 @@
+//! The output layout: counts → exclusive scan → where every vertex and triangle goes.
+//!
+//! **The numbering rule**, the one every writer (CPU generic, CPU fast evaluation, GPU) uses:
+//!
+//! 1. vertices `0 .. corners`: the topology's corner entries (`topology.corner_entries`, one
+//!    per vertex and normal variant), evaluated by their owner patch;
+//! 2. then, edge after edge in `topology.edges` order, each edge's inner samples
+//!    `k = 1 .. segments − 1` in canonical orientation, normal variant after variant: sample
+//!    `k` of variant `v` of edge `e` is `edge_offsets[e] + v·(segments − 1) + k − 1`. Collapsed
+//!    edges, and edges whose patches are all culled, have none (every sample of a collapsed
+//!    curve is its corner);
+//! 3. then, patch after patch, the pattern's interior vertices in the pattern's order:
+//!    interior vertex `j` of patch `p` is `interior_offsets[p] + j`;
+//! 4. triangles patch after patch, each patch's in the pattern's order minus those that
+//!    degenerate at a repeated corner: triangle `t` of patch `p` is `triangle_offsets[p] + t`.
+//!
+//! All offsets are prefix sums with one extra entry at the end, so the count of edge `e`,
+//! patch `p` is `offsets[i + 1] − offsets[i]` and the totals are the last entries. Counts are
+//! known before anything is evaluated, so every task writes its own disjoint range.
+//!
+//! **For the GPU engine.** `edge_offsets`, `interior_offsets` and `triangle_offsets` (u32) are
+//! uploaded as they are, beside the plan's arrays; a write shader finds its ranges there and
+//! numbers vertices with [`Layout::edge_vertex`]'s and [`Layout::interior_vertex`]'s formulas.
+
+use super::{check_size, TessellateOptions};
+use crate::criterion::Plan;
+use crate::error::Result;
+use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
+use crate::surface::SurfaceSet;
+use rayon::prelude::*;
+
+/// Where every vertex and triangle of one tessellation goes (see the module doc).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Layout {
+    /// Number of corner entries: the first vertices.
+    pub corners: u32,
+    /// `E + 1` entries: the first vertex of each edge's inner samples.
+    pub edge_offsets: Vec<u32>,
+    /// `P + 1` entries: the first interior vertex of each patch.
+    pub interior_offsets: Vec<u32>,
+    /// `P + 1` entries: the first triangle of each patch.
+    pub triangle_offsets: Vec<u32>,
+    /// Pattern triangles left out because two of their corners are one vertex.
+    pub collapsed_triangles: u64,
+}
+
+impl Layout {
+    /// Total vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.interior_offsets.last().copied().unwrap_or(self.corners) as usize
+    }
+
+    /// Total triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangle_offsets.last().copied().unwrap_or(0) as usize
+    }
+
+    /// Vertex of canonical sample `k` (`1 ≤ k < segments`) of variant `variant` of edge `e`.
+    #[inline]
+    pub fn edge_vertex(&self, e: usize, variant: u32, segments: u32, k: u32) -> u32 {
+        self.edge_offsets[e] + variant * (segments - 1) + k - 1
+    }
+
+    /// Vertex of interior vertex `j` of patch `p`.
+    #[inline]
+    pub fn interior_vertex(&self, p: usize, j: u32) -> u32 {
+        self.interior_offsets[p] + j
+    }
+
+    /// Counts and scans the output of `pattern` on `set` following `plan` into `self`
+    /// (reusing its buffers), refusing with [`crate::Error::OutputTooLarge`] an output beyond
+    /// the limits of `options` before anything of its size exists, and with
+    /// [`crate::Error::PlanMismatch`] a plan made for another set.
+    ///
+    /// Cost: O(E + P) plus one pattern count per visible patch; patches with a repeated corner
+    /// (a collapsed curve) also build their pattern once to count what degenerates.
+    pub fn build(
+        &mut self,
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        options: &TessellateOptions,
+    ) -> Result<()> {
+        plan.check(set)?;
+        let topo = &set.topology;
+        self.corners = topo.corner_entries.len() as u32;
+        // Edges: inner samples per variant; none for collapsed edges or edges seen by no
+        // visible patch (nothing refers to them).
+        let mut total = self.corners as u64;
+        self.edge_offsets.clear();
+        for (e, edge) in topo.edges.iter().enumerate() {
+            self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
+            let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
+            if !edge.collapsed && seen {
+                total += (plan.segments(e) as u64 - 1) * edge.variants as u64;
+            }
+        }
+        self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
+        // Pattern counts first, without building anything: a triangle count is an upper bound
+        // (triangles collapsed at a repeated corner are dropped below), so an output that is
+        // too large is refused here, before any pattern or buffer of its size exists.
+        let counts: Vec<(u64, u64)> = (0..set.patches.len())
+            .into_par_iter()
+            .map(|p| {
+                if !plan.is_visible(p) {
+                    return (0, 0);
+                }
+                let (v, t) = pattern.counts(&pattern_input(set, plan, p));
+                (v as u64, t as u64)
+            })
+            .collect();
+        let interior: u64 = counts.iter().map(|c| c.0).sum();
+        let upper: u64 = counts.iter().map(|c| c.1).sum();
+        check_size(total + interior, upper, options)?;
+        let kept: Vec<u64> = counts
+            .par_iter()
+            .enumerate()
+            .map_init(LocalTessellation::default, |scratch, (p, &(_, t))| {
+                if t == 0 || !has_repeated_corner(set, p) {
+                    return t;
+                }
+                let input = pattern_input(set, plan, p);
+                pattern.build(&input, scratch);
+                scratch.triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
+                    as u64
+            })
+            .collect();
+        // Scan: both totals fit u32 now (check_size).
+        self.interior_offsets.clear();
+        self.triangle_offsets.clear();
+        let (mut vertices, mut triangles) = (total as u32, 0u32);
+        for (&(v, _), &t) in counts.iter().zip(&kept) {
+            self.interior_offsets.push(vertices);
+            self.triangle_offsets.push(triangles);
+            vertices += v as u32;
+            triangles += t as u32;
+        }
+        self.interior_offsets.push(vertices);
+        self.triangle_offsets.push(triangles);
+        self.collapsed_triangles = upper - triangles as u64;
+        Ok(())
+    }
+}
+
+/// What the pattern of patch `p` gets from the plan: its edges' segments and factors and its
+/// interior factors.
+pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
+    let domain = set.patches[p].domain();
+    let mut segments = [1; 4];
+    let mut factors = [1.0; 4];
+    for e in 0..domain.corner_count() {
+        let edge = set.topology.patch_edges[p][e].edge as usize;
+        segments[e] = plan.segments(edge);
+        factors[e] = plan.factor(edge);
+    }
+    PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32 }
+}
+
+/// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
+/// starts and ends at one point): only then can a pattern triangle degenerate.
+pub(crate) fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
+    let n = set.patches[p].domain().corner_count();
+    let c = &set.topology.patch_corners[p][..n];
+    (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))
+}
+
+/// True when two corners of a pattern triangle of patch `p` land on the same output vertex
+/// because they lie on a collapsed boundary curve (or at its ends). Decided from local indices
+/// only, so the count pass and the write pass agree.
+pub(crate) fn degenerate_after_collapse(
+    set: &SurfaceSet,
+    input: &PatternInput,
+    p: usize,
+    tri: &[u32; 3],
+) -> bool {
+    let topo = &set.topology;
+    // Corners and samples of collapsed curves are identified by their vertex; every other
+    // local index is a distinct vertex of its own.
+    let id = |l: u32| -> (bool, u32) {
+        match input.slot(l) {
+            Slot::Corner(c) => (true, topo.patch_corner_entries[p][c]),
+            Slot::Edge(e, _) if topo.edges[topo.patch_edges[p][e].edge as usize].collapsed => {
+                (true, topo.patch_corner_entries[p][e])
+            }
+            _ => (false, l),
+        }
+    };
+    let [a, b, c] = tri.map(id);
+    a == b || b == c || a == c
+}

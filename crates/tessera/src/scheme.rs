@@ -1,0 +1,627 @@
+//! Schemes: each published tessellation scheme as one closed type that owns its pattern, its
+//! edge rule, its interior rule, its caps and the criteria it accepts.
+//!
+//! ```text
+//! Scheme::plan(set, criterion, options) ─► Planned { plan (plain arrays), pattern, report }
+//!                                             └─► engine::tessellate(set, &plan, &pattern, ..)
+//! ```
+//!
+//! | scheme | edge rule | interior rule | criteria |
+//! | --- | --- | --- | --- |
+//! | [`Scheme::Uniform`] | integer, one factor everywhere | global | factor, tolerance, pixel error, view |
+//! | [`Scheme::Transition`] (CudaTess) | integer, maximum over the edge's patches | core + transition strips | the same |
+//! | [`Scheme::SemiUniform`] (paper 000) | powers of two up to `2^max_level` | the patch level | the same |
+//! | [`Scheme::Sd2`] (paper 001) | symmetric real factors (warped) | largest edge | factor, distance, vertex silhouettes |
+//! | [`Scheme::Hardware`] (Direct3D 11) | its partitioning, in 16.16 fixed point | `max` reduction | factor, view |
+//! | [`Scheme::Esc`] (paper 002) | lattice points chosen by the distance test | level `3n` | its own ([`Criterion::Esc`]) |
+//!
+//! Asking a scheme for a criterion it does not accept is an
+//! [`Error::CriterionNotAccepted`]; a factor it cannot draw is an [`Error::FactorOutOfRange`].
+
+use crate::camera::Camera;
+use crate::criterion::esc::{self as esc_criterion, EscOptions, Threshold};
+use crate::criterion::resolve::{Caps, EdgeRule, InteriorRule};
+use crate::criterion::sd2::{self as sd2_criterion, LevelFunction, Sd2Options};
+use crate::criterion::tolerance::{self, minimum_interior, minimum_segments, PlanReport};
+use crate::criterion::view::{self, EdgeFactors, Mapping, ViewCriterion};
+use crate::criterion::{screen, Plan, MAX_FACTOR};
+use crate::domain::Domain;
+use crate::error::{Error, Result};
+use crate::pattern::esc::Esc;
+use crate::pattern::hardware::{Hardware, Partitioning};
+use crate::pattern::sd2::Sd2;
+use crate::pattern::semi_uniform::{SemiUniform, MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL};
+use crate::pattern::transition::Transition;
+use crate::pattern::uniform::Uniform;
+use crate::pattern::{LocalTessellation, Pattern, PatternInput};
+use crate::sampling::Spacing;
+use crate::surface::SurfaceSet;
+
+/// A tessellation scheme: a pattern with the rules that feed it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scheme {
+    /// One factor everywhere: the baseline.
+    Uniform,
+    /// CudaTess (paper 003): per-edge factors, a uniform core, transition strips.
+    Transition,
+    /// Semi-uniform (paper 000): power-of-two edge factors up to `2^max_level`
+    /// (`max_level ≤ 8`), the dyadic pattern of the patch's level with coarser edges snapped.
+    SemiUniform { max_level: u32 },
+    /// SD-2 (paper 001): at most two real factors per triangle, strips; `warp`
+    /// reverse-projects the pattern with the vertex depths (§3.3). Triangles only.
+    Sd2 { warp: bool },
+    /// The Direct3D 11 hardware tessellator with one of its partitionings.
+    Hardware(Partitioning),
+    /// ESC (paper 002): bicubic patches only, level per object up to `max_level` (`≤ 6`).
+    Esc { max_level: u32 },
+}
+
+/// What decides the factors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Criterion {
+    /// One factor everywhere (a real number for SD-2 and the fractional partitionings).
+    Factor(f64),
+    /// Guaranteed object-space error on every patch.
+    Tolerance(f64),
+    /// Guaranteed screen-space error in pixels, for [`PlanOptions::camera`].
+    PixelError(f64),
+    /// A view heuristic without guarantee: factors in `[fmin, fmax]`.
+    View { criterion: ViewCriterion, fmin: f64, fmax: f64 },
+    /// ESC's own criterion: a level per object from the camera (or `level` for every patch)
+    /// and the distance test with `threshold`.
+    Esc { threshold: Threshold, level: Option<u32> },
+}
+
+impl Criterion {
+    /// A short name for messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Criterion::Factor(_) => "a fixed factor",
+            Criterion::Tolerance(_) => "an error tolerance",
+            Criterion::PixelError(_) => "a pixel error",
+            Criterion::View { criterion: ViewCriterion::Distance(_), .. } => "distance factors",
+            Criterion::View { criterion: ViewCriterion::SilhouetteVertices, .. } => "vertex silhouettes",
+            Criterion::View { criterion: ViewCriterion::Silhouetteness, .. } => "silhouetteness",
+            Criterion::Esc { .. } => "the ESC criterion",
+        }
+    }
+}
+
+/// Options of [`Scheme::plan`] that are not the criterion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanOptions {
+    /// The camera, for view-dependent criteria, SD-2 and ESC levels and culling. Criteria
+    /// that need one fail with [`Error::NeedsCamera`] without it.
+    pub camera: Option<Camera>,
+    /// Leave out patches outside the view or facing away from [`PlanOptions::camera`] (the
+    /// mesh is then open where they were).
+    pub cull: bool,
+    /// Largest factor an adaptive criterion may use (`1..=MAX_FACTOR`); where it stops a
+    /// bound, the report says so.
+    pub max_factor: u32,
+    /// Largest output the error-bounded criteria may build while they check their bounds;
+    /// beyond it they refuse with [`Error::OutputTooLarge`].
+    pub max_triangles: u64,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions { camera: None, cull: false, max_factor: 64, max_triangles: u64::MAX }
+    }
+}
+
+/// A plan, the pattern that draws it, and the guarantee report where the criterion has one.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    pub plan: Plan,
+    pub pattern: SchemePattern,
+    pub report: Option<PlanReport>,
+}
+
+/// The pattern of each scheme, as one closed type (no allocation, and an engine can match on
+/// it).
+#[derive(Debug, Clone)]
+pub enum SchemePattern {
+    Uniform(Uniform),
+    Transition(Transition),
+    SemiUniform(SemiUniform),
+    Sd2(Sd2),
+    Hardware(Hardware),
+    Esc(Esc),
+}
+
+impl SchemePattern {
+    fn inner(&self) -> &dyn Pattern {
+        match self {
+            SchemePattern::Uniform(p) => p,
+            SchemePattern::Transition(p) => p,
+            SchemePattern::SemiUniform(p) => p,
+            SchemePattern::Sd2(p) => p,
+            SchemePattern::Hardware(p) => p,
+            SchemePattern::Esc(p) => p,
+        }
+    }
+}
+
+impl Pattern for SchemePattern {
+    fn counts(&self, input: &PatternInput) -> (u32, u32) {
+        self.inner().counts(input)
+    }
+    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        self.inner().build(input, out)
+    }
+    fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        self.inner().interior_grid(input)
+    }
+    fn depends_on_patch(&self) -> bool {
+        self.inner().depends_on_patch()
+    }
+    fn strips(&self, input: &PatternInput, out: &mut Vec<u32>) -> bool {
+        self.inner().strips(input, out)
+    }
+    fn name(&self) -> &'static str {
+        match self {
+            SchemePattern::Uniform(_) => "uniform",
+            SchemePattern::Transition(_) => "transition",
+            SchemePattern::SemiUniform(_) => "semi-uniform",
+            SchemePattern::Sd2(_) => "sd2",
+            SchemePattern::Hardware(h) => h.partitioning.name(),
+            SchemePattern::Esc(_) => "esc",
+        }
+    }
+}
+
+impl Scheme {
+    /// Semi-uniform's default highest level (paper 000's benchmarks use 3 and 5).
+    pub const DEFAULT_SEMI_UNIFORM_LEVEL: u32 = 5;
+    /// ESC's default `Lmax` (the paper's).
+    pub const DEFAULT_ESC_LEVEL: u32 = 3;
+
+    /// The scheme used when none is named: uniform for a fixed factor, ESC for its own
+    /// criterion, transition for the adaptive criteria.
+    pub fn default_for(criterion: &Criterion) -> Scheme {
+        match criterion {
+            Criterion::Factor(_) => Scheme::Uniform,
+            Criterion::Esc { .. } => Scheme::Esc { max_level: Self::DEFAULT_ESC_LEVEL },
+            _ => Scheme::Transition,
+        }
+    }
+
+    /// The name the command line and reports use.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Scheme::Uniform => "uniform",
+            Scheme::Transition => "transition",
+            Scheme::SemiUniform { .. } => "semi-uniform",
+            Scheme::Sd2 { .. } => "sd2",
+            Scheme::Hardware(Partitioning::Integer) => "integer",
+            Scheme::Hardware(Partitioning::Pow2) => "pow2",
+            Scheme::Hardware(Partitioning::FractionalOdd) => "fractional-odd",
+            Scheme::Hardware(Partitioning::FractionalEven) => "fractional-even",
+            Scheme::Esc { .. } => "esc",
+        }
+    }
+
+    /// The silhouette test [`ViewCriterion`] a scheme draws silhouettes with by default:
+    /// SD-2 needs a level function (vertex classification), the others use silhouetteness.
+    pub fn default_silhouette(&self) -> ViewCriterion {
+        match self {
+            Scheme::Sd2 { .. } => ViewCriterion::SilhouetteVertices,
+            _ => ViewCriterion::Silhouetteness,
+        }
+    }
+
+    /// How resolved factors become edge samplings (None for ESC, whose edges are decided by
+    /// their owner patch's distance test).
+    pub fn edge_rule(&self) -> Option<EdgeRule> {
+        match self {
+            Scheme::Uniform | Scheme::Transition => Some(EdgeRule::Integer),
+            Scheme::SemiUniform { .. } => Some(EdgeRule::PowerOfTwo),
+            Scheme::Sd2 { .. } => Some(EdgeRule::Fractional(Spacing::Symmetric)),
+            Scheme::Hardware(p) => Some(EdgeRule::Fractional(Spacing::Hardware(*p))),
+            Scheme::Esc { .. } => None,
+        }
+    }
+
+    /// How interior factors follow from the edges.
+    pub fn interior_rule(&self) -> InteriorRule {
+        match self {
+            Scheme::Uniform => InteriorRule::Global,
+            Scheme::Transition => InteriorRule::Core,
+            Scheme::SemiUniform { .. } | Scheme::Esc { .. } => InteriorRule::Level,
+            Scheme::Sd2 { .. } | Scheme::Hardware(_) => InteriorRule::MaxEdge,
+        }
+    }
+
+    /// The largest edge factor the scheme itself can draw (before `--max-factor`).
+    pub fn factor_cap(&self) -> f64 {
+        match self {
+            Scheme::SemiUniform { max_level } => (1u32 << (*max_level).min(SEMI_UNIFORM_MAX_LEVEL)) as f64,
+            Scheme::Hardware(p) => p.range().1 as f64,
+            _ => MAX_FACTOR as f64,
+        }
+    }
+
+    /// Whether the scheme accepts `criterion`; the error names what it accepts instead.
+    /// Cost: O(1).
+    pub fn accepts(&self, criterion: &Criterion) -> Result<()> {
+        let refuse = |hint: &str| {
+            Err(Error::CriterionNotAccepted {
+                scheme: self.name(),
+                criterion: criterion.name(),
+                hint: hint.to_string(),
+            })
+        };
+        match (self, criterion) {
+            (Scheme::Esc { .. }, Criterion::Esc { .. }) => Ok(()),
+            (Scheme::Esc { .. }, _) => refuse("ESC has its own criterion: a quality threshold and levels"),
+            (_, Criterion::Esc { .. }) => refuse("the ESC criterion goes with the esc scheme only"),
+            (
+                Scheme::Sd2 { .. } | Scheme::Hardware(_),
+                Criterion::Tolerance(_) | Criterion::PixelError(_),
+            ) => refuse(
+                "it gives no error guarantee: use a factor or a view criterion, or the uniform, \
+                     transition or semi-uniform scheme for an error bound",
+            ),
+            (Scheme::Sd2 { .. }, Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }) => {
+                refuse("SD-2 needs a level function: use vertex silhouettes or distance factors")
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Plans `set` under `criterion`. Checks everything a caller can get wrong first: the
+    /// criterion ([`Scheme::accepts`]), the factor ranges ([`Error::FactorOutOfRange`]), the
+    /// patch kinds ([`Error::PatchKindNotAccepted`]), the camera ([`Error::NeedsCamera`]).
+    /// Cost: that of the criterion — O(V + E + P) evaluations for the view criteria, bound
+    /// computations and a-posteriori pattern checks for the error-bounded ones.
+    pub fn plan(&self, set: &SurfaceSet, criterion: &Criterion, options: &PlanOptions) -> Result<Planned> {
+        self.check(criterion, options)?;
+        if let Scheme::Esc { max_level } = *self {
+            return self.plan_esc(set, criterion, options, max_level);
+        }
+        if let Scheme::Sd2 { warp } = *self {
+            return self.plan_sd2(set, criterion, options, warp);
+        }
+        let rule = self.edge_rule().expect("every scheme but ESC has an edge rule");
+        let interior = self.interior_rule();
+        let pattern = match self {
+            Scheme::Uniform => SchemePattern::Uniform(Uniform),
+            Scheme::Transition => SchemePattern::Transition(Transition),
+            Scheme::SemiUniform { .. } => SchemePattern::SemiUniform(SemiUniform),
+            Scheme::Hardware(p) => SchemePattern::Hardware(Hardware { partitioning: *p }),
+            Scheme::Sd2 { .. } | Scheme::Esc { .. } => unreachable!("planned above"),
+        };
+        let cap = self.cap(options);
+        let (minimum, minimum_inner) = (minimum_segments(set), minimum_interior(set));
+        let caps = Caps { max_factor: cap, minimum_segments: &minimum, minimum_interior: &minimum_inner };
+        let camera = options.camera;
+        let cull_camera = || camera.ok_or(Error::NeedsCamera { what: "culling" });
+        let planned = |plan, report| Ok(Planned { plan, pattern: pattern.clone(), report });
+        match *criterion {
+            Criterion::Factor(f) if rule == EdgeRule::Integer || rule == EdgeRule::PowerOfTwo => {
+                let mut plan = Plan::uniform(set, f as u32)?;
+                if options.cull {
+                    plan.visible = screen::visibility(set, &cull_camera()?, true);
+                }
+                planned(plan, None)
+            }
+            Criterion::Factor(f) => {
+                let camera =
+                    if options.cull { cull_camera()? } else { camera.unwrap_or_else(|| framing(set)) };
+                let plan =
+                    view::plan(set, &camera, EdgeFactors::Fixed(f), rule, interior, &caps, options.cull);
+                planned(plan, None)
+            }
+            Criterion::Tolerance(eps) => {
+                let eps = if options.cull {
+                    let camera = cull_camera()?;
+                    set.patches.iter().map(|p| (!screen::culled(p, &camera)).then_some(eps)).collect()
+                } else {
+                    vec![Some(eps); set.patches.len()]
+                };
+                let (plan, report) = tolerance::plan_limited(
+                    set,
+                    &eps,
+                    rule,
+                    interior,
+                    &pattern,
+                    cap as u32,
+                    options.max_triangles,
+                )?;
+                planned(plan, Some(report))
+            }
+            Criterion::PixelError(px) => {
+                let camera = camera.ok_or(Error::NeedsCamera { what: "a pixel error" })?;
+                let eps = screen::tolerances(set, &camera, px, options.cull);
+                let (plan, report) = tolerance::plan_limited(
+                    set,
+                    &eps,
+                    rule,
+                    interior,
+                    &pattern,
+                    cap as u32,
+                    options.max_triangles,
+                )?;
+                planned(plan, Some(report))
+            }
+            Criterion::View { criterion, fmin, fmax } => {
+                let camera = camera.ok_or(Error::NeedsCamera { what: "a view criterion" })?;
+                let fmax = fmax.min(cap);
+                let factors = EdgeFactors::View { criterion, fmin: fmin.min(fmax), fmax };
+                let plan = view::plan(set, &camera, factors, rule, interior, &caps, options.cull);
+                planned(plan, None)
+            }
+            Criterion::Esc { .. } => unreachable!("refused by accepts"),
+        }
+    }
+
+    /// The largest factor this scheme may use under `options`: the scheme's own cap and
+    /// `max_factor`, a power of two for semi-uniform.
+    fn cap(&self, options: &PlanOptions) -> f64 {
+        let cap = self.factor_cap().min(options.max_factor.max(1) as f64);
+        match self {
+            Scheme::SemiUniform { .. } => (1u32 << (31 - (cap as u32).leading_zeros())) as f64,
+            _ => cap,
+        }
+    }
+
+    /// Validates `criterion` and `options` against the scheme before any work.
+    fn check(&self, criterion: &Criterion, options: &PlanOptions) -> Result<()> {
+        self.accepts(criterion)?;
+        if options.max_factor == 0 || options.max_factor > MAX_FACTOR {
+            return Err(Error::InvalidParameter {
+                name: "max factor",
+                reason: format!("{}: use 1 to {MAX_FACTOR}", options.max_factor),
+            });
+        }
+        let name = self.name();
+        let out_of_range =
+            |factor: f64, expected: String| Err(Error::FactorOutOfRange { scheme: name, factor, expected });
+        match (*self, *criterion) {
+            (Scheme::SemiUniform { max_level }, _) if max_level > SEMI_UNIFORM_MAX_LEVEL => {
+                Err(Error::InvalidParameter {
+                    name: "max level",
+                    reason: format!("{max_level}: semi-uniform levels go from 0 to {SEMI_UNIFORM_MAX_LEVEL}"),
+                })
+            }
+            (Scheme::Esc { max_level }, _) if max_level > crate::pattern::esc::MAX_LEVEL => {
+                Err(Error::InvalidParameter {
+                    name: "max level",
+                    reason: format!(
+                        "{max_level}: ESC levels go from 0 to {}",
+                        crate::pattern::esc::MAX_LEVEL
+                    ),
+                })
+            }
+            (Scheme::Esc { .. }, _) if options.cull => Err(Error::InvalidParameter {
+                name: "cull",
+                reason: "the esc scheme chooses one level per object and culls nothing".into(),
+            }),
+            (Scheme::Uniform | Scheme::Transition, Criterion::Factor(f)) => {
+                if f.fract() != 0.0 || !(1.0..=MAX_FACTOR as f64).contains(&f) {
+                    return out_of_range(
+                        f,
+                        format!(
+                            "an integer from 1 to {MAX_FACTOR} (real factors need the fractional-odd, \
+                             fractional-even or sd2 scheme)"
+                        ),
+                    );
+                }
+                Ok(())
+            }
+            (Scheme::SemiUniform { max_level }, Criterion::Factor(f)) => {
+                let top = 1u32 << max_level;
+                if f.fract() != 0.0 || !(1.0..=top as f64).contains(&f) || !(f as u32).is_power_of_two() {
+                    return out_of_range(f, format!("a power of two up to 2^{max_level} (the max level)"));
+                }
+                Ok(())
+            }
+            (Scheme::Sd2 { .. } | Scheme::Hardware(_), Criterion::Factor(f)) => {
+                let hi = self.factor_cap().min(options.max_factor as f64);
+                if !(f.is_finite() && f >= 1.0 && f <= hi) {
+                    let why = match self {
+                        Scheme::Hardware(p) if hi == p.range().1 as f64 => {
+                            format!("a number from 1 to {hi}, the hardware's {} range", p.name())
+                        }
+                        _ => format!("a number from 1 to the max factor {hi}"),
+                    };
+                    return out_of_range(f, why);
+                }
+                Ok(())
+            }
+            (_, Criterion::Tolerance(eps) | Criterion::PixelError(eps))
+                if !(eps.is_finite() && eps > 0.0) =>
+            {
+                Err(Error::InvalidParameter {
+                    name: if matches!(criterion, Criterion::Tolerance(_)) {
+                        "tolerance"
+                    } else {
+                        "pixel error"
+                    },
+                    reason: format!("{eps}: must be a positive number"),
+                })
+            }
+            (_, Criterion::View { fmin, fmax, .. }) => {
+                let integer = matches!(self.edge_rule(), Some(EdgeRule::Integer | EdgeRule::PowerOfTwo));
+                let valid = |f: f64| f.is_finite() && f >= 1.0 && (!integer || f.fract() == 0.0);
+                if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
+                    let what = if integer { "integers" } else { "numbers" };
+                    return out_of_range(
+                        if valid(fmin) { fmax } else { fmin },
+                        format!("a range FMIN:FMAX of {what} with 1 ≤ FMIN ≤ FMAX"),
+                    );
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn plan_sd2(
+        &self,
+        set: &SurfaceSet,
+        criterion: &Criterion,
+        options: &PlanOptions,
+        warp: bool,
+    ) -> Result<Planned> {
+        let cap = self.cap(options);
+        let (level, fmin, fmax) = match *criterion {
+            Criterion::Factor(f) => (LevelFunction::Distance(Mapping::Linear), f, f),
+            Criterion::View { criterion: ViewCriterion::Distance(m), fmin, fmax } => {
+                let fmax = fmax.min(cap);
+                (LevelFunction::Distance(m), fmin.min(fmax), fmax)
+            }
+            Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin, fmax } => {
+                let fmax = fmax.min(cap);
+                (LevelFunction::Silhouette, fmin.min(fmax), fmax)
+            }
+            _ => unreachable!("refused by accepts"),
+        };
+        // A fixed factor needs no camera, but the warp and culling do.
+        let camera = match (options.camera, criterion) {
+            (Some(c), _) => c,
+            (None, Criterion::Factor(_)) if !warp && !options.cull => framing(set),
+            _ => return Err(Error::NeedsCamera { what: "SD-2 with a level function, the warp or culling" }),
+        };
+        let sd2_options = Sd2Options { level, fmin, fmax, warp, cull: options.cull };
+        let (plan, pattern) = sd2_criterion::plan(set, &camera, &sd2_options)?;
+        Ok(Planned { plan, pattern: SchemePattern::Sd2(pattern), report: None })
+    }
+
+    fn plan_esc(
+        &self,
+        set: &SurfaceSet,
+        criterion: &Criterion,
+        options: &PlanOptions,
+        max_level: u32,
+    ) -> Result<Planned> {
+        let Criterion::Esc { threshold, level } = *criterion else { unreachable!("refused by accepts") };
+        if let Some(p) = set.patches.iter().position(|p| p.domain() != Domain::Quad) {
+            return Err(Error::PatchKindNotAccepted {
+                scheme: "esc",
+                kind: "triangle",
+                patch: p,
+                hint: "ESC tessellates bicubic Bézier patches only (a mesh gives PN triangles)",
+            });
+        }
+        let camera = match (options.camera, level) {
+            (Some(c), _) => c,
+            (None, Some(_)) => framing(set),
+            (None, None) => return Err(Error::NeedsCamera { what: "ESC's levels per object" }),
+        };
+        let esc_options = EscOptions { max_level, level, threshold, ..EscOptions::default() };
+        let (plan, pattern) = esc_criterion::plan(set, &camera, &esc_options)?;
+        Ok(Planned { plan, pattern: SchemePattern::Esc(pattern), report: None })
+    }
+}
+
+/// The camera that frames the set's bounding box (1280×720, 45°): where a plan needs some
+/// camera for data the criterion does not depend on.
+fn framing(set: &SurfaceSet) -> Camera {
+    let (lo, hi) = set.bounds();
+    Camera::framing(lo, hi, 1280, 720)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::{Patch, RationalBicubic};
+    use glam::DVec3;
+
+    fn flat() -> SurfaceSet {
+        let points = std::array::from_fn(|k| DVec3::new((k / 4) as f64, (k % 4) as f64, 0.0));
+        SurfaceSet::from_patches(
+            vec![Patch::Bicubic(RationalBicubic { points, weights: [1.0; 16] })],
+            Default::default(),
+        )
+    }
+
+    #[test]
+    fn schemes_refuse_what_they_cannot_honour_with_typed_errors() {
+        let set = flat();
+        let options = PlanOptions::default();
+        let err = |scheme: Scheme, criterion: Criterion| scheme.plan(&set, &criterion, &options).unwrap_err();
+        let hardware = Scheme::Hardware(Partitioning::FractionalOdd);
+        assert!(matches!(
+            err(hardware, Criterion::Tolerance(0.1)),
+            Error::CriterionNotAccepted { scheme: "fractional-odd", .. }
+        ));
+        assert!(matches!(
+            err(Scheme::Transition, Criterion::Esc { threshold: Threshold::High, level: None }),
+            Error::CriterionNotAccepted { .. }
+        ));
+        assert!(matches!(
+            err(Scheme::Esc { max_level: 3 }, Criterion::Factor(4.0)),
+            Error::CriterionNotAccepted { scheme: "esc", .. }
+        ));
+        assert!(matches!(
+            err(Scheme::Uniform, Criterion::Factor(5.5)),
+            Error::FactorOutOfRange { scheme: "uniform", .. }
+        ));
+        assert!(matches!(
+            err(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(6.0)),
+            Error::FactorOutOfRange { scheme: "semi-uniform", .. }
+        ));
+        assert!(matches!(err(hardware, Criterion::Factor(64.0)), Error::FactorOutOfRange { .. }));
+        assert!(matches!(err(Scheme::Transition, Criterion::PixelError(1.0)), Error::NeedsCamera { .. }));
+        assert!(matches!(
+            err(Scheme::Transition, Criterion::Tolerance(-1.0)),
+            Error::InvalidParameter { .. }
+        ));
+        assert!(matches!(
+            err(Scheme::Sd2 { warp: false }, Criterion::Factor(3.0)),
+            Error::PatchKindNotAccepted { scheme: "sd2", kind: "quad", patch: 0, .. }
+        ));
+        let camera = Camera::framing(DVec3::ZERO, DVec3::ONE, 64, 64);
+        let culled = PlanOptions { camera: Some(camera), cull: true, ..options };
+        assert!(matches!(
+            Scheme::Esc { max_level: 3 }.plan(
+                &set,
+                &Criterion::Esc { threshold: Threshold::High, level: Some(1) },
+                &culled
+            ),
+            Err(Error::InvalidParameter { name: "cull", .. })
+        ));
+    }
+
+    #[test]
+    fn every_scheme_plans_its_default_criterion() {
+        let set = flat();
+        let camera = Camera::framing(DVec3::ZERO, DVec3::new(3.0, 3.0, 0.0), 64, 64);
+        let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+        for scheme in [
+            Scheme::Uniform,
+            Scheme::Transition,
+            Scheme::SemiUniform { max_level: 5 },
+            Scheme::Hardware(Partitioning::Integer),
+            Scheme::Hardware(Partitioning::Pow2),
+            Scheme::Hardware(Partitioning::FractionalOdd),
+            Scheme::Hardware(Partitioning::FractionalEven),
+        ] {
+            let planned = scheme.plan(&set, &Criterion::Factor(8.0), &options).unwrap();
+            planned.plan.check(&set).unwrap();
+            // Factor 8 everywhere; fractional_odd cuts it into 9 segments (odd counts).
+            let segments = if scheme == Scheme::Hardware(Partitioning::FractionalOdd) { 9 } else { 8 };
+            assert!(
+                planned.plan.segments.iter().all(|&s| s == segments),
+                "{scheme:?}: {:?}",
+                planned.plan.segments
+            );
+            assert!(planned.plan.factors.iter().all(|&f| f == 8.0), "{scheme:?}: {:?}", planned.plan.factors);
+            assert_eq!(
+                planned.pattern.name(),
+                match scheme {
+                    Scheme::Hardware(p) => p.name(),
+                    _ => scheme.name(),
+                }
+            );
+        }
+        let esc = Scheme::Esc { max_level: 2 };
+        let criterion = Criterion::Esc { threshold: Threshold::Medium, level: None };
+        assert_eq!(Scheme::default_for(&criterion), Scheme::Esc { max_level: Scheme::DEFAULT_ESC_LEVEL });
+        let planned = esc.plan(&set, &criterion, &options).unwrap();
+        planned.plan.check(&set).unwrap();
+        assert_eq!(planned.plan.kind, crate::sampling::SamplingKind::Lattice);
+    }
+}
