@@ -8,6 +8,9 @@
 //! `cargo run --release -p tessera --example esc_teacups [path/to/teacup.patches]`; the
 //! default path is `$TESSERA_DATA/patches/teacup.patches`, else `../shared/data/...`.
 
+#[path = "common/teacups.rs"]
+mod teacups;
+
 use std::path::PathBuf;
 use tessera::criterion::esc::{self, EscOptions, Threshold};
 use tessera::criterion::Plan;
@@ -25,15 +28,16 @@ fn main() -> tessera::Result<()> {
         data.join("patches/teacup.patches")
     });
     let cup = SurfaceSet::from_patch_file(&read_patches(&path)?, Default::default());
-    let (scene, cameras) = esc::teacups_scene(&cup)?;
+    let (scene, cameras) = teacups::teacups_scene(&cup)?;
     let frames = cameras.len() as f64;
     println!("Teacups: {} input surfaces, {} frames, Lmax = 3", scene.patches.len(), cameras.len());
 
     let options = |threshold| EscOptions { max_level: 3, threshold, ..Default::default() };
-    let high = esc::frame_counts(&scene, &cameras, &options(Threshold::High))?;
-    let medium = esc::frame_counts(&scene, &cameras, &options(Threshold::Medium))?;
-    let avg =
-        |v: &[esc::FrameCount], f: fn(&esc::FrameCount) -> u64| v.iter().map(f).sum::<u64>() as f64 / frames;
+    let high = teacups::frame_counts(&scene, &cameras, &options(Threshold::High))?;
+    let medium = teacups::frame_counts(&scene, &cameras, &options(Threshold::Medium))?;
+    let avg = |v: &[teacups::FrameCount], f: fn(&teacups::FrameCount) -> u64| {
+        v.iter().map(f).sum::<u64>() as f64 / frames
+    };
     let base = avg(&high, |c| c.non_adaptive);
     let (h, m) = (avg(&high, |c| c.adaptive), avg(&medium, |c| c.adaptive));
     println!("{:<22}{:>12}{:>10}   paper", "", "triangles", "share");

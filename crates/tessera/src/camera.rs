@@ -25,7 +25,7 @@ impl Camera {
     /// Checks the camera is usable: finite, eye ≠ target, up not parallel to the view, field
     /// of view in (0°, 180°), a non-empty viewport, `0 < near < far`.
     pub fn validate(&self) -> Result<()> {
-        let bad = |why: &str| Err(Error::InvalidArgument(format!("camera: {why}")));
+        let bad = |why: &str| Err(Error::InvalidParameter { name: "camera", reason: why.to_string() });
         if !(self.eye.is_finite() && self.target.is_finite() && self.up.is_finite()) {
             return bad("eye, target and up must be finite");
         }
@@ -120,9 +120,12 @@ impl Camera {
     /// camera), so `fov=30` alone only narrows the default view.
     pub fn parse(text: &str, default: &Camera) -> Result<Camera> {
         let bad = |why: String| {
-            Error::InvalidArgument(format!(
-                "--camera {text}: {why} (expected eye=X,Y,Z,target=X,Y,Z,fov=DEG,size=WxH[,up=X,Y,Z][,near=D][,far=D])"
-            ))
+            Error::InvalidParameter {
+                name: "camera",
+                reason: format!(
+                    "{text}: {why} (expected eye=X,Y,Z,target=X,Y,Z,fov=DEG,size=WxH[,up=X,Y,Z][,near=D][,far=D])"
+                ),
+            }
         };
         let mut cam = *default;
         let mut explicit_near_far = false;

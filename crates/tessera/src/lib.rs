@@ -43,8 +43,14 @@
 //!
 //! ## Example
 //!
+//! The front door is a [`tessellator::Tessellator`]: a surface set prepared once for a
+//! [`scheme::Scheme`] and a [`scheme::Criterion`], re-tessellated per frame into reused
+//! buffers (`examples/frame_loop.rs` runs a 60-frame camera walk).
+//!
 //! ```
-//! use tessera::{criterion::Plan, engine, pattern::uniform::Uniform, surface::SurfaceSet};
+//! use tessera::scheme::{Criterion, Scheme};
+//! use tessera::surface::SurfaceSet;
+//! use tessera::tessellator::{Tessellator, TessellatorOptions};
 //! use tessera::io::patches::parse_patches;
 //! use std::path::Path;
 //!
@@ -53,8 +59,8 @@
 //! for i in 0..4 { for j in 0..4 { text += &format!("{i},{j},0\n"); } }
 //! let file = parse_patches(&text, Path::new("<example>"))?;
 //! let set = SurfaceSet::from_patch_file(&file, Default::default());
-//! let plan = Plan::uniform(&set, 8)?;
-//! let mesh = engine::tessellate(&set, &plan, &Uniform, Default::default())?;
+//! let mut tess = Tessellator::new(&set, Scheme::Uniform, Criterion::Factor(8.0), TessellatorOptions::default())?;
+//! let mesh = tess.frame(None)?;
 //! assert_eq!(mesh.triangle_count(), 2 * 8 * 8);
 //! assert_eq!(mesh.vertex_count(), 9 * 9);
 //! # Ok::<(), tessera::Error>(())
@@ -73,6 +79,7 @@ pub mod pattern;
 pub mod sampling;
 pub mod scheme;
 pub mod surface;
+pub mod tessellator;
 pub mod topology;
 pub mod verify;
 

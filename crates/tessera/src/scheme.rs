@@ -20,9 +20,9 @@
 
 use crate::camera::Camera;
 use crate::criterion::esc::{self as esc_criterion, EscOptions, Threshold};
-use crate::criterion::resolve::{Caps, EdgeRule, InteriorRule};
+use crate::criterion::resolve::{EdgeRule, InteriorRule};
 use crate::criterion::sd2::{self as sd2_criterion, LevelFunction, Sd2Options};
-use crate::criterion::tolerance::{self, minimum_interior, minimum_segments, PlanReport};
+use crate::criterion::tolerance::{self, PlanReport};
 use crate::criterion::view::{self, EdgeFactors, Mapping, ViewCriterion};
 use crate::criterion::{screen, Plan, MAX_FACTOR};
 use crate::domain::Domain;
@@ -107,6 +107,15 @@ pub struct PlanOptions {
 impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions { camera: None, cull: false, max_factor: 64, max_triangles: u64::MAX }
+    }
+}
+
+pub use crate::criterion::Prepared;
+
+impl Prepared {
+    /// [`Prepared::new`] with the bounds where `criterion` needs them.
+    pub fn for_criterion(set: &SurfaceSet, criterion: &Criterion) -> Prepared {
+        Prepared::new(set, matches!(criterion, Criterion::Tolerance(_) | Criterion::PixelError(_)))
     }
 }
 
@@ -277,6 +286,21 @@ impl Scheme {
     /// computations and a-posteriori pattern checks for the error-bounded ones.
     pub fn plan(&self, set: &SurfaceSet, criterion: &Criterion, options: &PlanOptions) -> Result<Planned> {
         self.check(criterion, options)?;
+        self.plan_prepared(set, &Prepared::for_criterion(set, criterion), criterion, options)
+    }
+
+    /// [`Scheme::plan`] with the view-independent data prepared once ([`Prepared`]), as a
+    /// per-frame loop ([`crate::tessellator::Tessellator`]) calls it. Preconditions: `prepared`
+    /// was made for `set` (with bounds for the error-bounded criteria; they are computed here
+    /// otherwise).
+    pub fn plan_prepared(
+        &self,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+        criterion: &Criterion,
+        options: &PlanOptions,
+    ) -> Result<Planned> {
+        self.check(criterion, options)?;
         if let Scheme::Esc { max_level } = *self {
             return self.plan_esc(set, criterion, options, max_level);
         }
@@ -293,8 +317,7 @@ impl Scheme {
             Scheme::Sd2 { .. } | Scheme::Esc { .. } => unreachable!("planned above"),
         };
         let cap = self.cap(options);
-        let (minimum, minimum_inner) = (minimum_segments(set), minimum_interior(set));
-        let caps = Caps { max_factor: cap, minimum_segments: &minimum, minimum_interior: &minimum_inner };
+        let caps = prepared.caps(cap);
         let camera = options.camera;
         let cull_camera = || camera.ok_or(Error::NeedsCamera { what: "culling" });
         let planned = |plan, report| Ok(Planned { plan, pattern: pattern.clone(), report });
@@ -322,6 +345,7 @@ impl Scheme {
                 };
                 let (plan, report) = tolerance::plan_limited(
                     set,
+                    prepared,
                     &eps,
                     rule,
                     interior,
@@ -336,6 +360,7 @@ impl Scheme {
                 let eps = screen::tolerances(set, &camera, px, options.cull);
                 let (plan, report) = tolerance::plan_limited(
                     set,
+                    prepared,
                     &eps,
                     rule,
                     interior,

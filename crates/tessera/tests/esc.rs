@@ -13,6 +13,8 @@
 //! vector already checked give the same plan (asserted) and are not tessellated again.
 
 mod common;
+#[path = "../examples/common/teacups.rs"]
+mod teacups;
 
 use glam::DVec3;
 use proptest::prelude::*;
@@ -191,9 +193,9 @@ fn esc_is_watertight_on_the_torus() {
 #[test]
 fn teacups_scene_is_watertight_with_mixed_levels() {
     let cup = common::load(&common::model("patches/teacup.patches")).unwrap();
-    let (scene, cameras) = esc::teacups_scene(&cup).unwrap();
+    let (scene, cameras) = teacups::teacups_scene(&cup).unwrap();
     assert_eq!(scene.patches.len(), 2600);
-    assert_eq!(cameras.len(), esc::TEACUPS_FRAMES);
+    assert_eq!(cameras.len(), teacups::TEACUPS_FRAMES);
     let uniform =
         tessellate(&scene, &Plan::uniform(&scene, 2).unwrap(), &Uniform, Default::default()).unwrap();
     let u = verify::watertight(&uniform);
@@ -202,7 +204,7 @@ fn teacups_scene_is_watertight_with_mixed_levels() {
     let levels: std::collections::BTreeSet<u32> = (0..2600).map(|p| pattern.grid(p).n - 1).collect();
     assert!(levels.len() > 1, "the first frame should mix levels: {levels:?}");
     check(&scene, &plan, &pattern, (u.boundary_edges, u.nonmanifold_edges), "teacups frame 0");
-    let counts = esc::frame_counts(&scene, &cameras[..3], &options).unwrap();
+    let counts = teacups::frame_counts(&scene, &cameras[..3], &options).unwrap();
     for c in counts {
         assert!(c.adaptive < c.non_adaptive && c.non_adaptive <= 2600 * 288, "{c:?}");
     }

@@ -23,6 +23,45 @@ use crate::surface::SurfaceSet;
 
 pub use crate::sampling::MAX_FACTOR;
 
+/// What the criteria need that does not depend on the view or the tolerance, computed once
+/// per surface set: the topology's minimum samplings and, for the error-bounded criteria,
+/// every patch's second-derivative bound.
+#[derive(Debug, Clone, Default)]
+pub struct Prepared {
+    /// Minimum segments per edge ([`tolerance::minimum_segments`]).
+    pub minimum_segments: Vec<u32>,
+    /// Minimum interior factors per patch ([`tolerance::minimum_interior`]).
+    pub minimum_interior: Vec<[u32; 2]>,
+    /// Second-derivative bound per patch ([`bounds::hessian`]); empty unless asked for.
+    pub hessians: Vec<bounds::HessianBound>,
+}
+
+impl Prepared {
+    /// Prepares `set`; `with_bounds` also computes the error bounds. Cost: O(E + P), plus a
+    /// bound per patch with `with_bounds`.
+    pub fn new(set: &SurfaceSet, with_bounds: bool) -> Prepared {
+        use rayon::prelude::*;
+        Prepared {
+            minimum_segments: tolerance::minimum_segments(set),
+            minimum_interior: tolerance::minimum_interior(set),
+            hessians: if with_bounds {
+                set.patches.par_iter().map(bounds::hessian).collect()
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    /// The caps for `max_factor` over these minimums.
+    pub fn caps(&self, max_factor: f64) -> resolve::Caps<'_> {
+        resolve::Caps {
+            max_factor,
+            minimum_segments: &self.minimum_segments,
+            minimum_interior: &self.minimum_interior,
+        }
+    }
+}
+
 /// Samplings for every edge and interior factors for every patch, as plain arrays a GPU can
 /// upload as they are.
 ///

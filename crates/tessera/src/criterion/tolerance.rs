@@ -8,8 +8,8 @@
 //! Interior factors are private to a patch and may be raised freely.
 
 use super::bounds::{self, HessianBound};
-use super::resolve::{self, Caps, EdgeRule, InteriorRule};
-use super::Plan;
+use super::resolve::{self, EdgeRule, InteriorRule};
+use super::{Plan, Prepared};
 use crate::error::{Error, Result};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, Patch, SurfaceSet};
@@ -186,6 +186,7 @@ pub fn minimum_interior(set: &SurfaceSet) -> Vec<[u32; 2]> {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_limited(
     set: &SurfaceSet,
+    prepared: &Prepared,
     eps: &[Option<f64>],
     rule: EdgeRule,
     interior: InteriorRule,
@@ -195,7 +196,13 @@ pub(crate) fn plan_limited(
 ) -> Result<(Plan, PlanReport)> {
     let cap = max_factor.max(1);
     let topo = &set.topology;
-    let hessians: Vec<HessianBound> = set.patches.par_iter().map(bounds::hessian).collect();
+    let computed;
+    let hessians: &[HessianBound] = if prepared.hessians.len() == set.patches.len() {
+        &prepared.hessians
+    } else {
+        computed = set.patches.par_iter().map(bounds::hessian).collect::<Vec<_>>();
+        &computed
+    };
     let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
 
     // Each visible patch's proposal per local edge.
@@ -223,9 +230,8 @@ pub(crate) fn plan_limited(
         })
         .collect();
 
-    let minimum = minimum_segments(set);
-    let minimum_inner = minimum_interior(set);
-    let caps = Caps { max_factor: cap as f64, minimum_segments: &minimum, minimum_interior: &minimum_inner };
+    let caps = prepared.caps(cap as f64);
+    let minimum_inner = &prepared.minimum_interior;
     let visible: Vec<u32> = eps.iter().map(|e| u32::from(e.is_some())).collect();
     let mut proposals = proposals;
     let mut factors = Vec::new();
@@ -284,8 +290,8 @@ pub(crate) fn plan_limited(
             interior,
             &limit,
             cap,
-            &minimum_inner,
-            &hessians,
+            minimum_inner,
+            hessians,
             &proposals,
             &segments,
             &affected,

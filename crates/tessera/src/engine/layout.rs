@@ -188,3 +188,93 @@ pub(crate) fn degenerate_after_collapse(
     let [a, b, c] = tri.map(id);
     a == b || b == c || a == c
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pattern::transition::Transition;
+    use crate::pattern::uniform::Uniform;
+    use crate::surface::{Patch, RationalBicubic};
+    use glam::DVec3;
+
+    /// `count` flat patches in a row, each sharing its right curve with the next; with
+    /// `apex`, the first patch's bottom curve collapses to a point.
+    fn strip(count: usize, apex: bool) -> SurfaceSet {
+        let patches = (0..count)
+            .map(|p| {
+                let points = std::array::from_fn(|k| {
+                    let (i, j) = ((k / 4) as f64, (k % 4) as f64);
+                    let x = if apex && p == 0 && j == 0.0 { 1.5 } else { p as f64 * 3.0 + i };
+                    DVec3::new(x, j, 0.0)
+                });
+                Patch::Bicubic(RationalBicubic { points, weights: [1.0; 16] })
+            })
+            .collect();
+        SurfaceSet::from_patches(patches, Default::default())
+    }
+
+    #[test]
+    fn offsets_follow_the_numbering_rule() {
+        let set = strip(3, false);
+        let plan = Plan::uniform(&set, 4).unwrap();
+        let mut layout = Layout::default();
+        layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap();
+        let (c, e, p) = (layout.corners as usize, set.topology.edges.len(), set.patches.len());
+        assert_eq!(c, 8);
+        assert_eq!(layout.edge_offsets.len(), e + 1);
+        assert!(layout.edge_offsets.windows(2).all(|w| w[1] - w[0] == 3), "{:?}", layout.edge_offsets);
+        assert_eq!(layout.edge_offsets[0] as usize, c);
+        assert_eq!(layout.interior_offsets[0], layout.edge_offsets[e]);
+        assert!(layout.interior_offsets.windows(2).all(|w| w[1] - w[0] == 9));
+        assert!(layout.triangle_offsets.windows(2).all(|w| w[1] - w[0] == 32));
+        assert_eq!(layout.vertex_count(), 8 + 3 * e + 9 * p);
+        assert_eq!(layout.triangle_count(), 32 * p);
+        assert_eq!(layout.edge_vertex(2, 0, 4, 1), layout.edge_offsets[2]);
+        assert_eq!(layout.interior_vertex(1, 0), layout.interior_offsets[1]);
+    }
+
+    #[test]
+    fn collapsed_curves_and_culled_patches_take_no_space() {
+        let set = strip(2, true);
+        assert_eq!(set.topology.report.collapsed_edges, 1);
+        let mut plan = Plan::uniform(&set, 4).unwrap();
+        let mut layout = Layout::default();
+        layout.build(&set, &plan, &Transition, &TessellateOptions::default()).unwrap();
+        let collapsed = set.topology.edges.iter().position(|e| e.collapsed).unwrap();
+        assert_eq!(
+            layout.edge_offsets[collapsed + 1],
+            layout.edge_offsets[collapsed],
+            "no samples on a point"
+        );
+        assert!(layout.collapsed_triangles > 0, "triangles at the apex degenerate");
+        let kept = (layout.triangle_offsets[1] - layout.triangle_offsets[0]) as u64;
+        assert_eq!(
+            kept + layout.collapsed_triangles,
+            Transition.counts(&pattern_input(&set, &plan, 0)).1 as u64
+        );
+        // Culling the second patch leaves its own curves without vertices.
+        plan.visible[1] = 0;
+        layout.build(&set, &plan, &Transition, &TessellateOptions::default()).unwrap();
+        assert_eq!(layout.triangle_offsets[2], layout.triangle_offsets[1], "a culled patch has no triangles");
+        for e in 0..set.topology.edges.len() {
+            let only_culled = set.topology.edge_uses(e).iter().all(|u| u.patch == 1);
+            if only_culled {
+                assert_eq!(layout.edge_offsets[e + 1], layout.edge_offsets[e], "edge {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_plan_for_another_set_or_too_large_an_output_is_refused() {
+        let set = strip(2, false);
+        let other = strip(3, false);
+        let plan = Plan::uniform(&other, 4).unwrap();
+        let mut layout = Layout::default();
+        let err = layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap_err();
+        assert!(matches!(err, crate::Error::PlanMismatch { .. }), "{err}");
+        let plan = Plan::uniform(&set, 64).unwrap();
+        let small = TessellateOptions { max_triangles: Some(1000), ..Default::default() };
+        let err = layout.build(&set, &plan, &Uniform, &small).unwrap_err();
+        assert!(matches!(err, crate::Error::OutputTooLarge { triangles: 16384, .. }), "{err}");
+    }
+}

@@ -259,3 +259,73 @@ impl Topology {
         &self.uses[r.start as usize..r.end as usize]
     }
 }
+
+/// Hand-broken inputs: each defect must be found exactly, so a lenient topology (matching
+/// curves by end points only, or ignoring orientation) fails these.
+#[cfg(test)]
+mod tests {
+    use crate::surface::{BuildOptions, Orientation, Patch, RationalBicubic, SurfaceSet};
+    use glam::DVec3;
+
+    /// A flat bicubic patch over `[x0, x1] × [y0, y1]` at height 0; `flip` reverses its `u`
+    /// direction (and so its orientation).
+    fn quad(x0: f64, x1: f64, y0: f64, y1: f64, flip: bool) -> Patch {
+        let points = std::array::from_fn(|k| {
+            let (i, j) = ((k / 4) as f64 / 3.0, (k % 4) as f64 / 3.0);
+            let i = if flip { 1.0 - i } else { i };
+            DVec3::new(x0 + (x1 - x0) * i, y0 + (y1 - y0) * j, 0.0)
+        });
+        Patch::Bicubic(RationalBicubic { points, weights: [1.0; 16] })
+    }
+
+    fn report(patches: Vec<Patch>) -> super::TopologyReport {
+        let options = BuildOptions { orientation: Orientation::AsGiven, ..Default::default() };
+        SurfaceSet::from_patches(patches, options).topology.report
+    }
+
+    #[test]
+    fn two_patches_sharing_a_curve_have_one_shared_edge() {
+        let r = report(vec![quad(0.0, 3.0, 0.0, 3.0, false), quad(3.0, 6.0, 0.0, 3.0, false)]);
+        assert_eq!((r.edges, r.boundary_edges, r.nonmanifold_edges), (7, 6, 0), "{r:?}");
+        assert_eq!(r.inconsistently_oriented_edges, 0);
+    }
+
+    #[test]
+    fn a_crack_shares_nothing() {
+        let r = report(vec![quad(0.0, 3.0, 0.0, 3.0, false), quad(3.001, 6.0, 0.0, 3.0, false)]);
+        assert_eq!((r.edges, r.boundary_edges), (8, 8), "{r:?}");
+    }
+
+    #[test]
+    fn a_t_junction_is_not_a_shared_curve() {
+        // The tall patch's right curve spans both small patches' left curves.
+        let r = report(vec![
+            quad(0.0, 3.0, 0.0, 6.0, false),
+            quad(3.0, 6.0, 0.0, 3.0, false),
+            quad(3.0, 6.0, 3.0, 6.0, false),
+        ]);
+        assert_eq!((r.edges, r.boundary_edges, r.nonmanifold_edges), (11, 10, 0), "{r:?}");
+    }
+
+    #[test]
+    fn a_flipped_patch_is_inconsistently_oriented() {
+        let r = report(vec![quad(0.0, 3.0, 0.0, 3.0, false), quad(3.0, 6.0, 0.0, 3.0, true)]);
+        assert_eq!((r.edges, r.boundary_edges), (7, 6), "{r:?}");
+        assert_eq!(r.inconsistently_oriented_edges, 1, "{r:?}");
+    }
+
+    #[test]
+    fn three_patches_on_a_curve_make_it_non_manifold() {
+        // A fin: the third patch stands up from the shared curve x = 3.
+        let fin = {
+            let points = std::array::from_fn(|k| {
+                let (i, j) = ((k / 4) as f64 / 3.0, (k % 4) as f64 / 3.0);
+                DVec3::new(3.0, 3.0 * j, 3.0 * i)
+            });
+            Patch::Bicubic(RationalBicubic { points, weights: [1.0; 16] })
+        };
+        let r = report(vec![quad(0.0, 3.0, 0.0, 3.0, false), quad(3.0, 6.0, 0.0, 3.0, false), fin]);
+        assert_eq!(r.nonmanifold_edges, 1, "{r:?}");
+        assert!(!r.is_closed());
+    }
+}

@@ -216,18 +216,23 @@ pub struct ErrorReport {
 /// parameters. Preconditions: `mesh.corner_params` is filled (ask the engine for it) and
 /// `mesh.triangle_patch` refers to `set`. Cost: O(T · order²) surface evaluations, parallel.
 pub fn approximation_error(mesh: &Mesh, set: &SurfaceSet, order: u32) -> Result<ErrorReport> {
-    let params = mesh
-        .corner_params
-        .as_ref()
-        .ok_or_else(|| Error::InvalidArgument("the mesh has no per-corner patch parameters".into()))?;
+    let params = mesh.corner_params.as_ref().ok_or_else(|| Error::InvalidParameter {
+        name: "mesh",
+        reason: "it has no per-corner patch parameters (ask the engine for them)".into(),
+    })?;
     if params.len() != mesh.indices.len() || mesh.triangle_patch.len() != mesh.triangle_count() {
-        return Err(Error::InvalidArgument("mesh parameter arrays have inconsistent lengths".into()));
+        return Err(Error::InvalidParameter {
+            name: "mesh",
+            reason: "its parameter arrays have inconsistent lengths".into(),
+        });
     }
     if let Some(&p) = mesh.triangle_patch.iter().find(|&&p| p as usize >= set.patches.len()) {
-        return Err(Error::InvalidArgument(format!(
-            "triangle refers to patch {p}, but the surface has {} patches",
-            set.patches.len()
-        )));
+        return Err(Error::PlanMismatch {
+            what: format!(
+                "a triangle refers to patch {p}, but the surface has {} patches",
+                set.patches.len()
+            ),
+        });
     }
     let order = order.max(2);
     // Sample points strictly inside or on the edges, excluding the three vertices.

@@ -35,6 +35,10 @@
 //! building. With all levels equal to `m` nothing moves and the output is the uniform pattern
 //! at `2^m`, triangle for triangle.
 
+mod instanced;
+
+pub use instanced::{snap, PatternVertex, StaticPattern};
+
 use super::{LocalTessellation, Pattern, PatternInput};
 use crate::domain::Domain;
 

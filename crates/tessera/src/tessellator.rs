@@ -1,0 +1,250 @@
+//! The front door: a [`Tessellator`] prepares a surface set once for a scheme and a criterion,
+//! then re-tessellates it per frame — from a camera, or once for a tolerance — into buffers it
+//! reuses.
+//!
+//! ```
+//! use tessera::scheme::{Criterion, Scheme};
+//! use tessera::tessellator::{Tessellator, TessellatorOptions};
+//! use tessera::camera::Camera;
+//! use tessera::surface::SurfaceSet;
+//! # use tessera::io::patches::parse_patches;
+//! # let mut text = String::from("1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n16\n");
+//! # for i in 0..4 { for j in 0..4 { text += &format!("{i},{j},{}\n", (i * j) as f64 * 0.1); } }
+//! # let set = SurfaceSet::from_patch_file(&parse_patches(&text, "<doc>".as_ref())?, Default::default());
+//!
+//! // Prepared once: topology minimums and the patches' error bounds.
+//! let mut tess = Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), TessellatorOptions::default())?;
+//! let (lo, hi) = set.bounds();
+//! for frame in 0..3 {
+//!     let mut camera = Camera::framing(lo, hi, 1280, 720);
+//!     camera.eye.x += frame as f64;
+//!     let mesh = tess.frame(Some(&camera))?; // reuses last frame's buffers
+//!     assert!(mesh.triangle_count() > 0);
+//! }
+//! assert!(tess.report().unwrap().worst_ratio <= 1.0); // the pixel error is guaranteed
+//! # Ok::<(), tessera::Error>(())
+//! ```
+//!
+//! Output goes through [`MeshBuilder`]: [`Tessellator::frame`] hands out the tessellator's own
+//! [`Mesh`] (a struct of arrays, zero copies); [`Tessellator::frame_into`] feeds any builder,
+//! such as an application's interleaved vertex buffer with its own index type.
+
+use crate::camera::Camera;
+use crate::criterion::tolerance::PlanReport;
+use crate::criterion::Plan;
+use crate::engine::{self, Layout, TessellateOptions};
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::scheme::{Criterion, PlanOptions, Planned, Prepared, Scheme};
+use crate::surface::SurfaceSet;
+
+/// Receives a tessellation, vertex after vertex, then triangle after triangle.
+///
+/// [`Mesh`] is one implementation. An application implements it for its own layout —
+/// interleaved vertices, `u16` indices, a mapped GPU buffer — and clears rather than frees
+/// between frames, so that a frame that fits the last one's capacity allocates nothing.
+pub trait MeshBuilder {
+    /// Called once per frame, first, with the exact sizes that follow.
+    fn begin(&mut self, vertices: usize, triangles: usize);
+    /// Vertex `i` of the frame, for `i = 0, 1, …` in order: position, unit normal, the
+    /// parameters in `patch` that evaluated it.
+    fn vertex(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], patch: u32);
+    /// The next triangle: vertex indices (counter-clockwise seen from the normal side) and
+    /// its patch.
+    fn triangle(&mut self, indices: [u32; 3], patch: u32);
+    /// Called once per frame, last.
+    fn end(&mut self) {}
+}
+
+impl MeshBuilder for Mesh {
+    fn begin(&mut self, vertices: usize, triangles: usize) {
+        for v in [&mut self.positions, &mut self.normals] {
+            v.clear();
+            v.reserve(vertices);
+        }
+        self.uvs.clear();
+        self.uvs.reserve(vertices);
+        self.vertex_patch.clear();
+        self.vertex_patch.reserve(vertices);
+        self.indices.clear();
+        self.indices.reserve(3 * triangles);
+        self.triangle_patch.clear();
+        self.triangle_patch.reserve(triangles);
+        self.corner_params = None;
+        self.strips = None;
+        self.collapsed_triangles = 0;
+    }
+    fn vertex(&mut self, position: [f32; 3], normal: [f32; 3], uv: [f32; 2], patch: u32) {
+        self.positions.push(position);
+        self.normals.push(normal);
+        self.uvs.push(uv);
+        self.vertex_patch.push(patch);
+    }
+    fn triangle(&mut self, indices: [u32; 3], patch: u32) {
+        self.indices.extend_from_slice(&indices);
+        self.triangle_patch.push(patch);
+    }
+}
+
+/// Options of a [`Tessellator`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TessellatorOptions {
+    /// Everything about planning but the camera, which comes per frame
+    /// (`plan.camera` is ignored).
+    pub plan: PlanOptions,
+    /// The engine's options (size limits, corner parameters, strips).
+    pub engine: TessellateOptions,
+}
+
+/// A surface set prepared for one scheme and criterion, re-tessellated per frame into reused
+/// buffers. See the [module documentation](self) for an example.
+pub struct Tessellator<'a> {
+    set: &'a SurfaceSet,
+    scheme: Scheme,
+    criterion: Criterion,
+    options: TessellatorOptions,
+    prepared: Prepared,
+    layout: Layout,
+    planned: Option<Planned>,
+    mesh: Mesh,
+}
+
+impl<'a> Tessellator<'a> {
+    /// Prepares `set` for `scheme` under `criterion`: checks that the scheme accepts the
+    /// criterion (else [`crate::Error::CriterionNotAccepted`]) and computes what does not
+    /// depend on the view — the topology's minimum samplings and, for error-bounded
+    /// criteria, every patch's second-derivative bound. Cost: O(P) bound computations.
+    pub fn new(
+        set: &'a SurfaceSet,
+        scheme: Scheme,
+        criterion: Criterion,
+        options: TessellatorOptions,
+    ) -> Result<Tessellator<'a>> {
+        scheme.accepts(&criterion)?;
+        let prepared = Prepared::for_criterion(set, &criterion);
+        Ok(Tessellator {
+            set,
+            scheme,
+            criterion,
+            options,
+            prepared,
+            layout: Layout::default(),
+            planned: None,
+            mesh: Mesh::default(),
+        })
+    }
+
+    /// Tessellates one frame seen from `camera` (None for criteria and options that need no
+    /// camera) into the tessellator's own buffers, reused from the last frame, and returns
+    /// them. Cost: the plan's (see [`Scheme::plan`]) plus O(output), parallel.
+    pub fn frame(&mut self, camera: Option<&Camera>) -> Result<&Mesh> {
+        let options = PlanOptions { camera: camera.copied(), ..self.options.plan };
+        let planned = self.scheme.plan_prepared(self.set, &self.prepared, &self.criterion, &options)?;
+        let planned = self.planned.insert(planned);
+        self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
+        engine::write(
+            self.set,
+            &planned.plan,
+            &planned.pattern,
+            &self.layout,
+            self.options.engine,
+            &mut self.mesh,
+        )?;
+        Ok(&self.mesh)
+    }
+
+    /// [`Tessellator::frame`], handed to `builder`. Cost: that of `frame` plus one pass over
+    /// the output.
+    pub fn frame_into(&mut self, camera: Option<&Camera>, builder: &mut impl MeshBuilder) -> Result<()> {
+        let mesh = self.frame(camera)?;
+        builder.begin(mesh.vertex_count(), mesh.triangle_count());
+        for i in 0..mesh.vertex_count() {
+            builder.vertex(mesh.positions[i], mesh.normals[i], mesh.uvs[i], mesh.vertex_patch[i]);
+        }
+        for t in 0..mesh.triangle_count() {
+            builder.triangle(mesh.triangle(t), mesh.triangle_patch[t]);
+        }
+        builder.end();
+        Ok(())
+    }
+
+    /// The last frame's plan (None before the first frame).
+    pub fn plan(&self) -> Option<&Plan> {
+        self.planned.as_ref().map(|p| &p.plan)
+    }
+
+    /// The last frame's guarantee report, for error-bounded criteria.
+    pub fn report(&self) -> Option<&PlanReport> {
+        self.planned.as_ref().and_then(|p| p.report.as_ref())
+    }
+
+    /// The last frame's output layout (offsets by edge and patch; see [`engine::layout`]).
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// The scheme this tessellator draws.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn teapot() -> SurfaceSet {
+        let path = std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/"))
+            .join("patches/teapot.patches");
+        SurfaceSet::from_patch_file(
+            &crate::io::patches::read_patches(&path).expect("test model"),
+            Default::default(),
+        )
+    }
+
+    /// Frames through the tessellator equal a fresh plan and tessellation per camera, with
+    /// buffers reused from frame to frame, and a builder receives the same mesh.
+    #[test]
+    fn frames_equal_fresh_tessellations() {
+        let set = teapot();
+        let (lo, hi) = set.bounds();
+        let criterion = Criterion::PixelError(2.0);
+        let mut tess =
+            Tessellator::new(&set, Scheme::Transition, criterion, TessellatorOptions::default()).unwrap();
+        let mut built = Mesh::default();
+        for k in 0..4 {
+            let mut camera = Camera::framing(lo, hi, 640, 480);
+            camera.eye = camera.target + (camera.eye - camera.target) * (1.0 + 0.7 * k as f64);
+            let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+            let planned = Scheme::Transition.plan(&set, &criterion, &options).unwrap();
+            let fresh =
+                engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default()).unwrap();
+            let mesh = tess.frame(Some(&camera)).unwrap();
+            assert_eq!(*mesh, fresh, "frame {k}");
+            tess.frame_into(Some(&camera), &mut built).unwrap();
+            assert_eq!(built.positions, fresh.positions, "frame {k}: builder");
+            assert_eq!(built.indices, fresh.indices, "frame {k}: builder");
+            assert_eq!(built.triangle_patch, fresh.triangle_patch, "frame {k}: builder");
+            assert_eq!(tess.plan(), Some(&planned.plan));
+            assert_eq!(tess.layout().triangle_count(), fresh.triangle_count());
+        }
+        // Farther cameras need fewer triangles: the frames really differ.
+        assert!(tess.report().unwrap().worst_ratio <= 1.0);
+    }
+
+    #[test]
+    fn a_criterion_the_scheme_refuses_is_refused_up_front() {
+        let set = teapot();
+        let hardware = Scheme::Hardware(crate::sampling::Partitioning::FractionalOdd);
+        let err = Tessellator::new(&set, hardware, Criterion::Tolerance(0.1), TessellatorOptions::default());
+        assert!(matches!(err, Err(crate::Error::CriterionNotAccepted { .. })));
+        let mut tess = Tessellator::new(
+            &set,
+            Scheme::Transition,
+            Criterion::PixelError(1.0),
+            TessellatorOptions::default(),
+        )
+        .unwrap();
+        assert!(matches!(tess.frame(None), Err(crate::Error::NeedsCamera { .. })));
+    }
+}
