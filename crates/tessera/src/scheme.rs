@@ -336,28 +336,20 @@ impl Scheme {
                     view::plan(set, &camera, EdgeFactors::Fixed(f), rule, interior, &caps, options.cull);
                 planned(plan, None)
             }
-            Criterion::Tolerance(eps) => {
-                let eps = if options.cull {
-                    let camera = cull_camera()?;
-                    set.patches.iter().map(|p| (!screen::culled(p, &camera)).then_some(eps)).collect()
-                } else {
-                    vec![Some(eps); set.patches.len()]
+            Criterion::Tolerance(_) | Criterion::PixelError(_) => {
+                // Each patch's object-space tolerance (None: culled).
+                let eps = match *criterion {
+                    Criterion::PixelError(px) => {
+                        let camera = camera.ok_or(Error::NeedsCamera { what: "a pixel error" })?;
+                        screen::tolerances(set, &camera, px, options.cull)
+                    }
+                    Criterion::Tolerance(eps) if options.cull => {
+                        let camera = cull_camera()?;
+                        set.patches.iter().map(|p| (!screen::culled(p, &camera)).then_some(eps)).collect()
+                    }
+                    Criterion::Tolerance(eps) => vec![Some(eps); set.patches.len()],
+                    _ => unreachable!("matched above"),
                 };
-                let (plan, report) = tolerance::plan_limited(
-                    set,
-                    prepared,
-                    &eps,
-                    rule,
-                    interior,
-                    &pattern,
-                    cap as u32,
-                    options.max_triangles,
-                )?;
-                planned(plan, Some(report))
-            }
-            Criterion::PixelError(px) => {
-                let camera = camera.ok_or(Error::NeedsCamera { what: "a pixel error" })?;
-                let eps = screen::tolerances(set, &camera, px, options.cull);
                 let (plan, report) = tolerance::plan_limited(
                     set,
                     prepared,
