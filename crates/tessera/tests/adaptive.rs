@@ -43,9 +43,19 @@ fn diagonal(set: &SurfaceSet) -> f64 {
 }
 
 #[test]
+fn tolerance_bounds_hold_on_the_fast_models() {
+    tolerance_bounds_hold(&common::fast_models());
+}
+
+#[test]
+#[ignore = "slow tier (every model): scripts/test runs it"]
 fn tolerance_bounds_hold_on_every_model() {
-    for path in common::all_surface_models() {
-        let set = common::load(&path).unwrap();
+    tolerance_bounds_hold(&common::all_surface_models());
+}
+
+fn tolerance_bounds_hold(models: &[std::path::PathBuf]) {
+    for path in models {
+        let set = common::load(path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         for share in [1e-2, 1e-3, 1e-4] {
             let eps = share * diagonal(&set);
@@ -93,11 +103,20 @@ fn projected_error(mesh: &Mesh, set: &SurfaceSet, camera: &Camera) -> f64 {
 /// `--no-cull`; with culling, open only along culled neighbours), and the measured projected
 /// error of visible patches stays under the requested pixels.
 #[test]
-fn screen_space_bounds_hold_for_random_cameras() {
-    for path in common::all_surface_models() {
-        let set = common::load(&path).unwrap();
+fn screen_space_bounds_hold_for_random_cameras_on_the_fast_models() {
+    screen_space_bounds_hold(&common::fast_models(), 12);
+}
+
+#[test]
+#[ignore = "slow tier (every model, 100 cameras): scripts/test runs it"]
+fn screen_space_bounds_hold_for_random_cameras_on_every_model() {
+    screen_space_bounds_hold(&common::all_surface_models(), 100);
+}
+
+fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32) {
+    for path in models {
+        let set = common::load(path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let cases = 100;
         let start = std::time::Instant::now();
         // Seeded: the same cameras on every run.
         let mut runner = TestRunner::new_with_rng(

@@ -35,7 +35,33 @@ fn view(kind: u8, fmin: f64, fmax: f64) -> Criterion {
     Criterion::View { criterion: view_criterion(kind), fmin, fmax }
 }
 
-const CAMERAS: u32 = 50;
+/// The fast tier runs the scheme properties on [`common::fast_models`] with a few cameras; the
+/// slow tier (`#[ignore]`d, run by `scripts/test`) on every model with 50 cameras each.
+#[derive(Debug, Clone, Copy)]
+enum Tier {
+    Fast,
+    Slow,
+}
+
+impl Tier {
+    fn cameras(self) -> u32 {
+        match self {
+            Tier::Fast => 6,
+            Tier::Slow => 50,
+        }
+    }
+
+    /// `all`, or the fast models among them.
+    fn models(self, all: Vec<std::path::PathBuf>) -> Vec<std::path::PathBuf> {
+        match self {
+            Tier::Slow => all,
+            Tier::Fast => {
+                let fast = common::fast_models();
+                all.into_iter().filter(|p| fast.contains(p)).collect()
+            }
+        }
+    }
+}
 
 fn name_of(path: &std::path::Path) -> String {
     path.file_name().unwrap().to_string_lossy().to_string()
@@ -51,9 +77,10 @@ fn top_factor(set: &SurfaceSet) -> f64 {
     }
 }
 
-/// Runs `check` on `CAMERAS` seeded random cameras per model, with random extra inputs.
+/// Runs `check` on `cameras` seeded random cameras per model, with random extra inputs.
 fn for_cameras<S: Strategy + Clone>(
     models: &[std::path::PathBuf],
+    cameras: u32,
     extra: S,
     check: impl Fn(&SurfaceSet, &str, Camera, S::Value) -> Result<(), TestCaseError>,
 ) {
@@ -62,7 +89,7 @@ fn for_cameras<S: Strategy + Clone>(
         let name = name_of(path);
         let start = std::time::Instant::now();
         let mut runner = TestRunner::new_with_rng(
-            Config { cases: CAMERAS, failure_persistence: None, ..Config::default() },
+            Config { cases: cameras, failure_persistence: None, ..Config::default() },
             TestRng::deterministic_rng(RngAlgorithm::ChaCha),
         );
         runner
@@ -70,7 +97,7 @@ fn for_cameras<S: Strategy + Clone>(
                 check(&set, &name, camera, x)
             })
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        println!("{name}: {CAMERAS} cameras in {:.1} s", start.elapsed().as_secs_f64());
+        println!("{name}: {cameras} cameras in {:.1} s", start.elapsed().as_secs_f64());
     }
 }
 
@@ -89,40 +116,55 @@ fn options(strips: bool) -> TessellateOptions {
 
 #[test]
 fn semi_uniform_is_watertight_and_its_render_queues_match() {
-    let models = common::all_surface_models();
-    for_cameras(&models, (any::<u8>(), 0.0..1.0f64, any::<bool>()), |set, name, camera, (kind, lo, cull)| {
-        let top = top_factor(set) as u32;
-        let fmin = 1 + (lo * (top - 1) as f64) as u32;
-        let Planned { plan, pattern, .. } =
-            planned(set, SEMI_UNIFORM, view(kind, fmin as f64, top as f64), camera, cull);
-        let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
-        common::expect_topology(set, &plan, &mesh, name);
-        let w = tessera::verify::watertight(&mesh);
-        prop_assert_eq!(w.degenerate_triangles(), 0, "compacted mesh has degenerate triangles");
-        // The render queues hold every visible patch once, at its level, with its edge levels.
-        let queues = render_queues::build(set, &plan, 5).unwrap();
-        let mut seen = vec![false; set.patches.len()];
-        for m in 0..=queues.max_level() {
-            let mut last = None;
-            for e in queues.level(m) {
-                let p = e.patch as usize;
-                prop_assert!(plan.is_visible(p) && !seen[p]);
-                prop_assert!(last < Some(e.patch), "queue not sorted by patch id");
-                last = Some(e.patch);
-                seen[p] = true;
-                prop_assert_eq!(plan.interior[p][0], 1 << m);
-                for l in 0..set.patches[p].domain().corner_count() {
-                    let s = plan.segments(set.topology.patch_edges[p][l].edge as usize);
-                    prop_assert_eq!(1u32 << e.edge_levels[l], s);
+    semi_uniform_is_watertight_and_its_render_queues_match_in(Tier::Fast);
+}
+
+#[test]
+#[ignore = "slow tier (every model, 50 cameras): scripts/test runs it"]
+fn semi_uniform_is_watertight_and_its_render_queues_match_on_every_model() {
+    semi_uniform_is_watertight_and_its_render_queues_match_in(Tier::Slow);
+}
+
+fn semi_uniform_is_watertight_and_its_render_queues_match_in(tier: Tier) {
+    let models = tier.models(common::all_surface_models());
+    for_cameras(
+        &models,
+        tier.cameras(),
+        (any::<u8>(), 0.0..1.0f64, any::<bool>()),
+        |set, name, camera, (kind, lo, cull)| {
+            let top = top_factor(set) as u32;
+            let fmin = 1 + (lo * (top - 1) as f64) as u32;
+            let Planned { plan, pattern, .. } =
+                planned(set, SEMI_UNIFORM, view(kind, fmin as f64, top as f64), camera, cull);
+            let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
+            common::expect_topology(set, &plan, &mesh, name);
+            let w = tessera::verify::watertight(&mesh);
+            prop_assert_eq!(w.degenerate_triangles(), 0, "compacted mesh has degenerate triangles");
+            // The render queues hold every visible patch once, at its level, with its edge levels.
+            let queues = render_queues::build(set, &plan, 5).unwrap();
+            let mut seen = vec![false; set.patches.len()];
+            for m in 0..=queues.max_level() {
+                let mut last = None;
+                for e in queues.level(m) {
+                    let p = e.patch as usize;
+                    prop_assert!(plan.is_visible(p) && !seen[p]);
+                    prop_assert!(last < Some(e.patch), "queue not sorted by patch id");
+                    last = Some(e.patch);
+                    seen[p] = true;
+                    prop_assert_eq!(plan.interior[p][0], 1 << m);
+                    for l in 0..set.patches[p].domain().corner_count() {
+                        let s = plan.segments(set.topology.patch_edges[p][l].edge as usize);
+                        prop_assert_eq!(1u32 << e.edge_levels[l], s);
+                    }
                 }
             }
-        }
-        prop_assert!(
-            seen.iter().zip(&plan.visible).all(|(&s, &v)| s == (v != 0)),
-            "a visible patch is in no queue"
-        );
-        Ok(())
-    });
+            prop_assert!(
+                seen.iter().zip(&plan.visible).all(|(&s, &v)| s == (v != 0)),
+                "a visible patch is in no queue"
+            );
+            Ok(())
+        },
+    );
 }
 
 /// The instanced draw (static `P^m`, `φ` in the "vertex shader") gives, once its degenerate
@@ -201,9 +243,19 @@ fn triangle_models() -> Vec<std::path::PathBuf> {
 /// strips decode to exactly the triangle list, with and without the reverse-projection warp.
 #[test]
 fn sd2_is_two_different_watertight_and_strips_decode() {
-    let models = triangle_models();
+    sd2_is_two_different_watertight_and_strips_decode_in(Tier::Fast);
+}
+
+#[test]
+#[ignore = "slow tier (every model, 50 cameras): scripts/test runs it"]
+fn sd2_is_two_different_watertight_and_strips_decode_on_every_model() {
+    sd2_is_two_different_watertight_and_strips_decode_in(Tier::Slow);
+}
+
+fn sd2_is_two_different_watertight_and_strips_decode_in(tier: Tier) {
+    let models = tier.models(triangle_models());
     let extra = (any::<bool>(), 0.0..1.0f64, 0.0..1.0f64, any::<bool>(), any::<bool>());
-    for_cameras(&models, extra, |set, name, camera, (silhouette, a, b, warp, cull)| {
+    for_cameras(&models, tier.cameras(), extra, |set, name, camera, (silhouette, a, b, warp, cull)| {
         let top = top_factor(set);
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
         let (fmin, fmax) = (fmin.min(fmax), fmin.max(fmax));
@@ -230,9 +282,19 @@ fn sd2_is_two_different_watertight_and_strips_decode() {
 /// modes, watertight.
 #[test]
 fn hardware_partitionings_are_watertight() {
-    let models = common::all_surface_models();
+    hardware_partitionings_are_watertight_in(Tier::Fast);
+}
+
+#[test]
+#[ignore = "slow tier (every model, 50 cameras): scripts/test runs it"]
+fn hardware_partitionings_are_watertight_on_every_model() {
+    hardware_partitionings_are_watertight_in(Tier::Slow);
+}
+
+fn hardware_partitionings_are_watertight_in(tier: Tier) {
+    let models = tier.models(common::all_surface_models());
     let extra = (any::<u8>(), 0.0..1.0f64, 0.0..1.0f64, 0..4usize, any::<bool>());
-    for_cameras(&models, extra, |set, name, camera, (kind, a, b, mode, cull)| {
+    for_cameras(&models, tier.cameras(), extra, |set, name, camera, (kind, a, b, mode, cull)| {
         let top = top_factor(set);
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
         let criterion = view(kind, fmin.min(fmax), fmin.max(fmax));

@@ -53,6 +53,21 @@ pub fn load_with(path: &Path, options: BuildOptions) -> tessera::Result<SurfaceS
     }
 }
 
+/// The fast tier's models, for the property tests that the slow tier (`#[ignore]`d, run by
+/// `scripts/test`) runs on [`all_surface_models`]: the teapot (bicubic, a lid apex collapsed
+/// to a point, an open rim), the teacup (a handle whose halves share all four corners), spot
+/// (a closed PN-triangle mesh) and a non-manifold PN mesh.
+pub fn fast_models() -> Vec<PathBuf> {
+    [
+        "patches/teapot.patches",
+        "patches/teacup.patches",
+        "meshes/spot.obj",
+        "awkward/teapot_tri_nonmanifold.obj",
+    ]
+    .map(model)
+    .to_vec()
+}
+
 /// Every patch model and every triangle-mesh model (the quad cages are polygon meshes and
 /// are covered by the error tests).
 pub fn all_surface_models() -> Vec<PathBuf> {
