@@ -32,6 +32,7 @@
 use crate::camera::Camera;
 use crate::criterion::tolerance::PlanReport;
 use crate::criterion::Plan;
+use crate::engine::uniform_quads::FastEvaluator;
 use crate::engine::{self, Layout, TessellateOptions};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -107,13 +108,17 @@ pub struct Tessellator<'a> {
     layout: Layout,
     planned: Option<Planned>,
     mesh: Mesh,
+    /// The vectorized bicubic evaluation's per-set tables (None unless every patch is a
+    /// polynomial bicubic), kept from frame to frame.
+    fast: Option<FastEvaluator<'a>>,
 }
 
 impl<'a> Tessellator<'a> {
     /// Prepares `set` for `scheme` under `criterion`: checks that the scheme accepts the
     /// criterion (else [`crate::Error::CriterionNotAccepted`]) and computes what does not
     /// depend on the view — the topology's minimum samplings and, for error-bounded
-    /// criteria, every patch's second-derivative bound. Cost: O(P) bound computations.
+    /// criteria, every patch's second-derivative bound — and the vectorized evaluation's
+    /// control-point tables. Cost: O(P) bound computations.
     pub fn new(
         set: &'a SurfaceSet,
         scheme: Scheme,
@@ -122,6 +127,7 @@ impl<'a> Tessellator<'a> {
     ) -> Result<Tessellator<'a>> {
         scheme.accepts(&criterion)?;
         let prepared = Prepared::for_criterion(set, &criterion);
+        let fast = FastEvaluator::for_set(set, true);
         Ok(Tessellator {
             set,
             scheme,
@@ -131,6 +137,7 @@ impl<'a> Tessellator<'a> {
             layout: Layout::default(),
             planned: None,
             mesh: Mesh::default(),
+            fast,
         })
     }
 
@@ -142,14 +149,10 @@ impl<'a> Tessellator<'a> {
         let planned = self.scheme.plan_prepared(self.set, &self.prepared, &self.criterion, &options)?;
         let planned = self.planned.insert(planned);
         self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
-        engine::write(
-            self.set,
-            &planned.plan,
-            &planned.pattern,
-            &self.layout,
-            self.options.engine,
-            &mut self.mesh,
-        )?;
+        let applies = self.fast.as_mut().is_some_and(|f| f.retarget(&planned.plan));
+        let fast = self.fast.as_ref().filter(|_| applies);
+        let (plan, pattern, layout) = (&planned.plan, &planned.pattern, &self.layout);
+        engine::write_with(self.set, plan, pattern, layout, self.options.engine, &mut self.mesh, fast)?;
         Ok(&self.mesh)
     }
 

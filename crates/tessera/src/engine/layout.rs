@@ -25,12 +25,12 @@
 use super::{check_size, TessellateOptions};
 use crate::criterion::Plan;
 use crate::error::Result;
-use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
+use crate::pattern::{Pattern, PatternInput, Slot};
 use crate::surface::SurfaceSet;
 use rayon::prelude::*;
 
 /// Where every vertex and triangle of one tessellation goes (see the module doc).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default)]
 pub struct Layout {
     /// Number of corner entries: the first vertices.
     pub corners: u32,
@@ -42,6 +42,11 @@ pub struct Layout {
     pub triangle_offsets: Vec<u32>,
     /// Pattern triangles left out because two of their corners are one vertex.
     pub collapsed_triangles: u64,
+    /// Per patch: pattern interior vertices and triangles (before dropping collapsed ones),
+    /// kept to reuse the allocation from call to call.
+    counts: Vec<(u32, u32)>,
+    /// Per patch: triangles kept.
+    kept: Vec<u32>,
 }
 
 impl Layout {
@@ -99,41 +104,38 @@ impl Layout {
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
-        let counts: Vec<(u64, u64)> = (0..set.patches.len())
+        (0..set.patches.len())
             .into_par_iter()
-            .map(|p| {
-                if !plan.is_visible(p) {
-                    return (0, 0);
-                }
-                let (v, t) = pattern.counts(&pattern_input(set, plan, p));
-                (v as u64, t as u64)
-            })
-            .collect();
-        let interior: u64 = counts.iter().map(|c| c.0).sum();
-        let upper: u64 = counts.iter().map(|c| c.1).sum();
+            .map(|p| if plan.is_visible(p) { pattern.counts(&pattern_input(set, plan, p)) } else { (0, 0) })
+            .collect_into_vec(&mut self.counts);
+        let interior: u64 = self.counts.iter().map(|c| c.0 as u64).sum();
+        let upper: u64 = self.counts.iter().map(|c| c.1 as u64).sum();
         check_size(total + interior, upper, options)?;
-        let kept: Vec<u64> = counts
+        let generation = super::next_generation();
+        self.counts
             .par_iter()
             .enumerate()
-            .map_init(LocalTessellation::default, |scratch, (p, &(_, t))| {
+            .map(|(p, &(_, t))| {
                 if t == 0 || !has_repeated_corner(set, p) {
                     return t;
                 }
                 let input = pattern_input(set, plan, p);
-                pattern.build(&input, scratch);
-                scratch.triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
-                    as u64
+                super::with_scratch(generation, |scratch| {
+                    let triangles = &scratch.build_once(pattern, &input).triangles;
+                    triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
+                        as u32
+                })
             })
-            .collect();
+            .collect_into_vec(&mut self.kept);
         // Scan: both totals fit u32 now (check_size).
         self.interior_offsets.clear();
         self.triangle_offsets.clear();
         let (mut vertices, mut triangles) = (total as u32, 0u32);
-        for (&(v, _), &t) in counts.iter().zip(&kept) {
+        for (&(v, _), &t) in self.counts.iter().zip(&self.kept) {
             self.interior_offsets.push(vertices);
             self.triangle_offsets.push(triangles);
-            vertices += v as u32;
-            triangles += t as u32;
+            vertices += v;
+            triangles += t;
         }
         self.interior_offsets.push(vertices);
         self.triangle_offsets.push(triangles);

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 pub mod layout;
 pub mod render_queues;
-mod uniform_quads;
+pub(crate) mod uniform_quads;
 
 pub use layout::Layout;
 
@@ -110,7 +110,8 @@ pub fn write(
     options: TessellateOptions,
     out: &mut Mesh,
 ) -> Result<()> {
-    write_with(set, plan, pattern, layout, options, out, uniform_quads::FastEvaluator::new(set, plan))
+    let fast = uniform_quads::FastEvaluator::new(set, plan);
+    write_with(set, plan, pattern, layout, options, out, fast.as_ref())
 }
 
 /// [`write`] with the evaluator chosen by the caller (None: the generic f64 evaluation
@@ -122,7 +123,7 @@ pub(crate) fn write_with(
     layout: &Layout,
     options: TessellateOptions,
     out: &mut Mesh,
-    fast: Option<uniform_quads::FastEvaluator<'_>>,
+    fast: Option<&uniform_quads::FastEvaluator<'_>>,
 ) -> Result<()> {
     let topo = &set.topology;
     let (vertices, triangles) = (layout.vertex_count(), layout.triangle_count());
@@ -150,76 +151,15 @@ pub(crate) fn write_with(
         patch: &mut out.vertex_patch,
     };
     let corner_part = all.take_front(layout.corners as usize);
-    let edge_counts: Vec<usize> = layout.edge_offsets.windows(2).map(|w| (w[1] - w[0]) as usize).collect();
-    let interior_counts: Vec<usize> =
-        layout.interior_offsets.windows(2).map(|w| (w[1] - w[0]) as usize).collect();
-    let tri_counts: Vec<usize> = layout.triangle_offsets.windows(2).map(|w| (w[1] - w[0]) as usize).collect();
-    let edge_parts = all.split(&edge_counts);
-    let interior_parts = all.split(&interior_counts);
-    let tri3: Vec<usize> = tri_counts.iter().map(|c| 3 * c).collect();
-    let index_parts = split_by_counts(&mut out.indices, &tri3);
-    let patch_parts = split_by_counts(&mut out.triangle_patch, &tri_counts);
-    let param_counts: Vec<usize> = if options.corner_params { tri3.clone() } else { vec![0; tri3.len()] };
-    let param_parts = split_by_counts(params, &param_counts);
-
+    let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
+    let patch_part = PatchOut { verts: all, idx: &mut out.indices, tp: &mut out.triangle_patch, params };
+    let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
     rayon::join(
         || {
-            write_corners(set, fast.as_ref(), corner_part);
-            edge_parts.into_par_iter().enumerate().for_each(|(e, out)| {
-                if out.pos.is_empty() {
-                    return;
-                }
-                match &fast {
-                    Some(f) if f.covers_edge(plan, e) => f.edge(e, out),
-                    _ => write_edge(set, plan, e, out),
-                }
-            });
+            write_corners(set, fast, corner_part);
+            writer.edges(0..topo.edges.len(), edge_part);
         },
-        || {
-            interior_parts
-                .into_par_iter()
-                .zip(index_parts)
-                .zip(patch_parts)
-                .zip(param_parts)
-                .enumerate()
-                .for_each_init(PatchScratch::default, |scratch, (p, (((mut verts, idx), tp), params))| {
-                    if !plan.is_visible(p) {
-                        return;
-                    }
-                    let map =
-                        LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
-                    scratch.build(pattern, &map.input);
-                    let local = &scratch.local;
-                    match &fast {
-                        Some(f) if f.covers_patch(pattern, &map.input) => f.interior(p, verts),
-                        _ => {
-                            for (k, &uv) in local.interior.iter().enumerate() {
-                                verts.set(k, set, p as u32, uv);
-                            }
-                        }
-                    }
-                    map.vertex_table(local.interior.len(), &mut scratch.vertex);
-                    if !params.is_empty() {
-                        map.param_table(local, &mut scratch.param);
-                    }
-                    let collapsed = layout::has_repeated_corner(set, p);
-                    let mut t = 0;
-                    for tri in &local.triangles {
-                        if collapsed && layout::degenerate_after_collapse(set, &map.input, p, tri) {
-                            continue;
-                        }
-                        for c in 0..3 {
-                            idx[3 * t + c] = scratch.vertex[tri[c] as usize];
-                            if !params.is_empty() {
-                                params[3 * t + c] = scratch.param[tri[c] as usize];
-                            }
-                        }
-                        t += 1;
-                    }
-                    debug_assert_eq!(t, tp.len());
-                    tp.fill(p as u32);
-                });
-        },
+        || writer.patches(0..set.patches.len(), patch_part),
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -264,11 +204,6 @@ impl<'a> VertexSlices<'a> {
         }
     }
 
-    /// Splits off consecutive parts of the given lengths.
-    fn split(&mut self, counts: &[usize]) -> Vec<VertexSlices<'a>> {
-        counts.iter().map(|&c| self.take_front(c)).collect()
-    }
-
     /// Vertex `k`: patch `patch` evaluated at `uv` (f64, rounded once).
     fn set(&mut self, k: usize, set: &SurfaceSet, patch: u32, uv: DVec2) {
         let p = set.patches[patch as usize].eval(uv);
@@ -284,11 +219,6 @@ pub(crate) fn take_front<'a, T>(s: &mut &'a mut [T], k: usize) -> &'a mut [T] {
     let (head, tail) = std::mem::take(s).split_at_mut(k);
     *s = tail;
     head
-}
-
-/// Splits `data` into consecutive slices of the given lengths.
-fn split_by_counts<'a, T>(mut data: &'a mut [T], counts: &[usize]) -> Vec<&'a mut [T]> {
-    counts.iter().map(|&c| take_front(&mut data, c)).collect()
 }
 
 /// Every corner entry, evaluated at its owner's corner.
@@ -328,25 +258,193 @@ fn write_edge(set: &SurfaceSet, plan: &Plan, e: usize, mut out: VertexSlices<'_>
     }
 }
 
-/// A task's pattern and tables, reused from patch to patch. Patterns that do not depend on
-/// the patch (all but ESC's and the warped SD-2's) are built once per distinct input.
+/// Output work below this many triangles (or vertices) runs as one task: smaller tasks cost
+/// more to schedule than they save.
+const GRAIN: u32 = 2048;
+
+/// What every write task reads.
+struct Writer<'a> {
+    set: &'a SurfaceSet,
+    plan: &'a Plan,
+    pattern: &'a dyn Pattern,
+    layout: &'a Layout,
+    fast: Option<&'a uniform_quads::FastEvaluator<'a>>,
+    /// This call's number, so that a thread's scratch built in an earlier call (for another
+    /// pattern) is never taken for this one's.
+    generation: u64,
+}
+
+/// The output of a range of patches: their interior vertices, indices, triangle patches and
+/// (when asked for) corner parameters.
+struct PatchOut<'a> {
+    verts: VertexSlices<'a>,
+    idx: &'a mut [u32],
+    tp: &'a mut [u32],
+    params: &'a mut [[f32; 2]],
+}
+
+impl Writer<'_> {
+    /// The inner samples of `edges`, split in halves by output size and written in parallel
+    /// (rayon's `join` allocates nothing, unlike collecting per-edge slices).
+    fn edges(&self, edges: std::ops::Range<usize>, mut out: VertexSlices<'_>) {
+        let offsets = &self.layout.edge_offsets;
+        let size = offsets[edges.end] - offsets[edges.start];
+        if edges.len() > 1 && size > GRAIN {
+            let mid = split_point(offsets, edges.clone());
+            let left = out.split_off_front(mid, offsets, edges.start);
+            rayon::join(|| self.edges(edges.start..mid, left), || self.edges(mid..edges.end, out));
+            return;
+        }
+        for e in edges {
+            let part = out.take_front((offsets[e + 1] - offsets[e]) as usize);
+            if part.pos.is_empty() {
+                continue;
+            }
+            match self.fast {
+                Some(f) if f.covers_edge(self.plan, e) => f.edge(e, part),
+                _ => write_edge(self.set, self.plan, e, part),
+            }
+        }
+    }
+
+    /// The interiors and triangles of `patches`, split like [`Writer::edges`].
+    fn patches(&self, patches: std::ops::Range<usize>, mut out: PatchOut<'_>) {
+        let tris = &self.layout.triangle_offsets;
+        let verts = &self.layout.interior_offsets;
+        let size = (tris[patches.end] - tris[patches.start]) + (verts[patches.end] - verts[patches.start]);
+        if patches.len() > 1 && size > GRAIN {
+            let mid = split_point(tris, patches.clone());
+            let left = out.split_off_front(mid, self.layout, patches.start);
+            rayon::join(|| self.patches(patches.start..mid, left), || self.patches(mid..patches.end, out));
+            return;
+        }
+        for p in patches {
+            let part = out.split_off_front(p + 1, self.layout, p);
+            if self.plan.is_visible(p) {
+                with_scratch(self.generation, |scratch| self.patch(p, part, scratch));
+            }
+        }
+    }
+
+    /// One visible patch: its pattern (reused from the last patch of the same input where the
+    /// pattern allows), its interior vertices and its triangles through the local → output
+    /// table.
+    fn patch(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
+        let PatchOut { mut verts, idx, tp, params } = out;
+        let (set, plan, layout) = (self.set, self.plan, self.layout);
+        let map = LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
+        scratch.build(self.pattern, &map.input);
+        let local = &scratch.local;
+        match self.fast {
+            Some(f) if f.covers_patch(self.pattern, &map.input) => f.interior(p, verts),
+            _ => {
+                for (k, &uv) in local.interior.iter().enumerate() {
+                    verts.set(k, set, p as u32, uv);
+                }
+            }
+        }
+        map.vertex_table(local.interior.len(), &mut scratch.vertex);
+        if !params.is_empty() {
+            map.param_table(local, &mut scratch.param);
+        }
+        let collapsed = layout::has_repeated_corner(set, p);
+        let mut t = 0;
+        for tri in &local.triangles {
+            if collapsed && layout::degenerate_after_collapse(set, &map.input, p, tri) {
+                continue;
+            }
+            for c in 0..3 {
+                idx[3 * t + c] = scratch.vertex[tri[c] as usize];
+                if !params.is_empty() {
+                    params[3 * t + c] = scratch.param[tri[c] as usize];
+                }
+            }
+            t += 1;
+        }
+        debug_assert_eq!(t, tp.len());
+        tp.fill(p as u32);
+    }
+}
+
+/// The index in `range` that splits the output between `offsets[range.start]` and
+/// `offsets[range.end]` about in half (strictly inside the range).
+fn split_point(offsets: &[u32], range: std::ops::Range<usize>) -> usize {
+    let half = offsets[range.start] + (offsets[range.end] - offsets[range.start]) / 2;
+    let k = offsets[range.start..range.end].partition_point(|&o| o <= half);
+    (range.start + k.max(1)).min(range.end - 1).max(range.start + 1)
+}
+
+impl<'a> VertexSlices<'a> {
+    /// Splits off the vertices of parts `start..end` (by `offsets`).
+    fn split_off_front(&mut self, end: usize, offsets: &[u32], start: usize) -> VertexSlices<'a> {
+        self.take_front((offsets[end] - offsets[start]) as usize)
+    }
+}
+
+impl<'a> PatchOut<'a> {
+    /// Splits off the output of patches `start..end`.
+    fn split_off_front(&mut self, end: usize, layout: &Layout, start: usize) -> PatchOut<'a> {
+        let t = (layout.triangle_offsets[end] - layout.triangle_offsets[start]) as usize;
+        PatchOut {
+            verts: self.verts.split_off_front(end, &layout.interior_offsets, start),
+            idx: take_front(&mut self.idx, 3 * t),
+            tp: take_front(&mut self.tp, t),
+            params: if self.params.is_empty() { &mut [] } else { take_front(&mut self.params, 3 * t) },
+        }
+    }
+}
+
+/// A thread's pattern and tables, kept from call to call so that a steady loop allocates
+/// nothing. Patterns that do not depend on the patch (all but ESC's and the warped SD-2's)
+/// are built once per distinct input within a call.
 #[derive(Default)]
-struct PatchScratch {
+pub(crate) struct PatchScratch {
     local: LocalTessellation,
-    /// The input `local` was built for, when the pattern ignores the patch id.
-    built: Option<PatternInput>,
+    /// The call and input `local` was built for, when the pattern ignores the patch id.
+    built: Option<(u64, PatternInput)>,
+    generation: u64,
     vertex: Vec<u32>,
     param: Vec<[f32; 2]>,
 }
 
 impl PatchScratch {
+    /// Builds `input`'s pattern for a use that does not keep it (the cache is dropped).
+    pub(crate) fn build_once(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
+        pattern.build(input, &mut self.local);
+        self.built = None;
+        &self.local
+    }
+
     fn build(&mut self, pattern: &dyn Pattern, input: &PatternInput) {
-        let key = PatternInput { patch: 0, ..*input };
+        let key = (self.generation, PatternInput { patch: 0, ..*input });
         if pattern.depends_on_patch() || self.built != Some(key) {
             pattern.build(input, &mut self.local);
             self.built = (!pattern.depends_on_patch()).then_some(key);
         }
     }
+}
+
+static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A number no earlier call got.
+pub(crate) fn next_generation() -> u64 {
+    GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<PatchScratch> = std::cell::RefCell::new(PatchScratch::default());
+}
+
+/// Runs `f` with this thread's scratch for call `generation` (a fresh one if the thread's is
+/// in use further up its stack, as when rayon runs another task inside a join).
+pub(crate) fn with_scratch<R>(generation: u64, f: impl FnOnce(&mut PatchScratch) -> R) -> R {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut scratch) => {
+            scratch.generation = generation;
+            f(&mut scratch)
+        }
+        Err(_) => f(&mut PatchScratch { generation, ..PatchScratch::default() }),
+    })
 }
 
 /// Per-patch mapping from local vertex indices to output vertices: the numbering rule of

@@ -56,6 +56,7 @@ fn bernstein3(t: f64) -> ([f64; 4], [f64; 4]) {
 /// `B_k(i / n)` and `B_k'(i / n)` for `i = 0..=n`, padded by [`LANES`] copies of the values at
 /// `n`, so that a block of lanes may start at any `i ≤ n` and its spare lanes hold a real point
 /// (whose result is ignored, but which does not spoil [`Block::all_ok`]).
+#[derive(Default)]
 struct Basis {
     b: [Vec<f32>; 4],
     d: [Vec<f32>; 4],
@@ -64,24 +65,24 @@ struct Basis {
 }
 
 impl Basis {
-    fn new(n: usize) -> Basis {
+    /// Refills the tables for factor `n`, reusing their allocations.
+    fn refill(&mut self, n: usize) {
         let len = n + 1 + LANES;
-        let mut basis = Basis {
-            b: std::array::from_fn(|_| vec![0.0; len]),
-            d: std::array::from_fn(|_| vec![0.0; len]),
-            at: Vec::new(),
-        };
+        for v in self.b.iter_mut().chain(self.d.iter_mut()) {
+            v.clear();
+            v.resize(len, 0.0);
+        }
         for i in 0..len {
             // The edge sampling's parameters: exactly 1 at the end.
             let (b, d) = bernstein3(uniform_param(n as u32, i.min(n) as u32));
             for k in 0..4 {
-                basis.b[k][i] = b[k] as f32;
-                basis.d[k][i] = d[k] as f32;
+                self.b[k][i] = b[k] as f32;
+                self.d[k][i] = d[k] as f32;
             }
         }
-        basis.at =
-            (0..=n).map(|i| (basis.b.each_ref().map(|b| b[i]), basis.d.each_ref().map(|d| d[i]))).collect();
-        basis
+        self.at.clear();
+        let (b, d) = (&self.b, &self.d);
+        self.at.extend((0..=n).map(|i| (b.each_ref().map(|b| b[i]), d.each_ref().map(|d| d[i]))));
     }
 }
 
@@ -345,11 +346,48 @@ impl<'a> FastEvaluator<'a> {
         plan: &Plan,
         avx2_fma: bool,
     ) -> Option<FastEvaluator<'a>> {
-        let n = plan.interior.first()?[0];
-        let applies = n >= 1
-            && plan.kind == SamplingKind::Uniform
-            && set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if b.is_polynomial()));
-        applies.then(|| FastEvaluator::build(set, n, avx2_fma))
+        let mut f = Self::for_set(set, avx2_fma)?;
+        f.retarget(plan).then_some(f)
+    }
+
+    /// The evaluator's per-set part, prepared once: every patch in its local frame. None
+    /// unless every patch is a polynomial bicubic. Cost: O(P).
+    pub(crate) fn for_set(set: &'a SurfaceSet, avx2_fma: bool) -> Option<FastEvaluator<'a>> {
+        if !set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if b.is_polynomial())) {
+            return None;
+        }
+        Some(FastEvaluator {
+            set,
+            n: 0,
+            basis: Basis::default(),
+            grid: Vec::new(),
+            grid32: Vec::new(),
+            edge_uv: Default::default(),
+            locals: set
+                .patches
+                .par_iter()
+                .with_min_len(64)
+                .map(|p| match p {
+                    Patch::Bicubic(b) => LocalPatch::new(b),
+                    _ => unreachable!("checked above: every patch is bicubic"),
+                })
+                .collect(),
+            avx2_fma: avx2_fma && has_avx2_fma(),
+        })
+    }
+
+    /// Sets the factor to `plan`'s (the first patch's interior factor), refilling the tables
+    /// in place when it changed, and says whether the evaluator applies to the plan (integer
+    /// samplings). Cost: O(n) when the factor changed, else O(1).
+    pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
+        let Some(&[n, _]) = plan.interior.first() else { return false };
+        if n == 0 || plan.kind != SamplingKind::Uniform {
+            return false;
+        }
+        if n as usize != self.n {
+            self.fill(n);
+        }
+        true
     }
 
     /// Whether edge `e`'s samples are this evaluator's: `n` segments, one normal variant.
@@ -364,38 +402,25 @@ impl<'a> FastEvaluator<'a> {
         input.domain == Domain::Quad && pattern.interior_grid(input) == Some([self.n as u32; 2])
     }
 
-    /// Precondition: `avx2_fma` only where [`has_avx2_fma`].
-    fn build(set: &'a SurfaceSet, n: u32, avx2_fma: bool) -> FastEvaluator<'a> {
+    /// The tables of factor `n`: bases, grid parameters, edge parameters.
+    fn fill(&mut self, n: u32) {
         let step = 1.0 / n as f64;
         let nu = n as usize;
+        self.n = nu;
+        self.basis.refill(nu);
+        self.grid.clear();
+        self.grid.extend((0..=nu).map(|i| i as f64 * step));
+        self.grid32.clear();
+        self.grid32.extend((0..=nu).map(|i| (i as f64 * step) as f32));
         let d = Domain::Quad;
-        let edge_uv = std::array::from_fn(|e| {
-            std::array::from_fn(|rev| {
-                (0..=n)
-                    .map(|k| {
-                        let t = uniform_param(n, k);
-                        d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
-                    })
-                    .collect()
-            })
-        });
-        FastEvaluator {
-            set,
-            n: nu,
-            basis: Basis::new(nu),
-            grid: (0..=nu).map(|i| i as f64 * step).collect(),
-            grid32: (0..=nu).map(|i| (i as f64 * step) as f32).collect(),
-            edge_uv,
-            locals: set
-                .patches
-                .par_iter()
-                .with_min_len(64)
-                .map(|p| match p {
-                    Patch::Bicubic(b) => LocalPatch::new(b),
-                    _ => unreachable!("the evaluator checked that every patch is bicubic"),
-                })
-                .collect(),
-            avx2_fma: avx2_fma && has_avx2_fma(),
+        for (e, by_direction) in self.edge_uv.iter_mut().enumerate() {
+            for (rev, uvs) in by_direction.iter_mut().enumerate() {
+                uvs.clear();
+                uvs.extend((0..=n).map(|k| {
+                    let t = uniform_param(n, k);
+                    d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
+                }));
+            }
         }
     }
 
@@ -553,7 +578,7 @@ mod tests {
         let mut layout = Layout::default();
         layout.build(set, plan, &Uniform, &options).expect("layout");
         let evaluator = FastEvaluator::with_kernels(set, plan, avx2_fma).expect("the evaluator applies");
-        write_with(set, plan, &Uniform, &layout, options, out, Some(evaluator)).expect("fast evaluation");
+        write_with(set, plan, &Uniform, &layout, options, out, Some(&evaluator)).expect("fast evaluation");
     }
 
     /// The engine's writer with the generic f64 evaluation everywhere.
