@@ -299,7 +299,7 @@ fn sd2_with_strips_writes_a_closed_ply_whose_strips_decode_to_its_faces() {
     let v = stats_of(&out);
     assert_eq!(v["boundary_edges"], 0);
     assert!(v["strips"].as_u64().unwrap() > 0);
-    let mesh = tessera::mesh::read_mesh(&dir.join("cow.ply")).unwrap();
+    let mesh = tessera::io::read_mesh(&dir.join("cow.ply")).unwrap();
     let strips = mesh.strips.as_ref().expect("tristrips element");
     let decoded: Vec<u32> = tessera::mesh::strips::decode(strips).into_iter().flatten().collect();
     assert_eq!(decoded, mesh.indices);

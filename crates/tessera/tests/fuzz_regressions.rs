@@ -16,7 +16,9 @@ use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::TessellateOptions;
 use tessera::fuzzing::{self, Criterion, EngineCase, EngineOutcome, Scheme, Shape};
-use tessera::mesh::write::{write_glb, write_ply, write_stl};
+use tessera::io::glb::write_glb;
+use tessera::io::ply::write_ply;
+use tessera::io::stl::write_stl;
 use tessera::mesh::Mesh;
 
 /// The engine check as a parser-style check, for the table below.
