@@ -603,7 +603,9 @@ fn read_ply_vertices(
 }
 
 /// Reads the face element into `mesh`'s indices and triangle patches; returns the corner
-/// params when every face carried a full `texcoord` list.
+/// params when every face carried a full `patch_uv` list (or `texcoord`, the name tessera
+/// wrote before, used only when there is no `patch_uv`: another tool's `texcoord` next to
+/// tessera's `patch_uv` is texture data, not patch parameters).
 fn read_ply_faces(
     element: &Element,
     encoding: Encoding,
@@ -615,12 +617,20 @@ fn read_ply_faces(
     let mut roles = Vec::with_capacity(element.props.len());
     let mut has_indices = false;
     let mut has_texcoord = false;
+    let params_name = if element.props.iter().any(|p| p.name == PATCH_UV) { PATCH_UV } else { OLD_PATCH_UV };
     for p in &element.props {
         let role = match (p.name.as_str(), p.kind) {
             ("vertex_indices" | "vertex_index", PropKind::List { .. }) => FaceRole::Indices,
             ("patch", PropKind::Scalar(_)) => FaceRole::Patch,
-            ("texcoord", PropKind::List { .. }) => FaceRole::TexCoord,
-            ("vertex_indices" | "vertex_index" | "patch" | "texcoord", _) => {
+            (name, PropKind::List { .. }) if name == params_name => FaceRole::TexCoord,
+            (name, PropKind::Scalar(_)) if name == params_name => {
+                return Err(Error::parse(
+                    file,
+                    p.line,
+                    format!("face property {} has the wrong shape (list or scalar)", p.name),
+                ));
+            }
+            ("vertex_indices" | "vertex_index" | "patch", _) => {
                 return Err(Error::parse(
                     file,
                     p.line,
@@ -685,11 +695,10 @@ fn read_ply_faces(
                 // One face without params makes the whole set unusable.
                 params = None;
             } else if texcoord.len() != 2 * n {
-                return Err(
-                    src.error(format!("face {i} has {} texcoord values for {n} corners", texcoord.len()))
-                );
+                return Err(src
+                    .error(format!("face {i} has {} {params_name} values for {n} corners", texcoord.len())));
             } else if !all_finite(&texcoord) {
-                return Err(src.error(format!("face {i} has a non-finite texcoord")));
+                return Err(src.error(format!("face {i} has a non-finite {params_name}")));
             } else {
                 let corner = |k: usize| [texcoord[2 * k], texcoord[2 * k + 1]];
                 for k in 1..n - 1 {
@@ -709,11 +718,17 @@ fn read_ply_faces(
 // =============================================================================================
 // Writing
 
+/// The face property of the per-corner patch parameters.
+const PATCH_UV: &str = "patch_uv";
+/// Its name in files tessera wrote before; still read.
+const OLD_PATCH_UV: &str = "texcoord";
+
 /// Writes `mesh` as binary little-endian PLY to `w`. Vertex properties: `float x y z`,
 /// `float nx ny nz`, `float u v`, `uint patch`; face properties:
 /// `list uchar uint vertex_indices`, `uint patch` and, when [`Mesh::corner_params`] is set,
-/// `list uchar float texcoord` with the six values u0 v0 u1 v1 u2 v2 (MeshLab's name for
-/// per-corner texture coordinates).
+/// `list uchar float patch_uv` with the six values u0 v0 u1 v1 u2 v2 (the corners' parameters
+/// in the triangle's own patch; not called `texcoord`, which standard clients read as texture
+/// coordinates and split vertices for, see the module documentation).
 ///
 /// Preconditions: as [`write_mesh`]. I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
@@ -747,7 +762,7 @@ pub(super) fn emit_ply<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
         mesh.triangle_count()
     )?;
     if mesh.corner_params.is_some() {
-        writeln!(w, "property list uchar float texcoord")?;
+        writeln!(w, "property list uchar float {PATCH_UV}")?;
     }
     if mesh.strips.is_some() {
         // The Stanford `tristrips` convention: one list, strips separated by -1.
@@ -799,6 +814,31 @@ mod tests {
         }
         let empty = Mesh::default();
         assert_eq!(parse_ply(&bytes(|w| write_ply(&empty, w)), label()).unwrap(), empty);
+    }
+
+    #[test]
+    fn corner_params_under_the_old_name_are_still_read() {
+        let mesh = grid(3, true);
+        let new = bytes(|w| write_ply(&mesh, w));
+        // Same length, so the binary body stays where the header says.
+        let end = new.windows(10).position(|w| w == b"end_header").unwrap();
+        let header = std::str::from_utf8(&new[..end]).unwrap().replace("float patch_uv", "float texcoord");
+        let old = [header.as_bytes(), &new[end..]].concat();
+        assert_eq!(parse_ply(&old, label()).unwrap(), mesh);
+    }
+
+    #[test]
+    fn patch_uv_wins_over_another_tools_texcoord() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                    property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+                    property list uchar float texcoord\nproperty list uchar float patch_uv\n\
+                    end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 6 9 9 9 9 9 9 6 0 0 1 0 0 1\n";
+        let mesh = parse_ply(text.as_bytes(), label()).unwrap();
+        assert_eq!(mesh.corner_params, Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]));
+        let old_only =
+            text.replace("property list uchar float patch_uv\n", "").replace(" 6 0 0 1 0 0 1\n", "\n");
+        let mesh = parse_ply(old_only.as_bytes(), label()).unwrap();
+        assert_eq!(mesh.corner_params, Some(vec![[9.0, 9.0]; 3]));
     }
 
     const ASCII_PLY: &str = "ply\r
@@ -937,7 +977,7 @@ end_header\r
         let mut bad = data.clone();
         bad[faces + 17] = 5;
         let (_, reason) = parse_error(parse_ply(&bad, label()));
-        assert!(reason.contains("5 texcoord values for 3 corners"), "{reason}");
+        assert!(reason.contains("5 patch_uv values for 3 corners"), "{reason}");
     }
 
     #[test]
@@ -984,7 +1024,8 @@ end_header\r
             assert!(header.contains("element vertex 16\n"));
             assert!(header.contains("element face 18\n"));
             assert!(header.contains("property list uchar uint vertex_indices\nproperty uint patch\n"));
-            assert_eq!(header.contains("property list uchar float texcoord\n"), with_params);
+            assert_eq!(header.contains("property list uchar float patch_uv\n"), with_params);
+            assert!(!header.contains("texcoord"));
             let face = 1 + 12 + 4 + if with_params { 1 + 24 } else { 0 };
             assert_eq!(bytes.len() - end, 16 * 36 + 18 * face);
         }
