@@ -184,9 +184,15 @@ impl<'a> Glb<'a> {
             mesh.normals = self.floats::<3>(index, "NORMAL", Type::Vec3)?;
             self.check_count("NORMAL", mesh.normals.len(), n)?;
         }
-        if let Some(index) = attribute(Semantic::TexCoords(0)) {
-            mesh.uvs = self.floats::<2>(index, "TEXCOORD_0", Type::Vec2)?;
-            self.check_count("TEXCOORD_0", mesh.uvs.len(), n)?;
+        // `_PATCH_UV` since tessera stopped writing the parameters as TEXCOORD_0, which files
+        // written before still have.
+        let uv = match attribute(Semantic::Extras("PATCH_UV".to_string())) {
+            Some(index) => Some((index, "_PATCH_UV")),
+            None => attribute(Semantic::TexCoords(0)).map(|index| (index, "TEXCOORD_0")),
+        };
+        if let Some((index, name)) = uv {
+            mesh.uvs = self.floats::<2>(index, name, Type::Vec2)?;
+            self.check_count(name, mesh.uvs.len(), n)?;
         }
         if let Some(index) = attribute(Semantic::Extras("PATCH".to_string())) {
             let e = self.elements(index, "_PATCH", Type::Scalar)?;
@@ -239,8 +245,9 @@ impl<'a> Glb<'a> {
         Err(self.err(format!("{what} has {count} elements for {vertices} vertices")))
     }
 
-    /// Reads tessera's triangle patches and corner params from the views the primitive's
-    /// extras name.
+    /// Reads tessera's triangle patches and corner params from the byte ranges the primitive's
+    /// extras name (`trianglePatch`, `cornerParams`), or from the buffer views files written
+    /// before named (`trianglePatchView`, `cornerParamsView`).
     fn read_extras(&self, primitive: &gj::mesh::Primitive, mesh: &mut Mesh) -> Result<()> {
         let Some(raw) = &primitive.extras else {
             return Ok(());
@@ -251,30 +258,41 @@ impl<'a> Glb<'a> {
         let Some(tessera) = value.get("tessera") else {
             return Ok(());
         };
-        let view_of =
-            |key: &str| -> Result<Option<usize>> {
-                match tessera.get(key) {
-                    None => Ok(None),
-                    Some(v) => v.as_u64().and_then(|v| usize::try_from(v).ok()).map(Some).ok_or_else(|| {
-                        self.err(format!("extras.tessera.{key} is {v}, not a buffer view index"))
-                    }),
-                }
-            };
+        let bytes_of = |key: &str, old_key: &str| -> Result<Option<&'a [u8]>> {
+            if let Some(range) = tessera.get(key) {
+                let field = |name: &str| {
+                    range.get(name).and_then(serde_json::Value::as_u64).ok_or_else(|| {
+                        self.err(format!("extras.tessera.{key}.{name} is missing or not a byte count"))
+                    })
+                };
+                let (offset, len) = (field("byteOffset")?, field("byteLength")?);
+                return self.buffer_bytes(0, offset, len, &format!("extras.tessera.{key}")).map(Some);
+            }
+            match tessera.get(old_key) {
+                None => Ok(None),
+                Some(v) => match v.as_u64().and_then(|v| usize::try_from(v).ok()) {
+                    Some(view) => self.view_bytes(view, old_key).map(Some),
+                    None => {
+                        Err(self.err(format!("extras.tessera.{old_key} is {v}, not a buffer view index")))
+                    }
+                },
+            }
+        };
         let t = mesh.indices.len() / 3;
-        if let Some(view) = view_of("trianglePatchView")? {
-            let bytes = self.view_bytes(view, "trianglePatchView")?;
+        if let Some(bytes) = bytes_of("trianglePatch", "trianglePatchView")? {
             if bytes.len() != 4 * t {
-                return Err(self
-                    .err(format!("triangle patch view {view} has {} bytes for {t} triangles", bytes.len())));
+                return Err(
+                    self.err(format!("the triangle patches have {} bytes for {t} triangles", bytes.len()))
+                );
             }
             mesh.triangle_patch =
                 bytes.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
         }
-        if let Some(view) = view_of("cornerParamsView")? {
-            let bytes = self.view_bytes(view, "cornerParamsView")?;
+        if let Some(bytes) = bytes_of("cornerParams", "cornerParamsView")? {
             if bytes.len() != 24 * t {
-                return Err(self
-                    .err(format!("corner params view {view} has {} bytes for {t} triangles", bytes.len())));
+                return Err(
+                    self.err(format!("the corner params have {} bytes for {t} triangles", bytes.len()))
+                );
             }
             let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
             let params: Vec<[f32; 2]> = bytes.chunks_exact(8).map(|b| [f(&b[..4]), f(&b[4..])]).collect();
@@ -294,25 +312,29 @@ impl<'a> Glb<'a> {
                 self.root.buffer_views.len()
             )));
         };
-        let buffer_index = view.buffer.value();
+        let start = view.byte_offset.map_or(0, |o| o.0);
+        self.buffer_bytes(view.buffer.value(), start, view.byte_length.0, &format!("buffer view {index}"))
+    }
+
+    /// Bytes `start..start + len` of buffer `buffer_index`, checked to lie in the buffer and
+    /// the buffer in the BIN chunk; `what` names the range in errors.
+    fn buffer_bytes(&self, buffer_index: usize, start: u64, len: u64, what: &str) -> Result<&'a [u8]> {
         let Some(buffer) = self.root.buffers.get(buffer_index) else {
-            return Err(self.err(format!("buffer view {index} refers to missing buffer")));
+            return Err(self.err(format!("{what} refers to missing buffer {buffer_index}")));
         };
         if buffer_index != 0 || buffer.uri.is_some() {
-            return Err(self.unsupported(format!(
-                "buffer view {index} uses an external buffer; only the GLB's own is read"
-            )));
+            return Err(
+                self.unsupported(format!("{what} uses an external buffer; only the GLB's own is read"))
+            );
         }
         let Some((bin, bin_offset)) = self.bin else {
-            return Err(self.err(format!("buffer view {index} needs a BIN chunk, but there is none")));
+            return Err(self.err(format!("{what} needs a BIN chunk, but there is none")));
         };
-        let start = view.byte_offset.map_or(0, |o| o.0);
-        let len = view.byte_length.0;
         let end = start.checked_add(len);
         if buffer.byte_length.0 > bin.len() as u64 || end.is_none_or(|e| e > buffer.byte_length.0) {
             return Err(self.err(format!(
-                "buffer view {index} spans bytes {start}..{} of a {}-byte buffer (BIN chunk of {} \
-                 bytes at byte offset {bin_offset})",
+                "{what} spans bytes {start}..{} of a {}-byte buffer (BIN chunk of {} bytes at byte \
+                 offset {bin_offset})",
                 start.saturating_add(len),
                 buffer.byte_length.0,
                 bin.len()
@@ -744,9 +766,10 @@ fn decode_base64(s: &str) -> Option<Vec<u8>> {
 // Writing
 
 /// Writes `mesh` as glTF 2.0 binary (GLB) to `w`: one buffer, one mesh with one indexed
-/// triangle primitive (`POSITION` with min/max, `NORMAL`, `TEXCOORD_0`, the float vertex patch
-/// id `_PATCH`, `u32` indices), one node and one scene. Triangle patches and corner params go
-/// to buffer views named in the primitive's extras (see the module documentation). A mesh
+/// triangle primitive (`POSITION` with min/max, `NORMAL`, the vertex's patch parameters
+/// `_PATCH_UV`, the float vertex patch id `_PATCH`, `u32` indices), one node and one scene.
+/// Triangle patches and corner params go to byte ranges of the buffer named in the
+/// primitive's extras (see the module documentation). A mesh
 /// without triangles is written as a file holding only the asset, since glTF forbids empty
 /// accessors; any vertices are dropped.
 ///
@@ -831,8 +854,6 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         let v_uvs = view(&uvs, array);
         let v_patches = view(&patches, array);
         let v_indices = view(&indices, Some(gj::buffer::Target::ElementArrayBuffer));
-        let v_triangle_patch = view(&triangle_patch, None);
-        let v_corner_params = corner_params.as_ref().map(|s| view(s, None));
 
         let (min, max) = position_bounds(&mesh.positions);
         let mut accessor = |view, count, component, type_, bounds: Option<([f32; 3], [f32; 3])>| {
@@ -857,10 +878,13 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         let a_patches = accessor(v_patches, n, C::F32, T::Scalar, None);
         let a_indices = accessor(v_indices, 3 * t, C::U32, T::Scalar, None);
 
+        // Byte ranges of the buffer, not buffer views: a view no accessor uses is an unused
+        // object to the glTF validator (see the module documentation).
+        let range = |s: &Span| serde_json::json!({ "byteOffset": s.offset, "byteLength": s.len });
         let mut extras = serde_json::Map::new();
-        extras.insert("trianglePatchView".into(), v_triangle_patch.value().into());
-        if let Some(v) = v_corner_params {
-            extras.insert("cornerParamsView".into(), v.value().into());
+        extras.insert("trianglePatch".into(), range(&triangle_patch));
+        if let Some(s) = &corner_params {
+            extras.insert("cornerParams".into(), range(s));
         }
         let mut wrapper = serde_json::Map::new();
         wrapper.insert("tessera".into(), extras.into());
@@ -871,7 +895,8 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         let attributes = [
             (Semantic::Positions, a_positions),
             (Semantic::Normals, a_normals),
-            (Semantic::TexCoords(0), a_uvs),
+            // "_PATCH_UV": patch parameters, not texture coordinates (module documentation).
+            (Semantic::Extras("PATCH_UV".to_string()), a_uvs),
             // Serialised as "_PATCH": glTF requires application attributes to start with '_'.
             (Semantic::Extras("PATCH".to_string()), a_patches),
         ]
@@ -1058,18 +1083,27 @@ mod tests {
         let good = bytes(|w| write_glb(&mesh, w));
         let (json, bin) = glb_chunks(&good);
         let json = std::str::from_utf8(json).unwrap().trim_end();
-        let edit = |from: &str, to: &str| {
-            assert!(json.contains(from), "{from}");
-            glb(&json.replacen(from, to, 1), bin)
+        let edit = |change: &dyn Fn(&mut serde_json::Value)| {
+            let mut v: serde_json::Value = serde_json::from_str(json).unwrap();
+            change(&mut v);
+            glb(&v.to_string(), bin)
         };
-        assert!(
-            reason(&edit("\"trianglePatchView\":5", "\"trianglePatchView\":50")).contains("buffer view 50")
-        );
-        assert!(reason(&edit("\"trianglePatchView\":5", "\"trianglePatchView\":\"x\""))
-            .contains("not a buffer view"));
-        let length = format!("\"byteLength\":{}}}", bin.len());
-        assert!(reason(&edit(&length, "\"byteLength\":100000}")).contains("spans bytes"));
-        match parse_glb(&edit(&length, &length.replace('}', ",\"uri\":\"x.bin\"}")), label()) {
+        let far = edit(&|v| extras(v)["trianglePatch"]["byteOffset"] = 100000.into());
+        assert!(reason(&far).contains("extras.tessera.trianglePatch spans bytes 100000.."));
+        let bad = edit(&|v| extras(v)["trianglePatch"] = "x".into());
+        assert!(reason(&bad).contains("trianglePatch.byteOffset is missing or not a byte count"));
+        let old_key = |value: serde_json::Value| {
+            edit(&move |v| {
+                let e = extras(v).as_object_mut().unwrap();
+                e.remove("trianglePatch");
+                e.insert("trianglePatchView".into(), value.clone());
+            })
+        };
+        assert!(reason(&old_key(50.into())).contains("buffer view 50"));
+        assert!(reason(&old_key("x".into())).contains("not a buffer view"));
+        let big = edit(&|v| v["buffers"][0]["byteLength"] = 100000.into());
+        assert!(reason(&big).contains("spans bytes"));
+        match parse_glb(&edit(&|v| v["buffers"][0]["uri"] = "x.bin".into()), label()) {
             Err(Error::Unsupported { reason, .. }) => assert!(reason.contains("external buffer")),
             other => panic!("{other:?}"),
         }
@@ -1077,6 +1111,11 @@ mod tests {
         let at = good.len() - bin.len();
         nan[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
         assert!(reason(&nan).contains("POSITION element 0 is not finite"));
+    }
+
+    /// tessera's part of a GLB primitive's extras, in the JSON of a GLB.
+    fn extras(v: &mut serde_json::Value) -> &mut serde_json::Value {
+        &mut v["meshes"][0]["primitives"][0]["extras"]["tessera"]
     }
 
     #[test]
@@ -1133,7 +1172,7 @@ mod tests {
         };
         let n = mesh.vertex_count() as u64;
         for (name, ty) in
-            [("POSITION", "VEC3"), ("NORMAL", "VEC3"), ("TEXCOORD_0", "VEC2"), ("_PATCH", "SCALAR")]
+            [("POSITION", "VEC3"), ("NORMAL", "VEC3"), ("_PATCH_UV", "VEC2"), ("_PATCH", "SCALAR")]
         {
             let a = attr(name);
             assert_eq!(a.count.0, n, "{name}");
@@ -1161,9 +1200,106 @@ mod tests {
         assert_eq!(read, mesh.indices);
         let extras: serde_json::Value =
             serde_json::from_str(primitive.extras.as_ref().unwrap().get()).unwrap();
-        assert!(extras["tessera"]["trianglePatchView"].is_u64());
-        assert!(extras["tessera"]["cornerParamsView"].is_u64());
+        let range = |key: &str| {
+            let r = &extras["tessera"][key];
+            (r["byteOffset"].as_u64().unwrap() as usize, r["byteLength"].as_u64().unwrap() as usize)
+        };
+        let (start, len) = range("trianglePatch");
+        let patches: Vec<u32> = bin[start..start + len]
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        assert_eq!(patches, mesh.triangle_patch);
+        assert_eq!(range("cornerParams").1, 24 * mesh.triangle_count());
         assert!(json.windows(8).any(|w| w == b"\"_PATCH\""));
+        assert!(!json.windows(10).any(|w| w == b"TEXCOORD_0"));
+    }
+
+    /// What the Khronos validator reports as unused objects, checked without it: every
+    /// accessor, buffer view, buffer, mesh and node must be referenced, the scene must be the
+    /// default one, and POSITION must carry min and max.
+    #[test]
+    fn glb_has_no_unused_objects() {
+        for with_params in [false, true] {
+            let mesh = grid(4, with_params);
+            let data = bytes(|w| write_glb(&mesh, w));
+            let (json, _) = glb_chunks(&data);
+            let v: serde_json::Value = serde_json::from_slice(json).unwrap();
+            let len = |key: &str| v[key].as_array().map_or(0, Vec::len);
+            let mut accessors = vec![false; len("accessors")];
+            let mut views = vec![false; len("bufferViews")];
+            let mut buffers = vec![false; len("buffers")];
+            let mut meshes = vec![false; len("meshes")];
+            let mut nodes = vec![false; len("nodes")];
+            let mark = |used: &mut Vec<bool>, index: &serde_json::Value| {
+                let i = index.as_u64().expect("an index") as usize;
+                assert!(i < used.len(), "index {i} out of range");
+                used[i] = true;
+            };
+            assert_eq!(v["scene"], 0);
+            for scene in v["scenes"].as_array().unwrap() {
+                for n in scene["nodes"].as_array().unwrap() {
+                    mark(&mut nodes, n);
+                }
+            }
+            for node in v["nodes"].as_array().unwrap() {
+                mark(&mut meshes, &node["mesh"]);
+            }
+            for m in v["meshes"].as_array().unwrap() {
+                for p in m["primitives"].as_array().unwrap() {
+                    for (name, a) in p["attributes"].as_object().unwrap() {
+                        assert!(
+                            ["POSITION", "NORMAL"].contains(&name.as_str()) || name.starts_with('_'),
+                            "{name}: a standard semantic no material uses is unused"
+                        );
+                        mark(&mut accessors, a);
+                    }
+                    mark(&mut accessors, &p["indices"]);
+                    let position = &v["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+                    assert_eq!(position["min"].as_array().map(Vec::len), Some(3));
+                    assert_eq!(position["max"].as_array().map(Vec::len), Some(3));
+                }
+            }
+            for a in v["accessors"].as_array().unwrap() {
+                mark(&mut views, &a["bufferView"]);
+            }
+            for view in v["bufferViews"].as_array().unwrap() {
+                mark(&mut buffers, &view["buffer"]);
+            }
+            for (what, used) in [
+                ("accessor", accessors),
+                ("buffer view", views),
+                ("buffer", buffers),
+                ("mesh", meshes),
+                ("node", nodes),
+            ] {
+                assert!(!used.is_empty(), "no {what}");
+                assert!(used.iter().all(|&u| u), "an unused {what}: {used:?}");
+            }
+        }
+    }
+
+    /// Files tessera wrote before this layout (TEXCOORD_0, buffer views named in extras)
+    /// still read back to the same mesh.
+    #[test]
+    fn glb_of_the_old_layout_is_still_read() {
+        let mesh = grid(3, true);
+        let data = bytes(|w| write_glb(&mesh, w));
+        let (json, bin) = glb_chunks(&data);
+        let mut v: serde_json::Value = serde_json::from_slice(json).unwrap();
+        let primitive = &mut v["meshes"][0]["primitives"][0];
+        let uv = primitive["attributes"].as_object_mut().unwrap().remove("_PATCH_UV").unwrap();
+        primitive["attributes"]["TEXCOORD_0"] = uv;
+        let tessera = primitive["extras"]["tessera"].take();
+        let views = v["bufferViews"].as_array_mut().unwrap();
+        let mut extras = serde_json::Map::new();
+        for (key, old) in [("trianglePatch", "trianglePatchView"), ("cornerParams", "cornerParamsView")] {
+            let r = &tessera[key];
+            views.push(serde_json::json!({"buffer": 0, "byteOffset": r["byteOffset"], "byteLength": r["byteLength"]}));
+            extras.insert(old.into(), (views.len() - 1).into());
+        }
+        v["meshes"][0]["primitives"][0]["extras"] = serde_json::json!({ "tessera": extras });
+        assert_eq!(parse_glb(&glb(&v.to_string(), bin), label()).unwrap(), mesh);
     }
 
     #[test]
