@@ -104,8 +104,8 @@ pub fn parse_bezt(text: &str, file: &Path) -> Result<BezierTriangleFile> {
     Ok(BezierTriangleFile { triangles, points, lines })
 }
 
-/// Writes `file` in the `.bezt` text format (the inverse of [`parse_bezt`]): numbers in the
-/// shortest form that reads back to the same `f64`.
+/// Writes `file` in the `.bezt` text format (the inverse of [`parse_bezt`]): 1-based indices,
+/// and numbers in the shortest form that reads back to the same `f64` (`{:?}`).
 ///
 /// Preconditions: every index `< points.len()` and finite points, as [`parse_bezt`] returns;
 /// otherwise the text does not parse back.
@@ -122,7 +122,7 @@ pub fn to_bezt_text(file: &BezierTriangleFile) -> String {
     }
     let _ = writeln!(out, "{}", file.points.len());
     for p in &file.points {
-        let _ = writeln!(out, "{},{},{}", p.x, p.y, p.z);
+        let _ = writeln!(out, "{:?},{:?},{:?}", p.x, p.y, p.z);
     }
     out
 }

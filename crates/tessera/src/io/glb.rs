@@ -470,11 +470,32 @@ pub fn read_gltf_triangles(path: &Path) -> Result<ObjMesh> {
 /// Cost: O(`data.len()` + buffers + instanced triangles).
 pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Result<ObjMesh> {
     let err = |reason: String| Error::parse(file, 0, reason);
-    let gltf = gltf::Gltf::from_slice(data).map_err(|e| err(format!("invalid glTF: {e}")))?;
+    let unchecked =
+        gltf::Gltf::from_slice_without_validation(data).map_err(|e| err(format!("invalid glTF: {e}")))?;
+    // gltf-json's validation indexes `accessors` with a primitive's POSITION index before it
+    // has checked that index (it panics on a file whose POSITION names a missing accessor;
+    // found by fuzzing), so that one index is checked here first.
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (k, primitive) in mesh.primitives.iter().enumerate() {
+            let position =
+                primitive.attributes.get(&gj::validation::Checked::Valid(gj::mesh::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= json.accessors.len()) {
+                return Err(err(format!(
+                    "mesh {m} primitive {k}: POSITION refers to accessor {}, but there are {}",
+                    index.value(),
+                    json.accessors.len()
+                )));
+            }
+        }
+    }
+    let blob = unchecked.blob;
+    let gltf = gltf::Document::from_json(unchecked.document.into_json())
+        .map_err(|e| err(format!("invalid glTF: {e}")))?;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in gltf.buffers() {
         let bytes = match buffer.source() {
-            gltf::buffer::Source::Bin => match &gltf.blob {
+            gltf::buffer::Source::Bin => match &blob {
                 Some(blob) => blob.clone(),
                 None => {
                     return Err(err(format!(
@@ -583,7 +604,11 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Res
                     if !all_finite(&v) {
                         return Err(err(format!("{what}: NORMAL element {i} is not finite")));
                     }
-                    out.normals.push(normal_matrix * glam::DVec3::from(v.map(f64::from)));
+                    let n = normal_matrix * glam::DVec3::from(v.map(f64::from));
+                    if !n.is_finite() {
+                        return Err(err(format!("{what}: normal {i} is not finite once transformed")));
+                    }
+                    out.normals.push(n);
                 }
             }
             let indices: Vec<u32> = match reader.read_indices() {

@@ -198,6 +198,37 @@ fn plural(what: &str) -> String {
     }
 }
 
+/// Writes `file` in the patch format (the inverse of [`parse_patches`]): 1-based indices, and
+/// numbers in the shortest form that reads back to the same `f64` (`{:?}`, which keeps
+/// exponents short). The weight column is written only for points whose weight is not 1, so
+/// a polynomial file stays in Newell's original format.
+///
+/// Preconditions: every index `< points.len()`, one weight per point, finite numbers, as
+/// [`parse_patches`] returns; otherwise the text does not parse back.
+///
+/// Cost: O(patches + points) time and output size.
+pub fn to_patches_text(file: &PatchFile) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    // Writing to a String cannot fail.
+    let _ = writeln!(text, "{}", file.patches.len());
+    for patch in &file.patches {
+        let indices: Vec<String> = patch.iter().map(|&i| (u64::from(i) + 1).to_string()).collect();
+        let _ = writeln!(text, "{}", indices.join(","));
+    }
+    let _ = writeln!(text, "{}", file.points.len());
+    for (k, p) in file.points.iter().enumerate() {
+        let _ = write!(text, "{:?},{:?},{:?}", p.x, p.y, p.z);
+        match file.weights.get(k) {
+            Some(&w) if w != 1.0 => {
+                let _ = writeln!(text, ",{w:?}");
+            }
+            _ => text.push('\n'),
+        }
+    }
+    text
+}
+
 /// The non-blank lines of a text, trimmed, with their 1-based line numbers.
 struct DataLines<'a> {
     file: &'a Path,
