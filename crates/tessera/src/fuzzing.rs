@@ -26,7 +26,7 @@ use crate::io::bezt;
 use crate::io::glb::{self, parse_glb, write_glb};
 use crate::io::obj::write_obj;
 use crate::io::obj::{self, ObjMesh};
-use crate::io::patches::{self, PatchFile};
+use crate::io::patches;
 use crate::io::ply::{parse_ply, write_ply};
 use crate::io::stl::{parse_stl, write_stl};
 use crate::mesh::strips;

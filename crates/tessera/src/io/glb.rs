@@ -19,7 +19,9 @@
 //!
 //! **Reading** ([`parse_glb`]) takes the layout above and the one tessera wrote before
 //! (`TEXCOORD_0` for the vertex parameters, `trianglePatchView`/`cornerParamsView` naming
-//! buffer views). It is written by hand rather than with the `gltf` crate because it reads
+//! buffer views): one mesh with one triangle primitive, `POSITION`, optional `NORMAL`, vertex
+//! parameters and `_PATCH`, `u8`/`u16`/`u32` indices (or none), and tessera's triangle patches
+//! and corner params. A file without meshes gives an empty mesh. It is written by hand rather than with the `gltf` crate because it reads
 //! tessera's own data (the `_PATCH` attributes and the ranges in `extras`), and because it
 //! checks every count and offset before use: the `gltf` crate's accessor iterators compute
 //! `stride * (count - 1)` unchecked (a count of 0 underflows) and trust the component type,
@@ -53,7 +55,8 @@ const GLB_CHUNK_JSON: u32 = u32::from_le_bytes(*b"JSON");
 const GLB_CHUNK_BIN: u32 = u32::from_le_bytes(*b"BIN\0");
 
 /// Parses glTF binary `data`; `file` only labels errors. Reads the layout `write_glb`
-/// produces; see [`read_mesh`] for what else is accepted and what is filled in.
+/// produces, and the one it wrote before (see the module documentation); whatever the file
+/// lacks is filled in as [`read_mesh`](super::read_mesh) says.
 ///
 /// Preconditions: none; any bytes give a mesh or an error. Errors carry line 0 and, for the
 /// binary container, the byte offset; JSON errors carry serde's line and column in the JSON
@@ -798,7 +801,7 @@ fn decode_base64(s: &str) -> Option<Vec<u8>> {
 /// without triangles is written as a file holding only the asset, since glTF forbids empty
 /// accessors; any vertices are dropped.
 ///
-/// Preconditions: as [`write_mesh`], vertex patch ids at most 2^24 (exact in the float
+/// Preconditions: as [`write_mesh`](super::write_mesh), vertex patch ids at most 2^24 (exact in the float
 /// `_PATCH`), and a file under 4 GiB; otherwise [`Error::InvalidArgument`]. I/O errors are
 /// [`Error::Write`] labelled `<writer>`.
 ///

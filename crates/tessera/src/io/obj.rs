@@ -350,7 +350,7 @@ impl At<'_> {
 /// before each run of triangles of the same patch. Floats are printed in the shortest form that
 /// reads back to the same `f32`.
 ///
-/// Preconditions: as [`write_mesh`]. I/O errors are [`Error::Write`] labelled `<writer>`.
+/// Preconditions: as [`write_mesh`](super::write_mesh). I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(vertices + triangles) time; no allocation beyond a 64 KiB buffer.
 pub fn write_obj<W: Write>(mesh: &Mesh, w: W) -> Result<()> {

@@ -31,7 +31,7 @@ use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
 /// Parses PLY `data` (ASCII or binary, either byte order); `file` only labels errors.
-/// See [`read_mesh`] for what is read and what is filled in.
+/// See the module documentation for what is read and what is filled in.
 ///
 /// Preconditions: none; any bytes give a mesh or an error. Errors in the header and in ASCII
 /// bodies carry the line; errors in binary bodies carry line 0 and the byte offset.
@@ -730,7 +730,7 @@ const OLD_PATCH_UV: &str = "texcoord";
 /// in the triangle's own patch; not called `texcoord`, which standard clients read as texture
 /// coordinates and split vertices for, see the module documentation).
 ///
-/// Preconditions: as [`write_mesh`]. I/O errors are [`Error::Write`] labelled `<writer>`.
+/// Preconditions: as [`write_mesh`](super::write_mesh). I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(vertices + triangles) time; no allocation beyond a 64 KiB buffer.
 pub fn write_ply<W: Write>(mesh: &Mesh, w: W) -> Result<()> {

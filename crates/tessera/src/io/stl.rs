@@ -27,7 +27,7 @@ const STL_RECORD: usize = 50;
 
 /// Parses STL `data`, binary or ASCII; `file` only labels errors. Binary is assumed when the
 /// size matches the header's triangle count or the file does not start with `solid`.
-/// See [`read_mesh`] for welding and what is filled in.
+/// See the module documentation for welding and what is filled in.
 ///
 /// Preconditions: none; any bytes give a mesh or an error.
 ///
@@ -214,7 +214,7 @@ fn parse_stl_ascii(data: &[u8], file: &Path) -> Result<Mesh> {
 /// degenerate triangle), its three corners and a zero attribute word. Vertex normals, uvs and
 /// patches are not stored.
 ///
-/// Preconditions: as [`write_mesh`], and at most `u32::MAX` triangles, else
+/// Preconditions: as [`write_mesh`](super::write_mesh), and at most `u32::MAX` triangles, else
 /// [`Error::InvalidArgument`]. I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(triangles) time; no allocation beyond a 64 KiB buffer.
