@@ -32,6 +32,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+use gltf::accessor::{DataType, Dimensions};
 use gltf_json as gj;
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::validation::{Checked, USize64};
@@ -453,7 +454,8 @@ impl<'a> Glb<'a> {
 /// does not fit its buffer view, a position or normal that is not a finite `f32` `VEC3`, an
 /// index out of range, an index count that is not a multiple of 3, or a node that appears
 /// twice in the hierarchy; [`Error::Unsupported`] for sparse or normalized accessors, triangle
-/// strips and fans, accessors without a buffer view, and a file without any triangle.
+/// strips and fans, accessors without a buffer view, a singular node transform, a scene that
+/// instances more than 2^27 vertices, and a file without any triangle.
 ///
 /// Cost: reads the file and its buffers into memory, then O(file size + instanced triangles).
 pub fn read_gltf_triangles(path: &Path) -> Result<ObjMesh> {
@@ -473,6 +475,17 @@ pub fn read_gltf_triangles(path: &Path) -> Result<ObjMesh> {
 /// Cost: O(`data.len()` + buffers + instanced triangles).
 pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Result<ObjMesh> {
     let err = |reason: String| Error::parse(file, 0, reason);
+    // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
+    // (an overflow panic with overflow checks on), so a shorter length is refused here.
+    if data.starts_with(GLB_MAGIC) {
+        let declared = data.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if declared.is_none_or(|len| len < GLB_HEADER_LEN as u32) {
+            return Err(err(format!(
+                "invalid glTF: GLB header of {} bytes declares less than its own 12",
+                data.len().min(12)
+            )));
+        }
+    }
     let unchecked =
         gltf::Gltf::from_slice_without_validation(data).map_err(|e| err(format!("invalid glTF: {e}")))?;
     // gltf-json's validation indexes `accessors` with a primitive's POSITION index before it
@@ -586,8 +599,14 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Res
             }
             let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let base = out.positions.len();
-            if base + n > u32::MAX as usize {
-                return Err(Error::unsupported(file, 0, "more than 2^32 vertices"));
+            // Instancing multiplies a small file's vertices by its node count, so the bound is
+            // on the result, not on the file.
+            if base + n > MAX_INSTANCED_VERTICES {
+                return Err(Error::unsupported(
+                    file,
+                    0,
+                    format!("the scene instances more than {MAX_INSTANCED_VERTICES} vertices"),
+                ));
             }
             for (i, p) in reader.read_positions().into_iter().flatten().enumerate() {
                 if !all_finite(&p) {
@@ -649,7 +668,9 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Res
     Ok(out)
 }
 
-use gltf::accessor::{DataType, Dimensions};
+/// The most vertices [`parse_gltf_triangles`] instantiates (2^27: 3 GiB of positions), far
+/// below the `u32` index range.
+const MAX_INSTANCED_VERTICES: usize = 1 << 27;
 
 const FLOAT_VEC3: (DataType, Dimensions) = (DataType::F32, Dimensions::Vec3);
 const INDEX_TYPES: [(DataType, Dimensions); 3] = [
@@ -1139,6 +1160,21 @@ mod tests {
         let at = good.len() - bin.len();
         nan[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
         assert!(reason(&nan).contains("POSITION element 0 is not finite"));
+    }
+
+    #[test]
+    fn gltf_reader_reads_tessera_output_and_refuses_short_headers() {
+        let mesh = grid(3, true);
+        let read = parse_gltf_triangles(&bytes(|w| write_glb(&mesh, w)), label(), None).unwrap();
+        let positions: Vec<[f32; 3]> = read.positions.iter().map(|p| p.as_vec3().to_array()).collect();
+        assert_eq!(positions, mesh.positions);
+        let indices: Vec<u32> = read.faces.iter().flat_map(|f| f.positions.clone()).collect();
+        assert_eq!(indices, mesh.indices);
+        assert!(read.faces.iter().all(|f| f.normals.as_ref() == Some(&f.positions)));
+        for short in [&b"glTF"[..], b"glTF\x02\0\0\0\x05\0\0\0", b"glTF\x02\0\0\0\0\0\0\0JSON"] {
+            let e = parse_gltf_triangles(short, label(), None).unwrap_err();
+            assert!(e.to_string().contains("invalid glTF"), "{e}");
+        }
     }
 
     /// tessera's part of a GLB primitive's extras, in the JSON of a GLB.

@@ -3,8 +3,8 @@
 //!
 //! | module | extension | read as | written from |
 //! |---|---|---|---|
-//! | [`patches`] | `.patches` | bicubic (rational) Bézier patches, Newell's text format | — |
-//! | [`bezt`] | `.bezt` | cubic Bézier triangles, tessera's text format | — |
+//! | [`patches`] | `.patches` | bicubic (rational) Bézier patches, Newell's text format | its text ([`patches::to_patches_text`]) |
+//! | [`bezt`] | `.bezt` | cubic Bézier triangles, tessera's text format | its text ([`bezt::to_bezt_text`]) |
 //! | [`obj`] | `.obj` | a polygon mesh: PN triangles, or a mesh to check | a [`Mesh`] |
 //! | [`ply`] | `.ply` | a mesh (ASCII or binary): PN triangles, or a mesh to check | a [`Mesh`] (binary) |
 //! | [`stl`] | `.stl` | a mesh (ASCII or binary), corners welded: PN triangles, or a mesh to check | a [`Mesh`] (binary) |
