@@ -1,4 +1,4 @@
-//! Fuzzes the GLB reader: `mesh::read::parse_glb` on any bytes must return a consistent mesh
+//! Fuzzes the GLB reader: `io::glb::parse_glb` on any bytes must return a consistent mesh
 //! or an error, never panic, and a parsed mesh survives `write_glb` → `parse_glb` unchanged
 //! (see `tessera::fuzzing::check_glb`).
 #![no_main]

@@ -1,4 +1,4 @@
-//! Fuzzes the PLY reader: `mesh::read::parse_ply` on any bytes must return a consistent mesh
+//! Fuzzes the PLY reader: `io::ply::parse_ply` on any bytes must return a consistent mesh
 //! or an error, never panic, and a parsed mesh survives `write_ply` → `parse_ply` unchanged
 //! (see `tessera::fuzzing::check_ply`).
 #![no_main]

@@ -34,8 +34,9 @@ struct Cli {
 #[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
-    /// Tessellate a patch file (.patches, bicubic Bézier) or a triangle mesh (.obj, as PN
-    /// triangles) into one watertight indexed mesh.
+    /// Tessellate a patch file (.patches, bicubic Bézier), a Bézier triangle file (.bezt) or a
+    /// triangle mesh (.obj, .ply, .stl, .glb, .gltf, as PN triangles) into one watertight
+    /// indexed mesh.
     Mesh(MeshArgs),
     /// Check a mesh: watertightness, triangle quality and, with --against, the input's
     /// topology and the approximation error.
@@ -65,7 +66,8 @@ struct InputArgs {
 
 #[derive(Args)]
 struct MeshArgs {
-    /// Input: .patches (Newell bicubic patch format) or .obj (triangle mesh → PN triangles).
+    /// Input: .patches (Newell bicubic patch format), .bezt (cubic Bézier triangles) or a
+    /// triangle mesh → PN triangles: .obj, .ply, .stl, .glb or .gltf.
     input: PathBuf,
     /// Output mesh; the format follows the extension: .obj, .ply, .stl or .glb.
     #[arg(short, long, value_name = "OUT")]
@@ -161,37 +163,10 @@ fn build_options(a: &InputArgs) -> Result<BuildOptions, Box<dyn std::error::Erro
     })
 }
 
-/// Loads a surface set from a patch file or an OBJ mesh, by extension; a set left without a
-/// patch by its repairs is an error naming the file.
-fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, Box<dyn std::error::Error>> {
-    let set = load_surfaces_as_given(path, options)?;
-    if set.patches.is_empty() {
-        let weld = match options.weld {
-            Weld::Within(eps) => format!(" (--weld {eps} merged them: use a smaller distance)"),
-            _ => String::new(),
-        };
-        return Err(format!(
-            "{}: no usable patch: all {} collapsed to a single point{weld}",
-            path.display(),
-            set.repairs.dropped_collapsed_patches
-        )
-        .into());
-    }
-    Ok(set)
-}
-
-fn load_surfaces_as_given(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    match ext.as_str() {
-        "obj" => {
-            let mesh = tessera::io::obj::read_obj(path)?;
-            SurfaceSet::pn_from_mesh(&mesh, path, options)
-        }
-        _ => {
-            let file = tessera::io::patches::read_patches(path)?;
-            Ok(SurfaceSet::from_patch_file(&file, options))
-        }
-    }
+/// Loads a surface set by extension (`tessera::io::load`: .patches, .bezt, .obj, .ply, .stl,
+/// .glb, .gltf).
+fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
+    tessera::io::load(path, options)
 }
 
 /// Output buffers may use up to 3/4 of the memory available now (Linux `MemAvailable`), or
@@ -296,7 +271,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         return Err("--max-triangles 0: use 1 or more".into());
     }
     if let Some(out) = &a.output {
-        tessera::mesh::check_output_path(out)?;
+        tessera::io::check_output_path(out)?;
     }
     let pb = spinner(&format!("reading {}", a.input.display()));
     let set = load_surfaces(&a.input, options)?;
@@ -356,7 +331,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     if let Some(out) = &a.output {
         pb.set_message(format!("writing {}", out.display()));
-        tessera::mesh::write_mesh(&mesh, out)?;
+        tessera::io::write_mesh(&mesh, out)?;
     }
     pb.finish_and_clear();
     let repairs = report_repairs(&set, &mesh);
@@ -520,40 +495,6 @@ fn write_instanced(
     Ok(())
 }
 
-fn read_any_mesh(path: &Path) -> Result<Mesh, Box<dyn std::error::Error>> {
-    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("obj") => {}
-        Some("ply" | "stl" | "glb") => return Ok(tessera::mesh::read_mesh(path)?),
-        Some(other) => {
-            return Err(format!(
-                "{}: unsupported mesh extension \".{other}\"; supported: .obj, .ply, .stl, .glb",
-                path.display()
-            )
-            .into())
-        }
-        None => {
-            return Err(format!(
-                "{}: the mesh file has no extension; supported: .obj, .ply, .stl, .glb",
-                path.display()
-            )
-            .into())
-        }
-    }
-    let obj = tessera::io::obj::read_obj(path)?;
-    let tris = obj.triangles(path)?;
-    let mut mesh = Mesh {
-        positions: obj.positions.iter().map(|p| p.as_vec3().to_array()).collect(),
-        indices: tris.iter().flatten().copied().collect(),
-        ..Default::default()
-    };
-    mesh.normals = vec![[0.0; 3]; mesh.positions.len()];
-    mesh.uvs = vec![[0.0; 2]; mesh.positions.len()];
-    mesh.vertex_patch = vec![0; mesh.positions.len()];
-    mesh.triangle_patch = vec![0; tris.len()];
-    Ok(mesh)
-}
-
 fn print_report(mesh: &Mesh, w: &verify::WatertightReport) {
     let q = verify::quality(mesh);
     println!("triangles            {}", w.triangles);
@@ -582,7 +523,7 @@ fn run_check(a: CheckArgs) -> CliResult {
     // Checked even without --against, so a bad option never passes unnoticed.
     let build = build_options(&a.input_args)?;
     let pb = spinner(&format!("reading {}", a.mesh.display()));
-    let mesh = read_any_mesh(&a.mesh)?;
+    let mesh = tessera::io::read_mesh(&a.mesh)?;
     let w = verify::watertight(&mesh);
     pb.finish_and_clear();
     println!("mesh                 {}", a.mesh.display());
@@ -632,7 +573,7 @@ fn run_check(a: CheckArgs) -> CliResult {
 }
 
 fn run_demo(a: DemoArgs) -> CliResult {
-    tessera::mesh::check_output_path(&a.output)?;
+    tessera::io::check_output_path(&a.output)?;
     let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
     let plan = Plan::uniform(&set, a.factor)?;
@@ -640,7 +581,7 @@ fn run_demo(a: DemoArgs) -> CliResult {
     let opts = limits(None, true);
     let mesh = engine::tessellate(&set, &plan, &Uniform, opts).map_err(|e| explain_limit(e, &opts))?;
     let seconds = start.elapsed().as_secs_f64();
-    tessera::mesh::write_mesh(&mesh, &a.output)?;
+    tessera::io::write_mesh(&mesh, &a.output)?;
     let w = verify::watertight(&mesh);
     let e = verify::approximation_error(&mesh, &set, 6)?;
     println!("Utah teapot: {} bicubic patches, uniform factor {}", set.patches.len(), a.factor);

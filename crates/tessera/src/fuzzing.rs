@@ -20,11 +20,14 @@ use crate::criterion::view::{Mapping, ViewCriterion};
 use crate::criterion::Plan;
 use crate::engine::{self, TessellateOptions};
 use crate::error::Result;
+use crate::io::bezt;
+use crate::io::glb::{self, parse_glb, write_glb};
+use crate::io::obj::write_obj;
 use crate::io::obj::{self, ObjMesh};
-use crate::io::patches::{self, PatchFile};
-use crate::mesh::read::{parse_glb, parse_ply, parse_stl};
+use crate::io::patches;
+use crate::io::ply::{parse_ply, write_ply};
+use crate::io::stl::{parse_stl, write_stl};
 use crate::mesh::strips;
-use crate::mesh::write::{write_glb, write_obj, write_ply, write_stl};
 use crate::mesh::Mesh;
 use crate::pattern::hardware::Partitioning;
 use crate::pattern::transition::Transition;
@@ -131,7 +134,7 @@ pub fn check_patches(data: &[u8]) {
         file.patches.iter().flatten().all(|&i| (i as usize) < file.points.len()),
         "parse_patches returned an index out of range"
     );
-    let text = newell_text(&file);
+    let text = patches::to_patches_text(&file);
     let again = patches::parse_patches(&text, label())
         .unwrap_or_else(|e| panic!("the Newell text of a parsed file does not parse: {e}\n{text}"));
     assert_eq!(
@@ -144,20 +147,43 @@ pub fn check_patches(data: &[u8]) {
     }
 }
 
-/// `file` in the Newell format, every weight written out; `{:?}` prints the shortest text
-/// that reads back to the same `f64`.
-fn newell_text(file: &PatchFile) -> String {
-    let mut text = format!("{}\n", file.patches.len());
-    for patch in &file.patches {
-        let indices: Vec<String> = patch.iter().map(|i| (i + 1).to_string()).collect();
-        text += &indices.join(",");
-        text.push('\n');
+/// Checks the Bézier triangle reader: [`bezt::parse_bezt`] on the bytes (invalid UTF-8
+/// replaced). A parsed file must keep its invariants, read back identically from its own
+/// text ([`bezt::to_bezt_text`]), and small files must build and tessellate.
+pub fn check_bezt(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let Ok(file) = bezt::parse_bezt(&text, label()) else { return };
+    assert!(!file.triangles.is_empty(), "parse_bezt returned a file without triangles");
+    assert_eq!(file.lines.len(), file.triangles.len(), "one line per triangle");
+    assert!(file.points.iter().all(|p| p.is_finite()), "parse_bezt returned a non-finite point");
+    assert!(
+        file.triangles.iter().flatten().all(|&i| (i as usize) < file.points.len()),
+        "parse_bezt returned an index out of range"
+    );
+    let text = bezt::to_bezt_text(&file);
+    let again = bezt::parse_bezt(&text, label())
+        .unwrap_or_else(|e| panic!("the text of a parsed .bezt file does not parse: {e}\n{text}"));
+    assert_eq!(
+        (&again.triangles, &again.points),
+        (&file.triangles, &file.points),
+        "parse → text → parse changed the file"
+    );
+    if file.triangles.len() <= ENGINE_PATCH_LIMIT {
+        tessellate_small(&SurfaceSet::from_bezier_triangle_file(&file, BuildOptions::default()));
     }
-    let _ = writeln!(text, "{}", file.points.len());
-    for (p, w) in file.points.iter().zip(&file.weights) {
-        let _ = writeln!(text, "{:?},{:?},{:?},{:?}", p.x, p.y, p.z, w);
+}
+
+/// Checks the outside-glTF reader: [`glb::parse_gltf_triangles`] on the bytes (no folder, so
+/// only the GLB's own buffer and `data:` URIs). A parsed mesh must have its indices in range
+/// and finite numbers, and must build PN triangles or refuse them with an error.
+pub fn check_gltf(data: &[u8]) {
+    let Ok(mesh) = glb::parse_gltf_triangles(data, label(), None) else { return };
+    assert_obj_invariants(&mesh);
+    if let Ok(set) = SurfaceSet::pn_from_mesh(&mesh, label(), BuildOptions::default()) {
+        if set.patches.len() <= ENGINE_PATCH_LIMIT {
+            tessellate_small(&set);
+        }
     }
-    text
 }
 
 /// Uniform factor 2 through the engine's fast path and factor 3 through the generic path:

@@ -9,7 +9,9 @@
 //! input ─► SurfaceSet ─► Criterion ─► resolve ─► Plan (edge samplings) ─► Pattern per patch ─► Engine ─► Mesh
 //! ```
 //!
-//! 1. [`io`] parses OBJ meshes and Newell patch files, with errors naming file, line and reason.
+//! 1. [`io`] reads the inputs — Newell patch files, cubic Bézier triangle files, and triangle
+//!    meshes (OBJ, PLY, STL, glTF) for PN triangles — with errors naming file, line and reason;
+//!    [`io::load`] picks the format by extension.
 //! 2. [`surface::SurfaceSet`] holds the patches and their [`topology`]: shared boundary curves
 //!    found by index and by welding coincident control points.
 //! 3. A [`criterion`] proposes factors per use of each shared edge; one resolver
@@ -20,7 +22,8 @@
 //!    evaluate surfaces.
 //! 5. The [`engine`] counts, scans and writes in parallel; each shared edge vertex is evaluated
 //!    once and referenced by every patch on it.
-//! 6. [`mesh`] writes OBJ, PLY, STL or glTF; [`verify`] checks watertightness, error and quality.
+//! 6. [`mesh::Mesh`] holds the result, which [`io::write_mesh`] writes as OBJ, PLY, STL or glTF
+//!    binary; [`verify`] checks watertightness, error and quality.
 //!
 //! ## Schemes
 //!

@@ -16,7 +16,9 @@ use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::TessellateOptions;
 use tessera::fuzzing::{self, Criterion, EngineCase, EngineOutcome, Scheme, Shape};
-use tessera::mesh::write::{write_glb, write_ply, write_stl};
+use tessera::io::glb::write_glb;
+use tessera::io::ply::write_ply;
+use tessera::io::stl::write_stl;
 use tessera::mesh::Mesh;
 
 /// The engine check as a parser-style check, for the table below.
@@ -29,9 +31,11 @@ type Check = fn(&[u8]);
 
 /// Each fuzz target's name (its `fuzz_targets/<name>.rs` and `fuzz/regressions/<name>/`) and
 /// the check it runs.
-const TARGETS: [(&str, Check); 7] = [
+const TARGETS: [(&str, Check); 9] = [
     ("obj", fuzzing::check_obj),
     ("patches", fuzzing::check_patches),
+    ("bezt", fuzzing::check_bezt),
+    ("gltf", fuzzing::check_gltf),
     ("ply", fuzzing::check_ply),
     ("stl", fuzzing::check_stl),
     ("glb", fuzzing::check_glb),
@@ -254,6 +258,29 @@ endfacet
 endsolid square
 ";
 
+/// Two flat cubic Bézier triangles sharing the edge (3,0,0)-(0,3,0).
+const FLAT_BEZT: &str = "2
+1,2,3,4,5,6,7,8,9,10
+7,11,8,12,13,9,14,15,16,10
+16
+0,0,0
+1,0,0
+0,1,0
+2,0,0
+1,1,0
+0,2,0
+3,0,0
+2,1,0
+1,2,0
+0,3,0
+3,1,0
+2,2,0
+1,3,0
+3,3,0
+2,3,0
+3,2,0
+";
+
 #[test]
 fn parser_checks_survive_mutated_real_files() {
     check_mutations("obj", "catmark_cube", &model_bytes("cages/catmark_cube.obj"), 64);
@@ -266,6 +293,8 @@ fn parser_checks_survive_mutated_real_files() {
     check_mutations("stl", "dragknob", &written(|out| write_stl(&mesh, out)), 48);
     check_mutations("stl", "ascii", ASCII_STL.as_bytes(), 48);
     check_mutations("glb", "dragknob", &written(|out| write_glb(&mesh, out)), 64);
+    check_mutations("gltf", "dragknob", &written(|out| write_glb(&mesh, out)), 64);
+    check_mutations("bezt", "flat", FLAT_BEZT.as_bytes(), 48);
     let spec = "eye=10,-4.5,2,target=0,0.25,0,up=0,0,1,fov=30,size=640x480,near=0.5,far=100";
     check_mutations("camera", "full spec", spec.as_bytes(), 64);
     check_mutations("camera", "one key", b"fov=30", 32);

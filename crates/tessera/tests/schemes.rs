@@ -324,8 +324,8 @@ fn strips_round_trip_through_ply() {
     let dir = std::env::temp_dir().join(format!("tessera-strips-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("spool.ply");
-    tessera::mesh::write_mesh(&mesh, &path).unwrap();
-    let back = tessera::mesh::read_mesh(&path).unwrap();
+    tessera::io::write_mesh(&mesh, &path).unwrap();
+    let back = tessera::io::read_mesh(&path).unwrap();
     assert_eq!(back.strips, mesh.strips);
     assert_eq!(back.indices, mesh.indices);
     std::fs::remove_dir_all(&dir).ok();

@@ -1,7 +1,8 @@
-//! Wavefront OBJ reader for polygon meshes (positions, normals and faces).
+//! Wavefront OBJ: the reader for polygon meshes (positions, normals and faces), the input of
+//! PN triangles and of `tessera check`, and the writer of tessera's OBJ output.
 //!
-//! Written by hand rather than with `tobj` because `tobj` does not report line numbers, and
-//! every input error here must name the file and the line.
+//! The reader is written by hand rather than with `tobj` because `tobj` does not report line
+//! numbers, and every input error here must name the file and the line.
 //!
 //! Supported: `v x y z [w]` (a 4th value `w` or vertex colours after `x y z` are ignored),
 //! `vn x y z`, `vt` (ignored, but counted so texture indices can be checked), and `f` with
@@ -13,12 +14,15 @@
 //! its kind defined *so far* (1-based), a negative index `-k` to the `k`-th most recent one.
 //! An index that is 0 or refers to an element not yet defined is an error.
 
+use std::io::{self, Write};
 use std::path::Path;
 
 use glam::DVec3;
 
 use super::patches::{quote, read_text};
+use super::Format;
 use crate::error::{Error, Result};
+use crate::mesh::Mesh;
 
 /// One polygon of an OBJ file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -74,6 +78,57 @@ impl ObjMesh {
             }
         }
         Ok(out)
+    }
+}
+
+impl ObjMesh {
+    /// The mesh as a triangle [`Mesh`] (for checking, not tessellating): positions rounded to
+    /// `f32`, zero normals and uvs, patch 0 everywhere.
+    ///
+    /// # Errors
+    ///
+    /// As [`ObjMesh::triangles`]: [`Error::Unsupported`] at the first face that is not a
+    /// triangle.
+    ///
+    /// Cost: O(vertices + faces).
+    pub fn to_mesh(&self, file: &Path) -> Result<Mesh> {
+        let tris = self.triangles(file)?;
+        let n = self.positions.len();
+        Ok(Mesh {
+            positions: self.positions.iter().map(|p| p.as_vec3().to_array()).collect(),
+            normals: vec![[0.0; 3]; n],
+            uvs: vec![[0.0; 2]; n],
+            vertex_patch: vec![0; n],
+            indices: tris.iter().flatten().copied().collect(),
+            triangle_patch: vec![0; tris.len()],
+            ..Default::default()
+        })
+    }
+
+    /// A triangle [`Mesh`] as an OBJ-like polygon mesh, the input of
+    /// [`SurfaceSet::pn_from_mesh`](crate::surface::SurfaceSet::pn_from_mesh): every vertex
+    /// keeps its position, and its normal when the mesh has any non-zero normal (a mesh read
+    /// from a file without normals has all zero ones, which count as none). Faces get line 0.
+    ///
+    /// Preconditions: a consistent mesh (indices in range), as every reader returns.
+    ///
+    /// Cost: O(vertices + triangles).
+    pub fn from_mesh(mesh: &Mesh) -> ObjMesh {
+        let has_normals = mesh.normals.iter().any(|n| n.iter().any(|&c| c != 0.0));
+        let faces = mesh
+            .indices
+            .chunks_exact(3)
+            .map(|t| ObjFace { positions: t.to_vec(), normals: has_normals.then(|| t.to_vec()), line: 0 })
+            .collect();
+        ObjMesh {
+            positions: mesh.positions.iter().map(|p| DVec3::from(p.map(f64::from))).collect(),
+            normals: if has_normals {
+                mesh.normals.iter().map(|n| DVec3::from(n.map(f64::from))).collect()
+            } else {
+                Vec::new()
+            },
+            faces,
+        }
     }
 }
 
@@ -287,10 +342,104 @@ impl At<'_> {
     }
 }
 
+// =============================================================================================
+// Writing
+
+/// Writes `mesh` as Wavefront OBJ text to `w`: a `# tessera` header, `v`, `vn` and `vt` lines
+/// (the vertex's own uv), then `f a/a/a b/b/b c/c/c` faces (1-based), with a `g patch_<id>` line
+/// before each run of triangles of the same patch. Floats are printed in the shortest form that
+/// reads back to the same `f32`.
+///
+/// Preconditions: as [`write_mesh`](super::write_mesh). I/O errors are [`Error::Write`] labelled `<writer>`.
+///
+/// Cost: O(vertices + triangles) time; no allocation beyond a 64 KiB buffer.
+pub fn write_obj<W: Write>(mesh: &Mesh, w: W) -> Result<()> {
+    super::write_to(mesh, Format::Obj, w)
+}
+
+// OBJ
+
+pub(super) fn emit_obj<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
+    writeln!(w, "# tessera")?;
+    writeln!(w, "# {} vertices, {} triangles", mesh.vertex_count(), mesh.triangle_count())?;
+    for p in &mesh.positions {
+        writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
+    }
+    for n in &mesh.normals {
+        writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
+    }
+    for uv in &mesh.uvs {
+        writeln!(w, "vt {} {}", uv[0], uv[1])?;
+    }
+    let mut group = None;
+    for (tri, &patch) in mesh.indices.chunks_exact(3).zip(&mesh.triangle_patch) {
+        if group != Some(patch) {
+            writeln!(w, "g patch_{patch}")?;
+            group = Some(patch);
+        }
+        // u64 because index u32::MAX would overflow when made 1-based.
+        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| u64::from(i) + 1);
+        writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::binary::test_meshes::{bytes, grid};
     use crate::io::patches::test_support::{assert_parse_error, data, Lcg};
+
+    #[test]
+    fn obj_lines_match_the_mesh() {
+        let mesh = grid(4, false);
+        let text = String::from_utf8(bytes(|w| write_obj(&mesh, w))).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("# tessera"));
+        let (mut v, mut vn, mut vt, mut f, mut groups) = (vec![], vec![], vec![], vec![], vec![]);
+        let mut group = None;
+        for line in lines {
+            let mut tokens = line.split_whitespace();
+            let floats =
+                |t: std::str::SplitWhitespace| t.map(|x| x.parse::<f32>().unwrap()).collect::<Vec<_>>();
+            match tokens.next() {
+                Some("#") => {}
+                Some("v") => v.push(floats(tokens)),
+                Some("vn") => vn.push(floats(tokens)),
+                Some("vt") => vt.push(floats(tokens)),
+                Some("g") => {
+                    let name = tokens.next().unwrap();
+                    group = Some(name.strip_prefix("patch_").unwrap().parse::<u32>().unwrap());
+                    groups.push(group.unwrap());
+                }
+                Some("f") => {
+                    let corners: Vec<u32> = tokens
+                        .map(|c| {
+                            let parts: Vec<u32> = c.split('/').map(|x| x.parse().unwrap()).collect();
+                            assert_eq!(parts.len(), 3);
+                            assert!(parts.iter().all(|&p| p == parts[0]), "v/vt/vn agree: {c}");
+                            parts[0]
+                        })
+                        .collect();
+                    assert_eq!(corners.len(), 3);
+                    f.push((corners, group.expect("a g line precedes the first face")));
+                }
+                other => panic!("unexpected line {other:?}"),
+            }
+        }
+        let as_vecs = |a: &[[f32; 3]]| a.iter().map(|p| p.to_vec()).collect::<Vec<_>>();
+        assert_eq!(v, as_vecs(&mesh.positions), "floats read back exactly");
+        assert_eq!(vn, as_vecs(&mesh.normals));
+        assert_eq!(vt, mesh.uvs.iter().map(|p| p.to_vec()).collect::<Vec<_>>());
+        assert_eq!(f.len(), mesh.triangle_count());
+        for (t, (corners, patch)) in f.iter().enumerate() {
+            let expected: Vec<u32> = mesh.triangle(t).iter().map(|i| i + 1).collect();
+            assert_eq!(corners, &expected);
+            assert_eq!(*patch, mesh.triangle_patch[t]);
+        }
+        // One g line per run: the patch alternates 3,7 on each of the 4 rows.
+        assert_eq!(groups, [3, 7, 3, 7, 3, 7, 3, 7]);
+    }
 
     fn parse(text: &str) -> Result<ObjMesh> {
         parse_obj(text, Path::new("test.obj"))

@@ -80,22 +80,51 @@ pub fn read_patches(path: &Path) -> Result<PatchFile> {
 /// are capped by the number of lines left, so an absurd count in a tiny file fails (as
 /// truncated) without a large allocation.
 pub fn parse_patches(text: &str, file: &Path) -> Result<PatchFile> {
+    let (patches, points, weights, lines) = parse_indexed::<PATCH_POINTS>(text, file, "patch", true)?;
+    Ok(PatchFile { patches, points, weights, lines })
+}
+
+/// What [`parse_indexed`] returns: per element its `N` 0-based indices, the points, their
+/// weights and each element's source line.
+pub(super) type Indexed<const N: usize> = (Vec<[u32; N]>, Vec<DVec3>, Vec<f64>, Vec<usize>);
+
+/// The parser shared by the indexed control-point formats (this one and [`super::bezt`]): an
+/// element count, that many lines of `N` comma-separated 1-based indices, a point count and
+/// that many `x,y,z` lines (with an optional weight `w` when `weights` is set). `what` names
+/// an element in messages ("patch", "triangle").
+///
+/// # Errors
+///
+/// As [`parse_patches`], with `N` in place of 16; a 4th value on a point line when `weights`
+/// is not set is [`Error::Parse`].
+///
+/// Cost: as [`parse_patches`].
+pub(super) fn parse_indexed<const N: usize>(
+    text: &str,
+    file: &Path,
+    what_one: &str,
+    weights_allowed: bool,
+) -> Result<Indexed<N>> {
     let mut src = DataLines::new(text, file);
     let Some((count_line, count_text)) = src.next() else {
-        return Err(Error::parse(file, 1, "empty file: expected the patch count on line 1"));
+        return Err(Error::parse(file, 1, format!("empty file: expected the {what_one} count on line 1")));
     };
-    let patch_count = parse_count(count_text, "patch", count_line, file)?;
+    let patch_count = parse_count(count_text, what_one, count_line, file)?;
     if patch_count == 0 {
-        return Err(Error::unsupported(file, count_line, "the file declares 0 patches"));
+        return Err(Error::unsupported(
+            file,
+            count_line,
+            format!("the file declares 0 {}", plural(what_one)),
+        ));
     }
 
     // Patch lines: syntax only here; the indices are checked once the point count is known.
-    let mut raw: Vec<[u64; PATCH_POINTS]> = Vec::with_capacity(patch_count.min(src.remaining()));
+    let mut raw: Vec<[u64; N]> = Vec::with_capacity(patch_count.min(src.remaining()));
     let mut lines = Vec::with_capacity(raw.capacity());
     for p in 0..patch_count {
-        let what = || format!("patch {} of {patch_count}", p + 1);
-        let (line, body) = src.expect(|| format!("{} (16 comma-separated indices)", what()))?;
-        raw.push(parse_patch_line(body, line, file, &what)?);
+        let what = || format!("{what_one} {} of {patch_count}", p + 1);
+        let (line, body) = src.expect(|| format!("{} ({N} comma-separated indices)", what()))?;
+        raw.push(parse_patch_line::<N>(body, line, file, &what)?);
         lines.push(line);
     }
 
@@ -111,7 +140,7 @@ pub fn parse_patches(text: &str, file: &Path) -> Result<PatchFile> {
 
     let mut patches = Vec::with_capacity(raw.len());
     for (p, (indices, &line)) in raw.iter().zip(&lines).enumerate() {
-        let mut out = [0u32; PATCH_POINTS];
+        let mut out = [0u32; N];
         for (k, (&i, slot)) in indices.iter().zip(out.iter_mut()).enumerate() {
             // `point_count <= u32::MAX`, so `i - 1` fits in u32 whenever `1 <= i <= point_count`.
             match u32::try_from(i) {
@@ -121,8 +150,8 @@ pub fn parse_patches(text: &str, file: &Path) -> Result<PatchFile> {
                         file,
                         line,
                         format!(
-                            "patch {} of {patch_count}: index {} of 16 is {i}, but indices must be \
-                             in 1..={point_count} (the file has {point_count} points)",
+                            "{what_one} {} of {patch_count}: index {} of {N} is {i}, but indices \
+                             must be in 1..={point_count} (the file has {point_count} points)",
                             p + 1,
                             k + 1,
                         ),
@@ -139,7 +168,7 @@ pub fn parse_patches(text: &str, file: &Path) -> Result<PatchFile> {
     for v in 0..point_count {
         let what = || format!("point {} of {point_count}", v + 1);
         let (line, body) = src.expect(|| format!("{} (`x,y,z` or `x,y,z,w`)", what()))?;
-        let (p, w) = parse_point_line(body, line, file, &what)?;
+        let (p, w) = parse_point_line(body, line, file, &what, weights_allowed)?;
         points.push(p);
         weights.push(w);
     }
@@ -149,14 +178,55 @@ pub fn parse_patches(text: &str, file: &Path) -> Result<PatchFile> {
             file,
             line,
             format!(
-                "unexpected content after the last point (the counts say {patch_count} patches \
+                "unexpected content after the last point (the counts say {patch_count} {} \
                  and {point_count} points, all already read): {}",
+                plural(what_one),
                 quote(extra)
             ),
         ));
     }
 
-    Ok(PatchFile { patches, points, weights, lines })
+    Ok((patches, points, weights, lines))
+}
+
+/// `patch` → `patches`, `triangle` → `triangles`.
+fn plural(what: &str) -> String {
+    if what.ends_with('h') {
+        format!("{what}es")
+    } else {
+        format!("{what}s")
+    }
+}
+
+/// Writes `file` in the patch format (the inverse of [`parse_patches`]): 1-based indices, and
+/// numbers in the shortest form that reads back to the same `f64` (`{:?}`, which keeps
+/// exponents short). The weight column is written only for points whose weight is not 1, so
+/// a polynomial file stays in Newell's original format.
+///
+/// Preconditions: every index `< points.len()`, one weight per point, finite numbers, as
+/// [`parse_patches`] returns; otherwise the text does not parse back.
+///
+/// Cost: O(patches + points) time and output size.
+pub fn to_patches_text(file: &PatchFile) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    // Writing to a String cannot fail.
+    let _ = writeln!(text, "{}", file.patches.len());
+    for patch in &file.patches {
+        let indices: Vec<String> = patch.iter().map(|&i| (u64::from(i) + 1).to_string()).collect();
+        let _ = writeln!(text, "{}", indices.join(","));
+    }
+    let _ = writeln!(text, "{}", file.points.len());
+    for (k, p) in file.points.iter().enumerate() {
+        let _ = write!(text, "{:?},{:?},{:?}", p.x, p.y, p.z);
+        match file.weights.get(k) {
+            Some(&w) if w != 1.0 => {
+                let _ = writeln!(text, ",{w:?}");
+            }
+            _ => text.push('\n'),
+        }
+    }
+    text
 }
 
 /// The non-blank lines of a text, trimmed, with their 1-based line numbers.
@@ -223,15 +293,15 @@ fn parse_count(text: &str, what: &str, line: usize, file: &Path) -> Result<usize
     })
 }
 
-/// Parses the 16 comma-separated 1-based indices of a patch line (range checked later).
-fn parse_patch_line(
+/// Parses the `N` comma-separated 1-based indices of an element line (range checked later).
+fn parse_patch_line<const N: usize>(
     body: &str,
     line: usize,
     file: &Path,
     what: &dyn Fn() -> String,
-) -> Result<[u64; PATCH_POINTS]> {
+) -> Result<[u64; N]> {
     let found = body.split(',').count();
-    if found != PATCH_POINTS {
+    if found != N {
         let hint = if found == 1 && body.contains(char::is_whitespace) {
             " (indices must be separated by commas)"
         } else {
@@ -240,10 +310,10 @@ fn parse_patch_line(
         return Err(Error::parse(
             file,
             line,
-            format!("{}: expected 16 comma-separated indices, found {found}{hint}", what()),
+            format!("{}: expected {N} comma-separated indices, found {found}{hint}", what()),
         ));
     }
-    let mut out = [0u64; PATCH_POINTS];
+    let mut out = [0u64; N];
     for (k, (field, slot)) in body.split(',').zip(out.iter_mut()).enumerate() {
         let field = field.trim();
         *slot = field.parse::<u64>().map_err(|_| {
@@ -258,9 +328,22 @@ fn parse_patch_line(
 }
 
 /// Parses `x,y,z` or `x,y,z,w`.
-fn parse_point_line(body: &str, line: usize, file: &Path, what: &dyn Fn() -> String) -> Result<(DVec3, f64)> {
+fn parse_point_line(
+    body: &str,
+    line: usize,
+    file: &Path,
+    what: &dyn Fn() -> String,
+    weights_allowed: bool,
+) -> Result<(DVec3, f64)> {
     const NAMES: [&str; 4] = ["x", "y", "z", "weight w"];
     let found = body.split(',').count();
+    if !weights_allowed && found != 3 {
+        return Err(Error::parse(
+            file,
+            line,
+            format!("{}: expected 3 comma-separated coordinates `x,y,z`, found {found} values", what()),
+        ));
+    }
     if !(3..=4).contains(&found) {
         return Err(Error::parse(
             file,

@@ -3,6 +3,7 @@
 
 use super::{pn_triangle, BezierTriangle, Domain, Patch, PnTriangle};
 use crate::error::{Error, Result};
+use crate::io::bezt::BezierTriangleFile;
 use crate::io::obj::ObjMesh;
 use crate::io::patches::PatchFile;
 use crate::surface::RationalBicubic;
@@ -202,6 +203,23 @@ impl SurfaceSet {
                     weights: idx.map(|i| file.weights[i as usize]),
                 })
             })
+            .collect();
+        Self::from_patches(patches, options)
+    }
+
+    /// Builds cubic Bézier triangles from a parsed `.bezt` file
+    /// ([`crate::io::bezt`]). Triangles that use the same control points (by index, or by
+    /// position up to `options.weld`) share boundary curves in the topology, so their
+    /// tessellation is crack-free; all-collapsed triangles are dropped and counted in
+    /// [`Repairs`].
+    ///
+    /// Preconditions: indices in range and finite points, as the parser guarantees.
+    /// Cost: O(triangles) hashing, as [`SurfaceSet::from_patches`].
+    pub fn from_bezier_triangle_file(file: &BezierTriangleFile, options: BuildOptions) -> SurfaceSet {
+        let patches = file
+            .triangles
+            .iter()
+            .map(|idx| Patch::BezierTriangle(BezierTriangle { points: idx.map(|i| file.points[i as usize]) }))
             .collect();
         Self::from_patches(patches, options)
     }
