@@ -978,10 +978,6 @@ pub fn run_engine_case(case: &EngineCase) -> EngineOutcome {
 fn open_watertight_finding(case: &EngineCase, set: &SurfaceSet, plan: &Plan) -> Option<&'static str> {
     let collapsed = |e: usize| set.topology.edges[e].collapsed;
     match case.scheme {
-        // The ESC pattern emits, next to a curve collapsed to a point, two triangles whose
-        // third corners are different samples of that curve: the same triangle twice, once
-        // each way round, after the collapse.
-        Scheme::Esc if (0..set.topology.edges.len()).any(collapsed) => Some("esc-fold-at-collapsed-edge"),
         // A collapsed curve sampled more than once gives the transition strip a fan from the
         // point over several samples of the neighbouring shared curve, and the neighbour
         // across that curve emits the same fan. (Sampling such curves once fixes the fan but
