@@ -220,6 +220,7 @@ pub fn build(a: &PatternArgs) -> CmdResult<DomainPattern> {
                 interior: [1, 1],
                 factors,
                 patch: 0,
+                collapsed: [false; 4],
             };
             let params = (0..nc)
                 .map(|e| (0..=input.segments[e]).map(|k| sd2::symmetric_param(factors[e], k)).collect())
