@@ -221,6 +221,7 @@ pub fn build(a: &PatternArgs) -> CmdResult<DomainPattern> {
                 interior: [1, 1],
                 factors,
                 patch: 0,
+                collapsed: [false; 4],
             };
             let params = (0..nc)
                 .map(|e| {

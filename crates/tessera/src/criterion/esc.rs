@@ -36,6 +36,25 @@
 //! cell diagonal is decided once and stored in the patch's grid, which both its coarse
 //! triangles read. So neighbours always agree, and the engine's once-per-edge evaluation
 //! makes the mesh watertight bit for bit.
+//!
+//! # Collapsed curves
+//!
+//! A coarse triangle with an edge on a patch boundary curve collapsed to a point (the teapot
+//! lid's apex, a spindle's poles) inserts every candidate of its three edges, whatever the
+//! distance test says: it gets the complete pattern, which after the collapse is the uniform
+//! pattern's fan at the point. The engine gives every sample of a collapsed curve the
+//! corner's vertex, so there the candidates cost nothing, and there the test cannot decide
+//! (surface and control mesh are both the point, so it never inserts). Sparser patterns break
+//! the mesh once the curve is one point, which the pattern's tests show on two that the
+//! fuzzer and those tests found: with the curve's candidates missing, a row kept by its other
+//! extreme takes virtual vertices on the curve, one sample above it (the fill of an empty row
+//! from the apex) and another below, so its first segment gets the same triangle on both
+//! sides (a fold); with the curve's candidates present but none on the other two edges, the
+//! two remaining edges join the same two vertices, the point and the far corner, and no row
+//! vertex inside fits between them. Forcing the other two edges' candidates is consistent
+//! like any decision: each is a decision of its coarse edge (for a boundary curve, forced
+//! when any patch on the curve forces it), which the neighbouring coarse triangle reads as it
+//! reads any inserted candidate.
 
 use super::Plan;
 use crate::camera::Camera;
@@ -198,8 +217,9 @@ fn far(patch: &RationalBicubic, uv: DVec2, a: DVec3, b: DVec3, s: f64, rho: f64)
     patch.position(uv).distance(a * (1.0 - s) + b * s) > rho
 }
 
-/// Decides every candidate of patch `p` off the boundary: inner cell edges and diagonals,
-/// then the rows. The boundary lattice points are already set from the edge samplings.
+/// Decides every candidate of patch `p` off the boundary: inner cell edges and diagonals
+/// (the rows are filled afterwards, by [`PatchGrid::insert_rows`]). The boundary lattice
+/// points are already set from the edge samplings.
 fn decide_inner(patch: &RationalBicubic, grid: &mut PatchGrid, rho: f64) {
     let n = grid.n;
     let side = grid.side();
@@ -228,7 +248,25 @@ fn decide_inner(patch: &RationalBicubic, grid: &mut PatchGrid, rho: f64) {
             }
         }
     }
-    grid.insert_rows();
+}
+
+/// The candidates patch `p` inserts whatever the distance test says, as a grid (None when
+/// there are none): every candidate of each coarse triangle with an edge on a boundary curve
+/// collapsed to a point (module doc, "Collapsed curves"). Cost: O(n²) per such triangle.
+fn forced_candidates(set: &SurfaceSet, p: usize, n: u32) -> Option<PatchGrid> {
+    let topo = &set.topology;
+    let collapsed: Vec<usize> =
+        (0..4).filter(|&e| topo.edges[topo.patch_edges[p][e].edge as usize].collapsed).collect();
+    if collapsed.is_empty() {
+        return None;
+    }
+    let mut forced = PatchGrid::coarse(n);
+    for t in 0..18 {
+        if collapsed.iter().any(|&e| forced.coarse_triangle_on_edge(t, e)) {
+            forced.fill_coarse_triangle(t);
+        }
+    }
+    Some(forced)
 }
 
 /// Levels per patch from the camera (or the fixed level), and `ρ` per patch.
@@ -275,6 +313,10 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &EscOptions) -> Result<(
     let (levels, rho) = levels_and_thresholds(set, camera, options);
     let topo = &set.topology;
     let (_, edge_points) = corner_and_edge_points(Domain::Quad);
+    let forced: Vec<Option<PatchGrid>> = (0..set.patches.len())
+        .into_par_iter()
+        .map(|p| forced_candidates(set, p, segments_for_level(levels[p])))
+        .collect();
 
     // Boundary curves: one decision per topology edge, by its owner, in canonical order.
     let edges: Vec<Vec<bool>> = (0..topo.edges.len())
@@ -286,11 +328,22 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &EscOptions) -> Result<(
             let side = 3 * n;
             let le = owner.local as usize;
             let cps = edge_points[le].map(|i| patches[p].points[i]);
+            // Forced on the curve when forced in any patch on it (all share the level: one
+            // component).
+            let forced_in_a_use = |k: u32| {
+                topo.edge_uses(e).iter().any(|u| {
+                    forced[u.patch as usize].as_ref().is_some_and(|g| {
+                        let (i, j) =
+                            edge_lattice(u.local as usize, if u.reversed { side - k } else { k }, side);
+                        g.get(i, j)
+                    })
+                })
+            };
             (0..=side)
                 .map(|k| {
                     let kl = if owner.reversed { side - k } else { k };
-                    if kl % n == 0 {
-                        return true; // a control-net vertex: a coarse-triangle corner
+                    if kl % n == 0 || forced_in_a_use(k) {
+                        return true; // a control-net vertex (a coarse-triangle corner) or forced
                     }
                     let (i, j) = edge_lattice(le, kl, side);
                     let (c, s) = ((kl / n) as usize, (kl % n) as f64 / n as f64);
@@ -315,6 +368,16 @@ pub fn plan(set: &SurfaceSet, camera: &Camera, options: &EscOptions) -> Result<(
                 }
             }
             decide_inner(patches[p], &mut grid, rho[p]);
+            if let Some(f) = &forced[p] {
+                for j in 0..=side {
+                    for i in 0..=side {
+                        if f.get(i, j) {
+                            grid.set(i, j, true);
+                        }
+                    }
+                }
+            }
+            grid.insert_rows();
             grid
         })
         .collect();

@@ -417,6 +417,11 @@ fn check_patches(
 ) -> Vec<([u32; 2], f64, bool)> {
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
+    // The engine's input, collapsed edges included, so the bound is that of the output.
+    let input_of = |p: usize, domain, segments, interior| PatternInput {
+        collapsed: crate::engine::collapsed_edges(set, p),
+        ..PatternInput::new(domain, segments, interior)
+    };
     // Each patch's first pattern: its edges and the smallest interior the layout gives it.
     let first = |p: usize| {
         let domain = set.patches[p].domain();
@@ -458,7 +463,7 @@ fn check_patches(
         .iter()
         .zip(&firsts)
         .filter(|(&p, _)| eps[p].is_some())
-        .map(|(&p, &(domain, seg, interior))| (p, PatternInput::new(domain, seg, interior)))
+        .map(|(&p, &(domain, seg, interior))| (p, input_of(p, domain, seg, interior)))
         .collect();
     let admitted = limit.reserve(&visible);
     which
@@ -471,7 +476,7 @@ fn check_patches(
             let Some(e) = eps[p] else { return (interior, 0.0, false) };
             let mut previous = f64::INFINITY;
             loop {
-                let input = PatternInput::new(domain, seg, interior);
+                let input = input_of(p, domain, seg, interior);
                 if !limit.admit(p, &input) {
                     // The output could not hold this pattern; the plan is refused at the end.
                     return (interior, f64::INFINITY, true);

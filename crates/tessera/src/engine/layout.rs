@@ -144,8 +144,8 @@ impl Layout {
     }
 }
 
-/// What the pattern of patch `p` gets from the plan: its edges' segments and factors and its
-/// interior factors.
+/// What the pattern of patch `p` gets from the plan: its edges' segments and factors, its
+/// interior factors and which of its edges are collapsed.
 pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.patches[p].domain();
     let mut segments = [1; 4];
@@ -155,7 +155,19 @@ pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternI
         segments[e] = plan.segments(edge);
         factors[e] = plan.factor(edge);
     }
-    PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32 }
+    let collapsed = collapsed_edges(set, p);
+    PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32, collapsed }
+}
+
+/// [`PatternInput::collapsed`] of patch `p`: which of its edges are boundary curves collapsed
+/// to a point. Whoever builds a patch's pattern to predict the engine's output (the error-
+/// bounded criteria) passes these too, or it predicts another triangulation. Cost: O(1).
+pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
+    let mut collapsed = [false; 4];
+    for (e, c) in collapsed.iter_mut().enumerate().take(set.patches[p].domain().corner_count()) {
+        *c = set.topology.edges[set.topology.patch_edges[p][e].edge as usize].collapsed;
+    }
+    collapsed
 }
 
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that

@@ -23,6 +23,7 @@ pub mod layout;
 pub mod render_queues;
 pub(crate) mod uniform_quads;
 
+pub(crate) use layout::collapsed_edges;
 pub use layout::Layout;
 
 /// Engine options.

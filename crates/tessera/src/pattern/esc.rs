@@ -318,6 +318,31 @@ impl PatchGrid {
         }
     }
 
+    /// True when an edge of coarse triangle `t` lies on patch edge `e` (edge 0: `J = 0`,
+    /// 1: `I = 3n`, 2: `J = 3n`, 3: `I = 0`). Only the left edge `AB` or the right edge `AC`
+    /// can: the base is a cell diagonal.
+    pub fn coarse_triangle_on_edge(&self, t: u32, e: usize) -> bool {
+        let (n, s) = (self.n, self.side());
+        let on = |(i, j): (u32, u32)| match e {
+            0 => j == 0,
+            1 => i == s,
+            2 => j == s,
+            _ => i == 0,
+        };
+        let a = on(self.lattice(t, (0, 0)));
+        a && (on(self.lattice(t, (n, 0))) || on(self.lattice(t, (n, n))))
+    }
+
+    /// Inserts every candidate of coarse triangle `t`: its edges and its rows.
+    pub fn fill_coarse_triangle(&mut self, t: u32) {
+        for k in 0..=self.n {
+            for p in 0..=k {
+                let (i, j) = self.lattice(t, (k, p));
+                self.set(i, j, true);
+            }
+        }
+    }
+
     fn get_rv(&self, t: u32, v: RowVertex) -> bool {
         let (i, j) = self.lattice(t, v);
         self.get(i, j)
@@ -628,6 +653,143 @@ mod tests {
                     c.base[k] = bits >> (2 * m + k - 1) & 1 == 1;
                 }
                 check_tiling(&c).unwrap_or_else(|e| panic!("n={n} bits={bits:b}: {e}"));
+            }
+        }
+    }
+
+    /// Which edge of a coarse triangle lies on a patch boundary curve collapsed to a point: the
+    /// left edge `AB` (patch edges 0 and 2) or the right edge `AC` (patch edges 1 and 3).
+    #[derive(Debug, Clone, Copy)]
+    enum Collapsed {
+        Left,
+        Right,
+    }
+
+    /// The triangulation stays a disk after the collapsed edge becomes one point (the engine
+    /// gives every sample of such a curve the corner's vertex and drops the triangles that
+    /// degenerate): no directed edge twice, no triangle twice, Euler characteristic 1, and the
+    /// boundary exactly the other two edges' present vertices, both ending at the point.
+    fn check_collapsed(c: &CoarseTriangle, side: Collapsed) -> Result<(), String> {
+        const POINT: RowVertex = (u32::MAX, u32::MAX);
+        let n = c.n;
+        let on = |(k, p): RowVertex| match side {
+            Collapsed::Left => p == 0,
+            Collapsed::Right => p == k,
+        };
+        let map = |v: RowVertex| if on(v) { POINT } else { v };
+        let tris: Vec<[RowVertex; 3]> = triangles(&c.strips())
+            .into_iter()
+            .map(|t| t.map(map))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        let mut sets: Vec<[RowVertex; 3]> = tris
+            .iter()
+            .map(|t| {
+                let mut s = *t;
+                s.sort_unstable();
+                s
+            })
+            .collect();
+        sets.sort_unstable();
+        if let Some(w) = sets.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("triangle {:?} twice", w[0]));
+        }
+        let mut directed: HashMap<(RowVertex, RowVertex), u32> = HashMap::new();
+        for t in &tris {
+            for e in 0..3 {
+                *directed.entry((t[e], t[(e + 1) % 3])).or_default() += 1;
+            }
+        }
+        if let Some(((a, b), _)) = directed.iter().find(|(_, &count)| count > 1) {
+            return Err(format!("edge {a:?}→{b:?} used twice"));
+        }
+        // Counter-clockwise A → C → B → A, over present vertices, after the collapse.
+        let mut ring: Vec<RowVertex> = (0..=n).map(|k| (k, k)).collect();
+        ring.extend((0..n).rev().map(|p| (n, p)));
+        ring.extend((0..n).rev().map(|k| (k, 0)));
+        let ring: Vec<RowVertex> = ring.into_iter().filter(|&v| c.present(v)).map(map).collect();
+        let mut expected: Vec<(RowVertex, RowVertex)> =
+            ring.windows(2).filter(|w| w[0] != w[1]).map(|w| (w[0], w[1])).collect();
+        if expected.len() == 2 {
+            // Only one vertex off the point on the boundary: the coarse triangle is a segment.
+            return if tris.is_empty() { Ok(()) } else { Err(format!("{tris:?} in a segment")) };
+        }
+        expected.sort_unstable();
+        let mut boundary: Vec<(RowVertex, RowVertex)> =
+            directed.keys().filter(|&&(a, b)| !directed.contains_key(&(b, a))).copied().collect();
+        boundary.sort_unstable();
+        if boundary != expected {
+            return Err(format!("boundary {boundary:?}, expected {expected:?}"));
+        }
+        let mut vertices: Vec<RowVertex> = tris.iter().flatten().copied().collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        let edges = directed.keys().filter(|&&(a, b)| a < b || !directed.contains_key(&(b, a))).count();
+        let euler = vertices.len() as i64 - edges as i64 + tris.len() as i64;
+        if euler != 1 {
+            return Err(format!("Euler characteristic {euler}, not a disk"));
+        }
+        Ok(())
+    }
+
+    /// Next to a curve collapsed to a point the criterion inserts every candidate of the coarse
+    /// triangle (criterion::esc, "Collapsed curves"): the complete pattern stays a disk after
+    /// the collapse, at every level and on either edge that can lie on a patch boundary.
+    #[test]
+    fn a_complete_coarse_triangle_stays_a_disk_at_a_collapsed_edge() {
+        for side in [Collapsed::Left, Collapsed::Right] {
+            for n in 1..=MAX_LEVEL + 1 {
+                let c = CoarseTriangle::full(n);
+                check_collapsed(&c, side).unwrap_or_else(|e| panic!("{side:?} n={n}: {e}"));
+            }
+        }
+    }
+
+    /// Why the whole coarse triangle: sparser patterns that tile the domain break once the
+    /// edge is one point. First the fold the fuzzer found (fuzz/regressions/engine/
+    /// esc-fold-at-collapsed-edge): none of the collapsed edge's candidates, rows 1 and 2
+    /// empty, row 3 kept by its right extreme, no base candidate; row 3's first segment gets
+    /// a triangle to the apex above and one to `B` below, the same triangle after the
+    /// collapse. Then every candidate of the collapsed edge (so complete rows) but none on
+    /// the other two: those join the point and `C` twice, and row 2's vertex inside gets the
+    /// triangle between them on both sides.
+    #[test]
+    fn sparser_patterns_fold_at_a_collapsed_edge() {
+        let mut c = CoarseTriangle::full(4);
+        c.left = vec![true, false, false, false, true];
+        c.right = vec![true, false, false, true, true];
+        c.base = vec![true, false, false, false, true];
+        check_tiling(&c).unwrap();
+        let err = check_collapsed(&c, Collapsed::Left).unwrap_err();
+        assert!(err.contains("twice"), "{err}");
+        let mut c = CoarseTriangle::full(3);
+        c.right = vec![true, false, false, true];
+        c.base = vec![true, false, false, true];
+        check_tiling(&c).unwrap();
+        let err = check_collapsed(&c, Collapsed::Left).unwrap_err();
+        assert!(err.contains("twice"), "{err}");
+    }
+
+    #[test]
+    fn three_coarse_triangles_lie_on_each_patch_edge() {
+        for n in 1..=4 {
+            let g = &PatchGrid::coarse(n);
+            for e in 0..4 {
+                let on: Vec<u32> = (0..18).filter(|&t| g.coarse_triangle_on_edge(t, e)).collect();
+                // Their edges on the patch edge cover its 3n lattice segments.
+                let mut points: Vec<(u32, u32)> = on
+                    .iter()
+                    .flat_map(|&t| (0..=n).flat_map(move |k| [(k, 0), (k, k)]).map(move |v| g.lattice(t, v)))
+                    .filter(|&(i, j)| match e {
+                        0 => j == 0,
+                        1 => i == 3 * n,
+                        2 => j == 3 * n,
+                        _ => i == 0,
+                    })
+                    .collect();
+                points.sort_unstable();
+                points.dedup();
+                assert_eq!((on.len(), points.len() as u32), (3, 3 * n + 1), "n={n} e={e}: {on:?}");
             }
         }
     }

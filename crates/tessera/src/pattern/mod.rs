@@ -30,12 +30,25 @@ pub struct PatternInput {
     pub factors: [f64; 4],
     /// The patch's index in its set, for patterns that hold per-patch decisions (`esc`).
     pub patch: u32,
+    /// Edges whose boundary curve is collapsed to a point (entries past the corner count are
+    /// ignored). The engine gives every sample of such an edge the vertex of the edge's first
+    /// corner and drops the triangles that degenerate, so a pattern's triangles there must
+    /// still form a fan at the point once its samples are one vertex; [`transition`] reads
+    /// this to keep its strips from fanning over a neighbouring edge.
+    pub collapsed: [bool; 4],
 }
 
 impl PatternInput {
-    /// An integer input: `factors` equal to `segments`, patch 0.
+    /// An integer input: `factors` equal to `segments`, patch 0, no collapsed edge.
     pub fn new(domain: Domain, segments: [u32; 4], interior: [u32; 2]) -> Self {
-        PatternInput { domain, segments, interior, factors: segments.map(f64::from), patch: 0 }
+        PatternInput {
+            domain,
+            segments,
+            interior,
+            factors: segments.map(f64::from),
+            patch: 0,
+            collapsed: [false; 4],
+        }
     }
 
     /// Index of the first local vertex of edge `e`'s inner samples.

@@ -227,6 +227,7 @@ mod tests {
             interior: [1, 1],
             factors: [f[0], f[1], f[2], 1.0],
             patch: 0,
+            collapsed: [false; 4],
         }
     }
 

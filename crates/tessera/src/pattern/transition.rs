@@ -45,9 +45,30 @@
 //! triangle factor below its strip count) the pattern raises the factor it uses internally
 //! to that minimum (re-deciding which sides need strips, since an edge that matched the old
 //! factor may not match the new one). This can only happen for inputs the paper's criterion
-//! (minimum per direction for quads, maximum for triangles) never produces, and it cannot
+//! (minimum per direction for quads, maximum for triangles) never produces, or where
+//! collapsed edges take strips (below), and it cannot
 //! cause cracks: interior vertices belong to one patch, and edges keep their sampling. A core
 //! of zero width (a line or a single point) is allowed; the strips then meet along it.
+//!
+//! **Collapsed edges.** Where an edge's curve is collapsed to a point
+//! ([`PatternInput::collapsed`]: a pole, the teapot lid's apex), the engine makes every sample
+//! of the edge that point's vertex and drops the triangles that degenerate. A strip on a
+//! neighbouring edge whose core line ended on such an edge (the collapsed edge matching the
+//! core factor, so without a strip, and the core reaching it) would end at a sample of the
+//! edge, i.e. at the point: its last triangles would join the point to several samples of
+//! the neighbouring edge, slivers lying along that edge's curve, and the patch across that
+//! curve, seeing the same point at its end, emits them again the other way round
+//! (non-manifold edges; found by fuzzing a spindle). So a collapsed edge next to a strip gets
+//! a strip of its own, even where its segments match the core: the core then stops one row
+//! short of it, the neighbouring strip ends at a core corner inside the domain, and the
+//! collapsed edge's strip is a fan from the point over the core line (its triangles on outer
+//! segments degenerate and are dropped), the same triangles the core's row next to the edge
+//! gave. On a quad the core side facing that strip keeps at least one segment (raising the
+//! factor along the edge to 3 if needed): a core line there would be the inner line of both
+//! neighbouring strips, which could each put the point's triangle on its first segment, one
+//! from each side, the same triangle after the collapse. The edge's own sampling is left as the plan made it: sampling a collapsed curve once
+//! would also end such fans, but the criteria derive the core factors from the edges (the
+//! minimum per direction), so the core next to the point would lose its resolution.
 //!
 //! The pattern assumes uniform edge samples (`t_k = k / segments`, `SamplingKind::Uniform`):
 //! its triangles have positive area for those positions.
@@ -103,11 +124,17 @@ impl QuadLayout {
         let mut nu = input.interior[0].max(1);
         let mut nv = input.interior[1].max(1);
         // Raising a factor can create strips on the sides that matched the old one, which can
-        // require raising the other factor; both only grow (to at most 2), so this ends.
+        // require raising the other factor; both only grow (to at most 3), so this ends.
         loop {
-            let strip = [s[0] != nu, s[1] != nv, s[2] != nu, s[3] != nv];
-            let need_u = u32::from(strip[1]) + u32::from(strip[3]);
-            let need_v = u32::from(strip[0]) + u32::from(strip[2]);
+            let mut strip = [s[0] != nu, s[1] != nv, s[2] != nu, s[3] != nv];
+            strips_at_collapsed_edges(&mut strip, &input.collapsed);
+            // A strip on a collapsed edge needs a core side of at least one segment facing it
+            // (module doc, "Collapsed edges").
+            let c = input.collapsed;
+            let fan_u = (strip[0] && c[0]) || (strip[2] && c[2]);
+            let fan_v = (strip[1] && c[1]) || (strip[3] && c[3]);
+            let need_u = u32::from(strip[1]) + u32::from(strip[3]) + u32::from(fan_u);
+            let need_v = u32::from(strip[0]) + u32::from(strip[2]) + u32::from(fan_v);
             if nu >= need_u && nv >= need_v {
                 return QuadLayout {
                     nu,
@@ -209,6 +236,19 @@ impl QuadLayout {
     }
 }
 
+/// Gives a strip to every collapsed edge next to an edge with a strip (module doc, "Collapsed
+/// edges"), for the `N` edges of a domain (`strip.len()`; neighbours cyclic). Repeated until
+/// nothing changes, as a new strip can be next to another collapsed edge. Cost: O(N²).
+fn strips_at_collapsed_edges<const N: usize>(strip: &mut [bool; N], collapsed: &[bool; 4]) {
+    for _ in 0..N {
+        for e in 0..N {
+            if collapsed[e] && (strip[(e + 1) % N] || strip[(e + N - 1) % N]) {
+                strip[e] = true;
+            }
+        }
+    }
+}
+
 /// The core grid and strips of a triangle patch.
 #[derive(Debug, Clone, Copy)]
 struct TriLayout {
@@ -226,7 +266,8 @@ impl TriLayout {
         let mut n = input.interior[0].max(1);
         // As for quads: raising can add strips, so iterate (n only grows, to at most 3).
         loop {
-            let strip = [s[0] != n, s[1] != n, s[2] != n];
+            let mut strip = [s[0] != n, s[1] != n, s[2] != n];
+            strips_at_collapsed_edges(&mut strip, &input.collapsed);
             let need = strip.iter().map(|&x| u32::from(x)).sum::<u32>();
             if n >= need {
                 let i_lo = u32::from(strip[2]);
@@ -564,6 +605,146 @@ mod tests {
         // Triangle core 5 with edge 1 at 3: core of size 4 (16) + 3 + 4.
         let input = tri([5, 3, 5], 5);
         assert_eq!(Transition.counts(&input), (6, 16 + 7));
+    }
+
+    /// The patch after the engine's collapse of the edges in `collapsed`: local indices with
+    /// every sample and the end corners of a collapsed edge replaced by one vertex,
+    /// degenerate triangles dropped. (`input.collapsed` is what the pattern was told.)
+    /// Returns `Err` when a surviving triangle lies on one boundary edge (all three vertices
+    /// on its closure, and not just the patch's own boundary segments: the point and samples
+    /// of a neighbouring edge, a sliver that the patch across that edge emits too), uses a
+    /// directed edge twice, or the boundary is not the other edges' segments.
+    fn check_collapsed(input: &PatternInput, collapsed: [bool; 4]) -> Result<(), String> {
+        let nc = input.domain.corner_count();
+        let mut out = LocalTessellation::default();
+        Transition.build(input, &mut out);
+        let (_, count) = Transition.counts(input);
+        assert_eq!(out.triangles.len() as u32, count, "{input:?}: triangle count");
+        super::super::assert_tiles(input, &out, &local_params(input, &out), 1e-12);
+        // Corners joined by collapsed edges are one vertex (the smallest corner index).
+        let mut corner: Vec<u32> = (0..nc as u32).collect();
+        for _ in 0..nc {
+            for e in (0..nc).filter(|&e| collapsed[e]) {
+                let m = corner[e].min(corner[(e + 1) % nc]);
+                let (a, b) = (corner[e], corner[(e + 1) % nc]);
+                corner.iter_mut().filter(|c| **c == a || **c == b).for_each(|c| *c = m);
+            }
+        }
+        let id = |l: u32| match input.slot(l) {
+            super::super::Slot::Corner(c) => corner[c],
+            super::super::Slot::Edge(e, _) if collapsed[e] => corner[e],
+            _ => l,
+        };
+        let edge_ids = |e: usize| -> Vec<u32> {
+            (0..=input.segments[e]).map(|k| id(input.boundary_vertex(e, k))).collect()
+        };
+        let tris: Vec<[u32; 3]> = out
+            .triangles
+            .iter()
+            .map(|t| t.map(id))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        let segment = |a: u32, b: u32| {
+            (0..nc)
+                .filter(|&e| !collapsed[e])
+                .any(|e| edge_ids(e).windows(2).any(|w| (w[0], w[1]) == (a, b) || (w[1], w[0]) == (a, b)))
+        };
+        for t in &tris {
+            // All three on one curve, joined by a chord of it that is not one of its segments.
+            let chord = (0..3).any(|k| !segment(t[k], t[(k + 1) % 3]));
+            if let Some(e) = (0..nc).find(|&e| chord && t.iter().all(|v| edge_ids(e).contains(v))) {
+                return Err(format!("triangle {t:?} lies on edge {e}"));
+            }
+        }
+        let mut directed: Vec<(u32, u32)> =
+            tris.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+        directed.sort_unstable();
+        if let Some(w) = directed.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("directed edge {:?} twice", w[0]));
+        }
+        let mut boundary: Vec<(u32, u32)> =
+            directed.iter().filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err()).copied().collect();
+        boundary.sort_unstable();
+        let mut expected: Vec<(u32, u32)> = (0..nc)
+            .filter(|&e| !collapsed[e])
+            .flat_map(|e| edge_ids(e).windows(2).map(|w| (w[0], w[1])).collect::<Vec<_>>())
+            .collect();
+        expected.sort_unstable();
+        if expected.len() == 2 {
+            // Two vertices left on the boundary, joined both ways: the patch is a segment, and
+            // no pattern can place a vertex inside it. Plans never ask for one: two curves
+            // between the same two corners get at least 2 segments each
+            // (`tolerance::minimum_segments`).
+            return Ok(());
+        }
+        if boundary != expected {
+            return Err(format!("boundary {boundary:?}, expected {expected:?}"));
+        }
+        Ok(())
+    }
+
+    /// The collapsed edges plans meet (one edge of a quad or a triangle, or two opposite edges
+    /// of a quad: a spindle's patch), for small factors: the patch stays a fan at the point.
+    /// Curves between the same two corners have at least 2 segments, as
+    /// `tolerance::minimum_segments` gives them (with 1 each, no triangulation of the patch
+    /// avoids slivers). The same inputs without the flag (the pattern not told) fail the check
+    /// somewhere, as the spindle did (fuzz/regressions/engine/transition-fan-at-collapsed-edge).
+    #[test]
+    fn collapsed_edges_fan_without_slivers() {
+        let mut unflagged_failures = 0;
+        let mut run = |input: PatternInput| {
+            check_collapsed(&input, input.collapsed).unwrap_or_else(|e| panic!("{input:?}: {e}"));
+            let unflagged = PatternInput { collapsed: [false; 4], ..input };
+            if check_collapsed(&unflagged, input.collapsed).is_err() {
+                unflagged_failures += 1;
+            }
+        };
+        let quads = [
+            [true, false, false, false],
+            [false, true, false, false],
+            [true, false, true, false],
+            [false, true, false, true],
+        ];
+        for c in quads {
+            for s0 in 1..=5 {
+                for s1 in 1..=5 {
+                    for s2 in 1..=5 {
+                        for s3 in 1..=5 {
+                            let s = [s0, s1, s2, s3];
+                            // Opposite collapsed edges: the other two join the same points.
+                            if (0..4)
+                                .any(|e| c[e] && c[(e + 2) % 4] && s[(e + 1) % 4].min(s[(e + 3) % 4]) < 2)
+                            {
+                                continue;
+                            }
+                            for nu in 1..=5 {
+                                for nv in 1..=5 {
+                                    run(PatternInput { collapsed: c, ..quad(s, [nu, nv]) });
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for e in 0..3 {
+            let mut c = [false; 4];
+            c[e] = true;
+            for s0 in 1..=6 {
+                for s1 in 1..=6 {
+                    for s2 in 1..=6 {
+                        // The other two edges join the same two points.
+                        if [s0, s1, s2].iter().enumerate().any(|(k, &s)| k != e && s < 2) {
+                            continue;
+                        }
+                        for n in 1..=6 {
+                            run(PatternInput { collapsed: c, ..tri([s0, s1, s2], n) });
+                        }
+                    }
+                }
+            }
+        }
+        assert!(unflagged_failures > 0, "the check cannot fail");
     }
 
     #[test]

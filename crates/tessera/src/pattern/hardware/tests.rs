@@ -72,6 +72,7 @@ fn input(domain: Domain, partitioning: Partitioning, factors: [f64; 4]) -> Patte
         interior: [1, 1],
         factors,
         patch: 0,
+        collapsed: [false; 4],
     }
 }
 
