@@ -39,9 +39,18 @@ pub enum Error {
     /// (a polygon where a triangle is needed, a mesh with no faces, ...).
     #[error("{at}: {reason}")]
     Unsupported { at: Location, reason: String },
-    /// An argument is out of range (factor 0, negative tolerance, ...).
-    #[error("invalid argument: {0}")]
-    InvalidArgument(String),
+    /// A file name whose extension (`role`: input, mesh or output) tessera does not read or
+    /// write; `supported` lists those it does.
+    #[error("{}: {}; supported: {supported}", .path.display(), describe_extension(.role, .extension))]
+    UnknownFormat { path: PathBuf, role: &'static str, extension: Option<String>, supported: &'static str },
+    /// A mesh handed to a writer breaks its invariants (array lengths, indices in range,
+    /// finite numbers); nothing was written.
+    #[error("invalid mesh: {reason}")]
+    InvalidMesh { reason: String },
+    /// The mesh is valid but exceeds what the output format can hold (STL's or GLB's size
+    /// limits, glTF's exact float range); nothing was written.
+    #[error("{format}: {reason}")]
+    FormatLimit { format: &'static str, reason: String },
     /// A parameter is out of its range or malformed: `name` says which (`camera`,
     /// `tolerance`, `esc threshold`, ...).
     #[error("{name}: {reason}")]
@@ -90,6 +99,13 @@ impl Error {
     /// An unsupported-input error at `file:line`.
     pub fn unsupported(file: impl Into<PathBuf>, line: usize, reason: impl Into<String>) -> Self {
         Error::Unsupported { at: Location { file: file.into(), line }, reason: reason.into() }
+    }
+}
+
+fn describe_extension(role: &str, extension: &Option<String>) -> String {
+    match extension {
+        Some(e) => format!("unsupported {role} extension \".{e}\""),
+        None => format!("the {role} file has no extension"),
     }
 }
 

@@ -17,7 +17,7 @@ pub(crate) const WRITER_LABEL: &str = "<writer>";
 /// Rejects meshes whose buffers disagree or hold non-finite numbers: every format would either
 /// index out of bounds or write a file its readers refuse.
 pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
-    let invalid = |reason: String| Err(Error::InvalidArgument(reason));
+    let invalid = |reason: String| Err(Error::InvalidMesh { reason });
     let n = mesh.positions.len();
     for (what, len) in [
         ("normals", mesh.normals.len()),

@@ -823,7 +823,7 @@ fn decode_base64(s: &str) -> Option<Vec<u8>> {
 /// accessors; any vertices are dropped.
 ///
 /// Preconditions: as [`write_mesh`](super::write_mesh), vertex patch ids at most 2^24 (exact in the float
-/// `_PATCH`), and a file under 4 GiB; otherwise [`Error::InvalidArgument`]. I/O errors are
+/// `_PATCH`), and a file under 4 GiB; otherwise [`Error::InvalidMesh`] or [`Error::FormatLimit`]. I/O errors are
 /// [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(vertices + triangles) time; the JSON is built in memory (a few KiB, independent of
@@ -857,11 +857,14 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
     let mut bin_len = 0u64;
     if t > 0 {
         if let Some(i) = mesh.vertex_patch.iter().position(|&p| p > MAX_EXACT_F32_INT) {
-            return Err(Error::InvalidArgument(format!(
-                "vertex {i} has patch id {}, above 2^24, the largest a float glTF attribute \
-                 holds exactly",
-                mesh.vertex_patch[i]
-            )));
+            return Err(Error::FormatLimit {
+                format: "glTF",
+                reason: format!(
+                    "vertex {i} has patch id {}, above 2^24, the largest a float glTF attribute \
+                     holds exactly",
+                    mesh.vertex_patch[i]
+                ),
+            });
         }
         // Every section is a whole number of 4-byte words, so each stays aligned for its
         // component type without padding between them.
@@ -937,8 +940,10 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         }
         let mut wrapper = serde_json::Map::new();
         wrapper.insert("tessera".into(), extras.into());
-        let extras = serde_json::value::to_raw_value(&wrapper)
-            .map_err(|e| Error::InvalidArgument(format!("cannot encode glTF extras: {e}")))?;
+        let extras = serde_json::value::to_raw_value(&wrapper).map_err(|e| Error::FormatLimit {
+            format: "glTF",
+            reason: format!("cannot encode the extras: {e}"),
+        })?;
 
         use gj::mesh::Semantic;
         let attributes = [
@@ -973,15 +978,17 @@ pub(super) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
     // Without triangles the file holds only the asset: glTF forbids empty accessors, and
     // gltf-json cannot read back a scene without nodes.
 
-    let mut json =
-        root.to_vec().map_err(|e| Error::InvalidArgument(format!("cannot encode glTF JSON: {e}")))?;
+    let mut json = root
+        .to_vec()
+        .map_err(|e| Error::FormatLimit { format: "glTF", reason: format!("cannot encode the JSON: {e}") })?;
     // The GLB spec pads the JSON chunk with spaces so that it stays valid JSON.
     json.resize(json.len().next_multiple_of(4), b' ');
     let total = glb_total_len(json.len() as u64, bin_len);
     if total > u64::from(u32::MAX) {
-        return Err(Error::InvalidArgument(format!(
-            "the mesh needs a {total}-byte GLB, above the format's 4 GiB limit"
-        )));
+        return Err(Error::FormatLimit {
+            format: "GLB",
+            reason: format!("the mesh needs a {total}-byte GLB, above the format's 4 GiB limit"),
+        });
     }
     Ok(GlbPlan { json, bin_len })
 }
@@ -1381,7 +1388,7 @@ mod tests {
         let mut mesh = grid(1, false);
         mesh.vertex_patch[2] = (1 << 24) + 1;
         let err = write_glb(&mesh, Vec::new()).unwrap_err();
-        assert!(matches!(&err, Error::InvalidArgument(m) if m.contains("vertex 2")), "{err}");
+        assert!(matches!(&err, Error::FormatLimit { reason, .. } if reason.contains("vertex 2")), "{err}");
         mesh.vertex_patch[2] = 1 << 24;
         write_glb(&mesh, Vec::new()).unwrap();
     }

@@ -68,7 +68,7 @@ pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gl
 ///
 /// `options` say how control points or vertices are welded and how the set is oriented.
 ///
-/// Errors: an unknown or missing extension is [`Error::InvalidArgument`] naming the supported
+/// Errors: an unknown or missing extension is [`Error::UnknownFormat`] naming the supported
 /// list; otherwise the reader's errors, which name `path`, the line where there is one, and
 /// the reason; and [`Error::Unsupported`] naming `path` when no patch is left after the
 /// repairs (every patch collapsed to a single point, for example by too wide a weld).
@@ -85,18 +85,7 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
             SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?
         }
         Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path)?, path, options)?,
-        Some(other) => {
-            return Err(Error::InvalidArgument(format!(
-                "{}: unsupported input extension \".{other}\"; supported: {INPUT_EXTENSIONS}",
-                path.display()
-            )))
-        }
-        None => {
-            return Err(Error::InvalidArgument(format!(
-                "{}: input file has no extension; supported: {INPUT_EXTENSIONS}",
-                path.display()
-            )))
-        }
+        other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };
     if set.patches.is_empty() {
         let weld = match options.weld {
@@ -126,7 +115,7 @@ const SUPPORTED_MESHES: &str = ".obj, .ply, .stl, .glb";
 /// Whatever the file lacks is filled in: zero normals and uvs, patch 0 for vertices and
 /// triangles, no corner params.
 ///
-/// Errors: an unknown extension is [`Error::InvalidArgument`]; an unreadable file is
+/// Errors: an unknown extension is [`Error::UnknownFormat`]; an unreadable file is
 /// [`Error::Io`]; malformed, truncated or out-of-range content is [`Error::Parse`], and valid
 /// content beyond what the reader handles (sparse accessors, several primitives, polygons in
 /// an OBJ, ...) is [`Error::Unsupported`]; all name `path`.
@@ -143,21 +132,20 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
         Some("ply") => ply::parse_ply,
         Some("stl") => stl::parse_stl,
         Some("glb") => glb::parse_glb,
-        Some(other) => {
-            return Err(Error::InvalidArgument(format!(
-                "{}: unsupported mesh extension \".{other}\"; supported: {SUPPORTED_MESHES}",
-                path.display()
-            )))
-        }
-        None => {
-            return Err(Error::InvalidArgument(format!(
-                "{}: the mesh file has no extension; supported: {SUPPORTED_MESHES}",
-                path.display()
-            )))
-        }
+        other => return Err(unknown(path, "mesh", other, SUPPORTED_MESHES)),
     };
     let data = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     parse(&data, path)
+}
+
+/// The error for a file name whose extension `role` files cannot have.
+fn unknown(path: &Path, role: &'static str, extension: Option<&str>, supported: &'static str) -> Error {
+    Error::UnknownFormat {
+        path: path.to_path_buf(),
+        role,
+        extension: extension.map(str::to_string),
+        supported,
+    }
 }
 
 /// Output formats, chosen by file extension.
@@ -171,22 +159,13 @@ pub(crate) enum Format {
 
 impl Format {
     fn from_path(path: &Path) -> Result<Format> {
-        let Some(ext) = path.extension() else {
-            return Err(Error::InvalidArgument(format!(
-                "{}: output file has no extension; supported: {SUPPORTED}",
-                path.display()
-            )));
-        };
-        let ext = ext.to_string_lossy();
-        match ext.to_ascii_lowercase().as_str() {
-            "obj" => Ok(Format::Obj),
-            "ply" => Ok(Format::Ply),
-            "stl" => Ok(Format::Stl),
-            "glb" => Ok(Format::Glb),
-            _ => Err(Error::InvalidArgument(format!(
-                "{}: unsupported output extension \".{ext}\"; supported: {SUPPORTED}",
-                path.display()
-            ))),
+        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("obj") => Ok(Format::Obj),
+            Some("ply") => Ok(Format::Ply),
+            Some("stl") => Ok(Format::Stl),
+            Some("glb") => Ok(Format::Glb),
+            other => Err(unknown(path, "output", other, SUPPORTED)),
         }
     }
 }
@@ -204,8 +183,8 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 ///
 /// Preconditions: the mesh is consistent (one normal, uv and vertex patch per position, one
 /// triangle patch per triangle, `corner_params` parallel to `indices`, indices in range, finite
-/// numbers); otherwise [`Error::InvalidArgument`], checked before the file is created. An
-/// unknown or missing extension is [`Error::InvalidArgument`] naming it and the supported list.
+/// numbers); otherwise [`Error::InvalidMesh`], checked before the file is created. An
+/// unknown or missing extension is [`Error::UnknownFormat`] naming it and the supported list.
 /// I/O failures are [`Error::Write`] naming `path`; a failure part-way leaves a partial file.
 ///
 /// Cost: O(vertices + triangles) time; memory: a 64 KiB buffer, plus the GLB JSON (a few KiB,
@@ -237,12 +216,13 @@ fn prepare(mesh: &Mesh, format: Format) -> Result<Prepared> {
         Format::Obj => Prepared::Obj,
         Format::Ply => Prepared::Ply,
         Format::Stl => {
-            let count = u32::try_from(mesh.triangle_count()).map_err(|_| {
-                Error::InvalidArgument(format!(
+            let count = u32::try_from(mesh.triangle_count()).map_err(|_| Error::FormatLimit {
+                format: "STL",
+                reason: format!(
                     "{} triangles exceed the binary STL limit of {}",
                     mesh.triangle_count(),
                     u32::MAX
-                ))
+                ),
             })?;
             Prepared::Stl { count }
         }
@@ -291,7 +271,10 @@ mod tests {
         assert_eq!((read.positions, read.indices), (mesh.positions.clone(), mesh.indices.clone()));
 
         let err = read_mesh(&dir.join("m.xyz")).unwrap_err();
-        assert!(matches!(&err, Error::InvalidArgument(m) if m.contains(".obj, .ply, .stl, .glb")), "{err}");
+        assert!(
+            matches!(&err, Error::UnknownFormat { supported, .. } if supported.contains(".obj, .ply, .stl, .glb")),
+            "{err}"
+        );
         let missing = dir.join("absent.ply");
         assert!(matches!(read_mesh(&missing), Err(Error::Io { path, .. }) if path == missing));
         let broken = dir.join("broken.ply");
@@ -331,8 +314,10 @@ mod tests {
             for format in [Format::Obj, Format::Ply, Format::Stl, Format::Glb] {
                 let mut out = Vec::new();
                 match write_to(&mesh, format, &mut out) {
-                    Err(Error::InvalidArgument(m)) => assert!(m.contains(expected), "{m} lacks {expected}"),
-                    other => panic!("expected InvalidArgument({expected}), got {other:?}"),
+                    Err(Error::InvalidMesh { reason }) => {
+                        assert!(reason.contains(expected), "{reason} lacks {expected}")
+                    }
+                    other => panic!("expected InvalidMesh({expected}), got {other:?}"),
                 }
                 assert!(out.is_empty(), "nothing is written for an invalid mesh");
             }
@@ -375,7 +360,8 @@ mod tests {
         for name in ["e.gltf", "noext"] {
             let path = dir.join(name);
             let err = write_mesh(&mesh, &path).unwrap_err();
-            let Error::InvalidArgument(m) = &err else { panic!("{err:?}") };
+            assert!(matches!(&err, Error::UnknownFormat { role: "output", .. }), "{err:?}");
+            let m = err.to_string();
             assert!(m.contains(".obj, .ply, .stl, .glb"), "{m}");
             assert!(m.contains(name), "{m}");
             assert!(!path.exists());

@@ -215,7 +215,7 @@ fn parse_stl_ascii(data: &[u8], file: &Path) -> Result<Mesh> {
 /// patches are not stored.
 ///
 /// Preconditions: as [`write_mesh`](super::write_mesh), and at most `u32::MAX` triangles, else
-/// [`Error::InvalidArgument`]. I/O errors are [`Error::Write`] labelled `<writer>`.
+/// [`Error::InvalidMesh`] or [`Error::FormatLimit`]. I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(triangles) time; no allocation beyond a 64 KiB buffer.
 pub fn write_stl<W: Write>(mesh: &Mesh, w: W) -> Result<()> {
