@@ -466,10 +466,13 @@ fn check_patches(
         .map(|(&p, &(domain, seg, interior))| (p, input_of(p, domain, seg, interior)))
         .collect();
     let admitted = limit.reserve(&visible);
+    // Each thread's pattern buffers are kept from call to call (a per-frame loop then
+    // allocates none here).
+    let generation = crate::engine::next_generation();
     which
         .par_iter()
         .zip(firsts)
-        .map_init(LocalTessellation::default, |scratch, (&p, (domain, seg, mut interior))| {
+        .map(|(&p, (domain, seg, mut interior))| {
             if !admitted {
                 return (interior, f64::INFINITY, true);
             }
@@ -481,7 +484,9 @@ fn check_patches(
                     // The output could not hold this pattern; the plan is refused at the end.
                     return (interior, f64::INFINITY, true);
                 }
-                let bound = patch_bound(&hessians[p], &input, limit.pattern, scratch);
+                let bound = crate::engine::with_scratch(generation, |s| {
+                    patch_bound(&hessians[p], &input, limit.pattern, s.local_mut())
+                });
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
                 }
