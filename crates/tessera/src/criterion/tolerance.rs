@@ -243,18 +243,8 @@ pub(crate) fn plan_limited(
     let all: Vec<usize> = (0..set.patches.len()).collect();
     let mut segments = edge_segments(&proposals);
     let limit = Limit::new(pattern, max_triangles, set.patches.len());
-    let mut results = check_patches(
-        set,
-        eps,
-        interior,
-        &limit,
-        cap,
-        &minimum_inner,
-        &hessians,
-        &proposals,
-        &segments,
-        &all,
-    );
+    let mut results =
+        check_patches(set, eps, interior, &limit, cap, minimum_inner, hessians, &proposals, &segments, &all);
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.

@@ -108,7 +108,7 @@ pub fn edge_factors(
     (0..topo.edges.len()).map(|e| factor(e).clamp(lo, hi)).collect()
 }
 
-/// Where the edge factors of [`plan`] come from.
+/// Where the edge factors of a view plan come from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum EdgeFactors {
     /// One factor on every edge.

@@ -1,13 +1,13 @@
 //! The CPU engine: count → exclusive scan ([`layout`]) → parallel write (rayon).
 //!
 //! [`Layout::build`] counts every edge's and patch's output and scans the counts into
-//! offsets with the one numbering rule (see [`layout`]); [`write`] then fills the buffers,
+//! offsets with the one numbering rule (see [`layout`]); [`write()`] then fills the buffers,
 //! each task its own disjoint slice. A shared edge's inner vertices are evaluated once, by the
 //! edge's owner patch, and every patch on the edge indexes them: the mesh is watertight bit
 //! for bit without welding. Split-normal variants copy the owner's position bits and take
 //! their normal from a patch of their own variant. Polynomial bicubic patches whose pattern
 //! interior is a uniform grid are evaluated by a vectorized specialisation
-//! ([`uniform_quads`]'s evaluator); that changes how positions are computed, never which
+//! (`uniform_quads`'s evaluator); that changes how positions are computed, never which
 //! vertices and triangles there are.
 
 use crate::criterion::Plan;
@@ -96,7 +96,7 @@ pub fn tessellate_into(
 }
 
 /// Writes the tessellation `layout` describes into `out`, reusing its buffers: the one writer
-/// every CPU path uses. Vertices are evaluated by [`uniform_quads::FastEvaluator`] where it
+/// every CPU path uses. Vertices are evaluated by `uniform_quads::FastEvaluator` where it
 /// applies (polynomial bicubic patches whose pattern interior is a uniform grid) and by the
 /// generic f64 evaluation elsewhere; the numbering, the triangles and every other array do
 /// not depend on which.

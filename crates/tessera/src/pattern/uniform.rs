@@ -55,7 +55,7 @@ impl Pattern for Uniform {
         "uniform"
     }
 
-    /// Quads: the `n × n` grid, built by [`grid`] row after row.
+    /// Quads: the `n × n` grid, built by `grid` row after row.
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
         (input.domain == Domain::Quad).then_some(input.interior)
     }

@@ -43,19 +43,20 @@
 
 use super::{LocalTessellation, Pattern, PatternInput};
 use crate::domain::Domain;
-use glam::DVec2;
-use partition::{
+use crate::sampling::hardware::{
     clamp, parity_odd, to_f64, to_fixed, Fixed, EPSILON, FRACTION_BITS, HALF, ONE, ONE_THIRD, TWO_THIRDS,
 };
+use glam::DVec2;
 use std::cell::RefCell;
 use stitch::{Diagonals, Emit};
 
-mod partition;
 mod stitch;
 #[cfg(test)]
 mod tests;
 
-pub use partition::{edge_param, edge_segments, settled_factor, Axis, Partitioning, OUTPUT_GAP};
+pub use crate::sampling::hardware::{
+    edge_param, edge_segments, settled_factor, Axis, Partitioning, OUTPUT_GAP,
+};
 
 /// Factors processed for one patch.
 #[derive(Debug, Clone, Copy)]
@@ -77,7 +78,8 @@ impl Processed {
         let n = domain.corner_count();
         let edges = &edges[..n];
         let inside = &inside[..if domain == Domain::Quad { 2 } else { 1 }];
-        if edges.iter().any(|f| !(*f > 0.0)) {
+        // Not `f <= 0`: a NaN factor culls the patch too, as in the hardware.
+        if edges.iter().any(|f| f.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)) {
             return None;
         }
         let (lo, hi) = partitioning.range();
@@ -103,14 +105,13 @@ impl Processed {
         for k in 0..n {
             outer[k] = Axis::new(to_fixed(e[k]), parity_odd(e[k], partitioning, false));
         }
-        let mut inner = [Axis::new(ONE, true); 2];
-        for k in 0..2 {
+        let inner: [Axis; 2] = std::array::from_fn(|k| {
             let j = k.min(i.len() - 1);
             let mut a = Axis::new(to_fixed(i[j]), parity_odd(i[j], partitioning, true));
             // Fewer points would leave no interior: the transition regions degenerate instead.
             a.points = a.points.max(if a.odd { 4 } else { 3 });
-            inner[k] = a;
-        }
+            a
+        });
         Some(Processed { domain, minimum, outer, inside: inner })
     }
 

@@ -1,8 +1,8 @@
 //! Stitching the band between two rows of points, as the hardware does: the ruler-function
 //! transition between rows of any two factors, and regular bands with the hardware's diagonals.
 
-use super::partition::Axis;
 use super::HardwareTessellation;
+use crate::sampling::hardware::Axis;
 
 /// Where vertex `i` of the half edge ends up at the largest factor, in ruler-function split
 /// order: the transition stitch advances on a row when the row has a point at that position.

@@ -1,9 +1,9 @@
 //! Tests of the hardware patterns; the comparison with the Direct3D 11 reference file is
 //! `tests/hardware_reference.rs`.
 
-use super::partition::reciprocal;
 use super::*;
 use crate::pattern::assert_tiles;
+use crate::sampling::hardware::reciprocal;
 use proptest::prelude::RngExt;
 use proptest::test_runner::{RngAlgorithm, TestRng};
 

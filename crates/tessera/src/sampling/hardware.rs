@@ -52,23 +52,23 @@ impl Partitioning {
 
 /// 16.16 fixed point, held in 64 bits so no intermediate product overflows (the hardware's
 /// 32-bit unsigned arithmetic never wraps on these ranges, so the results are the same).
-pub(super) type Fixed = i64;
-pub(super) const FRACTION_BITS: u32 = 16;
-pub(super) const ONE: Fixed = 1 << FRACTION_BITS;
-pub(super) const HALF: Fixed = ONE >> 1;
-pub(super) const ONE_THIRD: Fixed = 0x5555;
-pub(super) const TWO_THIRDS: Fixed = 0xaaaa;
+pub(crate) type Fixed = i64;
+pub(crate) const FRACTION_BITS: u32 = 16;
+pub(crate) const ONE: Fixed = 1 << FRACTION_BITS;
+pub(crate) const HALF: Fixed = ONE >> 1;
+pub(crate) const ONE_THIRD: Fixed = 0x5555;
+pub(crate) const TWO_THIRDS: Fixed = 0xaaaa;
 /// `2⁻¹⁶`, the smallest positive fixed-point fraction.
-pub(super) const EPSILON: f32 = 1.0 / 65536.0;
+pub(crate) const EPSILON: f32 = 1.0 / 65536.0;
 
 /// `x ≥ 0` (below 2¹⁵) to fixed point, rounding to nearest, ties to even, as the hardware's
 /// float-to-fixed conversion does. Exact: `x · 2¹⁶` of an `f32` is exact in `f64`.
-pub(super) fn to_fixed(x: f32) -> Fixed {
+pub(crate) fn to_fixed(x: f32) -> Fixed {
     (x as f64 * ONE as f64).round_ties_even() as Fixed
 }
 
 /// Fixed point to `f64`, exactly.
-pub(super) fn to_f64(x: Fixed) -> f64 {
+pub(crate) fn to_f64(x: Fixed) -> f64 {
     x as f64 / ONE as f64
 }
 
@@ -86,12 +86,12 @@ fn fixed_ceil(x: Fixed) -> Fixed {
 
 /// `1/n` in fixed point, rounded to nearest: the hardware's reciprocal table (`1 ≤ n ≤ 64`;
 /// no `65536/n` is a tie in that range).
-pub(super) fn reciprocal(n: i64) -> Fixed {
+pub(crate) fn reciprocal(n: i64) -> Fixed {
     (ONE + n / 2) / n
 }
 
 /// `v` without its most significant set bit (0 for `v ≤ 0`).
-pub(super) fn remove_msb(v: i64) -> i64 {
+pub(crate) fn remove_msb(v: i64) -> i64 {
     if v <= 0 {
         0
     } else {
@@ -103,22 +103,22 @@ pub(super) fn remove_msb(v: i64) -> i64 {
 /// with its parity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Axis {
-    pub(super) odd: bool,
+    pub(crate) odd: bool,
     /// `h − ⌊h⌋` of the half factor `h`.
     half_fraction: Fixed,
     /// `⌈h⌉`: points on the half edge (for even, without the midpoint).
-    pub(super) half_points: i64,
+    pub(crate) half_points: i64,
     /// The point that is split off on the floor partition (ignored when `h` is an integer).
     split_point: i64,
     inv_floor_segments: Fixed,
     inv_ceil_segments: Fixed,
     /// Points on the whole edge, ends included.
-    pub(super) points: i64,
+    pub(crate) points: i64,
 }
 
 impl Axis {
     /// The partition of fixed-point factor `f` with the given parity.
-    pub(super) fn new(f: Fixed, odd: bool) -> Axis {
+    pub(crate) fn new(f: Fixed, odd: bool) -> Axis {
         let mut half = (f + 1) / 2;
         // A factor of 1 with even parity behaves as odd here (its half is exactly ½).
         if odd || half == HALF {
@@ -171,7 +171,7 @@ impl Axis {
     }
 
     /// Point `k` (`0 ≤ k < points`) in fixed point.
-    pub(super) fn place(&self, k: i64) -> Fixed {
+    pub(crate) fn place(&self, k: i64) -> Fixed {
         let (mut point, flip) = if k >= self.half_points {
             ((self.half_points << 1) - k - i64::from(self.odd), true)
         } else {
@@ -204,7 +204,7 @@ impl Axis {
 }
 
 /// The hardware clamp: NaN gives `lo`; integer partitionings round up.
-pub(super) fn clamp(x: f32, lo: f32, hi: f32, partitioning: Partitioning) -> f32 {
+pub(crate) fn clamp(x: f32, lo: f32, hi: f32, partitioning: Partitioning) -> f32 {
     let c = if x.is_nan() { lo } else { x.max(lo).min(hi) };
     if partitioning.is_integer() {
         c.ceil()
@@ -215,7 +215,7 @@ pub(super) fn clamp(x: f32, lo: f32, hi: f32, partitioning: Partitioning) -> f32
 
 /// Parity of a processed factor: the mode's, or for integer modes the rounded value's (an
 /// inside factor of 1 counts as even).
-pub(super) fn parity_odd(f: f32, partitioning: Partitioning, inside: bool) -> bool {
+pub(crate) fn parity_odd(f: f32, partitioning: Partitioning, inside: bool) -> bool {
     match partitioning {
         Partitioning::FractionalOdd => true,
         Partitioning::FractionalEven => false,
