@@ -197,8 +197,7 @@ mod tests {
     use super::*;
 
     fn teapot() -> SurfaceSet {
-        let path = std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/"))
-            .join("patches/teapot.patches");
+        let path = crate::io::patches::test_support::data("patches/teapot.patches");
         SurfaceSet::from_patch_file(
             &crate::io::patches::read_patches(&path).expect("test model"),
             Default::default(),

@@ -564,9 +564,8 @@ mod tests {
     use crate::verify;
 
     fn load(name: &str) -> SurfaceSet {
-        let path = std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/"))
-            .join(name);
-        let file = crate::io::patches::read_patches(&path).expect("test model");
+        let file = crate::io::patches::read_patches(&crate::io::patches::test_support::data(name))
+            .expect("test model");
         SurfaceSet::from_patch_file(&file, Default::default())
     }
 

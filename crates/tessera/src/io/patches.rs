@@ -415,18 +415,19 @@ pub(super) fn quote(s: &str) -> String {
 
 /// Helpers shared by the tests of the parsers in this folder.
 #[cfg(test)]
-pub(super) mod test_support {
+pub(crate) mod test_support {
     use std::fmt::Debug;
     use std::path::{Path, PathBuf};
 
     use crate::error::{Error, Location, Result};
 
-    /// The shared test models (`/work/shared/data`).
-    const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data");
-
-    /// Path of a test model, relative to the data folder.
+    /// Path of a test model, relative to the shared data folder: `$TESSERA_DATA`, else
+    /// `../shared/data` beside the checkout (as the integration tests find it).
     pub fn data(rel: &str) -> PathBuf {
-        Path::new(DATA).join(rel)
+        let dir = std::env::var_os("TESSERA_DATA")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+        dir.join(rel)
     }
 
     /// Asserts that `result` is a parse error at `file:line` whose message names the file
