@@ -348,21 +348,38 @@ impl Writer<'_> {
         if !params.is_empty() {
             map.param_table(local, &mut scratch.param);
         }
-        let collapsed = layout::has_repeated_corner(set, p);
-        let mut t = 0;
-        for tri in &local.triangles {
-            if collapsed && layout::degenerate_after_collapse(set, &map.input, p, tri) {
-                continue;
-            }
-            for c in 0..3 {
-                idx[3 * t + c] = scratch.vertex[tri[c] as usize];
-                if !params.is_empty() {
-                    params[3 * t + c] = scratch.param[tri[c] as usize];
+        if layout::has_repeated_corner(set, p) || !params.is_empty() {
+            // The general form: triangles may drop out, parameters go along.
+            let mut t = 0;
+            for tri in &local.triangles {
+                if layout::degenerate_after_collapse(set, &map.input, p, tri) {
+                    continue;
                 }
+                for c in 0..3 {
+                    idx[3 * t + c] = scratch.vertex[tri[c] as usize];
+                    if !params.is_empty() {
+                        params[3 * t + c] = scratch.param[tri[c] as usize];
+                    }
+                }
+                t += 1;
             }
-            t += 1;
+            debug_assert_eq!(t, tp.len());
+        } else {
+            // Every triangle is kept. Interior vertices are numbered in the same order locally
+            // and in the output, so a triangle of interior vertices only (most of a fine
+            // pattern) maps by one addition instead of three table reads.
+            let first = map.input.interior_base();
+            let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
+            let table = &scratch.vertex[..];
+            for (out, tri) in idx.chunks_exact_mut(3).zip(&local.triangles) {
+                let mapped = if tri[0].min(tri[1]).min(tri[2]) >= first {
+                    tri.map(|l| l.wrapping_add(delta))
+                } else {
+                    tri.map(|l| table[l as usize])
+                };
+                out.copy_from_slice(&mapped);
+            }
         }
-        debug_assert_eq!(t, tp.len());
         tp.fill(p as u32);
     }
 }
