@@ -169,14 +169,7 @@ impl Pattern for SchemePattern {
         self.inner().strips(input, out)
     }
     fn name(&self) -> &'static str {
-        match self {
-            SchemePattern::Uniform(_) => "uniform",
-            SchemePattern::Transition(_) => "transition",
-            SchemePattern::SemiUniform(_) => "semi-uniform",
-            SchemePattern::Sd2(_) => "sd2",
-            SchemePattern::Hardware(h) => h.partitioning.name(),
-            SchemePattern::Esc(_) => "esc",
-        }
+        self.inner().name()
     }
 }
 

@@ -449,6 +449,10 @@ impl Esc {
 }
 
 impl Pattern for Esc {
+    fn name(&self) -> &'static str {
+        "esc"
+    }
+
     fn depends_on_patch(&self) -> bool {
         true // each patch's own insertion grid
     }

@@ -155,6 +155,10 @@ impl Sd2 {
 }
 
 impl Pattern for Sd2 {
+    fn name(&self) -> &'static str {
+        "sd2"
+    }
+
     fn depends_on_patch(&self) -> bool {
         self.corner_depths.is_some() // the warp reads the patch's corner depths
     }

@@ -430,6 +430,10 @@ fn walk(
 }
 
 impl Pattern for Transition {
+    fn name(&self) -> &'static str {
+        "transition"
+    }
+
     /// Interior vertex and triangle counts; O(1).
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         match input.domain {

@@ -553,6 +553,11 @@ impl Hardware {
 }
 
 impl Pattern for Hardware {
+    /// The partitioning's Direct3D name (`fractional_odd`, ...).
+    fn name(&self) -> &'static str {
+        self.partitioning.name()
+    }
+
     /// O(rings).
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let pre = self.processed(input);
