@@ -83,11 +83,26 @@ impl Camera {
         (r, u, f)
     }
 
-    /// A world point in camera space.
+    /// A world point in camera space. Computes the basis each call; a loop over many points
+    /// takes [`Camera::view`] once instead.
     pub fn to_camera(&self, p: DVec3) -> DVec3 {
-        let (r, u, f) = self.basis();
-        let d = p - self.eye;
-        DVec3::new(d.dot(r), d.dot(u), d.dot(f))
+        self.view().to_camera(p)
+    }
+
+    /// The camera's basis, planes and focal length computed once, for loops over many
+    /// points (culling and pixel tolerances per patch). Cost: two normalisations.
+    pub fn view(&self) -> View {
+        let (right, up, forward) = self.basis();
+        View {
+            eye: self.eye,
+            right,
+            up,
+            forward,
+            near: self.near,
+            far: self.far,
+            half_tangents: self.half_tangents(),
+            focal_pixels: self.focal_pixels(),
+        }
     }
 
     /// Focal length in pixels: a unit offset at depth 1 spans this many pixels.
@@ -184,6 +199,31 @@ impl Camera {
         }
         cam.validate()?;
         Ok(cam)
+    }
+}
+
+/// A [`Camera`] with its basis and derived constants computed ([`Camera::view`]): the
+/// per-frame form the criteria loop over patches with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct View {
+    pub eye: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+    pub forward: DVec3,
+    pub near: f64,
+    pub far: f64,
+    /// [`Camera::half_tangents`].
+    pub half_tangents: DVec2,
+    /// [`Camera::focal_pixels`].
+    pub focal_pixels: f64,
+}
+
+impl View {
+    /// A world point in camera space (x right, y up, z forward).
+    #[inline]
+    pub fn to_camera(&self, p: DVec3) -> DVec3 {
+        let d = p - self.eye;
+        DVec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
     }
 }
 

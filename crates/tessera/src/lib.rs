@@ -80,6 +80,7 @@ pub mod io;
 pub mod mesh;
 pub mod pattern;
 pub mod sampling;
+pub mod scene;
 pub mod scheme;
 pub mod surface;
 pub mod tessellator;

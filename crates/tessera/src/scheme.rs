@@ -24,6 +24,7 @@ use crate::criterion::resolve::{EdgeRule, InteriorRule};
 use crate::criterion::sd2::{self as sd2_criterion, LevelFunction, Sd2Options};
 use crate::criterion::tolerance::{self, PlanReport};
 use crate::criterion::view::{self, EdgeFactors, Mapping, ViewCriterion};
+pub use crate::criterion::PlanScratch;
 use crate::criterion::{screen, Plan, MAX_FACTOR};
 use crate::domain::Domain;
 use crate::error::{Error, Result};
@@ -36,6 +37,7 @@ use crate::pattern::uniform::Uniform;
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use crate::sampling::Spacing;
 use crate::surface::SurfaceSet;
+use rayon::prelude::*;
 
 /// A tessellation scheme: a pattern with the rules that feed it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -125,6 +127,13 @@ pub struct Planned {
     pub plan: Plan,
     pub pattern: SchemePattern,
     pub report: Option<PlanReport>,
+}
+
+impl Default for Planned {
+    /// An empty uniform plan, for [`Scheme::plan_into`] to fill.
+    fn default() -> Self {
+        Planned { plan: Plan::default(), pattern: SchemePattern::Uniform(Uniform), report: None }
+    }
 }
 
 /// The pattern of each scheme, as one closed type (no allocation, and an engine can match on
@@ -282,10 +291,9 @@ impl Scheme {
         self.plan_prepared(set, &Prepared::for_criterion(set, criterion), criterion, options)
     }
 
-    /// [`Scheme::plan`] with the view-independent data prepared once ([`Prepared`]), as a
-    /// per-frame loop ([`crate::tessellator::Tessellator`]) calls it. Preconditions: `prepared`
-    /// was made for `set` (with bounds for the error-bounded criteria; they are computed here
-    /// otherwise).
+    /// [`Scheme::plan`] with the view-independent data prepared once ([`Prepared`]).
+    /// Preconditions: `prepared` was made for `set` (with bounds for the error-bounded
+    /// criteria; they are computed here otherwise).
     pub fn plan_prepared(
         &self,
         set: &SurfaceSet,
@@ -293,77 +301,121 @@ impl Scheme {
         criterion: &Criterion,
         options: &PlanOptions,
     ) -> Result<Planned> {
+        let mut planned = Planned::default();
+        self.plan_into(set, prepared, criterion, options, &mut PlanScratch::default(), &mut planned)?;
+        Ok(planned)
+    }
+
+    /// [`Scheme::plan_prepared`] into `out`, reusing its buffers and `scratch`'s, as a
+    /// per-frame loop ([`crate::tessellator::Tessellator`]) calls it: for the uniform and
+    /// error-bounded criteria (factor, tolerance, pixel error) with the integer schemes, a
+    /// frame allocates nothing once the buffers have grown to the set. On error `out` is
+    /// left in an unspecified but valid state.
+    pub fn plan_into(
+        &self,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+        criterion: &Criterion,
+        options: &PlanOptions,
+        scratch: &mut PlanScratch,
+        out: &mut Planned,
+    ) -> Result<()> {
         self.check(criterion, options)?;
+        scratch.criterion_time = Default::default();
+        scratch.resolve_time = Default::default();
         if let Scheme::Esc { max_level } = *self {
-            return self.plan_esc(set, criterion, options, max_level);
+            *out = self.plan_esc(set, criterion, options, max_level)?;
+            return Ok(());
         }
         if let Scheme::Sd2 { warp } = *self {
-            return self.plan_sd2(set, criterion, options, warp);
+            *out = self.plan_sd2(set, criterion, options, warp)?;
+            return Ok(());
         }
         let rule = self.edge_rule().expect("every scheme but ESC has an edge rule");
         let interior = self.interior_rule();
-        let pattern = match self {
+        out.pattern = match self {
             Scheme::Uniform => SchemePattern::Uniform(Uniform),
             Scheme::Transition => SchemePattern::Transition(Transition),
             Scheme::SemiUniform { .. } => SchemePattern::SemiUniform(SemiUniform),
             Scheme::Hardware(p) => SchemePattern::Hardware(Hardware { partitioning: *p }),
             Scheme::Sd2 { .. } | Scheme::Esc { .. } => unreachable!("planned above"),
         };
+        out.report = None;
         let cap = self.cap(options);
         let caps = prepared.caps(cap);
         let camera = options.camera;
         let cull_camera = || camera.ok_or(Error::NeedsCamera { what: "culling" });
-        let planned = |plan, report| Ok(Planned { plan, pattern: pattern.clone(), report });
         match *criterion {
             Criterion::Factor(f) if rule == EdgeRule::Integer || rule == EdgeRule::PowerOfTwo => {
-                let mut plan = Plan::uniform(set, f as u32)?;
+                let plan = &mut out.plan;
+                plan.set_uniform(set, f as u32)?;
                 if options.cull {
-                    plan.visible = screen::visibility(set, &cull_camera()?, true);
+                    let view = cull_camera()?.view();
+                    screen::visibility_into(set, prepared.views(set), &view, true, &mut plan.visible);
                 }
-                planned(plan, None)
             }
             Criterion::Factor(f) => {
                 let camera =
                     if options.cull { cull_camera()? } else { camera.unwrap_or_else(|| framing(set)) };
-                let plan =
+                out.plan =
                     view::plan(set, &camera, EdgeFactors::Fixed(f), rule, interior, &caps, options.cull);
-                planned(plan, None)
             }
             Criterion::Tolerance(_) | Criterion::PixelError(_) => {
                 // Each patch's object-space tolerance (None: culled).
-                let eps = match *criterion {
+                let start = std::time::Instant::now();
+                let eps = &mut scratch.tolerances;
+                match *criterion {
                     Criterion::PixelError(px) => {
                         let camera = camera.ok_or(Error::NeedsCamera { what: "a pixel error" })?;
-                        screen::tolerances(set, &camera, px, options.cull)
+                        screen::tolerances_into(
+                            set,
+                            prepared.views(set),
+                            &camera.view(),
+                            px,
+                            options.cull,
+                            eps,
+                        );
                     }
-                    Criterion::Tolerance(eps) if options.cull => {
-                        let camera = cull_camera()?;
-                        set.patches.iter().map(|p| (!screen::culled(p, &camera)).then_some(eps)).collect()
+                    Criterion::Tolerance(e) if options.cull => {
+                        let view = cull_camera()?.view();
+                        let views = prepared.views(set);
+                        eps.resize(set.patches.len(), None);
+                        eps.par_iter_mut().zip(&set.patches).zip(views).for_each(|((o, patch), v)| {
+                            *o = (!v.culled(patch, &view)).then_some(e);
+                        });
                     }
-                    Criterion::Tolerance(eps) => vec![Some(eps); set.patches.len()],
+                    Criterion::Tolerance(e) => {
+                        eps.clear();
+                        eps.resize(set.patches.len(), Some(e));
+                    }
                     _ => unreachable!("matched above"),
-                };
-                let (plan, report) = tolerance::plan_limited(
+                }
+                scratch.criterion_time = start.elapsed();
+                let start = std::time::Instant::now();
+                let report = tolerance::plan_limited(
                     set,
                     prepared,
-                    &eps,
+                    eps,
                     rule,
                     interior,
-                    &pattern,
+                    &out.pattern,
                     cap as u32,
                     options.max_triangles,
+                    &mut scratch.tolerance,
+                    &mut out.plan,
                 )?;
-                planned(plan, Some(report))
+                scratch.resolve_time = start.elapsed();
+                out.report = Some(report);
             }
             Criterion::View { criterion, fmin, fmax } => {
                 let camera = camera.ok_or(Error::NeedsCamera { what: "a view criterion" })?;
                 let fmax = fmax.min(cap);
                 let factors = EdgeFactors::View { criterion, fmin: fmin.min(fmax), fmax };
-                let plan = view::plan(set, &camera, factors, rule, interior, &caps, options.cull);
-                planned(plan, None)
+                out.plan = view::plan(set, &camera, factors, rule, interior, &caps, options.cull);
             }
             Criterion::Esc { .. } => unreachable!("refused by accepts"),
         }
+        Ok(())
     }
 
     /// The largest factor this scheme may use under `options`: the scheme's own cap and

@@ -36,7 +36,28 @@ use crate::engine::uniform_quads::FastEvaluator;
 use crate::engine::{self, Layout, TessellateOptions};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scheme::{Criterion, PlanOptions, Planned, Prepared, Scheme};
+use crate::scheme::{Criterion, PlanOptions, PlanScratch, Planned, Prepared, Scheme};
+use std::time::{Duration, Instant};
+
+/// Wall time of each stage of a frame ([`Tessellator::timings`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameTimings {
+    /// Per-patch view work: culling and the pixel → object-space tolerances.
+    pub criterion: Duration,
+    /// Proposals, the edge resolve and the error checks: the rest of the plan.
+    pub resolve: Duration,
+    /// The output layout (counts and offsets).
+    pub layout: Duration,
+    /// Vertex and index writes.
+    pub write: Duration,
+}
+
+impl FrameTimings {
+    /// The whole frame, criterion to last index.
+    pub fn total(&self) -> Duration {
+        self.criterion + self.resolve + self.layout + self.write
+    }
+}
 use crate::surface::SurfaceSet;
 
 /// Receives a tessellation, vertex after vertex, then triangle after triangle.
@@ -106,7 +127,11 @@ pub struct Tessellator<'a> {
     options: TessellatorOptions,
     prepared: Prepared,
     layout: Layout,
-    planned: Option<Planned>,
+    /// The last frame's plan, valid when `planned_ok`; its buffers are reused.
+    planned: Planned,
+    planned_ok: bool,
+    scratch: PlanScratch,
+    timings: FrameTimings,
     mesh: Mesh,
     /// The vectorized bicubic evaluation's per-set tables (None unless every patch is a
     /// polynomial bicubic), kept from frame to frame.
@@ -135,7 +160,10 @@ impl<'a> Tessellator<'a> {
             options,
             prepared,
             layout: Layout::default(),
-            planned: None,
+            planned: Planned::default(),
+            planned_ok: false,
+            scratch: PlanScratch::default(),
+            timings: FrameTimings::default(),
             mesh: Mesh::default(),
             fast,
         })
@@ -146,14 +174,41 @@ impl<'a> Tessellator<'a> {
     /// them. Cost: the plan's (see [`Scheme::plan`]) plus O(output), parallel.
     pub fn frame(&mut self, camera: Option<&Camera>) -> Result<&Mesh> {
         let options = PlanOptions { camera: camera.copied(), ..self.options.plan };
-        let planned = self.scheme.plan_prepared(self.set, &self.prepared, &self.criterion, &options)?;
-        let planned = self.planned.insert(planned);
+        let start = Instant::now();
+        self.planned_ok = false;
+        self.scheme.plan_into(
+            self.set,
+            &self.prepared,
+            &self.criterion,
+            &options,
+            &mut self.scratch,
+            &mut self.planned,
+        )?;
+        self.planned_ok = true;
+        let planned = &self.planned;
+        let (criterion, resolve) = self.scratch.stage_times();
+        let planning = start.elapsed();
+        let start = Instant::now();
         self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
+        let layout = start.elapsed();
+        let start = Instant::now();
         let applies = self.fast.as_mut().is_some_and(|f| f.retarget(&planned.plan));
         let fast = self.fast.as_ref().filter(|_| applies);
-        let (plan, pattern, layout) = (&planned.plan, &planned.pattern, &self.layout);
-        engine::write_with(self.set, plan, pattern, layout, self.options.engine, &mut self.mesh, fast)?;
+        let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
+        engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, &mut self.mesh, fast)?;
+        self.timings = FrameTimings {
+            criterion,
+            // Whatever planning did besides the criterion counts as resolving.
+            resolve: planning.saturating_sub(criterion).max(resolve),
+            layout,
+            write: start.elapsed(),
+        };
         Ok(&self.mesh)
+    }
+
+    /// How long each stage of the last successful frame took.
+    pub fn timings(&self) -> FrameTimings {
+        self.timings
     }
 
     /// [`Tessellator::frame`], handed to `builder`. Cost: that of `frame` plus one pass over
@@ -173,12 +228,12 @@ impl<'a> Tessellator<'a> {
 
     /// The last frame's plan (None before the first frame).
     pub fn plan(&self) -> Option<&Plan> {
-        self.planned.as_ref().map(|p| &p.plan)
+        self.planned_ok.then_some(&self.planned.plan)
     }
 
     /// The last frame's guarantee report, for error-bounded criteria.
     pub fn report(&self) -> Option<&PlanReport> {
-        self.planned.as_ref().and_then(|p| p.report.as_ref())
+        self.planned.report.as_ref().filter(|_| self.planned_ok)
     }
 
     /// The last frame's output layout (offsets by edge and patch; see [`engine::layout`]).

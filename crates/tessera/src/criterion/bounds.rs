@@ -35,26 +35,27 @@ impl HessianBound {
         0.5 * ((a + c) + ((a - c) * (a - c) + 4.0 * b * b).sqrt())
     }
 
-    /// Bound over one triangle with the domain measured in coordinates `(a·u, b·v)`.
-    fn scaled_error(&self, t: [DVec2; 3], s: DVec2) -> f64 {
-        let scaled =
-            HessianBound { uu: self.uu / (s.x * s.x), uv: self.uv / (s.x * s.y), vv: self.vv / (s.y * s.y) };
-        let r = enclosing_radius(t.map(|p| p * s));
-        scaled.lambda() * r * r / 2.0
-    }
-
     /// Guaranteed bound on `|S − L|` over the parameter triangle `t`: the smallest of the bounds
     /// for three scalings of the domain (each is valid; `(√Muu, √Mvv)` matches Filip's bound on
-    /// grid cells whose sides follow `√Muu·hu = √Mvv·hv`). Cost: O(1).
+    /// grid cells whose sides follow `√Muu·hu = √Mvv·hv`). Cost: O(1); a loop over many
+    /// triangles of one patch takes [`HessianBound::triangle_errors`] instead.
     pub fn triangle_error(&self, t: [DVec2; 3]) -> f64 {
+        self.triangle_errors().error(t)
+    }
+
+    /// [`HessianBound::triangle_error`] with what depends only on the bound computed once.
+    pub fn triangle_errors(&self) -> TriangleErrors {
         let tiny = 1e-300 + 1e-12 * (self.uu + self.uv + self.vv);
         let scales = [
             DVec2::new((self.uu + tiny).sqrt(), (self.vv + tiny).sqrt()),
             DVec2::new((self.uu + self.uv + tiny).sqrt(), (self.vv + self.uv + tiny).sqrt()),
             DVec2::ONE,
         ];
-        let general = scales.iter().map(|&s| self.scaled_error(t, s)).fold(f64::INFINITY, f64::min);
-        general.min(self.axis_aligned_error(t).unwrap_or(f64::INFINITY))
+        let lambdas = scales.map(|s| {
+            HessianBound { uu: self.uu / (s.x * s.x), uv: self.uv / (s.x * s.y), vv: self.vv / (s.y * s.y) }
+                .lambda()
+        });
+        TriangleErrors { bound: *self, scales, lambdas }
     }
 
     /// Filip's bound `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8` for a right triangle whose legs
@@ -76,6 +77,31 @@ impl HessianBound {
             return Some((hu * hu * self.uu + 2.0 * hu * hv * self.uv + hv * hv * self.vv) / 8.0);
         }
         None
+    }
+}
+
+/// [`HessianBound::triangle_error`] for one bound and many triangles: the scalings and their
+/// eigenvalues computed once ([`HessianBound::triangle_errors`]). Gives the same bits as
+/// `triangle_error`.
+#[derive(Debug, Clone, Copy)]
+pub struct TriangleErrors {
+    bound: HessianBound,
+    scales: [DVec2; 3],
+    /// Largest eigenvalue of the bound in each scaling's coordinates.
+    lambdas: [f64; 3],
+}
+
+impl TriangleErrors {
+    /// The bound over parameter triangle `t`. Cost: three enclosing discs.
+    #[inline]
+    pub fn error(&self, t: [DVec2; 3]) -> f64 {
+        let mut general = f64::INFINITY;
+        for (s, lambda) in self.scales.iter().zip(self.lambdas) {
+            // The bound with the domain measured in coordinates `(a·u, b·v)`.
+            let r = enclosing_radius(t.map(|p| p * *s));
+            general = general.min(lambda * r * r / 2.0);
+        }
+        general.min(self.bound.axis_aligned_error(t).unwrap_or(f64::INFINITY))
     }
 }
 

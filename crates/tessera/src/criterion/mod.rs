@@ -24,8 +24,9 @@ use crate::surface::SurfaceSet;
 pub use crate::sampling::MAX_FACTOR;
 
 /// What the criteria need that does not depend on the view or the tolerance, computed once
-/// per surface set: the topology's minimum samplings and, for the error-bounded criteria,
-/// every patch's second-derivative bound.
+/// per surface set: the topology's minimum samplings, for the error-bounded criteria every
+/// patch's second-derivative bounds, and for the screen criteria every patch's box, sphere
+/// and normal cone (made on first use).
 #[derive(Debug, Clone, Default)]
 pub struct Prepared {
     /// Minimum segments per edge ([`tolerance::minimum_segments`]).
@@ -34,6 +35,10 @@ pub struct Prepared {
     pub minimum_interior: Vec<[u32; 2]>,
     /// Second-derivative bound per patch ([`bounds::hessian`]); empty unless asked for.
     pub hessians: Vec<bounds::HessianBound>,
+    /// Second-derivative bound of each patch's boundary curves ([`tolerance::curve_bounds`]);
+    /// empty unless asked for.
+    pub curves: Vec<[f64; 4]>,
+    views: std::sync::OnceLock<Vec<screen::PatchView>>,
 }
 
 impl Prepared {
@@ -49,7 +54,17 @@ impl Prepared {
             } else {
                 Vec::new()
             },
+            curves: if with_bounds { tolerance::curve_bounds(set) } else { Vec::new() },
+            views: Default::default(),
         }
+    }
+
+    /// Every patch's [`screen::PatchView`] (box, sphere, normal cone), computed on the first
+    /// call and kept. Precondition: `set` is the set this was prepared for. Cost: the first
+    /// call O(P) cone computations, parallel; later calls nothing.
+    pub fn views(&self, set: &SurfaceSet) -> &[screen::PatchView] {
+        use rayon::prelude::*;
+        self.views.get_or_init(|| set.patches.par_iter().map(screen::PatchView::new).collect())
     }
 
     /// The caps for `max_factor` over these minimums.
@@ -59,6 +74,26 @@ impl Prepared {
             minimum_segments: &self.minimum_segments,
             minimum_interior: &self.minimum_interior,
         }
+    }
+}
+
+/// The buffers a plan is made with, kept by a per-frame loop so that planning allocates
+/// nothing once they have grown to the set ([`crate::scheme::Scheme::plan_into`]).
+#[derive(Debug, Default)]
+pub struct PlanScratch {
+    pub(crate) tolerances: Vec<Option<f64>>,
+    pub(crate) tolerance: tolerance::Scratch,
+    /// Time of the last plan's per-patch view stage and of its resolve stage.
+    pub(crate) criterion_time: std::time::Duration,
+    pub(crate) resolve_time: std::time::Duration,
+}
+
+impl PlanScratch {
+    /// How long the last plan made with these buffers spent in its criterion stage
+    /// (culling, tolerances) and in resolving (proposals, edges, checks), where the plan
+    /// measures them (the error-bounded criteria); zero otherwise.
+    pub fn stage_times(&self) -> (std::time::Duration, std::time::Duration) {
+        (self.criterion_time, self.resolve_time)
     }
 }
 
@@ -91,9 +126,26 @@ pub struct Plan {
     pub visible: Vec<u32>,
 }
 
+impl Default for Plan {
+    /// An empty plan (no edges, no patches), to fill with [`Plan::set_uniform`] or
+    /// [`crate::scheme::Scheme::plan_into`].
+    fn default() -> Self {
+        Plan::integer(Vec::new(), Vec::new(), 0)
+    }
+}
+
 impl Plan {
     /// The uniform plan: factor `n` everywhere. Errors for `n = 0` or `n > MAX_FACTOR`.
     pub fn uniform(set: &SurfaceSet, n: u32) -> Result<Plan> {
+        let mut plan = Plan::default();
+        plan.set_uniform(set, n)?;
+        Ok(plan)
+    }
+
+    /// Makes this the uniform plan of factor `n` for `set`, every patch visible, reusing the
+    /// buffers. Errors for `n = 0` or `n > MAX_FACTOR`. Cost: O(E + P), no allocation once
+    /// the buffers have the set's size.
+    pub fn set_uniform(&mut self, set: &SurfaceSet, n: u32) -> Result<()> {
         if n == 0 || n > MAX_FACTOR {
             return Err(Error::FactorOutOfRange {
                 scheme: "uniform",
@@ -101,11 +153,20 @@ impl Plan {
                 expected: format!("an integer from 1 to {MAX_FACTOR}"),
             });
         }
-        Ok(Plan::integer(
-            vec![n; set.topology.edges.len()],
-            vec![[n, n]; set.patches.len()],
-            set.patches.len(),
-        ))
+        let (edges, patches) = (set.topology.edges.len(), set.patches.len());
+        self.kind = SamplingKind::Uniform;
+        self.segments.clear();
+        self.segments.resize(edges, n);
+        self.factors.clear();
+        self.factors.resize(edges, n as f32);
+        self.depths.clear();
+        self.lattice_offsets.clear();
+        self.lattice.clear();
+        self.interior.clear();
+        self.interior.resize(patches, [n, n]);
+        self.visible.clear();
+        self.visible.resize(patches, 1);
+        Ok(())
     }
 
     /// A plan of uniform samplings with the given segments and interiors, every patch

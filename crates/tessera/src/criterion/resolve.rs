@@ -129,7 +129,7 @@ pub fn interiors(
     let topo = &set.topology;
     out.clear();
     out.extend((0..set.patches.len()).map(|p| {
-        let domain = set.patches[p].domain();
+        let domain = set.topology.patch_domains[p];
         let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
         let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
         let minimum = caps.minimum_interior[p];
@@ -155,7 +155,7 @@ pub fn from_edge_factors(set: &SurfaceSet, per_edge: &[f64], out: &mut Vec<Propo
     out.clear();
     out.extend((0..set.patches.len()).map(|p| {
         let mut row = [0.0; 4];
-        for (l, r) in row.iter_mut().enumerate().take(set.patches[p].domain().corner_count()) {
+        for (l, r) in row.iter_mut().enumerate().take(set.topology.patch_domains[p].corner_count()) {
             *r = per_edge[topo.patch_edges[p][l].edge as usize];
         }
         row

@@ -9,80 +9,163 @@
 //! displacement inside the box — in particular between a mesh point and its surface point —
 //! under `P` pixels.
 
-use crate::camera::Camera;
+use crate::camera::{Camera, View};
 use crate::surface::{Patch, SurfaceSet};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// The object-space tolerance for patch `p` seen by `camera` at `pixels` of error, or None
-/// when the patch is culled (`cull`): outside the frustum, or back-facing by a conservative
-/// normal cone.
-pub fn patch_tolerance(patch: &Patch, camera: &Camera, pixels: f64, cull: bool) -> Option<f64> {
-    if cull && culled(patch, camera) {
-        return None;
+/// What the screen criteria need of a patch that does not depend on the view, computed once
+/// when a set is prepared: its control-point box, bounding sphere and normal cone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchView {
+    /// Corners of the control points' axis-aligned box.
+    pub lo: DVec3,
+    pub hi: DVec3,
+    /// A sphere around every control point: their centroid and largest distance from it.
+    pub centre: DVec3,
+    pub radius: f64,
+    /// [`normal_cone`]: `(axis, half-angle)`, None when no cone narrower than a half-space
+    /// is known.
+    pub cone: Option<(DVec3, f64)>,
+    /// Sine and cosine of the cone's half-angle.
+    cone_sin_cos: (f64, f64),
+}
+
+impl PatchView {
+    /// The patch's box, sphere and cone. Cost: O(control points²) for the cone.
+    pub fn new(patch: &Patch) -> PatchView {
+        let pts = patch.control_points();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for &p in pts {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let centre = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
+        let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        let cone = normal_cone(patch);
+        let cone_sin_cos = cone.map_or((0.0, 1.0), |(_, alpha)| alpha.sin_cos());
+        PatchView { lo, hi, centre, radius, cone, cone_sin_cos }
     }
-    let pts = patch.control_points();
-    let t = camera.half_tangents();
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for &p in pts {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    // Camera-space corners of the world-space box around the control points.
-    let corners: Vec<DVec3> = (0..8)
-        .map(|i| {
-            let p = DVec3::new(
+
+    /// [`patch_tolerance`] with the view-independent data precomputed: no allocation, eight
+    /// point transforms.
+    pub fn tolerance(&self, patch: &Patch, view: &View, pixels: f64, cull: bool) -> Option<f64> {
+        if cull && self.culled(patch, view) {
+            return None;
+        }
+        let t = view.half_tangents;
+        let (lo, hi) = (self.lo, self.hi);
+        // Camera-space corners of the world-space box around the control points.
+        let corners: [DVec3; 8] = std::array::from_fn(|i| {
+            view.to_camera(DVec3::new(
                 if i & 1 == 0 { lo.x } else { hi.x },
                 if i & 2 == 0 { lo.y } else { hi.y },
                 if i & 4 == 0 { lo.z } else { hi.z },
-            );
-            camera.to_camera(p)
-        })
-        .collect();
-    let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
-    let (z, tx, ty) = if z_min >= camera.near {
-        let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
-        let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
-        (z_min, tx, ty)
-    } else {
-        // The box reaches the near plane: only points inside the frustum are seen, where
-        // z ≥ near and the ratios stay within the field of view.
-        (camera.near, t.x, t.y)
-    };
-    Some(pixels * z / (camera.focal_pixels() * (1.0 + tx * tx + ty * ty).sqrt()))
+            ))
+        });
+        let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+        let (z, tx, ty) = if z_min >= view.near {
+            let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
+            let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
+            (z_min, tx, ty)
+        } else {
+            // The box reaches the near plane: only points inside the frustum are seen, where
+            // z ≥ near and the ratios stay within the field of view.
+            (view.near, t.x, t.y)
+        };
+        Some(pixels * z / (view.focal_pixels * (1.0 + tx * tx + ty * ty).sqrt()))
+    }
+
+    /// [`culled`] with the view-independent data precomputed. The bounding sphere decides
+    /// each frustum plane it lies wholly inside of; only the planes it reaches test the
+    /// control points, so the answer is that of the control-point test.
+    pub fn culled(&self, patch: &Patch, view: &View) -> bool {
+        let t = view.half_tangents;
+        let c = view.to_camera(self.centre);
+        // Signed distances to the six planes, positive outside; the side planes pass through
+        // the eye with normals (±1, 0, −t)/√(1+t²) in camera space.
+        let (nx, ny) = ((1.0 + t.x * t.x).sqrt(), (1.0 + t.y * t.y).sqrt());
+        let distances = [
+            view.near - c.z,
+            c.z - view.far,
+            (c.x - t.x * c.z) / nx,
+            (-c.x - t.x * c.z) / nx,
+            (c.y - t.y * c.z) / ny,
+            (-c.y - t.y * c.z) / ny,
+        ];
+        // Rounding of the transforms is far below this margin.
+        let margin = self.radius + 1e-9 * (self.radius + c.length() + view.far);
+        let outside = |plane: usize, p: DVec3| match plane {
+            0 => p.z < view.near,
+            1 => p.z > view.far,
+            2 => p.x > t.x * p.z,
+            3 => p.x < -t.x * p.z,
+            4 => p.y > t.y * p.z,
+            _ => p.y < -t.y * p.z,
+        };
+        for (plane, &d) in distances.iter().enumerate() {
+            if d < -margin {
+                continue; // every control point is inside this plane
+            }
+            if patch.control_points().iter().all(|&p| outside(plane, view.to_camera(p))) {
+                return true;
+            }
+        }
+        self.back_facing(view.eye)
+    }
+
+    /// [`back_facing`] with the cone and sphere precomputed. The angle test
+    /// `γ > 90° + α + β` is done on cosines (no inverse trigonometry per frame), with a margin
+    /// of 1e-12 so that rounding can only keep a patch, never cull it.
+    pub fn back_facing(&self, eye: DVec3) -> bool {
+        let Some((axis, _)) = self.cone else { return false };
+        let to_eye = eye - self.centre;
+        let dist = to_eye.length();
+        if dist <= self.radius {
+            return false;
+        }
+        let (sin_a, cos_a) = self.cone_sin_cos;
+        let sin_b = self.radius / dist;
+        let cos_b = (1.0 - sin_b * sin_b).max(0.0).sqrt();
+        // θ = α + β: at 90° or more no direction lies beyond 90° + θ.
+        let (sin_t, cos_t) = (sin_a * cos_b + cos_a * sin_b, cos_a * cos_b - sin_a * sin_b);
+        if cos_t <= 0.0 {
+            return false;
+        }
+        let cos_g = axis.dot(to_eye / dist).clamp(-1.0, 1.0);
+        cos_g < -sin_t - 1e-12
+    }
+}
+
+/// The object-space tolerance for patch `p` seen by `camera` at `pixels` of error, or None
+/// when the patch is culled (`cull`): outside the frustum, or back-facing by a conservative
+/// normal cone. A per-frame loop prepares [`PatchView`]s once instead.
+pub fn patch_tolerance(patch: &Patch, camera: &Camera, pixels: f64, cull: bool) -> Option<f64> {
+    PatchView::new(patch).tolerance(patch, &camera.view(), pixels, cull)
 }
 
 /// True when the patch cannot be seen: every control point lies beyond one frustum plane
 /// (the convex hull holds the patch), or it faces away (see [`back_facing`]).
 pub fn culled(patch: &Patch, camera: &Camera) -> bool {
-    let cam: Vec<DVec3> = patch.control_points().iter().map(|&p| camera.to_camera(p)).collect();
-    let t = camera.half_tangents();
-    let outside = |f: &dyn Fn(&DVec3) -> bool| cam.iter().all(f);
-    outside(&|c| c.z < camera.near)
-        || outside(&|c| c.z > camera.far)
-        || outside(&|c| c.x > t.x * c.z)
-        || outside(&|c| c.x < -t.x * c.z)
-        || outside(&|c| c.y > t.y * c.z)
-        || outside(&|c| c.y < -t.y * c.z)
-        || back_facing(patch, camera.eye)
+    PatchView::new(patch).culled(patch, &camera.view())
 }
 
 /// Cone of normal directions of a polynomial patch: `S_u × S_v` is a positive combination of
 /// cross products of control-net differences `Δu × Δv`, so it lies in their cone. Returns
 /// `(axis, half-angle)`, or None for rational patches and cones wider than a half-space.
 pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
-    let mut crosses = Vec::with_capacity(144);
-    match patch {
+    if matches!(patch, Patch::Bicubic(b) if !b.is_polynomial()) {
+        return None;
+    }
+    // The cross products are visited twice (sum, then spread) rather than stored.
+    let for_each_cross = |f: &mut dyn FnMut(DVec3)| match patch {
         Patch::Bicubic(b) => {
-            if !b.is_polynomial() {
-                return None;
-            }
             for i in 0..3 {
                 for j in 0..4 {
                     let du = b.point(i + 1, j) - b.point(i, j);
                     for k in 0..4 {
                         for l in 0..3 {
-                            crosses.push(du.cross(b.point(k, l + 1) - b.point(k, l)));
+                            f(du.cross(b.point(k, l + 1) - b.point(k, l)));
                         }
                     }
                 }
@@ -94,25 +177,37 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
                 Patch::Pn(p) => &p.geometry,
                 Patch::Bicubic(_) => unreachable!(),
             };
-            let mut du = Vec::new();
-            let mut dv = Vec::new();
+            // The six control-net differences along each parameter direction.
+            let (mut du, mut dv) = ([DVec3::ZERO; 6], [DVec3::ZERO; 6]);
+            let mut n = 0;
             for i in 0..=2usize {
                 for j in 0..=2 - i {
                     let k = 2 - i - j;
-                    du.push(t.b(i, j + 1, k) - t.b(i + 1, j, k));
-                    dv.push(t.b(i, j, k + 1) - t.b(i + 1, j, k));
+                    du[n] = t.b(i, j + 1, k) - t.b(i + 1, j, k);
+                    dv[n] = t.b(i, j, k + 1) - t.b(i + 1, j, k);
+                    n += 1;
                 }
             }
             for a in &du {
                 for b in &dv {
-                    crosses.push(a.cross(*b));
+                    f(a.cross(*b));
                 }
             }
         }
-    }
-    let units: Vec<DVec3> = crosses.iter().filter_map(|c| c.try_normalize()).collect();
-    let axis = units.iter().copied().sum::<DVec3>().try_normalize()?;
-    let cos_min = units.iter().map(|u| u.dot(axis)).fold(1.0f64, f64::min);
+    };
+    let mut sum = DVec3::ZERO;
+    for_each_cross(&mut |c| {
+        if let Some(u) = c.try_normalize() {
+            sum += u;
+        }
+    });
+    let axis = sum.try_normalize()?;
+    let mut cos_min = 1.0f64;
+    for_each_cross(&mut |c| {
+        if let Some(u) = c.try_normalize() {
+            cos_min = cos_min.min(u.dot(axis));
+        }
+    });
     if cos_min <= 0.0 {
         return None;
     }
@@ -123,18 +218,7 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
 /// directions towards the eye from the bounding sphere (half-angle `β`) are more than 90°
 /// apart. Conservative: false when unsure.
 pub fn back_facing(patch: &Patch, eye: DVec3) -> bool {
-    let Some((axis, alpha)) = normal_cone(patch) else { return false };
-    let pts = patch.control_points();
-    let centre = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
-    let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-    let to_eye = eye - centre;
-    let dist = to_eye.length();
-    if dist <= radius {
-        return false;
-    }
-    let beta = (radius / dist).asin();
-    let gamma = axis.dot(to_eye / dist).clamp(-1.0, 1.0).acos();
-    gamma > std::f64::consts::FRAC_PI_2 + alpha + beta
+    PatchView::new(patch).back_facing(eye)
 }
 
 /// Tolerances for every patch of `set` (None = culled).
@@ -142,11 +226,115 @@ pub fn tolerances(set: &SurfaceSet, camera: &Camera, pixels: f64, cull: bool) ->
     set.patches.par_iter().map(|p| patch_tolerance(p, camera, pixels, cull)).collect()
 }
 
+/// [`tolerances`] from prepared [`PatchView`]s (one per patch), into `out` (resized; no
+/// allocation once it has the capacity). Cost: O(P) box transforms, parallel.
+pub fn tolerances_into(
+    set: &SurfaceSet,
+    views: &[PatchView],
+    camera: &View,
+    pixels: f64,
+    cull: bool,
+    out: &mut Vec<Option<f64>>,
+) {
+    out.resize(set.patches.len(), None);
+    out.par_iter_mut().zip(&set.patches).zip(views).for_each(|((o, patch), v)| {
+        *o = v.tolerance(patch, camera, pixels, cull);
+    });
+}
+
 /// The plan's visibility row: 1 for every patch, or, with `cull`, 0 for the patches
 /// [`culled`] for `camera`. Cost: O(P) cone tests.
 pub fn visibility(set: &SurfaceSet, camera: &Camera, cull: bool) -> Vec<u32> {
+    let views: Vec<PatchView> =
+        if cull { set.patches.par_iter().map(PatchView::new).collect() } else { vec![] };
+    let mut out = Vec::new();
+    visibility_into(set, &views, &camera.view(), cull, &mut out);
+    out
+}
+
+/// [`visibility`] from prepared [`PatchView`]s, into `out` (resized). Cost: O(P) plane and
+/// cone tests, parallel.
+pub fn visibility_into(set: &SurfaceSet, views: &[PatchView], camera: &View, cull: bool, out: &mut Vec<u32>) {
+    out.resize(set.patches.len(), 1);
     if !cull {
-        return vec![1; set.patches.len()];
+        out.fill(1);
+        return;
     }
-    set.patches.par_iter().map(|p| u32::from(!culled(p, camera))).collect()
+    out.par_iter_mut().zip(&set.patches).zip(views).for_each(|((o, patch), v)| {
+        *o = u32::from(!v.culled(patch, camera));
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::patches::{read_patches, test_support::data};
+
+    /// The control-point test, transforming every point and taking the angles with inverse
+    /// trigonometry, as culling was first written: the oracle of the prepared form.
+    fn culled_directly(patch: &Patch, camera: &Camera) -> (bool, bool) {
+        let cam: Vec<DVec3> = patch.control_points().iter().map(|&p| camera.to_camera(p)).collect();
+        let t = camera.half_tangents();
+        let outside = |f: &dyn Fn(&DVec3) -> bool| cam.iter().all(f);
+        let frustum = outside(&|c| c.z < camera.near)
+            || outside(&|c| c.z > camera.far)
+            || outside(&|c| c.x > t.x * c.z)
+            || outside(&|c| c.x < -t.x * c.z)
+            || outside(&|c| c.y > t.y * c.z)
+            || outside(&|c| c.y < -t.y * c.z);
+        let back = normal_cone(patch).is_some_and(|(axis, alpha)| {
+            let pts = patch.control_points();
+            let centre = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
+            let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+            let to_eye = camera.eye - centre;
+            let dist = to_eye.length();
+            dist > radius && {
+                let beta = (radius / dist).asin();
+                let gamma = axis.dot(to_eye / dist).clamp(-1.0, 1.0).acos();
+                gamma > std::f64::consts::FRAC_PI_2 + alpha + beta
+            }
+        });
+        (frustum, back)
+    }
+
+    /// The prepared test culls exactly what the direct one does, over many cameras around and
+    /// inside two models (a patch model and PN triangles): the sphere only skips planes it
+    /// lies wholly inside, and the cosine form of the cone test agrees with the angles.
+    #[test]
+    fn prepared_culling_equals_the_control_point_test() {
+        let teapot = SurfaceSet::from_patch_file(
+            &read_patches(&data("patches/teapot.patches")).expect("test model"),
+            Default::default(),
+        );
+        let path = data("meshes/spot.obj");
+        let spot = SurfaceSet::pn_from_mesh(
+            &crate::io::obj::read_obj(&path).expect("test model"),
+            &path,
+            Default::default(),
+        )
+        .expect("test model");
+        let mut culled = [0usize; 2];
+        for set in [&teapot, &spot] {
+            let views: Vec<PatchView> = set.patches.iter().map(PatchView::new).collect();
+            let (lo, hi) = set.bounds();
+            let (centre, radius) = ((lo + hi) * 0.5, lo.distance(hi) * 0.5);
+            for k in 0..40 {
+                let a = k as f64 * 0.61;
+                let mut camera = Camera::framing(lo, hi, 640, 480);
+                let distance = radius * (0.3 + 0.15 * k as f64);
+                camera.eye = centre + DVec3::new(a.cos(), (0.7 * a).sin(), a.sin()).normalize() * distance;
+                camera.target = centre + DVec3::new(0.0, radius * 0.4 * (a * 1.3).sin(), 0.0);
+                camera.near = distance * 0.05;
+                for (patch, view) in set.patches.iter().zip(&views) {
+                    let (frustum, back) = culled_directly(patch, &camera);
+                    let v = camera.view();
+                    assert_eq!(view.culled(patch, &v), frustum || back, "camera {k}");
+                    culled[0] += usize::from(frustum);
+                    culled[1] += usize::from(back && !frustum);
+                }
+            }
+        }
+        // Both kinds of culling happened, so both paths were compared.
+        assert!(culled[0] > 100 && culled[1] > 100, "culled by frustum, by cone: {culled:?}");
+    }
 }

@@ -67,11 +67,10 @@ fn uniform_factor(m: &HessianBound, eps: f64) -> f64 {
     ((m.uu + 2.0 * m.uv + m.vv) / (8.0 * eps)).sqrt().ceil().max(1.0)
 }
 
-/// Segments a boundary curve needs on its own: `sqrt(M_edge / 8ε)` from its four control
-/// points — data both neighbours share.
-fn curve_factor(patch: &Patch, local: usize, eps: f64) -> f64 {
-    let (points, weights) = edge_control_points(patch, local);
-    (bounds::curve_second_derivative(points, weights) / (8.0 * eps)).sqrt().ceil().max(1.0)
+/// Segments a boundary curve needs on its own: `sqrt(M_edge / 8ε)` from the bound of its
+/// four control points ([`curve_bounds`]) — data both neighbours share.
+fn curve_factor(m_edge: f64, eps: f64) -> f64 {
+    (m_edge / (8.0 * eps)).sqrt().ceil().max(1.0)
 }
 
 /// The four control points (and weights) of a patch's boundary curve `local`, from corner
@@ -93,13 +92,19 @@ pub fn patch_bound(
     scratch: &mut LocalTessellation,
 ) -> f64 {
     pattern.build(input, scratch);
+    built_pattern_bound(m, input, scratch)
+}
+
+/// [`patch_bound`] of a pattern already built for `input`.
+fn built_pattern_bound(m: &HessianBound, input: &PatternInput, built: &LocalTessellation) -> f64 {
     let d = input.domain;
     let param = |l: u32| match input.slot(l) {
         Slot::Corner(c) => d.corner(c),
         Slot::Edge(e, k) => d.edge_point(e, k as f64 / input.segments[e] as f64),
-        Slot::Interior(j) => scratch.interior[j as usize],
+        Slot::Interior(j) => built.interior[j as usize],
     };
-    scratch.triangles.iter().map(|t| m.triangle_error(t.map(param))).fold(0.0, f64::max)
+    let errors = m.triangle_errors();
+    built.triangles.iter().map(|t| errors.error(t.map(param))).fold(0.0, f64::max)
 }
 
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:
@@ -172,17 +177,42 @@ pub fn minimum_interior(set: &SurfaceSet) -> Vec<[u32; 2]> {
         .collect()
 }
 
+/// One patch's a-posteriori result: its interior factors, its guaranteed bound, and whether
+/// the bound misses the tolerance.
+type Check = ([u32; 2], f64, bool);
+
+/// A patch's first pattern to check: its domain, edge segments and smallest interior.
+type First = (Domain, [u32; 4], [u32; 2]);
+
+/// The buffers of [`plan_limited`], kept from call to call so that a per-frame loop
+/// allocates nothing once they have grown to the set's size.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    proposals: Vec<[f64; 4]>,
+    next_segments: Vec<u32>,
+    next_factors: Vec<f32>,
+    results: Vec<Check>,
+    rechecked: Vec<Check>,
+    which: Vec<usize>,
+    failing: Vec<usize>,
+    firsts: Vec<First>,
+    counts: Vec<u64>,
+    per_patch: Vec<AtomicU64>,
+}
+
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
 /// for `pattern` with the scheme's `rule` and `interior` rule, factors capped at `max_factor`
-/// (a power of two for [`EdgeRule::PowerOfTwo`]), for an output of at most `max_triangles`.
-/// [`crate::scheme::Scheme::plan`] is the public door: it pairs the pattern with its rules.
+/// (a power of two for [`EdgeRule::PowerOfTwo`]), for an output of at most `max_triangles`,
+/// into `plan` (its buffers reused). [`crate::scheme::Scheme::plan`] is the public door: it
+/// pairs the pattern with its rules.
 ///
 /// Before each round of a-posteriori checks (which build patterns), the output the current
 /// factors give is counted, and a plan that would exceed the limit is refused with
 /// [`Error::OutputTooLarge`] instead of building patterns of that size; a single patch whose
 /// check would build more than `max_triangles` stops refining and counts as capped.
-/// Cost: O(P) bound computations plus one pattern build per patch and round for the
-/// a-posteriori check, and O(P) pattern counts per round.
+/// Cost: O(P) proposals from the prepared bounds plus one pattern build per patch and round
+/// for the a-posteriori check, and O(P) pattern counts per round; no allocation once
+/// `scratch` and `plan` have grown to the set.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_limited(
     set: &SurfaceSet,
@@ -193,100 +223,118 @@ pub(crate) fn plan_limited(
     pattern: &dyn Pattern,
     max_factor: u32,
     max_triangles: u64,
-) -> Result<(Plan, PlanReport)> {
+    scratch: &mut Scratch,
+    plan: &mut Plan,
+) -> Result<PlanReport> {
     let cap = max_factor.max(1);
     let topo = &set.topology;
-    let computed;
-    let hessians: &[HessianBound] = if prepared.hessians.len() == set.patches.len() {
+    let patches = set.patches.len();
+    let (computed_hessians, computed_curves);
+    let hessians: &[HessianBound] = if prepared.hessians.len() == patches {
         &prepared.hessians
     } else {
-        computed = set.patches.par_iter().map(bounds::hessian).collect::<Vec<_>>();
-        &computed
+        computed_hessians = set.patches.par_iter().map(bounds::hessian).collect::<Vec<_>>();
+        &computed_hessians
+    };
+    let curves: &[[f64; 4]] = if prepared.curves.len() == patches {
+        &prepared.curves
+    } else {
+        computed_curves = curve_bounds(set);
+        &computed_curves
     };
     let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
+    let Scratch {
+        proposals,
+        next_segments,
+        next_factors,
+        results,
+        rechecked,
+        which,
+        failing,
+        firsts,
+        counts,
+        per_patch,
+    } = scratch;
 
     // Each visible patch's proposal per local edge.
-    let proposals: Vec<[f64; 4]> = (0..set.patches.len())
-        .into_par_iter()
-        .map(|p| {
-            let Some(e) = eps[p] else { return [0.0; 4] };
-            let patch = &set.patches[p];
-            let m = &hessians[p];
-            let mut out = [0.0; 4];
-            match (interior, patch.domain()) {
-                (InteriorRule::Core, Domain::Quad) => {
-                    let (nu, nv) = quad_grid(m, e, cap).unwrap_or((cap, cap));
-                    out = [nu as f64, nv as f64, nu as f64, nv as f64];
-                }
-                _ => {
-                    let n = uniform_factor(m, e);
-                    out[..patch.domain().corner_count()].fill(n);
-                }
+    proposals.resize(patches, [0.0; 4]);
+    proposals.par_iter_mut().enumerate().for_each(|(p, out)| {
+        *out = [0.0; 4];
+        let Some(e) = eps[p] else { return };
+        let domain = set.topology.patch_domains[p];
+        let m = &hessians[p];
+        match (interior, domain) {
+            (InteriorRule::Core, Domain::Quad) => {
+                let (nu, nv) = quad_grid(m, e, cap).unwrap_or((cap, cap));
+                *out = [nu as f64, nv as f64, nu as f64, nv as f64];
             }
-            for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
-                *o = o.max(curve_factor(patch, l, e));
+            _ => {
+                let n = uniform_factor(m, e);
+                out[..domain.corner_count()].fill(n);
             }
-            out
-        })
-        .collect();
+        }
+        for (l, o) in out.iter_mut().enumerate().take(domain.corner_count()) {
+            *o = o.max(curve_factor(curves[p][l], e));
+        }
+    });
 
     let caps = prepared.caps(cap as f64);
     let minimum_inner = &prepared.minimum_interior;
-    let visible: Vec<u32> = eps.iter().map(|e| u32::from(e.is_some())).collect();
-    let mut proposals = proposals;
-    let mut factors = Vec::new();
-    let mut edge_segments = |proposals: &[[f64; 4]]| -> Vec<u32> {
-        let mut segments = Vec::new();
-        resolve::edges(set, proposals, rule, interior, &caps, &mut segments, &mut factors);
-        segments
+    plan.kind = crate::sampling::SamplingKind::Uniform;
+    plan.depths.clear();
+    plan.lattice_offsets.clear();
+    plan.lattice.clear();
+    plan.visible.clear();
+    plan.visible.extend(eps.iter().map(|e| u32::from(e.is_some())));
+    resolve::edges(set, proposals, rule, interior, &caps, &mut plan.segments, &mut plan.factors);
+    if per_patch.len() != patches {
+        per_patch.clear();
+        per_patch.extend((0..patches).map(|_| AtomicU64::new(0)));
+    }
+    per_patch.iter_mut().for_each(|c| *c.get_mut() = 0);
+    let limit = Limit::new(pattern, max_triangles, per_patch);
+    which.clear();
+    which.extend(0..patches);
+    let mut check = |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>| {
+        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, hessians };
+        check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, out)
     };
-    let all: Vec<usize> = (0..set.patches.len()).collect();
-    let mut segments = edge_segments(&proposals);
-    let limit = Limit::new(pattern, max_triangles, set.patches.len());
-    let mut results =
-        check_patches(set, eps, interior, &limit, cap, minimum_inner, hessians, &proposals, &segments, &all);
+    check(&plan.segments, proposals, which, results);
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
     // Errors shrink as h², hence the square root.
     for _round in 0..256 {
-        let failing: Vec<usize> = (0..set.patches.len()).filter(|&p| results[p].2).collect();
+        failing.clear();
+        failing.extend((0..patches).filter(|&p| results[p].2));
         if failing.is_empty() || interior == InteriorRule::Global {
             break;
         }
-        for &p in &failing {
+        for &p in failing.iter() {
             let (e, bound) = (eps[p].unwrap_or(f64::INFINITY), results[p].1);
             let grow = (bound / e).sqrt().max(1.2);
             for v in proposals[p].iter_mut() {
                 *v = (*v * grow).ceil().min(cap as f64);
             }
         }
-        let next = edge_segments(&proposals);
-        let mut affected: Vec<usize> = failing.clone();
-        for (e, (&a, &b)) in segments.iter().zip(&next).enumerate() {
+        resolve::edges(set, proposals, rule, interior, &caps, next_segments, next_factors);
+        // The patches to check again: the failing ones and every user of a changed edge.
+        which.clear();
+        which.extend_from_slice(failing);
+        for (e, (&a, &b)) in plan.segments.iter().zip(next_segments.iter()).enumerate() {
             if a != b {
-                affected.extend(topo.edge_uses(e).iter().map(|u| u.patch as usize));
+                which.extend(topo.edge_uses(e).iter().map(|u| u.patch as usize));
             }
         }
-        affected.sort_unstable();
-        affected.dedup();
-        if next == segments {
+        which.sort_unstable();
+        which.dedup();
+        if *next_segments == plan.segments {
             break; // every failing patch is at the cap
         }
-        segments = next;
-        let rechecked = check_patches(
-            set,
-            eps,
-            interior,
-            &limit,
-            cap,
-            minimum_inner,
-            hessians,
-            &proposals,
-            &segments,
-            &affected,
-        );
-        for (i, &p) in affected.iter().enumerate() {
+        std::mem::swap(&mut plan.segments, next_segments);
+        std::mem::swap(&mut plan.factors, next_factors);
+        check(&plan.segments, proposals, which, rechecked);
+        for (i, &p) in which.iter().enumerate() {
             results[p] = rechecked[i];
         }
     }
@@ -300,9 +348,26 @@ pub(crate) fn plan_limited(
         }
     }
     limit.result()?;
-    let mut plan = Plan::integer(segments, results.iter().map(|r| r.0).collect(), set.patches.len());
-    plan.visible = visible;
-    Ok((plan, report))
+    plan.interior.clear();
+    plan.interior.extend(results.iter().map(|r| r.0));
+    Ok(report)
+}
+
+/// The boundary curves' second-derivative bounds per patch and local edge
+/// ([`bounds::curve_second_derivative`]), view-independent, for [`curve_factor`].
+/// Cost: O(P).
+pub fn curve_bounds(set: &SurfaceSet) -> Vec<[f64; 4]> {
+    set.patches
+        .par_iter()
+        .map(|patch| {
+            let mut out = [0.0; 4];
+            for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
+                let (points, weights) = edge_control_points(patch, l);
+                *o = bounds::curve_second_derivative(points, weights);
+            }
+            out
+        })
+        .collect()
 }
 
 /// The output budget of [`plan_limited`]: the triangles of each patch's latest checked
@@ -312,24 +377,27 @@ struct Limit<'a> {
     pattern: &'a dyn Pattern,
     max_triangles: u64,
     used: AtomicU64,
-    per_patch: Vec<AtomicU64>,
+    per_patch: &'a [AtomicU64],
     /// The total a refused check would have reached (0: none refused).
     exceeded: AtomicU64,
 }
 
 impl<'a> Limit<'a> {
-    fn new(pattern: &'a dyn Pattern, max_triangles: u64, patches: usize) -> Self {
-        Limit {
-            pattern,
-            max_triangles,
-            used: AtomicU64::new(0),
-            per_patch: (0..patches).map(|_| AtomicU64::new(0)).collect(),
-            exceeded: AtomicU64::new(0),
-        }
+    /// A budget over `per_patch` (one zeroed counter per patch).
+    fn new(pattern: &'a dyn Pattern, max_triangles: u64, per_patch: &'a [AtomicU64]) -> Self {
+        Limit { pattern, max_triangles, used: AtomicU64::new(0), per_patch, exceeded: AtomicU64::new(0) }
+    }
+
+    /// No limit: nothing to count (the default of a per-frame loop).
+    fn unlimited(&self) -> bool {
+        self.max_triangles == u64::MAX
     }
 
     /// Whether patch `p` may build a pattern of `input`; records its count if so.
     fn admit(&self, p: usize, input: &PatternInput) -> bool {
+        if self.unlimited() {
+            return true;
+        }
         let t = self.pattern.counts(input).1 as u64;
         let previous = self.per_patch[p].load(Ordering::Relaxed);
         let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
@@ -348,24 +416,23 @@ impl<'a> Limit<'a> {
         }
     }
 
-    /// [`Limit::admit`] for many patches at once, all or none: when their patterns together
-    /// would exceed the limit, the whole total is what the refusal reports.
-    fn reserve(&self, inputs: &[(usize, PatternInput)]) -> bool {
-        let (mut add, mut remove) = (0u64, 0u64);
-        let counts: Vec<u64> =
-            inputs.par_iter().map(|(_, input)| self.pattern.counts(input).1 as u64).collect();
-        for ((p, _), &t) in inputs.iter().zip(&counts) {
-            add += t;
-            remove += self.per_patch[*p].load(Ordering::Relaxed);
+    /// [`Limit::admit`] for the patches of `which` at once (`counts[i]` the triangles of
+    /// `which[i]`'s pattern, 0 for culled patches), all or none: when their patterns
+    /// together would exceed the limit, the whole total is what the refusal reports.
+    fn reserve(&self, which: &[usize], counts: &[u64]) -> bool {
+        if self.unlimited() {
+            return true;
         }
+        let add: u64 = counts.iter().sum();
+        let remove: u64 = which.iter().map(|&p| self.per_patch[p].load(Ordering::Relaxed)).sum();
         let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
             let n = u - remove + add;
             (n <= self.max_triangles).then_some(n)
         });
         match update {
             Ok(_) => {
-                for ((p, _), &t) in inputs.iter().zip(&counts) {
-                    self.per_patch[*p].store(t, Ordering::Relaxed);
+                for (&p, &t) in which.iter().zip(counts) {
+                    self.per_patch[p].store(t, Ordering::Relaxed);
                 }
                 true
             }
@@ -388,23 +455,33 @@ impl<'a> Limit<'a> {
     }
 }
 
+/// What [`check_patches`] reads that does not change between rounds.
+struct CheckInputs<'a> {
+    set: &'a SurfaceSet,
+    eps: &'a [Option<f64>],
+    layout: InteriorRule,
+    cap: u32,
+    minimum: &'a [[u32; 2]],
+    hessians: &'a [HessianBound],
+}
+
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
 /// the pattern's own triangles meet the bound (interior vertices are private, so this never
 /// opens a crack), growing like the square root of the excess since errors shrink as h².
-/// Returns, for each patch of `which`, (interior, guaranteed bound, bound not met).
+/// Writes, for each patch of `which`, (interior, guaranteed bound, bound not met) into `out`
+/// (`firsts` and `counts` are its buffers).
 #[allow(clippy::too_many_arguments)]
 fn check_patches(
-    set: &SurfaceSet,
-    eps: &[Option<f64>],
-    layout: InteriorRule,
+    inputs: &CheckInputs<'_>,
     limit: &Limit,
-    cap: u32,
-    minimum: &[[u32; 2]],
-    hessians: &[HessianBound],
     proposals: &[[f64; 4]],
     segments: &[u32],
     which: &[usize],
-) -> Vec<([u32; 2], f64, bool)> {
+    firsts: &mut Vec<First>,
+    counts: &mut Vec<u64>,
+    out: &mut Vec<Check>,
+) {
+    let CheckInputs { set, eps, layout, cap, minimum, hessians } = *inputs;
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
     // The engine's input, collapsed edges included, so the bound is that of the output.
@@ -414,7 +491,7 @@ fn check_patches(
     };
     // Each patch's first pattern: its edges and the smallest interior the layout gives it.
     let first = |p: usize| {
-        let domain = set.patches[p].domain();
+        let domain = set.topology.patch_domains[p];
         let nc = domain.corner_count();
         let mut seg = [1u32; 4];
         for (l, s) in seg.iter_mut().enumerate().take(nc) {
@@ -448,21 +525,24 @@ fn check_patches(
     };
     // Interiors only grow, so the first patterns' triangles are a lower bound of the output:
     // count them all before building any, and build nothing when they already exceed the limit.
-    let firsts: Vec<_> = which.par_iter().map(|&p| first(p)).collect();
-    let visible: Vec<(usize, PatternInput)> = which
-        .iter()
-        .zip(&firsts)
-        .filter(|(&p, _)| eps[p].is_some())
-        .map(|(&p, &(domain, seg, interior))| (p, input_of(p, domain, seg, interior)))
-        .collect();
-    let admitted = limit.reserve(&visible);
+    firsts.resize(which.len(), (Domain::Quad, [1; 4], [1; 2]));
+    counts.resize(which.len(), 0);
+    let count = !limit.unlimited();
+    firsts.par_iter_mut().zip(counts.par_iter_mut()).zip(which).for_each(|((f, c), &p)| {
+        *f = first(p);
+        *c = match eps[p] {
+            Some(_) if count => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
+            _ => 0,
+        };
+    });
+    let admitted = limit.reserve(which, counts);
     // Each thread's pattern buffers are kept from call to call (a per-frame loop then
     // allocates none here).
     let generation = crate::engine::next_generation();
-    which
-        .par_iter()
-        .zip(firsts)
-        .map(|(&p, (domain, seg, mut interior))| {
+    out.resize(which.len(), ([1; 2], 0.0, false));
+    out.par_iter_mut().zip(which).zip(firsts.par_iter()).for_each(|((o, &p), &(domain, seg, interior))| {
+        let mut interior = interior;
+        *o = (|| {
             if !admitted {
                 return (interior, f64::INFINITY, true);
             }
@@ -474,8 +554,10 @@ fn check_patches(
                     // The output could not hold this pattern; the plan is refused at the end.
                     return (interior, f64::INFINITY, true);
                 }
+                // Neighbouring patches often share an input: the thread's last pattern is
+                // reused when it is the same.
                 let bound = crate::engine::with_scratch(generation, |s| {
-                    patch_bound(&hessians[p], &input, limit.pattern, s.local_mut())
+                    built_pattern_bound(&hessians[p], &input, s.built(limit.pattern, &input))
                 });
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
@@ -492,8 +574,8 @@ fn check_patches(
                     interior = interior.map(|n| n.next_power_of_two().min(cap));
                 }
             }
-        })
-        .collect()
+        })();
+    });
 }
 
 #[cfg(test)]

@@ -104,9 +104,26 @@ impl Layout {
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
+        // Neighbouring patches often share an input: each task keeps its last count.
         (0..set.patches.len())
             .into_par_iter()
-            .map(|p| if plan.is_visible(p) { pattern.counts(&pattern_input(set, plan, p)) } else { (0, 0) })
+            .map_init(
+                || None,
+                |last: &mut Option<(PatternInput, (u32, u32))>, p| {
+                    if !plan.is_visible(p) {
+                        return (0, 0);
+                    }
+                    let input = PatternInput { patch: 0, ..pattern_input(set, plan, p) };
+                    match *last {
+                        Some((seen, counts)) if seen == input && !pattern.depends_on_patch() => counts,
+                        _ => {
+                            let counts = pattern.counts(&PatternInput { patch: p as u32, ..input });
+                            *last = Some((input, counts));
+                            counts
+                        }
+                    }
+                },
+            )
             .collect_into_vec(&mut self.counts);
         let interior: u64 = self.counts.iter().map(|c| c.0 as u64).sum();
         let upper: u64 = self.counts.iter().map(|c| c.1 as u64).sum();
@@ -147,7 +164,7 @@ impl Layout {
 /// What the pattern of patch `p` gets from the plan: its edges' segments and factors, its
 /// interior factors and which of its edges are collapsed.
 pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
-    let domain = set.patches[p].domain();
+    let domain = set.topology.patch_domains[p];
     let mut segments = [1; 4];
     let mut factors = [1.0; 4];
     for e in 0..domain.corner_count() {
@@ -164,8 +181,8 @@ pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternI
 /// bounded criteria) passes these too, or it predicts another triangulation. Cost: O(1).
 pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
     let mut collapsed = [false; 4];
-    for (e, c) in collapsed.iter_mut().enumerate().take(set.patches[p].domain().corner_count()) {
-        *c = set.topology.edges[set.topology.patch_edges[p][e].edge as usize].collapsed;
+    for (e, c) in collapsed.iter_mut().enumerate().take(set.topology.patch_domains[p].corner_count()) {
+        *c = set.topology.patch_edges[p][e].collapsed;
     }
     collapsed
 }
@@ -173,7 +190,7 @@ pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
 /// starts and ends at one point): only then can a pattern triangle degenerate.
 pub(crate) fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
-    let n = set.patches[p].domain().corner_count();
+    let n = set.topology.patch_domains[p].corner_count();
     let c = &set.topology.patch_corners[p][..n];
     (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))
 }
@@ -193,9 +210,7 @@ pub(crate) fn degenerate_after_collapse(
     let id = |l: u32| -> (bool, u32) {
         match input.slot(l) {
             Slot::Corner(c) => (true, topo.patch_corner_entries[p][c]),
-            Slot::Edge(e, _) if topo.edges[topo.patch_edges[p][e].edge as usize].collapsed => {
-                (true, topo.patch_corner_entries[p][e])
-            }
+            Slot::Edge(e, _) if topo.patch_edges[p][e].collapsed => (true, topo.patch_corner_entries[p][e]),
             _ => (false, l),
         }
     };

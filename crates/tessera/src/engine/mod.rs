@@ -426,17 +426,17 @@ pub(crate) struct PatchScratch {
 }
 
 impl PatchScratch {
-    /// The tessellation buffers, for a caller that builds into them itself (the cache is
-    /// dropped).
-    pub(crate) fn local_mut(&mut self) -> &mut LocalTessellation {
-        self.built = None;
-        &mut self.local
-    }
-
     /// Builds `input`'s pattern for a use that does not keep it (the cache is dropped).
     pub(crate) fn build_once(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
         pattern.build(input, &mut self.local);
         self.built = None;
+        &self.local
+    }
+
+    /// `input`'s pattern, rebuilt only when it differs from the last one this scratch built
+    /// in the same generation.
+    pub(crate) fn built(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
+        self.build(pattern, input);
         &self.local
     }
 

@@ -66,7 +66,7 @@ fn patch_levels(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<Vec<Opt
                 return Ok(None);
             }
             let n = plan.interior[p][0];
-            let nc = set.patches[p].domain().corner_count();
+            let nc = set.topology.patch_domains[p].corner_count();
             let edges_ok = (0..nc).all(|e| {
                 let s = plan.segments(topo.patch_edges[p][e].edge as usize);
                 s.is_power_of_two() && s <= n
@@ -132,7 +132,8 @@ pub fn build(set: &SurfaceSet, plan: &Plan, max_level: u32) -> Result<RenderQueu
                 let Some(m) = m else { continue };
                 let p = c * CHUNK + i;
                 let mut edge_levels = [0u8; 4];
-                for (e, l) in edge_levels.iter_mut().enumerate().take(set.patches[p].domain().corner_count())
+                for (e, l) in
+                    edge_levels.iter_mut().enumerate().take(set.topology.patch_domains[p].corner_count())
                 {
                     *l = plan.segments(topo.patch_edges[p][e].edge as usize).trailing_zeros() as u8;
                 }

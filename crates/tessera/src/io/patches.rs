@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 const PATCH_POINTS: usize = 16;
 
 /// A parsed patch file: indexed bicubic Bézier patches and their control points.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct PatchFile {
     /// Per patch, its 16 control-point indices, 0-based into `points`; index `k` is control
     /// point `P[k / 4][k % 4]`. Every index is `< points.len()`.

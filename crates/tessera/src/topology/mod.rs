@@ -64,6 +64,9 @@ pub struct PatchEdge {
     pub edge: u32,
     pub reversed: bool,
     pub variant: u8,
+    /// The canonical edge's `collapsed`, kept here too because every per-patch loop asks
+    /// (reading it from `edges` is a cache miss per patch edge).
+    pub collapsed: bool,
 }
 
 /// An output vertex at a corner: one per (vertex, normal key) pair.
@@ -111,6 +114,9 @@ pub struct Topology {
     pub patch_corners: Vec<[u32; 4]>,
     /// Output corner entry of each patch corner.
     pub patch_corner_entries: Vec<[u32; 4]>,
+    /// Each patch's domain, kept beside its edges: per-patch loops read it with them, and
+    /// the patches themselves are large.
+    pub patch_domains: Vec<Domain>,
     pub corner_entries: Vec<CornerEntry>,
     pub report: TopologyReport,
 }
@@ -190,7 +196,7 @@ impl Topology {
                 let variant = variant.min(u8::MAX as usize) as u8;
                 uses.push(EdgeUse { patch: u.0, local: u.1, reversed: u.2, variant });
                 patch_edges[u.0 as usize][u.1 as usize] =
-                    PatchEdge { edge: id as u32, reversed: u.2, variant };
+                    PatchEdge { edge: id as u32, reversed: u.2, variant, collapsed };
             }
             if collapsed {
                 report.collapsed_edges += 1;
@@ -248,6 +254,7 @@ impl Topology {
             patch_edges,
             patch_corners,
             patch_corner_entries,
+            patch_domains: keys.iter().map(|k| k.domain).collect(),
             corner_entries,
             report,
         }

@@ -1,0 +1,68 @@
+//! One real-time frame of a large scene, repeated: 45 copies of the 2,048-patch torus in a
+//! grid (92,160 bicubic patches), or 11 copies of the killeroo cage as PN triangles, seen
+//! whole at 1280×1024 with a guaranteed error of half a pixel and culling on. Prints the
+//! median frame time and each stage's median.
+//!
+//! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo [FRAMES]]`
+
+use std::path::PathBuf;
+use std::time::Instant;
+use tessera::camera::Camera;
+use tessera::scheme::{Criterion, PlanOptions, Scheme};
+use tessera::surface::SurfaceSet;
+use tessera::tessellator::{Tessellator, TessellatorOptions};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let which = std::env::args().nth(1).unwrap_or_else(|| "torus".into());
+    let frames: usize = std::env::args().nth(2).map(|s| s.parse()).transpose()?.unwrap_or(21);
+    let data = std::env::var("TESSERA_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    let start = Instant::now();
+    let set = match which.as_str() {
+        "torus" => {
+            let file = tessera::io::patches::read_patches(&data.join("bench/torus_64x32.patches"))?;
+            SurfaceSet::from_patch_file(&tessera::scene::patch_grid(&file, 45), Default::default())
+        }
+        "killeroo" => {
+            let path = data.join("meshes/killeroo_cage.obj");
+            let mesh = tessera::io::obj::read_obj(&path)?;
+            SurfaceSet::pn_from_mesh(&tessera::scene::mesh_grid(&mesh, 11), &path, Default::default())?
+        }
+        other => return Err(format!("unknown scene {other}: use torus or killeroo").into()),
+    };
+    println!("{which}: {} patches, built in {:.0} ms", set.patches.len(), ms(start));
+    let (lo, hi) = set.bounds();
+    let camera = Camera::framing(lo, hi, 1280, 1024);
+    let options = TessellatorOptions {
+        plan: PlanOptions { cull: true, ..PlanOptions::default() },
+        ..TessellatorOptions::default()
+    };
+    let start = Instant::now();
+    let mut tess = Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), options)?;
+    println!("prepared in {:.0} ms", ms(start));
+    let mut stages: [Vec<f64>; 5] = Default::default();
+    let mut triangles = 0;
+    for _ in 0..frames {
+        triangles = tess.frame(Some(&camera))?.triangle_count();
+        let t = tess.timings();
+        for (s, d) in stages.iter_mut().zip([t.criterion, t.resolve, t.layout, t.write, t.total()]) {
+            s.push(d.as_secs_f64() * 1000.0);
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let [c, r, l, w, total] = stages.each_mut().map(median);
+    println!(
+        "{triangles} triangles; median frame {total:.2} ms over {frames} frames on {} threads: \
+         criterion {c:.2}, resolve {r:.2}, layout {l:.2}, write {w:.2} ms",
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1000.0
+}

@@ -1,0 +1,96 @@
+//! A per-frame loop allocates nothing once its buffers have grown: the same camera walk run
+//! twice, the second time counted by a global allocator. Runs without the test harness
+//! (`harness = false`) so that nothing else allocates while it counts, and in a one-thread
+//! rayon pool so that which thread builds which pattern, and so which thread's buffers grow,
+//! is the same in both walks.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, Ordering};
+use tessera::camera::Camera;
+use tessera::scheme::{Criterion, PlanOptions, Scheme};
+use tessera::surface::SurfaceSet;
+use tessera::tessellator::{Tessellator, TessellatorOptions};
+
+struct Counting;
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract is passed on as it is.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as above.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn load(relative: &str) -> SurfaceSet {
+    let data = std::env::var("TESSERA_DATA").map(std::path::PathBuf::from).unwrap_or_else(|_| {
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+    });
+    let path = data.join(relative);
+    let file = tessera::io::patches::read_patches(&path)
+        .unwrap_or_else(|e| panic!("test model {}: {e} (set TESSERA_DATA)", path.display()));
+    SurfaceSet::from_patch_file(&file, Default::default())
+}
+
+/// Allocations of the second of two identical camera walks.
+fn second_walk_allocations(set: &SurfaceSet, scheme: Scheme, criterion: Criterion, cull: bool) -> u64 {
+    let options = TessellatorOptions {
+        plan: PlanOptions { cull, ..PlanOptions::default() },
+        ..TessellatorOptions::default()
+    };
+    let mut tess = Tessellator::new(set, scheme, criterion, options).expect("tessellator");
+    let (lo, hi) = set.bounds();
+    let (centre, radius) = ((lo + hi) * 0.5, lo.distance(hi) * 0.5);
+    let mut counted = 0;
+    let mut triangles = Vec::new();
+    for walk in 0..2 {
+        for frame in 0..16 {
+            let a = frame as f64 / 16.0 * std::f64::consts::TAU;
+            let mut camera = Camera::framing(lo, hi, 1280, 720);
+            camera.eye = centre + glam::DVec3::new(a.cos(), 0.35, a.sin()) * radius * (4.0 + 2.0 * a.cos());
+            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            let mesh = tess.frame(Some(&camera)).expect("frame");
+            if walk == 0 {
+                triangles.push(mesh.triangle_count());
+            } else {
+                assert_eq!(mesh.triangle_count(), triangles[frame], "{scheme:?}: the walks differ");
+                counted += ALLOCATIONS.load(Ordering::Relaxed) - before;
+            }
+        }
+    }
+    // The frames really differ, so buffers were reused across different sizes.
+    assert!(triangles.iter().min() < triangles.iter().max(), "{scheme:?}: every frame the same size");
+    counted
+}
+
+fn main() {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("rayon pool");
+    let teapot = load("patches/teapot.patches");
+    let cases = [
+        (Scheme::Transition, Criterion::PixelError(1.0), false),
+        (Scheme::Transition, Criterion::PixelError(0.5), true),
+        (Scheme::SemiUniform { max_level: 6 }, Criterion::PixelError(1.0), true),
+        (Scheme::Uniform, Criterion::PixelError(2.0), true),
+    ];
+    let mut failed = false;
+    for (scheme, criterion, cull) in cases {
+        let n = pool.install(|| second_walk_allocations(&teapot, scheme, criterion, cull));
+        println!("{scheme:?} {criterion:?} cull {cull}: {n} allocations in the second walk");
+        failed |= n != 0;
+    }
+    assert!(!failed, "a per-frame loop allocated after its buffers had grown (see above)");
+    println!("test allocations ... ok");
+}
