@@ -17,6 +17,7 @@ use tessera::pattern::uniform::Uniform;
 use tessera::scheme::Scheme;
 use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
+use tessera::tessellator::{FrameTimings, Tessellator, TessellatorOptions};
 use tessera::topology::weld::Weld;
 use tessera::verify;
 
@@ -280,13 +281,31 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
     let opts = TessellateOptions { strips: a.strips, ..limits(a.max_triangles, wants_params) };
     let max_triangles = opts.max_triangles.unwrap_or(u64::MAX);
-    let chosen = plan::choose(&a.criterion, &set, &a.input, max_triangles).map_err(|e| match e
-        .downcast::<tessera::Error>()
-    {
-        Ok(e) => explain_limit(*e, &opts),
-        Err(e) => e,
-    })?;
-    if let Some(r) = &chosen.report {
+    let chosen = plan::choose(&a.criterion, &set, max_triangles)?;
+    // Plan and engine errors alike: about a patch, they name the file; about size, they say
+    // which limit.
+    let explain = |e: tessera::Error| -> Box<dyn std::error::Error> {
+        match e {
+            tessera::Error::PatchKindNotAccepted { .. } => format!("{}: {e}", a.input.display()).into(),
+            e => explain_limit(e, &opts),
+        }
+    };
+    let start = Instant::now();
+    let tess_options = TessellatorOptions { plan: chosen.options, engine: opts };
+    let mut tess = Tessellator::new(&set, chosen.scheme, chosen.criterion, tess_options).map_err(explain)?;
+    let prepare = start.elapsed();
+    pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
+    // Every repeat is a whole frame from the camera, criterion to last index, into buffers
+    // reused from the last one, as an application re-tessellating every frame would: the
+    // median then measures tessellation, not page faults.
+    let mut frames = Vec::new();
+    for _ in 0..a.repeat.max(1) {
+        tess.frame(chosen.options.camera.as_ref()).map_err(explain)?;
+        frames.push(tess.timings());
+    }
+    let plan = tess.plan().expect("a frame was planned");
+    let report = tess.report().copied();
+    if let Some(r) = &report {
         if r.capped_patches > 0 {
             // Semi-uniform's cap is its highest level, 2^M, not --max-factor.
             let (cap, flag) = if let Scheme::SemiUniform { max_level: m } = chosen.scheme {
@@ -312,29 +331,22 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             let Scheme::SemiUniform { max_level } = chosen.scheme else {
                 return Err("--instanced needs --scheme semi-uniform".into());
             };
-            let queues = render_queues::build(&set, &chosen.plan, max_level)?;
+            let queues = render_queues::build(&set, plan, max_level)?;
             write_instanced(path, &set, &queues)?;
             Some(queues)
         }
         None => None,
     };
-    pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
-    let mut times = Vec::new();
-    let mut mesh = Mesh::default();
-    for _ in 0..a.repeat.max(1) {
-        let start = Instant::now();
-        // Buffers are reused across repeats, as an application re-tessellating every frame
-        // would: the median then measures tessellation, not page faults.
-        engine::tessellate_into(&set, &chosen.plan, &chosen.pattern, opts, &mut mesh)
-            .map_err(|e| explain_limit(e, &opts))?;
-        times.push(start.elapsed().as_secs_f64());
-    }
+    let mesh = tess.mesh();
+    let mut output_file = None;
     if let Some(out) = &a.output {
         pb.set_message(format!("writing {}", out.display()));
-        tessera::io::write_mesh(&mesh, out)?;
+        let start = Instant::now();
+        tessera::io::write_mesh(mesh, out)?;
+        output_file = Some(start.elapsed().as_secs_f64());
     }
     pb.finish_and_clear();
-    let repairs = report_repairs(&set, &mesh);
+    let repairs = report_repairs(&set, mesh);
     if a.output.is_none() && !a.stats {
         eprintln!(
             "tessellated {} patches into {} triangles and {} vertices; nothing written: give -o OUT to write the mesh, or --stats for the figures",
@@ -343,7 +355,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             mesh.vertex_count()
         );
     }
-    let culled = chosen.plan.visible.iter().filter(|&&v| v == 0).count();
+    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
     if culled > 0 {
         eprintln!(
             "note: --cull left out {culled} of {} patches (outside the view or facing away): the mesh is open there",
@@ -352,10 +364,12 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     // Checked on every run: a mesh that is open, non-manifold or degenerate where the input
     // was not never leaves without a warning and exit status 1.
-    let w = verify::watertight(&mesh);
+    let w = verify::watertight(mesh);
     let problems = output_problems(&set, &w, culled);
     if a.stats {
-        let seconds = median(times);
+        let stage =
+            |f: fn(&FrameTimings) -> Duration| median(frames.iter().map(|t| f(t).as_secs_f64()).collect());
+        let seconds = stage(FrameTimings::total);
         let mut stats = serde_json::json!({
             "input": a.input.display().to_string(),
             "scheme": chosen.description,
@@ -374,9 +388,19 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             "repeat": a.repeat.max(1),
             "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
             "threads": rayon::current_num_threads(),
+            // Medians over the repeats; `seconds` is their whole frame. `prepare` (once per
+            // set) and `output_file` (once) are not part of it.
+            "stages": {
+                "prepare": prepare.as_secs_f64(),
+                "criterion": stage(|t| t.criterion),
+                "resolve": stage(|t| t.resolve),
+                "layout": stage(|t| t.layout),
+                "write": stage(|t| t.write),
+                "output_file": output_file,
+            },
             "repairs": repairs,
         });
-        if let Some(r) = &chosen.report {
+        if let Some(r) = &report {
             stats["guaranteed_bound"] = r.worst_bound.into();
             stats["bound_met"] = (r.capped_patches == 0).into();
             stats["capped_patches"] = r.capped_patches.into();
@@ -394,7 +418,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             stats["render_queues"] = sizes.into();
         }
         if a.measure_error {
-            let e = verify::approximation_error(&mesh, &set, 6)?;
+            let e = verify::approximation_error(mesh, &set, 6)?;
             stats["max_error"] = e.max.into();
             stats["rms_error"] = e.rms.into();
         }

@@ -3,14 +3,11 @@
 //! the library's [`Scheme`], [`Criterion`] and [`PlanOptions`]. No scheme rule lives here.
 
 use clap::{Args, ValueEnum};
-use std::path::Path;
 use tessera::camera::Camera;
 use tessera::criterion::esc::Threshold;
-use tessera::criterion::tolerance::PlanReport;
 use tessera::criterion::view::{Mapping, ViewCriterion};
-use tessera::criterion::Plan;
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePattern};
+use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug, ValueEnum)]
@@ -136,10 +133,9 @@ pub struct CriterionArgs {
 /// one applies.
 pub struct Chosen {
     pub scheme: Scheme,
-    pub plan: Plan,
-    pub pattern: SchemePattern,
+    pub criterion: Criterion,
+    pub options: PlanOptions,
     pub description: String,
-    pub report: Option<PlanReport>,
     pub tolerance: Option<f64>,
 }
 
@@ -250,14 +246,13 @@ fn criterion(
     Ok((Criterion::Factor(8.0), "factor 8".into()))
 }
 
-/// Maps the flags to a scheme, a criterion and plan options, and plans: every rule, cap and
-/// compatibility check is the library's ([`Scheme::plan`]). `input` names the file in errors
-/// about its patches. `max_triangles` bounds what the error-bounded criteria may build while
-/// they check their bounds.
+/// Maps the flags to a scheme, a criterion and plan options: every rule, cap and
+/// compatibility check is the library's ([`Scheme::plan`], run by the caller's
+/// [`tessera::tessellator::Tessellator`]). `max_triangles` bounds what the error-bounded
+/// criteria may build while they check their bounds.
 pub fn choose(
     args: &CriterionArgs,
     set: &SurfaceSet,
-    input: &Path,
     max_triangles: u64,
 ) -> Result<Chosen, Box<dyn std::error::Error>> {
     if args.warp && args.scheme != Some(SchemeArg::Sd2) {
@@ -272,12 +267,6 @@ pub fn choose(
         max_factor: args.max_factor,
         max_triangles,
     };
-    let planned = scheme.plan(set, &criterion, &options).map_err(|e| -> Box<dyn std::error::Error> {
-        match e {
-            tessera::Error::PatchKindNotAccepted { .. } => format!("{}: {e}", input.display()).into(),
-            e => Box::new(e),
-        }
-    })?;
     let mut description = format!("{}, {text}", scheme.name());
     match scheme {
         Scheme::Sd2 { warp: true } => description += ", warped",
@@ -291,10 +280,9 @@ pub fn choose(
     }
     Ok(Chosen {
         scheme,
-        plan: planned.plan,
-        pattern: planned.pattern,
+        criterion,
+        options,
         description,
-        report: planned.report,
         tolerance: match criterion {
             Criterion::Tolerance(eps) => Some(eps),
             _ => None,

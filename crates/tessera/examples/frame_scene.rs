@@ -3,7 +3,9 @@
 //! whole at 1280×1024 with a guaranteed error of half a pixel and culling on. Prints the
 //! median frame time and each stage's median.
 //!
-//! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo [FRAMES]]`
+//! `uniform16` instead runs the one torus at uniform factor 16 (1,048,576 triangles).
+//!
+//! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo|uniform16 [FRAMES]]`
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -29,7 +31,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mesh = tessera::io::obj::read_obj(&path)?;
             SurfaceSet::pn_from_mesh(&tessera::scene::mesh_grid(&mesh, 11), &path, Default::default())?
         }
-        other => return Err(format!("unknown scene {other}: use torus or killeroo").into()),
+        "uniform16" => {
+            let file = tessera::io::patches::read_patches(&data.join("bench/torus_64x32.patches"))?;
+            SurfaceSet::from_patch_file(&file, Default::default())
+        }
+        other => return Err(format!("unknown scene {other}: use torus, killeroo or uniform16").into()),
     };
     println!("{which}: {} patches, built in {:.0} ms", set.patches.len(), ms(start));
     let (lo, hi) = set.bounds();
@@ -39,7 +45,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..TessellatorOptions::default()
     };
     let start = Instant::now();
-    let mut tess = Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), options)?;
+    let mut tess = if which == "uniform16" {
+        // The one torus at uniform factor 16 (1,048,576 triangles), no camera work.
+        let options = TessellatorOptions::default();
+        Tessellator::new(&set, Scheme::Uniform, Criterion::Factor(16.0), options)?
+    } else {
+        Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), options)?
+    };
     println!("prepared in {:.0} ms", ms(start));
     let mut stages: [Vec<f64>; 5] = Default::default();
     let mut triangles = 0;

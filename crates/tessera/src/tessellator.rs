@@ -206,6 +206,11 @@ impl<'a> Tessellator<'a> {
         Ok(&self.mesh)
     }
 
+    /// The last frame's mesh (empty before the first frame).
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
     /// How long each stage of the last successful frame took.
     pub fn timings(&self) -> FrameTimings {
         self.timings

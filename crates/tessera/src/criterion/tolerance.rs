@@ -11,7 +11,7 @@ use super::bounds::{self, HessianBound};
 use super::resolve::{self, EdgeRule, InteriorRule};
 use super::{Plan, Prepared};
 use crate::error::{Error, Result};
-use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
+use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use crate::surface::{Domain, Patch, SurfaceSet};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -92,19 +92,29 @@ pub fn patch_bound(
     scratch: &mut LocalTessellation,
 ) -> f64 {
     pattern.build(input, scratch);
-    built_pattern_bound(m, input, scratch)
+    built_pattern_bound(m, input, scratch, &mut Vec::new())
 }
 
-/// [`patch_bound`] of a pattern already built for `input`.
-fn built_pattern_bound(m: &HessianBound, input: &PatternInput, built: &LocalTessellation) -> f64 {
+/// [`patch_bound`] of a pattern already built for `input`; `params` is a buffer for the
+/// parameters of its local vertices (computed once each, not once per triangle corner).
+fn built_pattern_bound(
+    m: &HessianBound,
+    input: &PatternInput,
+    built: &LocalTessellation,
+    params: &mut Vec<glam::DVec2>,
+) -> f64 {
+    // Local vertex order: corners, each edge's inner samples, the interior ([`Slot`]).
     let d = input.domain;
-    let param = |l: u32| match input.slot(l) {
-        Slot::Corner(c) => d.corner(c),
-        Slot::Edge(e, k) => d.edge_point(e, k as f64 / input.segments[e] as f64),
-        Slot::Interior(j) => built.interior[j as usize],
-    };
+    let nc = d.corner_count();
+    params.clear();
+    params.extend((0..nc).map(|c| d.corner(c)));
+    for e in 0..nc {
+        let n = input.segments[e];
+        params.extend((1..n).map(|k| d.edge_point(e, k as f64 / n as f64)));
+    }
+    params.extend_from_slice(&built.interior);
     let errors = m.triangle_errors();
-    built.triangles.iter().map(|t| errors.error(t.map(param))).fold(0.0, f64::max)
+    built.triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(0.0, f64::max)
 }
 
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:
@@ -557,7 +567,8 @@ fn check_patches(
                 // Neighbouring patches often share an input: the thread's last pattern is
                 // reused when it is the same.
                 let bound = crate::engine::with_scratch(generation, |s| {
-                    built_pattern_bound(&hessians[p], &input, s.built(limit.pattern, &input))
+                    let (built, params) = s.built(limit.pattern, &input);
+                    built_pattern_bound(&hessians[p], &input, built, params)
                 });
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);

@@ -302,7 +302,7 @@ impl Writer<'_> {
                 continue;
             }
             match self.fast {
-                Some(f) if f.covers_edge(self.plan, e) => f.edge(e, part),
+                Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
                 _ => write_edge(self.set, self.plan, e, part),
             }
         }
@@ -336,9 +336,9 @@ impl Writer<'_> {
         let map = LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
         scratch.build(self.pattern, &map.input);
         let local = &scratch.local;
-        match self.fast {
-            Some(f) if f.covers_patch(self.pattern, &map.input) => f.interior(p, verts),
-            _ => {
+        match self.fast.and_then(|f| Some((f, f.covers_patch(self.pattern, &map.input)?))) {
+            Some((f, grid)) => f.interior(p, grid, verts),
+            None => {
                 for (k, &uv) in local.interior.iter().enumerate() {
                     verts.set(k, set, p as u32, uv);
                 }
@@ -423,6 +423,8 @@ pub(crate) struct PatchScratch {
     generation: u64,
     vertex: Vec<u32>,
     param: Vec<[f32; 2]>,
+    /// Parameters of every local vertex, for the error checks.
+    params64: Vec<glam::DVec2>,
 }
 
 impl PatchScratch {
@@ -435,9 +437,13 @@ impl PatchScratch {
 
     /// `input`'s pattern, rebuilt only when it differs from the last one this scratch built
     /// in the same generation.
-    pub(crate) fn built(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
+    pub(crate) fn built(
+        &mut self,
+        pattern: &dyn Pattern,
+        input: &PatternInput,
+    ) -> (&LocalTessellation, &mut Vec<glam::DVec2>) {
         self.build(pattern, input);
-        &self.local
+        (&self.local, &mut self.params64)
     }
 
     fn build(&mut self, pattern: &dyn Pattern, input: &PatternInput) {
@@ -500,7 +506,7 @@ impl LocalMap<'_> {
     fn edge_vertex(&self, e: usize, k: u32) -> u32 {
         let pe = self.set.topology.patch_edges[self.patch][e];
         let edge = pe.edge as usize;
-        if self.set.topology.edges[edge].collapsed {
+        if pe.collapsed {
             // Every sample of a collapsed curve is its single point: the corner.
             return self.corner_vertex(e);
         }

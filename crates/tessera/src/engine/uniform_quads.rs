@@ -44,6 +44,13 @@ const LANES: usize = 8;
 /// no longer gives the normal to about 1e-5, and the point is evaluated in f64.
 const MIN_SIN2: f32 = 1e-4;
 
+/// Below this squared length of `∂S/∂u` or `∂S/∂v` in the local frame (where the control
+/// points lie within `[-1, 1]³`, so a derivative's f32 rounding is about 1e-6), the
+/// derivative's direction is no longer good to 1e-5, and the point is evaluated in f64: near a
+/// pole of the control net (teapot_teasetorig's lid) a derivative nearly vanishes while the
+/// angle between the two stays wide.
+const MIN_DERIVATIVE2: f32 = 0.04;
+
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
 fn bernstein3(t: f64) -> ([f64; 4], [f64; 4]) {
@@ -244,8 +251,10 @@ impl Line {
             let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
             let a2 = ax[l] * ax[l] + ay[l] * ay[l] + az[l] * az[l];
             let c2 = cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l];
-            // |a × c|² = |a|²|c|² sin²: the angle between the derivatives, scale-free.
-            margin[l] = n2 - MIN_SIN2 * (a2 * c2);
+            // |a × c|² = |a|²|c|² sin²: the angle between the derivatives, scale-free; and
+            // neither derivative so short that rounding turns it.
+            let long = a2 >= MIN_DERIVATIVE2 && c2 >= MIN_DERIVATIVE2;
+            margin[l] = if long { n2 - MIN_SIN2 * (a2 * c2) } else { -1.0 };
             let inv = sign / n2.sqrt();
             nx[l] *= inv;
             ny[l] *= inv;
@@ -310,9 +319,9 @@ fn has_avx2_fma() -> bool {
     false
 }
 
-/// The evaluator: everything its tasks share.
-pub(crate) struct FastEvaluator<'a> {
-    set: &'a SurfaceSet,
+/// The tables of one factor `n`: bases, grid parameters, edge parameters.
+#[derive(Default)]
+struct FactorTables {
     n: usize,
     basis: Basis,
     /// `(i / n)` as the uniform pattern computes interior parameters (`i · (1/n)`), in f64.
@@ -322,6 +331,38 @@ pub(crate) struct FastEvaluator<'a> {
     /// Per local edge and reversed flag, the f64 parameters of canonical sample `k` in the
     /// owner's domain, as the generic engine evaluates edge vertices.
     edge_uv: [[Vec<DVec2>; 2]; 4],
+}
+
+impl FactorTables {
+    /// Fills the tables for factor `n` (≥ 1).
+    fn fill(&mut self, n: u32) {
+        let step = 1.0 / n as f64;
+        let nu = n as usize;
+        self.n = nu;
+        self.basis.refill(nu);
+        self.grid.clear();
+        self.grid.extend((0..=nu).map(|i| i as f64 * step));
+        self.grid32.clear();
+        self.grid32.extend((0..=nu).map(|i| (i as f64 * step) as f32));
+        let d = Domain::Quad;
+        for (e, by_direction) in self.edge_uv.iter_mut().enumerate() {
+            for (rev, uvs) in by_direction.iter_mut().enumerate() {
+                uvs.clear();
+                uvs.extend((0..=n).map(|k| {
+                    let t = uniform_param(n, k);
+                    d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
+                }));
+            }
+        }
+    }
+}
+
+/// The evaluator: everything its tasks share.
+pub(crate) struct FastEvaluator<'a> {
+    set: &'a SurfaceSet,
+    /// `tables[n]` for every factor `n` a plan so far needed (`n == 0`: not filled yet);
+    /// kept from plan to plan, so a frame loop refills nothing once its factors were seen.
+    tables: Vec<FactorTables>,
     /// Every patch in its local frame; each is needed by several tasks (its corners, edges
     /// and rows), so it is made once.
     locals: Vec<LocalPatch>,
@@ -332,9 +373,10 @@ pub(crate) struct FastEvaluator<'a> {
 
 impl<'a> FastEvaluator<'a> {
     /// The evaluator for `set` and `plan`, or None where it cannot help: a plan of real
-    /// factors, or a patch that is not a polynomial bicubic. Its factor `n` is the first
-    /// patch's interior factor; vertices of other factors take the generic evaluation.
-    /// Cost: O(P) (each patch moved to its local frame).
+    /// factors, or a patch that is not a polynomial bicubic. It evaluates every corner, every
+    /// edge of one normal variant and every patch interior its pattern promises to be a grid
+    /// ([`Pattern::interior_grid`]), whatever the factors. Cost: O(P) (each patch moved to its
+    /// local frame).
     pub(crate) fn new(set: &'a SurfaceSet, plan: &Plan) -> Option<FastEvaluator<'a>> {
         Self::with_kernels(set, plan, has_avx2_fma())
     }
@@ -358,11 +400,7 @@ impl<'a> FastEvaluator<'a> {
         }
         Some(FastEvaluator {
             set,
-            n: 0,
-            basis: Basis::default(),
-            grid: Vec::new(),
-            grid32: Vec::new(),
-            edge_uv: Default::default(),
+            tables: Vec::new(),
             locals: set
                 .patches
                 .par_iter()
@@ -376,52 +414,48 @@ impl<'a> FastEvaluator<'a> {
         })
     }
 
-    /// Sets the factor to `plan`'s (the first patch's interior factor), refilling the tables
-    /// in place when it changed, and says whether the evaluator applies to the plan (integer
-    /// samplings). Cost: O(n) when the factor changed, else O(1).
+    /// Makes the tables of every factor `plan` uses (edge segments, interior factors, and
+    /// 1 to 3, which the transition pattern may raise a core to), and says whether the
+    /// evaluator applies to the plan (integer samplings). Cost: O(E + P), plus O(n) for each
+    /// factor not seen before.
     pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
-        let Some(&[n, _]) = plan.interior.first() else { return false };
-        if n == 0 || plan.kind != SamplingKind::Uniform {
+        if plan.kind != SamplingKind::Uniform {
             return false;
         }
-        if n as usize != self.n {
-            self.fill(n);
+        let needed =
+            plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()).chain(1..=3);
+        for n in needed {
+            let n = n as usize;
+            if n >= self.tables.len() {
+                self.tables.resize_with(n + 1, FactorTables::default);
+            }
+            if self.tables[n].n != n {
+                self.tables[n].fill(n as u32);
+            }
         }
         true
     }
 
-    /// Whether edge `e`'s samples are this evaluator's: `n` segments, one normal variant.
+    /// The tables of factor `n`, when made.
+    fn factor(&self, n: usize) -> Option<&FactorTables> {
+        self.tables.get(n).filter(|t| t.n == n && n > 0)
+    }
+
+    /// Whether edge `e`'s samples are this evaluator's: a factor with tables, one normal
+    /// variant, not collapsed.
     pub(crate) fn covers_edge(&self, plan: &Plan, e: usize) -> bool {
         let edge = &self.set.topology.edges[e];
-        plan.segments(e) as usize == self.n && edge.variants == 1 && !edge.collapsed
+        self.factor(plan.segments(e) as usize).is_some() && edge.variants == 1 && !edge.collapsed
     }
 
-    /// Whether the interior of the patch with `input` is this evaluator's: a quad whose
-    /// pattern promises the uniform `n × n` grid.
-    pub(crate) fn covers_patch(&self, pattern: &dyn Pattern, input: &PatternInput) -> bool {
-        input.domain == Domain::Quad && pattern.interior_grid(input) == Some([self.n as u32; 2])
-    }
-
-    /// The tables of factor `n`: bases, grid parameters, edge parameters.
-    fn fill(&mut self, n: u32) {
-        let step = 1.0 / n as f64;
-        let nu = n as usize;
-        self.n = nu;
-        self.basis.refill(nu);
-        self.grid.clear();
-        self.grid.extend((0..=nu).map(|i| i as f64 * step));
-        self.grid32.clear();
-        self.grid32.extend((0..=nu).map(|i| (i as f64 * step) as f32));
-        let d = Domain::Quad;
-        for (e, by_direction) in self.edge_uv.iter_mut().enumerate() {
-            for (rev, uvs) in by_direction.iter_mut().enumerate() {
-                uvs.clear();
-                uvs.extend((0..=n).map(|k| {
-                    let t = uniform_param(n, k);
-                    d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
-                }));
-            }
+    /// The interior grid `[nu, nv]` of the patch with `input` when it is this evaluator's: a
+    /// quad whose pattern promises a grid of factors with tables.
+    pub(crate) fn covers_patch(&self, pattern: &dyn Pattern, input: &PatternInput) -> Option<[u32; 2]> {
+        if input.domain != Domain::Quad {
+            return None;
         }
+        let grid = pattern.interior_grid(input)?;
+        (self.factor(grid[0] as usize).is_some() && self.factor(grid[1] as usize).is_some()).then_some(grid)
     }
 
     fn local(&self, p: usize) -> &LocalPatch {
@@ -438,7 +472,9 @@ impl<'a> FastEvaluator<'a> {
     /// Evaluates every corner entry at its owner's corner.
     pub(crate) fn corners(&self, out: VertexSlices<'_>) {
         let topo = &self.set.topology;
-        let n = self.n;
+        // Any factor's tables give the corners' bases (B(0) and B(1) exactly).
+        let tables = self.factor(1).expect("retarget makes factor 1");
+        let (basis, n) = (&tables.basis, 1);
         out.pos
             .par_iter_mut()
             .zip(out.nrm.par_iter_mut())
@@ -451,7 +487,7 @@ impl<'a> FastEvaluator<'a> {
                 let (p, c) = (entry.owner_patch as usize, entry.owner_corner as usize);
                 let local = self.local(p);
                 let (gi, gj) = [(0, 0), (n, 0), (n, n), (0, n)][c];
-                let block = local.row(&self.basis, gj).block::<false>(&self.basis, gi, local);
+                let block = local.row(basis, gj).block::<false>(basis, gi, local);
                 let corner = Domain::Quad.corner(c);
                 store(&block, 0, pos, nrm, || self.exact(p, corner));
                 *uv = corner.as_vec2().to_array();
@@ -461,13 +497,14 @@ impl<'a> FastEvaluator<'a> {
 
     /// Evaluates the inner samples of edge `e` (precondition: [`FastEvaluator::covers_edge`])
     /// with its owner patch, in canonical order.
-    pub(crate) fn edge(&self, e: usize, out: VertexSlices<'_>) {
+    pub(crate) fn edge(&self, plan: &Plan, e: usize, out: VertexSlices<'_>) {
+        let tables = self.factor(plan.segments(e) as usize).expect("covers_edge checked the factor");
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
-            return unsafe { self.edge_avx2_fma(e, out) };
+            return unsafe { self.edge_avx2_fma(tables, e, out) };
         }
-        self.edge_with::<false>(e, out)
+        self.edge_with::<false>(tables, e, out)
     }
 
     /// [`FastEvaluator::edge_with`] compiled for AVX2 and FMA (everything it calls is inlined).
@@ -476,26 +513,27 @@ impl<'a> FastEvaluator<'a> {
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn edge_avx2_fma(&self, e: usize, out: VertexSlices<'_>) {
-        self.edge_with::<true>(e, out)
+    unsafe fn edge_avx2_fma(&self, tables: &FactorTables, e: usize, out: VertexSlices<'_>) {
+        self.edge_with::<true>(tables, e, out)
     }
 
     /// The inner samples of edge `e`, evaluated by its owner.
     #[inline(always)]
-    fn edge_with<const FMA: bool>(&self, e: usize, out: VertexSlices<'_>) {
+    fn edge_with<const FMA: bool>(&self, tables: &FactorTables, e: usize, out: VertexSlices<'_>) {
         let owner = self.set.topology.edge_uses(e)[0];
         let (p, local_edge, rev) = (owner.patch as usize, owner.local as usize, owner.reversed);
+        let (basis, n) = (&tables.basis, tables.n);
         let local = self.local(p);
-        let line = edge_line(local, &self.basis, self.n, local_edge);
+        let line = edge_line(local, basis, n, local_edge);
         // The line runs with the patch's grid index; canonical sample k sits at line index k
         // or n − k (edges 2 and 3 run against the grid, reversed edges against the patch).
         let flip = rev ^ (local_edge >= 2);
-        let uvs = &self.edge_uv[local_edge][rev as usize];
-        for t0 in (1..self.n).step_by(LANES) {
-            let block = line.block::<FMA>(&self.basis, t0, local);
-            for l in 0..LANES.min(self.n - t0) {
+        let uvs = &tables.edge_uv[local_edge][rev as usize];
+        for t0 in (1..n).step_by(LANES) {
+            let block = line.block::<FMA>(basis, t0, local);
+            for l in 0..LANES.min(n - t0) {
                 let t = t0 + l;
-                let k = if flip { self.n - t } else { t };
+                let k = if flip { n - t } else { t };
                 store(&block, l, &mut out.pos[k - 1], &mut out.nrm[k - 1], || self.exact(p, uvs[k]));
                 out.uv[k - 1] = uvs[k].as_vec2().to_array();
             }
@@ -503,15 +541,17 @@ impl<'a> FastEvaluator<'a> {
         out.patch.fill(p as u32);
     }
 
-    /// Evaluates the interior of patch `p` (precondition: [`FastEvaluator::covers_patch`]):
-    /// the uniform pattern's `(n − 1)²` grid points, row after row.
-    pub(crate) fn interior(&self, p: usize, out: VertexSlices<'_>) {
+    /// Evaluates the interior of patch `p` on the grid `[nu, nv]` (precondition: the grid
+    /// [`FastEvaluator::covers_patch`] gave): the `(nu − 1)(nv − 1)` grid points, row after
+    /// row.
+    pub(crate) fn interior(&self, p: usize, grid: [u32; 2], out: VertexSlices<'_>) {
+        let [tu, tv] = grid.map(|n| self.factor(n as usize).expect("covers_patch checked the factors"));
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
-            return unsafe { self.interior_avx2_fma(p, out) };
+            return unsafe { self.interior_avx2_fma(p, tu, tv, out) };
         }
-        self.interior_with::<false>(p, out)
+        self.interior_with::<false>(p, tu, tv, out)
     }
 
     /// [`FastEvaluator::interior_with`] compiled for AVX2 and FMA (everything it calls is
@@ -521,35 +561,56 @@ impl<'a> FastEvaluator<'a> {
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn interior_avx2_fma(&self, p: usize, out: VertexSlices<'_>) {
-        self.interior_with::<true>(p, out)
+    unsafe fn interior_avx2_fma(
+        &self,
+        p: usize,
+        tu: &FactorTables,
+        tv: &FactorTables,
+        out: VertexSlices<'_>,
+    ) {
+        self.interior_with::<true>(p, tu, tv, out)
     }
 
     /// The body of [`FastEvaluator::interior`]. Inlined into both builds; so are the kernels
     /// it calls, which is what compiles them for AVX2 in the fast build (a kernel left out of
     /// line would be baseline code, and its `mul_add` a library call).
     #[inline(always)]
-    fn interior_with<const FMA: bool>(&self, p: usize, mut out: VertexSlices<'_>) {
-        let m = self.n - 1;
+    fn interior_with<const FMA: bool>(
+        &self,
+        p: usize,
+        tu: &FactorTables,
+        tv: &FactorTables,
+        mut out: VertexSlices<'_>,
+    ) {
+        let m = tu.n - 1;
         let local = self.local(p);
-        for j in 1..self.n {
-            self.interior_row::<FMA>(p, local, j, out.take_front(m));
+        for j in 1..tv.n {
+            self.interior_row::<FMA>(p, local, tu, tv, j, out.take_front(m));
         }
     }
 
-    /// Interior vertices `i = 1..n` of grid row `j` (`1 ≤ j < n`) of patch `p`.
+    /// Interior vertices `i = 1..nu` of grid row `j` (`1 ≤ j < nv`) of patch `p`: the row's
+    /// curve from the `v` tables, its points from the `u` tables.
     #[inline(always)]
-    fn interior_row<const FMA: bool>(&self, p: usize, local: &LocalPatch, j: usize, out: VertexSlices<'_>) {
-        let line = local.row(&self.basis, j);
-        let v = self.grid[j];
+    fn interior_row<const FMA: bool>(
+        &self,
+        p: usize,
+        local: &LocalPatch,
+        tu: &FactorTables,
+        tv: &FactorTables,
+        j: usize,
+        out: VertexSlices<'_>,
+    ) {
+        let line = local.row(&tv.basis, j);
+        let v = tv.grid[j];
         let chunks = out.pos.chunks_mut(LANES).zip(out.nrm.chunks_mut(LANES));
         for (b, (pos, nrm)) in chunks.enumerate() {
             let t0 = 1 + b * LANES;
-            let block = line.block::<FMA>(&self.basis, t0, local);
-            block.write(pos, nrm, |l| self.exact(p, DVec2::new(self.grid[t0 + l], v)));
+            let block = line.block::<FMA>(&tu.basis, t0, local);
+            block.write(pos, nrm, |l| self.exact(p, DVec2::new(tu.grid[t0 + l], v)));
         }
-        let v = self.grid32[j];
-        out.uv.iter_mut().zip(&self.grid32[1..self.n]).for_each(|(x, &u)| *x = [u, v]);
+        let v = tv.grid32[j];
+        out.uv.iter_mut().zip(&tu.grid32[1..tu.n]).for_each(|(x, &u)| *x = [u, v]);
         out.patch.fill(p as u32);
     }
 }
@@ -589,7 +650,7 @@ mod tests {
         mesh
     }
 
-    /// Layout, topology and parameters equal; positions within 1e-5 of the model's size and
+    /// Layout, topology and parameters equal; positions within 1e-6 of the bounding-box diagonal and
     /// normals within 1e-5.
     fn assert_same_mesh(fast: &Mesh, generic: &Mesh, what: &str) {
         assert_eq!(fast.indices, generic.indices, "{what}: indices");
@@ -610,8 +671,66 @@ mod tests {
         };
         let dp = max_diff(&fast.positions, &generic.positions) / size;
         let dn = max_diff(&fast.normals, &generic.normals);
-        assert!(dp <= 1e-5, "{what}: positions differ by {dp:e} of the model size");
+        assert!(dp <= 1e-6, "{what}: positions differ by {dp:e} of the bounding-box diagonal");
         assert!(dn <= 1e-5, "{what}: normals differ by {dn:e}");
+    }
+
+    /// Adaptive plans (edge and interior factors varying from patch to patch, transition
+    /// strips, semi-uniform snapping, collapsed curves, culled patches): the evaluator covers
+    /// every grid interior and uniform edge, and the mesh is the generic one index for index.
+    #[test]
+    fn fast_path_matches_the_generic_engine_on_adaptive_plans() {
+        use crate::scheme::{Criterion, PlanOptions, Scheme};
+        let mut adaptive = 0;
+        // Every bicubic model of the shared data.
+        let models = [
+            "bench/torus_64x32.patches",
+            "patches/teacup.patches",
+            "patches/teapot.patches",
+            "patches/teapot_teasetorig.patches",
+        ];
+        for model in models {
+            let set = load(model);
+            let (lo, hi) = set.bounds();
+            for (k, (scheme, criterion, cull)) in [
+                (Scheme::Transition, Criterion::PixelError(0.7), false),
+                (Scheme::Transition, Criterion::Tolerance(0.002 * lo.distance(hi)), false),
+                (Scheme::Transition, Criterion::PixelError(1.5), true),
+                (Scheme::SemiUniform { max_level: 5 }, Criterion::PixelError(1.0), false),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let mut camera = crate::camera::Camera::framing(lo, hi, 1280, 720);
+                camera.eye = camera.target + (camera.eye - camera.target) * (0.3 + 0.25 * k as f64);
+                let options = PlanOptions { camera: Some(camera), cull, ..PlanOptions::default() };
+                let planned = scheme.plan(&set, &criterion, &options).expect("plan");
+                let (plan, pattern) = (&planned.plan, &planned.pattern);
+                let distinct: std::collections::BTreeSet<u32> = plan.segments.iter().copied().collect();
+                adaptive += usize::from(distinct.len() > 2);
+                for avx2_fma in KERNELS {
+                    let opts = TessellateOptions::default();
+                    let mut layout = Layout::default();
+                    layout.build(&set, plan, pattern, &opts).expect("layout");
+                    let evaluator = FastEvaluator::with_kernels(&set, plan, avx2_fma).expect("applies");
+                    let covered = (0..set.patches.len())
+                        .filter(|&p| {
+                            let input = crate::engine::layout::pattern_input(&set, plan, p);
+                            evaluator.covers_patch(pattern, &input).is_some()
+                        })
+                        .count();
+                    assert_eq!(covered, set.patches.len(), "{model}: every quad interior is a grid");
+                    let mut mesh = Mesh::default();
+                    write_with(&set, plan, pattern, &layout, opts, &mut mesh, Some(&evaluator)).unwrap();
+                    let mut reference = Mesh::default();
+                    write_with(&set, plan, pattern, &layout, opts, &mut reference, None).unwrap();
+                    let what = format!("{model} {scheme:?} {criterion:?} cull={cull} avx2_fma={avx2_fma}");
+                    assert_same_mesh(&mesh, &reference, &what);
+                }
+            }
+        }
+        // Most plans mix several factors (the torus under a tolerance is uniform by symmetry).
+        assert!(adaptive >= 10, "only {adaptive} of 16 plans use more than two edge factors");
     }
 
     #[test]
@@ -712,11 +831,12 @@ mod tests {
         let f = FastEvaluator::new(&set, &plan).expect("a uniform polynomial bicubic plan");
         let mut other = plan.clone();
         other.segments[7] = 5;
-        assert!(f.covers_edge(&plan, 7) && !f.covers_edge(&other, 7));
+        assert!(f.covers_edge(&plan, 7) && !f.covers_edge(&other, 7), "5 has no tables yet");
         let input = |interior| PatternInput::new(Domain::Quad, [4; 4], interior);
-        assert!(f.covers_patch(&Uniform, &input([4, 4])));
-        assert!(!f.covers_patch(&Uniform, &input([5, 5])), "another factor");
-        assert!(!f.covers_patch(&crate::pattern::transition::Transition, &input([4, 4])), "no grid promise");
+        assert_eq!(f.covers_patch(&Uniform, &input([4, 4])), Some([4, 4]));
+        assert_eq!(f.covers_patch(&Uniform, &input([5, 5])), None, "a factor without tables");
+        let tri = PatternInput::new(Domain::Tri, [4; 4], [4, 4]);
+        assert_eq!(f.covers_patch(&Uniform, &tri), None, "triangles are not bicubic");
         let mut fractional = plan.clone();
         fractional.kind = SamplingKind::Fractional(crate::sampling::Spacing::Symmetric);
         assert!(FastEvaluator::new(&set, &fractional).is_none());

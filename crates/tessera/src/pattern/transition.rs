@@ -451,6 +451,18 @@ impl Pattern for Transition {
             Domain::Tri => TriLayout::new(input).build(input, out),
         }
     }
+
+    /// Quads: the core's grid, `(i/nu, j/nv)` row after row over every interior point (the
+    /// strips add no interior vertex), with the core factors as raised for the strips.
+    fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        match input.domain {
+            Domain::Quad => {
+                let layout = QuadLayout::new(input);
+                Some([layout.nu, layout.nv])
+            }
+            Domain::Tri => None,
+        }
+    }
 }
 
 /// Domain parameters of every local vertex of `local` (built for `input`), assuming uniform
