@@ -357,8 +357,20 @@ impl Scheme {
             Criterion::Factor(f) => {
                 let camera =
                     if options.cull { cull_camera()? } else { camera.unwrap_or_else(|| framing(set)) };
-                out.plan =
-                    view::plan(set, &camera, EdgeFactors::Fixed(f), rule, interior, &caps, options.cull);
+                let factors = EdgeFactors::Fixed(f);
+                let cull = options.cull;
+                view::plan_into(
+                    set,
+                    prepared,
+                    &camera,
+                    factors,
+                    rule,
+                    interior,
+                    &caps,
+                    cull,
+                    scratch,
+                    &mut out.plan,
+                );
             }
             Criterion::Tolerance(_) | Criterion::PixelError(_) => {
                 // Each patch's object-space tolerance (None: culled).
@@ -411,7 +423,19 @@ impl Scheme {
                 let camera = camera.ok_or(Error::NeedsCamera { what: "a view criterion" })?;
                 let fmax = fmax.min(cap);
                 let factors = EdgeFactors::View { criterion, fmin: fmin.min(fmax), fmax };
-                out.plan = view::plan(set, &camera, factors, rule, interior, &caps, options.cull);
+                let cull = options.cull;
+                view::plan_into(
+                    set,
+                    prepared,
+                    &camera,
+                    factors,
+                    rule,
+                    interior,
+                    &caps,
+                    cull,
+                    scratch,
+                    &mut out.plan,
+                );
             }
             Criterion::Esc { .. } => unreachable!("refused by accepts"),
         }

@@ -1,5 +1,7 @@
 //! A per-frame loop allocates nothing once its buffers have grown: the same camera walk run
-//! twice, the second time counted by a global allocator. Runs without the test harness
+//! twice, the second time counted by a global allocator, for the error-bounded and the view
+//! criteria with the integer schemes (the hardware patterns, SD-2 and ESC still allocate while
+//! they build their patterns). Runs without the test harness
 //! (`harness = false`) so that nothing else allocates while it counts, and in a one-thread
 //! rayon pool so that which thread builds which pattern, and so which thread's buffers grow,
 //! is the same in both walks.
@@ -7,6 +9,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 use tessera::camera::Camera;
+use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
@@ -76,6 +79,10 @@ fn second_walk_allocations(set: &SurfaceSet, scheme: Scheme, criterion: Criterio
     counted
 }
 
+fn view(criterion: ViewCriterion, fmin: f64, fmax: f64) -> Criterion {
+    Criterion::View { criterion, fmin, fmax }
+}
+
 fn main() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("rayon pool");
     let teapot = load("patches/teapot.patches");
@@ -84,6 +91,10 @@ fn main() {
         (Scheme::Transition, Criterion::PixelError(0.5), true),
         (Scheme::SemiUniform { max_level: 6 }, Criterion::PixelError(1.0), true),
         (Scheme::Uniform, Criterion::PixelError(2.0), true),
+        (Scheme::Transition, view(ViewCriterion::Silhouetteness, 1.0, 12.0), true),
+        (Scheme::SemiUniform { max_level: 5 }, view(ViewCriterion::Silhouetteness, 1.0, 16.0), false),
+        (Scheme::Transition, view(ViewCriterion::Distance(Mapping::Linear), 2.0, 10.0), true),
+        (Scheme::Transition, view(ViewCriterion::SilhouetteVertices, 2.0, 9.0), false),
     ];
     let mut failed = false;
     for (scheme, criterion, cull) in cases {

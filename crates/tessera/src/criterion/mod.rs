@@ -39,6 +39,8 @@ pub struct Prepared {
     /// empty unless asked for.
     pub curves: Vec<[f64; 4]>,
     views: std::sync::OnceLock<Vec<screen::PatchView>>,
+    vertex_data: std::sync::OnceLock<Vec<(glam::DVec3, glam::DVec3)>>,
+    edge_midpoints: std::sync::OnceLock<Vec<[(glam::DVec3, glam::DVec3); 2]>>,
 }
 
 impl Prepared {
@@ -56,6 +58,8 @@ impl Prepared {
             },
             curves: if with_bounds { tolerance::curve_bounds(set) } else { Vec::new() },
             views: Default::default(),
+            vertex_data: Default::default(),
+            edge_midpoints: Default::default(),
         }
     }
 
@@ -65,6 +69,20 @@ impl Prepared {
     pub fn views(&self, set: &SurfaceSet) -> &[screen::PatchView] {
         use rayon::prelude::*;
         self.views.get_or_init(|| set.patches.par_iter().map(screen::PatchView::new).collect())
+    }
+
+    /// Position and normal of every topology vertex (the view criteria's data), computed on
+    /// the first call and kept. Precondition: `set` is the set this was prepared for. Cost:
+    /// the first call O(V) evaluations.
+    pub fn vertex_data(&self, set: &SurfaceSet) -> &[(glam::DVec3, glam::DVec3)] {
+        self.vertex_data.get_or_init(|| view::vertex_data(set))
+    }
+
+    /// Every edge's midpoint and normals as its first and last patch see them (the
+    /// silhouetteness criterion's data), computed on the first call and kept. Precondition:
+    /// `set` is the set this was prepared for. Cost: the first call O(E) evaluations.
+    pub fn edge_midpoints(&self, set: &SurfaceSet) -> &[[(glam::DVec3, glam::DVec3); 2]] {
+        self.edge_midpoints.get_or_init(|| view::edge_midpoints(set))
     }
 
     /// The caps for `max_factor` over these minimums.
@@ -83,6 +101,8 @@ impl Prepared {
 pub struct PlanScratch {
     pub(crate) tolerances: Vec<Option<f64>>,
     pub(crate) tolerance: tolerance::Scratch,
+    pub(crate) per_edge: Vec<f64>,
+    pub(crate) proposals: Vec<resolve::Proposals>,
     /// Time of the last plan's per-patch view stage and of its resolve stage.
     pub(crate) criterion_time: std::time::Duration,
     pub(crate) resolve_time: std::time::Duration,

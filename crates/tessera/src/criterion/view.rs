@@ -37,8 +37,9 @@ pub enum ViewCriterion {
     Silhouetteness,
 }
 
+/// Position and normal of each topology vertex, from the first patch corner at it:
+/// view-independent, kept by [`super::Prepared::vertex_data`]. Cost: O(V) evaluations.
 pub(crate) fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
-    // Position and normal of each vertex, from the first patch corner at it.
     let topo = &set.topology;
     let mut out = vec![(DVec3::ZERO, DVec3::Z); topo.vertex_count as usize];
     for e in topo.corner_entries.iter().rev() {
@@ -49,8 +50,29 @@ pub(crate) fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
     out
 }
 
+/// Per edge, the position and normal at the midpoint as its first and its last patch see
+/// them (silhouetteness reads both): view-independent, kept by
+/// [`super::Prepared::edge_midpoints`]. Cost: O(E) evaluations, parallel.
+pub(crate) fn edge_midpoints(set: &SurfaceSet) -> Vec<[(DVec3, DVec3); 2]> {
+    use rayon::prelude::*;
+    let topo = &set.topology;
+    (0..topo.edges.len())
+        .into_par_iter()
+        .map(|e| {
+            let at = |u: &crate::topology::EdgeUse| {
+                let patch = &set.patches[u.patch as usize];
+                let p = patch.eval(patch.domain().edge_point(u.local as usize, 0.5));
+                (p.position, p.normal)
+            };
+            let uses = topo.edge_uses(e);
+            [at(&uses[0]), at(uses.last().unwrap_or(&uses[0]))]
+        })
+        .collect()
+}
+
 /// The real factor of every edge under a view criterion, in `[fmin, fmax]` (reals,
-/// `1 ≤ fmin ≤ fmax`), before rounding or minimums. Cost: O(V + E) evaluations.
+/// `1 ≤ fmin ≤ fmax`), before rounding or minimums. Cost: O(V + E) evaluations; a per-frame
+/// loop prepares them once ([`super::Prepared`]) and plans with [`crate::scheme::Scheme::plan_into`].
 pub fn edge_factors(
     set: &SurfaceSet,
     camera: &Camera,
@@ -58,15 +80,36 @@ pub fn edge_factors(
     fmin: f64,
     fmax: f64,
 ) -> Vec<f64> {
+    let prepared = super::Prepared::default();
+    let mut out = Vec::new();
+    edge_factors_into(set, &prepared, camera, criterion, fmin, fmax, &mut out);
+    out
+}
+
+/// [`edge_factors`] from `prepared`'s vertex and midpoint data (made on first use), into
+/// `out`. Precondition: `prepared` belongs to `set` (or is empty). Cost: O(V + E).
+fn edge_factors_into(
+    set: &SurfaceSet,
+    prepared: &super::Prepared,
+    camera: &Camera,
+    criterion: ViewCriterion,
+    fmin: f64,
+    fmax: f64,
+    out: &mut Vec<f64>,
+) {
     let (lo, hi) = (fmin.max(1.0), fmax.max(fmin.max(1.0)));
     let topo = &set.topology;
-    let verts = vertex_data(set);
+    let verts = prepared.vertex_data(set);
     let (_, _, forward) = camera.basis();
     let depth = |v: u32| (verts[v as usize].0 - camera.eye).dot(forward);
     let (dmin, dmax) = (0..topo.vertex_count)
         .map(depth)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
     let span = (dmax - dmin).max(1e-300);
+    let midpoints = match criterion {
+        ViewCriterion::Silhouetteness => prepared.edge_midpoints(set),
+        _ => &[],
+    };
     let factor = |e: usize| -> f64 {
         let edge = &topo.edges[e];
         let [a, b] = edge.ends;
@@ -87,25 +130,16 @@ pub fn edge_factors(
                 }
             }
             ViewCriterion::Silhouetteness => {
-                let uses = topo.edge_uses(e);
-                let normals: Vec<(DVec3, DVec3)> = uses
-                    .iter()
-                    .map(|u| {
-                        let patch = &set.patches[u.patch as usize];
-                        let p = patch.eval(patch.domain().edge_point(u.local as usize, 0.5));
-                        (p.position, p.normal)
-                    })
-                    .collect();
-                let mid = normals[0].0;
+                let [(mid, nl), (_, nr)] = midpoints[e];
                 let c = (mid - camera.eye).normalize_or_zero();
-                let (nl, nr) = (normals[0].1, normals.last().map_or(normals[0].1, |n| n.1));
                 let product = c.dot(nl) * c.dot(nr);
                 let s = if product <= 0.0 { 1.0 } else { (1.0 - product / 0.25).clamp(0.0, 1.0) };
                 lo + s * (hi - lo)
             }
         }
     };
-    (0..topo.edges.len()).map(|e| factor(e).clamp(lo, hi)).collect()
+    out.clear();
+    out.extend((0..topo.edges.len()).map(|e| factor(e).clamp(lo, hi)));
 }
 
 /// Where the edge factors of a view plan come from.
@@ -118,59 +152,60 @@ pub enum EdgeFactors {
 }
 
 /// Builds a plan from per-edge factors — fixed, or a view criterion's in `[fmin, fmax]` —
-/// resolved by `rule` and `interior` within `caps`, culling invisible patches when `cull`.
+/// resolved by `rule` and `interior` within `caps`, culling invisible patches when `cull`,
+/// into `plan` (its buffers and `scratch`'s reused: no allocation once they have grown).
 /// For [`EdgeRule::PowerOfTwo`] the criterion's value is interpolated between the levels of
 /// `fmin` and `fmax`, not between the factors (paper 000 / DRS08: level `⌈s·M⌉` for
 /// silhouetteness `s`), so half-way is half the levels, not a factor of `fmax/2` that rounds
 /// up to the top level. Crack-free: each factor comes from the edge's own data.
-/// Cost: O(V + E + P) evaluations.
-pub(crate) fn plan(
+/// Cost: O(V + E + P), the view-independent evaluations prepared once in `prepared`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn plan_into(
     set: &SurfaceSet,
+    prepared: &super::Prepared,
     camera: &Camera,
     factors: EdgeFactors,
     rule: EdgeRule,
     interior: InteriorRule,
     caps: &Caps<'_>,
     cull: bool,
-) -> Plan {
-    let per_edge: Vec<f64> = match factors {
-        EdgeFactors::Fixed(f) => vec![f; set.topology.edges.len()],
+    scratch: &mut super::PlanScratch,
+    plan: &mut Plan,
+) {
+    let per_edge = &mut scratch.per_edge;
+    match factors {
+        EdgeFactors::Fixed(f) => {
+            per_edge.clear();
+            per_edge.resize(set.topology.edges.len(), f);
+        }
         EdgeFactors::View { criterion, fmin, fmax } => {
-            let factors = edge_factors(set, camera, criterion, fmin, fmax);
-            if rule != EdgeRule::PowerOfTwo {
-                factors
-            } else {
+            edge_factors_into(set, prepared, camera, criterion, fmin, fmax, per_edge);
+            if rule == EdgeRule::PowerOfTwo {
                 let (fmin, fmax) = (fmin.max(1.0), fmax.max(fmin.max(1.0)));
                 let (lmin, lmax) = (fmin.log2(), fmax.log2());
                 let span = fmax - fmin;
-                factors
-                    .iter()
-                    .map(|&f| {
-                        let t = if span > 0.0 { ((f - fmin) / span).clamp(0.0, 1.0) } else { 1.0 };
-                        (lmin + t * (lmax - lmin)).exp2()
-                    })
-                    .collect()
+                for f in per_edge.iter_mut() {
+                    let t = if span > 0.0 { ((*f - fmin) / span).clamp(0.0, 1.0) } else { 1.0 };
+                    *f = (lmin + t * (lmax - lmin)).exp2();
+                }
             }
         }
-    };
-    let mut proposals = Vec::new();
-    resolve::from_edge_factors(set, &per_edge, &mut proposals);
-    let (mut segments, mut edge_factors) = (Vec::new(), Vec::new());
-    resolve::edges(set, &proposals, rule, interior, caps, &mut segments, &mut edge_factors);
-    let mut interiors = Vec::new();
-    resolve::interiors(set, &segments, interior, caps, &mut interiors);
-    let kind = match rule {
+    }
+    resolve::from_edge_factors(set, per_edge, &mut scratch.proposals);
+    resolve::edges(set, &scratch.proposals, rule, interior, caps, &mut plan.segments, &mut plan.factors);
+    resolve::interiors(set, &plan.segments, interior, caps, &mut plan.interior);
+    plan.kind = match rule {
         EdgeRule::Fractional(spacing) => SamplingKind::Fractional(spacing),
         EdgeRule::Integer | EdgeRule::PowerOfTwo => SamplingKind::Uniform,
     };
-    Plan {
-        kind,
-        segments,
-        factors: edge_factors,
-        depths: Vec::new(),
-        lattice_offsets: Vec::new(),
-        lattice: Vec::new(),
-        interior: interiors,
-        visible: screen::visibility(set, camera, cull),
-    }
+    plan.depths.clear();
+    plan.lattice_offsets.clear();
+    plan.lattice.clear();
+    screen::visibility_into(
+        set,
+        if cull { prepared.views(set) } else { &[] },
+        &camera.view(),
+        cull,
+        &mut plan.visible,
+    );
 }
