@@ -1,7 +1,7 @@
 //! A per-frame loop allocates nothing once its buffers have grown: the same camera walk run
 //! twice, the second time counted by a global allocator, for the error-bounded and the view
-//! criteria with the integer schemes (the hardware patterns, SD-2 and ESC still allocate while
-//! they build their patterns). Runs without the test harness
+//! criteria with the integer, transition, semi-uniform and hardware schemes (SD-2 and ESC
+//! still build a pattern object per frame). Runs without the test harness
 //! (`harness = false`) so that nothing else allocates while it counts, and in a one-thread
 //! rayon pool so that which thread builds which pattern, and so which thread's buffers grow,
 //! is the same in both walks.
@@ -10,6 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 use tessera::camera::Camera;
 use tessera::criterion::view::{Mapping, ViewCriterion};
+use tessera::pattern::hardware::Partitioning;
 use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
@@ -95,6 +96,12 @@ fn main() {
         (Scheme::SemiUniform { max_level: 5 }, view(ViewCriterion::Silhouetteness, 1.0, 16.0), false),
         (Scheme::Transition, view(ViewCriterion::Distance(Mapping::Linear), 2.0, 10.0), true),
         (Scheme::Transition, view(ViewCriterion::SilhouetteVertices, 2.0, 9.0), false),
+        (
+            Scheme::Hardware(Partitioning::FractionalOdd),
+            view(ViewCriterion::Distance(Mapping::Linear), 1.5, 9.5),
+            true,
+        ),
+        (Scheme::Hardware(Partitioning::Integer), view(ViewCriterion::Silhouetteness, 1.0, 12.0), false),
     ];
     let mut failed = false;
     for (scheme, criterion, cull) in cases {

@@ -191,8 +191,20 @@ struct Ring {
 }
 
 impl Ring {
-    fn from_cycle(cycle: Vec<u32>, side_points: [u32; 4]) -> Ring {
-        Ring { start: 0, len: cycle.len() as u32, cycle, side_points }
+    /// Empties the ring, keeping its cycle's allocation.
+    fn reset(&mut self) {
+        self.start = 0;
+        self.len = 0;
+        self.cycle.clear();
+        self.side_points = [0; 4];
+    }
+
+    /// Makes the ring the explicit cycle `points` (the degenerate ring).
+    fn set_cycle(&mut self, points: &[u32], side_points: [u32; 4]) {
+        self.reset();
+        self.cycle.extend_from_slice(points);
+        self.len = points.len() as u32;
+        self.side_points = side_points;
     }
 
     /// Appends point `id` to the cycle.
@@ -226,12 +238,34 @@ impl Ring {
         out.clear();
         out.extend((0..self.side_points[e]).map(|j| self.point(offset + j)));
     }
+}
 
-    fn side(&self, e: usize) -> Vec<u32> {
-        let mut out = Vec::new();
-        self.side_into(e, &mut out);
-        out
+/// The rings of one tessellation and the stitching's side buffers, kept per thread so that
+/// tessellating a patch allocates nothing once they have grown.
+#[derive(Default)]
+struct Rings {
+    rings: Vec<Ring>,
+    used: usize,
+    outer: Vec<u32>,
+    inner: Vec<u32>,
+    line: Vec<u32>,
+}
+
+impl Rings {
+    /// The next ring, empty.
+    fn next(&mut self) -> &mut Ring {
+        if self.used == self.rings.len() {
+            self.rings.push(Ring::default());
+        }
+        self.used += 1;
+        let ring = &mut self.rings[self.used - 1];
+        ring.reset();
+        ring
     }
+}
+
+thread_local! {
+    static RINGS: std::cell::RefCell<Rings> = std::cell::RefCell::default();
 }
 
 /// The Direct3D 11 tessellation of one domain.
@@ -298,10 +332,13 @@ pub fn tessellate_into(
     let (points, triangles) = pre.counts();
     out.points.reserve(points as usize);
     out.triangles.reserve(triangles as usize);
-    match domain {
-        Domain::Quad => quad(&pre, out),
-        Domain::Tri => tri(&pre, out),
-    }
+    RINGS.with_borrow_mut(|rings| {
+        rings.used = 0;
+        match domain {
+            Domain::Quad => quad(&pre, out, rings),
+            Domain::Tri => tri(&pre, out, rings),
+        }
+    });
     debug_assert_eq!((out.points.len() as u32, out.triangles.len() as u32), (points, triangles));
     true
 }
@@ -315,9 +352,9 @@ fn push(out: &mut HardwareTessellation, u: Fixed, v: Fixed) -> u32 {
 fn outer_ring(
     pre: &Processed,
     out: &mut HardwareTessellation,
+    ring: &mut Ring,
     point: impl Fn(usize, Fixed) -> (Fixed, Fixed),
-) -> Ring {
-    let mut ring = Ring::default();
+) {
     for e in 0..pre.domain.corner_count() {
         let axis = &pre.outer[e];
         let end = axis.points - 1;
@@ -328,7 +365,6 @@ fn outer_ring(
         }
         ring.side_points[e] = axis.points as u32;
     }
-    ring
 }
 
 /// Whether edge `e`'s points run against its 1-D partition (the outer ring and the rings are
@@ -345,41 +381,41 @@ fn reversed(domain: Domain, e: usize) -> bool {
 /// trapezoids with mirrored diagonals further in.
 fn stitch_bands<'a>(
     pre: &'a Processed,
-    rings: &[Ring],
+    rings: &mut Rings,
     band_rings: usize,
     inside: impl Fn(usize) -> &'a Axis,
     out: &mut HardwareTessellation,
 ) {
-    debug_assert_eq!(band_rings, rings.len());
-    let (mut outer, mut inner) = (Vec::new(), Vec::new());
+    debug_assert_eq!(band_rings, rings.used);
+    let Rings { rings, outer, inner, .. } = rings;
     for r in 1..band_rings {
         let mut emit = Emit { out, region: r as u32 };
         for e in 0..pre.domain.corner_count() {
-            rings[r - 1].side_into(e, &mut outer);
-            rings[r].side_into(e, &mut inner);
+            rings[r - 1].side_into(e, outer);
+            rings[r].side_into(e, inner);
             if r == 1 {
-                emit.transition(&inner, inside(e), &outer, &pre.outer[e]);
+                emit.transition(inner, inside(e), outer, &pre.outer[e]);
             } else {
-                emit.regular(true, Diagonals::Mirrored, &inner, &outer);
+                emit.regular(true, Diagonals::Mirrored, inner, outer);
             }
         }
     }
 }
 
-fn quad(pre: &Processed, out: &mut HardwareTessellation) {
+fn quad(pre: &Processed, out: &mut HardwareTessellation, rings: &mut Rings) {
     let [iu, iv] = pre.inside;
     let n = [iu.points, iv.points];
-    let mut rings = vec![outer_ring(pre, out, |e, x| match e {
+    outer_ring(pre, out, rings.next(), |e, x| match e {
         0 => (0, x),
         1 => (x, 0),
         2 => (ONE, x),
         _ => (x, ONE),
-    })];
+    });
     // Inner rings; side e runs along axis (e + 1) & 1 at a fixed coordinate of the other.
     let point_rings = n[0].min(n[1]) >> 1;
     for r in 1..point_rings {
         let end = [n[0] - 1 - r, n[1] - 1 - r];
-        let mut ring = Ring::default();
+        let ring = rings.next();
         for e in 0..4 {
             let (across, along) = (e & 1, (e + 1) & 1);
             let perp_point = if e < 2 { r } else { end[across] };
@@ -392,67 +428,73 @@ fn quad(pre: &Processed, out: &mut HardwareTessellation) {
             }
             ring.side_points[e] = (n[along] - 2 * r) as u32;
         }
-        rings.push(ring);
     }
     // An even inside partition ends in a degenerate ring: a row (or column, or one point)
     // through the middle, its sides running along it and back.
+    let r = point_rings;
+    let line = &mut rings.line;
+    line.clear();
     let degenerate = if n[0] > n[1] && !iv.odd {
-        let r = point_rings;
-        let row: Vec<u32> = (r..=n[0] - 1 - r).map(|p| push(out, iu.place(p), HALF)).collect();
-        let m = row.len() as u32;
-        Some((row, [1, m, 1, m]))
+        line.extend((r..=n[0] - 1 - r).map(|p| push(out, iu.place(p), HALF)));
+        let m = line.len() as u32;
+        Some([1, m, 1, m])
     } else if n[1] >= n[0] && !iu.odd {
-        let r = point_rings;
-        let column: Vec<u32> = (r..=n[1] - 1 - r).rev().map(|p| push(out, HALF, iv.place(p))).collect();
-        let m = column.len() as u32;
-        Some((column, [m, 1, m, 1]))
+        line.extend((r..=n[1] - 1 - r).rev().map(|p| push(out, HALF, iv.place(p))));
+        let m = line.len() as u32;
+        Some([m, 1, m, 1])
     } else {
         None
     };
-    if let Some((line, side_points)) = degenerate {
-        let mut points = line.clone();
-        if line.len() > 1 {
-            points.extend(line[1..line.len() - 1].iter().rev());
+    if let Some(side_points) = degenerate {
+        // The cycle: along the line and back (the inner buffer holds it).
+        let m = line.len();
+        let cycle = &mut rings.inner;
+        cycle.clear();
+        cycle.extend_from_slice(line);
+        if m > 1 {
+            cycle.extend(line[1..m - 1].iter().rev());
         }
-        rings.push(Ring::from_cycle(points, if line.len() == 1 { [1; 4] } else { side_points }));
+        let side_points = if m == 1 { [1; 4] } else { side_points };
+        let cycle = std::mem::take(cycle);
+        rings.next().set_cycle(&cycle, side_points);
+        rings.inner = cycle;
     }
     let band_rings = ((n[0] + 1) >> 1).min((n[1] + 1) >> 1) as usize;
-    stitch_bands(pre, &rings, band_rings, |e| &pre.inside[(e + 1) & 1], out);
+    stitch_bands(pre, rings, band_rings, |e| &pre.inside[(e + 1) & 1], out);
     // A strip of quads in the middle when the smaller inside partition is odd.
     if let Some((quads, horizontal)) = pre.centre_strip() {
-        let last = rings.last().expect("at least the outer ring");
+        let Rings { rings, used, outer, inner, .. } = rings;
+        let last = &rings[*used - 1];
         let mut emit = Emit { out, region: band_rings as u32 };
-        if horizontal {
-            let (outer, mut inner) = (last.side(1), last.side(3));
-            inner.reverse();
-            debug_assert_eq!(inner.len() as i64, quads + 1);
-            emit.regular(false, Diagonals::InsideToOutside, &inner, &outer);
+        let (a, b) = if horizontal { (1, 3) } else { (0, 2) };
+        last.side_into(a, outer);
+        last.side_into(b, inner);
+        inner.reverse();
+        debug_assert_eq!(inner.len() as i64, quads + 1);
+        let diagonals = if !horizontal && iv.odd {
+            Diagonals::InsideToOutsideExceptMiddle
         } else {
-            let (outer, mut inner) = (last.side(0), last.side(2));
-            inner.reverse();
-            debug_assert_eq!(inner.len() as i64, quads + 1);
-            let diagonals =
-                if iv.odd { Diagonals::InsideToOutsideExceptMiddle } else { Diagonals::InsideToOutside };
-            emit.regular(false, diagonals, &inner, &outer);
-        }
+            Diagonals::InsideToOutside
+        };
+        emit.regular(false, diagonals, inner, outer);
     }
 }
 
-fn tri(pre: &Processed, out: &mut HardwareTessellation) {
+fn tri(pre: &Processed, out: &mut HardwareTessellation, rings: &mut Rings) {
     let axis = pre.inside[0];
     let n = axis.points;
-    let mut rings = vec![outer_ring(pre, out, |e, x| match e {
+    outer_ring(pre, out, rings.next(), |e, x| match e {
         0 => (0, x),
         1 => (x, 0),
         _ => (x, ONE - x),
-    })];
+    });
     for r in 1..n >> 1 {
         let end = n - 1 - r;
         // The ring's distance from each side, scaled to barycentric size (2/3 of the 1-D
         // position), and the along-side parameters pushed in by half of it.
         let perp = (axis.place(r) * TWO_THIRDS + HALF) >> FRACTION_BITS;
         let shift = (perp + 1) / 2;
-        let mut ring = Ring::default();
+        let ring = rings.next();
         for e in 0..3 {
             for p in r..end {
                 let q = if e % 2 == 1 { p } else { end - (p - r) };
@@ -466,16 +508,15 @@ fn tri(pre: &Processed, out: &mut HardwareTessellation) {
             }
             ring.side_points[e] = (n - 2 * r) as u32;
         }
-        rings.push(ring);
     }
     if !axis.odd {
         let centre = push(out, ONE_THIRD, ONE_THIRD);
-        rings.push(Ring::from_cycle(vec![centre], [1; 4]));
+        rings.next().set_cycle(&[centre], [1; 4]);
     }
     let band_rings = ((n + 1) >> 1) as usize;
-    stitch_bands(pre, &rings, band_rings, |_| &axis, out);
+    stitch_bands(pre, rings, band_rings, |_| &axis, out);
     if axis.odd {
-        let last = &rings[band_rings - 1];
+        let last = &rings.rings[band_rings - 1];
         Emit { out, region: band_rings as u32 }.tri(last.point(0), last.point(1), last.point(2));
     }
 }
