@@ -364,7 +364,7 @@ pub(crate) fn plan_limited(
 }
 
 /// The boundary curves' second-derivative bounds per patch and local edge
-/// ([`bounds::curve_second_derivative`]), view-independent, for [`curve_factor`].
+/// ([`bounds::curve_second_derivative`]), view-independent: a curve needs `sqrt(M / 8ε)` segments on its own.
 /// Cost: O(P).
 pub fn curve_bounds(set: &SurfaceSet) -> Vec<[f64; 4]> {
     set.patches
