@@ -12,36 +12,16 @@
 //!
 //! `cargo run --release -p tessera --example frame_loop [-- PATCHES_OR_OBJ]`
 
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 use tessera::camera::Camera;
 use tessera::scheme::{Criterion, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{MeshBuilder, Tessellator, TessellatorOptions};
 
-/// Counts allocations, to check what a frame allocates.
-struct Counting;
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract is passed on as it is.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: as above.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+#[path = "common/counting.rs"]
+mod counting;
+use counting::{allocations as allocated, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -114,11 +94,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut camera = Camera::framing(lo, hi, 1280, 720);
             camera.eye = centre + glam::DVec3::new(a.cos(), 0.35, a.sin()) * distance;
             camera.target = centre;
-            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            let before = allocated();
             let t = Instant::now();
             tess.frame_into(Some(&camera), &mut out)?;
             times.push(ms(t));
-            allocations.push(ALLOCATIONS.load(Ordering::Relaxed) - before);
+            allocations.push(allocated() - before);
             println!(
                 "{frame:>5} {:>9.2} {:>10} {:>11}",
                 times[frame],

@@ -354,23 +354,26 @@ impl Scheme {
                     screen::visibility_into(set, prepared.views(set), &view, true, &mut plan.visible);
                 }
             }
-            Criterion::Factor(f) => {
-                let camera =
-                    if options.cull { cull_camera()? } else { camera.unwrap_or_else(|| framing(set)) };
-                let factors = EdgeFactors::Fixed(f);
+            Criterion::Factor(_) | Criterion::View { .. } => {
+                let (camera, factors) = match *criterion {
+                    Criterion::Factor(f) => {
+                        let camera = if options.cull {
+                            cull_camera()?
+                        } else {
+                            camera.unwrap_or_else(|| framing(set))
+                        };
+                        (camera, EdgeFactors::Fixed(f))
+                    }
+                    Criterion::View { criterion, fmin, fmax } => {
+                        let camera = camera.ok_or(Error::NeedsCamera { what: "a view criterion" })?;
+                        let fmax = fmax.min(cap);
+                        (camera, EdgeFactors::View { criterion, fmin: fmin.min(fmax), fmax })
+                    }
+                    _ => unreachable!("matched above"),
+                };
                 let cull = options.cull;
-                view::plan_into(
-                    set,
-                    prepared,
-                    &camera,
-                    factors,
-                    rule,
-                    interior,
-                    &caps,
-                    cull,
-                    scratch,
-                    &mut out.plan,
-                );
+                let plan = &mut out.plan;
+                view::plan_into(set, prepared, &camera, factors, rule, interior, &caps, cull, scratch, plan);
             }
             Criterion::Tolerance(_) | Criterion::PixelError(_) => {
                 // Each patch's object-space tolerance (None: culled).
@@ -418,24 +421,6 @@ impl Scheme {
                 )?;
                 scratch.resolve_time = start.elapsed();
                 out.report = Some(report);
-            }
-            Criterion::View { criterion, fmin, fmax } => {
-                let camera = camera.ok_or(Error::NeedsCamera { what: "a view criterion" })?;
-                let fmax = fmax.min(cap);
-                let factors = EdgeFactors::View { criterion, fmin: fmin.min(fmax), fmax };
-                let cull = options.cull;
-                view::plan_into(
-                    set,
-                    prepared,
-                    &camera,
-                    factors,
-                    rule,
-                    interior,
-                    &caps,
-                    cull,
-                    scratch,
-                    &mut out.plan,
-                );
             }
             Criterion::Esc { .. } => unreachable!("refused by accepts"),
         }

@@ -6,8 +6,6 @@
 //! rayon pool so that which thread builds which pattern, and so which thread's buffers grow,
 //! is the same in both walks.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicU64, Ordering};
 use tessera::camera::Camera;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::pattern::hardware::Partitioning;
@@ -15,26 +13,9 @@ use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 
-struct Counting;
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract is passed on as it is.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: as above.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+#[path = "../examples/common/counting.rs"]
+mod counting;
+use counting::{allocations, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -65,13 +46,13 @@ fn second_walk_allocations(set: &SurfaceSet, scheme: Scheme, criterion: Criterio
             let a = frame as f64 / 16.0 * std::f64::consts::TAU;
             let mut camera = Camera::framing(lo, hi, 1280, 720);
             camera.eye = centre + glam::DVec3::new(a.cos(), 0.35, a.sin()) * radius * (4.0 + 2.0 * a.cos());
-            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            let before = allocations();
             let mesh = tess.frame(Some(&camera)).expect("frame");
             if walk == 0 {
                 triangles.push(mesh.triangle_count());
             } else {
                 assert_eq!(mesh.triangle_count(), triangles[frame], "{scheme:?}: the walks differ");
-                counted += ALLOCATIONS.load(Ordering::Relaxed) - before;
+                counted += allocations() - before;
             }
         }
     }
