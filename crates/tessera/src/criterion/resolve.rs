@@ -57,7 +57,7 @@ pub struct Caps<'a> {
 }
 
 /// Resolves per-use proposals into per-edge segments and factors (written into `segments`
-/// and `factors`, cleared first). Cost: O(E) plus the edge uses.
+/// and `factors`, cleared first). Cost: O(E) plus the edge uses, parallel.
 pub fn edges(
     set: &SurfaceSet,
     proposals: &[Proposals],
@@ -67,44 +67,49 @@ pub fn edges(
     segments: &mut Vec<u32>,
     factors: &mut Vec<f32>,
 ) {
+    use rayon::prelude::*;
     let topo = &set.topology;
+    let edges = topo.edges.len();
     segments.clear();
+    segments.resize(edges, 0);
     factors.clear();
+    factors.resize(edges, 0.0);
     let cap = caps.max_factor.max(1.0);
-    for e in 0..topo.edges.len() {
-        let wanted = topo
-            .edge_uses(e)
-            .iter()
-            .map(|u| proposals[u.patch as usize][u.local as usize])
-            .fold(0.0, f64::max)
-            .min(cap);
-        let minimum = caps.minimum_segments[e].max(1);
-        let (s, f) = match rule {
-            EdgeRule::Integer => {
-                let s = (wanted.round() as u32).max(minimum);
-                (s, s as f32)
-            }
-            EdgeRule::PowerOfTwo => {
-                // Level ⌈log2 f⌉, with a margin for factors that are powers of two up to
-                // rounding (the view criteria interpolate levels, not factors).
-                let level = (wanted.max(1.0).log2() - 1e-9).ceil().max(0.0) as u32;
-                let s = (1u32 << level.min(31)).max(minimum).next_power_of_two().min(cap as u32);
-                (s, s as f32)
-            }
-            EdgeRule::Fractional(spacing) => {
-                let f = wanted.max(minimum as f64);
-                let f = match spacing {
-                    Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
-                    Spacing::Symmetric => f,
-                };
-                // Segments follow from the stored f32 factor, the one every engine reads.
-                let f = f as f32;
-                (spacing_segments(f as f64, spacing), f)
-            }
-        };
-        segments.push(s);
-        factors.push(f);
-    }
+    // Every edge on its own: parallel, in blocks large enough to outweigh the scheduling.
+    segments.par_iter_mut().zip(factors.par_iter_mut()).enumerate().with_min_len(1024).for_each(
+        |(e, (s, f))| {
+            let wanted = topo
+                .edge_uses(e)
+                .iter()
+                .map(|u| proposals[u.patch as usize][u.local as usize])
+                .fold(0.0, f64::max)
+                .min(cap);
+            let minimum = caps.minimum_segments[e].max(1);
+            (*s, *f) = match rule {
+                EdgeRule::Integer => {
+                    let s = (wanted.round() as u32).max(minimum);
+                    (s, s as f32)
+                }
+                EdgeRule::PowerOfTwo => {
+                    // Level ⌈log2 f⌉, with a margin for factors that are powers of two up to
+                    // rounding (the view criteria interpolate levels, not factors).
+                    let level = (wanted.max(1.0).log2() - 1e-9).ceil().max(0.0) as u32;
+                    let s = (1u32 << level.min(31)).max(minimum).next_power_of_two().min(cap as u32);
+                    (s, s as f32)
+                }
+                EdgeRule::Fractional(spacing) => {
+                    let f = wanted.max(minimum as f64);
+                    let f = match spacing {
+                        Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
+                        Spacing::Symmetric => f,
+                    };
+                    // Segments follow from the stored f32 factor, the one every engine reads.
+                    let f = f as f32;
+                    (spacing_segments(f as f64, spacing), f)
+                }
+            };
+        },
+    );
     if interior == InteriorRule::Global {
         let n = segments
             .iter()

@@ -91,16 +91,24 @@ impl Layout {
         self.corners = topo.corner_entries.len() as u32;
         // Edges: inner samples per variant; none for collapsed edges or edges seen by no
         // visible patch (nothing refers to them).
-        let mut total = self.corners as u64;
+        // Counts in parallel (segments ≤ MAX_FACTOR and ≤ 255 variants: a count fits u32),
+        // then the scan in place.
+        let edges = topo.edges.len();
         self.edge_offsets.clear();
-        for (e, edge) in topo.edges.iter().enumerate() {
-            self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
-            let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
-            if !edge.collapsed && seen {
-                total += (plan.segments(e) as u64 - 1) * edge.variants as u64;
-            }
+        self.edge_offsets.resize(edges + 1, 0);
+        self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024).for_each(
+            |(e, (count, edge))| {
+                let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
+                *count =
+                    if !edge.collapsed && seen { (plan.segments(e) - 1) * edge.variants as u32 } else { 0 };
+            },
+        );
+        let mut total = self.corners as u64;
+        for offset in self.edge_offsets.iter_mut() {
+            let count = *offset as u64;
+            *offset = total.min(u32::MAX as u64) as u32;
+            total += count;
         }
-        self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
