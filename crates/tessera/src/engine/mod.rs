@@ -336,7 +336,9 @@ impl Writer<'_> {
         let map = LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
         scratch.build(self.pattern, &map.input);
         let local = &scratch.local;
-        match self.fast.and_then(|f| Some((f, f.covers_patch(self.pattern, &map.input)?))) {
+        // A patch without interior vertices (most, in a distant view) asks no evaluator.
+        let fast = self.fast.filter(|_| !local.interior.is_empty());
+        match fast.and_then(|f| Some((f, f.covers_patch(self.pattern, &map.input)?))) {
             Some((f, grid)) => f.interior(p, grid, verts),
             None => {
                 for (k, &uv) in local.interior.iter().enumerate() {
