@@ -171,8 +171,10 @@ pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
 }
 
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
-/// starts and ends at one point): only then can a pattern triangle degenerate.
-pub(crate) fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
+/// starts and ends at one point): only then can a pattern triangle degenerate. Public so that
+/// the GPU engine (tessera-gpu) flags the same patches for its collapsed-triangle path.
+/// Cost: O(1).
+pub fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
     let n = set.patches[p].domain().corner_count();
     let c = &set.topology.patch_corners[p][..n];
     (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))

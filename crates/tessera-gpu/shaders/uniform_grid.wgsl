@@ -1,0 +1,75 @@
+// The uniform quad pattern's grid (`tessera::pattern::uniform`) mapped to output vertices
+// by the layout's numbering rule (`tessera::engine` `LocalMap::vertex`), and the rule that
+// drops triangles degenerate at a collapsed curve (`engine::layout::degenerate_after_collapse`).
+
+// What grid point (i, j) of an n-grid is: a corner, a sample of a local edge (counted in the
+// patch's own direction, corner e → e + 1) or an interior point. Mirrors `uniform::quad_local`.
+struct GridSlot {
+    // 0 corner, 1 edge sample, 2 interior.
+    kind: u32,
+    // The corner or the local edge.
+    index: u32,
+    // The sample along the edge (edges), the interior vertex j (interior).
+    k: u32,
+}
+
+fn grid_slot(n: u32, i: u32, j: u32) -> GridSlot {
+    if (j == 0u && i == 0u) { return GridSlot(0u, 0u, 0u); }
+    if (j == 0u && i == n) { return GridSlot(0u, 1u, 0u); }
+    if (j == n && i == n) { return GridSlot(0u, 2u, 0u); }
+    if (j == n && i == 0u) { return GridSlot(0u, 3u, 0u); }
+    if (j == 0u) { return GridSlot(1u, 0u, i); }
+    if (i == n) { return GridSlot(1u, 1u, j); }
+    if (j == n) { return GridSlot(1u, 2u, n - i); }
+    if (i == 0u) { return GridSlot(1u, 3u, n - j); }
+    return GridSlot(2u, 0u, (j - 1u) * (n - 1u) + (i - 1u));
+}
+
+// The output vertex of the patch's own sample k of local edge e: `LocalMap::edge_vertex`
+// (a collapsed curve's samples are its corner) with `Layout::edge_vertex`'s formula.
+fn edge_sample_vertex(p: u32, e: u32, k: u32) -> u32 {
+    if (patch_edge_collapsed(p, e)) {
+        return patch_corner_entry(p, e);
+    }
+    let edge = patch_edge(p, e);
+    let s = segments[edge];
+    var kc = k;
+    if (patch_edge_reversed(p, e)) { kc = s - k; }
+    return vertex_offsets[edge] + patch_edge_variant(p, e) * (s - 1u) + kc - 1u;
+}
+
+// The output vertex of grid point (i, j) of visible patch p: `LocalMap::vertex`.
+fn grid_vertex(p: u32, n: u32, i: u32, j: u32) -> u32 {
+    let s = grid_slot(n, i, j);
+    if (s.kind == 0u) { return patch_corner_entry(p, s.index); }
+    if (s.kind == 1u) { return edge_sample_vertex(p, s.index, s.k); }
+    return vertex_offsets[params.edges + p] + s.k;
+}
+
+// The identity `degenerate_after_collapse` compares: corners and samples of collapsed
+// curves are their corner entry (x = 1); any other grid point is itself (x = 0).
+fn collapse_id(p: u32, n: u32, i: u32, j: u32) -> vec2<u32> {
+    let s = grid_slot(n, i, j);
+    if (s.kind == 0u) { return vec2<u32>(1u, patch_corner_entry(p, s.index)); }
+    if (s.kind == 1u && patch_edge_collapsed(p, s.index)) { return vec2<u32>(1u, patch_corner_entry(p, s.index)); }
+    return vec2<u32>(0u, j * (n + 1u) + i);
+}
+
+// Triangle `half` (0 or 1) of cell (i, j), as `uniform::grid` emits it: [a, b, c], [a, c, d]
+// with a = (i, j), b = (i + 1, j), c = (i + 1, j + 1), d = (i, j + 1). Returns the grid
+// points as (i, j) pairs.
+fn cell_triangle(i: u32, j: u32, half: u32) -> array<vec2<u32>, 3> {
+    let a = vec2<u32>(i, j);
+    let c = vec2<u32>(i + 1u, j + 1u);
+    if (half == 0u) {
+        return array<vec2<u32>, 3>(a, vec2<u32>(i + 1u, j), c);
+    }
+    return array<vec2<u32>, 3>(a, c, vec2<u32>(i, j + 1u));
+}
+
+fn triangle_degenerates(p: u32, n: u32, t: array<vec2<u32>, 3>) -> bool {
+    let a = collapse_id(p, n, t[0].x, t[0].y);
+    let b = collapse_id(p, n, t[1].x, t[1].y);
+    let c = collapse_id(p, n, t[2].x, t[2].y);
+    return all(a == b) || all(b == c) || all(a == c);
+}

@@ -1,0 +1,82 @@
+// Vertex write passes: every output vertex evaluated once, at the place the layout gives it
+// (`tessera::engine::write`'s corners, edges and patches). Shared edge vertices are written
+// once, by the edge's owner use, and every patch indexes them: watertight bit for bit.
+
+// Corner entry x: position from its vertex's first entry's owner (`position_entry`), normal
+// and uv from its own owner, as `engine::write_corners` and the split-normal copy do.
+@compute @workgroup_size(WORKGROUP)
+fn write_corners(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let x = thread_index(wid, nwg, lid);
+    if (x >= params.corners) { return; }
+    let row = x * CORNER_ROW;
+    let owner = corner_rows[row];
+    let uv = quad_corner(corner_rows[row + 1u]);
+    let normal = bicubic_eval(owner, uv).normal;
+    let position = bicubic_eval(corner_rows[row + 2u], quad_corner(corner_rows[row + 3u])).position;
+    store_vertex(x, position, normal, uv);
+}
+
+// The first use of edge e with normal variant `variant` (the owner for variant 0).
+fn use_of_variant(e: u32, variant: u32) -> u32 {
+    var u = edge_first_use(e);
+    for (; u < edge_end_use(e); u = u + 1u) {
+        if (use_variant(u) == variant) { break; }
+    }
+    return u;
+}
+
+// Edge vertex corners + x: `engine::write_edge`. Sample k of variant v of edge e, evaluated by
+// the first use of variant v (its normal and uv) at the canonical parameter
+// `uniform_param(segments, k)` mirrored for a reversed use; its position is variant 0's.
+@compute @workgroup_size(WORKGROUP)
+fn write_edge_vertices(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let v = params.corners + thread_index(wid, nwg, lid);
+    if (v >= vertex_offsets[params.edges]) { return; }
+    let e = find_vertex_range(0u, params.edges, v);
+    let s = segments[e];
+    let local = v - vertex_offsets[e];
+    let variant = local / (s - 1u);
+    let k = local % (s - 1u) + 1u;
+    let t = uniform_param(s, k);
+    let owner = edge_first_use(e);
+    let u = use_of_variant(e, variant);
+    let uv = edge_use_point(u, t);
+    let normal = bicubic_eval(use_patch(u), uv).normal;
+    let position = bicubic_eval(use_patch(owner), edge_use_point(owner, t)).position;
+    store_vertex(v, position, normal, uv);
+}
+
+// Domain point of canonical parameter t of an edge, in the patch of use u.
+fn edge_use_point(u: u32, t: f32) -> vec2<f32> {
+    var local_t = t;
+    if (use_reversed(u)) { local_t = 1.0 - t; }
+    return quad_edge_point(use_local(u), local_t);
+}
+
+// Interior vertex j of patch p (`vertex_offsets[E + p] + j`): grid point
+// (j mod (n − 1) + 1, j div (n − 1) + 1) at `i · (1 / n)`, as `pattern::uniform::grid` places it.
+@compute @workgroup_size(WORKGROUP)
+fn write_interior_vertices(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let edges = params.edges;
+    let v = vertex_offsets[edges] + thread_index(wid, nwg, lid);
+    if (v >= vertex_offsets[edges + params.patches]) { return; }
+    let p = find_vertex_range(edges, edges + params.patches, v) - edges;
+    let j = v - vertex_offsets[edges + p];
+    let n = interior[p].x;
+    let step = 1.0 / f32(n);
+    let uv = vec2<f32>(f32(j % (n - 1u) + 1u) * step, f32(j / (n - 1u) + 1u) * step);
+    let point = bicubic_eval(p, uv);
+    store_vertex(v, point.position, point.normal, uv);
+}

@@ -1,0 +1,26 @@
+//! The tessera GPU engine: the CPU engine's count → scan → write pipeline (paper 003,
+//! CudaTess) as wgpu compute passes, reading the **same plan and layout rule** as the CPU.
+//!
+//! What the GPU reads is the CPU library's own data, uploaded as it is: the
+//! [`tessera::criterion::Plan`]'s arrays (segments, interior factors, visibility) byte for
+//! byte, and the topology's edge-use, patch-edge and corner-entry arrays packed into u32
+//! rows ([`upload`]). Where a shader computes something the CPU also computes (counts per
+//! edge and patch, the offsets of [`tessera::engine::Layout`], edge parameters), its comment
+//! names the Rust function it is the GPU form of, and the tests compare the two on every
+//! model.
+//!
+//! Start with [`GpuContext::new`] (an adapter, with the adapter's own limits), then
+//! [`GpuTessellator`]. Nothing in the frame path reads back from the GPU; [`readback`] is
+//! for tests and the command-line tool.
+
+pub mod context;
+pub mod error;
+pub mod readback;
+pub mod scan;
+pub mod shader;
+pub mod tessellator;
+pub mod upload;
+
+pub use context::{GpuContext, SOFTWARE_DRIVER_PACKAGES};
+pub use error::{GpuError, Result};
+pub use tessellator::{GpuTessellator, VERTEX_LAYOUT};

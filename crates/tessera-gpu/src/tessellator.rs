@@ -1,0 +1,572 @@
+//! [`GpuTessellator`]: the prepared set on the device once, a plan per frame, the frame's
+//! passes recorded into the caller's command encoder.
+//!
+//! The passes of a frame, each one compute pass (named in [`PASSES`], timed by
+//! [`PassTimer`] when the adapter has timestamp queries):
+//!
+//! 1. **count** (`count_uniform.wgsl`): per edge and per patch, the counts
+//!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
+//! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
+//!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
+//!    interior offsets), the triangle scan over `P + 1`;
+//! 3. **args** (`indirect_args.wgsl`): one invocation writes the write passes' dispatch
+//!    arguments and the `DrawIndexedIndirect` arguments from the totals;
+//! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
+//!    interior vertices;
+//! 5. **triangles** (`write_triangles_uniform.wgsl`): indices.
+//!
+//! **No read-back in the frame path, by construction**: [`GpuTessellator::record`] only
+//! records compute passes; the buffers it writes are read by the GPU (indirect dispatch and
+//! draw). The only `map_async` of the crate is in [`crate::readback`], which
+//! [`GpuTessellator::read_mesh`], [`GpuTessellator::read_layout`] and
+//! [`PassTimer::read`] use on request.
+
+use crate::context::GpuContext;
+use crate::error::{GpuError, Result};
+use crate::readback;
+use crate::scan::{Scan, ScanPipelines};
+use crate::shader::{self, Binding};
+use crate::upload::{self, GpuSet};
+use tessera::criterion::Plan;
+use tessera::mesh::Mesh;
+use tessera::sampling::SamplingKind;
+use tessera::surface::SurfaceSet;
+
+/// f32 per output vertex: position (3), normal (3), uv (2).
+pub const VERTEX_FLOATS: u32 = 8;
+
+/// Bytes per output vertex.
+pub const VERTEX_STRIDE: u64 = 4 * VERTEX_FLOATS as u64;
+
+/// The vertex buffer's layout for a render pipeline: position at location 0, normal at 1, uv
+/// at 2 (all f32), [`VERTEX_STRIDE`] bytes a vertex. Indices are u32.
+pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: VERTEX_STRIDE,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+};
+
+/// The compute passes of a frame, in order.
+pub const PASSES: [&str; 5] = ["count", "scan", "args", "vertices", "triangles"];
+
+const COMMON: &str = include_str!("../shaders/common.wgsl");
+const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
+const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
+const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
+const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
+const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
+const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
+
+/// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
+const MAIN_STORAGE: u32 = 12;
+/// Storage buffers in group 1 (the args pass's outputs).
+const ARGS_STORAGE: u32 = 3;
+
+/// Constants the tessellation shaders share with this crate.
+fn constants() -> Vec<(&'static str, u32)> {
+    vec![
+        ("PATCH_ROW", upload::PATCH_ROW),
+        ("EDGE_ROW", upload::EDGE_ROW),
+        ("USE_ROW", upload::USE_ROW),
+        ("CORNER_ROW", upload::CORNER_ROW),
+        ("CONTROL_POINTS", upload::CONTROL_POINTS),
+        ("VERTEX_FLOATS", VERTEX_FLOATS),
+    ]
+}
+
+fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
+    shader::module(device, label, parts, &constants())
+}
+
+/// Every pipeline of a frame.
+#[derive(Debug)]
+struct Pipelines {
+    main_layout: wgpu::BindGroupLayout,
+    args_layout: wgpu::BindGroupLayout,
+    count: wgpu::ComputePipeline,
+    scan: ScanPipelines,
+    args: wgpu::ComputePipeline,
+    corners: wgpu::ComputePipeline,
+    edge_vertices: wgpu::ComputePipeline,
+    interior_vertices: wgpu::ComputePipeline,
+    triangles: wgpu::ComputePipeline,
+    collapsed_triangles: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    fn new(device: &wgpu::Device) -> Pipelines {
+        use Binding::*;
+        let mut main = vec![Uniform];
+        main.extend(std::iter::repeat_n(Write, MAIN_STORAGE as usize));
+        let main_layout = shader::layout(device, &main);
+        let args_layout = shader::layout(device, &[Write; ARGS_STORAGE as usize]);
+        let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            })
+        };
+        let one = pipeline_layout(&[Some(&main_layout)]);
+        let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
+        let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let count = module(device, "count", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
+        let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
+        let vertices = module(device, "vertices", &[COMMON, BICUBIC, WRITE_VERTICES]);
+        let triangles = module(device, "triangles", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
+        Pipelines {
+            count: make(&one, &count, "count"),
+            scan: ScanPipelines::new(device),
+            args: make(&two, &args, "write_args"),
+            corners: make(&one, &vertices, "write_corners"),
+            edge_vertices: make(&one, &vertices, "write_edge_vertices"),
+            interior_vertices: make(&one, &vertices, "write_interior_vertices"),
+            triangles: make(&one, &triangles, "write_triangles"),
+            collapsed_triangles: make(&one, &triangles, "write_collapsed_patch_triangles"),
+            main_layout,
+            args_layout,
+        }
+    }
+}
+
+/// `common.wgsl`'s `Params`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    edges: u32,
+    patches: u32,
+    corners: u32,
+    vertex_capacity: u32,
+    triangle_capacity: u32,
+    _pad: [u32; 3],
+}
+
+/// The worst-case output of a plan, known before the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Capacity {
+    /// Vertices the output buffers hold.
+    pub vertices: u64,
+    /// Triangles the output buffers hold.
+    pub triangles: u64,
+}
+
+impl Capacity {
+    /// The bound of `plan` on `set`, the uniform pattern's counts without the triangles that
+    /// may degenerate at collapsed curves: every corner entry, `(s − 1) · variants` per edge,
+    /// `(n − 1)²` and `2n²` per visible patch. Cost: O(E + P).
+    pub fn of_plan(set: &SurfaceSet, plan: &Plan) -> Capacity {
+        let topo = &set.topology;
+        let mut vertices = topo.corner_entries.len() as u64;
+        for (e, edge) in topo.edges.iter().enumerate() {
+            vertices += (plan.segments[e] as u64 - 1) * edge.variants as u64;
+        }
+        let mut triangles = 0;
+        for (p, &[n, _]) in plan.interior.iter().enumerate() {
+            if plan.is_visible(p) {
+                let n = n as u64;
+                vertices += (n - 1) * (n - 1);
+                triangles += 2 * n * n;
+            }
+        }
+        Capacity { vertices, triangles }
+    }
+}
+
+/// Buffers whose size depends on the output capacity, and their bind groups.
+#[derive(Debug)]
+struct Output {
+    capacity: Capacity,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    main: wgpu::BindGroup,
+}
+
+/// The GPU engine for one surface set: uploads the set once, then tessellates a plan per
+/// frame into device buffers that a render pipeline binds directly (see the module doc for
+/// the passes).
+///
+/// Supported now: bicubic patches, [`SamplingKind::Uniform`] plans for the uniform pattern
+/// (every edge of a visible patch cut into its interior factor, as `Scheme::Uniform` plans
+/// are); anything else is refused with [`GpuError::Unsupported`].
+#[derive(Debug)]
+pub struct GpuTessellator {
+    set: GpuSet,
+    pipelines: Pipelines,
+    params: wgpu::Buffer,
+    segments: wgpu::Buffer,
+    interior: wgpu::Buffer,
+    visible: wgpu::Buffer,
+    vertex_offsets: wgpu::Buffer,
+    triangle_offsets: wgpu::Buffer,
+    vertex_scan: Scan,
+    triangle_scan: Scan,
+    draw_args: wgpu::Buffer,
+    dispatch_args: wgpu::Buffer,
+    status: wgpu::Buffer,
+    args: wgpu::BindGroup,
+    output: Option<Output>,
+    /// The largest buffer the device binds or allocates.
+    buffer_limit: u64,
+}
+
+fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(4), usage, mapped_at_creation: false })
+}
+
+impl GpuTessellator {
+    /// Uploads `set` (see [`crate::upload`]) and compiles the frame's pipelines.
+    ///
+    /// Errors: [`GpuError::Unsupported`] for triangle patches or an adapter with fewer than
+    /// 15 storage buffers per shader stage. Cost: O(P + E) packing, one upload, seven
+    /// shader compilations (about a second on lavapipe).
+    pub fn new(ctx: &GpuContext, set: &SurfaceSet) -> Result<GpuTessellator> {
+        let needed = MAIN_STORAGE + ARGS_STORAGE;
+        if ctx.limits.max_storage_buffers_per_shader_stage < needed {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "an adapter with {} storage buffers per shader stage ({needed} needed)",
+                    ctx.limits.max_storage_buffers_per_shader_stage
+                ),
+            });
+        }
+        let device = &ctx.device;
+        let gpu_set = GpuSet::new(device, set)?;
+        let (e, p) = (gpu_set.edges as u64, gpu_set.patches as u64);
+        use wgpu::BufferUsages as U;
+        let plan_usage = U::STORAGE | U::COPY_DST;
+        let layout_usage = U::STORAGE | U::COPY_SRC;
+        let vertex_offsets = buffer(device, "vertex offsets", 4 * (e + p + 1), layout_usage);
+        let triangle_offsets = buffer(device, "triangle offsets", 4 * (p + 1), layout_usage);
+        let pipelines = Pipelines::new(device);
+        let vertex_scan =
+            Scan::new(device, &pipelines.scan, &vertex_offsets, (e + p + 1) as u32, gpu_set.corners);
+        let triangle_scan = Scan::new(device, &pipelines.scan, &triangle_offsets, (p + 1) as u32, 0);
+        let draw_args = buffer(device, "draw indexed indirect", 20, U::STORAGE | U::INDIRECT | U::COPY_SRC);
+        let dispatch_args = buffer(device, "write dispatches", 36, U::STORAGE | U::INDIRECT);
+        let status = buffer(device, "status", 16, U::STORAGE | U::COPY_SRC);
+        let args = shader::bind(device, &pipelines.args_layout, &[&draw_args, &dispatch_args, &status]);
+        Ok(GpuTessellator {
+            params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
+            segments: buffer(device, "segments", 4 * e, plan_usage),
+            interior: buffer(device, "interior", 8 * p, plan_usage),
+            visible: buffer(device, "visible", 4 * p, plan_usage),
+            vertex_offsets,
+            triangle_offsets,
+            vertex_scan,
+            triangle_scan,
+            draw_args,
+            dispatch_args,
+            status,
+            args,
+            output: None,
+            buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
+            set: gpu_set,
+            pipelines,
+        })
+    }
+
+    /// Uploads `plan` for the next [`GpuTessellator::record`], growing the output buffers
+    /// to its worst case ([`Capacity::of_plan`]) when they are too small.
+    ///
+    /// Preconditions: `plan` was made for `set`, the set given to [`GpuTessellator::new`].
+    /// Errors: [`tessera::Error::PlanMismatch`] for a plan of another set;
+    /// [`GpuError::Unsupported`] for a plan that is not uniform per patch;
+    /// [`GpuError::OutputTooLarge`] when the worst case exceeds the u32 index range or the
+    /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the
+    /// plan's arrays (16 bytes a patch, 4 an edge); a reallocation when the output grows.
+    pub fn prepare(&mut self, ctx: &GpuContext, set: &SurfaceSet, plan: &Plan) -> Result<()> {
+        plan.check(set)?;
+        if set.patches.len() as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
+            return Err(tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into());
+        }
+        if plan.kind != SamplingKind::Uniform {
+            return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
+        }
+        for (p, &[n, _]) in plan.interior.iter().enumerate() {
+            let edges = &set.topology.patch_edges[p];
+            if plan.is_visible(p) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
+                return Err(GpuError::Unsupported {
+                    what: format!("patch {p}: edges cut unlike its interior (only the uniform pattern is on the GPU)"),
+                });
+            }
+        }
+        let capacity = Capacity::of_plan(set, plan);
+        self.reserve(ctx, capacity)?;
+        let queue = &ctx.queue;
+        queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
+        queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
+        queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
+        Ok(())
+    }
+
+    /// Makes the output buffers hold at least `capacity`. Errors with
+    /// [`GpuError::OutputTooLarge`] past the device's limits. Cost: a reallocation and new
+    /// bind groups when they grow; nothing otherwise.
+    pub fn reserve(&mut self, ctx: &GpuContext, capacity: Capacity) -> Result<()> {
+        if self.output.as_ref().is_some_and(|o| {
+            o.capacity.vertices >= capacity.vertices && o.capacity.triangles >= capacity.triangles
+        }) {
+            return Ok(());
+        }
+        let vertex_bytes = capacity.vertices * VERTEX_STRIDE;
+        let index_bytes = capacity.triangles * 12;
+        let too_large = capacity.vertices > u32::MAX as u64
+            || capacity.triangles > u32::MAX as u64 / 3
+            || vertex_bytes.max(index_bytes) > self.buffer_limit;
+        if too_large {
+            return Err(GpuError::OutputTooLarge {
+                vertices: capacity.vertices,
+                triangles: capacity.triangles,
+                bytes: vertex_bytes.max(index_bytes),
+                limit: self.buffer_limit,
+            });
+        }
+        let device = &ctx.device;
+        use wgpu::BufferUsages as U;
+        let usage = U::STORAGE | U::COPY_SRC;
+        let vertices = buffer(device, "tessera vertices", vertex_bytes, usage | U::VERTEX);
+        let indices = buffer(device, "tessera indices", index_bytes, usage | U::INDEX);
+        let params = Params {
+            edges: self.set.edges,
+            patches: self.set.patches,
+            corners: self.set.corners,
+            vertex_capacity: capacity.vertices as u32,
+            triangle_capacity: capacity.triangles as u32,
+            _pad: [0; 3],
+        };
+        ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let s = &self.set;
+        let main = shader::bind(
+            device,
+            &self.pipelines.main_layout,
+            &[
+                &self.params,
+                &s.control_points,
+                &s.patch_rows,
+                &s.edge_rows,
+                &s.uses,
+                &s.corner_rows,
+                &self.segments,
+                &self.interior,
+                &self.visible,
+                &self.vertex_offsets,
+                &self.triangle_offsets,
+                &vertices,
+                &indices,
+            ],
+        );
+        self.output = Some(Output { capacity, vertices, indices, main });
+        Ok(())
+    }
+
+    /// Records the frame's passes for the last prepared plan into `encoder`. Reads nothing
+    /// back. Precondition: [`GpuTessellator::prepare`] succeeded once (else nothing is
+    /// recorded). Cost on the GPU: O(output) work in about a dozen dispatches.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.record_timed(encoder, None)
+    }
+
+    /// [`GpuTessellator::record`], each pass timed by `timer` (see [`PassTimer`]).
+    pub fn record_timed(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<&PassTimer>) {
+        let Some(out) = &self.output else { return };
+        let p = &self.pipelines;
+        let (e, patches, corners) = (self.set.edges, self.set.patches, self.set.corners);
+        {
+            let mut c = begin_pass(encoder, timer, 0);
+            c.set_pipeline(&p.count);
+            c.set_bind_group(0, &out.main, &[]);
+            let (x, y) = shader::grid((e + patches + 1).div_ceil(shader::WORKGROUP));
+            c.dispatch_workgroups(x, y, 1);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 1);
+            self.vertex_scan.record(&p.scan, &mut c);
+            self.triangle_scan.record(&p.scan, &mut c);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 2);
+            c.set_pipeline(&p.args);
+            c.set_bind_group(0, &out.main, &[]);
+            c.set_bind_group(1, &self.args, &[]);
+            c.dispatch_workgroups(1, 1, 1);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 3);
+            c.set_bind_group(0, &out.main, &[]);
+            if corners > 0 {
+                c.set_pipeline(&p.corners);
+                let (x, y) = shader::grid(corners.div_ceil(shader::WORKGROUP));
+                c.dispatch_workgroups(x, y, 1);
+            }
+            c.set_pipeline(&p.edge_vertices);
+            c.dispatch_workgroups_indirect(&self.dispatch_args, 0);
+            c.set_pipeline(&p.interior_vertices);
+            c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 4);
+            c.set_bind_group(0, &out.main, &[]);
+            c.set_pipeline(&p.triangles);
+            c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
+            if self.set.any_repeated_corner {
+                c.set_pipeline(&p.collapsed_triangles);
+                let (x, y) = shader::grid(patches.div_ceil(shader::WORKGROUP));
+                c.dispatch_workgroups(x, y, 1);
+            }
+        }
+        if let Some(t) = timer {
+            encoder.resolve_query_set(&t.queries, 0..2 * PASSES.len() as u32, &t.resolved, 0);
+        }
+    }
+
+    /// The vertex buffer ([`VERTEX_LAYOUT`]); usages VERTEX, STORAGE, COPY_SRC. None before
+    /// the first [`GpuTessellator::prepare`]. It may be replaced by a larger one when a
+    /// later plan needs more room.
+    pub fn vertex_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.output.as_ref().map(|o| &o.vertices)
+    }
+
+    /// The u32 index buffer, a triangle list; usages INDEX, STORAGE, COPY_SRC.
+    pub fn index_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.output.as_ref().map(|o| &o.indices)
+    }
+
+    /// `DrawIndexedIndirectArgs` (20 bytes at offset 0) for
+    /// `RenderPass::draw_indexed_indirect`; usages INDIRECT, STORAGE, COPY_SRC.
+    pub fn indirect_buffer(&self) -> &wgpu::Buffer {
+        &self.draw_args
+    }
+
+    /// The output capacity, once prepared.
+    pub fn capacity(&self) -> Option<Capacity> {
+        self.output.as_ref().map(|o| o.capacity)
+    }
+
+    /// Reads the frame's status back: `(overflowed, vertices, triangles)`. For tests and
+    /// statistics. Cost: a queue wait.
+    pub fn read_status(&self, ctx: &GpuContext) -> Result<(bool, u32, u32)> {
+        let s: Vec<u32> = readback::read(ctx, &self.status, 4)?;
+        Ok((s[0] != 0, s[1], s[2]))
+    }
+
+    /// Reads the GPU's layout back as `(edge_offsets, interior_offsets, triangle_offsets)`,
+    /// to compare with [`tessera::engine::Layout`]. Cost: a queue wait.
+    pub fn read_layout(&self, ctx: &GpuContext) -> Result<(Vec<u32>, Vec<u32>, Vec<u32>)> {
+        let (e, p) = (self.set.edges as usize, self.set.patches as usize);
+        let v: Vec<u32> = readback::read(ctx, &self.vertex_offsets, e + p + 1)?;
+        let t: Vec<u32> = readback::read(ctx, &self.triangle_offsets, p + 1)?;
+        Ok((v[..=e].to_vec(), v[e..].to_vec(), t))
+    }
+
+    /// Reads the frame's mesh back into a [`Mesh`] (positions, normals, uvs, indices, the
+    /// patch of every triangle and vertex derived from the layout). For tests and the
+    /// command-line tool, never for a frame loop. Errors with [`GpuError::OutputTooLarge`] if
+    /// the frame overflowed. Cost: a queue wait and a copy of the whole output.
+    pub fn read_mesh(&self, ctx: &GpuContext, set: &SurfaceSet) -> Result<Mesh> {
+        let (overflow, vertices, triangles) = self.read_status(ctx)?;
+        let Some(out) = &self.output else { return Ok(Mesh::default()) };
+        if overflow {
+            return Err(GpuError::OutputTooLarge {
+                vertices: vertices as u64,
+                triangles: triangles as u64,
+                bytes: vertices as u64 * VERTEX_STRIDE,
+                limit: out.capacity.vertices * VERTEX_STRIDE,
+            });
+        }
+        let raw: Vec<f32> = readback::read(ctx, &out.vertices, vertices as usize * VERTEX_FLOATS as usize)?;
+        let indices: Vec<u32> = readback::read(ctx, &out.indices, 3 * triangles as usize)?;
+        let (edge_offsets, interior_offsets, triangle_offsets) = self.read_layout(ctx)?;
+        let mut mesh = Mesh { indices, ..Default::default() };
+        for v in raw.chunks_exact(VERTEX_FLOATS as usize) {
+            mesh.positions.push([v[0], v[1], v[2]]);
+            mesh.normals.push([v[3], v[4], v[5]]);
+            mesh.uvs.push([v[6], v[7]]);
+        }
+        // Which patch evaluated each vertex and owns each triangle: the layout's ranges.
+        let topo = &set.topology;
+        mesh.vertex_patch = topo.corner_entries.iter().map(|c| c.owner_patch).collect();
+        for (e, w) in edge_offsets.windows(2).enumerate() {
+            let uses = topo.edge_uses(e);
+            for k in 0..w[1] - w[0] {
+                let inner = (w[1] - w[0]) / topo.edges[e].variants.max(1) as u32;
+                let variant = k / inner.max(1);
+                let u = uses.iter().find(|u| u.variant as u32 == variant).unwrap_or(&uses[0]);
+                mesh.vertex_patch.push(u.patch);
+            }
+        }
+        for (p, w) in interior_offsets.windows(2).enumerate() {
+            mesh.vertex_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
+        }
+        for (p, w) in triangle_offsets.windows(2).enumerate() {
+            mesh.triangle_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
+        }
+        Ok(mesh)
+    }
+}
+
+/// Begins compute pass `index` of [`PASSES`], timed by `timer` if given.
+fn begin_pass<'e>(encoder: &'e mut wgpu::CommandEncoder, timer: Option<&PassTimer>, index: usize) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(PASSES[index]),
+        timestamp_writes: timer.map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: &t.queries,
+            beginning_of_pass_write_index: Some(2 * index as u32),
+            end_of_pass_write_index: Some(2 * index as u32 + 1),
+        }),
+    })
+}
+
+/// Timestamp queries around each of the frame's [`PASSES`], where the adapter has them
+/// ([`GpuContext::timestamps`]).
+#[derive(Debug)]
+pub struct PassTimer {
+    queries: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    period_ns: f32,
+}
+
+impl PassTimer {
+    /// A timer for one frame's passes, or None when the adapter has no timestamp queries.
+    /// Cost: a query set and a 80-byte buffer.
+    pub fn new(ctx: &GpuContext) -> Option<PassTimer> {
+        if !ctx.timestamps {
+            return None;
+        }
+        let count = 2 * PASSES.len() as u32;
+        let queries = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("pass timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
+        let resolved = buffer(
+            &ctx.device,
+            "resolved timestamps",
+            8 * count as u64,
+            wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        );
+        Some(PassTimer { queries, resolved, period_ns: ctx.queue.get_timestamp_period() })
+    }
+
+    /// The last recorded frame's time per pass, in milliseconds, in [`PASSES`] order. Reads
+    /// back (a queue wait): statistics on request only.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<(&'static str, f64)>> {
+        let ticks: Vec<u64> = readback::read(ctx, &self.resolved, 2 * PASSES.len())?;
+        Ok(PASSES
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| {
+                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
+                (name, dt as f64 * self.period_ns as f64 * 1e-6)
+            })
+            .collect())
+    }
+}

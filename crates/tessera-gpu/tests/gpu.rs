@@ -1,0 +1,195 @@
+//! The GPU engine against the CPU engine, on lavapipe in CI. Every expected value comes from
+//! the CPU library (`tessera::engine`) or a CPU scan, never from the GPU itself.
+//!
+//! No adapter is a failure, not a skip: the message names the packages to install.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use tessera::criterion::Plan;
+use tessera::engine::{self, Layout, TessellateOptions};
+use tessera::mesh::Mesh;
+use tessera::pattern::uniform::Uniform;
+use tessera::surface::{BuildOptions, SurfaceSet};
+use tessera_gpu::scan::{Scan, ScanPipelines};
+use tessera_gpu::{readback, GpuContext, GpuError, GpuTessellator};
+
+/// One device for the whole binary (creating one per test costs time on lavapipe).
+fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| match GpuContext::new() {
+        Ok(c) => c,
+        Err(e) => panic!("{e}"),
+    })
+}
+
+fn data_dir() -> PathBuf {
+    std::env::var_os("TESSERA_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
+}
+
+fn load(rel: &str) -> SurfaceSet {
+    let path = data_dir().join(rel);
+    assert!(path.exists(), "test model {} not found: set TESSERA_DATA to the shared data folder", path.display());
+    let file = tessera::io::patches::read_patches(&path).unwrap();
+    SurfaceSet::from_patch_file(&file, BuildOptions::default())
+}
+
+/// Every `.patches` model of the shared data (the small ones and the bench torus).
+fn patch_models() -> Vec<String> {
+    let mut models = Vec::new();
+    for sub in ["patches", "bench"] {
+        let mut names: Vec<String> = std::fs::read_dir(data_dir().join(sub))
+            .unwrap_or_else(|e| panic!("cannot list {sub}: {e}"))
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".patches"))
+            .map(|n| format!("{sub}/{n}"))
+            .collect();
+        names.sort();
+        models.extend(names);
+    }
+    assert!(models.len() >= 4, "{models:?}");
+    models
+}
+
+/// Tiny LCG: the tests' pseudo-random inputs, seeded.
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> u32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 33) as u32
+    }
+}
+
+#[test]
+fn no_adapter_error_names_the_packages() {
+    let e = GpuError::NoAdapter { reason: "none".into() };
+    assert!(e.to_string().contains("apt-get install -y mesa-vulkan-drivers libvulkan1"), "{e}");
+}
+
+#[test]
+fn scan_of_any_length_equals_a_cpu_scan() {
+    let ctx = ctx();
+    let pipelines = ScanPipelines::new(&ctx.device);
+    let mut rng = Lcg(12);
+    for len in [0u32, 1, 255, 256, 257, 65_535, 1_000_003, (1 << 24) + 3] {
+        let base = rng.next() % 1000;
+        let input: Vec<u32> = (0..len).map(|_| rng.next() % 16).collect();
+        let mut expected = Vec::with_capacity(len as usize);
+        let mut sum = base;
+        for &x in &input {
+            expected.push(sum);
+            sum += x;
+        }
+        let buffer = tessera_gpu::upload::storage_buffer(&ctx.device, "scan test", &input);
+        let scan = Scan::new(&ctx.device, &pipelines, &buffer, len, base);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            scan.record(&pipelines, &mut pass);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let got: Vec<u32> = readback::read(ctx, &buffer, len as usize).unwrap();
+        if let Some(i) = (0..len as usize).find(|&i| got[i] != expected[i]) {
+            panic!("length {len}: element {i} is {} instead of {}", got[i], expected[i]);
+        }
+    }
+}
+
+/// The CPU engine's layout and mesh for `plan`.
+fn cpu(set: &SurfaceSet, plan: &Plan) -> (Layout, Mesh) {
+    let mut layout = Layout::default();
+    layout.build(set, plan, &Uniform, &TessellateOptions::default()).unwrap();
+    let mesh = engine::tessellate(set, plan, &Uniform, TessellateOptions::default()).unwrap();
+    (layout, mesh)
+}
+
+fn diagonal(set: &SurfaceSet) -> f64 {
+    let (lo, hi) = set.bounds();
+    (hi - lo).length()
+}
+
+/// The GPU output of `plan` equals the CPU's: the layout's offsets, the triangles (the same
+/// numbering, so index for index), positions within 1e-5 of the diagonal, normals within a
+/// few degrees (a small step off a collapsed corner), the same watertightness report.
+fn assert_gpu_equals_cpu(name: &str, set: &SurfaceSet, gpu: &mut GpuTessellator, plan: &Plan) {
+    let ctx = ctx();
+    gpu.prepare(ctx, set, plan).unwrap();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+    let (layout, want) = cpu(set, plan);
+    let (edge_offsets, interior_offsets, triangle_offsets) = gpu.read_layout(ctx).unwrap();
+    assert_eq!(edge_offsets, layout.edge_offsets, "{name}: edge offsets");
+    assert_eq!(interior_offsets, layout.interior_offsets, "{name}: interior offsets");
+    assert_eq!(triangle_offsets, layout.triangle_offsets, "{name}: triangle offsets");
+    let got = gpu.read_mesh(ctx, set).unwrap();
+    assert_eq!(got.triangle_count(), want.triangle_count(), "{name}: triangles");
+    assert_eq!(got.vertex_count(), want.vertex_count(), "{name}: vertices");
+    // Same numbering rule: the index buffers are equal as they are, so canonically ordered too.
+    if let Some(t) = (0..want.triangle_count()).find(|&t| got.triangle(t) != want.triangle(t)) {
+        panic!("{name}: triangle {t} is {:?}, the CPU's {:?}", got.triangle(t), want.triangle(t));
+    }
+    let tolerance = 1e-5 * diagonal(set);
+    for (v, (g, w)) in got.positions.iter().zip(&want.positions).enumerate() {
+        let d = ((g[0] - w[0]) as f64).hypot((g[1] - w[1]) as f64).hypot((g[2] - w[2]) as f64);
+        assert!(d <= tolerance, "{name}: vertex {v} at {g:?}, the CPU's {w:?} ({d} > {tolerance})");
+    }
+    for (v, (g, w)) in got.normals.iter().zip(&want.normals).enumerate() {
+        let dot = g[0] * w[0] + g[1] * w[1] + g[2] * w[2];
+        assert!(dot > 0.99, "{name}: normal {v} is {g:?}, the CPU's {w:?}");
+    }
+    assert_eq!(got.vertex_patch, want.vertex_patch, "{name}: vertex patches");
+    assert_eq!(got.triangle_patch, want.triangle_patch, "{name}: triangle patches");
+    let (g, w) = (tessera::verify::watertight(&got), tessera::verify::watertight(&want));
+    assert_eq!(
+        (g.boundary_edges, g.nonmanifold_edges, g.misoriented_edges, g.euler_characteristic),
+        (w.boundary_edges, w.nonmanifold_edges, w.misoriented_edges, w.euler_characteristic),
+        "{name}: watertightness {g:?} vs the CPU's {w:?}"
+    );
+}
+
+#[test]
+fn uniform_tessellation_equals_the_cpu_engine_on_every_patch_model() {
+    for model in patch_models() {
+        let set = load(&model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        // The torus is large: fewer factors there keep the fast tier fast.
+        let factors: &[u32] = if set.patches.len() > 500 { &[1, 5] } else { &[1, 2, 3, 8] };
+        for &n in factors {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
+        }
+    }
+}
+
+#[test]
+fn culled_patches_emit_nothing_as_on_the_cpu() {
+    let mut rng = Lcg(3);
+    for model in ["patches/teapot.patches", "patches/teacup.patches"] {
+        let set = load(model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        for round in 0..3 {
+            let mut plan = Plan::uniform(&set, 4 + round).unwrap();
+            for v in plan.visible.iter_mut() {
+                *v = (rng.next() % 3 != 0) as u32;
+            }
+            assert_gpu_equals_cpu(&format!("{model} culled round {round}"), &set, &mut gpu, &plan);
+        }
+    }
+}
+
+#[test]
+fn an_output_past_the_device_limits_is_refused_not_truncated() {
+    let ctx = ctx();
+    let set = load("patches/teapot.patches");
+    let mut gpu = GpuTessellator::new(ctx, &set).unwrap();
+    let plan = Plan::uniform(&set, tessera::criterion::MAX_FACTOR).unwrap();
+    let err = gpu.prepare(ctx, &set, &plan).unwrap_err();
+    assert!(matches!(err, GpuError::OutputTooLarge { .. }), "{err}");
+    // A plan of another set is refused too.
+    let other = load("patches/teacup.patches");
+    let plan = Plan::uniform(&other, 2).unwrap();
+    assert!(gpu.prepare(ctx, &set, &plan).is_err());
+}
