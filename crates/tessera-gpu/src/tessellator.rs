@@ -27,6 +27,7 @@ use crate::readback;
 use crate::scan::{Scan, ScanPipelines};
 use crate::shader::{self, Binding};
 use crate::upload::{self, GpuSet};
+use tessera::camera::Camera;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
 use tessera::sampling::SamplingKind;
@@ -46,8 +47,9 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
     attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
 };
 
-/// The compute passes of a frame, in order.
-pub const PASSES: [&str; 5] = ["count", "scan", "args", "vertices", "triangles"];
+/// The compute passes of a frame, in order ("cull" only with a culling camera,
+/// [`GpuTessellator::set_cull_camera`]).
+pub const PASSES: [&str; 6] = ["cull", "count", "scan", "args", "vertices", "triangles"];
 
 const COMMON: &str = include_str!("../shaders/common.wgsl");
 const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
@@ -56,6 +58,7 @@ const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
 const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
 const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
 const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
+const CULL: &str = include_str!("../shaders/cull.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
@@ -83,6 +86,8 @@ fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderMod
 struct Pipelines {
     main_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
+    cull_layout: wgpu::BindGroupLayout,
+    cull: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
     scan: ScanPipelines,
     args: wgpu::ComputePipeline,
@@ -100,6 +105,7 @@ impl Pipelines {
         main.extend(std::iter::repeat_n(Write, MAIN_STORAGE as usize));
         let main_layout = shader::layout(device, &main);
         let args_layout = shader::layout(device, &[Write; ARGS_STORAGE as usize]);
+        let cull_layout = shader::layout(device, &[Uniform, Write]);
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -109,6 +115,7 @@ impl Pipelines {
         };
         let one = pipeline_layout(&[Some(&main_layout)]);
         let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
+        let with_view = pipeline_layout(&[Some(&main_layout), Some(&cull_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -120,10 +127,12 @@ impl Pipelines {
             })
         };
         let count = module(device, "count", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
+        let cull = module(device, "cull", &[COMMON, CULL]);
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let vertices = module(device, "vertices", &[COMMON, BICUBIC, WRITE_VERTICES]);
         let triangles = module(device, "triangles", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
         Pipelines {
+            cull: make(&with_view, &cull, "cull"),
             count: make(&one, &count, "count"),
             scan: ScanPipelines::new(device),
             args: make(&two, &args, "write_args"),
@@ -134,6 +143,7 @@ impl Pipelines {
             collapsed_triangles: make(&one, &triangles, "write_collapsed_patch_triangles"),
             main_layout,
             args_layout,
+            cull_layout,
         }
     }
 }
@@ -162,8 +172,9 @@ pub struct Capacity {
 impl Capacity {
     /// The bound of `plan` on `set`, the uniform pattern's counts without the triangles that
     /// may degenerate at collapsed curves: every corner entry, `(s − 1) · variants` per edge,
-    /// `(n − 1)²` and `2n²` per visible patch. Cost: O(E + P).
-    pub fn of_plan(set: &SurfaceSet, plan: &Plan) -> Capacity {
+    /// `(n − 1)²` and `2n²` per visible patch (per patch with `all_visible`, when the GPU
+    /// decides visibility). Cost: O(E + P).
+    pub fn of_plan(set: &SurfaceSet, plan: &Plan, all_visible: bool) -> Capacity {
         let topo = &set.topology;
         let mut vertices = topo.corner_entries.len() as u64;
         for (e, edge) in topo.edges.iter().enumerate() {
@@ -171,7 +182,7 @@ impl Capacity {
         }
         let mut triangles = 0;
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
-            if plan.is_visible(p) {
+            if all_visible || plan.is_visible(p) {
                 let n = n as u64;
                 vertices += (n - 1) * (n - 1);
                 triangles += 2 * n * n;
@@ -214,6 +225,10 @@ pub struct GpuTessellator {
     status: wgpu::Buffer,
     args: wgpu::BindGroup,
     output: Option<Output>,
+    /// The culling camera's uniform and bind group, when the GPU culls.
+    cull: Option<CullView>,
+    /// Per patch: normal cone and bounding sphere (`cull.wgsl`), prepared once.
+    cones: wgpu::Buffer,
     /// The largest buffer the device binds or allocates.
     buffer_limit: u64,
 }
@@ -242,7 +257,7 @@ impl GpuTessellator {
         let gpu_set = GpuSet::new(device, set)?;
         let (e, p) = (gpu_set.edges as u64, gpu_set.patches as u64);
         use wgpu::BufferUsages as U;
-        let plan_usage = U::STORAGE | U::COPY_DST;
+        let plan_usage = U::STORAGE | U::COPY_DST | U::COPY_SRC;
         let layout_usage = U::STORAGE | U::COPY_SRC;
         let vertex_offsets = buffer(device, "vertex offsets", 4 * (e + p + 1), layout_usage);
         let triangle_offsets = buffer(device, "triangle offsets", 4 * (p + 1), layout_usage);
@@ -268,6 +283,8 @@ impl GpuTessellator {
             status,
             args,
             output: None,
+            cull: None,
+            cones: upload::storage_buffer(device, "normal cones", &cones(set)),
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
             set: gpu_set,
             pipelines,
@@ -299,7 +316,7 @@ impl GpuTessellator {
                 });
             }
         }
-        let capacity = Capacity::of_plan(set, plan);
+        let capacity = Capacity::of_plan(set, plan, self.cull.is_some());
         self.reserve(ctx, capacity)?;
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
@@ -381,26 +398,37 @@ impl GpuTessellator {
         let p = &self.pipelines;
         let (e, patches, corners) = (self.set.edges, self.set.patches, self.set.corners);
         {
+            // Begun even without culling, so that every timestamp of the timer is written.
             let mut c = begin_pass(encoder, timer, 0);
+            if let Some(view) = &self.cull {
+                c.set_pipeline(&p.cull);
+                c.set_bind_group(0, &out.main, &[]);
+                c.set_bind_group(1, &view.bind, &[]);
+                let (x, y) = shader::grid(patches.div_ceil(shader::WORKGROUP));
+                c.dispatch_workgroups(x, y, 1);
+            }
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 1);
             c.set_pipeline(&p.count);
             c.set_bind_group(0, &out.main, &[]);
             let (x, y) = shader::grid((e + patches + 1).div_ceil(shader::WORKGROUP));
             c.dispatch_workgroups(x, y, 1);
         }
         {
-            let mut c = begin_pass(encoder, timer, 1);
+            let mut c = begin_pass(encoder, timer, 2);
             self.vertex_scan.record(&p.scan, &mut c);
             self.triangle_scan.record(&p.scan, &mut c);
         }
         {
-            let mut c = begin_pass(encoder, timer, 2);
+            let mut c = begin_pass(encoder, timer, 3);
             c.set_pipeline(&p.args);
             c.set_bind_group(0, &out.main, &[]);
             c.set_bind_group(1, &self.args, &[]);
             c.dispatch_workgroups(1, 1, 1);
         }
         {
-            let mut c = begin_pass(encoder, timer, 3);
+            let mut c = begin_pass(encoder, timer, 4);
             c.set_bind_group(0, &out.main, &[]);
             if corners > 0 {
                 c.set_pipeline(&p.corners);
@@ -413,7 +441,7 @@ impl GpuTessellator {
             c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
         }
         {
-            let mut c = begin_pass(encoder, timer, 4);
+            let mut c = begin_pass(encoder, timer, 5);
             c.set_bind_group(0, &out.main, &[]);
             c.set_pipeline(&p.triangles);
             c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
@@ -426,6 +454,39 @@ impl GpuTessellator {
         if let Some(t) = timer {
             encoder.resolve_query_set(&t.queries, 0..2 * PASSES.len() as u32, &t.resolved, 0);
         }
+    }
+
+    /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
+    /// following frame, writing the plan's visibility row on the device (the plan's own row
+    /// is then ignored); None goes back to the plan's row. The output capacity then covers
+    /// every patch. Cost: a 96-byte upload; nothing when unchanged.
+    pub fn set_cull_camera(&mut self, ctx: &GpuContext, camera: Option<&Camera>) {
+        let Some(camera) = camera else {
+            self.cull = None;
+            return;
+        };
+        let (r, u, f) = camera.basis();
+        let t = camera.half_tangents();
+        let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        let mut view = [0f32; 20];
+        view[0..4].copy_from_slice(&v4(camera.eye));
+        view[4..8].copy_from_slice(&v4(r));
+        view[8..12].copy_from_slice(&v4(u));
+        view[12..16].copy_from_slice(&v4(f));
+        view[16..20].copy_from_slice(&[camera.near as f32, camera.far as f32, t.x as f32, t.y as f32]);
+        if self.cull.is_none() {
+            let uniform = buffer(&ctx.device, "cull view", 80, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+            let bind = shader::bind(&ctx.device, &self.pipelines.cull_layout, &[&uniform, &self.cones]);
+            self.cull = Some(CullView { uniform, bind });
+        }
+        let cull = self.cull.as_ref().expect("set above");
+        ctx.queue.write_buffer(&cull.uniform, 0, bytemuck::cast_slice(&view));
+    }
+
+    /// Reads the plan's visibility row back (the GPU's, when it culls). For tests. Cost: a
+    /// queue wait.
+    pub fn read_visible(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
+        readback::read(ctx, &self.visible, self.set.patches as usize)
     }
 
     /// The vertex buffer ([`VERTEX_LAYOUT`]); usages VERTEX, STORAGE, COPY_SRC. None before
@@ -511,6 +572,34 @@ impl GpuTessellator {
         }
         Ok(mesh)
     }
+}
+
+/// The culling camera on the device.
+#[derive(Debug)]
+struct CullView {
+    uniform: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+/// Per patch, three `vec4<f32>` for `cull.wgsl`: the normal cone of
+/// [`tessera::criterion::screen::normal_cone`] (axis, half-angle α), the bounding sphere of
+/// the control points about their mean that `screen::back_facing` uses, and
+/// `(sin α, cos α, has cone, 0)`. View-independent: computed once. Cost: O(P) cone
+/// computations.
+fn cones(set: &SurfaceSet) -> Vec<[f32; 4]> {
+    let mut out = Vec::with_capacity(3 * set.patches.len());
+    for patch in &set.patches {
+        let cone = tessera::criterion::screen::normal_cone(patch);
+        let (axis, alpha) = cone.unwrap_or((glam::DVec3::Z, 0.0));
+        out.push([axis.x as f32, axis.y as f32, axis.z as f32, alpha as f32]);
+        // As in `screen::back_facing`: the centre is the control points' mean.
+        let pts = patch.control_points();
+        let centre = pts.iter().copied().sum::<glam::DVec3>() / pts.len() as f64;
+        let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        out.push([centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]);
+        out.push([alpha.sin() as f32, alpha.cos() as f32, cone.is_some() as u32 as f32, 0.0]);
+    }
+    out
 }
 
 /// Begins compute pass `index` of [`PASSES`], timed by `timer` if given.
