@@ -1,6 +1,7 @@
 //! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
 
 mod pattern_file;
+mod gpu;
 mod plan;
 
 use clap::{Args, Parser, Subcommand};
@@ -96,6 +97,10 @@ struct MeshArgs {
     /// (per level: patch id and edge levels).
     #[arg(long, value_name = "JSON")]
     instanced: Option<PathBuf>,
+    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu; uniform scheme of bicubic
+    /// patches for now; --stats adds per-pass GPU times).
+    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
+    engine: String,
     #[command(flatten)]
     input_args: InputArgs,
 }
@@ -321,7 +326,14 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
     let mut times = Vec::new();
     let mut mesh = Mesh::default();
-    for _ in 0..a.repeat.max(1) {
+    let mut gpu_run = None;
+    if a.engine == "gpu" {
+        if a.measure_error || a.strips {
+            return Err("--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips".into());
+        }
+        gpu_run = Some(gpu::tessellate(&set, &chosen.plan, &chosen.pattern, a.repeat, &mut mesh, &mut times)?);
+    }
+    for _ in 0..if gpu_run.is_some() { 0 } else { a.repeat.max(1) } {
         let start = Instant::now();
         // Buffers are reused across repeats, as an application re-tessellating every frame
         // would: the median then measures tessellation, not page faults.
@@ -383,6 +395,11 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         }
         if let Some(t) = chosen.tolerance {
             stats["tolerance"] = t.into();
+        }
+        if let Some(run) = &gpu_run {
+            stats["engine"] = "gpu".into();
+            stats["adapter"] = run.adapter.clone().into();
+            stats["gpu_pass_ms"] = run.passes_ms.iter().map(|&(n, ms)| (n.to_string(), ms.into())).collect::<serde_json::Map<_, _>>().into();
         }
         if let Some(strips) = &mesh.strips {
             stats["strip_indices"] = strips.len().into();

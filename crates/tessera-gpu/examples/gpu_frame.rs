@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("adapter: {} ({:?}, {})", ctx.info.name, ctx.info.backend, ctx.info.driver_info);
     let mut gpu = GpuTessellator::new(&ctx, &set)?;
     let plan = Plan::uniform(&set, factor)?;
-    gpu.prepare(&ctx, &set, &plan)?;
+    gpu.prepare(&ctx, &set, &plan, &tessera::pattern::uniform::Uniform)?;
     let timer = PassTimer::new(&ctx);
     let mut per_pass = vec![Vec::new(); PASSES.len()];
     let mut wall = Vec::new();

@@ -13,6 +13,8 @@
 //! [`GpuTessellator`]. Nothing in the frame path reads back from the GPU; [`readback`] is
 //! for tests and the command-line tool.
 
+#![warn(missing_docs)]
+
 pub mod context;
 pub mod error;
 pub mod readback;

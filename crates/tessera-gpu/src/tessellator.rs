@@ -30,6 +30,8 @@ use crate::upload::{self, GpuSet};
 use tessera::camera::Camera;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
+use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
 use tessera::sampling::SamplingKind;
 use tessera::surface::SurfaceSet;
 
@@ -225,6 +227,9 @@ pub struct GpuTessellator {
     status: wgpu::Buffer,
     args: wgpu::BindGroup,
     output: Option<Output>,
+    /// The last prepared plan's interior factors (for [`GpuTessellator::read_mesh`]'s count of
+    /// collapsed triangles).
+    interior_factors: Vec<[u32; 2]>,
     /// The culling camera's uniform and bind group, when the GPU culls.
     cull: Option<CullView>,
     /// Per patch: normal cone and bounding sphere (`cull.wgsl`), prepared once.
@@ -283,6 +288,7 @@ impl GpuTessellator {
             status,
             args,
             output: None,
+            interior_factors: Vec::new(),
             cull: None,
             cones: upload::storage_buffer(device, "normal cones", &cones(set)),
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
@@ -291,17 +297,21 @@ impl GpuTessellator {
         })
     }
 
-    /// Uploads `plan` for the next [`GpuTessellator::record`], growing the output buffers
+    /// Uploads `plan` (made for `pattern`, which must be the uniform pattern for now) for the
+    /// next [`GpuTessellator::record`], growing the output buffers
     /// to its worst case ([`Capacity::of_plan`]) when they are too small.
     ///
     /// Preconditions: `plan` was made for `set`, the set given to [`GpuTessellator::new`].
     /// Errors: [`tessera::Error::PlanMismatch`] for a plan of another set;
-    /// [`GpuError::Unsupported`] for a plan that is not uniform per patch;
+    /// [`GpuError::Unsupported`] for another pattern or a plan that is not uniform per patch;
     /// [`GpuError::OutputTooLarge`] when the worst case exceeds the u32 index range or the
     /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the
     /// plan's arrays (16 bytes a patch, 4 an edge); a reallocation when the output grows.
-    pub fn prepare(&mut self, ctx: &GpuContext, set: &SurfaceSet, plan: &Plan) -> Result<()> {
+    pub fn prepare(&mut self, ctx: &GpuContext, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Result<()> {
         plan.check(set)?;
+        if pattern.name() != Uniform.name() {
+            return Err(GpuError::Unsupported { what: format!("the {} pattern (only uniform is on the GPU)", pattern.name()) });
+        }
         if set.patches.len() as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
             return Err(tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into());
         }
@@ -322,6 +332,7 @@ impl GpuTessellator {
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
+        self.interior_factors.clone_from(&plan.interior);
         Ok(())
     }
 
@@ -570,6 +581,16 @@ impl GpuTessellator {
         for (p, w) in triangle_offsets.windows(2).enumerate() {
             mesh.triangle_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
         }
+        // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
+        let visible = self.read_visible(ctx)?;
+        let pattern: u64 = self
+            .interior_factors
+            .iter()
+            .zip(&visible)
+            .filter(|(_, &v)| v != 0)
+            .map(|(&[n, _], _)| 2 * n as u64 * n as u64)
+            .sum();
+        mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
         Ok(mesh)
     }
 }

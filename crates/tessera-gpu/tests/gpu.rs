@@ -115,7 +115,7 @@ fn diagonal(set: &SurfaceSet) -> f64 {
 /// few degrees (a small step off a collapsed corner), the same watertightness report.
 fn assert_gpu_equals_cpu(name: &str, set: &SurfaceSet, gpu: &mut GpuTessellator, plan: &Plan) {
     let ctx = ctx();
-    gpu.prepare(ctx, set, plan).unwrap();
+    gpu.prepare(ctx, set, plan, &tessera::pattern::uniform::Uniform).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     gpu.record(&mut encoder);
     ctx.queue.submit([encoder.finish()]);
@@ -150,6 +150,7 @@ fn assert_gpu_equals_cpu_after_record(name: &str, set: &SurfaceSet, gpu: &GpuTes
     }
     assert_eq!(got.vertex_patch, want.vertex_patch, "{name}: vertex patches");
     assert_eq!(got.triangle_patch, want.triangle_patch, "{name}: triangle patches");
+    assert_eq!(got.collapsed_triangles, want.collapsed_triangles, "{name}: collapsed triangles");
     let (g, w) = (tessera::verify::watertight(&got), tessera::verify::watertight(&want));
     assert_eq!(
         (g.boundary_edges, g.nonmanifold_edges, g.misoriented_edges, g.euler_characteristic),
@@ -194,12 +195,12 @@ fn an_output_past_the_device_limits_is_refused_not_truncated() {
     let set = load("patches/teapot.patches");
     let mut gpu = GpuTessellator::new(ctx, &set).unwrap();
     let plan = Plan::uniform(&set, tessera::criterion::MAX_FACTOR).unwrap();
-    let err = gpu.prepare(ctx, &set, &plan).unwrap_err();
+    let err = gpu.prepare(ctx, &set, &plan, &tessera::pattern::uniform::Uniform).unwrap_err();
     assert!(matches!(err, GpuError::OutputTooLarge { .. }), "{err}");
     // A plan of another set is refused too.
     let other = load("patches/teacup.patches");
     let plan = Plan::uniform(&other, 2).unwrap();
-    assert!(gpu.prepare(ctx, &set, &plan).is_err());
+    assert!(gpu.prepare(ctx, &set, &plan, &tessera::pattern::uniform::Uniform).is_err());
 }
 
 /// Seeded cameras around the model: eyes on a sphere of 0.6–3 bounding radii (some inside
@@ -266,7 +267,7 @@ fn culling_equals_the_cpu(cameras_per_model: usize, seed: u64) {
             // The GPU gets the plan with every patch visible and culls by itself.
             let uncull = Plan::uniform(&set, n).unwrap();
             gpu.set_cull_camera(ctx, Some(&camera));
-            gpu.prepare(ctx, &set, &uncull).unwrap();
+            gpu.prepare(ctx, &set, &uncull, &tessera::pattern::uniform::Uniform).unwrap();
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             gpu.record(&mut encoder);
             ctx.queue.submit([encoder.finish()]);
