@@ -174,6 +174,20 @@ fn uniform_tessellation_equals_the_cpu_engine_on_every_patch_model() {
 }
 
 #[test]
+#[ignore = "slow tier: larger factors on every patch model"]
+fn uniform_tessellation_equals_the_cpu_engine_at_larger_factors() {
+    for model in patch_models() {
+        let set = load(&model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let factors: &[u32] = if set.patches.len() > 500 { &[3, 16] } else { &[5, 13, 32, 64] };
+        for &n in factors {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
+        }
+    }
+}
+
+#[test]
 fn culled_patches_emit_nothing_as_on_the_cpu() {
     let mut rng = Lcg(3);
     for model in ["patches/teapot.patches", "patches/teacup.patches"] {
