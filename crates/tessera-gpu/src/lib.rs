@@ -12,6 +12,28 @@
 //! Start with [`GpuContext::new`] (an adapter, with the adapter's own limits), then
 //! [`GpuTessellator`]. Nothing in the frame path reads back from the GPU; [`readback`] is
 //! for tests and the command-line tool.
+//!
+//! ```no_run
+//! use tessera::criterion::Plan;
+//! use tessera::pattern::uniform::Uniform;
+//! use tessera_gpu::{GpuContext, GpuTessellator};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let file = tessera::io::patches::read_patches(std::path::Path::new("teapot.patches"))?;
+//! let set = tessera::surface::SurfaceSet::from_patch_file(&file, Default::default());
+//! let ctx = GpuContext::new()?; // fails with the packages to install when there is no adapter
+//! let mut gpu = GpuTessellator::new(&ctx, &set)?; // uploads the set once
+//! gpu.prepare(&ctx, &set, &Plan::uniform(&set, 16)?, &Uniform)?; // sizes the output
+//! let mut encoder = ctx.device.create_command_encoder(&Default::default());
+//! gpu.record(&mut encoder); // the frame: compute passes only, nothing read back
+//! // … a render pass binds gpu.vertex_buffer() (tessera_gpu::VERTEX_LAYOUT) and
+//! // gpu.index_buffer() (u32) and calls draw_indexed_indirect(gpu.indirect_buffer(), 0).
+//! ctx.queue.submit([encoder.finish()]);
+//! let mesh = gpu.read_mesh(&ctx, &set)?; // read-back, for tests and tools only
+//! assert!(mesh.triangle_count() > 0);
+//! # Ok(())
+//! # }
+//! ```
 
 #![warn(missing_docs)]
 
