@@ -320,7 +320,7 @@ impl GpuTessellator {
         }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p];
-            if plan.is_visible(p) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
+            if (self.cull.is_some() || plan.is_visible(p)) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
                 return Err(GpuError::Unsupported {
                     what: format!("patch {p}: edges cut unlike its interior (only the uniform pattern is on the GPU)"),
                 });
