@@ -110,6 +110,30 @@ fn uniform_param(segments: u32, k: u32) -> f32 {
     return f32(k) / f32(segments);
 }
 
+// The output vertex of the patch's own sample k of local edge e: `LocalMap::edge_vertex`
+// (a collapsed curve's samples are its corner) with `Layout::edge_vertex`'s formula.
+fn edge_sample_vertex(p: u32, e: u32, k: u32) -> u32 {
+    if (patch_edge_collapsed(p, e)) {
+        return patch_corner_entry(p, e);
+    }
+    let edge = patch_edge(p, e);
+    let s = segments[edge];
+    var kc = k;
+    if (patch_edge_reversed(p, e)) { kc = s - k; }
+    return vertex_offsets[edge] + patch_edge_variant(p, e) * (s - 1u) + kc - 1u;
+}
+
+// Edge e's inner vertices: `(segments − 1) · variants`, none for a collapsed edge or one no
+// visible patch uses (`engine::Layout::build`).
+fn edge_count(e: u32) -> u32 {
+    var seen = false;
+    for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
+        seen = seen || visible[use_patch(u)] != 0u;
+    }
+    if (!seen || edge_collapsed(e)) { return 0u; }
+    return (segments[e] - 1u) * edge_variants(e);
+}
+
 // Writes vertex v.
 fn store_vertex(v: u32, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) {
     let o = v * VERTEX_FLOATS;

@@ -16,15 +16,7 @@ fn count(
     let edges = params.edges;
     let patches = params.patches;
     if (x < edges) {
-        var seen = false;
-        for (var u = edge_first_use(x); u < edge_end_use(x); u = u + 1u) {
-            seen = seen || visible[use_patch(u)] != 0u;
-        }
-        var count = 0u;
-        if (seen && !edge_collapsed(x)) {
-            count = (segments[x] - 1u) * edge_variants(x);
-        }
-        vertex_offsets[x] = count;
+        vertex_offsets[x] = edge_count(x);
     } else if (x < edges + patches) {
         let p = x - edges;
         var inner = 0u;

@@ -20,8 +20,9 @@ struct Status {
 }
 
 @group(1) @binding(0) var<storage, read_write> draw: DrawIndexedIndirect;
-// x, y, z of the edge-vertex, interior-vertex and triangle passes, in that order.
-@group(1) @binding(1) var<storage, read_write> dispatch: array<u32, 9>;
+// x, y, z of the edge-vertex, interior-vertex, per-triangle and per-patch write passes, in
+// that order.
+@group(1) @binding(1) var<storage, read_write> dispatch: array<u32, 12>;
 @group(1) @binding(2) var<storage, read_write> status: Status;
 
 const MAX_GROUPS_PER_DIMENSION: u32 = {{MAX_GROUPS_PER_DIMENSION}}u;
@@ -54,11 +55,13 @@ fn write_args() {
         set_grid(0u, 0u);
         set_grid(1u, 0u);
         set_grid(2u, 0u);
+        set_grid(3u, 0u);
         draw = DrawIndexedIndirect(0u, 0u, 0u, 0, 0u);
         return;
     }
     set_grid(0u, vertex_offsets[edges] - params.corners);
     set_grid(1u, vertices_total - vertex_offsets[edges]);
     set_grid(2u, triangles_total);
+    set_grid(3u, params.patches);
     draw = DrawIndexedIndirect(3u * triangles_total, 1u, 0u, 0, 0u);
 }

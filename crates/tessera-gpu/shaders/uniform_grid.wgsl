@@ -25,17 +25,10 @@ fn grid_slot(n: u32, i: u32, j: u32) -> GridSlot {
     return GridSlot(2u, 0u, (j - 1u) * (n - 1u) + (i - 1u));
 }
 
-// The output vertex of the patch's own sample k of local edge e: `LocalMap::edge_vertex`
-// (a collapsed curve's samples are its corner) with `Layout::edge_vertex`'s formula.
-fn edge_sample_vertex(p: u32, e: u32, k: u32) -> u32 {
-    if (patch_edge_collapsed(p, e)) {
-        return patch_corner_entry(p, e);
-    }
-    let edge = patch_edge(p, e);
-    let s = segments[edge];
-    var kc = k;
-    if (patch_edge_reversed(p, e)) { kc = s - k; }
-    return vertex_offsets[edge] + patch_edge_variant(p, e) * (s - 1u) + kc - 1u;
+// The uniform pattern's interior grid: n × n cells (read by the interior vertex pass).
+fn interior_grid(p: u32) -> vec2<u32> {
+    let n = interior[p].x;
+    return vec2<u32>(n, n);
 }
 
 // The output vertex of grid point (i, j) of visible patch p: `LocalMap::vertex`.

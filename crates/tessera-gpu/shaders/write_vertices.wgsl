@@ -62,7 +62,8 @@ fn edge_use_point(u: u32, t: f32) -> vec2<f32> {
 }
 
 // Interior vertex j of patch p (`vertex_offsets[E + p] + j`): grid point
-// (j mod (n − 1) + 1, j div (n − 1) + 1) at `i · (1 / n)`, as `pattern::uniform::grid` places it.
+// (j mod (nu − 1) + 1, j div (nu − 1) + 1) at `(i · (1 / nu), j · (1 / nv))`, as the
+// uniform and transition patterns place their grids (`interior_grid` is the pattern's).
 @compute @workgroup_size(WORKGROUP)
 fn write_interior_vertices(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -74,9 +75,11 @@ fn write_interior_vertices(
     if (v >= vertex_offsets[edges + params.patches]) { return; }
     let p = find_vertex_range(edges, edges + params.patches, v) - edges;
     let j = v - vertex_offsets[edges + p];
-    let n = interior[p].x;
-    let step = 1.0 / f32(n);
-    let uv = vec2<f32>(f32(j % (n - 1u) + 1u) * step, f32(j / (n - 1u) + 1u) * step);
+    let grid = interior_grid(p);
+    let uv = vec2<f32>(
+        f32(j % (grid.x - 1u) + 1u) * (1.0 / f32(grid.x)),
+        f32(j / (grid.x - 1u) + 1u) * (1.0 / f32(grid.y)),
+    );
     let point = bicubic_eval(p, uv);
     store_vertex(v, point.position, point.normal, uv);
 }

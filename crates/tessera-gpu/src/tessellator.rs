@@ -4,7 +4,7 @@
 //! The passes of a frame, each one compute pass (named in [`PASSES`], timed by
 //! [`PassTimer`] when the adapter has timestamp queries):
 //!
-//! 1. **count** (`count_uniform.wgsl`): per edge and per patch, the counts
+//! 1. **count** (`count_uniform.wgsl`, `transition_quad.wgsl`): per edge and per patch, the counts
 //!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
 //!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
@@ -13,7 +13,10 @@
 //!    arguments and the `DrawIndexedIndirect` arguments from the totals;
 //! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
 //!    interior vertices;
-//! 5. **triangles** (`write_triangles_uniform.wgsl`): indices.
+//! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
+//!    triangle; transition (`transition_quad.wgsl`) one invocation per patch walking its core
+//!    and strips in the CPU's order (parallel over patches only: the next step is a
+//!    per-triangle form).
 //!
 //! **No read-back in the frame path, by construction**: [`GpuTessellator::record`] only
 //! records compute passes; the buffers it writes are read by the GPU (indirect dispatch and
@@ -30,6 +33,7 @@ use crate::upload::{self, GpuSet};
 use tessera::camera::Camera;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
+use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
 use tessera::sampling::SamplingKind;
@@ -61,6 +65,7 @@ const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
 const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
 const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
 const CULL: &str = include_str!("../shaders/cull.wgsl");
+const TRANSITION_QUAD: &str = include_str!("../shaders/transition_quad.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
@@ -83,6 +88,41 @@ fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderMod
     shader::module(device, label, parts, &constants())
 }
 
+/// The patterns the GPU draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpuPattern {
+    /// [`tessera::pattern::uniform::Uniform`]: one invocation per output triangle.
+    Uniform,
+    /// [`tessera::pattern::transition::Transition`] on quads (CudaTess): one invocation per
+    /// patch builds its core and strips serially.
+    Transition,
+}
+
+impl GpuPattern {
+    /// The GPU form of `pattern`, by its name; None for patterns not on the GPU.
+    pub fn of(pattern: &dyn Pattern) -> Option<GpuPattern> {
+        match pattern.name() {
+            n if n == Uniform.name() => Some(GpuPattern::Uniform),
+            n if n == Transition.name() => Some(GpuPattern::Transition),
+            _ => None,
+        }
+    }
+}
+
+/// The pattern-specific pipelines: counts, vertex writes (the interior grid is the
+/// pattern's), triangle writes.
+#[derive(Debug)]
+struct PatternPipelines {
+    count: wgpu::ComputePipeline,
+    corners: wgpu::ComputePipeline,
+    edge_vertices: wgpu::ComputePipeline,
+    interior_vertices: wgpu::ComputePipeline,
+    /// Uniform: one invocation per triangle (indirect), then the collapsed-corner patches.
+    /// Transition: one invocation per patch.
+    triangles: wgpu::ComputePipeline,
+    collapsed_triangles: Option<wgpu::ComputePipeline>,
+}
+
 /// Every pipeline of a frame.
 #[derive(Debug)]
 struct Pipelines {
@@ -90,14 +130,10 @@ struct Pipelines {
     args_layout: wgpu::BindGroupLayout,
     cull_layout: wgpu::BindGroupLayout,
     cull: wgpu::ComputePipeline,
-    count: wgpu::ComputePipeline,
     scan: ScanPipelines,
     args: wgpu::ComputePipeline,
-    corners: wgpu::ComputePipeline,
-    edge_vertices: wgpu::ComputePipeline,
-    interior_vertices: wgpu::ComputePipeline,
-    triangles: wgpu::ComputePipeline,
-    collapsed_triangles: wgpu::ComputePipeline,
+    uniform: PatternPipelines,
+    transition: PatternPipelines,
 }
 
 impl Pipelines {
@@ -128,21 +164,39 @@ impl Pipelines {
                 cache: None,
             })
         };
-        let count = module(device, "count", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
-        let cull = module(device, "cull", &[COMMON, CULL]);
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
-        let vertices = module(device, "vertices", &[COMMON, BICUBIC, WRITE_VERTICES]);
-        let triangles = module(device, "triangles", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
+        let cull = module(device, "cull", &[COMMON, CULL]);
+        let uniform = {
+            let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
+            let vertices = module(device, "vertices uniform", &[COMMON, BICUBIC, UNIFORM_GRID, WRITE_VERTICES]);
+            let triangles = module(device, "triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
+            PatternPipelines {
+                count: make(&one, &count, "count"),
+                corners: make(&one, &vertices, "write_corners"),
+                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
+                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
+                triangles: make(&one, &triangles, "write_triangles"),
+                collapsed_triangles: Some(make(&one, &triangles, "write_collapsed_patch_triangles")),
+            }
+        };
+        let transition = {
+            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD]);
+            let vertices = module(device, "vertices transition", &[COMMON, BICUBIC, TRANSITION_QUAD, WRITE_VERTICES]);
+            PatternPipelines {
+                count: make(&one, &pattern, "count"),
+                corners: make(&one, &vertices, "write_corners"),
+                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
+                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
+                triangles: make(&one, &pattern, "write_patch_triangles"),
+                collapsed_triangles: None,
+            }
+        };
         Pipelines {
             cull: make(&with_view, &cull, "cull"),
-            count: make(&one, &count, "count"),
             scan: ScanPipelines::new(device),
             args: make(&two, &args, "write_args"),
-            corners: make(&one, &vertices, "write_corners"),
-            edge_vertices: make(&one, &vertices, "write_edge_vertices"),
-            interior_vertices: make(&one, &vertices, "write_interior_vertices"),
-            triangles: make(&one, &triangles, "write_triangles"),
-            collapsed_triangles: make(&one, &triangles, "write_collapsed_patch_triangles"),
+            uniform,
+            transition,
             main_layout,
             args_layout,
             cull_layout,
@@ -172,22 +226,23 @@ pub struct Capacity {
 }
 
 impl Capacity {
-    /// The bound of `plan` on `set`, the uniform pattern's counts without the triangles that
-    /// may degenerate at collapsed curves: every corner entry, `(s − 1) · variants` per edge,
-    /// `(n − 1)²` and `2n²` per visible patch (per patch with `all_visible`, when the GPU
-    /// decides visibility). Cost: O(E + P).
-    pub fn of_plan(set: &SurfaceSet, plan: &Plan, all_visible: bool) -> Capacity {
+    /// The bound of `plan` on `set` under `pattern`: every corner entry,
+    /// `(s − 1) · variants` per edge, and the pattern's own counts
+    /// ([`Pattern::counts`] of [`tessera::engine::layout::pattern_input`]) per visible patch
+    /// (per patch with `all_visible`, when the GPU decides visibility), triangles that may
+    /// degenerate at collapsed curves included. Cost: O(E + P) pattern counts.
+    pub fn of_plan(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, all_visible: bool) -> Capacity {
         let topo = &set.topology;
         let mut vertices = topo.corner_entries.len() as u64;
         for (e, edge) in topo.edges.iter().enumerate() {
             vertices += (plan.segments[e] as u64 - 1) * edge.variants as u64;
         }
         let mut triangles = 0;
-        for (p, &[n, _]) in plan.interior.iter().enumerate() {
+        for p in 0..set.patches.len() {
             if all_visible || plan.is_visible(p) {
-                let n = n as u64;
-                vertices += (n - 1) * (n - 1);
-                triangles += 2 * n * n;
+                let (v, t) = pattern.counts(&tessera::engine::layout::pattern_input(set, plan, p));
+                vertices += v as u64;
+                triangles += t as u64;
             }
         }
         Capacity { vertices, triangles }
@@ -207,9 +262,10 @@ struct Output {
 /// frame into device buffers that a render pipeline binds directly (see the module doc for
 /// the passes).
 ///
-/// Supported now: bicubic patches, [`SamplingKind::Uniform`] plans for the uniform pattern
-/// (every edge of a visible patch cut into its interior factor, as `Scheme::Uniform` plans
-/// are); anything else is refused with [`GpuError::Unsupported`].
+/// Supported now: bicubic patches and [`SamplingKind::Uniform`] plans, for the uniform
+/// pattern (every edge of a visible patch cut into its interior factor, as `Scheme::Uniform`
+/// plans are) and the transition pattern (any per-edge segments and core factors, as
+/// `Scheme::Transition` plans); anything else is refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
@@ -227,9 +283,11 @@ pub struct GpuTessellator {
     status: wgpu::Buffer,
     args: wgpu::BindGroup,
     output: Option<Output>,
-    /// The last prepared plan's interior factors (for [`GpuTessellator::read_mesh`]'s count of
-    /// collapsed triangles).
-    interior_factors: Vec<[u32; 2]>,
+    /// The last prepared plan's pattern triangles per patch (for
+    /// [`GpuTessellator::read_mesh`]'s count of collapsed triangles).
+    pattern_triangles: Vec<u32>,
+    /// The last prepared plan's pattern.
+    pattern: GpuPattern,
     /// The culling camera's uniform and bind group, when the GPU culls.
     cull: Option<CullView>,
     /// Per patch: normal cone and bounding sphere (`cull.wgsl`), prepared once.
@@ -271,7 +329,7 @@ impl GpuTessellator {
             Scan::new(device, &pipelines.scan, &vertex_offsets, (e + p + 1) as u32, gpu_set.corners);
         let triangle_scan = Scan::new(device, &pipelines.scan, &triangle_offsets, (p + 1) as u32, 0);
         let draw_args = buffer(device, "draw indexed indirect", 20, U::STORAGE | U::INDIRECT | U::COPY_SRC);
-        let dispatch_args = buffer(device, "write dispatches", 36, U::STORAGE | U::INDIRECT);
+        let dispatch_args = buffer(device, "write dispatches", 48, U::STORAGE | U::INDIRECT);
         let status = buffer(device, "status", 16, U::STORAGE | U::COPY_SRC);
         let args = shader::bind(device, &pipelines.args_layout, &[&draw_args, &dispatch_args, &status]);
         Ok(GpuTessellator {
@@ -288,7 +346,8 @@ impl GpuTessellator {
             status,
             args,
             output: None,
-            interior_factors: Vec::new(),
+            pattern_triangles: Vec::new(),
+            pattern: GpuPattern::Uniform,
             cull: None,
             cones: upload::storage_buffer(device, "normal cones", &cones(set)),
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
@@ -309,9 +368,11 @@ impl GpuTessellator {
     /// plan's arrays (16 bytes a patch, 4 an edge); a reallocation when the output grows.
     pub fn prepare(&mut self, ctx: &GpuContext, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Result<()> {
         plan.check(set)?;
-        if pattern.name() != Uniform.name() {
-            return Err(GpuError::Unsupported { what: format!("the {} pattern (only uniform is on the GPU)", pattern.name()) });
-        }
+        let Some(kind) = GpuPattern::of(pattern) else {
+            return Err(GpuError::Unsupported {
+                what: format!("the {} pattern (uniform and transition are on the GPU)", pattern.name()),
+            });
+        };
         if set.patches.len() as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
             return Err(tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into());
         }
@@ -320,19 +381,23 @@ impl GpuTessellator {
         }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p];
-            if (self.cull.is_some() || plan.is_visible(p)) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
+            if kind == GpuPattern::Uniform && (self.cull.is_some() || plan.is_visible(p)) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
                 return Err(GpuError::Unsupported {
                     what: format!("patch {p}: edges cut unlike its interior (only the uniform pattern is on the GPU)"),
                 });
             }
         }
-        let capacity = Capacity::of_plan(set, plan, self.cull.is_some());
+        let capacity = Capacity::of_plan(set, plan, pattern, self.cull.is_some());
+        self.pattern_triangles.clear();
+        self.pattern_triangles.extend(
+            (0..set.patches.len()).map(|p| pattern.counts(&tessera::engine::layout::pattern_input(set, plan, p)).1),
+        );
         self.reserve(ctx, capacity)?;
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
-        self.interior_factors.clone_from(&plan.interior);
+        self.pattern = kind;
         Ok(())
     }
 
@@ -419,9 +484,13 @@ impl GpuTessellator {
                 c.dispatch_workgroups(x, y, 1);
             }
         }
+        let k = match self.pattern {
+            GpuPattern::Uniform => &p.uniform,
+            GpuPattern::Transition => &p.transition,
+        };
         {
             let mut c = begin_pass(encoder, timer, 1);
-            c.set_pipeline(&p.count);
+            c.set_pipeline(&k.count);
             c.set_bind_group(0, &out.main, &[]);
             let (x, y) = shader::grid((e + patches + 1).div_ceil(shader::WORKGROUP));
             c.dispatch_workgroups(x, y, 1);
@@ -442,24 +511,32 @@ impl GpuTessellator {
             let mut c = begin_pass(encoder, timer, 4);
             c.set_bind_group(0, &out.main, &[]);
             if corners > 0 {
-                c.set_pipeline(&p.corners);
+                c.set_pipeline(&k.corners);
                 let (x, y) = shader::grid(corners.div_ceil(shader::WORKGROUP));
                 c.dispatch_workgroups(x, y, 1);
             }
-            c.set_pipeline(&p.edge_vertices);
+            c.set_pipeline(&k.edge_vertices);
             c.dispatch_workgroups_indirect(&self.dispatch_args, 0);
-            c.set_pipeline(&p.interior_vertices);
+            c.set_pipeline(&k.interior_vertices);
             c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
         }
         {
             let mut c = begin_pass(encoder, timer, 5);
             c.set_bind_group(0, &out.main, &[]);
-            c.set_pipeline(&p.triangles);
-            c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
-            if self.set.any_repeated_corner {
-                c.set_pipeline(&p.collapsed_triangles);
-                let (x, y) = shader::grid(patches.div_ceil(shader::WORKGROUP));
-                c.dispatch_workgroups(x, y, 1);
+            // Per-patch passes take the fourth dispatch, which the args pass zeroes on overflow.
+            match (&k.collapsed_triangles, self.pattern) {
+                (Some(collapsed), GpuPattern::Uniform) => {
+                    c.set_pipeline(&k.triangles);
+                    c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
+                    if self.set.any_repeated_corner {
+                        c.set_pipeline(collapsed);
+                        c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
+                    }
+                }
+                _ => {
+                    c.set_pipeline(&k.triangles);
+                    c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
+                }
             }
         }
         if let Some(t) = timer {
@@ -583,13 +660,8 @@ impl GpuTessellator {
         }
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
         let visible = self.read_visible(ctx)?;
-        let pattern: u64 = self
-            .interior_factors
-            .iter()
-            .zip(&visible)
-            .filter(|(_, &v)| v != 0)
-            .map(|(&[n, _], _)| 2 * n as u64 * n as u64)
-            .sum();
+        let pattern: u64 =
+            self.pattern_triangles.iter().zip(&visible).filter(|(_, &v)| v != 0).map(|(&t, _)| t as u64).sum();
         mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
         Ok(mesh)
     }

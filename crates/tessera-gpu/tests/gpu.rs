@@ -9,6 +9,7 @@ use tessera::criterion::Plan;
 use tessera::engine::{self, Layout, TessellateOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
 use tessera::surface::{BuildOptions, SurfaceSet};
 use tessera_gpu::scan::{Scan, ScanPipelines};
 use tessera_gpu::{readback, GpuContext, GpuError, GpuTessellator};
@@ -98,10 +99,10 @@ fn scan_of_any_length_equals_a_cpu_scan() {
 }
 
 /// The CPU engine's layout and mesh for `plan`.
-fn cpu(set: &SurfaceSet, plan: &Plan) -> (Layout, Mesh) {
+fn cpu(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> (Layout, Mesh) {
     let mut layout = Layout::default();
-    layout.build(set, plan, &Uniform, &TessellateOptions::default()).unwrap();
-    let mesh = engine::tessellate(set, plan, &Uniform, TessellateOptions::default()).unwrap();
+    layout.build(set, plan, pattern, &TessellateOptions::default()).unwrap();
+    let mesh = engine::tessellate(set, plan, pattern, TessellateOptions::default()).unwrap();
     (layout, mesh)
 }
 
@@ -114,20 +115,31 @@ fn diagonal(set: &SurfaceSet) -> f64 {
 /// numbering, so index for index), positions within 1e-5 of the diagonal, normals within a
 /// few degrees (a small step off a collapsed corner), the same watertightness report.
 fn assert_gpu_equals_cpu(name: &str, set: &SurfaceSet, gpu: &mut GpuTessellator, plan: &Plan) {
+    assert_pattern_equals_cpu(name, set, gpu, plan, &Uniform);
+}
+
+/// [`assert_gpu_equals_cpu`] for `pattern`.
+fn assert_pattern_equals_cpu(name: &str, set: &SurfaceSet, gpu: &mut GpuTessellator, plan: &Plan, pattern: &dyn Pattern) {
     let ctx = ctx();
-    gpu.prepare(ctx, set, plan, &tessera::pattern::uniform::Uniform).unwrap();
+    gpu.prepare(ctx, set, plan, pattern).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     gpu.record(&mut encoder);
     ctx.queue.submit([encoder.finish()]);
-    assert_gpu_equals_cpu_after_record(name, set, gpu, plan);
+    assert_gpu_equals_cpu_after_record(name, set, gpu, plan, pattern);
 }
 
 /// The checks of [`assert_gpu_equals_cpu`] on a frame already recorded and submitted.
-fn assert_gpu_equals_cpu_after_record(name: &str, set: &SurfaceSet, gpu: &GpuTessellator, plan: &Plan) {
+fn assert_gpu_equals_cpu_after_record(
+    name: &str,
+    set: &SurfaceSet,
+    gpu: &GpuTessellator,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+) {
     let ctx = ctx();
     let (overflow, _, _) = gpu.read_status(ctx).unwrap();
     assert!(!overflow, "{name}: the frame overflowed");
-    let (layout, want) = cpu(set, plan);
+    let (layout, want) = cpu(set, plan, pattern);
     let (edge_offsets, interior_offsets, triangle_offsets) = gpu.read_layout(ctx).unwrap();
     assert_eq!(edge_offsets, layout.edge_offsets, "{name}: edge offsets");
     assert_eq!(interior_offsets, layout.interior_offsets, "{name}: interior offsets");
@@ -291,7 +303,7 @@ fn culling_equals_the_cpu(cameras_per_model: usize, seed: u64) {
             let why: Vec<bool> =
                 differ.iter().map(|&p| tessera::criterion::screen::back_facing(&set.patches[p], camera.eye)).collect();
             assert!(differ.is_empty(), "{model} camera {c}: patches {differ:?} culled differently (CPU back-facing: {why:?})");
-            assert_gpu_equals_cpu_after_record(&format!("{model} camera {c}"), &set, &gpu, &cpu_plan);
+            assert_gpu_equals_cpu_after_record(&format!("{model} camera {c}"), &set, &gpu, &cpu_plan, &Uniform);
         }
         assert!(culled_somewhere > 0, "{model}: the cameras culled nothing, the test proves little");
         // Without a culling camera the plan's own row counts again.
@@ -314,5 +326,46 @@ fn output_buffers_grow_with_the_plan_and_the_output_stays_complete() {
         let capacity = gpu.capacity().unwrap().triangles;
         assert!(capacity >= last, "capacity shrank");
         last = capacity;
+    }
+}
+
+#[test]
+fn transition_tessellation_equals_the_cpu_engine_on_every_patch_model() {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    for model in patch_models() {
+        let set = load(&model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let diagonal = diagonal(&set);
+        // CudaTess's own plans: per-edge factors from an object-space tolerance.
+        let tolerances: &[f64] = if set.patches.len() > 500 { &[1e-3] } else { &[1e-2, 1e-3] };
+        for &rel in tolerances {
+            let planned = Scheme::Transition
+                .plan(&set, &Criterion::Tolerance(rel * diagonal), &PlanOptions::default())
+                .unwrap();
+            let distinct: std::collections::BTreeSet<u32> = planned.plan.segments.iter().copied().collect();
+            assert!(distinct.len() > 1, "{model}: one factor everywhere, no strips tested");
+            assert_pattern_equals_cpu(&format!("{model} tolerance {rel}"), &set, &mut gpu, &planned.plan, &planned.pattern);
+        }
+    }
+}
+
+#[test]
+fn transition_equals_the_cpu_on_arbitrary_edge_and_core_factors() {
+    // Any combination of segments per edge and core factors: strips on any side, raised
+    // cores, collapsed edges with strips (the teapot's apex).
+    let mut rng = Lcg(99);
+    for model in ["patches/teapot.patches", "patches/teacup.patches", "patches/teapot_teasetorig.patches"] {
+        let set = load(model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        for round in 0..4 {
+            let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % 9).collect();
+            let interior = (0..set.patches.len()).map(|_| [1 + rng.next() % 9, 1 + rng.next() % 9]).collect();
+            let mut plan = Plan::integer(segments, interior, set.patches.len());
+            if round == 3 {
+                plan.visible.iter_mut().step_by(3).for_each(|v| *v = 0);
+            }
+            let name = format!("{model} random round {round}");
+            assert_pattern_equals_cpu(&name, &set, &mut gpu, &plan, &tessera::pattern::transition::Transition);
+        }
     }
 }

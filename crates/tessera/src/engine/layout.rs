@@ -145,8 +145,9 @@ impl Layout {
 }
 
 /// What the pattern of patch `p` gets from the plan: its edges' segments and factors, its
-/// interior factors and which of its edges are collapsed.
-pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
+/// interior factors and which of its edges are collapsed. Public so that the GPU engine
+/// (tessera-gpu) sizes its output with the same pattern counts. Cost: O(1).
+pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.patches[p].domain();
     let mut segments = [1; 4];
     let mut factors = [1.0; 4];
