@@ -351,17 +351,30 @@ fn transition_tessellation_equals_the_cpu_engine_on_every_patch_model() {
 
 #[test]
 fn transition_equals_the_cpu_on_arbitrary_edge_and_core_factors() {
-    // Any combination of segments per edge and core factors: strips on any side, raised
-    // cores, collapsed edges with strips (the teapot's apex).
-    let mut rng = Lcg(99);
-    for model in ["patches/teapot.patches", "patches/teacup.patches", "patches/teapot_teasetorig.patches"] {
+    transition_on_random_factors(&["patches/teapot.patches", "patches/teacup.patches", "patches/teapot_teasetorig.patches"], 4, 9, 99);
+}
+
+#[test]
+#[ignore = "slow tier: more random factor sets, up to 33, every patch model"]
+fn transition_equals_the_cpu_on_many_random_factor_sets() {
+    let models = patch_models();
+    let models: Vec<&str> = models.iter().map(|m| m.as_str()).collect();
+    transition_on_random_factors(&models, 12, 33, 2024);
+}
+
+/// Any combination of segments per edge and core factors (1 to `max`): strips on any side,
+/// raised cores, collapsed edges with strips (the teapot's apex); every fourth round culls a
+/// third of the patches.
+fn transition_on_random_factors(models: &[&str], rounds: u32, max: u32, seed: u64) {
+    let mut rng = Lcg(seed);
+    for &model in models {
         let set = load(model);
         let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
-        for round in 0..4 {
-            let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % 9).collect();
-            let interior = (0..set.patches.len()).map(|_| [1 + rng.next() % 9, 1 + rng.next() % 9]).collect();
+        for round in 0..rounds {
+            let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % max).collect();
+            let interior = (0..set.patches.len()).map(|_| [1 + rng.next() % max, 1 + rng.next() % max]).collect();
             let mut plan = Plan::integer(segments, interior, set.patches.len());
-            if round == 3 {
+            if round % 4 == 3 {
                 plan.visible.iter_mut().step_by(3).for_each(|v| *v = 0);
             }
             let name = format!("{model} random round {round}");
