@@ -54,6 +54,11 @@ fn patch_edge_collapsed(p: u32, e: u32) -> bool { return (patch_rows[p * PATCH_R
 fn patch_edge_variant(p: u32, e: u32) -> u32 { return (patch_rows[p * PATCH_ROW + 4u + e] >> 8u) & 255u; }
 fn patch_corner_entry(p: u32, c: u32) -> u32 { return patch_rows[p * PATCH_ROW + 8u + c]; }
 fn patch_repeated_corner(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 1u) != 0u; }
+fn patch_is_tri(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 2u) != 0u; }
+fn patch_has_pn_normals(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 4u) != 0u; }
+fn patch_corner_count(p: u32) -> u32 { return select(4u, 3u, patch_is_tri(p)); }
+// Control points of the patch's geometry (the rest of its 16 slots hold PN normals).
+fn patch_point_count(p: u32) -> u32 { return select(16u, 10u, patch_is_tri(p)); }
 
 // Edge rows and uses.
 fn edge_first_use(e: u32) -> u32 { return edge_rows[e * EDGE_ROW]; }
@@ -96,6 +101,20 @@ fn quad_corner(c: u32) -> vec2<f32> {
         case 2u: { return vec2<f32>(1.0, 1.0); }
         default: { return vec2<f32>(0.0, 1.0); }
     }
+}
+
+// Corner c of patch p's domain: `Domain::corner` (triangles: (0,0), (1,0), (0,1)).
+fn domain_corner(p: u32, c: u32) -> vec2<f32> {
+    if (patch_is_tri(p)) {
+        return array<vec2<f32>, 3>(vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0))[c];
+    }
+    return quad_corner(c);
+}
+
+// `Domain::edge_point` on patch p's domain.
+fn domain_edge_point(p: u32, e: u32, t: f32) -> vec2<f32> {
+    let n = patch_corner_count(p);
+    return domain_corner(p, e) * (1.0 - t) + domain_corner(p, (e + 1u) % n) * t;
 }
 
 // The point at t along local edge e: `Domain::edge_point`, a convex combination so that

@@ -2,9 +2,9 @@
 // place into the offset arrays (the scan turns them into offsets).
 // Invocation x < E: edge x's inner vertices, `(segments − 1) · variants`, none for a collapsed
 // edge or one no visible patch uses. E ≤ x < E + P: patch x − E's interior vertices
-// `(n − 1)²` and its triangles `2n²` (`pattern::uniform::Uniform::counts`) minus those that
-// degenerate at a collapsed curve (only patches with a repeated corner have any, and only
-// in the outer ring of cells). x = E + P: the trailing entry, 0.
+// and triangles (`pattern::uniform::Uniform::counts`) minus those that degenerate at a
+// collapsed curve (only patches with a repeated corner have any; on quads only in the outer
+// ring of cells). x = E + P: the trailing entry, 0.
 
 @compute @workgroup_size(WORKGROUP)
 fn count(
@@ -23,10 +23,16 @@ fn count(
         var triangles = 0u;
         if (visible[p] != 0u) {
             let n = interior[p].x;
-            inner = (n - 1u) * (n - 1u);
-            triangles = 2u * n * n;
+            let tri = patch_is_tri(p);
+            let counts = uniform_counts(tri, n);
+            inner = counts.x;
+            triangles = counts.y;
             if (patch_repeated_corner(p)) {
-                triangles = triangles - ring_degenerates(p, n);
+                if (tri) {
+                    triangles = kept_triangles(p, n);
+                } else {
+                    triangles = triangles - ring_degenerates(p, n);
+                }
             }
         }
         vertex_offsets[x] = inner;
@@ -60,4 +66,14 @@ fn cell_degenerates(p: u32, n: u32, i: u32, j: u32) -> u32 {
         if (triangle_degenerates(p, n, cell_triangle(i, j, h))) { dropped = dropped + 1u; }
     }
     return dropped;
+}
+
+// Pattern triangles of triangle patch p that do not degenerate. Cost: O(n²), serial; only
+// for patches with a repeated corner.
+fn kept_triangles(p: u32, n: u32) -> u32 {
+    var kept = 0u;
+    for (var t = 0u; t < n * n; t = t + 1u) {
+        if (!triangle_degenerates(p, n, pattern_triangle(true, n, t))) { kept = kept + 1u; }
+    }
+    return kept;
 }

@@ -61,7 +61,7 @@ fn cull(
     var left_of = true;
     var above = true;
     var below = true;
-    for (var k = 0u; k < CONTROL_POINTS; k = k + 1u) {
+    for (var k = 0u; k < patch_point_count(p); k = k + 1u) {
         let c = to_camera(control_points[p * CONTROL_POINTS + k].xyz);
         before_near = before_near && c.z < view.near;
         beyond_far = beyond_far && c.z > view.far;

@@ -2,7 +2,7 @@
 // `triangle_offsets[p] + t` with its corners mapped by `grid_vertex` (the layout's rule).
 
 // One invocation per output triangle, for patches without a repeated corner (every pattern
-// triangle kept, so triangle t is half t mod 2 of cell t div 2, cells row after row).
+// triangle kept, so output triangle t is pattern triangle t).
 @compute @workgroup_size(WORKGROUP)
 fn write_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -15,8 +15,7 @@ fn write_triangles(
     if (patch_repeated_corner(p)) { return; }
     let local = t - triangle_offsets[p];
     let n = interior[p].x;
-    let cell = local / 2u;
-    let tri = cell_triangle(cell % n, cell / n, local % 2u);
+    let tri = pattern_triangle(patch_is_tri(p), n, local);
     for (var c = 0u; c < 3u; c = c + 1u) {
         indices[3u * t + c] = grid_vertex(p, n, tri[c].x, tri[c].y);
     }
@@ -36,17 +35,14 @@ fn write_collapsed_patch_triangles(
     if (p >= params.patches) { return; }
     if (visible[p] == 0u || !patch_repeated_corner(p)) { return; }
     let n = interior[p].x;
+    let is_tri = patch_is_tri(p);
     var t = triangle_offsets[p];
-    for (var j = 0u; j < n; j = j + 1u) {
-        for (var i = 0u; i < n; i = i + 1u) {
-            for (var h = 0u; h < 2u; h = h + 1u) {
-                let tri = cell_triangle(i, j, h);
-                if (triangle_degenerates(p, n, tri)) { continue; }
-                for (var c = 0u; c < 3u; c = c + 1u) {
-                    indices[3u * t + c] = grid_vertex(p, n, tri[c].x, tri[c].y);
-                }
-                t = t + 1u;
-            }
+    for (var local = 0u; local < uniform_counts(is_tri, n).y; local = local + 1u) {
+        let tri = pattern_triangle(is_tri, n, local);
+        if (triangle_degenerates(p, n, tri)) { continue; }
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            indices[3u * t + c] = grid_vertex(p, n, tri[c].x, tri[c].y);
         }
+        t = t + 1u;
     }
 }

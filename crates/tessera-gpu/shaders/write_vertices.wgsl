@@ -14,9 +14,10 @@ fn write_corners(
     if (x >= params.corners) { return; }
     let row = x * CORNER_ROW;
     let owner = corner_rows[row];
-    let uv = quad_corner(corner_rows[row + 1u]);
-    let normal = bicubic_eval(owner, uv).normal;
-    let position = bicubic_eval(corner_rows[row + 2u], quad_corner(corner_rows[row + 3u])).position;
+    let uv = domain_corner(owner, corner_rows[row + 1u]);
+    let normal = eval_patch(owner, uv).normal;
+    let first = corner_rows[row + 2u];
+    let position = eval_patch(first, domain_corner(first, corner_rows[row + 3u])).position;
     store_vertex(x, position, normal, uv);
 }
 
@@ -49,8 +50,8 @@ fn write_edge_vertices(
     let owner = edge_first_use(e);
     let u = use_of_variant(e, variant);
     let uv = edge_use_point(u, t);
-    let normal = bicubic_eval(use_patch(u), uv).normal;
-    let position = bicubic_eval(use_patch(owner), edge_use_point(owner, t)).position;
+    let normal = eval_patch(use_patch(u), uv).normal;
+    let position = eval_patch(use_patch(owner), edge_use_point(owner, t)).position;
     store_vertex(v, position, normal, uv);
 }
 
@@ -58,10 +59,10 @@ fn write_edge_vertices(
 fn edge_use_point(u: u32, t: f32) -> vec2<f32> {
     var local_t = t;
     if (use_reversed(u)) { local_t = 1.0 - t; }
-    return quad_edge_point(use_local(u), local_t);
+    return domain_edge_point(use_patch(u), use_local(u), local_t);
 }
 
-// Interior vertex j of patch p (`vertex_offsets[E + p] + j`): grid point
+// Interior vertex j of patch p (`vertex_offsets[E + p] + j`): on a quad, grid point
 // (j mod (nu − 1) + 1, j div (nu − 1) + 1) at `(i · (1 / nu), j · (1 / nv))`, as the
 // uniform and transition patterns place their grids (`interior_grid` is the pattern's).
 @compute @workgroup_size(WORKGROUP)
@@ -76,10 +77,23 @@ fn write_interior_vertices(
     let p = find_vertex_range(edges, edges + params.patches, v) - edges;
     let j = v - vertex_offsets[edges + p];
     let grid = interior_grid(p);
-    let uv = vec2<f32>(
+    var uv = vec2<f32>(
         f32(j % (grid.x - 1u) + 1u) * (1.0 / f32(grid.x)),
         f32(j / (grid.x - 1u) + 1u) * (1.0 / f32(grid.y)),
     );
-    let point = bicubic_eval(p, uv);
+    if (patch_is_tri(p)) {
+        // The triangle grid's interior rows r = 1 … n − 2 hold n − 1 − r points each
+        // (`uniform::grid`). Cost: O(n) to find the row.
+        let n = grid.x;
+        var row = 1u;
+        var first = 0u;
+        while (j >= first + (n - 1u - row)) {
+            first = first + (n - 1u - row);
+            row = row + 1u;
+        }
+        let step = 1.0 / f32(n);
+        uv = vec2<f32>(f32(j - first + 1u) * step, f32(row) * step);
+    }
+    let point = eval_patch(p, uv);
     store_vertex(v, point.position, point.normal, uv);
 }

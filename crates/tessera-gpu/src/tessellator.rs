@@ -59,6 +59,7 @@ pub const PASSES: [&str; 6] = ["cull", "count", "scan", "args", "vertices", "tri
 
 const COMMON: &str = include_str!("../shaders/common.wgsl");
 const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
+const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
 const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
 const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
 const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
@@ -168,7 +169,7 @@ impl Pipelines {
         let cull = module(device, "cull", &[COMMON, CULL]);
         let uniform = {
             let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
-            let vertices = module(device, "vertices uniform", &[COMMON, BICUBIC, UNIFORM_GRID, WRITE_VERTICES]);
+            let vertices = module(device, "vertices uniform", &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, WRITE_VERTICES]);
             let triangles = module(device, "triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
             PatternPipelines {
                 count: make(&one, &count, "count"),
@@ -181,7 +182,7 @@ impl Pipelines {
         };
         let transition = {
             let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD]);
-            let vertices = module(device, "vertices transition", &[COMMON, BICUBIC, TRANSITION_QUAD, WRITE_VERTICES]);
+            let vertices = module(device, "vertices transition", &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION_QUAD, WRITE_VERTICES]);
             PatternPipelines {
                 count: make(&one, &pattern, "count"),
                 corners: make(&one, &vertices, "write_corners"),
@@ -262,10 +263,11 @@ struct Output {
 /// frame into device buffers that a render pipeline binds directly (see the module doc for
 /// the passes).
 ///
-/// Supported now: bicubic patches and [`SamplingKind::Uniform`] plans, for the uniform
-/// pattern (every edge of a visible patch cut into its interior factor, as `Scheme::Uniform`
-/// plans are) and the transition pattern (any per-edge segments and core factors, as
-/// `Scheme::Transition` plans); anything else is refused with [`GpuError::Unsupported`].
+/// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
+/// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
+/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on bicubic
+/// patches (any per-edge segments and core factors, as `Scheme::Transition` plans); anything
+/// else is refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
@@ -303,8 +305,8 @@ fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsag
 impl GpuTessellator {
     /// Uploads `set` (see [`crate::upload`]) and compiles the frame's pipelines.
     ///
-    /// Errors: [`GpuError::Unsupported`] for triangle patches or an adapter with fewer than
-    /// 15 storage buffers per shader stage. Cost: O(P + E) packing, one upload, seven
+    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than 15 storage buffers
+    /// per shader stage. Cost: O(P + E) packing, one upload, seven
     /// shader compilations (about a second on lavapipe).
     pub fn new(ctx: &GpuContext, set: &SurfaceSet) -> Result<GpuTessellator> {
         let needed = MAIN_STORAGE + ARGS_STORAGE;
@@ -379,8 +381,11 @@ impl GpuTessellator {
         if plan.kind != SamplingKind::Uniform {
             return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
         }
+        if kind == GpuPattern::Transition && set.patches.iter().any(|p| p.domain() != tessera::domain::Domain::Quad) {
+            return Err(GpuError::Unsupported { what: "the transition pattern on triangle patches".into() });
+        }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
-            let edges = &set.topology.patch_edges[p];
+            let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
             if kind == GpuPattern::Uniform && (self.cull.is_some() || plan.is_visible(p)) && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n) {
                 return Err(GpuError::Unsupported {
                     what: format!("patch {p}: edges cut unlike its interior (only the uniform pattern is on the GPU)"),

@@ -7,18 +7,20 @@
 //! - **patch row** ([`PATCH_ROW`] u32): `[0..4]` canonical edge of each local edge
 //!   (`patch_edges[p][e].edge`); `[4..8]` flags of each local edge: bit 0 reversed, bit 1 the
 //!   edge is collapsed, bits 8..16 the normal variant; `[8..12]` corner entry of each corner
-//!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`];
-//!   the rest 0.
+//!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`],
+//!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots); the
+//!   rest 0. Triangles fill three of the four edge and corner slots.
 //! - **edge row** ([`EDGE_ROW`] u32): first use, end of uses (`edges[e].uses`), variants,
 //!   collapsed.
 //! - **edge use** ([`USE_ROW`] u32): patch; local edge | reversed << 8 | variant << 16.
 //! - **corner row** ([`CORNER_ROW`] u32): owner patch and corner (the normal), then the patch
 //!   and corner of its `position_entry`'s owner (the position: split-normal entries take the
 //!   position bits of their vertex's first entry, as on the CPU).
-//! - **control points**: 16 `vec4<f32>` per bicubic patch, `(x, y, z, w)`, `points[4 i + j]`
-//!   order (`i` along `u`).
+//! - **control points**: 16 `vec4<f32>` per patch: a bicubic's `(x, y, z, w)` in
+//!   `points[4 i + j]` order (`i` along `u`); a Bézier triangle's 10 points
+//!   (`BezierTriangle::index` order, `w = 1`), then a PN triangle's six normals (`w = 0`).
 
-use crate::error::{GpuError, Result};
+use crate::error::Result;
 use tessera::surface::{Patch, SurfaceSet};
 use wgpu::util::DeviceExt;
 
@@ -30,7 +32,7 @@ pub const EDGE_ROW: u32 = 4;
 pub const USE_ROW: u32 = 2;
 /// u32 per corner row.
 pub const CORNER_ROW: u32 = 4;
-/// Control points per bicubic patch.
+/// Control-point slots per patch.
 pub const CONTROL_POINTS: u32 = 16;
 
 /// The packed rows of a set, on the CPU (what [`GpuSet::new`] uploads).
@@ -51,17 +53,14 @@ pub struct PackedSet {
 }
 
 impl PackedSet {
-    /// Packs `set`'s topology and control points. Errors with [`GpuError::Unsupported`] for
-    /// patches that are not bicubic (triangle patches are not on the GPU yet). Cost: O(P + E).
+    /// Packs `set`'s topology and control points. Cost: O(P + E).
     pub fn new(set: &SurfaceSet) -> Result<PackedSet> {
         let topo = &set.topology;
         let mut packed = PackedSet::default();
         for (p, patch) in set.patches.iter().enumerate() {
-            let Patch::Bicubic(b) = patch else {
-                return Err(GpuError::Unsupported { what: "triangle patches (PN, Bézier triangles)".into() });
-            };
             let mut row = [0u32; PATCH_ROW as usize];
-            for e in 0..4 {
+            let corners = patch.domain().corner_count();
+            for e in 0..corners {
                 let pe = topo.patch_edges[p][e];
                 row[e] = pe.edge;
                 let collapsed = topo.edges[pe.edge as usize].collapsed;
@@ -70,11 +69,25 @@ impl PackedSet {
             }
             let repeated = tessera::engine::layout::has_repeated_corner(set, p);
             packed.any_repeated_corner |= repeated;
-            row[12] = repeated as u32;
+            let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
+            let (tri, pn) = match patch {
+                Patch::Bicubic(b) => {
+                    packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
+                    (false, false)
+                }
+                Patch::BezierTriangle(t) => {
+                    packed.control_points.extend(t.points.iter().map(|q| point(q, 1.0)));
+                    packed.control_points.extend([[0.0; 4]; 6]);
+                    (true, false)
+                }
+                Patch::Pn(t) => {
+                    packed.control_points.extend(t.geometry.points.iter().map(|q| point(q, 1.0)));
+                    packed.control_points.extend(t.normals.iter().map(|n| point(n, 0.0)));
+                    (true, true)
+                }
+            };
+            row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2;
             packed.patch_rows.extend_from_slice(&row);
-            packed.control_points.extend(
-                b.points.iter().zip(&b.weights).map(|(q, &w)| [q.x as f32, q.y as f32, q.z as f32, w as f32]),
-            );
         }
         for edge in &topo.edges {
             packed.edge_rows.extend_from_slice(&[edge.uses.start, edge.uses.end, edge.variants as u32, edge.collapsed as u32]);

@@ -32,8 +32,29 @@ fn data_dir() -> PathBuf {
 fn load(rel: &str) -> SurfaceSet {
     let path = data_dir().join(rel);
     assert!(path.exists(), "test model {} not found: set TESSERA_DATA to the shared data folder", path.display());
+    if rel.ends_with(".obj") {
+        let mesh = tessera::io::obj::read_obj(&path).unwrap();
+        return SurfaceSet::pn_from_mesh(&mesh, &path, BuildOptions::default()).unwrap();
+    }
     let file = tessera::io::patches::read_patches(&path).unwrap();
     SurfaceSet::from_patch_file(&file, BuildOptions::default())
+}
+
+/// Every triangle-mesh model (PN triangles) of the shared data, smallest first.
+fn mesh_models() -> Vec<String> {
+    let mut models = Vec::new();
+    for sub in ["meshes", "awkward"] {
+        for entry in std::fs::read_dir(data_dir().join(sub)).unwrap_or_else(|e| panic!("cannot list {sub}: {e}")) {
+            let entry = entry.unwrap();
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.ends_with(".obj") {
+                models.push((entry.metadata().unwrap().len(), format!("{sub}/{name}")));
+            }
+        }
+    }
+    models.sort();
+    assert!(models.len() >= 10, "{models:?}");
+    models.into_iter().map(|(_, m)| m).collect()
 }
 
 /// Every `.patches` model of the shared data (the small ones and the bench torus).
@@ -179,6 +200,36 @@ fn uniform_tessellation_equals_the_cpu_engine_on_every_patch_model() {
         // The torus is large: fewer factors there keep the fast tier fast.
         let factors: &[u32] = if set.patches.len() > 500 { &[1, 5] } else { &[1, 2, 3, 8] };
         for &n in factors {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
+        }
+    }
+}
+
+#[test]
+fn uniform_pn_triangles_equal_the_cpu_engine_on_small_meshes() {
+    // The fast tier: the meshes under 40 kB (a closed blob, a knob, the non-manifold and the
+    // unwelded teapots, the bunny at resolution 4, ...), two factors; the slow tier has them all.
+    for model in mesh_models() {
+        if std::fs::metadata(data_dir().join(&model)).unwrap().len() > 40_000 {
+            continue;
+        }
+        let set = load(&model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        for n in [1, 4] {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
+        }
+    }
+}
+
+#[test]
+#[ignore = "slow tier: every mesh model (PN triangles) at three factors"]
+fn uniform_pn_triangles_equal_the_cpu_engine_on_every_mesh() {
+    for model in mesh_models() {
+        let set = load(&model);
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        for n in [2, 3, 7] {
             let plan = Plan::uniform(&set, n).unwrap();
             assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
         }
