@@ -433,3 +433,25 @@ fn transition_on_random_factors(models: &[&str], rounds: u32, max: u32, seed: u6
         }
     }
 }
+
+#[test]
+fn uniform_bezier_triangles_equal_the_cpu_engine() {
+    // Cubic Bézier triangles (normals from the derivatives): the PN geometry of two meshes.
+    for model in ["meshes/blob.obj", "awkward/teapot_tri_nonmanifold.obj"] {
+        let pn = load(model);
+        let patches = pn
+            .patches
+            .iter()
+            .map(|p| match p {
+                tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
+                other => other.clone(),
+            })
+            .collect();
+        let set = SurfaceSet::from_patches(patches, BuildOptions::default());
+        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        for n in [1, 3, 6] {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{model} as Bézier triangles, n={n}"), &set, &mut gpu, &plan);
+        }
+    }
+}
