@@ -1,5 +1,6 @@
 //! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
 
+mod gpu;
 mod pattern_file;
 mod plan;
 
@@ -97,6 +98,11 @@ struct MeshArgs {
     /// (per level: patch id and edge levels).
     #[arg(long, value_name = "JSON")]
     instanced: Option<PathBuf>,
+    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu; for now the uniform scheme on
+    /// every surface kind and the transition scheme on bicubic patches; --stats adds
+    /// per-pass GPU times).
+    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
+    engine: String,
     #[command(flatten)]
     input_args: InputArgs,
 }
@@ -299,7 +305,9 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     // reused from the last one, as an application re-tessellating every frame would: the
     // median then measures tessellation, not page faults.
     let mut frames = Vec::new();
-    for _ in 0..a.repeat.max(1) {
+    // The GPU engine takes the first frame's plan; only it repeats.
+    let cpu_frames = if a.engine == "gpu" { 1 } else { a.repeat.max(1) };
+    for _ in 0..cpu_frames {
         tess.frame(chosen.options.camera.as_ref()).map_err(explain)?;
         frames.push(tess.timings());
     }
@@ -337,7 +345,21 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         }
         None => None,
     };
-    let mesh = tess.mesh();
+    // --engine gpu: the tessellator's plan, tessellated again on the GPU and read back.
+    let mut gpu_mesh = Mesh::default();
+    let mut gpu_times = Vec::new();
+    let mut gpu_run = None;
+    if a.engine == "gpu" {
+        if a.measure_error || a.strips {
+            return Err(
+                "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips"
+                    .into(),
+            );
+        }
+        let pattern = tess.pattern().expect("a frame was planned");
+        gpu_run = Some(gpu::tessellate(&set, plan, pattern, a.repeat, &mut gpu_mesh, &mut gpu_times)?);
+    }
+    let mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
     let mut output_file = None;
     if let Some(out) = &a.output {
         pb.set_message(format!("writing {}", out.display()));
@@ -369,7 +391,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     if a.stats {
         let stage =
             |f: fn(&FrameTimings) -> Duration| median(frames.iter().map(|t| f(t).as_secs_f64()).collect());
-        let seconds = stage(FrameTimings::total);
+        let seconds = if gpu_run.is_some() { median(gpu_times.clone()) } else { stage(FrameTimings::total) };
         let mut stats = serde_json::json!({
             "input": a.input.display().to_string(),
             "scheme": chosen.description,
@@ -407,6 +429,16 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         }
         if let Some(t) = chosen.tolerance {
             stats["tolerance"] = t.into();
+        }
+        if let Some(run) = &gpu_run {
+            stats["engine"] = "gpu".into();
+            stats["adapter"] = run.adapter.clone().into();
+            stats["gpu_pass_ms"] = run
+                .passes_ms
+                .iter()
+                .map(|&(n, ms)| (n.to_string(), ms.into()))
+                .collect::<serde_json::Map<_, _>>()
+                .into();
         }
         if let Some(strips) = &mesh.strips {
             stats["strip_indices"] = strips.len().into();

@@ -604,3 +604,35 @@ fn trimesh_reads_ply_and_glb_outputs_as_reported() {
         assert_eq!(text(&run.stdout), expected, "{ext}: trimesh vertex count and watertightness");
     }
 }
+
+#[test]
+fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
+    let dir = scratch("engine_gpu");
+    let input = data("patches/teapot.patches");
+    let input = input.to_str().unwrap();
+    let cpu = tessera(&["mesh", input, "--factor", "5", "--stats", "-o", "cpu.obj"], &dir);
+    assert!(cpu.status.success(), "{}", text(&cpu.stderr));
+    let gpu = tessera(&["mesh", input, "--factor", "5", "--stats", "--engine", "gpu", "-o", "gpu.obj"], &dir);
+    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+    for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
+        assert_eq!(g[key], c[key], "{key}");
+    }
+    assert_eq!(g["repairs"]["collapsed_triangles"], c["repairs"]["collapsed_triangles"]);
+    assert_eq!(g["engine"], "gpu");
+    assert!(g["gpu_pass_ms"].is_object(), "{g}");
+    assert!(dir.join("gpu.obj").metadata().unwrap().len() > 0);
+    // The transition scheme (CudaTess) too, with per-edge factors from a tolerance.
+    let args = ["mesh", input, "--scheme", "transition", "--tolerance", "0.01", "--stats"];
+    let cpu = tessera(&args, &dir);
+    let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
+    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+    for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
+        assert_eq!(g[key], c[key], "transition: {key}");
+    }
+    let refused =
+        tessera(&["mesh", input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--engine", "gpu"], &dir);
+    assert!(!refused.status.success());
+    assert!(text(&refused.stderr).contains("does not support"), "{}", text(&refused.stderr));
+}

@@ -206,6 +206,11 @@ impl<'a> Tessellator<'a> {
         Ok(&self.mesh)
     }
 
+    /// The last frame's pattern (None before the first frame).
+    pub fn pattern(&self) -> Option<&crate::scheme::SchemePattern> {
+        self.planned_ok.then_some(&self.planned.pattern)
+    }
+
     /// The last frame's mesh (empty before the first frame).
     pub fn mesh(&self) -> &Mesh {
         &self.mesh

@@ -170,8 +170,9 @@ impl Layout {
 }
 
 /// What the pattern of patch `p` gets from the plan: its edges' segments and factors, its
-/// interior factors and which of its edges are collapsed.
-pub(crate) fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
+/// interior factors and which of its edges are collapsed. Public so that the GPU engine
+/// (tessera-gpu) sizes its output with the same pattern counts. Cost: O(1).
+pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.topology.patch_domains[p];
     let mut segments = [1; 4];
     let mut factors = [1.0; 4];
@@ -196,8 +197,10 @@ pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
 }
 
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
-/// starts and ends at one point): only then can a pattern triangle degenerate.
-pub(crate) fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
+/// starts and ends at one point): only then can a pattern triangle degenerate. Public so that
+/// the GPU engine (tessera-gpu) flags the same patches for its collapsed-triangle path.
+/// Cost: O(1).
+pub fn has_repeated_corner(set: &SurfaceSet, p: usize) -> bool {
     let n = set.topology.patch_domains[p].corner_count();
     let c = &set.topology.patch_corners[p][..n];
     (0..n).any(|i| (i + 1..n).any(|j| c[i] == c[j]))

@@ -1,0 +1,322 @@
+// The CudaTess transition pattern on quads, `tessera::pattern::transition` (`QuadLayout`,
+// `walk`), on the CPU's local vertex numbering (`tessera::pattern::PatternInput`), mapped
+// to output vertices by the layout's rule (`engine` `LocalMap::vertex`). One invocation
+// builds one patch, in the CPU's triangle order, so counting and writing agree with the CPU
+// triangle for triangle.
+
+// `transition::QuadLayout`: the (possibly raised) core factors, which edges have strips
+// (bit e), and the core rectangle [i_lo, i_hi] × [j_lo, j_hi].
+struct QuadLayout {
+    nu: u32,
+    nv: u32,
+    strips: u32,
+    i_lo: u32,
+    i_hi: u32,
+    j_lo: u32,
+    j_hi: u32,
+}
+
+// One patch's pattern input and local numbering bases (`PatternInput::edge_base`).
+struct PatchInput {
+    p: u32,
+    s: vec4<u32>,
+    collapsed: u32,
+    base: vec4<u32>,
+    interior_base: u32,
+    core: QuadLayout,
+}
+
+fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
+
+// `transition::strips_at_collapsed_edges` for N = 4, updating in place as the CPU does.
+fn strips_at_collapsed(strip: u32, collapsed: u32) -> u32 {
+    var s = strip;
+    for (var round = 0u; round < 4u; round = round + 1u) {
+        for (var e = 0u; e < 4u; e = e + 1u) {
+            if (bit(collapsed, e) != 0u && (bit(s, (e + 1u) % 4u) != 0u || bit(s, (e + 3u) % 4u) != 0u)) {
+                s = s | (1u << e);
+            }
+        }
+    }
+    return s;
+}
+
+// `QuadLayout::new`.
+fn quad_layout(s: vec4<u32>, interior_factors: vec2<u32>, c: u32) -> QuadLayout {
+    var nu = max(interior_factors.x, 1u);
+    var nv = max(interior_factors.y, 1u);
+    loop {
+        var strip = select(0u, 1u, s.x != nu) | select(0u, 2u, s.y != nv) | select(0u, 4u, s.z != nu)
+            | select(0u, 8u, s.w != nv);
+        strip = strips_at_collapsed(strip, c);
+        let fan_u = (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u));
+        let fan_v = (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u));
+        let need_u = bit(strip, 1u) + bit(strip, 3u) + fan_u;
+        let need_v = bit(strip, 0u) + bit(strip, 2u) + fan_v;
+        if (nu >= need_u && nv >= need_v) {
+            return QuadLayout(nu, nv, strip, bit(strip, 3u), nu - bit(strip, 1u), bit(strip, 0u), nv - bit(strip, 2u));
+        }
+        nu = max(nu, need_u);
+        nv = max(nv, need_v);
+    }
+    // Unreachable: the loop returns (both factors only grow, to at most 3).
+    return QuadLayout(1u, 1u, 0u, 0u, 1u, 0u, 1u);
+}
+
+// `engine::layout::pattern_input` for patch p, with its local bases.
+fn patch_input(p: u32) -> PatchInput {
+    var s = vec4<u32>(0u);
+    var collapsed = 0u;
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        s[e] = segments[patch_edge(p, e)];
+        if (patch_edge_collapsed(p, e)) { collapsed = collapsed | (1u << e); }
+    }
+    var base = vec4<u32>(0u);
+    var b = 4u;
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        base[e] = b;
+        b = b + s[e] - 1u;
+    }
+    return PatchInput(p, s, collapsed, base, b, quad_layout(s, interior[p], collapsed));
+}
+
+// The pattern's core factors: the interior grid is (nu − 1) × (nv − 1) points at
+// (i / nu, j / nv), rows of j (`QuadLayout::build`). Read by the interior vertex pass.
+fn interior_grid(p: u32) -> vec2<u32> {
+    let input = patch_input(p);
+    return vec2<u32>(input.core.nu, input.core.nv);
+}
+
+// `QuadLayout::counts`: interior vertices and pattern triangles.
+fn transition_counts(input: PatchInput) -> vec2<u32> {
+    let l = input.core;
+    var triangles = 2u * (l.i_hi - l.i_lo) * (l.j_hi - l.j_lo);
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + inner_segments(l, e); }
+    }
+    return vec2<u32>((l.nu - 1u) * (l.nv - 1u), triangles);
+}
+
+fn inner_segments(l: QuadLayout, e: u32) -> u32 {
+    if (e % 2u == 0u) { return l.i_hi - l.i_lo; }
+    return l.j_hi - l.j_lo;
+}
+
+// `QuadLayout::inner`: grid point t of the core side facing edge e.
+fn inner_point(l: QuadLayout, e: u32, t: u32) -> vec2<u32> {
+    switch e {
+        case 0u: { return vec2<u32>(l.i_lo + t, l.j_lo); }
+        case 1u: { return vec2<u32>(l.i_hi, l.j_lo + t); }
+        case 2u: { return vec2<u32>(l.i_hi - t, l.j_hi); }
+        default: { return vec2<u32>(l.i_lo, l.j_hi - t); }
+    }
+}
+
+// `QuadLayout::local`: local index of core grid point (i, j).
+fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
+    let nu = input.core.nu;
+    let nv = input.core.nv;
+    if (i == 0u && j == 0u) { return 0u; }
+    if (i == nu && j == 0u) { return 1u; }
+    if (i == nu && j == nv) { return 2u; }
+    if (i == 0u && j == nv) { return 3u; }
+    if (j == 0u) { return input.base[0] + i - 1u; }
+    if (i == nu) { return input.base[1] + j - 1u; }
+    if (j == nv) { return input.base[2] + (nu - i) - 1u; }
+    if (i == 0u) { return input.base[3] + (nv - j) - 1u; }
+    return input.interior_base + (j - 1u) * (nu - 1u) + (i - 1u);
+}
+
+// `PatternInput::boundary_vertex`.
+fn boundary_local(input: PatchInput, e: u32, k: u32) -> u32 {
+    if (k == 0u) { return e; }
+    if (k == input.s[e]) { return (e + 1u) % 4u; }
+    return input.base[e] + k - 1u;
+}
+
+// The local edge whose inner samples hold local index l (4 ≤ l < interior_base).
+fn local_edge(input: PatchInput, l: u32) -> u32 {
+    var e = 0u;
+    for (var f = 1u; f < 4u; f = f + 1u) {
+        if (l >= input.base[f]) { e = f; }
+    }
+    return e;
+}
+
+// `LocalMap::vertex`: the output vertex of local index l.
+fn local_vertex(input: PatchInput, l: u32) -> u32 {
+    if (l < 4u) { return patch_corner_entry(input.p, l); }
+    if (l < input.interior_base) {
+        let e = local_edge(input, l);
+        return edge_sample_vertex(input.p, e, l - input.base[e] + 1u);
+    }
+    return vertex_offsets[params.edges + input.p] + (l - input.interior_base);
+}
+
+// The identity `degenerate_after_collapse` compares for local index l.
+fn local_collapse_id(input: PatchInput, l: u32) -> vec2<u32> {
+    if (l < 4u) { return vec2<u32>(1u, patch_corner_entry(input.p, l)); }
+    if (l < input.interior_base) {
+        let e = local_edge(input, l);
+        if (bit(input.collapsed, e) != 0u) { return vec2<u32>(1u, patch_corner_entry(input.p, e)); }
+    }
+    return vec2<u32>(0u, l);
+}
+
+// Takes pattern triangle `tri` (local indices): left out if it degenerates at a collapsed
+// curve, else counted and, with `write`, written as output triangle `first + *kept`.
+fn emit(input: PatchInput, tri: vec3<u32>, write: bool, first: u32, kept: ptr<function, u32>) {
+    if (patch_repeated_corner(input.p)) {
+        let a = local_collapse_id(input, tri.x);
+        let b = local_collapse_id(input, tri.y);
+        let c = local_collapse_id(input, tri.z);
+        if (all(a == b) || all(b == c) || all(a == c)) { return; }
+    }
+    if (write) {
+        let t = first + *kept;
+        indices[3u * t] = local_vertex(input, tri.x);
+        indices[3u * t + 1u] = local_vertex(input, tri.y);
+        indices[3u * t + 2u] = local_vertex(input, tri.z);
+    }
+    *kept = *kept + 1u;
+}
+
+// Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
+fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
+    return quad_edge_point(e, f32(k) / f32(input.s[e]));
+}
+
+fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
+    let g = inner_point(input.core, e, t);
+    return vec2<f32>(f32(g.x) * (1.0 / f32(input.core.nu)), f32(g.y) * (1.0 / f32(input.core.nv)));
+}
+
+fn inner_local(input: PatchInput, e: u32, t: u32) -> u32 {
+    let g = inner_point(input.core, e, t);
+    return grid_local(input, g.x, g.y);
+}
+
+// Relative difference below which the two diagonals of a tie count as equal. The CPU
+// (f64) uses 1e-9; f32 positions carry ~1e-7 relative rounding, so equal diagonals (the
+// symmetric case, common) must not be told apart by it.
+const TIE_TOLERANCE: f32 = 1e-5;
+
+// `transition::walk`: the strip along edge e between its s outer segments and the m inner
+// ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification).
+fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, u32>) {
+    let l = input.core;
+    let s = input.s[e];
+    let m = inner_segments(l, e);
+    let lead = bit(l.strips, (e + 3u) % 4u);
+    let trail = bit(l.strips, (e + 1u) % 4u);
+    let span = i32(m + lead + trail);
+    let s32 = i32(s);
+    var d = span - (2 * i32(lead) + 1) * s32;
+    var i = 0u;
+    var j = 0u;
+    var o0 = boundary_local(input, e, 0u);
+    var o1 = boundary_local(input, e, 1u);
+    var n0 = inner_local(input, e, 0u);
+    var n1 = select(n0, inner_local(input, e, 1u), m > 0u);
+    while (i < s || j < m) {
+        var advance_outer = false;
+        if (j == m) {
+            advance_outer = true;
+        } else if (i == s) {
+            advance_outer = false;
+        } else if (d != 0) {
+            advance_outer = d < 0;
+        } else {
+            let o0p = outer_position(input, e, i);
+            let o1p = outer_position(input, e, i + 1u);
+            let n0p = inner_position(input, e, j);
+            let n1p = inner_position(input, e, j + 1u);
+            let via_outer = dot(o1p - n0p, o1p - n0p);
+            let via_inner = dot(o0p - n1p, o0p - n1p);
+            if (abs(via_outer - via_inner) > TIE_TOLERANCE * max(via_outer, via_inner)) {
+                advance_outer = via_outer < via_inner;
+            } else {
+                advance_outer = 2u * i + 1u > s;
+            }
+        }
+        if (advance_outer) {
+            emit(input, vec3<u32>(o0, o1, n0), write, first, kept);
+            i = i + 1u;
+            if (j < m && i < s) { d = d + 2 * span; }
+            o0 = o1;
+            if (i < s) { o1 = boundary_local(input, e, i + 1u); }
+        } else {
+            emit(input, vec3<u32>(o0, n1, n0), write, first, kept);
+            j = j + 1u;
+            if (j < m && i < s) { d = d - 2 * s32; }
+            n0 = n1;
+            if (j < m) { n1 = inner_local(input, e, j + 1u); }
+        }
+    }
+}
+
+// `QuadLayout::build`'s triangles: the core cells row after row, then each strip's walk.
+// Returns the triangles kept. Cost: O(pattern triangles), serial.
+fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
+    var kept = 0u;
+    let l = input.core;
+    for (var j = l.j_lo; j < l.j_hi; j = j + 1u) {
+        for (var i = l.i_lo; i < l.i_hi; i = i + 1u) {
+            let a = grid_local(input, i, j);
+            let b = grid_local(input, i + 1u, j);
+            let c = grid_local(input, i + 1u, j + 1u);
+            let d = grid_local(input, i, j + 1u);
+            emit(input, vec3<u32>(a, b, c), write, first, &kept);
+            emit(input, vec3<u32>(a, c, d), write, first, &kept);
+        }
+    }
+    for (var e = 0u; e < 4u; e = e + 1u) {
+        if (bit(l.strips, e) != 0u) { walk(input, e, write, first, &kept); }
+    }
+    return kept;
+}
+
+// Count pass (see `count_uniform.wgsl` for the layout of the counts).
+@compute @workgroup_size(WORKGROUP)
+fn count(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let x = thread_index(wid, nwg, lid);
+    let edges = params.edges;
+    let patches = params.patches;
+    if (x < edges) {
+        vertex_offsets[x] = edge_count(x);
+    } else if (x < edges + patches) {
+        let p = x - edges;
+        var inner = 0u;
+        var triangles = 0u;
+        if (visible[p] != 0u) {
+            let input = patch_input(p);
+            let counts = transition_counts(input);
+            inner = counts.x;
+            triangles = counts.y;
+            if (patch_repeated_corner(p)) {
+                triangles = build_transition(input, false, 0u);
+            }
+        }
+        vertex_offsets[x] = inner;
+        triangle_offsets[p] = triangles;
+    } else if (x == edges + patches) {
+        vertex_offsets[x] = 0u;
+        triangle_offsets[patches] = 0u;
+    }
+}
+
+// Triangle pass: one invocation per visible patch writes its pattern.
+@compute @workgroup_size(WORKGROUP)
+fn write_patch_triangles(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let p = thread_index(wid, nwg, lid);
+    if (p >= params.patches || visible[p] == 0u) { return; }
+    build_transition(patch_input(p), true, triangle_offsets[p]);
+}

@@ -1,0 +1,134 @@
+//! Loading the WGSL sources: shared constants are substituted from their Rust definitions, so
+//! no number is typed twice.
+
+/// Invocations per workgroup of the element-parallel passes (count, write, cull).
+pub const WORKGROUP: u32 = 64;
+
+/// Most workgroups in one dispatch dimension (WebGPU's and wgpu's default limit); larger
+/// dispatches are laid out in two dimensions ([`grid`]).
+pub const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
+
+/// `source` with every `{{NAME}}` replaced by its value from `constants`.
+///
+/// Panics when a placeholder is left unreplaced: a shader and its Rust constants out of step
+/// is a bug of this crate, found by the first test that loads it. Cost: O(source length).
+pub fn expand(source: &str, constants: &[(&str, u32)]) -> String {
+    let mut text = source.to_string();
+    for (name, value) in constants {
+        text = text.replace(&format!("{{{{{name}}}}}"), &value.to_string());
+    }
+    if let Some(at) = text.find("{{") {
+        let end = text[at..].find("}}").map_or(text.len(), |e| at + e + 2);
+        panic!("shader placeholder {} has no value", &text[at..end]);
+    }
+    text
+}
+
+/// The constants every shader may use.
+pub fn common_constants() -> Vec<(&'static str, u32)> {
+    vec![
+        ("WORKGROUP", WORKGROUP),
+        ("MAX_GROUPS_PER_DIMENSION", MAX_GROUPS_PER_DIMENSION),
+        ("SCAN_WORKGROUP", crate::scan::SCAN_WORKGROUP),
+        ("SCAN_ITEMS", crate::scan::SCAN_ITEMS),
+    ]
+}
+
+/// A shader module from the concatenation of `parts` (WGSL has no include), expanded with
+/// [`common_constants`] and `extra`. Cost: one WGSL compilation.
+pub fn module(
+    device: &wgpu::Device,
+    label: &str,
+    parts: &[&str],
+    extra: &[(&str, u32)],
+) -> wgpu::ShaderModule {
+    let mut constants = common_constants();
+    constants.extend_from_slice(extra);
+    let text = expand(&parts.concat(), &constants);
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(text.into()),
+    })
+}
+
+/// How a shader reads one binding of group 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    /// `var<uniform>`.
+    Uniform,
+    /// `var<storage, read>`.
+    Read,
+    /// `var<storage, read_write>`.
+    Write,
+}
+
+/// The bind group layout of group 0 with `bindings` at 0, 1, 2, … (compute stage). Explicit
+/// layouts, unlike derived ones, are shared by every pipeline made with them.
+pub fn layout(device: &wgpu::Device, bindings: &[Binding]) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = bindings
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupLayoutEntry {
+            binding: i as u32,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: match b {
+                    Binding::Uniform => wgpu::BufferBindingType::Uniform,
+                    Binding::Read => wgpu::BufferBindingType::Storage { read_only: true },
+                    Binding::Write => wgpu::BufferBindingType::Storage { read_only: false },
+                },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
+}
+
+/// A compute pipeline for `entry` of `module` with group 0 laid out by `layout`.
+pub fn pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::ComputePipeline {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(entry),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(&pipeline_layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// Workgroups `(x, y)` covering `groups` workgroups with at most
+/// [`MAX_GROUPS_PER_DIMENSION`] per dimension; shaders number them `y · x_count + x` and
+/// skip those past the end. The GPU form of this rule is `grid` in `indirect_args.wgsl`.
+pub fn grid(groups: u32) -> (u32, u32) {
+    if groups <= MAX_GROUPS_PER_DIMENSION {
+        (groups, 1)
+    } else {
+        (MAX_GROUPS_PER_DIMENSION, groups.div_ceil(MAX_GROUPS_PER_DIMENSION))
+    }
+}
+
+/// A bind group of `layout` with `buffers` at bindings 0, 1, 2, … in order.
+pub fn bind(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
+}

@@ -1,0 +1,803 @@
+//! [`GpuTessellator`]: the prepared set on the device once, a plan per frame, the frame's
+//! passes recorded into the caller's command encoder.
+//!
+//! The passes of a frame, each one compute pass (named in [`PASSES`], timed by
+//! [`PassTimer`] when the adapter has timestamp queries):
+//!
+//! 1. **count** (`count_uniform.wgsl`, `transition_quad.wgsl`): per edge and per patch, the counts
+//!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
+//! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
+//!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
+//!    interior offsets), the triangle scan over `P + 1`;
+//! 3. **args** (`indirect_args.wgsl`): one invocation writes the write passes' dispatch
+//!    arguments and the `DrawIndexedIndirect` arguments from the totals;
+//! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
+//!    interior vertices;
+//! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
+//!    triangle; transition (`transition_quad.wgsl`) one invocation per patch walking its core
+//!    and strips in the CPU's order (parallel over patches only: the next step is a
+//!    per-triangle form).
+//!
+//! **No read-back in the frame path, by construction**: [`GpuTessellator::record`] only
+//! records compute passes; the buffers it writes are read by the GPU (indirect dispatch and
+//! draw). The only `map_async` of the crate is in [`crate::readback`], which
+//! [`GpuTessellator::read_mesh`], [`GpuTessellator::read_layout`] and
+//! [`PassTimer::read`] use on request.
+
+use crate::context::GpuContext;
+use crate::error::{GpuError, Result};
+use crate::readback;
+use crate::scan::{Scan, ScanPipelines};
+use crate::shader::{self, Binding};
+use crate::upload::{self, GpuSet};
+use tessera::camera::Camera;
+use tessera::criterion::Plan;
+use tessera::mesh::Mesh;
+use tessera::pattern::transition::Transition;
+use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
+use tessera::sampling::SamplingKind;
+use tessera::surface::SurfaceSet;
+
+/// f32 per output vertex: position (3), normal (3), uv (2).
+pub const VERTEX_FLOATS: u32 = 8;
+
+/// Bytes per output vertex.
+pub const VERTEX_STRIDE: u64 = 4 * VERTEX_FLOATS as u64;
+
+/// The vertex buffer's layout for a render pipeline: position at location 0, normal at 1, uv
+/// at 2 (all f32), [`VERTEX_STRIDE`] bytes a vertex. Indices are u32.
+pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: VERTEX_STRIDE,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+};
+
+/// The compute passes of a frame, in order ("cull" only with a culling camera,
+/// [`GpuTessellator::set_cull_camera`]).
+pub const PASSES: [&str; 6] = ["cull", "count", "scan", "args", "vertices", "triangles"];
+
+const COMMON: &str = include_str!("../shaders/common.wgsl");
+const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
+const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
+const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
+const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
+const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
+const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
+const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
+const CULL: &str = include_str!("../shaders/cull.wgsl");
+const TRANSITION_QUAD: &str = include_str!("../shaders/transition_quad.wgsl");
+
+/// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
+const MAIN_STORAGE: u32 = 12;
+/// Storage buffers in group 1 (the args pass's outputs).
+const ARGS_STORAGE: u32 = 3;
+
+/// Constants the tessellation shaders share with this crate.
+fn constants() -> Vec<(&'static str, u32)> {
+    vec![
+        ("PATCH_ROW", upload::PATCH_ROW),
+        ("EDGE_ROW", upload::EDGE_ROW),
+        ("USE_ROW", upload::USE_ROW),
+        ("CORNER_ROW", upload::CORNER_ROW),
+        ("CONTROL_POINTS", upload::CONTROL_POINTS),
+        ("VERTEX_FLOATS", VERTEX_FLOATS),
+    ]
+}
+
+fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
+    shader::module(device, label, parts, &constants())
+}
+
+/// The patterns the GPU draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpuPattern {
+    /// [`tessera::pattern::uniform::Uniform`]: one invocation per output triangle.
+    Uniform,
+    /// [`tessera::pattern::transition::Transition`] on quads (CudaTess): one invocation per
+    /// patch builds its core and strips serially.
+    Transition,
+}
+
+impl GpuPattern {
+    /// The GPU form of `pattern`, by its name; None for patterns not on the GPU.
+    pub fn of(pattern: &dyn Pattern) -> Option<GpuPattern> {
+        match pattern.name() {
+            n if n == Uniform.name() => Some(GpuPattern::Uniform),
+            n if n == Transition.name() => Some(GpuPattern::Transition),
+            _ => None,
+        }
+    }
+}
+
+/// The pattern-specific pipelines: counts, vertex writes (the interior grid is the
+/// pattern's), triangle writes.
+#[derive(Debug)]
+struct PatternPipelines {
+    count: wgpu::ComputePipeline,
+    corners: wgpu::ComputePipeline,
+    edge_vertices: wgpu::ComputePipeline,
+    interior_vertices: wgpu::ComputePipeline,
+    /// Uniform: one invocation per triangle (indirect), then the collapsed-corner patches.
+    /// Transition: one invocation per patch.
+    triangles: wgpu::ComputePipeline,
+    collapsed_triangles: Option<wgpu::ComputePipeline>,
+}
+
+/// Every pipeline of a frame.
+#[derive(Debug)]
+struct Pipelines {
+    main_layout: wgpu::BindGroupLayout,
+    args_layout: wgpu::BindGroupLayout,
+    cull_layout: wgpu::BindGroupLayout,
+    cull: wgpu::ComputePipeline,
+    scan: ScanPipelines,
+    args: wgpu::ComputePipeline,
+    uniform: PatternPipelines,
+    transition: PatternPipelines,
+}
+
+impl Pipelines {
+    fn new(device: &wgpu::Device) -> Pipelines {
+        use Binding::*;
+        let mut main = vec![Uniform];
+        main.extend(std::iter::repeat_n(Write, MAIN_STORAGE as usize));
+        let main_layout = shader::layout(device, &main);
+        let args_layout = shader::layout(device, &[Write; ARGS_STORAGE as usize]);
+        let cull_layout = shader::layout(device, &[Uniform, Write]);
+        let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            })
+        };
+        let one = pipeline_layout(&[Some(&main_layout)]);
+        let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
+        let with_view = pipeline_layout(&[Some(&main_layout), Some(&cull_layout)]);
+        let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
+        let cull = module(device, "cull", &[COMMON, CULL]);
+        let uniform = {
+            let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
+            let vertices = module(
+                device,
+                "vertices uniform",
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, WRITE_VERTICES],
+            );
+            let triangles =
+                module(device, "triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
+            PatternPipelines {
+                count: make(&one, &count, "count"),
+                corners: make(&one, &vertices, "write_corners"),
+                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
+                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
+                triangles: make(&one, &triangles, "write_triangles"),
+                collapsed_triangles: Some(make(&one, &triangles, "write_collapsed_patch_triangles")),
+            }
+        };
+        let transition = {
+            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD]);
+            let vertices = module(
+                device,
+                "vertices transition",
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION_QUAD, WRITE_VERTICES],
+            );
+            PatternPipelines {
+                count: make(&one, &pattern, "count"),
+                corners: make(&one, &vertices, "write_corners"),
+                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
+                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
+                triangles: make(&one, &pattern, "write_patch_triangles"),
+                collapsed_triangles: None,
+            }
+        };
+        Pipelines {
+            cull: make(&with_view, &cull, "cull"),
+            scan: ScanPipelines::new(device),
+            args: make(&two, &args, "write_args"),
+            uniform,
+            transition,
+            main_layout,
+            args_layout,
+            cull_layout,
+        }
+    }
+}
+
+/// `common.wgsl`'s `Params`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    edges: u32,
+    patches: u32,
+    corners: u32,
+    vertex_capacity: u32,
+    triangle_capacity: u32,
+    _pad: [u32; 3],
+}
+
+/// The worst-case output of a plan, known before the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Capacity {
+    /// Vertices the output buffers hold.
+    pub vertices: u64,
+    /// Triangles the output buffers hold.
+    pub triangles: u64,
+}
+
+impl Capacity {
+    /// The bound of `plan` on `set` under `pattern`: every corner entry,
+    /// `(s − 1) · variants` per edge, and the pattern's own counts
+    /// ([`Pattern::counts`] of [`tessera::engine::layout::pattern_input`]) per visible patch
+    /// (per patch with `all_visible`, when the GPU decides visibility), triangles that may
+    /// degenerate at collapsed curves included. Cost: O(E + P) pattern counts.
+    pub fn of_plan(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, all_visible: bool) -> Capacity {
+        let topo = &set.topology;
+        let mut vertices = topo.corner_entries.len() as u64;
+        for (e, edge) in topo.edges.iter().enumerate() {
+            vertices += (plan.segments[e] as u64 - 1) * edge.variants as u64;
+        }
+        let mut triangles = 0;
+        for p in 0..set.patches.len() {
+            if all_visible || plan.is_visible(p) {
+                let (v, t) = pattern.counts(&tessera::engine::layout::pattern_input(set, plan, p));
+                vertices += v as u64;
+                triangles += t as u64;
+            }
+        }
+        Capacity { vertices, triangles }
+    }
+}
+
+/// Buffers whose size depends on the output capacity, and their bind groups.
+#[derive(Debug)]
+struct Output {
+    capacity: Capacity,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    main: wgpu::BindGroup,
+}
+
+/// The GPU engine for one surface set: uploads the set once, then tessellates a plan per
+/// frame into device buffers that a render pipeline binds directly (see the module doc for
+/// the passes).
+///
+/// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
+/// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
+/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on bicubic
+/// patches (any per-edge segments and core factors, as `Scheme::Transition` plans); anything
+/// else is refused with [`GpuError::Unsupported`].
+#[derive(Debug)]
+pub struct GpuTessellator {
+    set: GpuSet,
+    pipelines: Pipelines,
+    params: wgpu::Buffer,
+    segments: wgpu::Buffer,
+    interior: wgpu::Buffer,
+    visible: wgpu::Buffer,
+    vertex_offsets: wgpu::Buffer,
+    triangle_offsets: wgpu::Buffer,
+    vertex_scan: Scan,
+    triangle_scan: Scan,
+    draw_args: wgpu::Buffer,
+    dispatch_args: wgpu::Buffer,
+    status: wgpu::Buffer,
+    args: wgpu::BindGroup,
+    output: Option<Output>,
+    /// The last prepared plan's pattern triangles per patch (for
+    /// [`GpuTessellator::read_mesh`]'s count of collapsed triangles).
+    pattern_triangles: Vec<u32>,
+    /// The last prepared plan's pattern.
+    pattern: GpuPattern,
+    /// The culling camera's uniform and bind group, when the GPU culls.
+    cull: Option<CullView>,
+    /// Per patch: normal cone and bounding sphere (`cull.wgsl`), prepared once.
+    cones: wgpu::Buffer,
+    /// The largest buffer the device binds or allocates.
+    buffer_limit: u64,
+}
+
+fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(4),
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
+impl GpuTessellator {
+    /// Uploads `set` (see [`crate::upload`]) and compiles the frame's pipelines.
+    ///
+    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than 15 storage buffers
+    /// per shader stage. Cost: O(P + E) packing, one upload, seven
+    /// shader compilations (about a second on lavapipe).
+    pub fn new(ctx: &GpuContext, set: &SurfaceSet) -> Result<GpuTessellator> {
+        let needed = MAIN_STORAGE + ARGS_STORAGE;
+        if ctx.limits.max_storage_buffers_per_shader_stage < needed {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "an adapter with {} storage buffers per shader stage ({needed} needed)",
+                    ctx.limits.max_storage_buffers_per_shader_stage
+                ),
+            });
+        }
+        let device = &ctx.device;
+        let gpu_set = GpuSet::new(device, set)?;
+        let (e, p) = (gpu_set.edges as u64, gpu_set.patches as u64);
+        use wgpu::BufferUsages as U;
+        let plan_usage = U::STORAGE | U::COPY_DST | U::COPY_SRC;
+        let layout_usage = U::STORAGE | U::COPY_SRC;
+        let vertex_offsets = buffer(device, "vertex offsets", 4 * (e + p + 1), layout_usage);
+        let triangle_offsets = buffer(device, "triangle offsets", 4 * (p + 1), layout_usage);
+        let pipelines = Pipelines::new(device);
+        let vertex_scan =
+            Scan::new(device, &pipelines.scan, &vertex_offsets, (e + p + 1) as u32, gpu_set.corners);
+        let triangle_scan = Scan::new(device, &pipelines.scan, &triangle_offsets, (p + 1) as u32, 0);
+        let draw_args = buffer(device, "draw indexed indirect", 20, U::STORAGE | U::INDIRECT | U::COPY_SRC);
+        let dispatch_args = buffer(device, "write dispatches", 48, U::STORAGE | U::INDIRECT);
+        let status = buffer(device, "status", 16, U::STORAGE | U::COPY_SRC);
+        let args = shader::bind(device, &pipelines.args_layout, &[&draw_args, &dispatch_args, &status]);
+        Ok(GpuTessellator {
+            params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
+            segments: buffer(device, "segments", 4 * e, plan_usage),
+            interior: buffer(device, "interior", 8 * p, plan_usage),
+            visible: buffer(device, "visible", 4 * p, plan_usage),
+            vertex_offsets,
+            triangle_offsets,
+            vertex_scan,
+            triangle_scan,
+            draw_args,
+            dispatch_args,
+            status,
+            args,
+            output: None,
+            pattern_triangles: Vec::new(),
+            pattern: GpuPattern::Uniform,
+            cull: None,
+            cones: upload::storage_buffer(device, "normal cones", &cones(set)),
+            buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
+            set: gpu_set,
+            pipelines,
+        })
+    }
+
+    /// Uploads `plan` (made for `pattern`, which must be the uniform pattern for now) for the
+    /// next [`GpuTessellator::record`], growing the output buffers
+    /// to its worst case ([`Capacity::of_plan`]) when they are too small.
+    ///
+    /// Preconditions: `plan` was made for `set`, the set given to [`GpuTessellator::new`].
+    /// Errors: [`tessera::Error::PlanMismatch`] for a plan of another set;
+    /// [`GpuError::Unsupported`] for another pattern or a plan that is not uniform per patch;
+    /// [`GpuError::OutputTooLarge`] when the worst case exceeds the u32 index range or the
+    /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the
+    /// plan's arrays (16 bytes a patch, 4 an edge); a reallocation when the output grows.
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+    ) -> Result<()> {
+        plan.check(set)?;
+        let Some(kind) = GpuPattern::of(pattern) else {
+            return Err(GpuError::Unsupported {
+                what: format!("the {} pattern (uniform and transition are on the GPU)", pattern.name()),
+            });
+        };
+        if set.patches.len() as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
+            return Err(
+                tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
+            );
+        }
+        if plan.kind != SamplingKind::Uniform {
+            return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
+        }
+        if kind == GpuPattern::Transition
+            && set.patches.iter().any(|p| p.domain() != tessera::domain::Domain::Quad)
+        {
+            return Err(GpuError::Unsupported { what: "the transition pattern on triangle patches".into() });
+        }
+        for (p, &[n, _]) in plan.interior.iter().enumerate() {
+            let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
+            if kind == GpuPattern::Uniform
+                && (self.cull.is_some() || plan.is_visible(p))
+                && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n)
+            {
+                return Err(GpuError::Unsupported {
+                    what: format!(
+                        "patch {p}: edges cut unlike its interior (only the uniform pattern is on the GPU)"
+                    ),
+                });
+            }
+        }
+        let capacity = Capacity::of_plan(set, plan, pattern, self.cull.is_some());
+        self.pattern_triangles.clear();
+        self.pattern_triangles.extend(
+            (0..set.patches.len())
+                .map(|p| pattern.counts(&tessera::engine::layout::pattern_input(set, plan, p)).1),
+        );
+        self.reserve(ctx, capacity)?;
+        let queue = &ctx.queue;
+        queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
+        queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
+        queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
+        self.pattern = kind;
+        Ok(())
+    }
+
+    /// Makes the output buffers hold at least `capacity`. Errors with
+    /// [`GpuError::OutputTooLarge`] past the device's limits. Cost: a reallocation and new
+    /// bind groups when they grow; nothing otherwise.
+    pub fn reserve(&mut self, ctx: &GpuContext, capacity: Capacity) -> Result<()> {
+        if self.output.as_ref().is_some_and(|o| {
+            o.capacity.vertices >= capacity.vertices && o.capacity.triangles >= capacity.triangles
+        }) {
+            return Ok(());
+        }
+        let vertex_bytes = capacity.vertices * VERTEX_STRIDE;
+        let index_bytes = capacity.triangles * 12;
+        let too_large = capacity.vertices > u32::MAX as u64
+            || capacity.triangles > u32::MAX as u64 / 3
+            || vertex_bytes.max(index_bytes) > self.buffer_limit;
+        if too_large {
+            return Err(GpuError::OutputTooLarge {
+                vertices: capacity.vertices,
+                triangles: capacity.triangles,
+                bytes: vertex_bytes.max(index_bytes),
+                limit: self.buffer_limit,
+            });
+        }
+        let device = &ctx.device;
+        use wgpu::BufferUsages as U;
+        let usage = U::STORAGE | U::COPY_SRC;
+        let vertices = buffer(device, "tessera vertices", vertex_bytes, usage | U::VERTEX);
+        let indices = buffer(device, "tessera indices", index_bytes, usage | U::INDEX);
+        let params = Params {
+            edges: self.set.edges,
+            patches: self.set.patches,
+            corners: self.set.corners,
+            vertex_capacity: capacity.vertices as u32,
+            triangle_capacity: capacity.triangles as u32,
+            _pad: [0; 3],
+        };
+        ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let s = &self.set;
+        let main = shader::bind(
+            device,
+            &self.pipelines.main_layout,
+            &[
+                &self.params,
+                &s.control_points,
+                &s.patch_rows,
+                &s.edge_rows,
+                &s.uses,
+                &s.corner_rows,
+                &self.segments,
+                &self.interior,
+                &self.visible,
+                &self.vertex_offsets,
+                &self.triangle_offsets,
+                &vertices,
+                &indices,
+            ],
+        );
+        self.output = Some(Output { capacity, vertices, indices, main });
+        Ok(())
+    }
+
+    /// Records the frame's passes for the last prepared plan into `encoder`. Reads nothing
+    /// back. Precondition: [`GpuTessellator::prepare`] succeeded once (else nothing is
+    /// recorded). Cost on the GPU: O(output) work in about a dozen dispatches.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        self.record_timed(encoder, None)
+    }
+
+    /// [`GpuTessellator::record`], each pass timed by `timer` (see [`PassTimer`]).
+    pub fn record_timed(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<&PassTimer>) {
+        let Some(out) = &self.output else { return };
+        let p = &self.pipelines;
+        let (e, patches, corners) = (self.set.edges, self.set.patches, self.set.corners);
+        {
+            // Begun even without culling, so that every timestamp of the timer is written.
+            let mut c = begin_pass(encoder, timer, 0);
+            if let Some(view) = &self.cull {
+                c.set_pipeline(&p.cull);
+                c.set_bind_group(0, &out.main, &[]);
+                c.set_bind_group(1, &view.bind, &[]);
+                let (x, y) = shader::grid(patches.div_ceil(shader::WORKGROUP));
+                c.dispatch_workgroups(x, y, 1);
+            }
+        }
+        let k = match self.pattern {
+            GpuPattern::Uniform => &p.uniform,
+            GpuPattern::Transition => &p.transition,
+        };
+        {
+            let mut c = begin_pass(encoder, timer, 1);
+            c.set_pipeline(&k.count);
+            c.set_bind_group(0, &out.main, &[]);
+            let (x, y) = shader::grid((e + patches + 1).div_ceil(shader::WORKGROUP));
+            c.dispatch_workgroups(x, y, 1);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 2);
+            self.vertex_scan.record(&p.scan, &mut c);
+            self.triangle_scan.record(&p.scan, &mut c);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 3);
+            c.set_pipeline(&p.args);
+            c.set_bind_group(0, &out.main, &[]);
+            c.set_bind_group(1, &self.args, &[]);
+            c.dispatch_workgroups(1, 1, 1);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 4);
+            c.set_bind_group(0, &out.main, &[]);
+            if corners > 0 {
+                c.set_pipeline(&k.corners);
+                let (x, y) = shader::grid(corners.div_ceil(shader::WORKGROUP));
+                c.dispatch_workgroups(x, y, 1);
+            }
+            c.set_pipeline(&k.edge_vertices);
+            c.dispatch_workgroups_indirect(&self.dispatch_args, 0);
+            c.set_pipeline(&k.interior_vertices);
+            c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 5);
+            c.set_bind_group(0, &out.main, &[]);
+            // Per-patch passes take the fourth dispatch, which the args pass zeroes on overflow.
+            match (&k.collapsed_triangles, self.pattern) {
+                (Some(collapsed), GpuPattern::Uniform) => {
+                    c.set_pipeline(&k.triangles);
+                    c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
+                    if self.set.any_repeated_corner {
+                        c.set_pipeline(collapsed);
+                        c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
+                    }
+                }
+                _ => {
+                    c.set_pipeline(&k.triangles);
+                    c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
+                }
+            }
+        }
+        if let Some(t) = timer {
+            encoder.resolve_query_set(&t.queries, 0..2 * PASSES.len() as u32, &t.resolved, 0);
+        }
+    }
+
+    /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
+    /// following frame, writing the plan's visibility row on the device (the plan's own row
+    /// is then ignored); None goes back to the plan's row. The output capacity then covers
+    /// every patch. Cost: a 96-byte upload; nothing when unchanged.
+    pub fn set_cull_camera(&mut self, ctx: &GpuContext, camera: Option<&Camera>) {
+        let Some(camera) = camera else {
+            self.cull = None;
+            return;
+        };
+        let (r, u, f) = camera.basis();
+        let t = camera.half_tangents();
+        let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        let mut view = [0f32; 20];
+        view[0..4].copy_from_slice(&v4(camera.eye));
+        view[4..8].copy_from_slice(&v4(r));
+        view[8..12].copy_from_slice(&v4(u));
+        view[12..16].copy_from_slice(&v4(f));
+        view[16..20].copy_from_slice(&[camera.near as f32, camera.far as f32, t.x as f32, t.y as f32]);
+        if self.cull.is_none() {
+            let uniform = buffer(
+                &ctx.device,
+                "cull view",
+                80,
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            );
+            let bind = shader::bind(&ctx.device, &self.pipelines.cull_layout, &[&uniform, &self.cones]);
+            self.cull = Some(CullView { uniform, bind });
+        }
+        let cull = self.cull.as_ref().expect("set above");
+        ctx.queue.write_buffer(&cull.uniform, 0, bytemuck::cast_slice(&view));
+    }
+
+    /// Reads the plan's visibility row back (the GPU's, when it culls). For tests. Cost: a
+    /// queue wait.
+    pub fn read_visible(&self, ctx: &GpuContext) -> Result<Vec<u32>> {
+        readback::read(ctx, &self.visible, self.set.patches as usize)
+    }
+
+    /// The vertex buffer ([`VERTEX_LAYOUT`]); usages VERTEX, STORAGE, COPY_SRC. None before
+    /// the first [`GpuTessellator::prepare`]. It may be replaced by a larger one when a
+    /// later plan needs more room.
+    pub fn vertex_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.output.as_ref().map(|o| &o.vertices)
+    }
+
+    /// The u32 index buffer, a triangle list; usages INDEX, STORAGE, COPY_SRC.
+    pub fn index_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.output.as_ref().map(|o| &o.indices)
+    }
+
+    /// `DrawIndexedIndirectArgs` (20 bytes at offset 0) for
+    /// `RenderPass::draw_indexed_indirect`; usages INDIRECT, STORAGE, COPY_SRC.
+    pub fn indirect_buffer(&self) -> &wgpu::Buffer {
+        &self.draw_args
+    }
+
+    /// The output capacity, once prepared.
+    pub fn capacity(&self) -> Option<Capacity> {
+        self.output.as_ref().map(|o| o.capacity)
+    }
+
+    /// Reads the frame's status back: `(overflowed, vertices, triangles)`. For tests and
+    /// statistics. Cost: a queue wait.
+    pub fn read_status(&self, ctx: &GpuContext) -> Result<(bool, u32, u32)> {
+        let s: Vec<u32> = readback::read(ctx, &self.status, 4)?;
+        Ok((s[0] != 0, s[1], s[2]))
+    }
+
+    /// Reads the GPU's layout back as `(edge_offsets, interior_offsets, triangle_offsets)`,
+    /// to compare with [`tessera::engine::Layout`]. Cost: a queue wait.
+    pub fn read_layout(&self, ctx: &GpuContext) -> Result<(Vec<u32>, Vec<u32>, Vec<u32>)> {
+        let (e, p) = (self.set.edges as usize, self.set.patches as usize);
+        let v: Vec<u32> = readback::read(ctx, &self.vertex_offsets, e + p + 1)?;
+        let t: Vec<u32> = readback::read(ctx, &self.triangle_offsets, p + 1)?;
+        Ok((v[..=e].to_vec(), v[e..].to_vec(), t))
+    }
+
+    /// Reads the frame's mesh back into a [`Mesh`] (positions, normals, uvs, indices, the
+    /// patch of every triangle and vertex derived from the layout). For tests and the
+    /// command-line tool, never for a frame loop. Errors with [`GpuError::OutputTooLarge`] if
+    /// the frame overflowed. Cost: a queue wait and a copy of the whole output.
+    pub fn read_mesh(&self, ctx: &GpuContext, set: &SurfaceSet) -> Result<Mesh> {
+        let (overflow, vertices, triangles) = self.read_status(ctx)?;
+        let Some(out) = &self.output else { return Ok(Mesh::default()) };
+        if overflow {
+            return Err(GpuError::OutputTooLarge {
+                vertices: vertices as u64,
+                triangles: triangles as u64,
+                bytes: vertices as u64 * VERTEX_STRIDE,
+                limit: out.capacity.vertices * VERTEX_STRIDE,
+            });
+        }
+        let raw: Vec<f32> = readback::read(ctx, &out.vertices, vertices as usize * VERTEX_FLOATS as usize)?;
+        let indices: Vec<u32> = readback::read(ctx, &out.indices, 3 * triangles as usize)?;
+        let (edge_offsets, interior_offsets, triangle_offsets) = self.read_layout(ctx)?;
+        let mut mesh = Mesh { indices, ..Default::default() };
+        for v in raw.chunks_exact(VERTEX_FLOATS as usize) {
+            mesh.positions.push([v[0], v[1], v[2]]);
+            mesh.normals.push([v[3], v[4], v[5]]);
+            mesh.uvs.push([v[6], v[7]]);
+        }
+        // Which patch evaluated each vertex and owns each triangle: the layout's ranges.
+        let topo = &set.topology;
+        mesh.vertex_patch = topo.corner_entries.iter().map(|c| c.owner_patch).collect();
+        for (e, w) in edge_offsets.windows(2).enumerate() {
+            let uses = topo.edge_uses(e);
+            for k in 0..w[1] - w[0] {
+                let inner = (w[1] - w[0]) / topo.edges[e].variants.max(1) as u32;
+                let variant = k / inner.max(1);
+                let u = uses.iter().find(|u| u.variant as u32 == variant).unwrap_or(&uses[0]);
+                mesh.vertex_patch.push(u.patch);
+            }
+        }
+        for (p, w) in interior_offsets.windows(2).enumerate() {
+            mesh.vertex_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
+        }
+        for (p, w) in triangle_offsets.windows(2).enumerate() {
+            mesh.triangle_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
+        }
+        // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
+        let visible = self.read_visible(ctx)?;
+        let pattern: u64 = self
+            .pattern_triangles
+            .iter()
+            .zip(&visible)
+            .filter(|(_, &v)| v != 0)
+            .map(|(&t, _)| t as u64)
+            .sum();
+        mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
+        Ok(mesh)
+    }
+}
+
+/// The culling camera on the device.
+#[derive(Debug)]
+struct CullView {
+    uniform: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
+/// Per patch, three `vec4<f32>` for `cull.wgsl`: the normal cone of
+/// [`tessera::criterion::screen::normal_cone`] (axis, half-angle α), the bounding sphere of
+/// the control points about their mean that `screen::back_facing` uses, and
+/// `(sin α, cos α, has cone, 0)`. View-independent: computed once. Cost: O(P) cone
+/// computations.
+fn cones(set: &SurfaceSet) -> Vec<[f32; 4]> {
+    let mut out = Vec::with_capacity(3 * set.patches.len());
+    for patch in &set.patches {
+        let cone = tessera::criterion::screen::normal_cone(patch);
+        let (axis, alpha) = cone.unwrap_or((glam::DVec3::Z, 0.0));
+        out.push([axis.x as f32, axis.y as f32, axis.z as f32, alpha as f32]);
+        // As in `screen::back_facing`: the centre is the control points' mean.
+        let pts = patch.control_points();
+        let centre = pts.iter().copied().sum::<glam::DVec3>() / pts.len() as f64;
+        let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        out.push([centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]);
+        out.push([alpha.sin() as f32, alpha.cos() as f32, cone.is_some() as u32 as f32, 0.0]);
+    }
+    out
+}
+
+/// Begins compute pass `index` of [`PASSES`], timed by `timer` if given.
+fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    timer: Option<&PassTimer>,
+    index: usize,
+) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(PASSES[index]),
+        timestamp_writes: timer.map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: &t.queries,
+            beginning_of_pass_write_index: Some(2 * index as u32),
+            end_of_pass_write_index: Some(2 * index as u32 + 1),
+        }),
+    })
+}
+
+/// Timestamp queries around each of the frame's [`PASSES`], where the adapter has them
+/// ([`GpuContext::timestamps`]).
+#[derive(Debug)]
+pub struct PassTimer {
+    queries: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    period_ns: f32,
+}
+
+impl PassTimer {
+    /// A timer for one frame's passes, or None when the adapter has no timestamp queries.
+    /// Cost: a query set and a 80-byte buffer.
+    pub fn new(ctx: &GpuContext) -> Option<PassTimer> {
+        if !ctx.timestamps {
+            return None;
+        }
+        let count = 2 * PASSES.len() as u32;
+        let queries = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("pass timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
+        let resolved = buffer(
+            &ctx.device,
+            "resolved timestamps",
+            8 * count as u64,
+            wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+        );
+        Some(PassTimer { queries, resolved, period_ns: ctx.queue.get_timestamp_period() })
+    }
+
+    /// The last recorded frame's time per pass, in milliseconds, in [`PASSES`] order. Reads
+    /// back (a queue wait): statistics on request only.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<(&'static str, f64)>> {
+        let ticks: Vec<u64> = readback::read(ctx, &self.resolved, 2 * PASSES.len())?;
+        Ok(PASSES
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| {
+                let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
+                (name, dt as f64 * self.period_ns as f64 * 1e-6)
+            })
+            .collect())
+    }
+}

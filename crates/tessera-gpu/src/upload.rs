@@ -1,0 +1,177 @@
+//! The prepared set on the GPU: control points and the topology's arrays, uploaded once.
+//!
+//! The topology's rows are the CPU's own (`tessera::topology::Topology`), packed into u32 so
+//! that WGSL can read them; nothing is recomputed. Row formats (the WGSL accessors in
+//! `shaders/common.wgsl` read exactly these):
+//!
+//! - **patch row** ([`PATCH_ROW`] u32): `[0..4]` canonical edge of each local edge
+//!   (`patch_edges[p][e].edge`); `[4..8]` flags of each local edge: bit 0 reversed, bit 1 the
+//!   edge is collapsed, bits 8..16 the normal variant; `[8..12]` corner entry of each corner
+//!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`],
+//!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots); the
+//!   rest 0. Triangles fill three of the four edge and corner slots.
+//! - **edge row** ([`EDGE_ROW`] u32): first use, end of uses (`edges[e].uses`), variants,
+//!   collapsed.
+//! - **edge use** ([`USE_ROW`] u32): patch; local edge | reversed << 8 | variant << 16.
+//! - **corner row** ([`CORNER_ROW`] u32): owner patch and corner (the normal), then the patch
+//!   and corner of its `position_entry`'s owner (the position: split-normal entries take the
+//!   position bits of their vertex's first entry, as on the CPU).
+//! - **control points**: 16 `vec4<f32>` per patch: a bicubic's `(x, y, z, w)` in
+//!   `points[4 i + j]` order (`i` along `u`); a Bézier triangle's 10 points
+//!   (`BezierTriangle::index` order, `w = 1`), then a PN triangle's six normals (`w = 0`).
+
+use crate::error::Result;
+use tessera::surface::{Patch, SurfaceSet};
+use wgpu::util::DeviceExt;
+
+/// u32 per patch row.
+pub const PATCH_ROW: u32 = 16;
+/// u32 per edge row.
+pub const EDGE_ROW: u32 = 4;
+/// u32 per edge use.
+pub const USE_ROW: u32 = 2;
+/// u32 per corner row.
+pub const CORNER_ROW: u32 = 4;
+/// Control-point slots per patch.
+pub const CONTROL_POINTS: u32 = 16;
+
+/// The packed rows of a set, on the CPU (what [`GpuSet::new`] uploads).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PackedSet {
+    /// [`PATCH_ROW`] u32 per patch.
+    pub patch_rows: Vec<u32>,
+    /// [`EDGE_ROW`] u32 per edge.
+    pub edge_rows: Vec<u32>,
+    /// [`USE_ROW`] u32 per edge use.
+    pub uses: Vec<u32>,
+    /// [`CORNER_ROW`] u32 per corner entry.
+    pub corner_rows: Vec<u32>,
+    /// [`CONTROL_POINTS`] `[x, y, z, w]` per patch.
+    pub control_points: Vec<[f32; 4]>,
+    /// Whether any patch has a repeated corner (then the collapsed-triangle pass runs).
+    pub any_repeated_corner: bool,
+}
+
+impl PackedSet {
+    /// Packs `set`'s topology and control points. Cost: O(P + E).
+    pub fn new(set: &SurfaceSet) -> Result<PackedSet> {
+        let topo = &set.topology;
+        let mut packed = PackedSet::default();
+        for (p, patch) in set.patches.iter().enumerate() {
+            let mut row = [0u32; PATCH_ROW as usize];
+            let corners = patch.domain().corner_count();
+            for e in 0..corners {
+                let pe = topo.patch_edges[p][e];
+                row[e] = pe.edge;
+                let collapsed = topo.edges[pe.edge as usize].collapsed;
+                row[4 + e] = pe.reversed as u32 | (collapsed as u32) << 1 | (pe.variant as u32) << 8;
+                row[8 + e] = topo.patch_corner_entries[p][e];
+            }
+            let repeated = tessera::engine::layout::has_repeated_corner(set, p);
+            packed.any_repeated_corner |= repeated;
+            let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
+            let (tri, pn) = match patch {
+                Patch::Bicubic(b) => {
+                    packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
+                    (false, false)
+                }
+                Patch::BezierTriangle(t) => {
+                    packed.control_points.extend(t.points.iter().map(|q| point(q, 1.0)));
+                    packed.control_points.extend([[0.0; 4]; 6]);
+                    (true, false)
+                }
+                Patch::Pn(t) => {
+                    packed.control_points.extend(t.geometry.points.iter().map(|q| point(q, 1.0)));
+                    packed.control_points.extend(t.normals.iter().map(|n| point(n, 0.0)));
+                    (true, true)
+                }
+            };
+            row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2;
+            packed.patch_rows.extend_from_slice(&row);
+        }
+        for edge in &topo.edges {
+            packed.edge_rows.extend_from_slice(&[
+                edge.uses.start,
+                edge.uses.end,
+                edge.variants as u32,
+                edge.collapsed as u32,
+            ]);
+        }
+        for u in &topo.uses {
+            packed.uses.extend_from_slice(&[
+                u.patch,
+                u.local as u32 | (u.reversed as u32) << 8 | (u.variant as u32) << 16,
+            ]);
+        }
+        for entry in &topo.corner_entries {
+            let position = &topo.corner_entries[entry.position_entry as usize];
+            packed.corner_rows.extend_from_slice(&[
+                entry.owner_patch,
+                entry.owner_corner as u32,
+                position.owner_patch,
+                position.owner_corner as u32,
+            ]);
+        }
+        Ok(packed)
+    }
+}
+
+/// The set's buffers on the device (read-only storage), uploaded once.
+#[derive(Debug)]
+pub struct GpuSet {
+    /// Patches `P`.
+    pub patches: u32,
+    /// Canonical edges `E`.
+    pub edges: u32,
+    /// Corner entries: the first output vertices.
+    pub corners: u32,
+    /// Whether any patch has a repeated corner.
+    pub any_repeated_corner: bool,
+    /// Control points.
+    pub control_points: wgpu::Buffer,
+    /// Patch rows.
+    pub patch_rows: wgpu::Buffer,
+    /// Edge rows.
+    pub edge_rows: wgpu::Buffer,
+    /// Edge uses.
+    pub uses: wgpu::Buffer,
+    /// Corner rows.
+    pub corner_rows: wgpu::Buffer,
+}
+
+/// A storage buffer (usages STORAGE, COPY_DST, COPY_SRC) holding `data`, at least 4 bytes
+/// (empty buffers cannot be bound). Cost: one upload.
+pub fn storage_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, data: &[T]) -> wgpu::Buffer {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    let padded;
+    let contents = if bytes.len() < 4 {
+        padded = [0u8; 4];
+        &padded[..]
+    } else {
+        bytes
+    };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+    })
+}
+
+impl GpuSet {
+    /// Packs and uploads `set`. Errors as [`PackedSet::new`]. Cost: O(P + E) and one upload
+    /// of about 300 bytes per patch.
+    pub fn new(device: &wgpu::Device, set: &SurfaceSet) -> Result<GpuSet> {
+        let packed = PackedSet::new(set)?;
+        Ok(GpuSet {
+            patches: set.patches.len() as u32,
+            edges: set.topology.edges.len() as u32,
+            corners: set.topology.corner_entries.len() as u32,
+            any_repeated_corner: packed.any_repeated_corner,
+            control_points: storage_buffer(device, "control points", &packed.control_points),
+            patch_rows: storage_buffer(device, "patch rows", &packed.patch_rows),
+            edge_rows: storage_buffer(device, "edge rows", &packed.edge_rows),
+            uses: storage_buffer(device, "edge uses", &packed.uses),
+            corner_rows: storage_buffer(device, "corner rows", &packed.corner_rows),
+        })
+    }
+}
