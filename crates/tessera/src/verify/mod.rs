@@ -80,8 +80,8 @@ fn position_key(p: [f32; 3]) -> [u32; 3] {
 ///   table, every vertex taking the smallest index at its position as its id.
 /// - Edges: every side of a non-collapsed triangle becomes a 64-bit key (its smaller welded
 ///   end, its larger end and its direction), stored in the part of its smaller end (4,096
-///   vertices a part, in index order); each part is sorted on its own, so an edge's uses are
-///   one run of keys. The parts are filled in two passes (count, then place) without locks,
+///   vertices a part, in index order); each part is sorted on its own (a counting sort on the
+///   smaller end, then each end's few sides), so an edge's uses are one run of keys. The parts are filled in two passes (count, then place) without locks,
 ///   per fixed chunk of triangles.
 ///
 /// The counts do not depend on the thread count. Preconditions: indices in range (as every
@@ -97,30 +97,13 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
         return watertight_hashed(mesh);
     }
     let welded = weld(&mesh.positions);
-    let id = |i: u32| welded[i as usize].load(Relaxed);
     let t_count = mesh.triangle_count();
     let used: Vec<AtomicBool> = (0..n).map(|_| AtomicBool::new(false)).collect();
 
-    // Sides go to part `smaller end >> PART_BITS`, so a part's keys hold the smaller end
-    // relative to the part (PART_BITS bits), the larger end and the direction.
-    const PART_BITS: u32 = 12;
     let parts = n.div_ceil(1 << PART_BITS).max(1);
     let chunk = EDGE_CHUNK.max(t_count.div_ceil(MAX_CHUNKS));
     let chunks = t_count.div_ceil(chunk);
-    let side_keys = |t: usize| -> Option<[(usize, u64); 3]> {
-        let v = mesh.triangle(t).map(id);
-        if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
-            return None;
-        }
-        Some([0, 1, 2].map(|c| {
-            let (a, b) = (v[c], v[(c + 1) % 3]);
-            let (lo, hi) = (a.min(b), a.max(b));
-            let key =
-                (u64::from(lo & ((1 << PART_BITS) - 1)) << 32) | (u64::from(hi) << 1) | u64::from(a > b);
-            ((lo >> PART_BITS) as usize, key)
-        }))
-    };
-
+    let triangles_of = |c: usize| &mesh.indices[3 * c * chunk..3 * ((c + 1) * chunk).min(t_count)];
     // Pass 1, per chunk of triangles: the degenerate counts, the used vertices, and how many
     // sides each part gets from the chunk.
     let counted: Vec<(usize, usize, Vec<u32>)> = (0..chunks)
@@ -128,16 +111,19 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
         .map(|c| {
             let (mut collapsed, mut zero_area) = (0, 0);
             let mut per_part = vec![0u32; parts];
-            for t in c * chunk..((c + 1) * chunk).min(t_count) {
-                let Some(sides) = side_keys(t) else {
+            for corners in triangles_of(c).chunks_exact(3) {
+                let Some((ends, sides)) = side_keys(&welded, corners) else {
                     collapsed += 1;
                     continue;
                 };
-                let corners = mesh.triangle(t);
-                let p = corners.map(|i| Vec3::from(mesh.positions[i as usize]).as_dvec3());
-                zero_area += usize::from((p[1] - p[0]).cross(p[2] - p[0]) == DVec3::ZERO);
-                for i in corners {
-                    used[id(i) as usize].store(true, Relaxed);
+                // Spelled out rather than an array `map`: that version went through the stack
+                // and stalled on every triangle.
+                let p0 = Vec3::from(mesh.positions[corners[0] as usize]).as_dvec3();
+                let p1 = Vec3::from(mesh.positions[corners[1] as usize]).as_dvec3();
+                let p2 = Vec3::from(mesh.positions[corners[2] as usize]).as_dvec3();
+                zero_area += usize::from((p1 - p0).cross(p2 - p0) == DVec3::ZERO);
+                for v in ends {
+                    used[v as usize].store(true, Relaxed);
                 }
                 for (part, _) in sides {
                     per_part[part] += 1;
@@ -167,8 +153,8 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
     // Pass 2: place the keys.
     pieces.par_iter_mut().enumerate().for_each(|(c, pieces)| {
         let mut fill = vec![0usize; parts];
-        for t in c * chunk..((c + 1) * chunk).min(t_count) {
-            if let Some(sides) = side_keys(t) {
+        for corners in triangles_of(c).chunks_exact(3) {
+            if let Some((_, sides)) = side_keys(&welded, corners) {
                 for (part, key) in sides {
                     pieces[part][fill[part]] = key;
                     fill[part] += 1;
@@ -195,15 +181,40 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
     }
     let edges = part_keys
         .into_par_iter()
-        .map(|keys| {
-            keys.sort_unstable();
-            let mut r = WatertightReport::default();
-            for run in keys.chunk_by(|a, b| a >> 1 == b >> 1) {
-                let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
-                r.count_edge(run.len() as u32 - backward, backward);
-            }
-            r
-        })
+        .map_init(
+            || (vec![0u32; (1 << PART_BITS) + 1], vec![0u32; (1 << PART_BITS) + 1], Vec::new()),
+            |(starts, next, by_lo), keys| {
+                // A counting sort by the smaller end (in cache: one part), then each end's few
+                // sides (about six) sorted on their own: several times faster than sorting
+                // the part's keys whole.
+                starts.fill(0);
+                for &k in keys.iter() {
+                    starts[(k >> 32) as usize + 1] += 1;
+                }
+                for lo in 0..1 << PART_BITS {
+                    starts[lo + 1] += starts[lo];
+                }
+                by_lo.clear();
+                by_lo.resize(keys.len(), 0u32);
+                next.copy_from_slice(starts);
+                for &k in keys.iter() {
+                    let slot = &mut next[(k >> 32) as usize];
+                    // The larger end and the direction.
+                    by_lo[*slot as usize] = k as u32;
+                    *slot += 1;
+                }
+                let mut r = WatertightReport::default();
+                for lo in 0..1 << PART_BITS {
+                    let sides = &mut by_lo[starts[lo] as usize..starts[lo + 1] as usize];
+                    sides.sort_unstable();
+                    for run in sides.chunk_by(|a, b| a >> 1 == b >> 1) {
+                        let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
+                        r.count_edge(run.len() as u32 - backward, backward);
+                    }
+                }
+                r
+            },
+        )
         .reduce(WatertightReport::default, |a, b| WatertightReport {
             edges: a.edges + b.edges,
             boundary_edges: a.boundary_edges + b.boundary_edges,
@@ -217,6 +228,27 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
     report.misoriented_edges = edges.misoriented_edges;
     report.vertices = used.par_iter().filter(|u| u.load(Relaxed)).count();
     report.finish()
+}
+
+/// Sides go to part `smaller end >> PART_BITS`, so a part's keys hold the smaller end
+/// relative to the part (PART_BITS bits), the larger end and the direction.
+const PART_BITS: u32 = 12;
+
+/// The welded ends of the triangle with `corners`, and its three sides as (part, key) for
+/// [`watertight`]; `None` when two ends are one (a collapsed triangle).
+#[inline(always)]
+fn side_keys(welded: &[AtomicU32], corners: &[u32]) -> Option<([u32; 3], [(usize, u64); 3])> {
+    let v = [corners[0], corners[1], corners[2]].map(|i| welded[i as usize].load(Relaxed));
+    if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
+        return None;
+    }
+    #[inline(always)]
+    fn side(a: u32, b: u32) -> (usize, u64) {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let key = (u64::from(lo & ((1 << PART_BITS) - 1)) << 32) | (u64::from(hi) << 1) | u64::from(a > b);
+        ((lo >> PART_BITS) as usize, key)
+    }
+    Some((v, [side(v[0], v[1]), side(v[1], v[2]), side(v[2], v[0])]))
 }
 
 /// Triangles (or vertices) per chunk of the partitioned passes: enough that a chunk's count
