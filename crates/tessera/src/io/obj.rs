@@ -513,10 +513,10 @@ fn is_tie(x: f32, printed: &[u8]) -> bool {
     // Significant digits of the printed form: no sign, point or exponent, no leading or
     // trailing zeros (`ryu` writes `0.00125` and `1000.0`).
     let mantissa = printed.split(|&b| b == b'e').next().unwrap_or(printed);
-    let digits: Vec<u8> = mantissa.iter().copied().filter(u8::is_ascii_digit).collect();
-    let start = digits.iter().position(|&d| d != b'0').unwrap_or(digits.len());
-    let end = digits.iter().rposition(|&d| d != b'0').map_or(start, |i| i + 1);
-    let shortest = end.saturating_sub(start);
+    let digits = || mantissa.iter().copied().filter(u8::is_ascii_digit);
+    let leading = digits().take_while(|&d| d == b'0').count();
+    let trailing = digits().rev().take_while(|&d| d == b'0').count();
+    let shortest = digits().count().saturating_sub(leading + trailing);
     exact.ilog10() as usize + 1 == shortest + 1
 }
 

@@ -77,7 +77,8 @@ fn position_key(p: [f32; 3]) -> [u32; 3] {
 /// sequential passes over the mesh rather than one cache miss per vertex or side.
 /// - Weld: every position goes, by a hash of its bits, to one of about `V / 2048` parts
 ///   (copied with its index, 16 bytes); each part is welded with a small open-addressing
-///   table, every vertex taking the smallest index at its position as its id.
+///   table, every vertex taking the smallest index at its position as its id (so only
+///   duplicates write an id out of order).
 /// - Edges: every side of a non-collapsed triangle becomes a 64-bit key (its smaller welded
 ///   end, its larger end and its direction), stored in the part of its smaller end (4,096
 ///   vertices a part, in index order); each part is sorted on its own (a counting sort on the
@@ -98,7 +99,7 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
     }
     let welded = weld(&mesh.positions);
     let t_count = mesh.triangle_count();
-    let used: Vec<AtomicBool> = (0..n).map(|_| AtomicBool::new(false)).collect();
+    let used: Vec<AtomicBool> = (0..n).into_par_iter().map(|_| AtomicBool::new(false)).collect();
 
     let parts = n.div_ceil(1 << PART_BITS).max(1);
     let chunk = EDGE_CHUNK.max(t_count.div_ceil(MAX_CHUNKS));
@@ -256,12 +257,9 @@ fn side_keys(welded: &[AtomicU32], corners: &[u32]) -> Option<([u32; 3], [(usize
 const EDGE_CHUNK: usize = 1 << 16;
 const MAX_CHUNKS: usize = 64;
 
-/// A position's bits with its index, as the weld's parts hold them.
-#[derive(Clone, Copy, Default)]
-struct Keyed {
-    key: [u32; 3],
-    index: u32,
-}
+/// A position's bits with its index, `[x, y, z, index]`, as the weld's parts hold them: an
+/// array, so that a vector of them starts zeroed by the allocator.
+type Keyed = [u32; 4];
 
 /// A 64-bit hash of position bits: multiply-xorshift (splitmix64's finaliser), whose top bits
 /// choose the part and low bits the slot; well spread for the regular grids of a tessellation.
@@ -281,7 +279,9 @@ fn hash_key(k: [u32; 3]) -> u64 {
 /// positions.
 fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
     let n = positions.len();
-    let part_bits = (n / 2048).max(1).next_power_of_two().trailing_zeros();
+    // Parts of 8–16 K positions: their tables (64–128 KiB) stay in cache, and few enough
+    // parts that scattering the positions into them writes few streams at a time.
+    let part_bits = (n / 16384).max(1).next_power_of_two().trailing_zeros();
     let parts = 1usize << part_bits;
     let part_of = |h: u64| if part_bits == 0 { 0 } else { (h >> (64 - part_bits)) as usize };
     let chunk = EDGE_CHUNK.max(n.div_ceil(MAX_CHUNKS));
@@ -296,7 +296,8 @@ fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
             h
         })
         .collect();
-    let mut entries = vec![Keyed::default(); n];
+    // Zeroed by the allocator (lazily, page by page), not written here first.
+    let mut entries: Vec<Keyed> = vec![[0; 4]; n];
     let mut part_len = vec![0usize; parts];
     let mut pieces: Vec<Vec<&mut [Keyed]>> = (0..chunks).map(|_| Vec::with_capacity(parts)).collect();
     let mut rest: &mut [Keyed] = &mut entries;
@@ -316,12 +317,14 @@ fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
         for i in c * chunk..((c + 1) * chunk).min(n) {
             let key = position_key(positions[i]);
             let p = part_of(hash_key(key));
-            pieces[p][fill[p]] = Keyed { key, index: i as u32 };
+            pieces[p][fill[p]] = [key[0], key[1], key[2], i as u32];
             fill[p] += 1;
         }
     });
     drop(pieces);
-    let welded: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
+    // Every vertex its own id to begin with, so that only duplicates are stored below: one
+    // scattered store per duplicate, not per vertex.
+    let welded: Vec<AtomicU32> = (0..n as u32).into_par_iter().map(AtomicU32::new).collect();
     let mut part_entries: Vec<&[Keyed]> = Vec::with_capacity(parts);
     let mut rest: &[Keyed] = &entries;
     for len in part_len {
@@ -337,18 +340,21 @@ fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
         table.resize(size, u32::MAX);
         let mask = size - 1;
         for (k, e) in part.iter().enumerate() {
-            let mut slot = hash_key(e.key) as usize & mask;
+            let (key, index) = ([e[0], e[1], e[2]], e[3]);
+            let mut slot = hash_key(key) as usize & mask;
             let first = loop {
                 match table[slot] {
                     u32::MAX => {
                         table[slot] = k as u32;
-                        break e.index;
+                        break index;
                     }
-                    other if part[other as usize].key == e.key => break part[other as usize].index,
+                    other if part[other as usize][..3] == key => break part[other as usize][3],
                     _ => slot = (slot + 1) & mask,
                 }
             };
-            welded[e.index as usize].store(first, Relaxed);
+            if first != index {
+                welded[index as usize].store(first, Relaxed);
+            }
         }
     });
     welded
