@@ -17,6 +17,8 @@ pub(crate) const WRITER_LABEL: &str = "<writer>";
 /// Rejects meshes whose buffers disagree or hold non-finite numbers: every format would either
 /// index out of bounds or write a file its readers refuse.
 pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
+    // The scans are parallel (`first_where` keeps the first offender, as a sequential scan
+    // would): on a large mesh they would otherwise cost as much as the binary writing itself.
     let invalid = |reason: String| Err(Error::InvalidMesh { reason });
     let n = mesh.positions.len();
     for (what, len) in [
@@ -53,7 +55,7 @@ pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
             return invalid(format!("{} strip indices exceed the PLY list limit", strips.len()));
         }
     }
-    if let Some(k) = mesh.indices.iter().position(|&i| i as usize >= n) {
+    if let Some(k) = first_where(&mesh.indices, |&i| i as usize >= n) {
         return invalid(format!(
             "triangle {} refers to vertex {} but the mesh has {n} vertices",
             k / 3,
@@ -61,17 +63,17 @@ pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
         ));
     }
     let finite = |c: &[f32]| c.iter().all(|x| x.is_finite());
-    if let Some(i) = mesh.positions.iter().position(|p| !finite(p)) {
+    if let Some(i) = first_where(&mesh.positions, |p| !finite(p)) {
         return invalid(format!("vertex {i} has a non-finite position {:?}", mesh.positions[i]));
     }
-    if let Some(i) = mesh.normals.iter().position(|p| !finite(p)) {
+    if let Some(i) = first_where(&mesh.normals, |p| !finite(p)) {
         return invalid(format!("vertex {i} has a non-finite normal {:?}", mesh.normals[i]));
     }
-    if let Some(i) = mesh.uvs.iter().position(|p| !finite(p)) {
+    if let Some(i) = first_where(&mesh.uvs, |p| !finite(p)) {
         return invalid(format!("vertex {i} has a non-finite uv {:?}", mesh.uvs[i]));
     }
     if let Some(params) = &mesh.corner_params {
-        if let Some(k) = params.iter().position(|p| !finite(p)) {
+        if let Some(k) = first_where(&params, |p| !finite(p)) {
             return invalid(format!(
                 "corner {} of triangle {} has non-finite params {:?}",
                 k % 3,
@@ -83,9 +85,108 @@ pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
     Ok(())
 }
 
-pub(crate) fn put_f32s<W: Write>(w: &mut W, values: &[f32]) -> io::Result<()> {
-    for v in values {
-        w.write_all(&v.to_le_bytes())?;
+/// The index of the first item of `items` for which `bad` holds, scanning in parallel chunks.
+/// Why not rayon's `position_first`: it checks for an earlier hit after every item, which
+/// made the check of a million-triangle mesh slower than writing it.
+fn first_where<T: Sync>(items: &[T], bad: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1 << 16;
+    items
+        .par_chunks(CHUNK)
+        .enumerate()
+        .find_map_first(|(c, chunk)| chunk.iter().position(&bad).map(|k| c * CHUNK + k))
+}
+
+/// Writes `data`, made of 4-byte words (`f32`, `u32` and arrays of them), as little-endian
+/// words. On a little-endian machine the slice's own bytes go out in one call, so a large
+/// array costs one copy (the kernel's); elsewhere the words are swapped chunk by chunk.
+pub(crate) fn put_words<W: Write, T: bytemuck::Pod>(w: &mut W, data: &[T]) -> io::Result<()> {
+    let words: &[u32] = bytemuck::cast_slice(data);
+    if cfg!(target_endian = "little") {
+        return w.write_all(bytemuck::cast_slice(words));
+    }
+    write_chunks(w, words.len(), BIN_CHUNK, |range, out| {
+        out.extend(words[range].iter().flat_map(|x| x.to_le_bytes()));
+    })
+}
+
+/// Copies the words of `values` into `dst` as little-endian bytes; `dst` is `4 * N` long.
+/// Compiles to a plain copy on little-endian machines.
+#[inline]
+pub(crate) fn le_words<const N: usize>(dst: &mut [u8], values: [u32; N]) {
+    for (d, v) in dst.chunks_exact_mut(4).zip(values) {
+        d.copy_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// [`le_words`] for floats.
+#[inline]
+pub(crate) fn le_floats<const N: usize>(dst: &mut [u8], values: [f32; N]) {
+    le_words(dst, values.map(f32::to_bits));
+}
+
+/// Items per chunk of the binary writers: records of 12 to 50 bytes, so a chunk is a few
+/// hundred KiB, big enough to amortise a task and a `write` call, small enough to stay in cache.
+pub(crate) const BIN_CHUNK: usize = 1 << 14;
+
+/// Most chunks formatted ahead of the writer per thread-batch, whatever the thread count, so
+/// that the buffers stay a few MiB (two batches live at a time).
+const MAX_BATCH: usize = 16;
+
+/// Writes `count` items to `w` in order: `fill(range, buf)` appends the bytes of the items in
+/// `range` to the (cleared) `buf`. The items are cut into chunks of `per_chunk`, and a batch
+/// of chunks (two per rayon thread, at most 16) is formatted in parallel into their own
+/// buffers, then written in chunk order while the next batch is formatted.
+///
+/// Why: formatting dominates text output and is independent per item, while the `write`
+/// calls must stay in order. The bytes depend only on `count` and `per_chunk`, never on the
+/// number of threads or on scheduling.
+///
+/// Preconditions: `per_chunk > 0`; `fill` appends exactly the bytes of its items (it is
+/// called once per chunk). Errors: the first error of `w`, after which nothing more is
+/// written. Cost: the formatting work spread over the rayon threads, plus one `write_all`
+/// per chunk; memory: two batches of chunk buffers, reused.
+pub(crate) fn write_chunks<W, F>(w: &mut W, count: usize, per_chunk: usize, fill: F) -> io::Result<()>
+where
+    W: Write + ?Sized,
+    F: Fn(std::ops::Range<usize>, &mut Vec<u8>) + Sync,
+{
+    use rayon::prelude::*;
+    assert!(per_chunk > 0, "chunks must hold items");
+    let chunks = count.div_ceil(per_chunk);
+    if chunks == 0 {
+        return Ok(());
+    }
+    let batch = (2 * rayon::current_num_threads()).clamp(2, MAX_BATCH).min(chunks);
+    // Formats the batch whose first chunk is `first` into `bufs`; buffers past the last chunk
+    // are left empty.
+    let format = |first: usize, bufs: &mut [Vec<u8>]| {
+        bufs.par_iter_mut().enumerate().for_each(|(k, buf)| {
+            buf.clear();
+            let c = first + k;
+            if c < chunks {
+                fill(c * per_chunk..((c + 1) * per_chunk).min(count), buf);
+            }
+        })
+    };
+    let mut current = vec![Vec::new(); batch];
+    let mut next = vec![Vec::new(); batch];
+    format(0, &mut current);
+    for first in (0..chunks).step_by(batch) {
+        let following = first + batch;
+        let mut written = Ok(());
+        // In place: this thread writes (`w` need not be `Send`) while the pool formats the
+        // next batch.
+        rayon::in_place_scope(|s| {
+            if following < chunks {
+                let next = &mut next;
+                let format = &format;
+                s.spawn(move |_| format(following, next));
+            }
+            written = current.iter().try_for_each(|buf| w.write_all(buf));
+        });
+        written?;
+        std::mem::swap(&mut current, &mut next);
     }
     Ok(())
 }

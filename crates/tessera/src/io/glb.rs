@@ -37,7 +37,7 @@ use gltf_json as gj;
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::validation::{Checked, USize64};
 
-use super::binary::{all_finite, fill_missing, put_f32s, put_u32, to_u32};
+use super::binary::{all_finite, fill_missing, put_u32, put_words, to_u32, write_chunks, BIN_CHUNK};
 use super::obj::{ObjFace, ObjMesh};
 use super::Format;
 use crate::error::{Error, Result};
@@ -827,7 +827,8 @@ fn decode_base64(s: &str) -> Option<Vec<u8>> {
 /// [`Error::Write`] labelled `<writer>`.
 ///
 /// Cost: O(vertices + triangles) time; the JSON is built in memory (a few KiB, independent of
-/// the mesh size), the binary data is streamed through a 64 KiB buffer.
+/// the mesh size); the mesh's arrays are written as they are in memory (one `write` each on a
+/// little-endian machine), the float patch ids converted in parallel chunks.
 pub fn write_glb<W: Write>(mesh: &Mesh, w: W) -> Result<()> {
     super::write_to(mesh, Format::Glb, w)
 }
@@ -1025,29 +1026,19 @@ pub(super) fn emit_glb<W: Write>(mesh: &Mesh, plan: &GlbPlan, w: &mut W) -> io::
     let padded = plan.bin_len.next_multiple_of(4);
     put_u32(w, padded as u32)?;
     w.write_all(&GLB_CHUNK_BIN.to_le_bytes())?;
-    for p in &mesh.positions {
-        put_f32s(w, p)?;
-    }
-    for n in &mesh.normals {
-        put_f32s(w, n)?;
-    }
-    for uv in &mesh.uvs {
-        put_f32s(w, uv)?;
-    }
-    for &p in &mesh.vertex_patch {
+    // Every section but the float patch ids is one of the mesh's arrays as it is in memory:
+    // written straight from it, without a copy on a little-endian machine.
+    put_words(w, &mesh.positions)?;
+    put_words(w, &mesh.normals)?;
+    put_words(w, &mesh.uvs)?;
+    write_chunks(w, mesh.vertex_patch.len(), BIN_CHUNK, |range, out| {
         // Exact: plan_glb bounded the ids by 2^24.
-        put_f32s(w, &[p as f32])?;
-    }
-    for &i in &mesh.indices {
-        put_u32(w, i)?;
-    }
-    for &p in &mesh.triangle_patch {
-        put_u32(w, p)?;
-    }
+        out.extend(mesh.vertex_patch[range].iter().flat_map(|&p| (p as f32).to_le_bytes()));
+    })?;
+    put_words(w, &mesh.indices)?;
+    put_words(w, &mesh.triangle_patch)?;
     if let Some(params) = &mesh.corner_params {
-        for uv in params {
-            put_f32s(w, uv)?;
-        }
+        put_words(w, params)?;
     }
     // The BIN chunk is padded with zeros; with the current layout the padding is empty.
     w.write_all(&[0u8; 3][..(padded - plan.bin_len) as usize])

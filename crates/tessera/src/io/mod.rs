@@ -29,7 +29,6 @@
 //! system call per number. A format that cannot store strips keeps the decoded triangle list
 //! that [`Mesh::indices`] always holds.
 
-use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -187,14 +186,47 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 /// unknown or missing extension is [`Error::UnknownFormat`] naming it and the supported list.
 /// I/O failures are [`Error::Write`] naming `path`; a failure part-way leaves a partial file.
 ///
-/// Cost: O(vertices + triangles) time; memory: a 64 KiB buffer, plus the GLB JSON (a few KiB,
-/// independent of the mesh size).
+/// An existing regular file is overwritten in place and then cut to the new length, rather
+/// than emptied first: on tmpfs, freeing and allocating the pages again made writing a
+/// 60 MB file over itself several times slower than the copy.
+///
+/// Cost: O(vertices + triangles) time, formatted in parallel on the rayon threads (the bytes
+/// do not depend on the thread count); memory: a 64 KiB buffer and a few MiB of chunk buffers,
+/// plus the GLB JSON (a few KiB, independent of the mesh size).
 pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
     let format = Format::from_path(path)?;
     let prepared = prepare(mesh, format)?;
     let write_error = |source| Error::Write { path: path.to_path_buf(), source };
-    let file = File::create(path).map_err(write_error)?;
-    emit(mesh, &prepared, file).map_err(write_error)
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .map_err(write_error)?;
+    let mut counted = Counted { inner: &file, bytes: 0 };
+    emit(mesh, &prepared, &mut counted).map_err(write_error)?;
+    // Only a regular file has a length to cut (not a pipe or a device).
+    if file.metadata().map_err(write_error)?.is_file() {
+        file.set_len(counted.bytes).map_err(write_error)?;
+    }
+    Ok(())
+}
+
+/// A writer that counts the bytes it passes on.
+struct Counted<W> {
+    inner: W,
+    bytes: u64,
+}
+
+impl<W: Write> Write for Counted<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
 }
 
 pub(crate) fn write_to<W: Write>(mesh: &Mesh, format: Format, w: W) -> Result<()> {
@@ -366,9 +398,316 @@ mod tests {
             assert!(m.contains(name), "{m}");
             assert!(!path.exists());
         }
+        // Written over a longer file of the same name, the file holds the new bytes only.
+        let small = grid(1, false);
+        for name in ["a.obj", "b.PLY", "c.Stl", "d.glb"] {
+            let path = dir.join(name);
+            let before = std::fs::metadata(&path).unwrap().len();
+            let format = Format::from_path(&path).unwrap();
+            let mut expected = Vec::new();
+            write_to(&small, format, &mut expected).unwrap();
+            assert!((expected.len() as u64) < before, "{name}");
+            write_mesh(&small, &path).unwrap();
+            assert_eq!(std::fs::read(&path).unwrap(), expected, "{name}");
+        }
         let missing = dir.join("no/such/dir/f.obj");
         let err = write_mesh(&mesh, &missing).unwrap_err();
         assert!(matches!(&err, Error::Write { path, .. } if path == &missing), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A mesh of the real kind, several chunks long (100,866 vertices, 200,704 triangles,
+    /// 98 a patch so that chunk boundaries fall inside runs of one patch), with corner params.
+    fn torus_factor_7() -> Mesh {
+        use crate::criterion::Plan;
+        use crate::engine::{tessellate, TessellateOptions};
+        use crate::pattern::uniform::Uniform;
+        let file = patches::read_patches(&patches::test_support::data("bench/torus_64x32.patches")).unwrap();
+        let set = SurfaceSet::from_patch_file(&file, Default::default());
+        let plan = Plan::uniform(&set, 7).unwrap();
+        let options = TessellateOptions { corner_params: true, ..Default::default() };
+        let mut mesh = tessellate(&set, &plan, &Uniform, options).unwrap();
+        // Strips as the PLY writer stores them: a restart every 50 indices.
+        mesh.strips = Some(
+            mesh.indices[..3000]
+                .iter()
+                .enumerate()
+                .map(|(k, &i)| if k % 50 == 49 { crate::mesh::strips::RESTART } else { i })
+                .collect(),
+        );
+        mesh
+    }
+
+    /// The writers as they were before they formatted in parallel (commit 35bba34), kept to
+    /// show that the bytes did not change.
+    mod sequential {
+        use super::super::*;
+        use glam::DVec3;
+
+        fn f32s<W: Write>(w: &mut W, values: &[f32]) -> io::Result<()> {
+            values.iter().try_for_each(|v| w.write_all(&v.to_le_bytes()))
+        }
+
+        pub fn obj(mesh: &Mesh, w: &mut Vec<u8>) -> io::Result<()> {
+            writeln!(w, "# tessera")?;
+            writeln!(w, "# {} vertices, {} triangles", mesh.vertex_count(), mesh.triangle_count())?;
+            for p in &mesh.positions {
+                writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
+            }
+            for n in &mesh.normals {
+                writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
+            }
+            for uv in &mesh.uvs {
+                writeln!(w, "vt {} {}", uv[0], uv[1])?;
+            }
+            let mut group = None;
+            for (tri, &patch) in mesh.indices.chunks_exact(3).zip(&mesh.triangle_patch) {
+                if group != Some(patch) {
+                    writeln!(w, "g patch_{patch}")?;
+                    group = Some(patch);
+                }
+                let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| u64::from(i) + 1);
+                writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+            }
+            Ok(())
+        }
+
+        /// The body of the PLY file (everything after `end_header\n`).
+        pub fn ply_body(mesh: &Mesh, w: &mut Vec<u8>) -> io::Result<()> {
+            for (((p, n), uv), &patch) in
+                mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&mesh.vertex_patch)
+            {
+                f32s(w, p)?;
+                f32s(w, n)?;
+                f32s(w, uv)?;
+                w.write_all(&patch.to_le_bytes())?;
+            }
+            for (t, (tri, &patch)) in mesh.indices.chunks_exact(3).zip(&mesh.triangle_patch).enumerate() {
+                w.write_all(&[3])?;
+                for &i in tri {
+                    w.write_all(&i.to_le_bytes())?;
+                }
+                w.write_all(&patch.to_le_bytes())?;
+                if let Some(params) = &mesh.corner_params {
+                    w.write_all(&[6])?;
+                    for uv in &params[3 * t..3 * t + 3] {
+                        f32s(w, uv)?;
+                    }
+                }
+            }
+            if let Some(strips) = &mesh.strips {
+                w.write_all(&(strips.len() as u32).to_le_bytes())?;
+                for &i in strips {
+                    let v = if i == crate::mesh::strips::RESTART { -1 } else { i as i32 };
+                    w.write_all(&v.to_le_bytes())?;
+                }
+            }
+            Ok(())
+        }
+
+        pub fn stl(mesh: &Mesh, w: &mut Vec<u8>) -> io::Result<()> {
+            let mut header = [0u8; 80];
+            header[..7].copy_from_slice(b"tessera");
+            w.write_all(&header)?;
+            w.write_all(&(mesh.triangle_count() as u32).to_le_bytes())?;
+            let position = |i: u32| mesh.positions[i as usize];
+            for tri in mesh.indices.chunks_exact(3) {
+                let [a, b, c] = [tri[0], tri[1], tri[2]].map(position);
+                let [da, db, dc] = [a, b, c].map(|p| DVec3::from(p.map(f64::from)));
+                let n = (db - da).cross(dc - da).normalize_or_zero().as_vec3();
+                f32s(w, &n.to_array())?;
+                for p in [a, b, c] {
+                    f32s(w, &p)?;
+                }
+                w.write_all(&[0, 0])?;
+            }
+            Ok(())
+        }
+
+        /// The BIN chunk of the GLB (without its chunk header).
+        pub fn glb_bin(mesh: &Mesh, w: &mut Vec<u8>) -> io::Result<()> {
+            mesh.positions.iter().try_for_each(|p| f32s(w, p))?;
+            mesh.normals.iter().try_for_each(|p| f32s(w, p))?;
+            mesh.uvs.iter().try_for_each(|p| f32s(w, p))?;
+            mesh.vertex_patch.iter().try_for_each(|&p| f32s(w, &[p as f32]))?;
+            mesh.indices.iter().try_for_each(|i| w.write_all(&i.to_le_bytes()))?;
+            mesh.triangle_patch.iter().try_for_each(|i| w.write_all(&i.to_le_bytes()))?;
+            if let Some(params) = &mesh.corner_params {
+                params.iter().try_for_each(|p| f32s(w, p))?;
+            }
+            Ok(())
+        }
+    }
+
+    fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+    }
+
+    #[test]
+    fn parallel_writers_give_the_sequential_bytes_whatever_the_thread_count() {
+        let mesh = torus_factor_7();
+        let mut without_extras = mesh.clone();
+        without_extras.corner_params = None;
+        without_extras.strips = None;
+        for m in [&mesh, &without_extras, &grid(3, true), &Mesh::default()] {
+            let outputs = [1, 2, 3].map(|threads| {
+                in_pool(threads, || {
+                    [Format::Obj, Format::Ply, Format::Stl, Format::Glb].map(|f| {
+                        let mut out = Vec::new();
+                        write_to(m, f, &mut out).unwrap();
+                        out
+                    })
+                })
+            });
+            assert!(outputs.iter().all(|o| o == &outputs[0]), "the thread count changes the bytes");
+            let [obj, ply, stl, glb] = &outputs[0];
+            let old = |f: fn(&Mesh, &mut Vec<u8>) -> io::Result<()>| {
+                let mut out = Vec::new();
+                f(m, &mut out).unwrap();
+                out
+            };
+            assert!(*obj == old(sequential::obj), "OBJ text changed");
+            assert!(*stl == old(sequential::stl), "STL bytes changed");
+            let body = ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+            assert!(ply[body..] == old(sequential::ply_body), "PLY body changed");
+            if m.triangle_count() > 0 {
+                let bin = old(sequential::glb_bin);
+                assert!(glb.ends_with(&bin), "GLB BIN chunk changed");
+                assert_eq!(&glb[glb.len() - bin.len() - 4..glb.len() - bin.len()], b"BIN\0");
+            }
+        }
+    }
+
+    #[test]
+    fn obj_output_reads_back_exactly() {
+        let mesh = torus_factor_7();
+        let text = bytes(|w| write_obj(&mesh, w));
+        let read = obj::parse_obj(std::str::from_utf8(&text).unwrap(), Path::new("t.obj")).unwrap();
+        // Shortest round-trip digits: the positions read back to the same f32 bits.
+        let positions: Vec<[f32; 3]> = read.positions.iter().map(|p| p.as_vec3().to_array()).collect();
+        assert!(positions == mesh.positions, "positions changed on the way through the text");
+        let normals: Vec<[f32; 3]> = read.normals.iter().map(|p| p.as_vec3().to_array()).collect();
+        assert!(normals == mesh.normals, "normals changed");
+        assert_eq!(read.faces.len(), mesh.triangle_count());
+        for (t, f) in read.faces.iter().enumerate() {
+            assert_eq!(f.positions, mesh.triangle(t), "triangle {t}");
+            assert_eq!(f.normals.as_deref(), Some(&mesh.triangle(t)[..]));
+        }
+        // The reader skips `vt`: read them here.
+        let uvs: Vec<[f32; 2]> = std::str::from_utf8(&text)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("vt "))
+            .map(|l| {
+                let mut it = l.split(' ').map(|x| x.parse::<f32>().unwrap());
+                [it.next().unwrap(), it.next().unwrap()]
+            })
+            .collect();
+        assert!(uvs == mesh.uvs, "uvs changed");
+    }
+
+    #[test]
+    fn push_f32_prints_what_display_prints() {
+        let mut cases: Vec<f32> = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            0.5,
+            100.0,
+            1e-5,
+            1e-6,
+            1e-7,
+            1.5e-7,
+            1e-10,
+            1e12,
+            1e13,
+            1e14,
+            1e30,
+            123456789.0,
+            1.06640625,
+            -1.06640625,
+            f32::MAX,
+            f32::MIN,
+            f32::MIN_POSITIVE,
+            f32::EPSILON,
+            f32::from_bits(1),
+            f32::from_bits(0x007f_ffff),
+        ];
+        // Exact halfway cases, where ryu and the standard library round differently: odd
+        // multiples of small powers of two, and integers times powers of two.
+        for m in (1..200_000u32).step_by(2) {
+            for k in [1, 2, 3, 5, 8, 11, 14, 17] {
+                cases.push(m as f32 / (1u32 << k) as f32);
+            }
+            cases.push(m as f32 * 1024.0);
+        }
+        // Random bits, and a sweep of [1, 2) and of tiny numbers.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..1_000_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            cases.push(f32::from_bits(state as u32));
+        }
+        cases.extend((0x3f80_0000u32..0x4000_0000).step_by(61).map(f32::from_bits));
+        cases.extend((0..0x0100_0000u32).step_by(97).map(f32::from_bits));
+        let mut out = Vec::new();
+        let mut differences = 0;
+        for x in cases.into_iter().filter(|x| x.is_finite()) {
+            out.clear();
+            obj::push_f32(&mut out, x);
+            assert_eq!(std::str::from_utf8(&out).unwrap(), format!("{x}"), "bits {:#x}", x.to_bits());
+            let ryu = ryu::Buffer::new().format_finite(x).trim_end_matches(".0").to_string();
+            differences += usize::from(ryu != format!("{x}"));
+        }
+        // Not vacuous: many cases print differently in ryu's own form (exponents, ties).
+        assert!(differences > 1000, "{differences}");
+    }
+
+    /// Fails every write after `budget` bytes, as a full disk does part-way.
+    struct FailAfter(usize);
+    impl Write for FailAfter {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            if buf.len() > self.0 {
+                return Err(io::Error::other("disk full"));
+            }
+            self.0 -= buf.len();
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn errors_part_way_are_reported() {
+        let mesh = torus_factor_7();
+        for format in [Format::Obj, Format::Ply, Format::Stl, Format::Glb] {
+            for budget in [0, 100, 70_000, 3_000_000] {
+                let err = in_pool(2, || write_to(&mesh, format, FailAfter(budget))).unwrap_err();
+                assert!(
+                    matches!(&err, Error::Write { path, .. } if path == Path::new("<writer>")),
+                    "{format:?} {budget}: {err}"
+                );
+                assert!(err.to_string().contains("disk full"), "{err}");
+            }
+        }
+        // A real full device: the error names the path written to.
+        let full = Path::new("/dev/full");
+        if cfg!(target_os = "linux") && full.exists() {
+            let dir = std::env::temp_dir().join(format!("tessera-full-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            for name in ["m.obj", "m.ply", "m.stl", "m.glb"] {
+                let link = dir.join(name);
+                #[cfg(unix)]
+                std::os::unix::fs::symlink(full, &link).unwrap();
+                let err = write_mesh(&mesh, &link).unwrap_err();
+                assert!(matches!(&err, Error::Write { path, .. } if path == &link), "{name}: {err}");
+                assert!(err.to_string().contains(&*link.to_string_lossy()), "{err}");
+            }
+            std::fs::remove_dir_all(&dir).unwrap();
+        }
     }
 }

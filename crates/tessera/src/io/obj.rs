@@ -19,6 +19,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::binary::write_chunks;
 use super::patches::{quote, read_text};
 use super::Format;
 use crate::error::{Error, Result};
@@ -348,40 +349,175 @@ impl At<'_> {
 /// Writes `mesh` as Wavefront OBJ text to `w`: a `# tessera` header, `v`, `vn` and `vt` lines
 /// (the vertex's own uv), then `f a/a/a b/b/b c/c/c` faces (1-based), with a `g patch_<id>` line
 /// before each run of triangles of the same patch. Floats are printed in the shortest form that
-/// reads back to the same `f32`.
+/// reads back to the same `f32`, in plain decimal notation (as Rust's `{}` prints them).
 ///
 /// Preconditions: as [`write_mesh`](super::write_mesh). I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
-/// Cost: O(vertices + triangles) time; no allocation beyond a 64 KiB buffer.
+/// Cost: O(vertices + triangles) time, the text formatted in parallel on the rayon threads in
+/// chunks of 16,384 lines and written in order (the bytes do not depend on the thread count);
+/// memory: a 64 KiB buffer and a few MiB of chunk buffers.
 pub fn write_obj<W: Write>(mesh: &Mesh, w: W) -> Result<()> {
     super::write_to(mesh, Format::Obj, w)
 }
 
 // OBJ
 
+/// Lines per parallel chunk: about 0.5 MiB of text (30–50 bytes a line).
+const OBJ_CHUNK: usize = 1 << 14;
+
 pub(super) fn emit_obj<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
     writeln!(w, "# tessera")?;
     writeln!(w, "# {} vertices, {} triangles", mesh.vertex_count(), mesh.triangle_count())?;
-    for p in &mesh.positions {
-        writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
-    }
-    for n in &mesh.normals {
-        writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
-    }
-    for uv in &mesh.uvs {
-        writeln!(w, "vt {} {}", uv[0], uv[1])?;
-    }
-    let mut group = None;
-    for (tri, &patch) in mesh.indices.chunks_exact(3).zip(&mesh.triangle_patch) {
-        if group != Some(patch) {
-            writeln!(w, "g patch_{patch}")?;
-            group = Some(patch);
+    write_chunks(w, mesh.positions.len(), OBJ_CHUNK, |range, out| {
+        for p in &mesh.positions[range] {
+            floats_line(out, b"v", p);
         }
-        // u64 because index u32::MAX would overflow when made 1-based.
-        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| u64::from(i) + 1);
-        writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+    })?;
+    write_chunks(w, mesh.normals.len(), OBJ_CHUNK, |range, out| {
+        for n in &mesh.normals[range] {
+            floats_line(out, b"vn", n);
+        }
+    })?;
+    write_chunks(w, mesh.uvs.len(), OBJ_CHUNK, |range, out| {
+        for uv in &mesh.uvs[range] {
+            floats_line(out, b"vt", uv);
+        }
+    })?;
+    write_chunks(w, mesh.triangle_count(), OBJ_CHUNK, |range, out| {
+        // The group of the triangle before the chunk, so that a chunk starts a `g` line
+        // exactly where a sequential writer would.
+        let mut group = range.start.checked_sub(1).map(|t| mesh.triangle_patch[t]);
+        let mut ints = itoa::Buffer::new();
+        for t in range {
+            let patch = mesh.triangle_patch[t];
+            if group != Some(patch) {
+                out.extend_from_slice(b"g patch_");
+                out.extend_from_slice(ints.format(patch).as_bytes());
+                out.push(b'\n');
+                group = Some(patch);
+            }
+            out.push(b'f');
+            for &i in &mesh.indices[3 * t..3 * t + 3] {
+                // u64 because index u32::MAX would overflow when made 1-based.
+                let i = ints.format(u64::from(i) + 1).as_bytes();
+                out.push(b' ');
+                out.extend_from_slice(i);
+                out.push(b'/');
+                out.extend_from_slice(i);
+                out.push(b'/');
+                out.extend_from_slice(i);
+            }
+            out.push(b'\n');
+        }
+    })
+}
+
+/// Appends `keyword x y ...` and a newline.
+fn floats_line<const N: usize>(out: &mut Vec<u8>, keyword: &[u8], values: &[f32; N]) {
+    out.extend_from_slice(keyword);
+    for &x in values {
+        out.push(b' ');
+        push_f32(out, x);
     }
-    Ok(())
+    out.push(b'\n');
+}
+
+/// Appends `x` exactly as `format!("{x}")` prints a finite `f32`: the shortest decimal that
+/// reads back to the same `f32`, never in exponent notation, without a trailing `.0`
+/// (`1`, `-0`, `0.5`, `0.0000001`, `10000000000000000000000000000000`).
+///
+/// Why not `write!`: the standard formatter is several times slower than `ryu`, and OBJ
+/// output is almost all numbers. `ryu` finds the same shortest digits (both give the
+/// shortest representation nearest to the value), but prints `1.0` and `1e-7`; those two
+/// forms are rewritten here, so the text stays what tessera always wrote.
+///
+/// Preconditions: `x` is finite (the writers check the mesh first). Cost: O(1), no allocation
+/// beyond the growth of `out`.
+pub(super) fn push_f32(out: &mut Vec<u8>, x: f32) {
+    let mut buf = ryu::Buffer::new();
+    let s = buf.format_finite(x).as_bytes();
+    if is_tie(x, s) {
+        // Rare (16 of the 3.1 million numbers of the factor-16 torus): the standard formatter
+        // decides, so the text is the same.
+        write!(out, "{x}").expect("writing to a Vec cannot fail");
+        return;
+    }
+    let Some(e) = s.iter().position(|&b| b == b'e') else {
+        out.extend_from_slice(s.strip_suffix(b".0").unwrap_or(s));
+        return;
+    };
+    // `[-]d[.ddd]e[-]x`: the digits d.ddd times 10^x.
+    let (mantissa, exponent) = (&s[..e], &s[e + 1..]);
+    let (sign, mantissa) = match mantissa.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        _ => (false, mantissa),
+    };
+    let exponent: i32 =
+        std::str::from_utf8(exponent).ok().and_then(|x| x.parse().ok()).expect("ryu exponent");
+    let digits: Vec<u8> = mantissa.iter().copied().filter(|&b| b != b'.').collect();
+    if sign {
+        out.push(b'-');
+    }
+    // The decimal point goes after `point` digits (ryu writes one digit before its point).
+    let point = exponent + 1;
+    if point <= 0 {
+        out.extend_from_slice(b"0.");
+        out.extend(std::iter::repeat(b'0').take(point.unsigned_abs() as usize));
+        out.extend_from_slice(&digits);
+    } else if point as usize >= digits.len() {
+        out.extend_from_slice(&digits);
+        out.extend(std::iter::repeat(b'0').take(point as usize - digits.len()));
+    } else {
+        let (int, frac) = digits.split_at(point as usize);
+        out.extend_from_slice(int);
+        out.push(b'.');
+        out.extend_from_slice(frac);
+    }
+}
+
+/// Whether `x` lies exactly halfway between two shortest decimals, `ryu` having printed one of
+/// them as `printed`. There the two formatters differ: `ryu` takes the even last digit (the
+/// f32 1.06640625 prints as `1.0664062`), the standard library rounds up (`1.0664063`).
+///
+/// A tie needs the exact decimal expansion of `x` to have one digit more than the shortest
+/// form, ending in 5. With `x = m·2^e`, `m` odd: for `e < 0` the exact digits are those of
+/// `m·5^-e`; for `e ≥ 0` they are `m / 5^e` followed by zeros when that division is exact,
+/// and otherwise end in an even digit. The shortest form of an f32 has at most 9 digits, so
+/// only expansions of at most 10 digits matter, which bounds `-e` by 14. Cost: a few integer
+/// operations.
+fn is_tie(x: f32, printed: &[u8]) -> bool {
+    let bits = x.to_bits();
+    let (biased, fraction) = ((bits >> 23) & 0xff, bits & 0x7f_ffff);
+    let (mut m, mut e) =
+        if biased == 0 { (fraction, -149) } else { (fraction | 1 << 23, biased as i32 - 150) };
+    if m == 0 {
+        return false;
+    }
+    e += m.trailing_zeros() as i32;
+    m >>= m.trailing_zeros();
+    let exact = if e < 0 {
+        if e < -14 {
+            return false;
+        }
+        u64::from(m) * 5u64.pow(e.unsigned_abs())
+    } else {
+        let five = match 5u64.checked_pow(e as u32) {
+            Some(f) if u64::from(m) % f == 0 => f,
+            _ => return false,
+        };
+        u64::from(m) / five
+    };
+    if exact % 10 != 5 || exact >= 10_000_000_000 {
+        return false;
+    }
+    // Significant digits of the printed form: no sign, point or exponent, no leading or
+    // trailing zeros (`ryu` writes `0.00125` and `1000.0`).
+    let mantissa = printed.split(|&b| b == b'e').next().unwrap_or(printed);
+    let digits = || mantissa.iter().copied().filter(u8::is_ascii_digit);
+    let leading = digits().take_while(|&d| d == b'0').count();
+    let trailing = digits().rev().take_while(|&d| d == b'0').count();
+    let shortest = digits().count().saturating_sub(leading + trailing);
+    exact.ilog10() as usize + 1 == shortest + 1
 }
 
 #[cfg(test)]

@@ -25,7 +25,9 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::binary::{all_finite, fill_missing, put_f32s, put_u32, to_u32};
+use super::binary::{
+    all_finite, fill_missing, le_floats, le_words, put_u32, to_u32, write_chunks, BIN_CHUNK,
+};
 use super::Format;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -732,7 +734,9 @@ const OLD_PATCH_UV: &str = "texcoord";
 ///
 /// Preconditions: as [`write_mesh`](super::write_mesh). I/O errors are [`Error::Write`] labelled `<writer>`.
 ///
-/// Cost: O(vertices + triangles) time; no allocation beyond a 64 KiB buffer.
+/// Cost: O(vertices + triangles) time, the records filled in parallel chunks on the rayon
+/// threads and written in order (the bytes do not depend on the thread count); memory: a few
+/// MiB of chunk buffers.
 pub fn write_ply<W: Write>(mesh: &Mesh, w: W) -> Result<()> {
     super::write_to(mesh, Format::Ply, w)
 }
@@ -769,33 +773,40 @@ pub(super) fn emit_ply<W: Write>(mesh: &Mesh, w: &mut W) -> io::Result<()> {
         writeln!(w, "element tristrips 1\nproperty list uint int vertex_indices")?;
     }
     writeln!(w, "end_header")?;
-    for (((p, n), uv), &patch) in
-        mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&mesh.vertex_patch)
-    {
-        put_f32s(w, p)?;
-        put_f32s(w, n)?;
-        put_f32s(w, uv)?;
-        put_u32(w, patch)?;
-    }
-    for (t, (tri, &patch)) in mesh.indices.chunks_exact(3).zip(&mesh.triangle_patch).enumerate() {
-        w.write_all(&[3])?;
-        for &i in tri {
-            put_u32(w, i)?;
+    // Fixed-size records, filled in parallel chunks and written in order (binary::write_chunks).
+    const VERTEX: usize = 36;
+    write_chunks(w, mesh.vertex_count(), BIN_CHUNK, |range, out| {
+        out.resize(range.len() * VERTEX, 0);
+        for (rec, i) in out.chunks_exact_mut(VERTEX).zip(range) {
+            le_floats(&mut rec[0..12], mesh.positions[i]);
+            le_floats(&mut rec[12..24], mesh.normals[i]);
+            le_floats(&mut rec[24..32], mesh.uvs[i]);
+            le_words(&mut rec[32..36], [mesh.vertex_patch[i]]);
         }
-        put_u32(w, patch)?;
-        if let Some(params) = &mesh.corner_params {
-            w.write_all(&[6])?;
-            for uv in &params[3 * t..3 * t + 3] {
-                put_f32s(w, uv)?;
+    })?;
+    // `3 a b c patch`, then `6 u0 v0 u1 v1 u2 v2` with corner params.
+    let face = if mesh.corner_params.is_some() { 17 + 25 } else { 17 };
+    write_chunks(w, mesh.triangle_count(), BIN_CHUNK, |range, out| {
+        out.resize(range.len() * face, 0);
+        for (rec, t) in out.chunks_exact_mut(face).zip(range) {
+            rec[0] = 3;
+            le_words(&mut rec[1..13], mesh.triangle(t));
+            le_words(&mut rec[13..17], [mesh.triangle_patch[t]]);
+            if let Some(params) = &mesh.corner_params {
+                rec[17] = 6;
+                let [a, b, c] = [params[3 * t], params[3 * t + 1], params[3 * t + 2]];
+                le_floats(&mut rec[18..42], [a[0], a[1], b[0], b[1], c[0], c[1]]);
             }
         }
-    }
+    })?;
     if let Some(strips) = &mesh.strips {
         put_u32(w, strips.len() as u32)?;
-        for &i in strips {
-            let v = if i == crate::mesh::strips::RESTART { -1 } else { i as i32 };
-            w.write_all(&v.to_le_bytes())?;
-        }
+        write_chunks(w, strips.len(), BIN_CHUNK, |range, out| {
+            out.extend(strips[range].iter().flat_map(|&i| {
+                let v = if i == crate::mesh::strips::RESTART { -1 } else { i as i32 };
+                v.to_le_bytes()
+            }));
+        })?;
     }
     Ok(())
 }

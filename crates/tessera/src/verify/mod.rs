@@ -7,6 +7,7 @@ use crate::surface::SurfaceSet;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};
 
 /// Topological soundness of a mesh after welding bit-identical positions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -67,92 +68,300 @@ fn position_key(p: [f32; 3]) -> [u32; 3] {
 
 /// Welds positions by exact bits and counts boundary, non-manifold and misoriented edges.
 ///
-/// Parallel and sort-based (a hash map per edge is several times slower and larger): the
-/// positions are sorted to weld them, then every triangle side becomes one packed 64-bit key
-/// (the two welded ends and the direction) and the keys are sorted, so each edge's uses are
-/// one run. Memory: 24 bytes per vertex and 24 per triangle beside the mesh. Cost:
-/// O(V log V + T log T) work, parallel.
+/// Positions weld when their bits are equal (`-0.0` and `0.0` count as one). A triangle with
+/// two corners at one welded position is collapsed and left out of the edge counts; the
+/// others give their three sides, and each undirected side is one edge.
+///
+/// How, and why so: both steps are partitioned hashing and sorting, each part small enough to
+/// stay in a core's cache, so that the work is parallel and the memory traffic is a few
+/// sequential passes over the mesh rather than one cache miss per vertex or side.
+/// - Weld: every position goes, by a hash of its bits, to one of about `V / 2048` parts
+///   (copied with its index, 16 bytes); each part is welded with a small open-addressing
+///   table, every vertex taking the smallest index at its position as its id (so only
+///   duplicates write an id out of order).
+/// - Edges: every side of a non-collapsed triangle becomes a 64-bit key (its smaller welded
+///   end, its larger end and its direction), stored in the part of its smaller end (4,096
+///   vertices a part, in index order); each part is sorted on its own (a counting sort on the
+///   smaller end, then each end's few sides), so an edge's uses are one run of keys. The parts are filled in two passes (count, then place) without locks,
+///   per fixed chunk of triangles.
+///
+/// The counts do not depend on the thread count. Preconditions: indices in range (as every
+/// reader and the engine produce); fewer than 2³¹ vertices, beyond which the hash-map version
+/// runs. Memory beside the mesh: 4 bytes per vertex (the welded ids), 1 byte per vertex (used
+/// flags), 16 bytes per vertex during the weld (freed before the edges), and 24 bytes per
+/// triangle (the side keys); about half of the mesh's own memory for a typical tessellation
+/// with normals and uvs. Cost: O(V + T) expected work plus sorts of cache-sized parts,
+/// parallel on the rayon threads.
 pub fn watertight(mesh: &Mesh) -> WatertightReport {
     let n = mesh.positions.len();
     if n >= 1 << 31 {
         return watertight_hashed(mesh);
     }
-    // Weld: sort (position bits, index); equal bits form one run, numbered in sorted order.
-    let mut order: Vec<(u128, u32)> = mesh
-        .positions
-        .par_iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let [x, y, z] = position_key(p);
-            (((x as u128) << 64) | ((y as u128) << 32) | z as u128, i as u32)
-        })
-        .collect();
-    order.par_sort_unstable();
-    let mut welded = vec![0u32; n];
-    let mut distinct = 0u32;
-    for k in 0..n {
-        if k > 0 && order[k].0 != order[k - 1].0 {
-            distinct += 1;
-        }
-        welded[order[k].1 as usize] = distinct;
-    }
-    drop(order);
+    let welded = weld(&mesh.positions);
+    let t_count = mesh.triangle_count();
+    let used: Vec<AtomicBool> = (0..n).into_par_iter().map(|_| AtomicBool::new(false)).collect();
 
-    let mut report = WatertightReport { triangles: mesh.triangle_count(), ..Default::default() };
-    // Per triangle: collapsed, zero area, and its three sides as keys
-    // `min << 33 | max << 1 | (min is the second end)`.
-    let per_triangle: Vec<(bool, bool, [u64; 3])> = mesh
-        .indices
-        .par_chunks_exact(3)
-        .map(|t| {
-            let v = [t[0], t[1], t[2]].map(|i| welded[i as usize]);
-            if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
-                return (true, false, [0; 3]);
+    let parts = n.div_ceil(1 << PART_BITS).max(1);
+    let chunk = EDGE_CHUNK.max(t_count.div_ceil(MAX_CHUNKS));
+    let chunks = t_count.div_ceil(chunk);
+    let triangles_of = |c: usize| &mesh.indices[3 * c * chunk..3 * ((c + 1) * chunk).min(t_count)];
+    // Pass 1, per chunk of triangles: the degenerate counts, the used vertices, and how many
+    // sides each part gets from the chunk.
+    let counted: Vec<(usize, usize, Vec<u32>)> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let (mut collapsed, mut zero_area) = (0, 0);
+            let mut per_part = vec![0u32; parts];
+            for corners in triangles_of(c).chunks_exact(3) {
+                let Some((ends, sides)) = side_keys(&welded, corners) else {
+                    collapsed += 1;
+                    continue;
+                };
+                // Spelled out rather than an array `map`: that version went through the stack
+                // and stalled on every triangle.
+                let p0 = Vec3::from(mesh.positions[corners[0] as usize]).as_dvec3();
+                let p1 = Vec3::from(mesh.positions[corners[1] as usize]).as_dvec3();
+                let p2 = Vec3::from(mesh.positions[corners[2] as usize]).as_dvec3();
+                zero_area += usize::from((p1 - p0).cross(p2 - p0) == DVec3::ZERO);
+                for v in ends {
+                    used[v as usize].store(true, Relaxed);
+                }
+                for (part, _) in sides {
+                    per_part[part] += 1;
+                }
             }
-            let p = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]).as_dvec3());
-            let zero = (p[1] - p[0]).cross(p[2] - p[0]) == DVec3::ZERO;
-            let side = |c: usize| {
-                let (a, b) = (v[c] as u64, v[(c + 1) % 3] as u64);
-                (a.min(b) << 33) | (a.max(b) << 1) | u64::from(a > b)
-            };
-            (false, zero, [side(0), side(1), side(2)])
+            (collapsed, zero_area, per_part)
         })
         .collect();
-    let mut used = vec![false; n];
-    let mut sides = Vec::with_capacity(3 * per_triangle.len());
-    for (t, &(collapsed, zero, keys)) in per_triangle.iter().enumerate() {
-        if collapsed {
-            report.collapsed_triangles += 1;
-            continue;
-        }
-        report.zero_area_triangles += usize::from(zero);
-        for i in &mesh.indices[3 * t..3 * t + 3] {
-            used[welded[*i as usize] as usize] = true;
-        }
-        sides.extend_from_slice(&keys);
+
+    // Where each chunk's sides of each part go: parts in order, chunks in order within a part.
+    let mut part_start = vec![0usize; parts + 1];
+    for p in 0..parts {
+        part_start[p + 1] = part_start[p] + counted.iter().map(|(_, _, h)| h[p] as usize).sum::<usize>();
     }
-    drop(per_triangle);
-    sides.par_sort_unstable();
-    report.vertices = used.iter().filter(|&&u| u).count();
-    let mut k = 0;
-    while k < sides.len() {
-        let edge = sides[k] >> 1;
-        let (mut forward, mut backward) = (0, 0);
-        while k < sides.len() && sides[k] >> 1 == edge {
-            if sides[k] & 1 == 0 {
-                forward += 1;
-            } else {
-                backward += 1;
+    let mut keys = vec![0u64; part_start[parts]];
+    // One slice per (chunk, part), cut off the key array in order: the passes below write and
+    // read disjoint pieces without locks or unsafe code.
+    let mut pieces: Vec<Vec<&mut [u64]>> = (0..chunks).map(|_| Vec::with_capacity(parts)).collect();
+    let mut rest: &mut [u64] = &mut keys;
+    for p in 0..parts {
+        for (c, (_, _, h)) in counted.iter().enumerate() {
+            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(h[p] as usize);
+            pieces[c].push(piece);
+            rest = tail;
+        }
+    }
+    // Pass 2: place the keys.
+    pieces.par_iter_mut().enumerate().for_each(|(c, pieces)| {
+        let mut fill = vec![0usize; parts];
+        for corners in triangles_of(c).chunks_exact(3) {
+            if let Some((_, sides)) = side_keys(&welded, corners) {
+                for (part, key) in sides {
+                    pieces[part][fill[part]] = key;
+                    fill[part] += 1;
+                }
             }
-            k += 1;
         }
-        report.count_edge(forward, backward);
+    });
+    drop(pieces);
+    drop(welded);
+
+    let mut report = WatertightReport { triangles: t_count, ..Default::default() };
+    for (collapsed, zero_area, _) in &counted {
+        report.collapsed_triangles += collapsed;
+        report.zero_area_triangles += zero_area;
     }
+    drop(counted);
+    // Pass 3, per part: sort, then count each run of one edge's uses.
+    let mut part_keys: Vec<&mut [u64]> = Vec::with_capacity(parts);
+    let mut rest: &mut [u64] = &mut keys;
+    for p in 0..parts {
+        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(part_start[p + 1] - part_start[p]);
+        part_keys.push(piece);
+        rest = tail;
+    }
+    let edges = part_keys
+        .into_par_iter()
+        .map_init(
+            || (vec![0u32; (1 << PART_BITS) + 1], vec![0u32; (1 << PART_BITS) + 1], Vec::new()),
+            |(starts, next, by_lo), keys| {
+                // A counting sort by the smaller end (in cache: one part), then each end's few
+                // sides (about six) sorted on their own: several times faster than sorting
+                // the part's keys whole.
+                starts.fill(0);
+                for &k in keys.iter() {
+                    starts[(k >> 32) as usize + 1] += 1;
+                }
+                for lo in 0..1 << PART_BITS {
+                    starts[lo + 1] += starts[lo];
+                }
+                by_lo.clear();
+                by_lo.resize(keys.len(), 0u32);
+                next.copy_from_slice(starts);
+                for &k in keys.iter() {
+                    let slot = &mut next[(k >> 32) as usize];
+                    // The larger end and the direction.
+                    by_lo[*slot as usize] = k as u32;
+                    *slot += 1;
+                }
+                let mut r = WatertightReport::default();
+                for lo in 0..1 << PART_BITS {
+                    let sides = &mut by_lo[starts[lo] as usize..starts[lo + 1] as usize];
+                    sides.sort_unstable();
+                    for run in sides.chunk_by(|a, b| a >> 1 == b >> 1) {
+                        let backward = run.iter().filter(|&&k| k & 1 == 1).count() as u32;
+                        r.count_edge(run.len() as u32 - backward, backward);
+                    }
+                }
+                r
+            },
+        )
+        .reduce(WatertightReport::default, |a, b| WatertightReport {
+            edges: a.edges + b.edges,
+            boundary_edges: a.boundary_edges + b.boundary_edges,
+            nonmanifold_edges: a.nonmanifold_edges + b.nonmanifold_edges,
+            misoriented_edges: a.misoriented_edges + b.misoriented_edges,
+            ..a
+        });
+    report.edges = edges.edges;
+    report.boundary_edges = edges.boundary_edges;
+    report.nonmanifold_edges = edges.nonmanifold_edges;
+    report.misoriented_edges = edges.misoriented_edges;
+    report.vertices = used.par_iter().filter(|u| u.load(Relaxed)).count();
     report.finish()
 }
 
+/// Sides go to part `smaller end >> PART_BITS`, so a part's keys hold the smaller end
+/// relative to the part (PART_BITS bits), the larger end and the direction.
+const PART_BITS: u32 = 12;
+
+/// The welded ends of the triangle with `corners`, and its three sides as (part, key) for
+/// [`watertight`]; `None` when two ends are one (a collapsed triangle).
+#[inline(always)]
+fn side_keys(welded: &[AtomicU32], corners: &[u32]) -> Option<([u32; 3], [(usize, u64); 3])> {
+    let v = [corners[0], corners[1], corners[2]].map(|i| welded[i as usize].load(Relaxed));
+    if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
+        return None;
+    }
+    #[inline(always)]
+    fn side(a: u32, b: u32) -> (usize, u64) {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let key = (u64::from(lo & ((1 << PART_BITS) - 1)) << 32) | (u64::from(hi) << 1) | u64::from(a > b);
+        ((lo >> PART_BITS) as usize, key)
+    }
+    Some((v, [side(v[0], v[1]), side(v[1], v[2]), side(v[2], v[0])]))
+}
+
+/// Triangles (or vertices) per chunk of the partitioned passes: enough that a chunk's count
+/// of each part is worth its array, few enough chunks that the (chunk, part) table stays small.
+const EDGE_CHUNK: usize = 1 << 16;
+const MAX_CHUNKS: usize = 64;
+
+/// A position's bits with its index, `[x, y, z, index]`, as the weld's parts hold them: an
+/// array, so that a vector of them starts zeroed by the allocator.
+type Keyed = [u32; 4];
+
+/// A 64-bit hash of position bits: multiply-xorshift (splitmix64's finaliser), whose top bits
+/// choose the part and low bits the slot; well spread for the regular grids of a tessellation.
+fn hash_key(k: [u32; 3]) -> u64 {
+    let mut h =
+        (u64::from(k[0]) | u64::from(k[1]) << 32) ^ u64::from(k[2]).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    h ^= h >> 30;
+    h = h.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h ^= h >> 27;
+    h = h.wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^ (h >> 31)
+}
+
+/// For each vertex, the smallest index of a vertex with the same position bits, as relaxed
+/// atomics: the parts write the ids of scattered vertices in parallel, and a relaxed store or
+/// load is a plain one. See [`watertight`] for the method. Preconditions: fewer than 2³¹
+/// positions.
+fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
+    let n = positions.len();
+    // Parts of 8–16 K positions: their tables (64–128 KiB) stay in cache, and few enough
+    // parts that scattering the positions into them writes few streams at a time.
+    let part_bits = (n / 16384).max(1).next_power_of_two().trailing_zeros();
+    let parts = 1usize << part_bits;
+    let part_of = |h: u64| if part_bits == 0 { 0 } else { (h >> (64 - part_bits)) as usize };
+    let chunk = EDGE_CHUNK.max(n.div_ceil(MAX_CHUNKS));
+    let chunks = n.div_ceil(chunk);
+    let counts: Vec<Vec<u32>> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let mut h = vec![0u32; parts];
+            for p in &positions[c * chunk..((c + 1) * chunk).min(n)] {
+                h[part_of(hash_key(position_key(*p)))] += 1;
+            }
+            h
+        })
+        .collect();
+    // Zeroed by the allocator (lazily, page by page), not written here first.
+    let mut entries: Vec<Keyed> = vec![[0; 4]; n];
+    let mut part_len = vec![0usize; parts];
+    let mut pieces: Vec<Vec<&mut [Keyed]>> = (0..chunks).map(|_| Vec::with_capacity(parts)).collect();
+    let mut rest: &mut [Keyed] = &mut entries;
+    for p in 0..parts {
+        for (c, h) in counts.iter().enumerate() {
+            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(h[p] as usize);
+            pieces[c].push(piece);
+            part_len[p] += h[p] as usize;
+            rest = tail;
+        }
+    }
+    drop(counts);
+    // Chunks in index order, so each part lists its vertices in increasing index: the first
+    // one seen at a position is the smallest index there.
+    pieces.par_iter_mut().enumerate().for_each(|(c, pieces)| {
+        let mut fill = vec![0usize; parts];
+        for i in c * chunk..((c + 1) * chunk).min(n) {
+            let key = position_key(positions[i]);
+            let p = part_of(hash_key(key));
+            pieces[p][fill[p]] = [key[0], key[1], key[2], i as u32];
+            fill[p] += 1;
+        }
+    });
+    drop(pieces);
+    // Every vertex its own id to begin with, so that only duplicates are stored below: one
+    // scattered store per duplicate, not per vertex.
+    let welded: Vec<AtomicU32> = (0..n as u32).into_par_iter().map(AtomicU32::new).collect();
+    let mut part_entries: Vec<&[Keyed]> = Vec::with_capacity(parts);
+    let mut rest: &[Keyed] = &entries;
+    for len in part_len {
+        let (piece, tail) = rest.split_at(len);
+        part_entries.push(piece);
+        rest = tail;
+    }
+    part_entries.into_par_iter().for_each_init(Vec::new, |table: &mut Vec<u32>, part| {
+        // Open addressing, linear probing, at most half full; slots hold an entry's place
+        // in the part (u32::MAX: empty).
+        let size = (2 * part.len()).next_power_of_two().max(2);
+        table.clear();
+        table.resize(size, u32::MAX);
+        let mask = size - 1;
+        for (k, e) in part.iter().enumerate() {
+            let (key, index) = ([e[0], e[1], e[2]], e[3]);
+            let mut slot = hash_key(key) as usize & mask;
+            let first = loop {
+                match table[slot] {
+                    u32::MAX => {
+                        table[slot] = k as u32;
+                        break index;
+                    }
+                    other if part[other as usize][..3] == key => break part[other as usize][3],
+                    _ => slot = (slot + 1) & mask,
+                }
+            };
+            if first != index {
+                welded[index as usize].store(first, Relaxed);
+            }
+        }
+    });
+    welded
+}
+
 /// [`watertight`] with hash maps: for meshes of 2³¹ vertices or more, which the packed
-/// sort keys of the parallel version cannot hold, and as the tests' reference.
+/// keys of the parallel version cannot hold, and as the tests' reference.
 /// Cost: O(T) hashing.
 fn watertight_hashed(mesh: &Mesh) -> WatertightReport {
     let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.positions.len());
@@ -428,6 +637,205 @@ mod tests {
         assert_eq!((w.zero_area_triangles, w.collapsed_triangles), (1, 1), "{w:?}");
     }
 
+    /// The sort-based [`watertight`] that tessera used before the partitioned one (commit
+    /// 35bba34), kept as a second reference: one global sort of (position bits, index) to
+    /// weld, one global sort of all side keys. Memory: 32 bytes per vertex and 56 per triangle.
+    fn watertight_sorted(mesh: &Mesh) -> WatertightReport {
+        let n = mesh.positions.len();
+        if n >= 1 << 31 {
+            return super::watertight_hashed(mesh);
+        }
+        // Weld: sort (position bits, index); equal bits form one run, numbered in sorted order.
+        let mut order: Vec<(u128, u32)> = mesh
+            .positions
+            .par_iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                let [x, y, z] = position_key(p);
+                (((x as u128) << 64) | ((y as u128) << 32) | z as u128, i as u32)
+            })
+            .collect();
+        order.par_sort_unstable();
+        let mut welded = vec![0u32; n];
+        let mut distinct = 0u32;
+        for k in 0..n {
+            if k > 0 && order[k].0 != order[k - 1].0 {
+                distinct += 1;
+            }
+            welded[order[k].1 as usize] = distinct;
+        }
+        drop(order);
+
+        let mut report = WatertightReport { triangles: mesh.triangle_count(), ..Default::default() };
+        // Per triangle: collapsed, zero area, and its three sides as keys
+        // `min << 33 | max << 1 | (min is the second end)`.
+        let per_triangle: Vec<(bool, bool, [u64; 3])> = mesh
+            .indices
+            .par_chunks_exact(3)
+            .map(|t| {
+                let v = [t[0], t[1], t[2]].map(|i| welded[i as usize]);
+                if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
+                    return (true, false, [0; 3]);
+                }
+                let p = [t[0], t[1], t[2]].map(|i| Vec3::from(mesh.positions[i as usize]).as_dvec3());
+                let zero = (p[1] - p[0]).cross(p[2] - p[0]) == DVec3::ZERO;
+                let side = |c: usize| {
+                    let (a, b) = (v[c] as u64, v[(c + 1) % 3] as u64);
+                    (a.min(b) << 33) | (a.max(b) << 1) | u64::from(a > b)
+                };
+                (false, zero, [side(0), side(1), side(2)])
+            })
+            .collect();
+        let mut used = vec![false; n];
+        let mut sides = Vec::with_capacity(3 * per_triangle.len());
+        for (t, &(collapsed, zero, keys)) in per_triangle.iter().enumerate() {
+            if collapsed {
+                report.collapsed_triangles += 1;
+                continue;
+            }
+            report.zero_area_triangles += usize::from(zero);
+            for i in &mesh.indices[3 * t..3 * t + 3] {
+                used[welded[*i as usize] as usize] = true;
+            }
+            sides.extend_from_slice(&keys);
+        }
+        drop(per_triangle);
+        sides.par_sort_unstable();
+        report.vertices = used.iter().filter(|&&u| u).count();
+        let mut k = 0;
+        while k < sides.len() {
+            let edge = sides[k] >> 1;
+            let (mut forward, mut backward) = (0, 0);
+            while k < sides.len() && sides[k] >> 1 == edge {
+                if sides[k] & 1 == 0 {
+                    forward += 1;
+                } else {
+                    backward += 1;
+                }
+                k += 1;
+            }
+            report.count_edge(forward, backward);
+        }
+        report.finish()
+    }
+
+    /// The three implementations agree, and the partitioned one gives the same report with 1
+    /// and with 2 threads.
+    #[track_caller]
+    fn assert_all_agree(m: &Mesh, what: &str) -> WatertightReport {
+        let expected = watertight_hashed(m);
+        assert_eq!(watertight_sorted(m), expected, "{what}: old sorted vs hashed");
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            assert_eq!(pool.install(|| watertight(m)), expected, "{what}, {threads} threads");
+        }
+        expected
+    }
+
+    /// Models with boundaries, non-manifold edges, unwelded duplicates, repeated corners and
+    /// holes, read as meshes to check.
+    #[test]
+    fn implementations_agree_on_the_shared_meshes() {
+        use crate::io::patches::test_support::data;
+        let cases = [
+            ("meshes/bunny.obj", false),
+            ("meshes/spot.obj", true),
+            ("awkward/elephant_with_holes.obj", false),
+            ("awkward/teapot_tri_nonmanifold.obj", false),
+            ("awkward/teapot_unwelded.obj", false),
+            ("meshes/bunny_res4.obj", false),
+            ("meshes/dragon_res4.obj", false),
+        ];
+        for (rel, closed) in cases {
+            let m = crate::io::read_mesh(&data(rel)).unwrap();
+            let w = assert_all_agree(&m, rel);
+            assert_eq!(w.is_closed(), closed, "{rel}: {w:?}");
+        }
+        // Not vacuous: the awkward files have what their names say.
+        let w = watertight(&crate::io::read_mesh(&data("meshes/dragon_res4.obj")).unwrap());
+        assert!(w.nonmanifold_edges > 0, "{w:?}");
+        let w = watertight(&crate::io::read_mesh(&data("awkward/teapot_tri_nonmanifold.obj")).unwrap());
+        assert!(w.collapsed_triangles == 32 && w.boundary_edges == 64, "the README's counts: {w:?}");
+        let w = watertight(&crate::io::read_mesh(&data("awkward/elephant_with_holes.obj")).unwrap());
+        assert!(w.boundary_edges > 0, "{w:?}");
+    }
+
+    /// A tessellation large enough for several chunks and parts (262,144 triangles), whole
+    /// and with hand-made breaks; and the teapot, whose lid apex gives collapsed triangles.
+    #[test]
+    fn implementations_agree_on_broken_tessellations() {
+        use crate::criterion::Plan;
+        use crate::engine::{tessellate, TessellateOptions};
+        use crate::io::patches::{read_patches, test_support::data};
+        use crate::pattern::uniform::Uniform;
+        let tessellation = |rel: &str, factor: u32| {
+            let set = SurfaceSet::from_patch_file(&read_patches(&data(rel)).unwrap(), Default::default());
+            let plan = Plan::uniform(&set, factor).unwrap();
+            tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap()
+        };
+        let teapot = tessellation("patches/teapot.patches", 6);
+        assert_all_agree(&teapot, "teapot");
+
+        let torus = tessellation("bench/torus_64x32.patches", 8);
+        assert_eq!(torus.triangle_count(), 262_144);
+        let whole = assert_all_agree(&torus, "torus");
+        assert!(whole.is_closed() && whole.misoriented_edges == 0, "{whole:?}");
+        assert_eq!(whole.euler_characteristic, 0);
+
+        let t = torus.triangle_count();
+        let mut broken = torus.clone();
+        // A crack: a copy of every 97th triangle's first corner, nudged by one ulp.
+        for k in (0..t).step_by(97) {
+            let i = broken.indices[3 * k] as usize;
+            let mut p = broken.positions[i];
+            p[0] = f32::from_bits(p[0].to_bits() + 1);
+            broken.positions.push(p);
+            broken.indices[3 * k] = broken.positions.len() as u32 - 1;
+        }
+        // The same without the nudge welds back: unwelded duplicates, no crack.
+        let mut duplicated = torus.clone();
+        for k in (0..t).step_by(89) {
+            let i = duplicated.indices[3 * k + 1] as usize;
+            duplicated.positions.push(duplicated.positions[i]);
+            duplicated.indices[3 * k + 1] = duplicated.positions.len() as u32 - 1;
+        }
+        // Flipped triangles, a hole, a collapsed triangle, zero-area triangles and triangles
+        // stacked on existing edges (non-manifold).
+        let mut mixed = torus.clone();
+        for k in (0..t).step_by(1000) {
+            mixed.indices.swap(3 * k, 3 * k + 1);
+        }
+        mixed.indices.drain(3 * 5000..3 * 5010);
+        mixed.indices.extend([0, 0, 1]);
+        for k in (0..t).step_by(5003) {
+            mixed.indices.extend(torus.triangle(k));
+        }
+        let n = mixed.positions.len() as u32;
+        mixed.positions.extend([
+            [9.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [11.0, 0.0, 0.0],
+            [-0.0, 5.0, 5.0],
+            [0.0, 5.0, 5.0],
+        ]);
+        mixed.indices.extend([n, n + 1, n + 2, n + 3, n + 4, n]);
+        for m in [&mut broken, &mut duplicated, &mut mixed] {
+            let n = m.positions.len();
+            m.normals.resize(n, [0.0; 3]);
+            m.uvs.resize(n, [0.0; 2]);
+            m.vertex_patch.resize(n, 0);
+            m.triangle_patch.resize(m.indices.len() / 3, 0);
+        }
+        let w = assert_all_agree(&broken, "cracked torus");
+        // At least the two sides at each nudged corner: its triangle alone uses them.
+        assert!(w.boundary_edges >= 2 * t.div_ceil(97), "{w:?}");
+        assert_eq!(assert_all_agree(&duplicated, "duplicated torus"), whole);
+        let w = assert_all_agree(&mixed, "mixed torus");
+        assert!(w.misoriented_edges > 0 && w.boundary_edges > 0 && w.nonmanifold_edges > 0, "{w:?}");
+        assert_eq!(w.collapsed_triangles, 2, "{w:?}");
+        assert_eq!(w.zero_area_triangles, 1, "{w:?}");
+    }
+
     #[test]
     fn sorting_and_hashing_agree_on_random_meshes() {
         use proptest::prelude::RngExt;
@@ -442,7 +850,7 @@ mod tests {
                 .map(|_| [rng.random_range(0..n), rng.random_range(0..n), rng.random_range(0..n)])
                 .collect();
             let m = mesh(&p, &t);
-            assert_eq!(watertight(&m), watertight_hashed(&m));
+            assert_all_agree(&m, "random");
         }
     }
 }
