@@ -1,46 +1,19 @@
-// Count pass, uniform pattern: the counts `tessera::engine::Layout::build` scans, written in
-// place into the offset arrays (the scan turns them into offsets).
-// Invocation x < E: edge x's inner vertices, `(segments − 1) · variants`, none for a collapsed
-// edge or one no visible patch uses. E ≤ x < E + P: patch x − E's interior vertices
-// and triangles (`pattern::uniform::Uniform::counts`) minus those that degenerate at a
-// collapsed curve (only patches with a repeated corner have any; on quads only in the outer
-// ring of cells). x = E + P: the trailing entry, 0.
-
-@compute @workgroup_size(WORKGROUP)
-fn count(
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-    @builtin(local_invocation_index) lid: u32,
-) {
-    let x = thread_index(wid, nwg, lid);
-    let edges = params.edges;
-    let patches = params.patches;
-    if (x < edges) {
-        vertex_offsets[x] = edge_count(x);
-    } else if (x < edges + patches) {
-        let p = x - edges;
-        var inner = 0u;
-        var triangles = 0u;
-        if (visible[p] != 0u) {
-            let n = interior[p].x;
-            let tri = patch_is_tri(p);
-            let counts = uniform_counts(tri, n);
-            inner = counts.x;
-            triangles = counts.y;
-            if (patch_repeated_corner(p)) {
-                if (tri) {
-                    triangles = kept_triangles(p, n);
-                } else {
-                    triangles = triangles - ring_degenerates(p, n);
-                }
-            }
+// Counts of the uniform pattern for the count pass (`count.wgsl`): a visible patch's interior
+// vertices and triangles (`pattern::uniform::Uniform::counts`) minus those that degenerate at
+// a collapsed curve (only patches with a repeated corner have any; on quads only in the outer
+// ring of cells).
+fn patch_counts(p: u32) -> vec2<u32> {
+    let n = interior[p].x;
+    let tri = patch_is_tri(p);
+    var counts = uniform_counts(tri, n);
+    if (patch_repeated_corner(p)) {
+        if (tri) {
+            counts.y = kept_triangles(p, n);
+        } else {
+            counts.y = counts.y - ring_degenerates(p, n);
         }
-        vertex_offsets[x] = inner;
-        triangle_offsets[p] = triangles;
-    } else if (x == edges + patches) {
-        vertex_offsets[x] = 0u;
-        triangle_offsets[patches] = 0u;
     }
+    return counts;
 }
 
 // Triangles of the outer ring of cells of patch p that degenerate (no other cell has two

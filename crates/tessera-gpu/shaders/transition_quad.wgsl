@@ -276,37 +276,15 @@ fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
     return kept;
 }
 
-// Count pass (see `count_uniform.wgsl` for the layout of the counts).
-@compute @workgroup_size(WORKGROUP)
-fn count(
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-    @builtin(local_invocation_index) lid: u32,
-) {
-    let x = thread_index(wid, nwg, lid);
-    let edges = params.edges;
-    let patches = params.patches;
-    if (x < edges) {
-        vertex_offsets[x] = edge_count(x);
-    } else if (x < edges + patches) {
-        let p = x - edges;
-        var inner = 0u;
-        var triangles = 0u;
-        if (visible[p] != 0u) {
-            let input = patch_input(p);
-            let counts = transition_counts(input);
-            inner = counts.x;
-            triangles = counts.y;
-            if (patch_repeated_corner(p)) {
-                triangles = build_transition(input, false, 0u);
-            }
-        }
-        vertex_offsets[x] = inner;
-        triangle_offsets[p] = triangles;
-    } else if (x == edges + patches) {
-        vertex_offsets[x] = 0u;
-        triangle_offsets[patches] = 0u;
+// Counts of the transition pattern for the count pass (`count.wgsl`): a visible patch's
+// `transition_counts`, its triangles rebuilt and counted where a corner repeats.
+fn patch_counts(p: u32) -> vec2<u32> {
+    let input = patch_input(p);
+    var counts = transition_counts(input);
+    if (patch_repeated_corner(p)) {
+        counts.y = build_transition(input, false, 0u);
     }
+    return counts;
 }
 
 // Triangle pass: one invocation per visible patch writes its pattern.

@@ -61,6 +61,7 @@ const COMMON: &str = include_str!("../shaders/common.wgsl");
 const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
 const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
 const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
+const COUNT: &str = include_str!("../shaders/count.wgsl");
 const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
 const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
 const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
@@ -168,7 +169,7 @@ impl Pipelines {
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let cull = module(device, "cull", &[COMMON, CULL]);
         let uniform = {
-            let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM]);
+            let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]);
             let vertices = module(
                 device,
                 "vertices uniform",
@@ -186,7 +187,7 @@ impl Pipelines {
             }
         };
         let transition = {
-            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD]);
+            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD, COUNT]);
             let vertices = module(
                 device,
                 "vertices transition",

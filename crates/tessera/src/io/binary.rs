@@ -73,7 +73,7 @@ pub(crate) fn check_mesh(mesh: &Mesh) -> Result<()> {
         return invalid(format!("vertex {i} has a non-finite uv {:?}", mesh.uvs[i]));
     }
     if let Some(params) = &mesh.corner_params {
-        if let Some(k) = first_where(&params, |p| !finite(p)) {
+        if let Some(k) = first_where(params, |p| !finite(p)) {
             return invalid(format!(
                 "corner {} of triangle {} has non-finite params {:?}",
                 k % 3,

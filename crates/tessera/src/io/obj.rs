@@ -462,11 +462,11 @@ pub(super) fn push_f32(out: &mut Vec<u8>, x: f32) {
     let point = exponent + 1;
     if point <= 0 {
         out.extend_from_slice(b"0.");
-        out.extend(std::iter::repeat(b'0').take(point.unsigned_abs() as usize));
+        out.extend(std::iter::repeat_n(b'0', point.unsigned_abs() as usize));
         out.extend_from_slice(&digits);
     } else if point as usize >= digits.len() {
         out.extend_from_slice(&digits);
-        out.extend(std::iter::repeat(b'0').take(point as usize - digits.len()));
+        out.extend(std::iter::repeat_n(b'0', point as usize - digits.len()));
     } else {
         let (int, frac) = digits.split_at(point as usize);
         out.extend_from_slice(int);

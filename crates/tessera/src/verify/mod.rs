@@ -235,10 +235,13 @@ pub fn watertight(mesh: &Mesh) -> WatertightReport {
 /// relative to the part (PART_BITS bits), the larger end and the direction.
 const PART_BITS: u32 = 12;
 
+/// A triangle's three sides as (part, key).
+type TriangleSides = [(usize, u64); 3];
+
 /// The welded ends of the triangle with `corners`, and its three sides as (part, key) for
 /// [`watertight`]; `None` when two ends are one (a collapsed triangle).
 #[inline(always)]
-fn side_keys(welded: &[AtomicU32], corners: &[u32]) -> Option<([u32; 3], [(usize, u64); 3])> {
+fn side_keys(welded: &[AtomicU32], corners: &[u32]) -> Option<([u32; 3], TriangleSides)> {
     let v = [corners[0], corners[1], corners[2]].map(|i| welded[i as usize].load(Relaxed));
     if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
         return None;
@@ -314,8 +317,9 @@ fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
     // one seen at a position is the smallest index there.
     pieces.par_iter_mut().enumerate().for_each(|(c, pieces)| {
         let mut fill = vec![0usize; parts];
-        for i in c * chunk..((c + 1) * chunk).min(n) {
-            let key = position_key(positions[i]);
+        let range = c * chunk..((c + 1) * chunk).min(n);
+        for (i, &position) in positions[range.clone()].iter().enumerate().map(|(k, p)| (range.start + k, p)) {
+            let key = position_key(position);
             let p = part_of(hash_key(key));
             pieces[p][fill[p]] = [key[0], key[1], key[2], i as u32];
             fill[p] += 1;
