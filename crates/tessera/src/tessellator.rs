@@ -133,9 +133,8 @@ pub struct Tessellator<'a> {
     scratch: PlanScratch,
     timings: FrameTimings,
     mesh: Mesh,
-    /// The vectorized bicubic evaluation's per-set tables (None unless every patch is a
-    /// polynomial bicubic), kept from frame to frame.
-    fast: Option<FastEvaluator<'a>>,
+    /// The vectorized evaluation's per-set tables, kept from frame to frame.
+    fast: FastEvaluator<'a>,
 }
 
 impl<'a> Tessellator<'a> {
@@ -192,8 +191,9 @@ impl<'a> Tessellator<'a> {
         self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
         let layout = start.elapsed();
         let start = Instant::now();
-        let applies = self.fast.as_mut().is_some_and(|f| f.retarget(&planned.plan));
-        let fast = self.fast.as_ref().filter(|_| applies);
+        self.fast.retarget(&planned.plan);
+        self.fast.fill_patterns(&planned.plan, &planned.pattern, self.layout.triangle_count() as u64);
+        let fast = Some(&self.fast);
         let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
         engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, &mut self.mesh, fast)?;
         self.timings = FrameTimings {

@@ -15,12 +15,14 @@ use crate::error::{Error, Result};
 use crate::mesh::strips::RESTART;
 use crate::mesh::Mesh;
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
-use crate::surface::{Domain, SurfaceSet};
+use crate::surface::{Domain, Patch, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
 pub mod layout;
 pub mod render_queues;
+pub(crate) mod pattern_cache;
+pub(crate) mod point_blocks;
 pub(crate) mod uniform_quads;
 
 pub(crate) use layout::collapsed_edges;
@@ -111,8 +113,9 @@ pub fn write(
     options: TessellateOptions,
     out: &mut Mesh,
 ) -> Result<()> {
-    let fast = uniform_quads::FastEvaluator::new(set, plan);
-    write_with(set, plan, pattern, layout, options, out, fast.as_ref())
+    let mut fast = uniform_quads::FastEvaluator::new(set, plan);
+    fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+    write_with(set, plan, pattern, layout, options, out, Some(&fast))
 }
 
 /// [`write`] with the evaluator chosen by the caller (None: the generic f64 evaluation
@@ -228,33 +231,67 @@ fn write_corners(
     fast: Option<&uniform_quads::FastEvaluator<'_>>,
     mut out: VertexSlices<'_>,
 ) {
-    if let Some(f) = fast {
+    if let Some(f) = fast.filter(|f| f.grid()) {
         return f.corners(out);
     }
     let topo = &set.topology;
     for (i, e) in topo.corner_entries.iter().enumerate() {
-        let d = set.patches[e.owner_patch as usize].domain();
-        out.set(i, set, e.owner_patch, d.corner(e.owner_corner as usize));
+        let (patch, c) = (&set.patches[e.owner_patch as usize], e.owner_corner as usize);
+        match patch {
+            // Mesh input has a corner per vertex: the closed form saves the sums.
+            Patch::Pn(t) => {
+                let q = t.corner(c);
+                out.pos[i] = q.position.as_vec3().to_array();
+                out.nrm[i] = q.normal.as_vec3().to_array();
+                out.uv[i] = Domain::Tri.corner(c).as_vec2().to_array();
+                out.patch[i] = e.owner_patch;
+            }
+            _ => out.set(i, set, e.owner_patch, patch.domain().corner(c)),
+        }
     }
 }
 
 /// The inner samples of edge `e`, evaluated once per normal variant by a patch of that
-/// variant; variants after the first copy the first's position bits.
-fn write_edge(set: &SurfaceSet, plan: &Plan, e: usize, mut out: VertexSlices<'_>) {
+/// variant (in blocks where `points` is given); variants after the first copy the first's
+/// position bits. `uvs` is scratch.
+fn write_edge(
+    set: &SurfaceSet,
+    plan: &Plan,
+    e: usize,
+    out: VertexSlices<'_>,
+    points: Option<&point_blocks::PointBlocks>,
+    uvs: &mut Vec<DVec2>,
+) {
     let topo = &set.topology;
     let inner = plan.segments(e) as usize - 1;
     let uses = topo.edge_uses(e);
+    let VertexSlices { pos, nrm, uv, patch } = out;
     for variant in 0..topo.edges[e].variants as usize {
         let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
         let d = set.patches[u.patch as usize].domain();
-        for k in 1..=inner {
+        uvs.clear();
+        uvs.extend((1..=inner).map(|k| {
             let t = plan.param(e, k as u32);
-            let local_t = if u.reversed { 1.0 - t } else { t };
-            let slot = variant * inner + k - 1;
-            out.set(slot, set, u.patch, d.edge_point(u.local as usize, local_t));
-            if variant > 0 {
-                out.pos[slot] = out.pos[k - 1];
+            d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
+        }));
+        let r = variant * inner..(variant + 1) * inner;
+        let mut part = VertexSlices {
+            pos: &mut pos[r.clone()],
+            nrm: &mut nrm[r.clone()],
+            uv: &mut uv[r.clone()],
+            patch: &mut patch[r.clone()],
+        };
+        match points {
+            Some(points) => points.eval(set, u.patch as usize, uvs, part),
+            None => {
+                for (k, &q) in uvs.iter().enumerate() {
+                    part.set(k, set, u.patch, q);
+                }
             }
+        }
+        if variant > 0 {
+            // Every variant's points lie where the first variant's do, bit for bit.
+            pos.copy_within(0..inner, r.start);
         }
     }
 }
@@ -303,7 +340,10 @@ impl Writer<'_> {
             }
             match self.fast {
                 Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
-                _ => write_edge(self.set, self.plan, e, part),
+                fast => with_scratch(self.generation, |scratch| {
+                    let points = fast.map(|f| f.points());
+                    write_edge(self.set, self.plan, e, part, points, &mut scratch.params64)
+                }),
             }
         }
     }
@@ -334,12 +374,18 @@ impl Writer<'_> {
         let PatchOut { mut verts, idx, tp, params } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let map = LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
-        scratch.build(self.pattern, &map.input);
-        let local = &scratch.local;
+        let local = match self.fast.and_then(|f| f.patterns().get(p)) {
+            Some(cached) => cached,
+            None => {
+                scratch.build(self.pattern, &map.input);
+                &scratch.local
+            }
+        };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !local.interior.is_empty());
-        match fast.and_then(|f| Some((f, f.covers_patch(self.pattern, &map.input)?))) {
-            Some((f, grid)) => f.interior(p, grid, verts),
+        match fast.map(|f| (f, f.covers_patch(self.pattern, &map.input))) {
+            Some((f, Some(grid))) => f.interior(p, grid, verts),
+            Some((f, None)) => f.points().eval(set, p, &local.interior, verts),
             None => {
                 for (k, &uv) in local.interior.iter().enumerate() {
                     verts.set(k, set, p as u32, uv);

@@ -29,12 +29,14 @@
 //! that have them, for AVX2 and FMA, chosen at run time. Calling the AVX2 build is the
 //! module's only `unsafe`.
 
+use super::pattern_cache::PatternCache;
+use super::point_blocks::{has_avx2_fma, local_frame, PointBlocks};
 use super::VertexSlices;
 use crate::criterion::Plan;
 use crate::pattern::{Pattern, PatternInput};
 use crate::sampling::{uniform_param, SamplingKind};
-use crate::surface::{Domain, Patch, RationalBicubic, SurfacePoint, SurfaceSet};
-use glam::{DVec2, DVec3};
+use crate::surface::{Domain, RationalBicubic, SurfacePoint, SurfaceSet};
+use glam::DVec2;
 use rayon::prelude::*;
 
 /// Points evaluated together: 8 f32 lanes fill one AVX register (two SSE registers).
@@ -42,14 +44,14 @@ const LANES: usize = 8;
 
 /// Below this squared sine of the angle between `∂S/∂u` and `∂S/∂v`, the f32 cross product
 /// no longer gives the normal to about 1e-5, and the point is evaluated in f64.
-const MIN_SIN2: f32 = 1e-4;
+pub(crate) const MIN_SIN2: f32 = 1e-4;
 
 /// Below this squared length of `∂S/∂u` or `∂S/∂v` in the local frame (where the control
 /// points lie within `[-1, 1]³`, so a derivative's f32 rounding is about 1e-6), the
 /// derivative's direction is no longer good to 1e-5, and the point is evaluated in f64: near a
 /// pole of the control net (teapot_teasetorig's lid) a derivative nearly vanishes while the
 /// angle between the two stays wide.
-const MIN_DERIVATIVE2: f32 = 0.04;
+pub(crate) const MIN_DERIVATIVE2: f32 = 0.04;
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -93,23 +95,20 @@ impl Basis {
     }
 }
 
-/// One patch in a local frame: `P = origin + scale · p`, with `p` within `[-1, 1]³`.
-struct LocalPatch {
-    origin: [f32; 3],
-    scale: f32,
+/// One patch in a local frame ([`local_frame`]): `P = origin + scale · p`, with `p` within
+/// `[-1, 1]³`.
+pub(crate) struct LocalPatch {
+    pub(crate) origin: [f32; 3],
+    pub(crate) scale: f32,
     /// `by_v[c][j][i]`: component `c` of `p_ij` (`i` along `u`, `j` along `v`), so that a
     /// row's curve, a sum over `j`, is a sum of 4-vectors over `i`.
-    by_v: [[[f32; 4]; 4]; 3],
+    pub(crate) by_v: [[[f32; 4]; 4]; 3],
 }
 
 impl LocalPatch {
-    fn new(patch: &RationalBicubic) -> LocalPatch {
-        let (lo, hi) = patch
-            .points
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &q| (lo.min(q), hi.max(q)));
-        let origin = (lo + hi) * 0.5;
-        let scale = power_of_two_above(((hi - lo) * 0.5).max_element());
+    /// The polynomial bicubic `patch` (weights ignored) in its local frame.
+    pub(crate) fn new(patch: &RationalBicubic) -> LocalPatch {
+        let (origin, scale) = local_frame(&patch.points);
         // Exact: a power of two.
         let inv = 1.0 / scale;
         let mut local =
@@ -138,16 +137,6 @@ impl LocalPatch {
         let by_u = self.by_v.map(|q| std::array::from_fn(|a| std::array::from_fn(|b| q[b][a])));
         Line::new(&by_u, basis, i, true)
     }
-}
-
-/// A power of two above `x` (and at most `2x`), kept well inside f32's range; 1 for 0.
-fn power_of_two_above(x: f64) -> f64 {
-    if x <= 0.0 || !x.is_finite() {
-        return 1.0;
-    }
-    // 2^e ≤ x < 2^(e+1) for the unbiased exponent e of a normal x.
-    let e = ((x.to_bits() >> 52) & 0x7ff) as i64 - 1023;
-    f64::from_bits((((e + 1).clamp(-100, 100) + 1023) as u64) << 52)
 }
 
 /// A grid line of a patch as a cubic Bézier curve in the local frame, with the control points
@@ -309,16 +298,6 @@ fn edge_line(patch: &LocalPatch, basis: &Basis, n: usize, e: usize) -> Line {
     }
 }
 
-/// True when the CPU has AVX2 and FMA, so the kernels compiled for them may run.
-fn has_avx2_fma() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    false
-}
-
 /// The tables of one factor `n`: bases, grid parameters, edge parameters.
 #[derive(Default)]
 struct FactorTables {
@@ -357,7 +336,9 @@ impl FactorTables {
     }
 }
 
-/// The evaluator: everything its tasks share.
+/// The evaluator: everything its tasks share. It evaluates every point the engine asks for,
+/// on the grid kernels of this module where the plan and pattern allow, on
+/// [`PointBlocks`] elsewhere.
 pub(crate) struct FastEvaluator<'a> {
     set: &'a SurfaceSet,
     /// `tables[n]` for every factor `n` a plan so far needed (`n == 0`: not filled yet);
@@ -365,61 +346,54 @@ pub(crate) struct FastEvaluator<'a> {
     tables: Vec<FactorTables>,
     /// Every patch in its local frame; each is needed by several tasks (its corners, edges
     /// and rows), so it is made once.
-    locals: Vec<LocalPatch>,
+    points: PointBlocks,
+    /// The current plan's distinct patterns ([`FastEvaluator::fill_patterns`]).
+    patterns: PatternCache,
+    /// The grid kernels apply to the current plan: every patch a polynomial bicubic, integer
+    /// samplings ([`FastEvaluator::retarget`]).
+    grid: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
 }
 
 impl<'a> FastEvaluator<'a> {
-    /// The evaluator for `set` and `plan`, or None where it cannot help: a plan of real
-    /// factors, or a patch that is not a polynomial bicubic. It evaluates every corner, every
-    /// edge of one normal variant and every patch interior its pattern promises to be a grid
-    /// ([`Pattern::interior_grid`]), whatever the factors. Cost: O(P) (each patch moved to its
-    /// local frame).
-    pub(crate) fn new(set: &'a SurfaceSet, plan: &Plan) -> Option<FastEvaluator<'a>> {
+    /// The evaluator for `set` and `plan`. On polynomial bicubic patches and integer plans it
+    /// evaluates every corner, every edge of one normal variant and every patch interior its
+    /// pattern promises to be a grid ([`Pattern::interior_grid`]) on grids; every other point
+    /// of a polynomial patch (any surface kind) in [`PointBlocks`]. Cost: O(P) (each patch
+    /// moved to its local frame).
+    pub(crate) fn new(set: &'a SurfaceSet, plan: &Plan) -> FastEvaluator<'a> {
         Self::with_kernels(set, plan, has_avx2_fma())
     }
 
     /// [`FastEvaluator::new`] with the kernels chosen by the caller (`avx2_fma` is ignored
     /// where the CPU lacks either).
-    pub(crate) fn with_kernels(
-        set: &'a SurfaceSet,
-        plan: &Plan,
-        avx2_fma: bool,
-    ) -> Option<FastEvaluator<'a>> {
-        let mut f = Self::for_set(set, avx2_fma)?;
-        f.retarget(plan).then_some(f)
+    pub(crate) fn with_kernels(set: &'a SurfaceSet, plan: &Plan, avx2_fma: bool) -> FastEvaluator<'a> {
+        let mut f = Self::for_set(set, avx2_fma);
+        f.retarget(plan);
+        f
     }
 
-    /// The evaluator's per-set part, prepared once: every patch in its local frame. None
-    /// unless every patch is a polynomial bicubic. Cost: O(P).
-    pub(crate) fn for_set(set: &'a SurfaceSet, avx2_fma: bool) -> Option<FastEvaluator<'a>> {
-        if !set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if b.is_polynomial())) {
-            return None;
-        }
-        Some(FastEvaluator {
+    /// The evaluator's per-set part, prepared once: every patch in its local frame. Cost: O(P).
+    pub(crate) fn for_set(set: &'a SurfaceSet, avx2_fma: bool) -> FastEvaluator<'a> {
+        FastEvaluator {
             set,
             tables: Vec::new(),
-            locals: set
-                .patches
-                .par_iter()
-                .with_min_len(64)
-                .map(|p| match p {
-                    Patch::Bicubic(b) => LocalPatch::new(b),
-                    _ => unreachable!("checked above: every patch is bicubic"),
-                })
-                .collect(),
+            points: PointBlocks::for_set(set, avx2_fma),
+            patterns: PatternCache::default(),
+            grid: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
-        })
+        }
     }
 
     /// Makes the tables of every factor `plan` uses (edge segments, interior factors, and
-    /// 1 to 3, which the transition pattern may raise a core to), and says whether the
-    /// evaluator applies to the plan (integer samplings). Cost: O(E + P), plus O(n) for each
-    /// factor not seen before.
+    /// 1 to 3, which the transition pattern may raise a core to), and says whether the grid
+    /// kernels apply to the plan (polynomial bicubic patches, integer samplings). Cost:
+    /// O(E + P), plus O(n) for each factor not seen before.
     pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
-        if plan.kind != SamplingKind::Uniform {
+        self.grid = plan.kind == SamplingKind::Uniform && self.points.all_bicubic();
+        if !self.grid {
             return false;
         }
         let needed =
@@ -436,9 +410,30 @@ impl<'a> FastEvaluator<'a> {
         true
     }
 
+    /// Builds the distinct patterns of `plan` (see [`PatternCache::fill`]; `triangles` is the
+    /// layout's count), for the writer to read instead of building one per patch.
+    pub(crate) fn fill_patterns(&mut self, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
+        self.patterns.fill(self.set, plan, pattern, triangles);
+    }
+
+    /// The current plan's distinct patterns.
+    pub(crate) fn patterns(&self) -> &PatternCache {
+        &self.patterns
+    }
+
+    /// Whether the grid kernels apply to the current plan (corners among them).
+    pub(crate) fn grid(&self) -> bool {
+        self.grid
+    }
+
+    /// The evaluator of arbitrary parameter lists.
+    pub(crate) fn points(&self) -> &PointBlocks {
+        &self.points
+    }
+
     /// The tables of factor `n`, when made.
     fn factor(&self, n: usize) -> Option<&FactorTables> {
-        self.tables.get(n).filter(|t| t.n == n && n > 0)
+        self.tables.get(n).filter(|t| self.grid && t.n == n && n > 0)
     }
 
     /// Whether edge `e`'s samples are this evaluator's: a factor with tables, one normal
@@ -459,7 +454,7 @@ impl<'a> FastEvaluator<'a> {
     }
 
     fn local(&self, p: usize) -> &LocalPatch {
-        &self.locals[p]
+        self.points.bicubic(p).expect("the grid kernels run on polynomial bicubic patches only")
     }
 
     /// The generic f64 evaluation, for the rare points f32 cannot resolve.
@@ -621,7 +616,8 @@ mod tests {
     use crate::engine::{write_with, Layout, TessellateOptions};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
-    use crate::surface::{BuildOptions, Orientation};
+    use crate::surface::{BuildOptions, Orientation, Patch};
+    use glam::DVec3;
     use crate::verify;
 
     fn load(name: &str) -> SurfaceSet {
@@ -637,7 +633,8 @@ mod tests {
     fn fast(set: &SurfaceSet, plan: &Plan, options: TessellateOptions, out: &mut Mesh, avx2_fma: bool) {
         let mut layout = Layout::default();
         layout.build(set, plan, &Uniform, &options).expect("layout");
-        let evaluator = FastEvaluator::with_kernels(set, plan, avx2_fma).expect("the evaluator applies");
+        let evaluator = FastEvaluator::with_kernels(set, plan, avx2_fma);
+        assert!(evaluator.grid(), "the grid kernels apply");
         write_with(set, plan, &Uniform, &layout, options, out, Some(&evaluator)).expect("fast evaluation");
     }
 
@@ -712,7 +709,7 @@ mod tests {
                     let opts = TessellateOptions::default();
                     let mut layout = Layout::default();
                     layout.build(&set, plan, pattern, &opts).expect("layout");
-                    let evaluator = FastEvaluator::with_kernels(&set, plan, avx2_fma).expect("applies");
+                    let evaluator = FastEvaluator::with_kernels(&set, plan, avx2_fma);
                     let covered = (0..set.patches.len())
                         .filter(|&p| {
                             let input = crate::engine::layout::pattern_input(&set, plan, p);
@@ -828,7 +825,8 @@ mod tests {
     fn the_evaluator_covers_only_what_it_can_evaluate() {
         let set = load("bench/torus_64x32.patches");
         let plan = Plan::uniform(&set, 4).unwrap();
-        let f = FastEvaluator::new(&set, &plan).expect("a uniform polynomial bicubic plan");
+        let f = FastEvaluator::new(&set, &plan);
+        assert!(f.grid(), "a uniform polynomial bicubic plan");
         let mut other = plan.clone();
         other.segments[7] = 5;
         assert!(f.covers_edge(&plan, 7) && !f.covers_edge(&other, 7), "5 has no tables yet");
@@ -839,21 +837,13 @@ mod tests {
         assert_eq!(f.covers_patch(&Uniform, &tri), None, "triangles are not bicubic");
         let mut fractional = plan.clone();
         fractional.kind = SamplingKind::Fractional(crate::sampling::Spacing::Symmetric);
-        assert!(FastEvaluator::new(&set, &fractional).is_none());
+        assert!(!FastEvaluator::new(&set, &fractional).grid());
+        assert!(!FastEvaluator::new(&set, &fractional).covers_edge(&fractional, 7));
         let mut rational = set.clone();
         if let Patch::Bicubic(b) = &mut rational.patches[5] {
             b.weights[5] = 2.0;
         }
-        assert!(FastEvaluator::new(&rational, &plan).is_none());
+        assert!(!FastEvaluator::new(&rational, &plan).grid());
     }
 
-    #[test]
-    fn power_of_two_above_brackets_its_argument() {
-        for x in [1e-30, 0.3, 0.5, 1.0, 3.0, 1024.0, 1e30] {
-            let p = power_of_two_above(x);
-            assert!(x < p && p <= 2.0 * x, "{x} → {p}");
-            assert_eq!(p.to_bits() & ((1 << 52) - 1), 0, "{p} is a power of two");
-        }
-        assert_eq!(power_of_two_above(0.0), 1.0);
-    }
 }

@@ -97,6 +97,21 @@ impl PnTriangle {
         }
     }
 
+    /// [`PnTriangle::eval`] at corner `c` (0, 1, 2 at `uv` = (0,0), (1,0), (0,1)) without the
+    /// sums: the corner's control point and its normalised normal coefficient, which is what
+    /// the sums give there. Cost: one normalisation.
+    pub fn corner(&self, c: usize) -> SurfacePoint {
+        let (point, normal) = match c {
+            0 => (self.geometry.b(3, 0, 0), self.normals[0]),
+            1 => (self.geometry.b(0, 3, 0), self.normals[1]),
+            _ => (self.geometry.b(0, 0, 3), self.normals[2]),
+        };
+        match normal.try_normalize() {
+            Some(normal) => SurfacePoint { position: point, normal },
+            None => self.eval(super::Domain::Tri.corner(c)),
+        }
+    }
+
     /// The same patch with corners 1 and 2 exchanged (opposite orientation).
     pub fn swapped_uv(&self) -> Self {
         let [n200, n020, n002, n110, n011, n101] = self.normals;
@@ -108,5 +123,22 @@ impl PnTriangle {
         let mut out = self.swapped_uv();
         out.normals = out.normals.map(|n| -n);
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn corners_are_the_evaluation_at_the_corners() {
+        let p = [DVec3::new(1.0, 2.0, 3.0), DVec3::new(4.0, 2.5, 3.0), DVec3::new(1.5, 6.0, 2.0)];
+        let n = [DVec3::new(0.1, 0.2, 1.0), DVec3::new(-0.3, 0.1, 1.0), DVec3::new(0.0, -0.4, 1.0)];
+        let t = PnTriangle::new(p, n.map(|n| n.normalize()));
+        for (c, &corner) in p.iter().enumerate() {
+            let uv = crate::domain::Domain::Tri.corner(c);
+            assert_eq!(t.corner(c), t.eval(uv), "corner {c}");
+            assert_eq!(t.corner(c).position, corner);
+        }
     }
 }

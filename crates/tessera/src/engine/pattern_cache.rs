@@ -1,0 +1,157 @@
+//! Patterns that repeat within a frame, built once: a table from each distinct pattern input
+//! (the edge segments and factors, interior factors and collapsed edges of a patch) to its
+//! built pattern, as the semi-uniform render queues keep one pattern per level and the
+//! hardware tessellator one table per factor combination.
+//!
+//! Without it, the writer builds a pattern per visible patch and reuses it only for the next
+//! patch of the same input on the same thread; in an adaptive frame neighbours differ, and
+//! building is a large part of writing (CudaTess's transition strips, the hardware patterns'
+//! rings). With it, the distinct inputs are found in one pass over the patches, built in
+//! parallel, and every patch reads its pattern by index.
+//!
+//! **No allocation in a steady frame loop.** The table, the index and each slot's buffers keep
+//! their capacity from frame to frame. Inputs get slots in patch order, so the same sequence of
+//! frames fills the same slots with the same patterns: a second walk along a camera path
+//! allocates nothing, whichever threads built what.
+
+use super::layout::pattern_input;
+use crate::criterion::Plan;
+use crate::pattern::{LocalTessellation, Pattern, PatternInput};
+use crate::surface::SurfaceSet;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// The bits of a pattern input that a pattern may read (everything but the patch index).
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct Key {
+    segments: [u32; 4],
+    interior: [u32; 2],
+    factors: [u64; 4],
+    /// Domain (bit 4) and collapsed edges (bits 0–3).
+    flags: u8,
+}
+
+impl Key {
+    fn of(input: &PatternInput) -> Key {
+        let collapsed = input.collapsed.iter().enumerate().fold(0u8, |m, (e, &c)| m | (u8::from(c) << e));
+        Key {
+            segments: input.segments,
+            interior: input.interior,
+            factors: input.factors.map(f64::to_bits),
+            flags: collapsed | (u8::from(input.domain == crate::domain::Domain::Quad) << 4),
+        }
+    }
+}
+
+/// A multiply-rotate hash of the key's words. The standard library's SipHash resists
+/// adversarial keys, which these are not, at several times the cost per lookup; the key is
+/// hashed once per patch per frame, so it matters. (The field's hashers — FxHash and kin — are
+/// not among this project's dependencies; this is their few lines.)
+#[derive(Default)]
+struct WordHasher(u64);
+
+impl Hasher for WordHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u8(&mut self, x: u8) {
+        self.write_u64(x as u64);
+    }
+
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(x as u64);
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+}
+
+/// Patch `p` has no cached pattern (invisible, or the pattern depends on the patch).
+const NONE: u32 = u32::MAX;
+
+/// Below this many triangles per visible patch on average, patterns are small enough that
+/// building one costs about what finding it in the table costs, and the cache stays off.
+const MIN_TRIANGLES_PER_PATCH: u32 = 24;
+
+/// The frame's distinct patterns. See the [module documentation](self).
+#[derive(Default)]
+pub(crate) struct PatternCache {
+    index: HashMap<Key, u32, BuildHasherDefault<WordHasher>>,
+    /// The input of each slot in use (`inputs.len()` slots), its patch index the first
+    /// patch's.
+    inputs: Vec<PatternInput>,
+    /// Every slot ever used; slots past `inputs.len()` keep their buffers for later frames.
+    slots: Vec<LocalTessellation>,
+    /// Each patch's slot, or [`NONE`]; empty when the cache is off for the frame.
+    of_patch: Vec<u32>,
+}
+
+impl PatternCache {
+    /// Finds the distinct inputs of `plan`'s visible patches and builds each once, or turns
+    /// the cache off for this frame where it would not pay (patterns that depend on the patch,
+    /// or fewer than [`MIN_TRIANGLES_PER_PATCH`] triangles per visible patch: `triangles` is
+    /// the layout's count). Cost: one hash lookup per visible patch (sequential), then the
+    /// distinct builds (parallel); no allocation once the buffers have grown to the frame.
+    pub(crate) fn fill(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
+        self.index.clear();
+        self.inputs.clear();
+        self.of_patch.clear();
+        let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
+        if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
+            return;
+        }
+        let patches = set.patches.len();
+        if self.of_patch.capacity() < patches {
+            self.of_patch.reserve(patches);
+        }
+        for p in 0..patches {
+            if !plan.is_visible(p) {
+                self.of_patch.push(NONE);
+                continue;
+            }
+            let input = pattern_input(set, plan, p);
+            let next = self.inputs.len() as u32;
+            let slot = *self.index.entry(Key::of(&input)).or_insert(next);
+            if slot == next {
+                self.inputs.push(input);
+            }
+            self.of_patch.push(slot);
+        }
+        let used = self.inputs.len();
+        if self.slots.len() < used {
+            self.slots.resize_with(used, LocalTessellation::default);
+        }
+        self.slots[..used]
+            .par_iter_mut()
+            .zip(&self.inputs)
+            .with_min_len(4)
+            .for_each(|(local, input)| pattern.build(input, local));
+    }
+
+    /// Patch `p`'s pattern, when the cache holds it for this frame.
+    pub(crate) fn get(&self, p: usize) -> Option<&LocalTessellation> {
+        let slot = *self.of_patch.get(p)?;
+        (slot != NONE).then(|| &self.slots[slot as usize])
+    }
+
+    /// How many distinct patterns this frame built (0 when the cache is off).
+    #[cfg(test)]
+    pub(crate) fn distinct(&self) -> usize {
+        self.inputs.len()
+    }
+}
