@@ -26,19 +26,25 @@ impl Domain {
         }
     }
 
-    /// Parameters of corner `i`.
+    /// Parameters of corner `i` (`i` below [`Domain::corner_count`]).
+    #[inline]
     pub fn corner(self, i: usize) -> DVec2 {
-        match self {
-            Domain::Tri => [DVec2::ZERO, DVec2::X, DVec2::Y][i],
-            Domain::Quad => [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y][i],
+        // A match rather than indexing an array literal: the array would be built on the stack
+        // per call, and this runs once per edge sample in the engine.
+        match (self, i) {
+            (_, 0) => DVec2::ZERO,
+            (_, 1) => DVec2::X,
+            (Domain::Tri, 2) | (Domain::Quad, 3) => DVec2::Y,
+            (Domain::Quad, 2) => DVec2::ONE,
+            _ => panic!("corner {i} of a {self:?} domain"),
         }
     }
 
     /// Parameters of the point at `t ∈ [0,1]` along edge `e` (from corner `e` to `e+1`).
+    #[inline]
     pub fn edge_point(self, e: usize, t: f64) -> DVec2 {
-        let n = self.corner_count();
         let a = self.corner(e);
-        let b = self.corner((e + 1) % n);
+        let b = self.corner(if e + 1 == self.corner_count() { 0 } else { e + 1 });
         // Written as a convex combination so t=0 and t=1 give the corners exactly.
         a * (1.0 - t) + b * t
     }

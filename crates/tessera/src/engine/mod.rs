@@ -373,9 +373,14 @@ impl Writer<'_> {
     fn patch(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
         let PatchOut { mut verts, idx, tp, params } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
-        let map = LocalMap { set, plan, layout, input: layout::pattern_input(set, plan, p), patch: p };
-        let local = match self.fast.and_then(|f| f.patterns().get(p)) {
-            Some(cached) => cached,
+        let cached = self.fast.and_then(|f| f.patterns().get(p));
+        let input = match cached {
+            Some((input, _)) => PatternInput { patch: p as u32, ..*input },
+            None => layout::pattern_input(set, plan, p),
+        };
+        let map = LocalMap { set, plan, layout, input, patch: p };
+        let local = match cached {
+            Some((_, local)) => local,
             None => {
                 scratch.build(self.pattern, &map.input);
                 &scratch.local

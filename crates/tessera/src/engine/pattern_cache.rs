@@ -143,10 +143,11 @@ impl PatternCache {
             .for_each(|(local, input)| pattern.build(input, local));
     }
 
-    /// Patch `p`'s pattern, when the cache holds it for this frame.
-    pub(crate) fn get(&self, p: usize) -> Option<&LocalTessellation> {
-        let slot = *self.of_patch.get(p)?;
-        (slot != NONE).then(|| &self.slots[slot as usize])
+    /// Patch `p`'s pattern input and pattern, when the cache holds them for this frame (the
+    /// input's `patch` is the first patch's of that input: set it to `p`).
+    pub(crate) fn get(&self, p: usize) -> Option<(&PatternInput, &LocalTessellation)> {
+        let slot = *self.of_patch.get(p)? as usize;
+        (slot != NONE as usize).then(|| (&self.inputs[slot], &self.slots[slot]))
     }
 
     /// How many distinct patterns this frame built (0 when the cache is off).

@@ -166,13 +166,13 @@ pub(crate) fn has_avx2_fma() -> bool {
     false
 }
 
-/// [`LANES`] points of one patch in structure-of-arrays form.
-struct Block {
-    pos: [[f32; LANES]; 3],
-    nrm: [[f32; LANES]; 3],
+/// `L` points of one patch in structure-of-arrays form.
+struct Block<const L: usize> {
+    pos: [[f32; L]; 3],
+    nrm: [[f32; L]; 3],
     /// Positive where the f32 normal is reliable; elsewhere (zero, negative or NaN) the point
     /// must be evaluated in f64.
-    margin: [f32; LANES],
+    margin: [f32; L],
 }
 
 /// `a · b + c`, fused in the kernels compiled for FMA (elsewhere `mul_add` would be a slow
@@ -188,10 +188,10 @@ fn madd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
 
 /// Cubic Bernstein polynomials and their derivatives of each lane's `t`.
 #[inline(always)]
-fn bernstein_lanes(t: &[f32; LANES]) -> ([[f32; LANES]; 4], [[f32; LANES]; 4]) {
-    let mut b = [[0f32; LANES]; 4];
-    let mut d = [[0f32; LANES]; 4];
-    for l in 0..LANES {
+fn bernstein_lanes<const L: usize>(t: &[f32; L]) -> ([[f32; L]; 4], [[f32; L]; 4]) {
+    let mut b = [[0f32; L]; 4];
+    let mut d = [[0f32; L]; 4];
+    for l in 0..L {
         let (t, s) = (t[l], 1.0 - t[l]);
         b[0][l] = s * s * s;
         b[1][l] = 3.0 * t * s * s;
@@ -208,20 +208,20 @@ fn bernstein_lanes(t: &[f32; LANES]) -> ([[f32; LANES]; 4], [[f32; LANES]; 4]) {
 /// Normals `a × c` (times `sign`), normalised, and the reliability margin of each lane, as the
 /// grid path computes them.
 #[inline(always)]
-fn cross_normals(a: &[[f32; LANES]; 3], c: &[[f32; LANES]; 3]) -> ([[f32; LANES]; 3], [f32; LANES]) {
+fn cross_normals<const L: usize>(a: &[[f32; L]; 3], c: &[[f32; L]; 3]) -> ([[f32; L]; 3], [f32; L]) {
     let ([ax, ay, az], [cx, cy, cz]) = (a, c);
-    let mut nrm = [[0f32; LANES]; 3];
-    let mut margin = [0f32; LANES];
+    let mut nrm = [[0f32; L]; 3];
+    let mut margin = [0f32; L];
     {
         let [nx, ny, nz] = &mut nrm;
-        for l in 0..LANES {
+        for l in 0..L {
             nx[l] = ay[l] * cz[l] - az[l] * cy[l];
             ny[l] = az[l] * cx[l] - ax[l] * cz[l];
             nz[l] = ax[l] * cy[l] - ay[l] * cx[l];
         }
     }
     let [nx, ny, nz] = &mut nrm;
-    for l in 0..LANES {
+    for l in 0..L {
         let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
         let a2 = ax[l] * ax[l] + ay[l] * ay[l] + az[l] * az[l];
         let c2 = cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l];
@@ -237,7 +237,7 @@ fn cross_normals(a: &[[f32; LANES]; 3], c: &[[f32; LANES]; 3]) -> ([[f32; LANES]
 
 /// Moves local positions back to the model: `origin + scale · p`.
 #[inline(always)]
-fn to_model<const FMA: bool>(pos: &mut [[f32; LANES]; 3], origin: &[f32; 3], scale: f32) {
+fn to_model<const FMA: bool, const L: usize>(pos: &mut [[f32; L]; 3], origin: &[f32; 3], scale: f32) {
     for (row, &origin) in pos.iter_mut().zip(origin) {
         for x in row {
             *x = madd::<FMA>(scale, *x, origin);
@@ -249,25 +249,25 @@ fn to_model<const FMA: bool>(pos: &mut [[f32; LANES]; 3], origin: &[f32; 3], sca
 // Index loops mirror the sums over control points (and vectorize over lanes).
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
-fn bicubic_block<const FMA: bool>(patch: &LocalPatch, u: &[f32; LANES], v: &[f32; LANES]) -> Block {
+fn bicubic_block<const FMA: bool, const L: usize>(patch: &LocalPatch, u: &[f32; L], v: &[f32; L]) -> Block<L> {
     let (bu, du) = bernstein_lanes(u);
     let (bv, dv) = bernstein_lanes(v);
-    let mut pos = [[0f32; LANES]; 3];
-    let mut su = [[0f32; LANES]; 3];
-    let mut sv = [[0f32; LANES]; 3];
+    let mut pos = [[0f32; L]; 3];
+    let mut su = [[0f32; L]; 3];
+    let mut sv = [[0f32; L]; 3];
     for c in 0..3 {
         for i in 0..4 {
             // The curve of constant u's control point i and its v-derivative's, per lane.
-            let mut ci = [0f32; LANES];
-            let mut di = [0f32; LANES];
+            let mut ci = [0f32; L];
+            let mut di = [0f32; L];
             for j in 0..4 {
                 let q = patch.by_v[c][j][i];
-                for l in 0..LANES {
+                for l in 0..L {
                     ci[l] = madd::<FMA>(bv[j][l], q, ci[l]);
                     di[l] = madd::<FMA>(dv[j][l], q, di[l]);
                 }
             }
-            for l in 0..LANES {
+            for l in 0..L {
                 pos[c][l] = madd::<FMA>(bu[i][l], ci[l], pos[c][l]);
                 su[c][l] = madd::<FMA>(du[i][l], ci[l], su[c][l]);
                 sv[c][l] = madd::<FMA>(bu[i][l], di[l], sv[c][l]);
@@ -275,19 +275,19 @@ fn bicubic_block<const FMA: bool>(patch: &LocalPatch, u: &[f32; LANES], v: &[f32
         }
     }
     let (nrm, margin) = cross_normals(&su, &sv);
-    to_model::<FMA>(&mut pos, &patch.origin, patch.scale);
+    to_model::<FMA, L>(&mut pos, &patch.origin, patch.scale);
     Block { pos, nrm, margin }
 }
 
 /// The monomials `λ0^i λ1^j λ2^k` of each lane for the exponents `table`.
 #[inline(always)]
-fn monomials<const M: usize>(
-    powers: &[[[f32; LANES]; 4]; 3],
+fn monomials<const L: usize, const M: usize>(
+    powers: &[[[f32; L]; 4]; 3],
     table: &[(usize, usize, usize); M],
-) -> [[f32; LANES]; M] {
-    let mut out = [[0f32; LANES]; M];
+) -> [[f32; L]; M] {
+    let mut out = [[0f32; L]; M];
     for (m, &(i, j, k)) in table.iter().enumerate() {
-        for l in 0..LANES {
+        for l in 0..L {
             out[m][l] = powers[0][i][l] * powers[1][j][l] * powers[2][k][l];
         }
     }
@@ -296,15 +296,15 @@ fn monomials<const M: usize>(
 
 /// `Σ_m coefficients[c][m] · basis[m]` per component and lane.
 #[inline(always)]
-fn combine<const FMA: bool, const M: usize>(
+fn combine<const FMA: bool, const L: usize, const M: usize>(
     coefficients: &[[f32; M]; 3],
-    basis: &[[f32; LANES]; M],
-) -> [[f32; LANES]; 3] {
-    let mut out = [[0f32; LANES]; 3];
+    basis: &[[f32; L]; M],
+) -> [[f32; L]; 3] {
+    let mut out = [[0f32; L]; 3];
     for (c, row) in out.iter_mut().enumerate() {
         for (m, b) in basis.iter().enumerate() {
             let q = coefficients[c][m];
-            for l in 0..LANES {
+            for l in 0..L {
                 row[l] = madd::<FMA>(b[l], q, row[l]);
             }
         }
@@ -314,10 +314,10 @@ fn combine<const FMA: bool, const M: usize>(
 
 /// A cubic Bézier or PN triangle at each lane's `(u, v)`.
 #[inline(always)]
-fn triangle_block<const FMA: bool>(t: &LocalTriangle, u: &[f32; LANES], v: &[f32; LANES]) -> Block {
+fn triangle_block<const FMA: bool, const L: usize>(t: &LocalTriangle, u: &[f32; L], v: &[f32; L]) -> Block<L> {
     // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v).
-    let mut powers = [[[1f32; LANES]; 4]; 3];
-    for l in 0..LANES {
+    let mut powers = [[[1f32; L]; 4]; 3];
+    for l in 0..L {
         let lambda = [1.0 - u[l] - v[l], u[l], v[l]];
         for a in 0..3 {
             let x = lambda[a];
@@ -326,17 +326,17 @@ fn triangle_block<const FMA: bool>(t: &LocalTriangle, u: &[f32; LANES], v: &[f32
             powers[a][3][l] = x * x * x;
         }
     }
-    let mut pos = combine::<FMA, 10>(&t.pos, &monomials(&powers, &CUBIC));
+    let mut pos = combine::<FMA, L, 10>(&t.pos, &monomials(&powers, &CUBIC));
     let (nrm, margin) = match &t.pn {
         None => {
             let quadratic = monomials(&powers, &QUADRATIC);
-            cross_normals(&combine::<FMA, 6>(&t.du, &quadratic), &combine::<FMA, 6>(&t.dv, &quadratic))
+            cross_normals(&combine::<FMA, L, 6>(&t.du, &quadratic), &combine::<FMA, L, 6>(&t.dv, &quadratic))
         }
         Some(field) => {
-            let mut n = combine::<FMA, 6>(field, &monomials(&powers, &PN_NORMAL));
-            let mut margin = [0f32; LANES];
+            let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
+            let mut margin = [0f32; L];
             let [nx, ny, nz] = &mut n;
-            for l in 0..LANES {
+            for l in 0..L {
                 let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
                 margin[l] = n2 - MIN_PN_NORMAL2;
                 let inv = 1.0 / n2.sqrt();
@@ -347,7 +347,7 @@ fn triangle_block<const FMA: bool>(t: &LocalTriangle, u: &[f32; LANES], v: &[f32
             (n, margin)
         }
     };
-    to_model::<FMA>(&mut pos, &t.origin, t.scale);
+    to_model::<FMA, L>(&mut pos, &t.origin, t.scale);
     Block { pos, nrm, margin }
 }
 
@@ -413,20 +413,37 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
+        // Short lists (the inner samples of a coarse edge, a small interior) in half-width
+        // blocks, so that fewer lanes are spent on padding.
+        if uvs.len() <= LANES / 2 {
+            self.blocks::<FMA, { LANES / 2 }>(set, p, uvs, out)
+        } else {
+            self.blocks::<FMA, LANES>(set, p, uvs, out)
+        }
+    }
+
+    #[inline(always)]
+    fn blocks<const FMA: bool, const L: usize>(
+        &self,
+        set: &SurfaceSet,
+        p: usize,
+        uvs: &[DVec2],
+        out: VertexSlices<'_>,
+    ) {
         let local = &self.locals[p];
-        let chunks = uvs.chunks(LANES).zip(out.pos.chunks_mut(LANES).zip(out.nrm.chunks_mut(LANES)));
+        let chunks = uvs.chunks(L).zip(out.pos.chunks_mut(L).zip(out.nrm.chunks_mut(L)));
         for (uv, (pos, nrm)) in chunks {
             // Spare lanes repeat the last point: a real point, so its margin is meaningful.
-            let mut u = [0f32; LANES];
-            let mut v = [0f32; LANES];
-            for l in 0..LANES {
+            let mut u = [0f32; L];
+            let mut v = [0f32; L];
+            for l in 0..L {
                 let q = uv[l.min(uv.len() - 1)];
                 u[l] = q.x as f32;
                 v[l] = q.y as f32;
             }
             let block = match local {
-                Local::Bicubic(b) => bicubic_block::<FMA>(b, &u, &v),
-                Local::Triangle(t) => triangle_block::<FMA>(t, &u, &v),
+                Local::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
+                Local::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
                 Local::Generic => unreachable!("handled by the caller"),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
@@ -497,7 +514,7 @@ mod tests {
         for avx2_fma in [false, true] {
             let blocks = PointBlocks::for_set(&set, avx2_fma);
             for (p, patch) in set.patches.iter().enumerate() {
-                for count in [1, 7, 8, 9, 23] {
+                for count in [1, 3, 4, 5, 7, 8, 9, 23] {
                     let uvs: Vec<DVec2> = (0..count)
                         .map(|k| {
                             let (a, b) = ((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
