@@ -396,15 +396,28 @@ impl<'a> FastEvaluator<'a> {
         if !self.grid {
             return false;
         }
-        let needed =
-            plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()).chain(1..=3);
-        for n in needed {
-            let n = n as usize;
-            if n >= self.tables.len() {
-                self.tables.resize_with(n + 1, FactorTables::default);
+        // Every factor up to the plan's largest (at most DENSE) gets its tables: a max is one
+        // vectorized pass over the plan, where asking for each factor in turn cost a lookup
+        // per edge and patch every frame; the tables of factors up to 64 take a few hundred
+        // kilobytes. Larger factors (rare, and up to MAX_FACTOR) get tables only where used.
+        const DENSE: usize = 64;
+        let max_edge = plan.segments.iter().copied().max().unwrap_or(1);
+        let max_interior = plan.interior.iter().map(|f| f[0].max(f[1])).max().unwrap_or(1);
+        let max = max_edge.max(max_interior).max(3) as usize;
+        if max >= self.tables.len() {
+            self.tables.resize_with(max + 1, FactorTables::default);
+        }
+        for (n, tables) in self.tables.iter_mut().enumerate().take(max.min(DENSE) + 1).skip(1) {
+            if tables.n != n {
+                tables.fill(n as u32);
             }
-            if self.tables[n].n != n {
-                self.tables[n].fill(n as u32);
+        }
+        if max > DENSE {
+            for n in plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()) {
+                let n = n as usize;
+                if n > DENSE && self.tables[n].n != n {
+                    self.tables[n].fill(n as u32);
+                }
             }
         }
         true
