@@ -6,7 +6,12 @@
 //!   pixel of guaranteed error, culling on;
 //! - `killeroo_herd_91476/pixel_0.5`: 11 copies of the killeroo cage as PN triangles, the same
 //!   criterion;
-//! - `torus_64x32/uniform_16`: the one torus at uniform factor 16 (1,048,576 triangles).
+//! - `torus_64x32/uniform_16`: the one torus at uniform factor 16 (1,048,576 triangles);
+//! - `torus_64x32/tolerance_0.001%`: the torus under a guaranteed object-space error of
+//!   0.001 % of its diagonal (transition);
+//! - `cow/…`: the cow as PN triangles with paper 001's silhouette criteria (transition 4:7,
+//!   semi-uniform 4:8) and the fractional-odd partitioning at factor 6.4;
+//! - `{elephant_refined,bunny,armadillo}/pn_uniform_4`: PN triangles at uniform factor 4.
 //!
 //! The scenes are built in code from the shared models, not stored. Criterion reports
 //! triangles per second; run with `RAYON_NUM_THREADS=1` and `=2` to compare thread counts.
@@ -14,6 +19,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::path::PathBuf;
 use tessera::camera::Camera;
+use tessera::pattern::hardware::Partitioning;
 use tessera::scheme::{self, PlanOptions, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
@@ -64,6 +70,33 @@ fn frames(c: &mut Criterion) {
 
     let one = SurfaceSet::from_patch_file(&torus, Default::default());
     bench_frames(c, "torus_64x32/uniform_16", &one, Scheme::Uniform, scheme::Criterion::Factor(16.0), false);
+    let (lo, hi) = one.bounds();
+    let tolerance = scheme::Criterion::Tolerance(1e-5 * lo.distance(hi));
+    bench_frames(c, "torus_64x32/tolerance_0.001%", &one, Scheme::Transition, tolerance, false);
+    drop(one);
+
+    let pn = |rel: &str| {
+        let path = data_dir().join(rel);
+        let mesh = tessera::io::obj::read_obj(&path).expect("benchmark model");
+        SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).expect("benchmark model")
+    };
+    let cow = pn("meshes/cow.obj");
+    let silhouette = |criterion, fmin, fmax| scheme::Criterion::View { criterion, fmin, fmax };
+    // Each scheme's own silhouette criterion, as `tessera mesh --silhouette` picks it.
+    let transition = Scheme::Transition;
+    let vertices = silhouette(transition.default_silhouette(), 4.0, 7.0);
+    bench_frames(c, "cow/transition_silhouette_4_7", &cow, transition, vertices, false);
+    let semi_uniform = Scheme::SemiUniform { max_level: Scheme::DEFAULT_SEMI_UNIFORM_LEVEL };
+    let semi = silhouette(semi_uniform.default_silhouette(), 4.0, 8.0);
+    bench_frames(c, "cow/semi_uniform_silhouette_4_8", &cow, semi_uniform, semi, false);
+    let odd = Scheme::Hardware(Partitioning::FractionalOdd);
+    bench_frames(c, "cow/fractional_odd_6.4", &cow, odd, scheme::Criterion::Factor(6.4), false);
+    drop(cow);
+    for name in ["elephant_refined", "bunny", "armadillo"] {
+        let set = pn(&format!("meshes/{name}.obj"));
+        let four = scheme::Criterion::Factor(4.0);
+        bench_frames(c, &format!("{name}/pn_uniform_4"), &set, Scheme::Uniform, four, false);
+    }
 }
 
 criterion_group!(benches, frames);
