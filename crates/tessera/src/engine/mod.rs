@@ -5,10 +5,15 @@
 //! each task its own disjoint slice. A shared edge's inner vertices are evaluated once, by the
 //! edge's owner patch, and every patch on the edge indexes them: the mesh is watertight bit
 //! for bit without welding. Split-normal variants copy the owner's position bits and take
-//! their normal from a patch of their own variant. Polynomial bicubic patches whose pattern
-//! interior is a uniform grid are evaluated by a vectorized specialisation
-//! (`uniform_quads`'s evaluator); that changes how positions are computed, never which
-//! vertices and triangles there are.
+//! their normal from a patch of their own variant.
+//!
+//! Two specialisations of evaluation change how positions are computed, never which vertices
+//! and triangles there are (the tests compare each with the generic f64 evaluation):
+//! polynomial bicubic patches whose pattern interior is a uniform grid, and edges of integer
+//! factors, are evaluated row by row (`uniform_quads`); every other point of a polynomial
+//! patch — any scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
+//! (`point_blocks`). Rational patches keep the generic evaluation. Patterns that repeat within
+//! a frame are built once (`pattern_cache`).
 
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
