@@ -103,16 +103,13 @@ fn built_pattern_bound(
     built: &LocalTessellation,
     params: &mut Vec<glam::DVec2>,
 ) -> f64 {
-    // Local vertex order: corners, each edge's inner samples, the interior ([`Slot`]).
-    let d = input.domain;
-    let nc = d.corner_count();
-    params.clear();
-    params.extend((0..nc).map(|c| d.corner(c)));
-    for e in 0..nc {
-        let n = input.segments[e];
-        params.extend((1..n).map(|k| d.edge_point(e, k as f64 / n as f64)));
-    }
-    params.extend_from_slice(&built.interior);
+    crate::engine::pattern_cache::local_params(input, built, params);
+    params_bound(m, built, params)
+}
+
+/// The bound of the pattern `built` over its local-vertex parameters `params`
+/// ([`crate::engine::pattern_cache::local_params`]): the largest triangle error.
+fn params_bound(m: &HessianBound, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
     let errors = m.triangle_errors();
     built.triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(0.0, f64::max)
 }
@@ -208,6 +205,8 @@ pub(crate) struct Scratch {
     firsts: Vec<First>,
     counts: Vec<u64>,
     per_patch: Vec<AtomicU64>,
+    /// The first patterns of a round of checks, each distinct one built once.
+    patterns: crate::engine::pattern_cache::PatternCache,
 }
 
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
@@ -264,6 +263,7 @@ pub(crate) fn plan_limited(
         firsts,
         counts,
         per_patch,
+        patterns,
     } = scratch;
 
     // Each visible patch's proposal per local edge.
@@ -307,7 +307,7 @@ pub(crate) fn plan_limited(
     which.extend(0..patches);
     let mut check = |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>| {
         let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, hessians };
-        check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, out)
+        check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, patterns, out)
     };
     check(&plan.segments, proposals, which, results);
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
@@ -489,6 +489,7 @@ fn check_patches(
     which: &[usize],
     firsts: &mut Vec<First>,
     counts: &mut Vec<u64>,
+    patterns: &mut crate::engine::pattern_cache::PatternCache,
     out: &mut Vec<Check>,
 ) {
     let CheckInputs { set, eps, layout, cap, minimum, hessians } = *inputs;
@@ -546,11 +547,26 @@ fn check_patches(
         };
     });
     let admitted = limit.reserve(which, counts);
+    // The first patterns (admitted by the reservation above) are built once per distinct
+    // input, with their local-vertex parameters: neighbours share inputs, and most patches
+    // pass on their first pattern. Later rounds of a patch build on the thread instead.
+    if admitted && !limit.pattern.depends_on_patch() {
+        let first_input = |i: usize| {
+            let (p, (domain, seg, interior)) = (which[i], firsts[i]);
+            eps[p].map(|_| input_of(p, domain, seg, interior))
+        };
+        patterns.fill_inputs(limit.pattern, which.len(), first_input, true);
+    } else {
+        patterns.clear();
+    }
+    let patterns = &*patterns;
     // Each thread's pattern buffers are kept from call to call (a per-frame loop then
     // allocates none here).
     let generation = crate::engine::next_generation();
     out.resize(which.len(), ([1; 2], 0.0, false));
-    out.par_iter_mut().zip(which).zip(firsts.par_iter()).for_each(|((o, &p), &(domain, seg, interior))| {
+    let items = out.par_iter_mut().zip(which).zip(firsts.par_iter()).enumerate();
+    items.for_each(|(i, ((o, &p), &(domain, seg, interior)))| {
+        let first = interior;
         let mut interior = interior;
         *o = (|| {
             if !admitted {
@@ -564,12 +580,16 @@ fn check_patches(
                     // The output could not hold this pattern; the plan is refused at the end.
                     return (interior, f64::INFINITY, true);
                 }
-                // Neighbouring patches often share an input: the thread's last pattern is
-                // reused when it is the same.
-                let bound = crate::engine::with_scratch(generation, |s| {
-                    let (built, params) = s.built(limit.pattern, &input);
-                    built_pattern_bound(&hessians[p], &input, built, params)
-                });
+                let cached = patterns.params(i).filter(|_| interior == first);
+                let bound = match cached {
+                    Some((_, built, params)) => params_bound(&hessians[p], built, params),
+                    // Neighbouring patches often share an input: the thread's last pattern
+                    // is reused when it is the same.
+                    None => crate::engine::with_scratch(generation, |s| {
+                        let (built, params) = s.built(limit.pattern, &input);
+                        built_pattern_bound(&hessians[p], &input, built, params)
+                    }),
+                };
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
                 }

@@ -18,6 +18,7 @@ use super::layout::pattern_input;
 use crate::criterion::Plan;
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use crate::surface::SurfaceSet;
+use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -99,6 +100,26 @@ pub(crate) struct PatternCache {
     slots: Vec<LocalTessellation>,
     /// Each patch's slot, or [`NONE`]; empty when the cache is off for the frame.
     of_patch: Vec<u32>,
+    /// Per slot, the parameters of the pattern's local vertices (filled on request).
+    params: Vec<Vec<DVec2>>,
+    /// `params` holds this fill's tables.
+    with_params: bool,
+}
+
+/// The parameters of every local vertex of `built` (made for `input`), in local order:
+/// corners, each edge's inner samples at `k / n`, the interior — the table the a-posteriori
+/// error check evaluates triangles on (`criterion::tolerance`), computed once per distinct
+/// pattern instead of once per patch.
+pub(crate) fn local_params(input: &PatternInput, built: &LocalTessellation, params: &mut Vec<DVec2>) {
+    let d = input.domain;
+    let nc = d.corner_count();
+    params.clear();
+    params.extend((0..nc).map(|c| d.corner(c)));
+    for e in 0..nc {
+        let n = input.segments[e];
+        params.extend((1..n).map(|k| d.edge_point(e, k as f64 / n as f64)));
+    }
+    params.extend_from_slice(&built.interior);
 }
 
 impl PatternCache {
@@ -108,23 +129,44 @@ impl PatternCache {
     /// the layout's count). Cost: one hash lookup per visible patch (sequential), then the
     /// distinct builds (parallel); no allocation once the buffers have grown to the frame.
     pub(crate) fn fill(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
+        let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
+        if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
+            self.clear();
+            return;
+        }
+        let input_of = |p: usize| plan.is_visible(p).then(|| pattern_input(set, plan, p));
+        self.fill_inputs(pattern, set.patches.len(), input_of, false);
+    }
+
+    /// Empties the cache: every [`PatternCache::get`] answers None.
+    pub(crate) fn clear(&mut self) {
         self.index.clear();
         self.inputs.clear();
         self.of_patch.clear();
-        let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
-        if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
-            return;
+    }
+
+    /// Fills the cache for items `0..count` with the inputs `input_of(i)` (None: no pattern
+    /// for item `i`), building each distinct input once; with `params`, also the parameters of
+    /// every local vertex of each pattern (the a-posteriori check's table, see
+    /// [`PatternCache::params`]). Precondition: the pattern does not depend on the patch.
+    /// Cost: one hash lookup per item (sequential), then the distinct builds (parallel).
+    pub(crate) fn fill_inputs(
+        &mut self,
+        pattern: &dyn Pattern,
+        count: usize,
+        input_of: impl Fn(usize) -> Option<PatternInput>,
+        params: bool,
+    ) {
+        debug_assert!(!pattern.depends_on_patch());
+        self.clear();
+        if self.of_patch.capacity() < count {
+            self.of_patch.reserve(count);
         }
-        let patches = set.patches.len();
-        if self.of_patch.capacity() < patches {
-            self.of_patch.reserve(patches);
-        }
-        for p in 0..patches {
-            if !plan.is_visible(p) {
+        for i in 0..count {
+            let Some(input) = input_of(i) else {
                 self.of_patch.push(NONE);
                 continue;
-            }
-            let input = pattern_input(set, plan, p);
+            };
             let next = self.inputs.len() as u32;
             let slot = *self.index.entry(Key::of(&input)).or_insert(next);
             if slot == next {
@@ -136,11 +178,19 @@ impl PatternCache {
         if self.slots.len() < used {
             self.slots.resize_with(used, LocalTessellation::default);
         }
-        self.slots[..used]
-            .par_iter_mut()
-            .zip(&self.inputs)
-            .with_min_len(4)
-            .for_each(|(local, input)| pattern.build(input, local));
+        if params && self.params.len() < used {
+            self.params.resize_with(used, Vec::new);
+        }
+        let built = self.slots[..used].par_iter_mut().zip(&self.inputs);
+        if params {
+            built.zip(&mut self.params[..used]).with_min_len(4).for_each(|((local, input), params)| {
+                pattern.build(input, local);
+                local_params(input, local, params);
+            });
+        } else {
+            built.with_min_len(4).for_each(|(local, input)| pattern.build(input, local));
+        }
+        self.with_params = params;
     }
 
     /// Patch `p`'s pattern input and pattern, when the cache holds them for this frame (the
@@ -150,9 +200,23 @@ impl PatternCache {
         (slot != NONE as usize).then(|| (&self.inputs[slot], &self.slots[slot]))
     }
 
+    /// Item `i`'s input, pattern and local-vertex parameters, when the last
+    /// [`PatternCache::fill_inputs`] made them (with `params`).
+    pub(crate) fn params(&self, i: usize) -> Option<(&PatternInput, &LocalTessellation, &[DVec2])> {
+        let slot = *self.of_patch.get(i)? as usize;
+        (self.with_params && slot != NONE as usize)
+            .then(|| (&self.inputs[slot], &self.slots[slot], &self.params[slot][..]))
+    }
+
     /// How many distinct patterns this frame built (0 when the cache is off).
     #[cfg(test)]
     pub(crate) fn distinct(&self) -> usize {
         self.inputs.len()
+    }
+}
+
+impl std::fmt::Debug for PatternCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PatternCache").field("distinct", &self.inputs.len()).finish_non_exhaustive()
     }
 }
