@@ -4,7 +4,7 @@
 //! The passes of a frame, each one compute pass (named in [`PASSES`], timed by
 //! [`PassTimer`] when the adapter has timestamp queries):
 //!
-//! 1. **count** (`count_uniform.wgsl`, `transition_quad.wgsl`): per edge and per patch, the counts
+//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`): per edge and per patch, the counts
 //!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
 //!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
@@ -14,7 +14,7 @@
 //! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
 //!    interior vertices;
 //! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
-//!    triangle; transition (`transition_quad.wgsl`) one invocation per patch walking its core
+//!    triangle; transition (`transition.wgsl`) one invocation per patch walking its core
 //!    and strips in the CPU's order (parallel over patches only: the next step is a
 //!    per-triangle form).
 //!
@@ -67,7 +67,7 @@ const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
 const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
 const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
 const CULL: &str = include_str!("../shaders/cull.wgsl");
-const TRANSITION_QUAD: &str = include_str!("../shaders/transition_quad.wgsl");
+const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
@@ -95,8 +95,8 @@ fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderMod
 pub enum GpuPattern {
     /// [`tessera::pattern::uniform::Uniform`]: one invocation per output triangle.
     Uniform,
-    /// [`tessera::pattern::transition::Transition`] on quads (CudaTess): one invocation per
-    /// patch builds its core and strips serially.
+    /// [`tessera::pattern::transition::Transition`] on quads and triangles (CudaTess): one
+    /// invocation per patch builds its core and strips serially.
     Transition,
 }
 
@@ -187,11 +187,11 @@ impl Pipelines {
             }
         };
         let transition = {
-            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD, COUNT]);
+            let pattern = module(device, "transition", &[COMMON, TRANSITION, COUNT]);
             let vertices = module(
                 device,
                 "vertices transition",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION_QUAD, WRITE_VERTICES],
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION, WRITE_VERTICES],
             );
             PatternPipelines {
                 count: make(&one, &pattern, "count"),
@@ -275,9 +275,9 @@ struct Output {
 ///
 /// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
 /// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
-/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on bicubic
-/// patches (any per-edge segments and core factors, as `Scheme::Transition` plans); anything
-/// else is refused with [`GpuError::Unsupported`].
+/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on every
+/// patch kind (any per-edge segments and core factors, as `Scheme::Transition` plans);
+/// anything else is refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
@@ -403,11 +403,6 @@ impl GpuTessellator {
         }
         if plan.kind != SamplingKind::Uniform {
             return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
-        }
-        if kind == GpuPattern::Transition
-            && set.patches.iter().any(|p| p.domain() != tessera::domain::Domain::Quad)
-        {
-            return Err(GpuError::Unsupported { what: "the transition pattern on triangle patches".into() });
         }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];

@@ -496,3 +496,65 @@ fn uniform_bezier_triangles_equal_the_cpu_engine() {
         }
     }
 }
+
+/// `set` with its PN triangles replaced by their cubic Bézier geometry (normals then come
+/// from the derivatives).
+fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
+    let patches = pn
+        .patches
+        .iter()
+        .map(|p| match p {
+            tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
+            other => other.clone(),
+        })
+        .collect();
+    SurfaceSet::from_patches(patches, BuildOptions::default())
+}
+
+#[test]
+fn transition_on_triangle_patches_equals_the_cpu_engine() {
+    // CudaTess's triangle regions (strips, raised cores, the two-region modification) on PN
+    // triangles and cubic Bézier triangles: the CPU's own transition plans from an
+    // object-space tolerance, then arbitrary per-edge and core factors.
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let mut rng = Lcg(31);
+    for model in ["meshes/blob.obj", "awkward/teapot_tri_nonmanifold.obj"] {
+        let pn = load(model);
+        for (kind, set) in [("PN", pn.clone()), ("Bézier", as_bezier_triangles(&pn))] {
+            let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+            let diagonal = diagonal(&set);
+            for rel in [1e-2, 2e-3] {
+                let planned = Scheme::Transition
+                    .plan(&set, &Criterion::Tolerance(rel * diagonal), &PlanOptions::default())
+                    .unwrap();
+                let distinct: std::collections::BTreeSet<u32> =
+                    planned.plan.segments.iter().copied().collect();
+                assert!(distinct.len() > 1, "{model}: one factor everywhere, no strips tested");
+                let name = format!("{model} {kind} tolerance {rel}");
+                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+            }
+            for round in 0..3 {
+                let max = 7;
+                let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % max).collect();
+                let interior = (0..set.patches.len())
+                    .map(|_| {
+                        let n = 1 + rng.next() % max;
+                        [n, n]
+                    })
+                    .collect();
+                let mut plan = Plan::integer(segments, interior, set.patches.len());
+                if round == 2 {
+                    plan.visible.iter_mut().step_by(3).for_each(|v| *v = 0);
+                }
+                let name = format!("{model} {kind} random round {round}");
+                assert_pattern_equals_cpu(
+                    &name,
+                    &set,
+                    &mut gpu,
+                    &plan,
+                    &tessera::pattern::transition::Transition,
+                );
+            }
+        }
+    }
+}
