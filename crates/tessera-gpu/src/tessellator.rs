@@ -478,14 +478,16 @@ impl GpuTessellator {
     /// Only [`Scheme::Uniform`] for now (the global factor: the largest over the visible
     /// patches); the transition scheme's a-posteriori checks are CPU-only. The output is
     /// sized for the worst case, every patch at `max_factor` (or at the largest minimum
-    /// when that is higher).
+    /// when that is higher), within the device's buffer limits, or as `criterion.capacity`
+    /// says; a frame that needs more draws nothing and is reported
+    /// ([`GpuTessellator::grow_if_overflowed`]).
     ///
     /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
     /// Errors: [`GpuError::Unsupported`] for another scheme or a `prepared` without bounds;
     /// [`tessera::Error::InvalidParameter`] for a pixel error that is not a positive number
-    /// or a `max_factor` outside `1..=MAX_FACTOR`; [`GpuError::OutputTooLarge`] as
-    /// [`GpuTessellator::reserve`]. Cost: O(E + P) and an upload of 128 bytes a patch and 4
-    /// an edge, once.
+    /// or a `max_factor` outside `1..=MAX_FACTOR`; [`GpuError::OutputTooLarge`] when the
+    /// worst case passes the u32 range of the scans, or as [`GpuTessellator::reserve`].
+    /// Cost: O(E + P) and an upload of 128 bytes a patch and 4 an edge, once.
     pub fn prepare_screen(
         &mut self,
         ctx: &GpuContext,
@@ -494,7 +496,7 @@ impl GpuTessellator {
         camera: &Camera,
         criterion: ScreenCriterion,
     ) -> Result<()> {
-        let ScreenCriterion { scheme, pixels, max_factor } = criterion;
+        let ScreenCriterion { scheme, pixels, max_factor, capacity } = criterion;
         if scheme != Scheme::Uniform {
             return Err(GpuError::Unsupported {
                 what: format!("pixel-error factors on the GPU for the {} scheme (uniform only)", scheme.name()),
@@ -532,7 +534,24 @@ impl GpuTessellator {
         // The largest global factor a frame can reach: the cap, or a minimum above it.
         let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
         let worst = minimum.copied().fold(max_factor, u32::max);
-        let capacity = Capacity::of_plan(set, &Plan::uniform(set, worst)?, &Uniform, true);
+        let worst = Capacity::of_plan(set, &Plan::uniform(set, worst)?, &Uniform, true);
+        // The scans count in u32: a set whose worst frame could pass that range is refused
+        // here, before any frame could wrap.
+        if worst.vertices > u32::MAX as u64 || worst.triangles > u32::MAX as u64 / 3 {
+            return Err(GpuError::OutputTooLarge {
+                vertices: worst.vertices,
+                triangles: worst.triangles,
+                bytes: (worst.vertices * VERTEX_STRIDE).max(worst.triangles * 12),
+                limit: self.buffer_limit,
+            });
+        }
+        // Past the buffer limits, the frames that need more overflow and are reported; the
+        // ones that fit draw completely.
+        let (most_vertices, most_triangles) = self.most();
+        let capacity = capacity.unwrap_or(Capacity {
+            vertices: worst.vertices.min(most_vertices),
+            triangles: worst.triangles.min(most_triangles),
+        });
         self.reserve(ctx, capacity)?;
         let queue = &ctx.queue;
         queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&patch_view_rows(set, Some(prepared))));
@@ -541,6 +560,52 @@ impl GpuTessellator {
         self.pattern = GpuPattern::Uniform;
         self.set_cull_camera(ctx, Some(camera));
         Ok(())
+    }
+
+    /// The largest output the device's limits allow: `(vertices, triangles)`.
+    fn most(&self) -> (u64, u64) {
+        let vertices = (self.buffer_limit / VERTEX_STRIDE).min(u32::MAX as u64);
+        let triangles = (self.buffer_limit / 12).min(u32::MAX as u64 / 3);
+        (vertices, triangles)
+    }
+
+    /// After a submitted frame: reads its status back and, when it overflowed (a frame
+    /// that needs more room than the buffers have draws nothing at all, never part of the
+    /// mesh), grows the output to what it needed and returns `Ok(true)`: record and submit
+    /// the frame again. `Ok(false)`: the frame was complete. A loop sized for the worst case
+    /// ([`GpuTessellator::prepare`], or [`GpuTessellator::prepare_screen`] within the
+    /// device's limits) never needs this; with a smaller start it is the grow-and-rerun
+    /// path, a read-back each time it is called.
+    ///
+    /// Errors: [`GpuError::OutputTooLarge`] when the frame needs more than the device's
+    /// buffer limits or the u32 index range (its output is then empty and reported, no
+    /// patch dropped silently). Cost: a queue wait; a reallocation when it grows.
+    pub fn grow_if_overflowed(&mut self, ctx: &GpuContext) -> Result<bool> {
+        let (overflow, vertices, triangles) = self.read_status(ctx)?;
+        if !overflow {
+            return Ok(false);
+        }
+        // The counts are the scans' totals, exact unless they wrapped past u32 (then the
+        // need is beyond the index range anyway).
+        let need = Capacity { vertices: vertices as u64, triangles: triangles as u64 };
+        let have = self.capacity().unwrap_or_default();
+        let (most_vertices, most_triangles) = self.most();
+        if need.vertices > most_vertices || need.triangles > most_triangles {
+            return Err(GpuError::OutputTooLarge {
+                vertices: need.vertices,
+                triangles: need.triangles,
+                bytes: (need.vertices * VERTEX_STRIDE).max(need.triangles * 12),
+                limit: self.buffer_limit,
+            });
+        }
+        // Grow with some room, so that a camera moving on does not grow every frame.
+        let grown = |need: u64, have: u64, most: u64| need.max(have).saturating_mul(5).div_ceil(4).min(most);
+        let capacity = Capacity {
+            vertices: grown(need.vertices, have.vertices, most_vertices),
+            triangles: grown(need.triangles, have.triangles, most_triangles),
+        };
+        self.reserve(ctx, capacity)?;
+        Ok(true)
     }
 
     /// Makes the output buffers hold at least `capacity`. Errors with
@@ -860,6 +925,11 @@ pub struct ScreenCriterion {
     pub pixels: f64,
     /// The factor cap, `1..=MAX_FACTOR`.
     pub max_factor: u32,
+    /// The output room to start with: None for the worst case (every patch at the cap),
+    /// clamped to the device's buffer limits; a smaller one saves memory, and a frame that
+    /// needs more overflows (drawing nothing) until [`GpuTessellator::grow_if_overflowed`]
+    /// grows it.
+    pub capacity: Option<Capacity>,
 }
 
 /// `view.wgsl`'s interior rules.
