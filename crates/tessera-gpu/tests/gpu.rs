@@ -915,3 +915,68 @@ fn capacity_at_the_cap_on_the_torus() {
         other => panic!("expected OutputTooLarge, got {other:?}"),
     }
 }
+
+/// The GPU's pixel-error factor against the CPU plan's on `cameras_per_model` seeded
+/// cameras per patch model and four pixel errors each, at a cap of 32: equal but for
+/// rounding ties of the deciding root (counted, at most one in a hundred), and spread over
+/// many values (the cap must not decide them all).
+fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let cap = 32;
+    let (mut frames, mut ties) = (0, 0);
+    let mut seen = std::collections::BTreeSet::new();
+    for model in ["patches/teapot.patches", "patches/teacup.patches", "patches/teapot_teasetorig.patches"] {
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            for pixels in [0.5, 2.0, 8.0, 32.0] {
+                let name = format!("{model} camera {c} {pixels} px");
+                let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+                let criterion = Criterion::PixelError(pixels);
+                let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+                let screen = ScreenCriterion { scheme: Scheme::Uniform, pixels, max_factor: cap, capacity: None };
+                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                let got = gpu.read_plan(ctx).unwrap();
+                frames += 1;
+                if got.visible != cpu.visible {
+                    // A culling tie: the factors then follow another set of patches.
+                    let differ = (0..got.visible.len()).filter(|&p| got.visible[p] != cpu.visible[p]);
+                    assert!(differ.clone().all(|p| near_cull_tie(&set, p, &camera)), "{name}: culling");
+                    ties += 1;
+                    continue;
+                }
+                let want = cpu.segments[0];
+                seen.insert(want);
+                if got.segments != cpu.segments || got.interior != cpu.interior {
+                    let root = uniform_pixel_error_root(&set, &prepared, &camera, pixels, &cpu.visible);
+                    let tie = (root - root.round()).abs() <= 1e-5 * root;
+                    assert!(
+                        tie && got.segments.iter().all(|&s| s.abs_diff(want) == 1),
+                        "{name}: GPU factor {:?}, the CPU's {want} (root {root})",
+                        got.segments.first()
+                    );
+                    ties += 1;
+                }
+            }
+        }
+    }
+    eprintln!("{frames} frames, {ties} rounding ties, factors {seen:?}");
+    assert!(100 * ties <= frames, "{ties} ties in {frames} frames");
+    assert!(seen.len() >= 8, "factors {seen:?}: too few distinct values to test the criterion");
+}
+
+#[test]
+fn gpu_pixel_error_factors_equal_the_cpu_plans() {
+    gpu_factors_equal_the_cpu_plans(5, 5);
+}
+
+#[test]
+#[ignore = "slow tier: 20 more cameras per patch model"]
+fn gpu_pixel_error_factors_equal_the_cpu_plans_on_20_more_cameras() {
+    gpu_factors_equal_the_cpu_plans(20, 55);
+}
