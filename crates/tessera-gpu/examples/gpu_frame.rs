@@ -68,7 +68,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let what = match (pixels, transition) {
         (Some(px), false) => {
             let prepared = Prepared::new(&set, true);
-            let screen = ScreenCriterion { scheme: Scheme::Uniform, pixels: px, max_factor, capacity: None };
+            let screen = ScreenCriterion {
+                scheme: Scheme::Uniform,
+                criterion: Criterion::PixelError(px),
+                max_factor,
+                capacity: None,
+            };
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
             format!("uniform, {px} px and cap {max_factor} planned on the GPU, culled on the GPU")
         }

@@ -19,6 +19,12 @@ struct View {
     pixels: f32,
     cap: f32,
     interior_rule: u32,
+    // The criterion (CRITERION_PIXEL_ERROR or CRITERION_SILHOUETTENESS) and the view
+    // criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap applied).
+    criterion: u32,
+    lo: f32,
+    hi: f32,
+    _pad: u32,
 }
 
 @group(1) @binding(0) var<uniform> view: View;
@@ -26,7 +32,9 @@ struct View {
 // sphere's centre and radius; (sin α, cos α, 1 with a cone / 0 without, 0); the control
 // points' box lo and hi (`screen::PatchView`); the second-derivative bound (uu, uv, vv, 0)
 // (`Prepared::hessians`); the boundary curves' bounds (`Prepared::curves`); the minimum
-// interior factors (`Prepared::minimum_interior`, as f32), 0, 0.
+// interior factors (`Prepared::minimum_interior`, as f32), 0, 0. After the P patch rows,
+// EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it, the normals there of
+// its first and its last patch (`Prepared::edge_midpoints`).
 @group(1) @binding(1) var<storage, read_write> patch_views: array<vec4<f32>>;
 // `Prepared::minimum_segments`, per edge.
 @group(1) @binding(2) var<storage, read_write> minimum_segments: array<u32>;
@@ -39,3 +47,6 @@ struct View {
 const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
 const INTERIOR_GLOBAL: u32 = 0u;
 const INTERIOR_CORE: u32 = 1u;
+const CRITERION_PIXEL_ERROR: u32 = 0u;
+const CRITERION_SILHOUETTENESS: u32 = 1u;
+const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;

@@ -39,7 +39,8 @@ use tessera::mesh::Mesh;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
-use tessera::scheme::{Prepared, Scheme};
+use tessera::criterion::view::ViewCriterion;
+use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::sampling::SamplingKind;
 use tessera::surface::SurfaceSet;
 
@@ -95,6 +96,7 @@ fn constants() -> Vec<(&'static str, u32)> {
         ("CONTROL_POINTS", upload::CONTROL_POINTS),
         ("VERTEX_FLOATS", VERTEX_FLOATS),
         ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
+        ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
     ]
 }
 
@@ -148,7 +150,7 @@ pub struct Pipelines {
     cull: wgpu::ComputePipeline,
     patch_proposals: wgpu::ComputePipeline,
     edge_segments: wgpu::ComputePipeline,
-    global_interiors: wgpu::ComputePipeline,
+    interiors: wgpu::ComputePipeline,
     scan: ScanPipelines,
     args: wgpu::ComputePipeline,
     uniform: PatternPipelines,
@@ -228,7 +230,7 @@ impl Pipelines {
             cull: make(&with_view, &cull, "cull"),
             patch_proposals: make(&with_view, &factors, "patch_proposals"),
             edge_segments: make(&with_view, &factors, "edge_segments"),
-            global_interiors: make(&with_view, &factors, "global_interiors"),
+            interiors: make(&with_view, &factors, "interiors"),
             scan: ScanPipelines::new(device),
             args: make(&two, &args, "write_args"),
             uniform,
@@ -465,29 +467,37 @@ impl GpuTessellator {
     }
 
     /// Makes every following frame plan itself on the GPU from the camera alone: culling
-    /// for `camera` (`cull.wgsl`), then the pixel-error factors of `criterion`'s `scheme`
-    /// for `pixels` of screen error within `max_factor` (`factors.wgsl`: per patch the object-space
-    /// tolerance of `screen::PatchView::tolerance` and its proposals from `prepared`'s
-    /// bounds, per edge the maximum over its patches through the topology's edge uses, the
-    /// cap and the minimum segments, then the interior rule), as `scheme.plan_prepared(set,
-    /// prepared, &Criterion::PixelError(pixels), &PlanOptions { camera, cull: true,
-    /// max_factor, .. })` plans on the CPU. Later cameras go to
-    /// [`GpuTessellator::set_cull_camera`] (a 96-byte upload a frame); the plan never comes
-    /// back to the CPU ([`GpuTessellator::read_plan`] reads it for tests).
+    /// for `camera` (`cull.wgsl`), then the factors of `criterion` (`factors.wgsl`: per
+    /// patch its proposals — for a pixel error the object-space tolerance of
+    /// `screen::PatchView::tolerance` and the proposals from `prepared`'s bounds, for
+    /// silhouetteness its edges' factors from `prepared`'s edge midpoints — per edge the
+    /// maximum over its patches through the topology's edge uses, the cap and the minimum
+    /// segments, then the scheme's interior rule), as `scheme.plan_prepared(set, prepared,
+    /// &criterion, &PlanOptions { camera, cull: true, max_factor, .. })` plans on the CPU.
+    /// Later cameras go to [`GpuTessellator::set_cull_camera`] (a 112-byte upload a frame);
+    /// the plan never comes back to the CPU ([`GpuTessellator::read_plan`] reads it for
+    /// tests).
     ///
-    /// Only [`Scheme::Uniform`] for now (the global factor: the largest over the visible
-    /// patches); the transition scheme's a-posteriori checks are CPU-only. The output is
+    /// On the GPU: [`Criterion::PixelError`] with [`Scheme::Uniform`] (the global factor:
+    /// the largest over the visible patches), and [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
+    /// (per-edge factors, CudaTess's core rule). The transition scheme's pixel-error plans
+    /// (a-posteriori checks that raise factors round by round) are CPU-only. The output is
     /// sized for the worst case, every patch at `max_factor` (or at the largest minimum
     /// when that is higher), within the device's buffer limits, or as `criterion.capacity`
     /// says; a frame that needs more draws nothing and is reported
     /// ([`GpuTessellator::grow_if_overflowed`]).
     ///
     /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
-    /// Errors: [`GpuError::Unsupported`] for another scheme or a `prepared` without bounds;
-    /// [`tessera::Error::InvalidParameter`] for a pixel error that is not a positive number
-    /// or a `max_factor` outside `1..=MAX_FACTOR`; [`GpuError::OutputTooLarge`] when the
-    /// worst case passes the u32 range of the scans, or as [`GpuTessellator::reserve`].
-    /// Cost: O(E + P) and an upload of 128 bytes a patch and 4 an edge, once.
+    /// Errors: [`GpuError::Unsupported`] for another scheme or criterion or a `prepared`
+    /// without bounds; [`tessera::Error::InvalidParameter`] for a pixel error that is not a
+    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` in integers, or a
+    /// `max_factor` outside `1..=MAX_FACTOR` (the checks of [`Scheme::plan`]);
+    /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
+    /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
+    /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
+    /// bytes a patch and 52 an edge; later calls (another camera, criterion or cap) O(P)
+    /// pattern counts for the capacity and a 112-byte upload.
     pub fn prepare_screen(
         &mut self,
         ctx: &GpuContext,
@@ -496,12 +506,39 @@ impl GpuTessellator {
         camera: &Camera,
         criterion: ScreenCriterion,
     ) -> Result<()> {
-        let ScreenCriterion { scheme, pixels, max_factor, capacity } = criterion;
-        if scheme != Scheme::Uniform {
-            return Err(GpuError::Unsupported {
-                what: format!("pixel-error factors on the GPU for the {} scheme (uniform only)", scheme.name()),
-            });
-        }
+        let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
+        let unsupported = || {
+            Err(GpuError::Unsupported {
+                what: format!("{} with the {} scheme planned on the GPU", criterion.name(), scheme.name()),
+            })
+        };
+        let invalid = |name: &'static str, reason: String| {
+            Err(GpuError::from(tessera::Error::InvalidParameter { name, reason }))
+        };
+        let cap = max_factor as f64;
+        let (kind, pixels, lo, hi) = match (scheme, criterion) {
+            (Scheme::Uniform, Criterion::PixelError(px)) => {
+                if !(px.is_finite() && px > 0.0) {
+                    return invalid("pixel error", format!("{px}: must be a positive number"));
+                }
+                (CRITERION_PIXEL_ERROR, px, 1.0, 1.0)
+            }
+            (
+                Scheme::Uniform | Scheme::Transition,
+                Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax },
+            ) => {
+                let valid = |f: f64| f.is_finite() && f >= 1.0 && f.fract() == 0.0;
+                if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
+                    return invalid("factor range", format!("{fmin}:{fmax}: use integers 1 ≤ FMIN ≤ FMAX"));
+                }
+                // As `Scheme::plan_into` and `view::edge_factors_into` bound the range.
+                let fmax = fmax.min(cap);
+                let lo = fmin.min(fmax).max(1.0);
+                (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
+            }
+            _ => return unsupported(),
+        };
+        let interior = if scheme == Scheme::Uniform { INTERIOR_GLOBAL } else { INTERIOR_CORE };
         let patches = set.patches.len();
         if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
             return Err(
@@ -517,24 +554,22 @@ impl GpuTessellator {
                 what: "a Prepared without the error bounds (make it with Prepared::new(set, true))".into(),
             });
         }
-        if !(pixels.is_finite() && pixels > 0.0) {
-            return Err(tessera::Error::InvalidParameter {
-                name: "pixel error",
-                reason: format!("{pixels}: must be a positive number"),
-            }
-            .into());
-        }
         if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
-            return Err(tessera::Error::InvalidParameter {
-                name: "max factor",
-                reason: format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR),
-            }
-            .into());
+            return invalid("max factor", format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR));
         }
         // The largest global factor a frame can reach: the cap, or a minimum above it.
         let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
         let worst = minimum.copied().fold(max_factor, u32::max);
-        let worst = Capacity::of_plan(set, &Plan::uniform(set, worst)?, &Uniform, true);
+        let mut worst_case = Capacity::of_plan(set, &Plan::uniform(set, worst)?, &Uniform, true);
+        if interior == INTERIOR_CORE {
+            // `Transition::counts` with every factor at most w = max(worst, 3) (cores are
+            // raised to 3 at most): 2·nu·nv core triangles plus s + m a strip, at most
+            // 2w² + 8w a patch, the uniform pattern's 2w² and 8w more; no more vertices.
+            let w = worst.max(3) as u64;
+            worst_case = Capacity::of_plan(set, &Plan::uniform(set, w as u32)?, &Uniform, true);
+            worst_case.triangles += 8 * w * patches as u64;
+        }
+        let worst = worst_case;
         // The scans count in u32: a set whose worst frame could pass that range is refused
         // here, before any frame could wrap.
         if worst.vertices > u32::MAX as u64 || worst.triangles > u32::MAX as u64 / 3 {
@@ -554,10 +589,15 @@ impl GpuTessellator {
         });
         self.reserve(ctx, capacity)?;
         let queue = &ctx.queue;
-        queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&patch_view_rows(set, Some(prepared))));
-        queue.write_buffer(&self.view.minimum_segments, 0, bytemuck::cast_slice(&prepared.minimum_segments));
-        self.screen = Some(Screen { pixels, max_factor, interior: INTERIOR_GLOBAL });
-        self.pattern = GpuPattern::Uniform;
+        if !self.view.bounds_uploaded {
+            // View-independent and the same for every `Prepared` of the set: uploaded once.
+            let rows = patch_view_rows(set, Some(prepared));
+            queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
+            queue.write_buffer(&self.view.minimum_segments, 0, bytemuck::cast_slice(&prepared.minimum_segments));
+            self.view.bounds_uploaded = true;
+        }
+        self.screen = Some(Screen { criterion: kind, pixels, lo, hi, max_factor, interior });
+        self.pattern = if scheme == Scheme::Uniform { GpuPattern::Uniform } else { GpuPattern::Transition };
         self.set_cull_camera(ctx, Some(camera));
         Ok(())
     }
@@ -707,7 +747,7 @@ impl GpuTessellator {
                 c.set_pipeline(&p.edge_segments);
                 let (x, y) = grid(e);
                 c.dispatch_workgroups(x, y, 1);
-                c.set_pipeline(&p.global_interiors);
+                c.set_pipeline(&p.interiors);
                 let (x, y) = grid(e.max(patches));
                 c.dispatch_workgroups(x, y, 1);
             }
@@ -776,7 +816,7 @@ impl GpuTessellator {
     /// following frame, writing the plan's visibility row on the device (the plan's own row
     /// is then ignored), and, after [`GpuTessellator::prepare_screen`], plan the factors for
     /// it; None goes back to the plan's row (and ends the GPU's own planning). The output
-    /// capacity then covers every patch. Cost: a 96-byte upload.
+    /// capacity then covers every patch. Cost: a 112-byte upload.
     pub fn set_cull_camera(&mut self, ctx: &GpuContext, camera: Option<&Camera>) {
         let Some(camera) = camera else {
             self.camera = None;
@@ -787,16 +827,23 @@ impl GpuTessellator {
         let view = camera.view();
         let f = |x: f64| (x as f32).to_bits();
         let v4 = |v: glam::DVec3| [f(v.x), f(v.y), f(v.z), 0];
-        let mut words = [0u32; 24];
+        let mut words = [0u32; 28];
         words[0..4].copy_from_slice(&v4(view.eye));
         words[4..8].copy_from_slice(&v4(view.right));
         words[8..12].copy_from_slice(&v4(view.up));
         words[12..16].copy_from_slice(&v4(view.forward));
         let t = view.half_tangents;
         words[16..20].copy_from_slice(&[f(view.near), f(view.far), f(t.x), f(t.y)]);
-        let (pixels, cap, rule) =
-            self.screen.map_or((1.0, 1.0, INTERIOR_GLOBAL), |s| (s.pixels, s.max_factor as f64, s.interior));
-        words[20..24].copy_from_slice(&[f(view.focal_pixels), f(pixels), f(cap), rule]);
+        let s = self.screen.unwrap_or(Screen {
+            criterion: CRITERION_PIXEL_ERROR,
+            pixels: 1.0,
+            lo: 1.0,
+            hi: 1.0,
+            max_factor: 1,
+            interior: INTERIOR_GLOBAL,
+        });
+        words[20..24].copy_from_slice(&[f(view.focal_pixels), f(s.pixels), f(s.max_factor as f64), s.interior]);
+        words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), 0]);
         ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::cast_slice(&words));
     }
 
@@ -915,14 +962,15 @@ impl GpuTessellator {
     }
 }
 
-/// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under
-/// `Criterion::PixelError(pixels)` with `PlanOptions::max_factor = max_factor`.
+/// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under `criterion`
+/// with `PlanOptions::max_factor = max_factor`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScreenCriterion {
-    /// The scheme ([`Scheme::Uniform`] only for now).
+    /// The scheme: [`Scheme::Uniform`] or [`Scheme::Transition`].
     pub scheme: Scheme,
-    /// Screen-space error in pixels (positive).
-    pub pixels: f64,
+    /// [`Criterion::PixelError`] (uniform scheme) or [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`].
+    pub criterion: Criterion,
     /// The factor cap, `1..=MAX_FACTOR`.
     pub max_factor: u32,
     /// The output room to start with: None for the worst case (every patch at the cap),
@@ -932,13 +980,21 @@ pub struct ScreenCriterion {
     pub capacity: Option<Capacity>,
 }
 
-/// `view.wgsl`'s interior rules.
+/// `view.wgsl`'s interior rules and criteria.
 const INTERIOR_GLOBAL: u32 = 0;
+const INTERIOR_CORE: u32 = 1;
+const CRITERION_PIXEL_ERROR: u32 = 0;
+const CRITERION_SILHOUETTENESS: u32 = 1;
+/// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
+const EDGE_VIEW_ROW: usize = 3;
 
-/// The pixel-error criterion of [`GpuTessellator::prepare_screen`].
+/// The criterion of [`GpuTessellator::prepare_screen`], as `view.wgsl` reads it.
 #[derive(Debug, Clone, Copy)]
 struct Screen {
+    criterion: u32,
     pixels: f64,
+    lo: f64,
+    hi: f64,
     max_factor: u32,
     interior: u32,
 }
@@ -951,6 +1007,9 @@ struct ViewBuffers {
     minimum_segments: wgpu::Buffer,
     global: wgpu::Buffer,
     bind: wgpu::BindGroup,
+    /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
+    /// device.
+    bounds_uploaded: bool,
 }
 
 impl ViewBuffers {
@@ -958,14 +1017,14 @@ impl ViewBuffers {
     /// [`GpuTessellator::prepare_screen`]). Cost: O(P) cone computations, one upload.
     fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, set: &SurfaceSet) -> ViewBuffers {
         use wgpu::BufferUsages as U;
-        let uniform = buffer(device, "view", 96, U::UNIFORM | U::COPY_DST);
+        let uniform = buffer(device, "view", 112, U::UNIFORM | U::COPY_DST);
         let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
         let minimum_segments =
             buffer(device, "minimum segments", 4 * set.topology.edges.len() as u64, U::STORAGE | U::COPY_DST);
         let proposals = buffer(device, "proposals", 16 * set.patches.len() as u64, U::STORAGE);
         let global = buffer(device, "global factor", 4, U::STORAGE | U::COPY_DST);
         let bind = shader::bind(device, layout, &[&uniform, &patch_views, &minimum_segments, &proposals, &global]);
-        ViewBuffers { uniform, patch_views, minimum_segments, global, bind }
+        ViewBuffers { uniform, patch_views, minimum_segments, global, bind, bounds_uploaded: false }
     }
 }
 
@@ -974,8 +1033,10 @@ impl ViewBuffers {
 /// bounding sphere of the control points about their mean (`screen::back_facing`'s),
 /// `(sin α, cos α, has cone, 0)`, the control-point box's lo and hi; then from `prepared`
 /// (zero without it) the second-derivative bound `(uu, uv, vv, 0)`, the four boundary
-/// curves' bounds and the minimum interior factors. View-independent: computed once. Cost:
-/// O(P) cone computations.
+/// curves' bounds and the minimum interior factors; after the patches, [`EDGE_VIEW_ROW`]
+/// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, the
+/// normals of its first and last patch). View-independent: computed once. Cost: O(P) cone
+/// computations, the midpoints' evaluations when `prepared` has none yet.
 fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
     let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
     let mut out = Vec::with_capacity(PATCH_VIEW_ROW as usize * set.patches.len());
@@ -997,6 +1058,15 @@ fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4
             }
             None => out.extend([[0.0; 4]; 3]),
         }
+    }
+    let edges = set.topology.edges.len();
+    match prepared {
+        Some(prepared) => {
+            for [(mid, nl), (_, nr)] in prepared.edge_midpoints(set) {
+                out.extend([v4(*mid, 0.0), v4(*nl, 0.0), v4(*nr, 0.0)]);
+            }
+        }
+        None => out.resize(out.len() + EDGE_VIEW_ROW * edges, [0.0; 4]),
     }
     out
 }

@@ -625,7 +625,8 @@ struct SweepCounts {
     culled: usize,
     /// Patches the GPU culled unlike the CPU, each a [`near_cull_tie`].
     cull_ties: usize,
-    /// Uniform frames whose GPU factor differs from the CPU's at a rounding boundary.
+    /// Uniform frames whose GPU factor, and transition edges whose GPU segments, differ from
+    /// the CPU's at a rounding boundary.
     factor_ties: usize,
     /// Uniform frames whose factor the cap did not decide.
     below_cap: usize,
@@ -686,13 +687,17 @@ fn uniform_pixel_error_root(
 ///   factors) equal `Scheme::Uniform`'s pixel-error plan on the CPU, but for the counted
 ///   rounding ties ([`near_cull_tie`]; a factor one off where the CPU's root is within
 ///   1e-5 relative of an integer);
-/// - **transition**: the CPU's pixel-error plan (per-edge factors from the view) uploaded,
-///   the GPU culling; the culled set equals the CPU's but for ties.
+/// - **transition**, odd cameras **from the camera alone**: the GPU culls and computes
+///   silhouetteness factors (per edge, maximum over the edge's patches, the core rule);
+///   its plan equals `Scheme::Transition`'s on the CPU but for counted rounding ties;
+///   even cameras: the CPU's pixel-error plan (CudaTess's per-edge factors, checked a
+///   posteriori) uploaded, the GPU culling; the culled set equals the CPU's but for ties.
 ///
 /// Then the whole output equals the CPU engine's for the plan the GPU drew
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
 /// index, positions within 1e-5 of the diagonal, the watertightness report).
 fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
+    use tessera::criterion::view::ViewCriterion;
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
     let mut counts = SweepCounts::default();
@@ -722,8 +727,12 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             let name = format!("{model} camera {c} uniform");
             let criterion = Criterion::PixelError(uniform_pixels);
             let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen =
-                ScreenCriterion { scheme: Scheme::Uniform, pixels: uniform_pixels, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion {
+                scheme: Scheme::Uniform,
+                criterion: Criterion::PixelError(uniform_pixels),
+                max_factor: cap,
+                capacity: None,
+            };
             gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             gpu.record(&mut encoder);
@@ -750,20 +759,59 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             counts.below_cap += (got.unwrap() < cap) as usize;
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &Uniform);
 
-            // Transition: the CPU's per-edge plan, the GPU culling.
-            let name = format!("{model} camera {c} transition");
-            let criterion = Criterion::PixelError(pixels);
-            let planned =
-                Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &transition_options(camera)).unwrap();
-            let mut plan = planned.plan.clone();
-            plan.visible.fill(1);
-            gpu.set_cull_camera(ctx, Some(&camera));
-            gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
-            plan.visible = check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
-            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &planned.pattern);
+            // Transition, odd cameras: the GPU plans the frame from the camera (silhouetteness
+            // factors); even cameras: the CPU's pixel-error plan (CudaTess's own per-edge
+            // factors, a-posteriori checked) uploaded, the GPU culling.
+            let options = transition_options(camera);
+            let (name, plan, pattern) = if c % 2 == 1 {
+                let name = format!("{model} camera {c} transition from the camera");
+                let fmax = options.max_factor as f64;
+                let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
+                let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Transition,
+                    criterion,
+                    max_factor: options.max_factor,
+                    capacity: None,
+                };
+                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
+                let drawn = gpu.read_plan(ctx).unwrap();
+                if drawn.segments != planned.plan.segments {
+                    // Only rounding ties (see `silhouetteness_on_the_gpu`), counted.
+                    let real = tessera::criterion::view::edge_factors(
+                        &set,
+                        &camera,
+                        ViewCriterion::Silhouetteness,
+                        1.0,
+                        fmax,
+                    );
+                    for e in (0..real.len()).filter(|&e| drawn.segments[e] != planned.plan.segments[e]) {
+                        assert!((real[e] - real[e].floor() - 0.5).abs() <= 1e-4, "{name}: edge {e} factor");
+                        counts.factor_ties += 1;
+                    }
+                } else {
+                    assert_eq!(drawn.interior, planned.plan.interior, "{name}: interior factors");
+                }
+                (name, drawn, planned.pattern)
+            } else {
+                let name = format!("{model} camera {c} transition");
+                let criterion = Criterion::PixelError(pixels);
+                let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let mut plan = planned.plan.clone();
+                plan.visible.fill(1);
+                gpu.set_cull_camera(ctx, Some(&camera));
+                gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                plan.visible = check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
+                (name, plan, planned.pattern)
+            };
+            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
             let s = &plan.segments;
             counts.strips += s.iter().any(|&x| x != s[0]) as usize;
             counts.frames += 2;
@@ -854,7 +902,7 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
     for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {
         let name = format!("{model} cap {cap}, {start}");
         let mut gpu = tessellator(&set);
-        let screen = ScreenCriterion { scheme: Scheme::Uniform, pixels, max_factor: cap, capacity };
+        let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion: Criterion::PixelError(pixels), max_factor: cap, capacity };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let mut grown = 0;
         loop {
@@ -901,7 +949,12 @@ fn capacity_at_the_cap_on_the_torus() {
     let set = load("bench/torus_64x32.patches");
     let prepared = tessera::scheme::Prepared::new(&set, true);
     let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion { scheme: Scheme::Uniform, pixels: 0.001, max_factor: 256, capacity: None };
+    let screen = ScreenCriterion {
+        scheme: Scheme::Uniform,
+        criterion: tessera::scheme::Criterion::PixelError(0.001),
+        max_factor: 256,
+        capacity: None,
+    };
     gpu.prepare_screen(ctx, &set, &prepared, &close_camera(&set), screen).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     gpu.record(&mut encoder);
@@ -936,7 +989,12 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                 let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
                 let criterion = Criterion::PixelError(pixels);
                 let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-                let screen = ScreenCriterion { scheme: Scheme::Uniform, pixels, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Uniform,
+                    criterion: Criterion::PixelError(pixels),
+                    max_factor: cap,
+                    capacity: None,
+                };
                 gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
                 let mut encoder = ctx.device.create_command_encoder(&Default::default());
                 gpu.record(&mut encoder);
@@ -979,4 +1037,99 @@ fn gpu_pixel_error_factors_equal_the_cpu_plans() {
 #[ignore = "slow tier: 20 more cameras per patch model"]
 fn gpu_pixel_error_factors_equal_the_cpu_plans_on_20_more_cameras() {
     gpu_factors_equal_the_cpu_plans(20, 55);
+}
+
+/// The transition frame from the camera alone (silhouetteness, `ViewCriterion::
+/// Silhouetteness` with factors 1 to 12, cap 16): the GPU's plan equals
+/// `Scheme::Transition`'s on the CPU — segments but for counted rounding ties (an edge whose
+/// real factor `view::edge_factors` lies within 1e-4 of a half-integer, one off), interiors
+/// exactly those of `resolve::interiors` on the GPU's segments, the culled set but for
+/// [`near_cull_tie`]s — and every `mesh_every`-th frame's output equals the CPU engine's for
+/// the plan drawn.
+fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u64, mesh_every: usize) {
+    use tessera::criterion::resolve::{self, InteriorRule};
+    use tessera::criterion::view::ViewCriterion;
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let (cap, fmin, fmax) = (16, 1.0, 12.0);
+    let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax };
+    let (mut frames, mut edges, mut ties, mut strips) = (0, 0, 0, 0);
+    for &model in models {
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            let name = format!("{model} camera {c} silhouetteness");
+            let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+            let cpu = &planned.plan;
+            let screen = ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
+            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            let drawn = gpu.read_plan(ctx).unwrap();
+            for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
+                assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
+            }
+            if drawn.segments != cpu.segments {
+                let real = tessera::criterion::view::edge_factors(&set, &camera, ViewCriterion::Silhouetteness, fmin, fmax);
+                for e in (0..cpu.segments.len()).filter(|&e| drawn.segments[e] != cpu.segments[e]) {
+                    let tie = (real[e] - real[e].floor() - 0.5).abs() <= 1e-4;
+                    assert!(
+                        tie && drawn.segments[e].abs_diff(cpu.segments[e]) == 1,
+                        "{name}: edge {e} has {} segments, the CPU's {} (factor {})",
+                        drawn.segments[e],
+                        cpu.segments[e],
+                        real[e]
+                    );
+                    ties += 1;
+                }
+            }
+            let mut interior = Vec::new();
+            resolve::interiors(&set, &drawn.segments, InteriorRule::Core, &prepared.caps(cap as f64), &mut interior);
+            assert_eq!(drawn.interior, interior, "{name}: interior factors");
+            if drawn.segments == cpu.segments {
+                assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
+            }
+            strips += drawn.segments.iter().any(|&s| s != drawn.segments[0]) as usize;
+            edges += cpu.segments.len();
+            frames += 1;
+            if c % mesh_every == 0 {
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &planned.pattern);
+            }
+        }
+    }
+    eprintln!("silhouetteness: {frames} frames, {edges} edges, {ties} rounding ties, {strips} frames with strips");
+    assert!(strips * 2 >= frames, "too few frames with two factors: {strips} of {frames}");
+    assert!(1000 * ties <= edges, "{ties} rounding ties in {edges} edges");
+}
+
+#[test]
+fn transition_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
+    silhouetteness_on_the_gpu(
+        &["patches/teapot.patches", "patches/teacup.patches", "meshes/blob.obj", "meshes/dragknob.obj"],
+        4,
+        8,
+        2,
+    );
+}
+
+#[test]
+#[ignore = "slow tier: the transition frame from the camera on every patch model and three meshes, 10 cameras"]
+fn transition_from_the_camera_on_the_gpu_on_10_cameras() {
+    silhouetteness_on_the_gpu(
+        &[
+            "patches/teapot.patches",
+            "patches/teacup.patches",
+            "patches/teapot_teasetorig.patches",
+            "bench/torus_64x32.patches",
+            "meshes/blob.obj",
+            "meshes/dragknob.obj",
+            "awkward/teapot_tri_nonmanifold.obj",
+        ],
+        10,
+        88,
+        5,
+    );
 }
