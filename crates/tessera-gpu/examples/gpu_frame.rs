@@ -1,7 +1,8 @@
 //! Per-pass GPU times of the GPU engine on a patch model.
 //!
 //! `cargo run --release -p tessera-gpu --example gpu_frame -- MODEL.patches [FACTOR] [FRAMES]
-//! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition]]`
+//! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition]]
+//! [--silhouetteness FMAX]`
 //!
 //! `--copies N` tessellates N copies of the model in a grid (`tessera::scene::patch_grid`;
 //! 45 copies of `bench/torus_64x32.patches` are the 92,160-patch scene of the real-time CPU
@@ -11,6 +12,8 @@
 //! uniform scheme's pixel-error factor within `--max-factor`, default 16:
 //! `GpuTessellator::prepare_screen`); with `--transition` the CPU plans the transition
 //! scheme for PX once instead, and the GPU culls and draws it every frame.
+//! `--silhouetteness FMAX` plans the transition scheme on the GPU from the camera alone
+//! (culling, silhouetteness factors in 1..=FMAX, the core rule).
 //! Records FRAMES frames (default 10) and prints, per pass, the median of the
 //! timestamp-query times when the adapter has them; otherwise the median wall time of a
 //! whole frame around `submit` + `poll(wait)`. Statistics are read back after each frame,
@@ -49,8 +52,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let copies: usize = option(&mut args, "--copies")?.unwrap_or(1);
     let pixels: Option<f64> = option(&mut args, "--pixel-error")?;
     let max_factor: u32 = option(&mut args, "--max-factor")?.unwrap_or(16);
+    let silhouetteness: Option<u32> = option(&mut args, "--silhouetteness")?;
     let usage = "usage: gpu_frame MODEL.patches [FACTOR] [FRAMES] [--copies N] [--cull] \
-                 [--pixel-error PX [--max-factor N] [--transition]]";
+                 [--pixel-error PX [--max-factor N] [--transition]] [--silhouetteness FMAX]";
     let path = args.get(1).ok_or(usage)?;
     let factor: u32 = args.get(2).map_or(Ok(16), |s| s.parse())?;
     let frames: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
@@ -66,6 +70,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gpu.set_cull_camera(&ctx, Some(&camera));
     }
     let what = match (pixels, transition) {
+        _ if silhouetteness.is_some() => {
+            let fmax = silhouetteness.unwrap_or(1);
+            let prepared = Prepared::new(&set, true);
+            let criterion = Criterion::View {
+                criterion: tessera::criterion::view::ViewCriterion::Silhouetteness,
+                fmin: 1.0,
+                fmax: fmax as f64,
+            };
+            let screen = ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: fmax, capacity: None };
+            gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
+            format!("transition, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU")
+        }
         (Some(px), false) => {
             let prepared = Prepared::new(&set, true);
             let screen = ScreenCriterion {
