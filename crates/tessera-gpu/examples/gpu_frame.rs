@@ -78,7 +78,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 fmin: 1.0,
                 fmax: fmax as f64,
             };
-            let screen = ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: fmax, capacity: None };
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: fmax, capacity: None };
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
             format!("transition, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU")
         }

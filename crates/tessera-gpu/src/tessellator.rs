@@ -34,14 +34,14 @@ use crate::scan::{Scan, ScanPipelines};
 use crate::shader::{self, Binding};
 use crate::upload::{self, GpuSet};
 use tessera::camera::Camera;
+use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
-use tessera::criterion::view::ViewCriterion;
-use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::sampling::SamplingKind;
+use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 
 /// f32 per output vertex: position (3), normal (3), uv (2).
@@ -555,7 +555,10 @@ impl GpuTessellator {
             });
         }
         if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
-            return invalid("max factor", format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR));
+            return invalid(
+                "max factor",
+                format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR),
+            );
         }
         // The largest global factor a frame can reach: the cap, or a minimum above it.
         let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
@@ -593,7 +596,11 @@ impl GpuTessellator {
             // View-independent and the same for every `Prepared` of the set: uploaded once.
             let rows = patch_view_rows(set, Some(prepared));
             queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
-            queue.write_buffer(&self.view.minimum_segments, 0, bytemuck::cast_slice(&prepared.minimum_segments));
+            queue.write_buffer(
+                &self.view.minimum_segments,
+                0,
+                bytemuck::cast_slice(&prepared.minimum_segments),
+            );
             self.view.bounds_uploaded = true;
         }
         self.screen = Some(Screen { criterion: kind, pixels, lo, hi, max_factor, interior });
@@ -842,7 +849,12 @@ impl GpuTessellator {
             max_factor: 1,
             interior: INTERIOR_GLOBAL,
         });
-        words[20..24].copy_from_slice(&[f(view.focal_pixels), f(s.pixels), f(s.max_factor as f64), s.interior]);
+        words[20..24].copy_from_slice(&[
+            f(view.focal_pixels),
+            f(s.pixels),
+            f(s.max_factor as f64),
+            s.interior,
+        ]);
         words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), 0]);
         ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::cast_slice(&words));
     }
@@ -1023,7 +1035,8 @@ impl ViewBuffers {
             buffer(device, "minimum segments", 4 * set.topology.edges.len() as u64, U::STORAGE | U::COPY_DST);
         let proposals = buffer(device, "proposals", 16 * set.patches.len() as u64, U::STORAGE);
         let global = buffer(device, "global factor", 4, U::STORAGE | U::COPY_DST);
-        let bind = shader::bind(device, layout, &[&uniform, &patch_views, &minimum_segments, &proposals, &global]);
+        let bind =
+            shader::bind(device, layout, &[&uniform, &patch_views, &minimum_segments, &proposals, &global]);
         ViewBuffers { uniform, patch_views, minimum_segments, global, bind, bounds_uploaded: false }
     }
 }

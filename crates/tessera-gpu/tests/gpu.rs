@@ -598,11 +598,8 @@ fn near_cull_tie(set: &SurfaceSet, p: usize, camera: &tessera::camera::Camera) -
         _ => (-c.y - t.y * c.z) / ny,
     };
     let frustum_tie = (0..6).any(|k| {
-        let least = patch
-            .control_points()
-            .iter()
-            .map(|&q| plane(k, view.to_camera(q)))
-            .fold(f64::INFINITY, f64::min);
+        let least =
+            patch.control_points().iter().map(|&q| plane(k, view.to_camera(q))).fold(f64::INFINITY, f64::min);
         least.abs() <= scale
     });
     let pv = tessera::criterion::screen::PatchView::new(patch);
@@ -722,7 +719,8 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
         };
         let (culled_before, strips_before) = (counts.culled, counts.strips);
         for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
-            let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             // Uniform: the GPU plans the frame from the camera.
             let name = format!("{model} camera {c} uniform");
             let criterion = Criterion::PixelError(uniform_pixels);
@@ -742,7 +740,10 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             assert_eq!(drawn.visible, visible);
             let (want, got) = (cpu.segments.iter().max().copied(), drawn.segments.iter().max().copied());
             assert!(drawn.segments.iter().all(|&s| Some(s) == got), "{name}: segments not uniform");
-            assert!(drawn.interior.iter().all(|&[u, v]| Some(u) == got && Some(v) == got), "{name}: interiors");
+            assert!(
+                drawn.interior.iter().all(|&[u, v]| Some(u) == got && Some(v) == got),
+                "{name}: interiors"
+            );
             if got != want {
                 // Only a rounding tie of the deciding root, with the same culled set.
                 let root = uniform_pixel_error_root(&set, &prepared, &camera, uniform_pixels, &visible);
@@ -767,7 +768,8 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let name = format!("{model} camera {c} transition from the camera");
                 let fmax = options.max_factor as f64;
                 let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
-                let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let planned =
+                    Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
                 let screen = ScreenCriterion {
                     scheme: Scheme::Transition,
                     criterion,
@@ -800,7 +802,8 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             } else {
                 let name = format!("{model} camera {c} transition");
                 let criterion = Criterion::PixelError(pixels);
-                let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let planned =
+                    Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
                 let mut plan = planned.plan.clone();
                 plan.visible.fill(1);
                 gpu.set_cull_camera(ctx, Some(&camera));
@@ -816,7 +819,10 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             counts.strips += s.iter().any(|&x| x != s[0]) as usize;
             counts.frames += 2;
         }
-        assert!(counts.culled > culled_before, "{model}: the cameras culled nothing, the sweep proves little");
+        assert!(
+            counts.culled > culled_before,
+            "{model}: the cameras culled nothing, the sweep proves little"
+        );
         assert!(counts.strips > strips_before, "{model}: no transition frame had two edge factors");
         eprintln!("{model}: cap {cap}, {:.1} s", start.elapsed().as_secs_f64());
     }
@@ -835,7 +841,9 @@ fn acceptance_sweep_on_the_small_models() {
     // The fast tier: the small patch models and the meshes under 15 kB, 4 cameras each.
     let models: Vec<String> = all_models()
         .into_iter()
-        .filter(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() < 15_000 || m.starts_with("patches/"))
+        .filter(|m| {
+            std::fs::metadata(data_dir().join(m)).unwrap().len() < 15_000 || m.starts_with("patches/")
+        })
         .collect();
     let counts = acceptance_sweep(&models, 3, 77);
     assert!(counts.below_cap > 0, "no uniform frame below the cap: the GPU factor was never tested");
@@ -846,8 +854,9 @@ fn acceptance_sweep_on_the_small_models() {
 fn acceptance_sweep_on_every_model_20_cameras() {
     // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).
-    let (large, rest): (Vec<String>, Vec<String>) =
-        all_models().into_iter().partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    let (large, rest): (Vec<String>, Vec<String>) = all_models()
+        .into_iter()
+        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
     let mut counts = acceptance_sweep(&rest, 20, 2026);
     let more = acceptance_sweep(&large, 10, 2026);
     counts.frames += more.frames;
@@ -893,7 +902,10 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
     let camera = close_camera(&set);
     let pixels = 0.001;
     let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
-    let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &Criterion::PixelError(pixels), &options).unwrap().plan;
+    let cpu = Scheme::Uniform
+        .plan_prepared(&set, &prepared, &Criterion::PixelError(pixels), &options)
+        .unwrap()
+        .plan;
     assert_eq!(cpu.segments.iter().max(), Some(&cap), "{model}: the camera does not reach the cap");
     let mut layout = Layout::default();
     layout.build(&set, &cpu, &Uniform, &TessellateOptions::default()).unwrap();
@@ -902,7 +914,12 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
     for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {
         let name = format!("{model} cap {cap}, {start}");
         let mut gpu = tessellator(&set);
-        let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion: Criterion::PixelError(pixels), max_factor: cap, capacity };
+        let screen = ScreenCriterion {
+            scheme: Scheme::Uniform,
+            criterion: Criterion::PixelError(pixels),
+            max_factor: cap,
+            capacity,
+        };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let mut grown = 0;
         loop {
@@ -986,7 +1003,8 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
         for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
             for pixels in [0.5, 2.0, 8.0, 32.0] {
                 let name = format!("{model} camera {c} {pixels} px");
-                let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+                let options =
+                    PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
                 let criterion = Criterion::PixelError(pixels);
                 let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
                 let screen = ScreenCriterion {
@@ -1060,10 +1078,12 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
         let mut gpu = tessellator(&set);
         for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
             let name = format!("{model} camera {c} silhouetteness");
-            let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
             let cpu = &planned.plan;
-            let screen = ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
             gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             gpu.record(&mut encoder);
@@ -1073,7 +1093,13 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
             }
             if drawn.segments != cpu.segments {
-                let real = tessera::criterion::view::edge_factors(&set, &camera, ViewCriterion::Silhouetteness, fmin, fmax);
+                let real = tessera::criterion::view::edge_factors(
+                    &set,
+                    &camera,
+                    ViewCriterion::Silhouetteness,
+                    fmin,
+                    fmax,
+                );
                 for e in (0..cpu.segments.len()).filter(|&e| drawn.segments[e] != cpu.segments[e]) {
                     let tie = (real[e] - real[e].floor() - 0.5).abs() <= 1e-4;
                     assert!(
@@ -1087,7 +1113,13 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 }
             }
             let mut interior = Vec::new();
-            resolve::interiors(&set, &drawn.segments, InteriorRule::Core, &prepared.caps(cap as f64), &mut interior);
+            resolve::interiors(
+                &set,
+                &drawn.segments,
+                InteriorRule::Core,
+                &prepared.caps(cap as f64),
+                &mut interior,
+            );
             assert_eq!(drawn.interior, interior, "{name}: interior factors");
             if drawn.segments == cpu.segments {
                 assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
@@ -1100,7 +1132,9 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
             }
         }
     }
-    eprintln!("silhouetteness: {frames} frames, {edges} edges, {ties} rounding ties, {strips} frames with strips");
+    eprintln!(
+        "silhouetteness: {frames} frames, {edges} edges, {ties} rounding ties, {strips} frames with strips"
+    );
     assert!(strips * 2 >= frames, "too few frames with two factors: {strips} of {frames}");
     assert!(1000 * ties <= edges, "{ties} rounding ties in {edges} edges");
 }
