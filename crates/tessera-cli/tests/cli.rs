@@ -631,6 +631,16 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
         assert_eq!(g[key], c[key], "transition: {key}");
     }
+    // And on PN triangles (CudaTess's triangle regions).
+    let blob = data("meshes/blob.obj");
+    let args = ["mesh", blob.to_str().unwrap(), "--scheme", "transition", "--tolerance", "0.2%", "--stats"];
+    let cpu = tessera(&args, &dir);
+    let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
+    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+    for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
+        assert_eq!(g[key], c[key], "PN transition: {key}");
+    }
     let refused =
         tessera(&["mesh", input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--engine", "gpu"], &dir);
     assert!(!refused.status.success());

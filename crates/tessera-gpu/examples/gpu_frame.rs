@@ -1,20 +1,29 @@
-//! Per-pass GPU times of the uniform GPU engine on a patch model.
+//! Per-pass GPU times of the GPU engine on a patch model.
 //!
 //! `cargo run --release -p tessera-gpu --example gpu_frame -- MODEL.patches [FACTOR] [FRAMES]
-//! [--copies N] [--cull]`
+//! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition]]
+//! [--silhouetteness FMAX]`
 //!
-//! `--copies N` tessellates N copies of the model side by side in a square grid (45 copies of
-//! `bench/torus_64x32.patches` are the 92,160-patch scene of the real-time CPU issue);
-//! `--cull` makes the GPU cull for a 1280×1024 camera framing the whole scene.
-//! Records FRAMES frames (default 10) at FACTOR (default 16) and prints, per pass, the median
-//! of the timestamp-query times when the adapter has them; otherwise the median wall time of
-//! a whole frame around `submit` + `poll(wait)`. Statistics are read back after each frame,
+//! `--copies N` tessellates N copies of the model in a grid (`tessera::scene::patch_grid`;
+//! 45 copies of `bench/torus_64x32.patches` are the 92,160-patch scene of the real-time CPU
+//! issue); `--cull` makes the GPU cull for a 1280×1024 camera framing the whole scene.
+//! By default the frame is the uniform pattern at FACTOR (default 16) from a CPU plan.
+//! `--pixel-error PX` plans the frame on the GPU from that camera alone (culling and the
+//! uniform scheme's pixel-error factor within `--max-factor`, default 16:
+//! `GpuTessellator::prepare_screen`); with `--transition` the CPU plans the transition
+//! scheme for PX once instead, and the GPU culls and draws it every frame.
+//! `--silhouetteness FMAX` plans the transition scheme on the GPU from the camera alone
+//! (culling, silhouetteness factors in 1..=FMAX, the core rule).
+//! Records FRAMES frames (default 10) and prints, per pass, the median of the
+//! timestamp-query times when the adapter has them; otherwise the median wall time of a
+//! whole frame around `submit` + `poll(wait)`. Statistics are read back after each frame,
 //! outside what a frame loop would do.
 
 use std::time::Instant;
 use tessera::criterion::Plan;
+use tessera::scheme::{Criterion, PlanOptions, Prepared, Scheme};
 use tessera::surface::{BuildOptions, SurfaceSet};
-use tessera_gpu::tessellator::{PassTimer, PASSES};
+use tessera_gpu::tessellator::{PassTimer, ScreenCriterion, PASSES};
 use tessera_gpu::{GpuContext, GpuTessellator};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -22,49 +31,83 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// `copies` copies of `set`'s patches in a square grid, 1.2 box sizes apart.
-fn grid_of_copies(set: &SurfaceSet, copies: usize) -> SurfaceSet {
-    let (lo, hi) = set.bounds();
-    let step = (hi - lo) * 1.2;
-    let side = (copies as f64).sqrt().ceil() as usize;
-    let mut patches = Vec::with_capacity(copies * set.patches.len());
-    for c in 0..copies {
-        let offset = glam::DVec3::new((c % side) as f64 * step.x, (c / side) as f64 * step.y, 0.0);
-        for patch in &set.patches {
-            let mut patch = patch.clone();
-            if let tessera::surface::Patch::Bicubic(b) = &mut patch {
-                b.points.iter_mut().for_each(|p| *p += offset);
-            }
-            patches.push(patch);
-        }
-    }
-    SurfaceSet::from_patches(patches, BuildOptions::default())
+/// Removes `--name VALUE` from `args` and parses VALUE.
+fn option<T: std::str::FromStr>(args: &mut Vec<String>, name: &str) -> Result<Option<T>, String> {
+    let Some(i) = args.iter().position(|a| a == name) else { return Ok(None) };
+    let value = args.get(i + 1).ok_or(format!("{name} needs a value"))?;
+    let parsed = value.parse().map_err(|_| format!("{name}: cannot read {value}"))?;
+    args.drain(i..i + 2);
+    Ok(Some(parsed))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args: Vec<String> = std::env::args().collect();
-    let cull = args.iter().any(|a| a == "--cull");
-    args.retain(|a| a != "--cull");
-    let mut copies = 1usize;
-    if let Some(i) = args.iter().position(|a| a == "--copies") {
-        copies = args.get(i + 1).ok_or("--copies needs a number")?.parse()?;
-        args.drain(i..i + 2);
-    }
-    let path = args.get(1).ok_or("usage: gpu_frame MODEL.patches [FACTOR] [FRAMES] [--copies N] [--cull]")?;
+    let flag = |args: &mut Vec<String>, name: &str| {
+        let found = args.iter().any(|a| a == name);
+        args.retain(|a| a != name);
+        found
+    };
+    let cull = flag(&mut args, "--cull");
+    let transition = flag(&mut args, "--transition");
+    let copies: usize = option(&mut args, "--copies")?.unwrap_or(1);
+    let pixels: Option<f64> = option(&mut args, "--pixel-error")?;
+    let max_factor: u32 = option(&mut args, "--max-factor")?.unwrap_or(16);
+    let silhouetteness: Option<u32> = option(&mut args, "--silhouetteness")?;
+    let usage = "usage: gpu_frame MODEL.patches [FACTOR] [FRAMES] [--copies N] [--cull] \
+                 [--pixel-error PX [--max-factor N] [--transition]] [--silhouetteness FMAX]";
+    let path = args.get(1).ok_or(usage)?;
     let factor: u32 = args.get(2).map_or(Ok(16), |s| s.parse())?;
     let frames: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let file = tessera::io::patches::read_patches(std::path::Path::new(path))?;
-    let one = SurfaceSet::from_patch_file(&file, BuildOptions::default());
-    let set = if copies > 1 { grid_of_copies(&one, copies) } else { one };
+    let file = if copies > 1 { tessera::scene::patch_grid(&file, copies) } else { file };
+    let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
+    let (lo, hi) = set.bounds();
+    let camera = tessera::camera::Camera::framing(lo, hi, 1280, 1024);
     let ctx = GpuContext::new()?;
     println!("adapter: {} ({:?}, {})", ctx.info.name, ctx.info.backend, ctx.info.driver_info);
     let mut gpu = GpuTessellator::new(&ctx, &set)?;
     if cull {
-        let (lo, hi) = set.bounds();
-        gpu.set_cull_camera(&ctx, Some(&tessera::camera::Camera::framing(lo, hi, 1280, 1024)));
+        gpu.set_cull_camera(&ctx, Some(&camera));
     }
-    let plan = Plan::uniform(&set, factor)?;
-    gpu.prepare(&ctx, &set, &plan, &tessera::pattern::uniform::Uniform)?;
+    let what = match (pixels, transition) {
+        _ if silhouetteness.is_some() => {
+            let fmax = silhouetteness.unwrap_or(1);
+            let prepared = Prepared::new(&set, true);
+            let criterion = Criterion::View {
+                criterion: tessera::criterion::view::ViewCriterion::Silhouetteness,
+                fmin: 1.0,
+                fmax: fmax as f64,
+            };
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: fmax, capacity: None };
+            gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
+            format!("transition, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU")
+        }
+        (Some(px), false) => {
+            let prepared = Prepared::new(&set, true);
+            let screen = ScreenCriterion {
+                scheme: Scheme::Uniform,
+                criterion: Criterion::PixelError(px),
+                max_factor,
+                capacity: None,
+            };
+            gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
+            format!("uniform, {px} px and cap {max_factor} planned on the GPU, culled on the GPU")
+        }
+        (Some(px), true) => {
+            let options = PlanOptions { camera: Some(camera), cull: true, max_factor, ..Default::default() };
+            let planned = Scheme::Transition.plan(&set, &Criterion::PixelError(px), &options)?;
+            let mut plan = planned.plan;
+            plan.visible.fill(1);
+            gpu.set_cull_camera(&ctx, Some(&camera));
+            gpu.prepare(&ctx, &set, &plan, &planned.pattern)?;
+            format!("transition, {px} px and cap {max_factor} planned once on the CPU, culled on the GPU")
+        }
+        (None, _) => {
+            gpu.prepare(&ctx, &set, &Plan::uniform(&set, factor)?, &tessera::pattern::uniform::Uniform)?;
+            format!("uniform factor {factor}{}", if cull { ", culled on the GPU" } else { "" })
+        }
+    };
     let timer = PassTimer::new(&ctx);
     let mut per_pass = vec![Vec::new(); PASSES.len()];
     let mut wall = Vec::new();
@@ -83,9 +126,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let (overflow, vertices, triangles) = gpu.read_status(&ctx)?;
     println!(
-        "{path} x{copies}: {} patches, factor {factor}{}: {vertices} vertices, {triangles} triangles{}",
+        "{path} x{copies}: {} patches, {what}: {vertices} vertices, {triangles} triangles{}",
         set.patches.len(),
-        if cull { ", culled on the GPU" } else { "" },
         if overflow { " (OVERFLOW)" } else { "" }
     );
     let frame = median(wall.clone());

@@ -3,24 +3,6 @@
 // plane (the convex hull holds the patch), or back-facing by the conservative normal cone
 // (`screen::back_facing`, with the cone and bounding sphere prepared once on the CPU).
 
-struct View {
-    eye: vec4<f32>,
-    // `Camera::basis`: right, up, forward (unit).
-    right: vec4<f32>,
-    up: vec4<f32>,
-    forward: vec4<f32>,
-    near: f32,
-    far: f32,
-    // `Camera::half_tangents`.
-    tan_x: f32,
-    tan_y: f32,
-}
-
-@group(1) @binding(0) var<uniform> view: View;
-// Per patch, three vec4: the normal cone's axis and half-angle α, the bounding sphere's
-// centre and radius, then (sin α, cos α, 1 with a cone / 0 without, 0).
-@group(1) @binding(1) var<storage, read_write> cones: array<vec4<f32>>;
-
 fn to_camera(p: vec3<f32>) -> vec3<f32> {
     let d = p - view.eye.xyz;
     return vec3<f32>(dot(d, view.right.xyz), dot(d, view.up.xyz), dot(d, view.forward.xyz));
@@ -31,9 +13,9 @@ fn to_camera(p: vec3<f32>) -> vec3<f32> {
 // acos and asin, whose f32 values lose half their digits near 0 and 1: with θ = α + β < π/2
 // the condition is cos γ < cos(π/2 + θ) = −sin θ; for θ ≥ π/2 it never holds (γ ≤ π).
 fn back_facing(p: u32) -> bool {
-    let cone = cones[3u * p];
-    let sphere = cones[3u * p + 1u];
-    let trig = cones[3u * p + 2u];
+    let cone = patch_views[PATCH_VIEW_ROW * p];
+    let sphere = patch_views[PATCH_VIEW_ROW * p + 1u];
+    let trig = patch_views[PATCH_VIEW_ROW * p + 2u];
     if (trig.z == 0.0) { return false; }
     let to_eye = view.eye.xyz - sphere.xyz;
     let dist = length(to_eye);

@@ -4,7 +4,10 @@
 //! The passes of a frame, each one compute pass (named in [`PASSES`], timed by
 //! [`PassTimer`] when the adapter has timestamp queries):
 //!
-//! 1. **count** (`count_uniform.wgsl`, `transition_quad.wgsl`): per edge and per patch, the counts
+//! 0. **cull** (`cull.wgsl`, with a culling camera) and **factors** (`factors.wgsl`, after
+//!    [`GpuTessellator::prepare_screen`]): the visibility row and the plan's segments and
+//!    interior factors from the camera alone, from view-independent rows uploaded once;
+//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`): per edge and per patch, the counts
 //!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
 //!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
@@ -14,7 +17,7 @@
 //! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
 //!    interior vertices;
 //! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
-//!    triangle; transition (`transition_quad.wgsl`) one invocation per patch walking its core
+//!    triangle; transition (`transition.wgsl`) one invocation per patch walking its core
 //!    and strips in the CPU's order (parallel over patches only: the next step is a
 //!    per-triangle form).
 //!
@@ -31,12 +34,14 @@ use crate::scan::{Scan, ScanPipelines};
 use crate::shader::{self, Binding};
 use crate::upload::{self, GpuSet};
 use tessera::camera::Camera;
+use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
 use tessera::sampling::SamplingKind;
+use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 
 /// f32 per output vertex: position (3), normal (3), uv (2).
@@ -54,8 +59,9 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
 };
 
 /// The compute passes of a frame, in order ("cull" only with a culling camera,
-/// [`GpuTessellator::set_cull_camera`]).
-pub const PASSES: [&str; 6] = ["cull", "count", "scan", "args", "vertices", "triangles"];
+/// [`GpuTessellator::set_cull_camera`]; "factors" only with factors from the camera,
+/// [`GpuTessellator::prepare_screen`]).
+pub const PASSES: [&str; 7] = ["cull", "factors", "count", "scan", "args", "vertices", "triangles"];
 
 const COMMON: &str = include_str!("../shaders/common.wgsl");
 const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
@@ -67,12 +73,18 @@ const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
 const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
 const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
 const CULL: &str = include_str!("../shaders/cull.wgsl");
-const TRANSITION_QUAD: &str = include_str!("../shaders/transition_quad.wgsl");
+const VIEW: &str = include_str!("../shaders/view.wgsl");
+const FACTORS: &str = include_str!("../shaders/factors.wgsl");
+const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
-/// Storage buffers in group 1 (the args pass's outputs).
+/// Storage buffers in group 1 of the args pass (its outputs).
 const ARGS_STORAGE: u32 = 3;
+/// Storage buffers in group 1 of the view passes (`view.wgsl`).
+const VIEW_STORAGE: u32 = 4;
+/// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
+const PATCH_VIEW_ROW: u32 = 8;
 
 /// Constants the tessellation shaders share with this crate.
 fn constants() -> Vec<(&'static str, u32)> {
@@ -83,6 +95,8 @@ fn constants() -> Vec<(&'static str, u32)> {
         ("CORNER_ROW", upload::CORNER_ROW),
         ("CONTROL_POINTS", upload::CONTROL_POINTS),
         ("VERTEX_FLOATS", VERTEX_FLOATS),
+        ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
+        ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
     ]
 }
 
@@ -95,8 +109,8 @@ fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderMod
 pub enum GpuPattern {
     /// [`tessera::pattern::uniform::Uniform`]: one invocation per output triangle.
     Uniform,
-    /// [`tessera::pattern::transition::Transition`] on quads (CudaTess): one invocation per
-    /// patch builds its core and strips serially.
+    /// [`tessera::pattern::transition::Transition`] on quads and triangles (CudaTess): one
+    /// invocation per patch builds its core and strips serially.
     Transition,
 }
 
@@ -125,13 +139,18 @@ struct PatternPipelines {
     collapsed_triangles: Option<wgpu::ComputePipeline>,
 }
 
-/// Every pipeline of a frame.
+/// Every compiled pipeline of a frame, independent of the set: made once per device
+/// ([`Pipelines::new`]) and shared by any number of tessellators
+/// ([`GpuTessellator::with_pipelines`]).
 #[derive(Debug)]
-struct Pipelines {
+pub struct Pipelines {
     main_layout: wgpu::BindGroupLayout,
     args_layout: wgpu::BindGroupLayout,
-    cull_layout: wgpu::BindGroupLayout,
+    view_layout: wgpu::BindGroupLayout,
     cull: wgpu::ComputePipeline,
+    patch_proposals: wgpu::ComputePipeline,
+    edge_segments: wgpu::ComputePipeline,
+    interiors: wgpu::ComputePipeline,
     scan: ScanPipelines,
     args: wgpu::ComputePipeline,
     uniform: PatternPipelines,
@@ -139,13 +158,17 @@ struct Pipelines {
 }
 
 impl Pipelines {
-    fn new(device: &wgpu::Device) -> Pipelines {
+    /// Compiles every shader of the frame on `device`. Cost: about a dozen WGSL compilations
+    /// (a second or more on lavapipe).
+    pub fn new(device: &wgpu::Device) -> Pipelines {
         use Binding::*;
         let mut main = vec![Uniform];
         main.extend(std::iter::repeat_n(Write, MAIN_STORAGE as usize));
         let main_layout = shader::layout(device, &main);
         let args_layout = shader::layout(device, &[Write; ARGS_STORAGE as usize]);
-        let cull_layout = shader::layout(device, &[Uniform, Write]);
+        let mut view = vec![Uniform];
+        view.extend(std::iter::repeat_n(Write, VIEW_STORAGE as usize));
+        let view_layout = shader::layout(device, &view);
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -155,7 +178,7 @@ impl Pipelines {
         };
         let one = pipeline_layout(&[Some(&main_layout)]);
         let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
-        let with_view = pipeline_layout(&[Some(&main_layout), Some(&cull_layout)]);
+        let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -167,7 +190,8 @@ impl Pipelines {
             })
         };
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
-        let cull = module(device, "cull", &[COMMON, CULL]);
+        let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
+        let factors = module(device, "factors", &[COMMON, VIEW, CULL, FACTORS]);
         let uniform = {
             let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]);
             let vertices = module(
@@ -187,11 +211,11 @@ impl Pipelines {
             }
         };
         let transition = {
-            let pattern = module(device, "transition", &[COMMON, TRANSITION_QUAD, COUNT]);
+            let pattern = module(device, "transition", &[COMMON, TRANSITION, COUNT]);
             let vertices = module(
                 device,
                 "vertices transition",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION_QUAD, WRITE_VERTICES],
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION, WRITE_VERTICES],
             );
             PatternPipelines {
                 count: make(&one, &pattern, "count"),
@@ -204,13 +228,16 @@ impl Pipelines {
         };
         Pipelines {
             cull: make(&with_view, &cull, "cull"),
+            patch_proposals: make(&with_view, &factors, "patch_proposals"),
+            edge_segments: make(&with_view, &factors, "edge_segments"),
+            interiors: make(&with_view, &factors, "interiors"),
             scan: ScanPipelines::new(device),
             args: make(&two, &args, "write_args"),
             uniform,
             transition,
             main_layout,
             args_layout,
-            cull_layout,
+            view_layout,
         }
     }
 }
@@ -275,13 +302,13 @@ struct Output {
 ///
 /// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
 /// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
-/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on bicubic
-/// patches (any per-edge segments and core factors, as `Scheme::Transition` plans); anything
-/// else is refused with [`GpuError::Unsupported`].
+/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on every
+/// patch kind (any per-edge segments and core factors, as `Scheme::Transition` plans);
+/// anything else is refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
-    pipelines: Pipelines,
+    pipelines: std::sync::Arc<Pipelines>,
     params: wgpu::Buffer,
     segments: wgpu::Buffer,
     interior: wgpu::Buffer,
@@ -295,15 +322,14 @@ pub struct GpuTessellator {
     status: wgpu::Buffer,
     args: wgpu::BindGroup,
     output: Option<Output>,
-    /// The last prepared plan's pattern triangles per patch (for
-    /// [`GpuTessellator::read_mesh`]'s count of collapsed triangles).
-    pattern_triangles: Vec<u32>,
     /// The last prepared plan's pattern.
     pattern: GpuPattern,
-    /// The culling camera's uniform and bind group, when the GPU culls.
-    cull: Option<CullView>,
-    /// Per patch: normal cone and bounding sphere (`cull.wgsl`), prepared once.
-    cones: wgpu::Buffer,
+    /// The view passes' buffers and bind group (`view.wgsl`).
+    view: ViewBuffers,
+    /// The camera the GPU culls for (and, with `screen`, plans for), if any.
+    camera: Option<Camera>,
+    /// The pixel-error criterion, when the GPU computes the factors from the camera.
+    screen: Option<Screen>,
     /// The largest buffer the device binds or allocates.
     buffer_limit: u64,
 }
@@ -320,11 +346,22 @@ fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsag
 impl GpuTessellator {
     /// Uploads `set` (see [`crate::upload`]) and compiles the frame's pipelines.
     ///
-    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than 15 storage buffers
-    /// per shader stage. Cost: O(P + E) packing, one upload, seven
-    /// shader compilations (about a second on lavapipe).
+    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than 16 storage buffers
+    /// per shader stage. Cost: O(P + E) packing, one upload, and [`Pipelines::new`]'s
+    /// compilations (a second or more on lavapipe; [`GpuTessellator::with_pipelines`]
+    /// shares them instead).
     pub fn new(ctx: &GpuContext, set: &SurfaceSet) -> Result<GpuTessellator> {
-        let needed = MAIN_STORAGE + ARGS_STORAGE;
+        Self::with_pipelines(ctx, set, std::sync::Arc::new(Pipelines::new(&ctx.device)))
+    }
+
+    /// [`GpuTessellator::new`] with pipelines compiled before on the same device. Errors as
+    /// `new`. Cost: O(P + E) packing and one upload.
+    pub fn with_pipelines(
+        ctx: &GpuContext,
+        set: &SurfaceSet,
+        pipelines: std::sync::Arc<Pipelines>,
+    ) -> Result<GpuTessellator> {
+        let needed = MAIN_STORAGE + ARGS_STORAGE.max(VIEW_STORAGE);
         if ctx.limits.max_storage_buffers_per_shader_stage < needed {
             return Err(GpuError::Unsupported {
                 what: format!(
@@ -341,7 +378,6 @@ impl GpuTessellator {
         let layout_usage = U::STORAGE | U::COPY_SRC;
         let vertex_offsets = buffer(device, "vertex offsets", 4 * (e + p + 1), layout_usage);
         let triangle_offsets = buffer(device, "triangle offsets", 4 * (p + 1), layout_usage);
-        let pipelines = Pipelines::new(device);
         let vertex_scan =
             Scan::new(device, &pipelines.scan, &vertex_offsets, (e + p + 1) as u32, gpu_set.corners);
         let triangle_scan = Scan::new(device, &pipelines.scan, &triangle_offsets, (p + 1) as u32, 0);
@@ -349,6 +385,7 @@ impl GpuTessellator {
         let dispatch_args = buffer(device, "write dispatches", 48, U::STORAGE | U::INDIRECT);
         let status = buffer(device, "status", 16, U::STORAGE | U::COPY_SRC);
         let args = shader::bind(device, &pipelines.args_layout, &[&draw_args, &dispatch_args, &status]);
+        let view = ViewBuffers::new(device, &pipelines.view_layout, set);
         Ok(GpuTessellator {
             params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
             segments: buffer(device, "segments", 4 * e, plan_usage),
@@ -363,18 +400,19 @@ impl GpuTessellator {
             status,
             args,
             output: None,
-            pattern_triangles: Vec::new(),
             pattern: GpuPattern::Uniform,
-            cull: None,
-            cones: upload::storage_buffer(device, "normal cones", &cones(set)),
+            view,
+            camera: None,
+            screen: None,
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
             set: gpu_set,
             pipelines,
         })
     }
 
-    /// Uploads `plan` (made for `pattern`, which must be the uniform pattern for now) for the
-    /// next [`GpuTessellator::record`], growing the output buffers
+    /// Uploads `plan` (made for `pattern`, the uniform or the transition pattern) for the
+    /// next [`GpuTessellator::record`] (ending [`GpuTessellator::prepare_screen`]'s own
+    /// planning), growing the output buffers
     /// to its worst case ([`Capacity::of_plan`]) when they are too small.
     ///
     /// Preconditions: `plan` was made for `set`, the set given to [`GpuTessellator::new`].
@@ -404,15 +442,10 @@ impl GpuTessellator {
         if plan.kind != SamplingKind::Uniform {
             return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
         }
-        if kind == GpuPattern::Transition
-            && set.patches.iter().any(|p| p.domain() != tessera::domain::Domain::Quad)
-        {
-            return Err(GpuError::Unsupported { what: "the transition pattern on triangle patches".into() });
-        }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
             if kind == GpuPattern::Uniform
-                && (self.cull.is_some() || plan.is_visible(p))
+                && (self.camera.is_some() || plan.is_visible(p))
                 && edges.iter().any(|pe| plan.segments[pe.edge as usize] != n)
             {
                 return Err(GpuError::Unsupported {
@@ -422,19 +455,204 @@ impl GpuTessellator {
                 });
             }
         }
-        let capacity = Capacity::of_plan(set, plan, pattern, self.cull.is_some());
-        self.pattern_triangles.clear();
-        self.pattern_triangles.extend(
-            (0..set.patches.len())
-                .map(|p| pattern.counts(&tessera::engine::layout::pattern_input(set, plan, p)).1),
-        );
+        let capacity = Capacity::of_plan(set, plan, pattern, self.camera.is_some());
         self.reserve(ctx, capacity)?;
+        self.screen = None;
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
         self.pattern = kind;
         Ok(())
+    }
+
+    /// Makes every following frame plan itself on the GPU from the camera alone: culling
+    /// for `camera` (`cull.wgsl`), then the factors of `criterion` (`factors.wgsl`: per
+    /// patch its proposals — for a pixel error the object-space tolerance of
+    /// `screen::PatchView::tolerance` and the proposals from `prepared`'s bounds, for
+    /// silhouetteness its edges' factors from `prepared`'s edge midpoints — per edge the
+    /// maximum over its patches through the topology's edge uses, the cap and the minimum
+    /// segments, then the scheme's interior rule), as `scheme.plan_prepared(set, prepared,
+    /// &criterion, &PlanOptions { camera, cull: true, max_factor, .. })` plans on the CPU.
+    /// Later cameras go to [`GpuTessellator::set_cull_camera`] (a 112-byte upload a frame);
+    /// the plan never comes back to the CPU ([`GpuTessellator::read_plan`] reads it for
+    /// tests).
+    ///
+    /// On the GPU: [`Criterion::PixelError`] with [`Scheme::Uniform`] (the global factor:
+    /// the largest over the visible patches), and [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
+    /// (per-edge factors, CudaTess's core rule). The transition scheme's pixel-error plans
+    /// (a-posteriori checks that raise factors round by round) are CPU-only. The output is
+    /// sized for the worst case, every patch at `max_factor` (or at the largest minimum
+    /// when that is higher), within the device's buffer limits, or as `criterion.capacity`
+    /// says; a frame that needs more draws nothing and is reported
+    /// ([`GpuTessellator::grow_if_overflowed`]).
+    ///
+    /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
+    /// Errors: [`GpuError::Unsupported`] for another scheme or criterion or a `prepared`
+    /// without bounds; [`tessera::Error::InvalidParameter`] for a pixel error that is not a
+    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` in integers, or a
+    /// `max_factor` outside `1..=MAX_FACTOR` (the checks of [`Scheme::plan`]);
+    /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
+    /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
+    /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
+    /// bytes a patch and 52 an edge; later calls (another camera, criterion or cap) O(P)
+    /// pattern counts for the capacity and a 112-byte upload.
+    pub fn prepare_screen(
+        &mut self,
+        ctx: &GpuContext,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+        camera: &Camera,
+        criterion: ScreenCriterion,
+    ) -> Result<()> {
+        let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
+        let unsupported = || {
+            Err(GpuError::Unsupported {
+                what: format!("{} with the {} scheme planned on the GPU", criterion.name(), scheme.name()),
+            })
+        };
+        let invalid = |name: &'static str, reason: String| {
+            Err(GpuError::from(tessera::Error::InvalidParameter { name, reason }))
+        };
+        let cap = max_factor as f64;
+        let (kind, pixels, lo, hi) = match (scheme, criterion) {
+            (Scheme::Uniform, Criterion::PixelError(px)) => {
+                if !(px.is_finite() && px > 0.0) {
+                    return invalid("pixel error", format!("{px}: must be a positive number"));
+                }
+                (CRITERION_PIXEL_ERROR, px, 1.0, 1.0)
+            }
+            (
+                Scheme::Uniform | Scheme::Transition,
+                Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax },
+            ) => {
+                let valid = |f: f64| f.is_finite() && f >= 1.0 && f.fract() == 0.0;
+                if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
+                    return invalid("factor range", format!("{fmin}:{fmax}: use integers 1 ≤ FMIN ≤ FMAX"));
+                }
+                // As `Scheme::plan_into` and `view::edge_factors_into` bound the range.
+                let fmax = fmax.min(cap);
+                let lo = fmin.min(fmax).max(1.0);
+                (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
+            }
+            _ => return unsupported(),
+        };
+        let interior = if scheme == Scheme::Uniform { INTERIOR_GLOBAL } else { INTERIOR_CORE };
+        let patches = set.patches.len();
+        if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
+            return Err(
+                tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
+            );
+        }
+        if prepared.hessians.len() != patches
+            || prepared.curves.len() != patches
+            || prepared.minimum_segments.len() != set.topology.edges.len()
+            || prepared.minimum_interior.len() != patches
+        {
+            return Err(GpuError::Unsupported {
+                what: "a Prepared without the error bounds (make it with Prepared::new(set, true))".into(),
+            });
+        }
+        if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
+            return invalid(
+                "max factor",
+                format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR),
+            );
+        }
+        // The largest global factor a frame can reach: the cap, or a minimum above it.
+        let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
+        let worst = minimum.copied().fold(max_factor, u32::max);
+        let mut worst_case = Capacity::of_plan(set, &Plan::uniform(set, worst)?, &Uniform, true);
+        if interior == INTERIOR_CORE {
+            // `Transition::counts` with every factor at most w = max(worst, 3) (cores are
+            // raised to 3 at most): 2·nu·nv core triangles plus s + m a strip, at most
+            // 2w² + 8w a patch, the uniform pattern's 2w² and 8w more; no more vertices.
+            let w = worst.max(3) as u64;
+            worst_case = Capacity::of_plan(set, &Plan::uniform(set, w as u32)?, &Uniform, true);
+            worst_case.triangles += 8 * w * patches as u64;
+        }
+        let worst = worst_case;
+        // The scans count in u32: a set whose worst frame could pass that range is refused
+        // here, before any frame could wrap.
+        if worst.vertices > u32::MAX as u64 || worst.triangles > u32::MAX as u64 / 3 {
+            return Err(GpuError::OutputTooLarge {
+                vertices: worst.vertices,
+                triangles: worst.triangles,
+                bytes: (worst.vertices * VERTEX_STRIDE).max(worst.triangles * 12),
+                limit: self.buffer_limit,
+            });
+        }
+        // Past the buffer limits, the frames that need more overflow and are reported; the
+        // ones that fit draw completely.
+        let (most_vertices, most_triangles) = self.most();
+        let capacity = capacity.unwrap_or(Capacity {
+            vertices: worst.vertices.min(most_vertices),
+            triangles: worst.triangles.min(most_triangles),
+        });
+        self.reserve(ctx, capacity)?;
+        let queue = &ctx.queue;
+        if !self.view.bounds_uploaded {
+            // View-independent and the same for every `Prepared` of the set: uploaded once.
+            let rows = patch_view_rows(set, Some(prepared));
+            queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
+            queue.write_buffer(
+                &self.view.minimum_segments,
+                0,
+                bytemuck::cast_slice(&prepared.minimum_segments),
+            );
+            self.view.bounds_uploaded = true;
+        }
+        self.screen = Some(Screen { criterion: kind, pixels, lo, hi, max_factor, interior });
+        self.pattern = if scheme == Scheme::Uniform { GpuPattern::Uniform } else { GpuPattern::Transition };
+        self.set_cull_camera(ctx, Some(camera));
+        Ok(())
+    }
+
+    /// The largest output the device's limits allow: `(vertices, triangles)`.
+    fn most(&self) -> (u64, u64) {
+        let vertices = (self.buffer_limit / VERTEX_STRIDE).min(u32::MAX as u64);
+        let triangles = (self.buffer_limit / 12).min(u32::MAX as u64 / 3);
+        (vertices, triangles)
+    }
+
+    /// After a submitted frame: reads its status back and, when it overflowed (a frame
+    /// that needs more room than the buffers have draws nothing at all, never part of the
+    /// mesh), grows the output to what it needed and returns `Ok(true)`: record and submit
+    /// the frame again. `Ok(false)`: the frame was complete. A loop sized for the worst case
+    /// ([`GpuTessellator::prepare`], or [`GpuTessellator::prepare_screen`] within the
+    /// device's limits) never needs this; with a smaller start it is the grow-and-rerun
+    /// path, a read-back each time it is called.
+    ///
+    /// Errors: [`GpuError::OutputTooLarge`] when the frame needs more than the device's
+    /// buffer limits or the u32 index range (its output is then empty and reported, no
+    /// patch dropped silently). Cost: a queue wait; a reallocation when it grows.
+    pub fn grow_if_overflowed(&mut self, ctx: &GpuContext) -> Result<bool> {
+        let (overflow, vertices, triangles) = self.read_status(ctx)?;
+        if !overflow {
+            return Ok(false);
+        }
+        // The counts are the scans' totals, exact unless they wrapped past u32 (then the
+        // need is beyond the index range anyway).
+        let need = Capacity { vertices: vertices as u64, triangles: triangles as u64 };
+        let have = self.capacity().unwrap_or_default();
+        let (most_vertices, most_triangles) = self.most();
+        if need.vertices > most_vertices || need.triangles > most_triangles {
+            return Err(GpuError::OutputTooLarge {
+                vertices: need.vertices,
+                triangles: need.triangles,
+                bytes: (need.vertices * VERTEX_STRIDE).max(need.triangles * 12),
+                limit: self.buffer_limit,
+            });
+        }
+        // Grow with some room, so that a camera moving on does not grow every frame.
+        let grown = |need: u64, have: u64, most: u64| need.max(have).saturating_mul(5).div_ceil(4).min(most);
+        let capacity = Capacity {
+            vertices: grown(need.vertices, have.vertices, most_vertices),
+            triangles: grown(need.triangles, have.triangles, most_triangles),
+        };
+        self.reserve(ctx, capacity)?;
+        Ok(true)
     }
 
     /// Makes the output buffers hold at least `capacity`. Errors with
@@ -509,14 +727,35 @@ impl GpuTessellator {
         let Some(out) = &self.output else { return };
         let p = &self.pipelines;
         let (e, patches, corners) = (self.set.edges, self.set.patches, self.set.corners);
+        let grid = |n: u32| shader::grid(n.div_ceil(shader::WORKGROUP));
         {
             // Begun even without culling, so that every timestamp of the timer is written.
             let mut c = begin_pass(encoder, timer, 0);
-            if let Some(view) = &self.cull {
+            if self.camera.is_some() {
                 c.set_pipeline(&p.cull);
                 c.set_bind_group(0, &out.main, &[]);
-                c.set_bind_group(1, &view.bind, &[]);
-                let (x, y) = shader::grid(patches.div_ceil(shader::WORKGROUP));
+                c.set_bind_group(1, &self.view.bind, &[]);
+                let (x, y) = grid(patches);
+                c.dispatch_workgroups(x, y, 1);
+            }
+        }
+        let screen = self.screen.is_some() && self.camera.is_some();
+        if screen {
+            encoder.clear_buffer(&self.view.global, 0, None);
+        }
+        {
+            let mut c = begin_pass(encoder, timer, 1);
+            if screen {
+                c.set_bind_group(0, &out.main, &[]);
+                c.set_bind_group(1, &self.view.bind, &[]);
+                c.set_pipeline(&p.patch_proposals);
+                let (x, y) = grid(patches);
+                c.dispatch_workgroups(x, y, 1);
+                c.set_pipeline(&p.edge_segments);
+                let (x, y) = grid(e);
+                c.dispatch_workgroups(x, y, 1);
+                c.set_pipeline(&p.interiors);
+                let (x, y) = grid(e.max(patches));
                 c.dispatch_workgroups(x, y, 1);
             }
         }
@@ -525,26 +764,26 @@ impl GpuTessellator {
             GpuPattern::Transition => &p.transition,
         };
         {
-            let mut c = begin_pass(encoder, timer, 1);
+            let mut c = begin_pass(encoder, timer, 2);
             c.set_pipeline(&k.count);
             c.set_bind_group(0, &out.main, &[]);
             let (x, y) = shader::grid((e + patches + 1).div_ceil(shader::WORKGROUP));
             c.dispatch_workgroups(x, y, 1);
         }
         {
-            let mut c = begin_pass(encoder, timer, 2);
+            let mut c = begin_pass(encoder, timer, 3);
             self.vertex_scan.record(&p.scan, &mut c);
             self.triangle_scan.record(&p.scan, &mut c);
         }
         {
-            let mut c = begin_pass(encoder, timer, 3);
+            let mut c = begin_pass(encoder, timer, 4);
             c.set_pipeline(&p.args);
             c.set_bind_group(0, &out.main, &[]);
             c.set_bind_group(1, &self.args, &[]);
             c.dispatch_workgroups(1, 1, 1);
         }
         {
-            let mut c = begin_pass(encoder, timer, 4);
+            let mut c = begin_pass(encoder, timer, 5);
             c.set_bind_group(0, &out.main, &[]);
             if corners > 0 {
                 c.set_pipeline(&k.corners);
@@ -557,7 +796,7 @@ impl GpuTessellator {
             c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
         }
         {
-            let mut c = begin_pass(encoder, timer, 5);
+            let mut c = begin_pass(encoder, timer, 6);
             c.set_bind_group(0, &out.main, &[]);
             // Per-patch passes take the fourth dispatch, which the args pass zeroes on overflow.
             match (&k.collapsed_triangles, self.pattern) {
@@ -582,34 +821,55 @@ impl GpuTessellator {
 
     /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
     /// following frame, writing the plan's visibility row on the device (the plan's own row
-    /// is then ignored); None goes back to the plan's row. The output capacity then covers
-    /// every patch. Cost: a 96-byte upload; nothing when unchanged.
+    /// is then ignored), and, after [`GpuTessellator::prepare_screen`], plan the factors for
+    /// it; None goes back to the plan's row (and ends the GPU's own planning). The output
+    /// capacity then covers every patch. Cost: a 112-byte upload.
     pub fn set_cull_camera(&mut self, ctx: &GpuContext, camera: Option<&Camera>) {
         let Some(camera) = camera else {
-            self.cull = None;
+            self.camera = None;
+            self.screen = None;
             return;
         };
-        let (r, u, f) = camera.basis();
-        let t = camera.half_tangents();
-        let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
-        let mut view = [0f32; 20];
-        view[0..4].copy_from_slice(&v4(camera.eye));
-        view[4..8].copy_from_slice(&v4(r));
-        view[8..12].copy_from_slice(&v4(u));
-        view[12..16].copy_from_slice(&v4(f));
-        view[16..20].copy_from_slice(&[camera.near as f32, camera.far as f32, t.x as f32, t.y as f32]);
-        if self.cull.is_none() {
-            let uniform = buffer(
-                &ctx.device,
-                "cull view",
-                80,
-                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            );
-            let bind = shader::bind(&ctx.device, &self.pipelines.cull_layout, &[&uniform, &self.cones]);
-            self.cull = Some(CullView { uniform, bind });
-        }
-        let cull = self.cull.as_ref().expect("set above");
-        ctx.queue.write_buffer(&cull.uniform, 0, bytemuck::cast_slice(&view));
+        self.camera = Some(*camera);
+        let view = camera.view();
+        let f = |x: f64| (x as f32).to_bits();
+        let v4 = |v: glam::DVec3| [f(v.x), f(v.y), f(v.z), 0];
+        let mut words = [0u32; 28];
+        words[0..4].copy_from_slice(&v4(view.eye));
+        words[4..8].copy_from_slice(&v4(view.right));
+        words[8..12].copy_from_slice(&v4(view.up));
+        words[12..16].copy_from_slice(&v4(view.forward));
+        let t = view.half_tangents;
+        words[16..20].copy_from_slice(&[f(view.near), f(view.far), f(t.x), f(t.y)]);
+        let s = self.screen.unwrap_or(Screen {
+            criterion: CRITERION_PIXEL_ERROR,
+            pixels: 1.0,
+            lo: 1.0,
+            hi: 1.0,
+            max_factor: 1,
+            interior: INTERIOR_GLOBAL,
+        });
+        words[20..24].copy_from_slice(&[
+            f(view.focal_pixels),
+            f(s.pixels),
+            f(s.max_factor as f64),
+            s.interior,
+        ]);
+        words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), 0]);
+        ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::cast_slice(&words));
+    }
+
+    /// Reads the plan the last frame drew back from the device: the uploaded one, or the
+    /// GPU's own after [`GpuTessellator::prepare_screen`] (segments, interior factors and
+    /// visibility; `factors` are the segments). For tests and statistics. Cost: a queue
+    /// wait.
+    pub fn read_plan(&self, ctx: &GpuContext) -> Result<Plan> {
+        let (e, p) = (self.set.edges as usize, self.set.patches as usize);
+        let segments: Vec<u32> = readback::read(ctx, &self.segments, e)?;
+        let interior: Vec<[u32; 2]> = readback::read(ctx, &self.interior, p)?;
+        let mut plan = Plan::integer(segments, interior, p);
+        plan.visible = self.read_visible(ctx)?;
+        Ok(plan)
     }
 
     /// Reads the plan's visibility row back (the GPU's, when it culls). For tests. Cost: a
@@ -700,43 +960,126 @@ impl GpuTessellator {
             mesh.triangle_patch.extend(std::iter::repeat_n(p as u32, (w[1] - w[0]) as usize));
         }
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
-        let visible = self.read_visible(ctx)?;
-        let pattern: u64 = self
-            .pattern_triangles
-            .iter()
-            .zip(&visible)
-            .filter(|(_, &v)| v != 0)
-            .map(|(&t, _)| t as u64)
+        let plan = self.read_plan(ctx)?;
+        let kind: &dyn Pattern = match self.pattern {
+            GpuPattern::Uniform => &Uniform,
+            GpuPattern::Transition => &Transition,
+        };
+        let pattern: u64 = (0..set.patches.len())
+            .filter(|&p| plan.is_visible(p))
+            .map(|p| kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64)
             .sum();
         mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
         Ok(mesh)
     }
 }
 
-/// The culling camera on the device.
-#[derive(Debug)]
-struct CullView {
-    uniform: wgpu::Buffer,
-    bind: wgpu::BindGroup,
+/// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under `criterion`
+/// with `PlanOptions::max_factor = max_factor`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenCriterion {
+    /// The scheme: [`Scheme::Uniform`] or [`Scheme::Transition`].
+    pub scheme: Scheme,
+    /// [`Criterion::PixelError`] (uniform scheme) or [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`].
+    pub criterion: Criterion,
+    /// The factor cap, `1..=MAX_FACTOR`.
+    pub max_factor: u32,
+    /// The output room to start with: None for the worst case (every patch at the cap),
+    /// clamped to the device's buffer limits; a smaller one saves memory, and a frame that
+    /// needs more overflows (drawing nothing) until [`GpuTessellator::grow_if_overflowed`]
+    /// grows it.
+    pub capacity: Option<Capacity>,
 }
 
-/// Per patch, three `vec4<f32>` for `cull.wgsl`: the normal cone of
-/// [`tessera::criterion::screen::normal_cone`] (axis, half-angle α), the bounding sphere of
-/// the control points about their mean that `screen::back_facing` uses, and
-/// `(sin α, cos α, has cone, 0)`. View-independent: computed once. Cost: O(P) cone
-/// computations.
-fn cones(set: &SurfaceSet) -> Vec<[f32; 4]> {
-    let mut out = Vec::with_capacity(3 * set.patches.len());
-    for patch in &set.patches {
-        let cone = tessera::criterion::screen::normal_cone(patch);
-        let (axis, alpha) = cone.unwrap_or((glam::DVec3::Z, 0.0));
-        out.push([axis.x as f32, axis.y as f32, axis.z as f32, alpha as f32]);
-        // As in `screen::back_facing`: the centre is the control points' mean.
-        let pts = patch.control_points();
-        let centre = pts.iter().copied().sum::<glam::DVec3>() / pts.len() as f64;
-        let radius = pts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-        out.push([centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]);
-        out.push([alpha.sin() as f32, alpha.cos() as f32, cone.is_some() as u32 as f32, 0.0]);
+/// `view.wgsl`'s interior rules and criteria.
+const INTERIOR_GLOBAL: u32 = 0;
+const INTERIOR_CORE: u32 = 1;
+const CRITERION_PIXEL_ERROR: u32 = 0;
+const CRITERION_SILHOUETTENESS: u32 = 1;
+/// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
+const EDGE_VIEW_ROW: usize = 3;
+
+/// The criterion of [`GpuTessellator::prepare_screen`], as `view.wgsl` reads it.
+#[derive(Debug, Clone, Copy)]
+struct Screen {
+    criterion: u32,
+    pixels: f64,
+    lo: f64,
+    hi: f64,
+    max_factor: u32,
+    interior: u32,
+}
+
+/// The view passes' buffers (`view.wgsl`'s group 1) and their bind group.
+#[derive(Debug)]
+struct ViewBuffers {
+    uniform: wgpu::Buffer,
+    patch_views: wgpu::Buffer,
+    minimum_segments: wgpu::Buffer,
+    global: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+    /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
+    /// device.
+    bounds_uploaded: bool,
+}
+
+impl ViewBuffers {
+    /// The buffers for `set`, the culling rows filled (the bounds come with
+    /// [`GpuTessellator::prepare_screen`]). Cost: O(P) cone computations, one upload.
+    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, set: &SurfaceSet) -> ViewBuffers {
+        use wgpu::BufferUsages as U;
+        let uniform = buffer(device, "view", 112, U::UNIFORM | U::COPY_DST);
+        let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
+        let minimum_segments =
+            buffer(device, "minimum segments", 4 * set.topology.edges.len() as u64, U::STORAGE | U::COPY_DST);
+        let proposals = buffer(device, "proposals", 16 * set.patches.len() as u64, U::STORAGE);
+        let global = buffer(device, "global factor", 4, U::STORAGE | U::COPY_DST);
+        let bind =
+            shader::bind(device, layout, &[&uniform, &patch_views, &minimum_segments, &proposals, &global]);
+        ViewBuffers { uniform, patch_views, minimum_segments, global, bind, bounds_uploaded: false }
+    }
+}
+
+/// Per patch, [`PATCH_VIEW_ROW`] `vec4<f32>` (`view.wgsl`): from
+/// [`tessera::criterion::screen::PatchView`] the normal cone (axis, half-angle α), the
+/// bounding sphere of the control points about their mean (`screen::back_facing`'s),
+/// `(sin α, cos α, has cone, 0)`, the control-point box's lo and hi; then from `prepared`
+/// (zero without it) the second-derivative bound `(uu, uv, vv, 0)`, the four boundary
+/// curves' bounds and the minimum interior factors; after the patches, [`EDGE_VIEW_ROW`]
+/// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, the
+/// normals of its first and last patch). View-independent: computed once. Cost: O(P) cone
+/// computations, the midpoints' evaluations when `prepared` has none yet.
+fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
+    let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+    let mut out = Vec::with_capacity(PATCH_VIEW_ROW as usize * set.patches.len());
+    for (p, patch) in set.patches.iter().enumerate() {
+        let view = tessera::criterion::screen::PatchView::new(patch);
+        let (axis, alpha) = view.cone.unwrap_or((glam::DVec3::Z, 0.0));
+        out.push(v4(axis, alpha));
+        out.push(v4(view.centre, view.radius));
+        out.push([alpha.sin() as f32, alpha.cos() as f32, view.cone.is_some() as u32 as f32, 0.0]);
+        out.push(v4(view.lo, 0.0));
+        out.push(v4(view.hi, 0.0));
+        match prepared {
+            Some(prepared) => {
+                let m = &prepared.hessians[p];
+                out.push([m.uu as f32, m.uv as f32, m.vv as f32, 0.0]);
+                out.push(prepared.curves[p].map(|c| c as f32));
+                let [u, v] = prepared.minimum_interior[p];
+                out.push([u as f32, v as f32, 0.0, 0.0]);
+            }
+            None => out.extend([[0.0; 4]; 3]),
+        }
+    }
+    let edges = set.topology.edges.len();
+    match prepared {
+        Some(prepared) => {
+            for [(mid, nl), (_, nr)] in prepared.edge_midpoints(set) {
+                out.extend([v4(*mid, 0.0), v4(*nl, 0.0), v4(*nr, 0.0)]);
+            }
+        }
+        None => out.resize(out.len() + EDGE_VIEW_ROW * edges, [0.0; 4]),
     }
     out
 }

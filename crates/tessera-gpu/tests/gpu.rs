@@ -12,6 +12,7 @@ use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
 use tessera::surface::{BuildOptions, SurfaceSet};
 use tessera_gpu::scan::{Scan, ScanPipelines};
+use tessera_gpu::tessellator::{Capacity, Pipelines, ScreenCriterion};
 use tessera_gpu::{readback, GpuContext, GpuError, GpuTessellator};
 
 /// One device for the whole binary (creating one per test costs time on lavapipe).
@@ -21,6 +22,18 @@ fn ctx() -> &'static GpuContext {
         Ok(c) => c,
         Err(e) => panic!("{e}"),
     })
+}
+
+/// One compiled pipeline set for the whole binary (a dozen WGSL compilations, seconds on
+/// lavapipe).
+fn pipelines() -> std::sync::Arc<Pipelines> {
+    static PIPELINES: OnceLock<std::sync::Arc<Pipelines>> = OnceLock::new();
+    PIPELINES.get_or_init(|| std::sync::Arc::new(Pipelines::new(&ctx().device))).clone()
+}
+
+/// A tessellator for `set` on the shared device and pipelines.
+fn tessellator(set: &SurfaceSet) -> GpuTessellator {
+    GpuTessellator::with_pipelines(ctx(), set, pipelines()).unwrap()
 }
 
 fn data_dir() -> PathBuf {
@@ -208,7 +221,7 @@ fn assert_gpu_equals_cpu_after_record(
 fn uniform_tessellation_equals_the_cpu_engine_on_every_patch_model() {
     for model in patch_models() {
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         // The torus is large: fewer factors there keep the fast tier fast.
         let factors: &[u32] = if set.patches.len() > 500 { &[1, 5] } else { &[1, 2, 3, 8] };
         for &n in factors {
@@ -227,7 +240,7 @@ fn uniform_pn_triangles_equal_the_cpu_engine_on_small_meshes() {
             continue;
         }
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         for n in [1, 4] {
             let plan = Plan::uniform(&set, n).unwrap();
             assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
@@ -240,7 +253,7 @@ fn uniform_pn_triangles_equal_the_cpu_engine_on_small_meshes() {
 fn uniform_pn_triangles_equal_the_cpu_engine_on_every_mesh() {
     for model in mesh_models() {
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         for n in [2, 3, 7] {
             let plan = Plan::uniform(&set, n).unwrap();
             assert_gpu_equals_cpu(&format!("{model} n={n}"), &set, &mut gpu, &plan);
@@ -253,7 +266,7 @@ fn uniform_pn_triangles_equal_the_cpu_engine_on_every_mesh() {
 fn uniform_tessellation_equals_the_cpu_engine_at_larger_factors() {
     for model in patch_models() {
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         // Torus factor 32: 4,194,304 triangles, 65,536 workgroups: the 2D dispatch layout.
         let factors: &[u32] = if set.patches.len() > 500 { &[3, 16, 32] } else { &[5, 13, 32, 64] };
         for &n in factors {
@@ -268,7 +281,7 @@ fn culled_patches_emit_nothing_as_on_the_cpu() {
     let mut rng = Lcg(3);
     for model in ["patches/teapot.patches", "patches/teacup.patches"] {
         let set = load(model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         for round in 0..3 {
             let mut plan = Plan::uniform(&set, 4 + round).unwrap();
             for v in plan.visible.iter_mut() {
@@ -283,6 +296,7 @@ fn culled_patches_emit_nothing_as_on_the_cpu() {
 fn an_output_past_the_device_limits_is_refused_not_truncated() {
     let ctx = ctx();
     let set = load("patches/teapot.patches");
+    // `new` compiles its own pipelines (every other test shares one set).
     let mut gpu = GpuTessellator::new(ctx, &set).unwrap();
     let plan = Plan::uniform(&set, tessera::criterion::MAX_FACTOR).unwrap();
     let err = gpu.prepare(ctx, &set, &plan, &tessera::pattern::uniform::Uniform).unwrap_err();
@@ -345,7 +359,7 @@ fn culling_equals_the_cpu(cameras_per_model: usize, seed: u64) {
     let ctx = ctx();
     for model in patch_models() {
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx, &set).unwrap();
+        let mut gpu = tessellator(&set);
         let n = if set.patches.len() > 500 { 2 } else { 4 };
         let mut culled_somewhere = 0;
         for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
@@ -390,9 +404,8 @@ fn culling_equals_the_cpu(cameras_per_model: usize, seed: u64) {
 
 #[test]
 fn output_buffers_grow_with_the_plan_and_the_output_stays_complete() {
-    let ctx = ctx();
     let set = load("patches/teacup.patches");
-    let mut gpu = GpuTessellator::new(ctx, &set).unwrap();
+    let mut gpu = tessellator(&set);
     let mut last = 0;
     for n in [2, 9, 3, 17] {
         let plan = Plan::uniform(&set, n).unwrap();
@@ -408,7 +421,7 @@ fn transition_tessellation_equals_the_cpu_engine_on_every_patch_model() {
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     for model in patch_models() {
         let set = load(&model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         let diagonal = diagonal(&set);
         // CudaTess's own plans: per-edge factors from an object-space tolerance.
         let tolerances: &[f64] = if set.patches.len() > 500 { &[1e-3] } else { &[1e-2, 1e-3] };
@@ -454,7 +467,7 @@ fn transition_on_random_factors(models: &[&str], rounds: u32, max: u32, seed: u6
     let mut rng = Lcg(seed);
     for &model in models {
         let set = load(model);
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         for round in 0..rounds {
             let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % max).collect();
             let interior =
@@ -489,10 +502,668 @@ fn uniform_bezier_triangles_equal_the_cpu_engine() {
             })
             .collect();
         let set = SurfaceSet::from_patches(patches, BuildOptions::default());
-        let mut gpu = GpuTessellator::new(ctx(), &set).unwrap();
+        let mut gpu = tessellator(&set);
         for n in [1, 3, 6] {
             let plan = Plan::uniform(&set, n).unwrap();
             assert_gpu_equals_cpu(&format!("{model} as Bézier triangles, n={n}"), &set, &mut gpu, &plan);
         }
     }
+}
+
+/// `set` with its PN triangles replaced by their cubic Bézier geometry (normals then come
+/// from the derivatives).
+fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
+    let patches = pn
+        .patches
+        .iter()
+        .map(|p| match p {
+            tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
+            other => other.clone(),
+        })
+        .collect();
+    SurfaceSet::from_patches(patches, BuildOptions::default())
+}
+
+#[test]
+fn transition_on_triangle_patches_equals_the_cpu_engine() {
+    // CudaTess's triangle regions (strips, raised cores, the two-region modification) on PN
+    // triangles and cubic Bézier triangles: the CPU's own transition plans from an
+    // object-space tolerance, then arbitrary per-edge and core factors.
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let mut rng = Lcg(31);
+    for model in ["meshes/blob.obj", "awkward/teapot_tri_nonmanifold.obj"] {
+        let pn = load(model);
+        for (kind, set) in [("PN", pn.clone()), ("Bézier", as_bezier_triangles(&pn))] {
+            let mut gpu = tessellator(&set);
+            let diagonal = diagonal(&set);
+            for rel in [1e-2, 2e-3] {
+                let planned = Scheme::Transition
+                    .plan(&set, &Criterion::Tolerance(rel * diagonal), &PlanOptions::default())
+                    .unwrap();
+                let distinct: std::collections::BTreeSet<u32> =
+                    planned.plan.segments.iter().copied().collect();
+                assert!(distinct.len() > 1, "{model}: one factor everywhere, no strips tested");
+                let name = format!("{model} {kind} tolerance {rel}");
+                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+            }
+            for round in 0..3 {
+                let max = 7;
+                let segments = (0..set.topology.edges.len()).map(|_| 1 + rng.next() % max).collect();
+                let interior = (0..set.patches.len())
+                    .map(|_| {
+                        let n = 1 + rng.next() % max;
+                        [n, n]
+                    })
+                    .collect();
+                let mut plan = Plan::integer(segments, interior, set.patches.len());
+                if round == 2 {
+                    plan.visible.iter_mut().step_by(3).for_each(|v| *v = 0);
+                }
+                let name = format!("{model} {kind} random round {round}");
+                assert_pattern_equals_cpu(
+                    &name,
+                    &set,
+                    &mut gpu,
+                    &plan,
+                    &tessera::pattern::transition::Transition,
+                );
+            }
+        }
+    }
+}
+
+/// Output size of a sweep frame: factors chosen so that no frame exceeds about this many
+/// triangles (lavapipe and the CPU comparison stay fast).
+const SWEEP_TRIANGLES: usize = 25_000;
+
+/// Whether patch `p`'s culling for `camera` is within rounding of the other answer, so
+/// that the GPU (f32) and the CPU (f64) may decide it differently: a frustum plane that
+/// every control point but one is beyond, that one within 1e-5 of the scene's size of it
+/// (`screen::PatchView::culled`'s control-point test), or the normal-cone test
+/// (`screen::PatchView::back_facing`) within 1e-5 of its bound. Only explains differences;
+/// the expected culled set is always the CPU's.
+fn near_cull_tie(set: &SurfaceSet, p: usize, camera: &tessera::camera::Camera) -> bool {
+    let view = camera.view();
+    let patch = &set.patches[p];
+    let scale = 1e-5 * (diagonal(set) + (camera.eye - set.bounds().0).length());
+    let t = view.half_tangents;
+    let (nx, ny) = ((1.0 + t.x * t.x).sqrt(), (1.0 + t.y * t.y).sqrt());
+    // Signed distances, positive outside; a plane culls when every point is outside.
+    let plane = |k: usize, c: glam::DVec3| match k {
+        0 => view.near - c.z,
+        1 => c.z - view.far,
+        2 => (c.x - t.x * c.z) / nx,
+        3 => (-c.x - t.x * c.z) / nx,
+        4 => (c.y - t.y * c.z) / ny,
+        _ => (-c.y - t.y * c.z) / ny,
+    };
+    let frustum_tie = (0..6).any(|k| {
+        let least =
+            patch.control_points().iter().map(|&q| plane(k, view.to_camera(q))).fold(f64::INFINITY, f64::min);
+        least.abs() <= scale
+    });
+    let pv = tessera::criterion::screen::PatchView::new(patch);
+    let cone_tie = pv.cone.is_some_and(|(axis, alpha)| {
+        let to_eye = camera.eye - pv.centre;
+        let dist = to_eye.length();
+        let sin_b = (pv.radius / dist).min(1.0);
+        let beta = sin_b.asin();
+        let gamma = axis.dot(to_eye / dist).clamp(-1.0, 1.0).acos();
+        (gamma - (std::f64::consts::FRAC_PI_2 + alpha + beta)).abs() <= 1e-5
+            || (alpha + beta - std::f64::consts::FRAC_PI_2).abs() <= 1e-5
+    });
+    frustum_tie || cone_tie
+}
+
+/// Per-sweep tallies, reported at the end.
+#[derive(Debug, Default)]
+struct SweepCounts {
+    frames: usize,
+    culled: usize,
+    /// Patches the GPU culled unlike the CPU, each a [`near_cull_tie`].
+    cull_ties: usize,
+    /// Uniform frames whose GPU factor, and transition edges whose GPU segments, differ from
+    /// the CPU's at a rounding boundary.
+    factor_ties: usize,
+    /// Uniform frames whose factor the cap did not decide.
+    below_cap: usize,
+    /// Transition frames with more than one edge factor.
+    strips: usize,
+}
+
+/// The GPU's culled set against the CPU plan's: equal but for [`near_cull_tie`]s, which
+/// are counted. Returns the GPU's row.
+fn check_culling(
+    name: &str,
+    set: &SurfaceSet,
+    gpu: &GpuTessellator,
+    cpu_visible: &[u32],
+    camera: &tessera::camera::Camera,
+    counts: &mut SweepCounts,
+) -> Vec<u32> {
+    let visible = gpu.read_visible(ctx()).unwrap();
+    let differ: Vec<usize> = (0..visible.len()).filter(|&p| visible[p] != cpu_visible[p]).collect();
+    for &p in &differ {
+        assert!(near_cull_tie(set, p, camera), "{name}: patch {p} culled unlike the CPU, and not at a tie");
+    }
+    counts.cull_ties += differ.len();
+    counts.culled += cpu_visible.iter().filter(|&&v| v == 0).count();
+    visible
+}
+
+/// The CPU's pixel-error value before `ceil` of the factor that decides the uniform plan's
+/// global factor: the largest over the visible patches of `tolerance::uniform_factor` and
+/// `curve_factor`'s square roots (the same formulas, in f64), for explaining a GPU factor
+/// one off the CPU's.
+fn uniform_pixel_error_root(
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    camera: &tessera::camera::Camera,
+    pixels: f64,
+    visible: &[u32],
+) -> f64 {
+    let view = camera.view();
+    let views = prepared.views(set);
+    let mut root = 0.0f64;
+    for p in (0..set.patches.len()).filter(|&p| visible[p] != 0) {
+        let eps = views[p].tolerance(&set.patches[p], &view, pixels, false).unwrap();
+        let m = &prepared.hessians[p];
+        root = root.max(((m.uu + 2.0 * m.uv + m.vv) / (8.0 * eps)).sqrt());
+        for l in 0..set.patches[p].domain().corner_count() {
+            root = root.max((prepared.curves[p][l] / (8.0 * eps)).sqrt());
+        }
+    }
+    root
+}
+
+/// The acceptance sweep on `models`: `cameras_per_model` seeded cameras each, two frames
+/// per camera, each against the CPU library:
+///
+/// - **uniform, from the camera alone**: the GPU culls and computes the pixel-error factor
+///   ([`GpuTessellator::prepare_screen`]); its culled set and plan (segments, interior
+///   factors) equal `Scheme::Uniform`'s pixel-error plan on the CPU, but for the counted
+///   rounding ties ([`near_cull_tie`]; a factor one off where the CPU's root is within
+///   1e-5 relative of an integer);
+/// - **transition**, odd cameras **from the camera alone**: the GPU culls and computes
+///   silhouetteness factors (per edge, maximum over the edge's patches, the core rule);
+///   its plan equals `Scheme::Transition`'s on the CPU but for counted rounding ties;
+///   even cameras: the CPU's pixel-error plan (CudaTess's per-edge factors, checked a
+///   posteriori) uploaded, the GPU culling; the culled set equals the CPU's but for ties.
+///
+/// Then the whole output equals the CPU engine's for the plan the GPU drew
+/// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
+/// index, positions within 1e-5 of the diagonal, the watertightness report).
+fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
+    use tessera::criterion::view::ViewCriterion;
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let mut counts = SweepCounts::default();
+    for model in models {
+        let start = std::time::Instant::now();
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        // The factor cap from the size: 2n² triangles a quad at factor n.
+        let per_patch = SWEEP_TRIANGLES / set.patches.len();
+        let cap = (1..=8u32).rev().find(|n| 2 * (n * n) as usize <= per_patch.max(2)).unwrap_or(1);
+        // Pixel errors: the uniform frame's global factor is the finest patch's, so it needs a
+        // coarser error to fall below the cap on some cameras.
+        // The largest meshes' patches are a few pixels wide: a finer error gives them strips.
+        let (uniform_pixels, pixels) = (16.0, if set.patches.len() > 40_000 { 2.0 } else { 4.0 });
+        // Transition strips need two factors: a cap of at least 2.
+        let transition_options = |camera| PlanOptions {
+            camera: Some(camera),
+            cull: true,
+            max_factor: cap.max(2),
+            ..Default::default()
+        };
+        let (culled_before, strips_before) = (counts.culled, counts.strips);
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            // Uniform: the GPU plans the frame from the camera.
+            let name = format!("{model} camera {c} uniform");
+            let criterion = Criterion::PixelError(uniform_pixels);
+            let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+            let screen = ScreenCriterion {
+                scheme: Scheme::Uniform,
+                criterion: Criterion::PixelError(uniform_pixels),
+                max_factor: cap,
+                capacity: None,
+            };
+            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
+            let drawn = gpu.read_plan(ctx).unwrap();
+            assert_eq!(drawn.visible, visible);
+            let (want, got) = (cpu.segments.iter().max().copied(), drawn.segments.iter().max().copied());
+            assert!(drawn.segments.iter().all(|&s| Some(s) == got), "{name}: segments not uniform");
+            assert!(
+                drawn.interior.iter().all(|&[u, v]| Some(u) == got && Some(v) == got),
+                "{name}: interiors"
+            );
+            if got != want {
+                // Only a rounding tie of the deciding root, with the same culled set.
+                let root = uniform_pixel_error_root(&set, &prepared, &camera, uniform_pixels, &visible);
+                let tie = (root - root.round()).abs() <= 1e-5 * root;
+                assert!(
+                    visible == cpu.visible && tie && want.unwrap().abs_diff(got.unwrap()) == 1,
+                    "{name}: GPU factor {got:?}, the CPU's {want:?} (root {root})"
+                );
+                counts.factor_ties += 1;
+            } else if visible == cpu.visible {
+                assert_eq!(drawn.segments, cpu.segments, "{name}: segments");
+                assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
+            }
+            counts.below_cap += (got.unwrap() < cap) as usize;
+            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &Uniform);
+
+            // Transition, odd cameras: the GPU plans the frame from the camera (silhouetteness
+            // factors); even cameras: the CPU's pixel-error plan (CudaTess's own per-edge
+            // factors, a-posteriori checked) uploaded, the GPU culling.
+            let options = transition_options(camera);
+            let (name, plan, pattern) = if c % 2 == 1 {
+                let name = format!("{model} camera {c} transition from the camera");
+                let fmax = options.max_factor as f64;
+                let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
+                let planned =
+                    Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Transition,
+                    criterion,
+                    max_factor: options.max_factor,
+                    capacity: None,
+                };
+                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
+                let drawn = gpu.read_plan(ctx).unwrap();
+                if drawn.segments != planned.plan.segments {
+                    // Only rounding ties (see `silhouetteness_on_the_gpu`), counted.
+                    let real = tessera::criterion::view::edge_factors(
+                        &set,
+                        &camera,
+                        ViewCriterion::Silhouetteness,
+                        1.0,
+                        fmax,
+                    );
+                    for e in (0..real.len()).filter(|&e| drawn.segments[e] != planned.plan.segments[e]) {
+                        assert!((real[e] - real[e].floor() - 0.5).abs() <= 1e-4, "{name}: edge {e} factor");
+                        counts.factor_ties += 1;
+                    }
+                } else {
+                    assert_eq!(drawn.interior, planned.plan.interior, "{name}: interior factors");
+                }
+                (name, drawn, planned.pattern)
+            } else {
+                let name = format!("{model} camera {c} transition");
+                let criterion = Criterion::PixelError(pixels);
+                let planned =
+                    Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let mut plan = planned.plan.clone();
+                plan.visible.fill(1);
+                gpu.set_cull_camera(ctx, Some(&camera));
+                gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                plan.visible = check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
+                (name, plan, planned.pattern)
+            };
+            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
+            let s = &plan.segments;
+            counts.strips += s.iter().any(|&x| x != s[0]) as usize;
+            counts.frames += 2;
+        }
+        assert!(
+            counts.culled > culled_before,
+            "{model}: the cameras culled nothing, the sweep proves little"
+        );
+        assert!(counts.strips > strips_before, "{model}: no transition frame had two edge factors");
+        eprintln!("{model}: cap {cap}, {:.1} s", start.elapsed().as_secs_f64());
+    }
+    eprintln!("{counts:?}");
+    counts
+}
+
+fn all_models() -> Vec<String> {
+    let mut models = patch_models();
+    models.extend(mesh_models());
+    models
+}
+
+#[test]
+fn acceptance_sweep_on_the_small_models() {
+    // The fast tier: the small patch models and the meshes under 15 kB, 4 cameras each.
+    let models: Vec<String> = all_models()
+        .into_iter()
+        .filter(|m| {
+            std::fs::metadata(data_dir().join(m)).unwrap().len() < 15_000 || m.starts_with("patches/")
+        })
+        .collect();
+    let counts = acceptance_sweep(&models, 3, 77);
+    assert!(counts.below_cap > 0, "no uniform frame below the cap: the GPU factor was never tested");
+}
+
+#[test]
+#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform and transition"]
+fn acceptance_sweep_on_every_model_20_cameras() {
+    // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
+    // at factors 1 and 2 most of their work is the CPU side of the comparison).
+    let (large, rest): (Vec<String>, Vec<String>) = all_models()
+        .into_iter()
+        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    let mut counts = acceptance_sweep(&rest, 20, 2026);
+    let more = acceptance_sweep(&large, 10, 2026);
+    counts.frames += more.frames;
+    counts.culled += more.culled;
+    counts.cull_ties += more.cull_ties;
+    counts.factor_ties += more.factor_ties;
+    counts.below_cap += more.below_cap;
+    assert!(counts.below_cap > 0, "no uniform frame below the cap: the GPU factor was never tested");
+    // Rounding ties must stay rare: at most one frame or patch in a hundred.
+    assert!(100 * counts.factor_ties <= counts.frames, "{counts:?}");
+    assert!(100 * counts.cull_ties <= counts.culled.max(100), "{counts:?}");
+}
+
+/// A camera inside the model's box looking at its centre: close patches drive a fine
+/// pixel error to the cap.
+fn close_camera(set: &SurfaceSet) -> tessera::camera::Camera {
+    let (lo, hi) = set.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    tessera::camera::Camera {
+        eye: centre + glam::DVec3::new(0.3, -0.5, 0.4) * radius,
+        target: centre,
+        up: glam::DVec3::Z,
+        fov_y_degrees: 70.0,
+        width: 1280,
+        height: 1024,
+        near: radius * 1e-3,
+        far: radius * 10.0,
+    }
+}
+
+/// The capacity test on `model` at factor cap `cap`: a close camera and a fine pixel error
+/// drive the GPU's factor to the cap (checked on the CPU plan). Started with the default
+/// room (the worst case within the device's limits) the frame fits or reports an overflow
+/// and grows; started with room for 16 triangles it must overflow, grow and rerun. Either
+/// way the final frame is complete: its layout (every offset, so every patch's triangle
+/// count) equals the CPU's for the CPU plan, and so does the triangle total.
+fn capacity_at_the_cap(model: &str, cap: u32) {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let set = load(model);
+    let prepared = tessera::scheme::Prepared::new(&set, true);
+    let camera = close_camera(&set);
+    let pixels = 0.001;
+    let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+    let cpu = Scheme::Uniform
+        .plan_prepared(&set, &prepared, &Criterion::PixelError(pixels), &options)
+        .unwrap()
+        .plan;
+    assert_eq!(cpu.segments.iter().max(), Some(&cap), "{model}: the camera does not reach the cap");
+    let mut layout = Layout::default();
+    layout.build(&set, &cpu, &Uniform, &TessellateOptions::default()).unwrap();
+    let total = *layout.triangle_offsets.last().unwrap();
+    let tiny = Capacity { vertices: 16, triangles: 16 };
+    for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {
+        let name = format!("{model} cap {cap}, {start}");
+        let mut gpu = tessellator(&set);
+        let screen = ScreenCriterion {
+            scheme: Scheme::Uniform,
+            criterion: Criterion::PixelError(pixels),
+            max_factor: cap,
+            capacity,
+        };
+        gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+        let mut grown = 0;
+        loop {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            if !gpu.grow_if_overflowed(ctx).unwrap() {
+                break;
+            }
+            grown += 1;
+            assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
+        }
+        assert!(capacity.is_none() || grown > 0, "{name}: 16 triangles of room and no overflow");
+        let (overflow, _, triangles) = gpu.read_status(ctx).unwrap();
+        assert!(!overflow, "{name}");
+        assert_eq!(triangles, total, "{name}: triangle total");
+        assert_eq!(gpu.read_plan(ctx).unwrap().visible, cpu.visible, "{name}: culled set");
+        let (edge_offsets, interior_offsets, triangle_offsets) = gpu.read_layout(ctx).unwrap();
+        assert_eq!(triangle_offsets, layout.triangle_offsets, "{name}: triangle offsets");
+        assert_eq!(edge_offsets, layout.edge_offsets, "{name}: edge offsets");
+        assert_eq!(interior_offsets, layout.interior_offsets, "{name}: interior offsets");
+        eprintln!(
+            "{name}: {total} triangles, grown {grown} times, capacity {:?}, device limit {} bytes",
+            gpu.capacity().unwrap(),
+            ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size)
+        );
+    }
+}
+
+#[test]
+fn capacity_at_the_cap_fits_or_grows_and_the_output_is_complete() {
+    capacity_at_the_cap("patches/teapot.patches", 64);
+}
+
+#[test]
+#[ignore = "slow tier: the torus at factor cap 64 (a worst case past the storage binding limit)"]
+fn capacity_at_the_cap_on_the_torus() {
+    capacity_at_the_cap("bench/torus_64x32.patches", 64);
+    // At cap 256 the frame needs several times the storage binding limit: it overflows,
+    // draws nothing (zero indirect counts, no partial mesh) and growing refuses with the
+    // sizes, so no patch is dropped silently.
+    use tessera::scheme::Scheme;
+    let ctx = ctx();
+    let set = load("bench/torus_64x32.patches");
+    let prepared = tessera::scheme::Prepared::new(&set, true);
+    let mut gpu = tessellator(&set);
+    let screen = ScreenCriterion {
+        scheme: Scheme::Uniform,
+        criterion: tessera::scheme::Criterion::PixelError(0.001),
+        max_factor: 256,
+        capacity: None,
+    };
+    gpu.prepare_screen(ctx, &set, &prepared, &close_camera(&set), screen).unwrap();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+    let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
+    assert_eq!(draw[0], 0, "an overflowing frame drew {} indices", draw[0]);
+    match gpu.grow_if_overflowed(ctx) {
+        Err(GpuError::OutputTooLarge { triangles, limit, .. }) => {
+            assert!(triangles * 12 > limit, "refused {triangles} triangles under the limit {limit}")
+        }
+        other => panic!("expected OutputTooLarge, got {other:?}"),
+    }
+}
+
+/// The GPU's pixel-error factor against the CPU plan's on `cameras_per_model` seeded
+/// cameras per patch model and four pixel errors each, at a cap of 32: equal but for
+/// rounding ties of the deciding root (counted, at most one in a hundred), and spread over
+/// many values (the cap must not decide them all).
+fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let cap = 32;
+    let (mut frames, mut ties) = (0, 0);
+    let mut seen = std::collections::BTreeSet::new();
+    for model in ["patches/teapot.patches", "patches/teacup.patches", "patches/teapot_teasetorig.patches"] {
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            for pixels in [0.5, 2.0, 8.0, 32.0] {
+                let name = format!("{model} camera {c} {pixels} px");
+                let options =
+                    PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+                let criterion = Criterion::PixelError(pixels);
+                let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Uniform,
+                    criterion: Criterion::PixelError(pixels),
+                    max_factor: cap,
+                    capacity: None,
+                };
+                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                let got = gpu.read_plan(ctx).unwrap();
+                frames += 1;
+                if got.visible != cpu.visible {
+                    // A culling tie: the factors then follow another set of patches.
+                    let differ = (0..got.visible.len()).filter(|&p| got.visible[p] != cpu.visible[p]);
+                    assert!(differ.clone().all(|p| near_cull_tie(&set, p, &camera)), "{name}: culling");
+                    ties += 1;
+                    continue;
+                }
+                let want = cpu.segments[0];
+                seen.insert(want);
+                if got.segments != cpu.segments || got.interior != cpu.interior {
+                    let root = uniform_pixel_error_root(&set, &prepared, &camera, pixels, &cpu.visible);
+                    let tie = (root - root.round()).abs() <= 1e-5 * root;
+                    assert!(
+                        tie && got.segments.iter().all(|&s| s.abs_diff(want) == 1),
+                        "{name}: GPU factor {:?}, the CPU's {want} (root {root})",
+                        got.segments.first()
+                    );
+                    ties += 1;
+                }
+            }
+        }
+    }
+    eprintln!("{frames} frames, {ties} rounding ties, factors {seen:?}");
+    assert!(100 * ties <= frames, "{ties} ties in {frames} frames");
+    assert!(seen.len() >= 8, "factors {seen:?}: too few distinct values to test the criterion");
+}
+
+#[test]
+fn gpu_pixel_error_factors_equal_the_cpu_plans() {
+    gpu_factors_equal_the_cpu_plans(5, 5);
+}
+
+#[test]
+#[ignore = "slow tier: 20 more cameras per patch model"]
+fn gpu_pixel_error_factors_equal_the_cpu_plans_on_20_more_cameras() {
+    gpu_factors_equal_the_cpu_plans(20, 55);
+}
+
+/// The transition frame from the camera alone (silhouetteness, `ViewCriterion::
+/// Silhouetteness` with factors 1 to 12, cap 16): the GPU's plan equals
+/// `Scheme::Transition`'s on the CPU — segments but for counted rounding ties (an edge whose
+/// real factor `view::edge_factors` lies within 1e-4 of a half-integer, one off), interiors
+/// exactly those of `resolve::interiors` on the GPU's segments, the culled set but for
+/// [`near_cull_tie`]s — and every `mesh_every`-th frame's output equals the CPU engine's for
+/// the plan drawn.
+fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u64, mesh_every: usize) {
+    use tessera::criterion::resolve::{self, InteriorRule};
+    use tessera::criterion::view::ViewCriterion;
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let (cap, fmin, fmax) = (16, 1.0, 12.0);
+    let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax };
+    let (mut frames, mut edges, mut ties, mut strips) = (0, 0, 0, 0);
+    for &model in models {
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            let name = format!("{model} camera {c} silhouetteness");
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+            let cpu = &planned.plan;
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
+            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            let drawn = gpu.read_plan(ctx).unwrap();
+            for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
+                assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
+            }
+            if drawn.segments != cpu.segments {
+                let real = tessera::criterion::view::edge_factors(
+                    &set,
+                    &camera,
+                    ViewCriterion::Silhouetteness,
+                    fmin,
+                    fmax,
+                );
+                for e in (0..cpu.segments.len()).filter(|&e| drawn.segments[e] != cpu.segments[e]) {
+                    let tie = (real[e] - real[e].floor() - 0.5).abs() <= 1e-4;
+                    assert!(
+                        tie && drawn.segments[e].abs_diff(cpu.segments[e]) == 1,
+                        "{name}: edge {e} has {} segments, the CPU's {} (factor {})",
+                        drawn.segments[e],
+                        cpu.segments[e],
+                        real[e]
+                    );
+                    ties += 1;
+                }
+            }
+            let mut interior = Vec::new();
+            resolve::interiors(
+                &set,
+                &drawn.segments,
+                InteriorRule::Core,
+                &prepared.caps(cap as f64),
+                &mut interior,
+            );
+            assert_eq!(drawn.interior, interior, "{name}: interior factors");
+            if drawn.segments == cpu.segments {
+                assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
+            }
+            strips += drawn.segments.iter().any(|&s| s != drawn.segments[0]) as usize;
+            edges += cpu.segments.len();
+            frames += 1;
+            if c % mesh_every == 0 {
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &planned.pattern);
+            }
+        }
+    }
+    eprintln!(
+        "silhouetteness: {frames} frames, {edges} edges, {ties} rounding ties, {strips} frames with strips"
+    );
+    assert!(strips * 2 >= frames, "too few frames with two factors: {strips} of {frames}");
+    assert!(1000 * ties <= edges, "{ties} rounding ties in {edges} edges");
+}
+
+#[test]
+fn transition_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
+    silhouetteness_on_the_gpu(
+        &["patches/teapot.patches", "patches/teacup.patches", "meshes/blob.obj", "meshes/dragknob.obj"],
+        4,
+        8,
+        2,
+    );
+}
+
+#[test]
+#[ignore = "slow tier: the transition frame from the camera on every patch model and three meshes, 10 cameras"]
+fn transition_from_the_camera_on_the_gpu_on_10_cameras() {
+    silhouetteness_on_the_gpu(
+        &[
+            "patches/teapot.patches",
+            "patches/teacup.patches",
+            "patches/teapot_teasetorig.patches",
+            "bench/torus_64x32.patches",
+            "meshes/blob.obj",
+            "meshes/dragknob.obj",
+            "awkward/teapot_tri_nonmanifold.obj",
+        ],
+        10,
+        88,
+        5,
+    );
 }

@@ -1,11 +1,13 @@
-// The CudaTess transition pattern on quads, `tessera::pattern::transition` (`QuadLayout`,
-// `walk`), on the CPU's local vertex numbering (`tessera::pattern::PatternInput`), mapped
-// to output vertices by the layout's rule (`engine` `LocalMap::vertex`). One invocation
-// builds one patch, in the CPU's triangle order, so counting and writing agree with the CPU
-// triangle for triangle.
+// The CudaTess transition pattern, `tessera::pattern::transition`, on quads (`QuadLayout`)
+// and triangles (`TriLayout`), with its strip walk (`walk`), on the CPU's local vertex
+// numbering (`tessera::pattern::PatternInput`), mapped to output vertices by the layout's
+// rule (`engine` `LocalMap::vertex`). One invocation builds one patch, in the CPU's triangle
+// order, so counting and writing agree with the CPU triangle for triangle.
 
-// `transition::QuadLayout`: the (possibly raised) core factors, which edges have strips
-// (bit e), and the core rectangle [i_lo, i_hi] × [j_lo, j_hi].
+// The core of either layout: the (possibly raised) core factors, which edges have strips
+// (bit e) and the core's extent in grid indices. Quads (`QuadLayout`): the rectangle
+// [i_lo, i_hi] × [j_lo, j_hi]. Triangles (`TriLayout`): nu = nv = n, the core triangle of
+// side m with its corner at (i_lo, j_lo); i_hi and j_hi unused.
 struct QuadLayout {
     nu: u32,
     nv: u32,
@@ -14,11 +16,14 @@ struct QuadLayout {
     i_hi: u32,
     j_lo: u32,
     j_hi: u32,
+    m: u32,
 }
 
-// One patch's pattern input and local numbering bases (`PatternInput::edge_base`).
+// One patch's pattern input and local numbering bases (`PatternInput::edge_base`); nc is
+// the domain's corner count (3 for a triangle domain).
 struct PatchInput {
     p: u32,
+    nc: u32,
     s: vec4<u32>,
     collapsed: u32,
     base: vec4<u32>,
@@ -28,12 +33,13 @@ struct PatchInput {
 
 fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
 
-// `transition::strips_at_collapsed_edges` for N = 4, updating in place as the CPU does.
-fn strips_at_collapsed(strip: u32, collapsed: u32) -> u32 {
+// `transition::strips_at_collapsed_edges` for N edges (3 or 4), updating in place as the
+// CPU does.
+fn strips_at_collapsed(strip: u32, collapsed: u32, n: u32) -> u32 {
     var s = strip;
-    for (var round = 0u; round < 4u; round = round + 1u) {
-        for (var e = 0u; e < 4u; e = e + 1u) {
-            if (bit(collapsed, e) != 0u && (bit(s, (e + 1u) % 4u) != 0u || bit(s, (e + 3u) % 4u) != 0u)) {
+    for (var round = 0u; round < n; round = round + 1u) {
+        for (var e = 0u; e < n; e = e + 1u) {
+            if (bit(collapsed, e) != 0u && (bit(s, (e + 1u) % n) != 0u || bit(s, (e + n - 1u) % n) != 0u)) {
                 s = s | (1u << e);
             }
         }
@@ -48,62 +54,105 @@ fn quad_layout(s: vec4<u32>, interior_factors: vec2<u32>, c: u32) -> QuadLayout 
     loop {
         var strip = select(0u, 1u, s.x != nu) | select(0u, 2u, s.y != nv) | select(0u, 4u, s.z != nu)
             | select(0u, 8u, s.w != nv);
-        strip = strips_at_collapsed(strip, c);
+        strip = strips_at_collapsed(strip, c, 4u);
         let fan_u = (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u));
         let fan_v = (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u));
         let need_u = bit(strip, 1u) + bit(strip, 3u) + fan_u;
         let need_v = bit(strip, 0u) + bit(strip, 2u) + fan_v;
         if (nu >= need_u && nv >= need_v) {
-            return QuadLayout(nu, nv, strip, bit(strip, 3u), nu - bit(strip, 1u), bit(strip, 0u), nv - bit(strip, 2u));
+            return QuadLayout(nu, nv, strip, bit(strip, 3u), nu - bit(strip, 1u), bit(strip, 0u), nv - bit(strip, 2u), 0u);
         }
         nu = max(nu, need_u);
         nv = max(nv, need_v);
     }
     // Unreachable: the loop returns (both factors only grow, to at most 3).
-    return QuadLayout(1u, 1u, 0u, 0u, 1u, 0u, 1u);
+    return QuadLayout(1u, 1u, 0u, 0u, 1u, 0u, 1u, 0u);
+}
+
+// `TriLayout::new`: the core factor n raised to the number of strips where needed.
+fn tri_layout(s: vec4<u32>, interior_factor: u32, c: u32) -> QuadLayout {
+    var n = max(interior_factor, 1u);
+    loop {
+        var strip = select(0u, 1u, s.x != n) | select(0u, 2u, s.y != n) | select(0u, 4u, s.z != n);
+        strip = strips_at_collapsed(strip, c, 3u);
+        let need = bit(strip, 0u) + bit(strip, 1u) + bit(strip, 2u);
+        if (n >= need) {
+            return QuadLayout(n, n, strip, bit(strip, 2u), 0u, bit(strip, 0u), 0u, n - need);
+        }
+        n = need;
+    }
+    // Unreachable: n only grows, to at most 3.
+    return QuadLayout(1u, 1u, 0u, 0u, 0u, 0u, 0u, 1u);
 }
 
 // `engine::layout::pattern_input` for patch p, with its local bases.
 fn patch_input(p: u32) -> PatchInput {
+    let nc = patch_corner_count(p);
     var s = vec4<u32>(0u);
     var collapsed = 0u;
-    for (var e = 0u; e < 4u; e = e + 1u) {
+    for (var e = 0u; e < nc; e = e + 1u) {
         s[e] = segments[patch_edge(p, e)];
         if (patch_edge_collapsed(p, e)) { collapsed = collapsed | (1u << e); }
     }
     var base = vec4<u32>(0u);
-    var b = 4u;
-    for (var e = 0u; e < 4u; e = e + 1u) {
+    var b = nc;
+    for (var e = 0u; e < nc; e = e + 1u) {
         base[e] = b;
         b = b + s[e] - 1u;
     }
-    return PatchInput(p, s, collapsed, base, b, quad_layout(s, interior[p], collapsed));
+    var core: QuadLayout;
+    if (nc == 3u) {
+        core = tri_layout(s, interior[p].x, collapsed);
+    } else {
+        core = quad_layout(s, interior[p], collapsed);
+    }
+    return PatchInput(p, nc, s, collapsed, base, b, core);
 }
 
-// The pattern's core factors: the interior grid is (nu − 1) × (nv − 1) points at
-// (i / nu, j / nv), rows of j (`QuadLayout::build`). Read by the interior vertex pass.
+// The pattern's core factors, read by the interior vertex pass: on a quad the interior grid
+// is (nu − 1) × (nv − 1) points at (i / nu, j / nv), rows of j (`QuadLayout::build`); on a
+// triangle the n-grid's interior points (`TriLayout::build`), nu = nv = n.
 fn interior_grid(p: u32) -> vec2<u32> {
     let input = patch_input(p);
     return vec2<u32>(input.core.nu, input.core.nv);
 }
 
-// `QuadLayout::counts`: interior vertices and pattern triangles.
+// `QuadLayout::counts` and `TriLayout::counts`: interior vertices and pattern triangles.
 fn transition_counts(input: PatchInput) -> vec2<u32> {
     let l = input.core;
+    if (input.nc == 3u) {
+        var triangles = l.m * l.m;
+        for (var e = 0u; e < 3u; e = e + 1u) {
+            if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + l.m; }
+        }
+        let n = l.nu;
+        return vec2<u32>(select(0u, (n - 1u) * (n - 2u) / 2u, n >= 2u), triangles);
+    }
     var triangles = 2u * (l.i_hi - l.i_lo) * (l.j_hi - l.j_lo);
     for (var e = 0u; e < 4u; e = e + 1u) {
-        if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + inner_segments(l, e); }
+        if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + inner_segments(input, e); }
     }
     return vec2<u32>((l.nu - 1u) * (l.nv - 1u), triangles);
 }
 
-fn inner_segments(l: QuadLayout, e: u32) -> u32 {
+// `QuadLayout::inner_segments`; a triangle's core sides all have m segments.
+fn inner_segments(input: PatchInput, e: u32) -> u32 {
+    let l = input.core;
+    if (input.nc == 3u) { return l.m; }
     if (e % 2u == 0u) { return l.i_hi - l.i_lo; }
     return l.j_hi - l.j_lo;
 }
 
-// `QuadLayout::inner`: grid point t of the core side facing edge e.
-fn inner_point(l: QuadLayout, e: u32, t: u32) -> vec2<u32> {
+// `QuadLayout::inner` and `TriLayout::inner`: grid point t of the core side facing edge e.
+fn inner_point(input: PatchInput, e: u32, t: u32) -> vec2<u32> {
+    let l = input.core;
+    if (input.nc == 3u) {
+        switch e {
+            case 0u: { return vec2<u32>(l.i_lo + t, l.j_lo); }
+            case 1u: { return vec2<u32>(l.i_lo + l.m - t, l.j_lo + t); }
+            default: { return vec2<u32>(l.i_lo, l.j_lo + l.m - t); }
+        }
+    }
     switch e {
         case 0u: { return vec2<u32>(l.i_lo + t, l.j_lo); }
         case 1u: { return vec2<u32>(l.i_hi, l.j_lo + t); }
@@ -112,8 +161,20 @@ fn inner_point(l: QuadLayout, e: u32, t: u32) -> vec2<u32> {
     }
 }
 
-// `QuadLayout::local`: local index of core grid point (i, j).
+// `QuadLayout::local` and `TriLayout::local`: local index of core grid point (i, j).
 fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
+    if (input.nc == 3u) {
+        let n = input.core.nu;
+        if (i == 0u && j == 0u) { return 0u; }
+        if (i == n && j == 0u) { return 1u; }
+        if (i == 0u && j == n) { return 2u; }
+        if (j == 0u) { return input.base[0] + i - 1u; }
+        if (i + j == n) { return input.base[1] + j - 1u; }
+        if (i == 0u) { return input.base[2] + (n - j) - 1u; }
+        // Interior rows 1 … j − 1 before this one hold n − 1 − r points each.
+        let before = (j - 1u) * (n - 1u) - (j - 1u) * j / 2u;
+        return input.interior_base + before + (i - 1u);
+    }
     let nu = input.core.nu;
     let nv = input.core.nv;
     if (i == 0u && j == 0u) { return 0u; }
@@ -130,14 +191,14 @@ fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
 // `PatternInput::boundary_vertex`.
 fn boundary_local(input: PatchInput, e: u32, k: u32) -> u32 {
     if (k == 0u) { return e; }
-    if (k == input.s[e]) { return (e + 1u) % 4u; }
+    if (k == input.s[e]) { return (e + 1u) % input.nc; }
     return input.base[e] + k - 1u;
 }
 
 // The local edge whose inner samples hold local index l (4 ≤ l < interior_base).
 fn local_edge(input: PatchInput, l: u32) -> u32 {
     var e = 0u;
-    for (var f = 1u; f < 4u; f = f + 1u) {
+    for (var f = 1u; f < input.nc; f = f + 1u) {
         if (l >= input.base[f]) { e = f; }
     }
     return e;
@@ -145,7 +206,7 @@ fn local_edge(input: PatchInput, l: u32) -> u32 {
 
 // `LocalMap::vertex`: the output vertex of local index l.
 fn local_vertex(input: PatchInput, l: u32) -> u32 {
-    if (l < 4u) { return patch_corner_entry(input.p, l); }
+    if (l < input.nc) { return patch_corner_entry(input.p, l); }
     if (l < input.interior_base) {
         let e = local_edge(input, l);
         return edge_sample_vertex(input.p, e, l - input.base[e] + 1u);
@@ -155,7 +216,7 @@ fn local_vertex(input: PatchInput, l: u32) -> u32 {
 
 // The identity `degenerate_after_collapse` compares for local index l.
 fn local_collapse_id(input: PatchInput, l: u32) -> vec2<u32> {
-    if (l < 4u) { return vec2<u32>(1u, patch_corner_entry(input.p, l)); }
+    if (l < input.nc) { return vec2<u32>(1u, patch_corner_entry(input.p, l)); }
     if (l < input.interior_base) {
         let e = local_edge(input, l);
         if (bit(input.collapsed, e) != 0u) { return vec2<u32>(1u, patch_corner_entry(input.p, e)); }
@@ -183,16 +244,16 @@ fn emit(input: PatchInput, tri: vec3<u32>, write: bool, first: u32, kept: ptr<fu
 
 // Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
 fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
-    return quad_edge_point(e, f32(k) / f32(input.s[e]));
+    return domain_edge_point(input.p, e, f32(k) / f32(input.s[e]));
 }
 
 fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
-    let g = inner_point(input.core, e, t);
+    let g = inner_point(input, e, t);
     return vec2<f32>(f32(g.x) * (1.0 / f32(input.core.nu)), f32(g.y) * (1.0 / f32(input.core.nv)));
 }
 
 fn inner_local(input: PatchInput, e: u32, t: u32) -> u32 {
-    let g = inner_point(input.core, e, t);
+    let g = inner_point(input, e, t);
     return grid_local(input, g.x, g.y);
 }
 
@@ -206,9 +267,9 @@ const TIE_TOLERANCE: f32 = 1e-5;
 fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, u32>) {
     let l = input.core;
     let s = input.s[e];
-    let m = inner_segments(l, e);
-    let lead = bit(l.strips, (e + 3u) % 4u);
-    let trail = bit(l.strips, (e + 1u) % 4u);
+    let m = inner_segments(input, e);
+    let lead = bit(l.strips, (e + input.nc - 1u) % input.nc);
+    let trail = bit(l.strips, (e + 1u) % input.nc);
     let span = i32(m + lead + trail);
     let s32 = i32(s);
     var d = span - (2 * i32(lead) + 1) * s32;
@@ -255,9 +316,36 @@ fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, 
     }
 }
 
-// `QuadLayout::build`'s triangles: the core cells row after row, then each strip's walk.
-// Returns the triangles kept. Cost: O(pattern triangles), serial.
+// `TriLayout::build`'s triangles: the core in the uniform pattern's loop and vertex order,
+// shifted to the core's corner, then each strip's walk. Returns the triangles kept.
+fn build_tri_transition(input: PatchInput, write: bool, first: u32) -> u32 {
+    var kept = 0u;
+    let l = input.core;
+    let i0 = l.i_lo;
+    let j0 = l.j_lo;
+    let m = l.m;
+    for (var j = 0u; j < m; j = j + 1u) {
+        for (var i = 0u; i < m - j; i = i + 1u) {
+            let a = grid_local(input, i0 + i, j0 + j);
+            let b = grid_local(input, i0 + i + 1u, j0 + j);
+            let d = grid_local(input, i0 + i, j0 + j + 1u);
+            emit(input, vec3<u32>(a, b, d), write, first, &kept);
+            if (i + j + 2u <= m) {
+                emit(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), write, first, &kept);
+            }
+        }
+    }
+    for (var e = 0u; e < 3u; e = e + 1u) {
+        if (bit(l.strips, e) != 0u) { walk(input, e, write, first, &kept); }
+    }
+    return kept;
+}
+
+// `QuadLayout::build`'s triangles: the core cells row after row, then each strip's walk
+// (`build_tri_transition` on triangles). Returns the triangles kept. Cost: O(pattern
+// triangles), serial.
 fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
+    if (input.nc == 3u) { return build_tri_transition(input, write, first); }
     var kept = 0u;
     let l = input.core;
     for (var j = l.j_lo; j < l.j_hi; j = j + 1u) {

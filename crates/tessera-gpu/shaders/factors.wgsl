@@ -1,0 +1,157 @@
+// Screen-space factors from the camera alone, the GPU form of `tessera::scheme::Scheme::
+// plan_into` for two criteria:
+//
+// - `Criterion::PixelError` (the uniform scheme): per visible patch the object-space
+//   tolerance of `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
+//   `uniform_factor` and `curve_factor` from the prepared bounds);
+// - `Criterion::View` with `ViewCriterion::Silhouetteness` (`view::edge_factors_into`): every
+//   patch proposes each of its edges' silhouetteness factor in [lo, hi];
+//
+// then per edge the maximum over the patches sharing it, read through the topology's edge
+// uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer`),
+// then the interiors (`resolve::interiors`): the global factor on every edge and patch
+// (`InteriorRule::Global`) or CudaTess's core rule (`InteriorRule::Core`).
+//
+// f32 where the CPU computes in f64: a pixel-error factor is `ceil` of a square root, a
+// silhouetteness factor is rounded, so the two can differ by one where that value lies within
+// f32 rounding (about 1e-6 relative) of an integer (of a half-integer). The tests count such
+// cases and allow no other difference.
+
+// `screen::PatchView::tolerance` for the view's pixel error.
+fn patch_tolerance(p: u32) -> f32 {
+    let lo = patch_views[PATCH_VIEW_ROW * p + 3u].xyz;
+    let hi = patch_views[PATCH_VIEW_ROW * p + 4u].xyz;
+    var z_min = 3.0e38;
+    var tx = 0.0;
+    var ty = 0.0;
+    for (var i = 0u; i < 8u; i = i + 1u) {
+        let corner = vec3<f32>(
+            select(lo.x, hi.x, (i & 1u) != 0u),
+            select(lo.y, hi.y, (i & 2u) != 0u),
+            select(lo.z, hi.z, (i & 4u) != 0u),
+        );
+        let c = to_camera(corner);
+        z_min = min(z_min, c.z);
+        tx = max(tx, abs(c.x / c.z));
+        ty = max(ty, abs(c.y / c.z));
+    }
+    var z = z_min;
+    if (!(z_min >= view.near)) {
+        // The box reaches the near plane: only points inside the frustum are seen.
+        z = view.near;
+        tx = view.tan_x;
+        ty = view.tan_y;
+    }
+    return view.pixels * z / (view.focal * sqrt(1.0 + tx * tx + ty * ty));
+}
+
+// `tolerance::uniform_factor` and `tolerance::curve_factor`.
+fn uniform_factor(m: vec4<f32>, eps: f32) -> f32 {
+    return max(ceil(sqrt((m.x + 2.0 * m.y + m.z) / (8.0 * eps))), 1.0);
+}
+
+fn curve_factor(m_edge: f32, eps: f32) -> f32 {
+    return max(ceil(sqrt(m_edge / (8.0 * eps))), 1.0);
+}
+
+// `view::edge_factors_into`'s silhouetteness factor of edge e: s = 1 where the two normals
+// at the midpoint face opposite ways from the eye, 1 − (c·nL)(c·nR)/β near it (β = 1/4).
+fn silhouetteness_factor(e: u32) -> f32 {
+    let row = PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * e;
+    let mid = patch_views[row].xyz;
+    let nl = patch_views[row + 1u].xyz;
+    let nr = patch_views[row + 2u].xyz;
+    // `DVec3::normalize_or_zero`.
+    let d = mid - view.eye.xyz;
+    let len = length(d);
+    var c = vec3<f32>(0.0);
+    if (len > 0.0) { c = d / len; }
+    let product = dot(c, nl) * dot(c, nr);
+    var s = 1.0;
+    if (product > 0.0) { s = clamp(1.0 - product / 0.25, 0.0, 1.0); }
+    return clamp(view.lo + s * (view.hi - view.lo), view.lo, view.hi);
+}
+
+// Per patch: its proposal for each local edge, and its minimum interior into the global
+// factor.
+@compute @workgroup_size(WORKGROUP)
+fn patch_proposals(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let p = thread_index(wid, nwg, lid);
+    if (p >= params.patches) { return; }
+    let row = PATCH_VIEW_ROW * p;
+    let minimum = patch_views[row + 7u];
+    if (view.interior_rule == INTERIOR_GLOBAL) {
+        atomicMax(&global_factor, u32(max(minimum.x, minimum.y)));
+    }
+    var out = vec4<f32>(0.0);
+    if (view.criterion == CRITERION_SILHOUETTENESS) {
+        // Every patch, culled or not, proposes its edges' factors (`from_edge_factors`).
+        for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
+            out[l] = silhouetteness_factor(patch_edge(p, l));
+        }
+    } else if (visible[p] != 0u) {
+        let eps = patch_tolerance(p);
+        let n = uniform_factor(patch_views[row + 5u], eps);
+        let curves = patch_views[row + 6u];
+        for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
+            out[l] = max(n, curve_factor(curves[l], eps));
+        }
+    }
+    proposals[p] = out;
+}
+
+// Per edge: `resolve::edges` with `EdgeRule::Integer` — the maximum over its uses, capped,
+// rounded half away from zero as `f64::round`, at least the minimum.
+@compute @workgroup_size(WORKGROUP)
+fn edge_segments(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let e = thread_index(wid, nwg, lid);
+    if (e >= params.edges) { return; }
+    var wanted = 0.0;
+    for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
+        wanted = max(wanted, proposals[use_patch(u)][use_local(u)]);
+    }
+    wanted = min(wanted, view.cap);
+    let s = max(u32(floor(wanted + 0.5)), max(minimum_segments[e], 1u));
+    segments[e] = s;
+    if (view.interior_rule == INTERIOR_GLOBAL) {
+        atomicMax(&global_factor, s);
+    }
+}
+
+// `resolve::interiors`. `InteriorRule::Global`: the frame's largest factor on every edge and
+// patch interior. `InteriorRule::Core`: a quad takes the smaller segments of its two edges
+// along each direction (at least its minimum), a triangle its largest edge.
+@compute @workgroup_size(WORKGROUP)
+fn interiors(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let x = thread_index(wid, nwg, lid);
+    if (view.interior_rule == INTERIOR_GLOBAL) {
+        let n = atomicLoad(&global_factor);
+        if (x < params.edges) { segments[x] = n; }
+        if (x < params.patches) { interior[x] = vec2<u32>(n, n); }
+        return;
+    }
+    if (x >= params.patches) { return; }
+    let s0 = segments[patch_edge(x, 0u)];
+    let s1 = segments[patch_edge(x, 1u)];
+    let s2 = segments[patch_edge(x, 2u)];
+    if (patch_is_tri(x)) {
+        let n = max(s0, max(s1, s2));
+        interior[x] = vec2<u32>(n, n);
+        return;
+    }
+    let s3 = segments[patch_edge(x, 3u)];
+    let minimum = patch_views[PATCH_VIEW_ROW * x + 7u];
+    interior[x] = vec2<u32>(max(min(s0, s2), u32(minimum.x)), max(min(s1, s3), u32(minimum.y)));
+}

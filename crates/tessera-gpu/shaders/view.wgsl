@@ -1,0 +1,52 @@
+// The camera and the view-independent per-patch data of the view passes (group 1): culling
+// (`cull.wgsl`) and the screen-space factors (`factors.wgsl`). Row formats:
+// `src/tessellator.rs` (`patch_view_rows`).
+
+struct View {
+    eye: vec4<f32>,
+    // `Camera::basis`: right, up, forward (unit).
+    right: vec4<f32>,
+    up: vec4<f32>,
+    forward: vec4<f32>,
+    near: f32,
+    far: f32,
+    // `Camera::half_tangents`.
+    tan_x: f32,
+    tan_y: f32,
+    // `Camera::focal_pixels`, the pixel error, the factor cap (`PlanOptions::max_factor`),
+    // the interior rule (INTERIOR_GLOBAL or INTERIOR_CORE).
+    focal: f32,
+    pixels: f32,
+    cap: f32,
+    interior_rule: u32,
+    // The criterion (CRITERION_PIXEL_ERROR or CRITERION_SILHOUETTENESS) and the view
+    // criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap applied).
+    criterion: u32,
+    lo: f32,
+    hi: f32,
+    _pad: u32,
+}
+
+@group(1) @binding(0) var<uniform> view: View;
+// Per patch, PATCH_VIEW_ROW vec4: the normal cone's axis and half-angle α; the bounding
+// sphere's centre and radius; (sin α, cos α, 1 with a cone / 0 without, 0); the control
+// points' box lo and hi (`screen::PatchView`); the second-derivative bound (uu, uv, vv, 0)
+// (`Prepared::hessians`); the boundary curves' bounds (`Prepared::curves`); the minimum
+// interior factors (`Prepared::minimum_interior`, as f32), 0, 0. After the P patch rows,
+// EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it, the normals there of
+// its first and its last patch (`Prepared::edge_midpoints`).
+@group(1) @binding(1) var<storage, read_write> patch_views: array<vec4<f32>>;
+// `Prepared::minimum_segments`, per edge.
+@group(1) @binding(2) var<storage, read_write> minimum_segments: array<u32>;
+// Per patch, the factor it proposes for each local edge (0 for culled patches).
+@group(1) @binding(3) var<storage, read_write> proposals: array<vec4<f32>>;
+// The largest segment count and minimum interior of the frame (the global factor of
+// `InteriorRule::Global`); zeroed before the factor passes.
+@group(1) @binding(4) var<storage, read_write> global_factor: atomic<u32>;
+
+const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
+const INTERIOR_GLOBAL: u32 = 0u;
+const INTERIOR_CORE: u32 = 1u;
+const CRITERION_PIXEL_ERROR: u32 = 0u;
+const CRITERION_SILHOUETTENESS: u32 = 1u;
+const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
