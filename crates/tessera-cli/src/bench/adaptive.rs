@@ -6,7 +6,8 @@
 //! Each scheme has one knob, swept on a grid and then bisected near each target: uniform the
 //! factor; transition and semi-uniform the guaranteed tolerance; SD-2 and fractional-odd (no
 //! error bound) the largest factor of paper 001's distance level function from the framing
-//! camera (f_min = f_max / 2); ESC its distance-test threshold ρ at level 6. Every point is
+//! camera (f_min = f_max / 2); ESC the level L = 1..6 and its distance-test threshold ρ (a
+//! grid of both, no bisection; its curve is the grid's Pareto front). Every point is
 //! measured with `tessera::verify::approximation_error` (order 5, as the tests and
 //! `tessera check --against` do).
 
@@ -32,7 +33,8 @@ enum Knob {
     Tolerance(Scheme),
     /// Distance level function with `f_max = s` (schemes without a bound).
     Distance(Scheme),
-    /// ESC at level 6 with `ρ = diagonal · 10^-s`.
+    /// ESC at level `L = ⌊s / 10⌋` with `ρ = diagonal · 10^-(s mod 10)`: two knobs in one
+    /// number, so that a point names both.
     Esc,
 }
 
@@ -81,7 +83,7 @@ fn sizes(quick: bool) -> Sizes {
         }
     } else {
         Sizes {
-            targets: &[1e-3, 1e-4],
+            targets: &[1e-2, 1e-3, 1e-4],
             tolerance_grid: steps(1.0, 4.5, 0.25),
             factor_grid: &[1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128],
             distance_grid: &[2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 63],
@@ -123,14 +125,11 @@ impl Model {
                 let criterion = ViewCriterion::Distance(Mapping::Linear);
                 (scheme, Criterion::View { criterion, fmin: (s / 2.0).max(1.0), fmax: s }, 64)
             }
-            Knob::Esc => (
-                Scheme::Esc { max_level: 6 },
-                Criterion::Esc {
-                    threshold: Threshold::Absolute(self.diagonal * 10f64.powf(-s)),
-                    level: Some(6),
-                },
-                64,
-            ),
+            Knob::Esc => {
+                let (level, r) = ((s / 10.0).floor(), s % 10.0);
+                let threshold = Threshold::Absolute(self.diagonal * 10f64.powf(-r));
+                (Scheme::Esc { max_level: 6 }, Criterion::Esc { threshold, level: Some(level as u32) }, 64)
+            }
         };
         let options = PlanOptions { camera: Some(self.camera), cull: false, max_factor, max_triangles };
         let too_large = |e: &tessera::Error| matches!(e, tessera::Error::OutputTooLarge { .. });
@@ -154,6 +153,21 @@ impl Model {
     }
 }
 
+/// The points no other point beats in both error and triangles, by error (for a knob of two
+/// dimensions, whose grid order is no curve).
+fn pareto(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    // By rising error, a point is on the front when it needs fewer triangles than every
+    // point of smaller error.
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for p in points {
+        if front.last().is_none_or(|q| p.1 < q.1) {
+            front.push(p);
+        }
+    }
+    front
+}
+
 /// The cheapest point of `points` whose error meets `target`.
 fn cheapest(points: &[Point], target: f64) -> Option<Point> {
     points.iter().filter(|p| p.error <= target).min_by_key(|p| p.triangles).copied()
@@ -172,7 +186,7 @@ fn at_error(
 ) -> BenchResult<Option<Point>> {
     points.sort_by(|a, b| a.s.total_cmp(&b.s));
     let Some(first) = points.iter().position(|p| p.error <= target) else { return Ok(None) };
-    if first == 0 {
+    if first == 0 || knob == Knob::Esc {
         return Ok(cheapest(points, target));
     }
     let (mut lo, mut hi) = (points[first - 1].s, points[first].s);
@@ -272,14 +286,18 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                 Knob::Uniform => sz.factor_grid.iter().map(|&f| f as f64).collect(),
                 Knob::Tolerance(_) => sz.tolerance_grid.clone(),
                 Knob::Distance(_) => sz.distance_grid.iter().map(|&f| f as f64).collect(),
-                Knob::Esc => sz.esc_grid.clone(),
+                Knob::Esc => {
+                    (1..=6).flat_map(|l| sz.esc_grid.iter().map(move |r| 10.0 * l as f64 + r)).collect()
+                }
             };
             let (points, at) = ctx.on_threads(threads, || -> BenchResult<_> {
                 let mut points = Vec::new();
                 for &s in &grid {
                     match model.measure(knob, s, sz.max_triangles)? {
                         Some(p) => points.push(p),
-                        None => break, // finer knobs only grow
+                        // Finer knobs only grow (ESC: the next level's coarse ρ may still fit).
+                        None if knob == Knob::Esc => continue,
+                        None => break,
                     }
                 }
                 let mut at = Vec::new();
@@ -293,7 +311,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                 Knob::Uniform => "factor",
                 Knob::Tolerance(_) => "-log10(tolerance / diagonal)",
                 Knob::Distance(_) => "f_max (distance, f_min = f_max/2)",
-                Knob::Esc => "-log10(rho / diagonal), level 6",
+                Knob::Esc => "10 L - log10(rho / diagonal)",
             };
             for p in &points {
                 curves.row(vec![
@@ -306,17 +324,18 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                     num(p.error / model.diagonal, 7),
                 ]);
             }
-            lines.push(Series {
-                name: name.into(),
-                points: points.iter().map(|p| (p.error / model.diagonal, p.triangles as f64)).collect(),
-            });
+            let mut line: Vec<(f64, f64)> =
+                points.iter().map(|p| (p.error / model.diagonal, p.triangles as f64)).collect();
+            if knob == Knob::Esc {
+                line = pareto(line);
+            }
+            lines.push(Series { name: name.into(), points: line });
             best.push(at);
         }
         for (k, &share) in sz.targets.iter().enumerate() {
             let uniform = best[0][k];
             let mut row: Vec<Cell> = vec![model.name.clone().into(), format!("{share:e}").into()];
             row.push(uniform.map(|p| p.triangles).into());
-            let mut winner: Option<(&str, usize)> = uniform.map(|p| ("uniform", p.triangles));
             for (j, &(name, _)) in SCHEMES.iter().enumerate() {
                 let p = best[j][k];
                 let share_of_uniform = match (p, uniform) {
@@ -334,14 +353,16 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                 ]);
                 if j > 0 {
                     row.push(share_of_uniform.map_or(Cell::None, |r| num(r, 1)));
-                    if let Some(p) = p {
-                        if winner.is_none_or(|w| p.triangles < w.1) {
-                            winner = Some((name, p.triangles));
-                        }
-                    }
                 }
             }
-            row.push(winner.map(|w| w.0).into());
+            // Every scheme with the fewest triangles (ties, e.g. the untessellated base mesh,
+            // are named together).
+            let fewest = (0..SCHEMES.len()).filter_map(|j| best[j][k].map(|p| p.triangles)).min();
+            let winners: Vec<&str> = (0..SCHEMES.len())
+                .filter(|&j| fewest.is_some() && best[j][k].map(|p| p.triangles) == fewest)
+                .map(|j| SCHEMES[j].0)
+                .collect();
+            row.push(if winners.is_empty() { Cell::None } else { winners.join(" = ").into() });
             ratio.row(row);
         }
         let title = format!("{}: triangles against measured max error", model.name);
@@ -363,8 +384,18 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
          bisection steps near the target); — = the scheme does not apply (SD-2: triangles only; ESC: bicubic only) or \
          does not reach the target below {} triangles. Knobs: transition, semi-uniform (M = 8): the guaranteed \
          tolerance; SD-2, fractional-odd: f_max of the distance level function from the framing camera (f_min = \
-         f_max/2, no error bound); ESC: ρ at level 6. Errors: tessera::verify::approximation_error, order 5.",
+         f_max/2, no error bound); ESC: levels 1–6 × a grid of ρ. Errors: tessera::verify::approximation_error, order 5.",
         sz.bisections, sz.max_triangles
     ));
     Ok(vec![ratio, equal, curves])
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_front_keeps_what_nothing_beats() {
+        let points =
+            vec![(0.1, 50.0), (0.01, 500.0), (0.05, 80.0), (0.01, 900.0), (0.03, 600.0), (0.2, 60.0)];
+        assert_eq!(super::pareto(points), vec![(0.01, 500.0), (0.05, 80.0), (0.1, 50.0)]);
+    }
 }

@@ -310,7 +310,7 @@ pub fn frames(
     Ok(series)
 }
 
-/// A short number for a table: three significant digits, thousands separated in integers.
+/// An integer with its thousands separated by commas (Markdown cells).
 pub fn thousands(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
