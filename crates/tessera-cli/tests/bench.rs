@@ -9,8 +9,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Rows every quick run must have, per table: (table, column, values that must appear).
-const EXPECTED_ROWS: [(&str, &str, &[&str]); 10] = [
+const EXPECTED_ROWS: [(&str, &str, &[&str]); 11] = [
     ("speed_uniform", "model", &["torus_64x32", "teapot", "spot"]),
+    ("speed_schemes", "scheme", &["transition"]),
     ("adaptive_ratio", "model", &["teapot", "teacup", "helmet"]),
     (
         "adaptive_equal_error",

@@ -52,9 +52,9 @@ impl Scene {
     }
 }
 
-/// The three scenes (reduced with `--quick`: 4 torus copies, 2 killeroos, 8 frames).
+/// The three scenes (reduced with `--quick`: 4 torus copies, 2 killeroos, 5 frames).
 pub fn scenes(ctx: &Ctx) -> BenchResult<Vec<Scene>> {
-    let (torus_copies, killeroos, walk) = if ctx.quick { (4, 2, 8) } else { (45, 11, 60) };
+    let (torus_copies, killeroos, walk) = if ctx.quick { (4, 2, 5) } else { (45, 11, 60) };
     let mut out = Vec::new();
     for (name, set) in [
         ("torus grid", scenes::torus_grid(ctx, torus_copies)?),
@@ -85,7 +85,7 @@ pub fn scenes(ctx: &Ctx) -> BenchResult<Vec<Scene>> {
 }
 
 pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
-    let repeats = if ctx.quick { 3 } else { 9 };
+    let repeats = if ctx.quick { 2 } else { 9 };
     ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64);
     let mut walk = Table::new(
         "frame_walk",

@@ -347,7 +347,13 @@ fn paper002(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         ]);
         Ok(())
     };
-    for (name, threshold) in [("high", Threshold::High), ("medium", Threshold::Medium)] {
+    // --quick: the medium preset only (the high one's meshes are the largest here).
+    let presets: &[(&str, Threshold)] = if ctx.quick {
+        &[("medium", Threshold::Medium)]
+    } else {
+        &[("high", Threshold::High), ("medium", Threshold::Medium)]
+    };
+    for &(name, threshold) in presets {
         let (plan, pattern) = tessera::criterion::esc::plan(&scene, camera, &options(threshold))?;
         let mesh = tessellate(&scene, &plan, &pattern, params)?;
         // Uniform factor f gives 2 f² triangles per surface.

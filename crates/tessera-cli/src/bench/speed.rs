@@ -4,9 +4,13 @@
 
 use super::plot::{self, Axes, Series};
 use super::table::{num, Cell, Table};
-use super::{frames, median_p95, scenes, BenchResult, Ctx};
+use super::{frames, median_p95, scenes, BenchResult, Ctx, StageSeries};
+use tessera::camera::Camera;
+use tessera::criterion::esc::Threshold;
+use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
+use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::uniform::Uniform;
 use tessera::scheme::{Criterion, Scheme};
 use tessera::tessellator::{Tessellator, TessellatorOptions};
@@ -50,27 +54,9 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     ctx.plan_steps((cpu_steps + gpu_steps) as u64);
     let adapter = if ctx.gpu { gpu_adapter(ctx) } else { None };
 
-    let mut table = Table::new(
-        "speed_uniform",
-        "speed: uniform tessellation, medians per stage",
-        &[
-            "model",
-            "patches",
-            "factor",
-            "engine",
-            "threads",
-            "triangles",
-            "vertices",
-            "criterion ms",
-            "resolve ms",
-            "layout ms",
-            "write ms",
-            "frame ms",
-            "frame p95 ms",
-            "Mtri/s",
-            "ns/vertex",
-        ],
-    );
+    let mut columns = vec!["model", "patches", "factor", "engine", "threads"];
+    columns.extend(STAGE_COLUMNS);
+    let mut table = Table::new("speed_uniform", "speed: uniform tessellation, medians per stage", &columns);
     let pass_columns: Vec<String> = ["model", "factor", "adapter"]
         .iter()
         .map(|c| c.to_string())
@@ -98,28 +84,17 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                     )?;
                     frames(&mut tess, &vec![None; runs], true)
                 })??;
-                let med = |v: &Vec<f64>| median_p95(v).0;
-                let (total, p95) = median_p95(&series.total);
-                let (tri, vert) = (series.triangles[0], series.vertices[0]);
-                let mtri = tri as f64 / total / 1e3;
+                let (cells, mtri) = stage_cells(&series);
                 curve.points.push((factor as f64, mtri));
-                table.row(vec![
+                let mut row: Vec<Cell> = vec![
                     name.clone().into(),
                     set.patches.len().into(),
                     (factor as usize).into(),
                     "cpu".into(),
                     threads.into(),
-                    tri.into(),
-                    vert.into(),
-                    num(med(&series.criterion), 3),
-                    num(med(&series.resolve), 3),
-                    num(med(&series.layout), 3),
-                    num(med(&series.write), 3),
-                    num(total, 3),
-                    num(p95, 3),
-                    num(mtri, 1),
-                    num(total * 1e6 / vert as f64, 2),
-                ]);
+                ];
+                row.extend(cells);
+                table.row(row);
             }
             curves.push(curve);
         }
@@ -164,6 +139,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
             curves.push(curve);
         }
     }
+    let schemes = schemes_table(ctx, runs)?;
     table.note(format!(
         "Medians of {runs} frames after one warm-up frame, each a whole `Tessellator::frame` into reused buffers \
          (criterion → resolve → layout → write, the stages `tessera mesh --stats` reports); Mtri/s = triangles / \
@@ -193,11 +169,117 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         },
         &curves,
     )?;
-    let mut tables = vec![table];
+    let mut tables = vec![table, schemes];
     if !gpu_passes.rows.is_empty() {
         tables.push(gpu_passes);
     }
     Ok(tables)
+}
+
+/// Triangles, vertices, each stage's median, the frame's median and p95, Mtri/s and ns per
+/// vertex of a series of frames (the columns after a row's labels), and the Mtri/s.
+fn stage_cells(series: &StageSeries) -> (Vec<Cell>, f64) {
+    let med = |v: &Vec<f64>| num(median_p95(v).0, 3);
+    let (total, p95) = median_p95(&series.total);
+    let (tri, vert) = (series.triangles[0], series.vertices[0]);
+    let mtri = tri as f64 / total / 1e3;
+    let cells = vec![
+        tri.into(),
+        vert.into(),
+        med(&series.criterion),
+        med(&series.resolve),
+        med(&series.layout),
+        med(&series.write),
+        num(total, 3),
+        num(p95, 3),
+        num(mtri, 1),
+        num(total * 1e6 / vert as f64, 2),
+    ];
+    (cells, mtri)
+}
+
+/// The columns after a row's labels ([`stage_cells`]).
+const STAGE_COLUMNS: [&str; 10] = [
+    "triangles",
+    "vertices",
+    "criterion ms",
+    "resolve ms",
+    "layout ms",
+    "write ms",
+    "frame ms",
+    "frame p95 ms",
+    "Mtri/s",
+    "ns/vertex",
+];
+
+/// The adaptive and hardware schemes' engines, the real-time issue's rows: the cow with
+/// silhouette factors 4:7 (transition, semi-uniform, SD-2), fractional-odd at factor 6.4,
+/// the torus at a tolerance of 0.001 % of its diagonal, ESC on the teapot; the framing
+/// camera at 1280×720 (`tessera mesh`'s default).
+fn schemes_table(ctx: &Ctx, runs: usize) -> BenchResult<Table> {
+    let mut columns = vec!["model", "scheme", "criterion", "threads"];
+    columns.extend(STAGE_COLUMNS);
+    let mut t = Table::new("speed_schemes", "speed: every scheme's engine, medians per stage", &columns);
+    let silhouette = |criterion, fmin| Criterion::View { criterion, fmin, fmax: 7.0 };
+    let cases: Vec<(&str, Scheme, Criterion, &str)> = vec![
+        (
+            "meshes/cow.obj",
+            Scheme::Transition,
+            silhouette(ViewCriterion::Silhouetteness, 4.0),
+            "--silhouette 4:7",
+        ),
+        (
+            "meshes/cow.obj",
+            Scheme::SemiUniform { max_level: 5 },
+            silhouette(ViewCriterion::Silhouetteness, 4.0),
+            "--silhouette 4:7",
+        ),
+        (
+            "meshes/cow.obj",
+            Scheme::Sd2 { warp: false },
+            silhouette(ViewCriterion::SilhouetteVertices, 4.0),
+            "--silhouette 4:7",
+        ),
+        (
+            "meshes/cow.obj",
+            Scheme::Hardware(Partitioning::FractionalOdd),
+            Criterion::Factor(6.4),
+            "--factor 6.4",
+        ),
+        ("bench/torus_64x32.patches", Scheme::Transition, Criterion::Tolerance(0.0), "--tolerance 0.001%"),
+        (
+            "patches/teapot.patches",
+            Scheme::Esc { max_level: 3 },
+            Criterion::Esc { threshold: Threshold::Medium, level: None },
+            "--quality medium",
+        ),
+    ];
+    let cases = if ctx.quick { &cases[..1] } else { &cases[..] };
+    ctx.plan_steps((cases.len() * ctx.threads.len()) as u64);
+    for (rel, scheme, criterion, text) in cases {
+        let set = scenes::load(ctx, rel)?;
+        let (lo, hi) = set.bounds();
+        let criterion = match criterion {
+            Criterion::Tolerance(_) => Criterion::Tolerance(1e-5 * lo.distance(hi)),
+            c => *c,
+        };
+        let camera = Some(Camera::framing(lo, hi, 1280, 720));
+        for &threads in &ctx.threads {
+            ctx.step(&format!("speed: {} {}, {threads} threads", short(rel), scheme.name()));
+            let series = ctx.on_threads(threads, || {
+                let mut tess = Tessellator::new(&set, *scheme, criterion, TessellatorOptions::default())?;
+                frames(&mut tess, &vec![camera; runs], true)
+            })??;
+            let mut row: Vec<Cell> =
+                vec![short(rel).into(), scheme.name().into(), (*text).into(), threads.into()];
+            row.extend(stage_cells(&series).0);
+            t.row(row);
+        }
+    }
+    t.note(format!(
+        "Medians of {runs} frames from the framing camera (1280×720), after a warm-up frame; criteria as          `tessera mesh` takes them (silhouetteness for transition and semi-uniform, vertex silhouettes for SD-2)."
+    ));
+    Ok(t)
 }
 
 /// The adapter's name when the GPU rows can run; otherwise a printed note and None (the bench
