@@ -1,5 +1,6 @@
 //! `tessera`: tessellate parametric surfaces into watertight triangle meshes.
 
+mod bench;
 mod gpu;
 mod pattern_file;
 mod plan;
@@ -50,6 +51,10 @@ enum Command {
     /// [u, v]; triangles in D3D's triangle_ccw order; edges in D3D's order: quad
     /// U==0,V==0,U==1,V==1, tri U==0,V==0,W==0).
     Pattern(pattern_file::PatternArgs),
+    /// Benchmarks: speed per stage, triangles against measured error per scheme, camera
+    /// walks of large scenes and the papers' tables; Markdown on stdout, CSV, JSON and SVG
+    /// plots in --out.
+    Bench(bench::BenchArgs),
 }
 
 #[derive(Args)]
@@ -136,6 +141,7 @@ fn main() -> ExitCode {
         Command::Check(a) => run_check(a),
         Command::Demo(a) => run_demo(a),
         Command::Pattern(a) => pattern_file::run(a).map(|()| ExitCode::SUCCESS),
+        Command::Bench(a) => bench::run(a),
     };
     match result {
         Ok(code) => code,

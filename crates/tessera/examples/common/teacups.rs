@@ -1,6 +1,6 @@
-//! The Teacups scene of paper 002's Table 1 and its walk-through, shared by the `esc_teacups`
-//! example and the ESC tests (`#[path]`-included by both): a scene for measurements, not part
-//! of the library.
+//! The Teacups scene of paper 002's Table 1 and its walk-through, shared by the ESC tests and
+//! `tessera bench` (its `paper` and `frame` suites; `#[path]`-included by both): a scene for
+//! measurements, not part of the library.
 
 #![allow(dead_code)] // each includer uses its part
 

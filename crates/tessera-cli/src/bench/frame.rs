@@ -1,0 +1,215 @@
+//! `frame`: per-frame re-tessellation along camera walks of scenes at the papers' scale —
+//! the 92,160-patch torus grid and the killeroo herd (≈ 91k PN patches) at a guaranteed half
+//! pixel with culling (the real-time issue's frames), and paper 002's 100 teacups with ESC.
+
+use super::plot::{self, Axes, Series};
+use super::table::{num, Table};
+use super::{frames, median_p95, scenes, BenchResult, Ctx, StageSeries};
+use tessera::camera::Camera;
+use tessera::criterion::esc::Threshold;
+use tessera::scheme::{Criterion, PlanOptions, Scheme};
+use tessera::surface::SurfaceSet;
+use tessera::tessellator::{Tessellator, TessellatorOptions};
+
+/// A scene with its walk and what draws it.
+pub struct Scene {
+    pub name: &'static str,
+    pub set: SurfaceSet,
+    pub scheme: Scheme,
+    pub criterion: Criterion,
+    pub cull: bool,
+    pub cameras: Vec<Camera>,
+}
+
+impl Scene {
+    pub fn describe(&self) -> String {
+        let what = match self.criterion {
+            Criterion::PixelError(px) => format!("{px} px"),
+            Criterion::Esc { threshold: Threshold::Medium, .. } => "medium quality".into(),
+            Criterion::Esc { threshold: Threshold::High, .. } => "high quality".into(),
+            _ => "-".into(),
+        };
+        format!("{} {what}{}", self.scheme.name(), if self.cull { ", cull" } else { "" })
+    }
+
+    /// The tessellator options of the scene (culling as set, factors up to 64).
+    pub fn options(&self) -> TessellatorOptions {
+        TessellatorOptions {
+            plan: PlanOptions { cull: self.cull, ..PlanOptions::default() },
+            ..Default::default()
+        }
+    }
+
+    /// Frames of the scene for `cameras` on `threads` threads (a fresh tessellator, one
+    /// warm-up frame).
+    pub fn run(&self, ctx: &Ctx, threads: usize, cameras: &[Camera]) -> BenchResult<StageSeries> {
+        let cameras: Vec<Option<Camera>> = cameras.iter().copied().map(Some).collect();
+        let series = ctx.on_threads(threads, || {
+            let mut tess = Tessellator::new(&self.set, self.scheme, self.criterion, self.options())?;
+            frames(&mut tess, &cameras, true)
+        })??;
+        Ok(series)
+    }
+}
+
+/// The three scenes (reduced with `--quick`: 4 torus copies, 2 killeroos, 5 frames).
+pub fn scenes(ctx: &Ctx) -> BenchResult<Vec<Scene>> {
+    let (torus_copies, killeroos, walk) = if ctx.quick { (4, 2, 5) } else { (45, 11, 60) };
+    let mut out = Vec::new();
+    for (name, set) in [
+        ("torus grid", scenes::torus_grid(ctx, torus_copies)?),
+        ("killeroo herd", scenes::killeroo_herd(ctx, killeroos)?),
+    ] {
+        let (lo, hi) = set.bounds();
+        let cameras = scenes::walk(lo, hi, walk, 1280, 1024);
+        out.push(Scene {
+            name,
+            set,
+            scheme: Scheme::Transition,
+            criterion: Criterion::PixelError(0.5),
+            cull: true,
+            cameras,
+        });
+    }
+    let (set, mut cameras) = scenes::teacups(ctx)?;
+    cameras.truncate(walk);
+    out.push(Scene {
+        name: "teacups",
+        set,
+        scheme: Scheme::Esc { max_level: 3 },
+        criterion: Criterion::Esc { threshold: Threshold::Medium, level: None },
+        cull: false,
+        cameras,
+    });
+    Ok(out)
+}
+
+pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
+    let repeats = if ctx.quick { 2 } else { 9 };
+    ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64);
+    let mut walk = Table::new(
+        "frame_walk",
+        "frame: camera walks, ms per stage over the walk (median / p95)",
+        &[
+            "scene",
+            "patches",
+            "scheme",
+            "threads",
+            "frames",
+            "triangles min",
+            "triangles median",
+            "triangles max",
+            "criterion ms",
+            "resolve ms",
+            "layout ms",
+            "write ms",
+            "frame ms",
+            "frame p95 ms",
+            "Mtri/s",
+        ],
+    );
+    let mut first = Table::new(
+        "frame_first",
+        "frame: the walk's first frame (the whole scene in view, 1280×1024), repeated",
+        &[
+            "scene",
+            "patches",
+            "scheme",
+            "threads",
+            "triangles",
+            "culled",
+            "criterion ms",
+            "resolve ms",
+            "layout ms",
+            "write ms",
+            "frame ms",
+            "Mtri/s",
+        ],
+    );
+    ctx.step("frame: building the scenes");
+    let all = scenes(ctx)?;
+    for scene in &all {
+        let slug = scene.name.replace(' ', "_");
+        let mut ms_lines = Vec::new();
+        let mut tri_line = None;
+        for &threads in &ctx.threads {
+            ctx.step(&format!("frame: {} walk, {threads} threads", scene.name));
+            let s = scene.run(ctx, threads, &scene.cameras)?;
+            let med = |v: &Vec<f64>| median_p95(v).0;
+            let fmt = |v: &Vec<f64>| {
+                let (m, p) = median_p95(v);
+                format!("{m:.2} / {p:.2}")
+            };
+            let mut tris = s.triangles.clone();
+            tris.sort_unstable();
+            let (total, p95) = median_p95(&s.total);
+            walk.row(vec![
+                scene.name.into(),
+                scene.set.patches.len().into(),
+                scene.describe().into(),
+                threads.into(),
+                s.total.len().into(),
+                tris[0].into(),
+                tris[tris.len() / 2].into(),
+                tris[tris.len() - 1].into(),
+                fmt(&s.criterion).into(),
+                fmt(&s.resolve).into(),
+                fmt(&s.layout).into(),
+                fmt(&s.write).into(),
+                num(total, 2),
+                num(p95, 2),
+                num(tris[tris.len() / 2] as f64 / med(&s.total) / 1e3, 1),
+            ]);
+            let points = |v: &Vec<f64>| v.iter().enumerate().map(|(i, &y)| (i as f64, y)).collect();
+            ms_lines.push(Series { name: format!("frame, {threads} thr"), points: points(&s.total) });
+            if threads == *ctx.threads.iter().max().unwrap_or(&1) {
+                for (stage, v) in s.stages().into_iter().take(4) {
+                    ms_lines.push(Series { name: format!("{stage}, {threads} thr"), points: points(v) });
+                }
+                tri_line = Some(Series {
+                    name: "triangles".into(),
+                    points: s.triangles.iter().enumerate().map(|(i, &t)| (i as f64, t as f64)).collect(),
+                });
+            }
+
+            ctx.step(&format!("frame: {} first frame, {threads} threads", scene.name));
+            let camera = scene.cameras[0];
+            let s = scene.run(ctx, threads, &vec![camera; repeats])?;
+            first.row(vec![
+                scene.name.into(),
+                scene.set.patches.len().into(),
+                scene.describe().into(),
+                threads.into(),
+                s.triangles[0].into(),
+                s.culled[0].into(),
+                num(med(&s.criterion), 2),
+                num(med(&s.resolve), 2),
+                num(med(&s.layout), 2),
+                num(med(&s.write), 2),
+                num(med(&s.total), 2),
+                num(s.triangles[0] as f64 / med(&s.total) / 1e3, 1),
+            ]);
+        }
+        let title = format!("{}: ms per frame along the walk", scene.name);
+        plot::lines(
+            &ctx.out.join(format!("frame_{slug}_ms.svg")),
+            &Axes { title: &title, x: "frame", y: "ms", log_x: false, log_y: false },
+            &ms_lines,
+        )?;
+        let title = format!("{}: triangles per frame along the walk", scene.name);
+        plot::lines(
+            &ctx.out.join(format!("frame_{slug}_triangles.svg")),
+            &Axes { title: &title, x: "frame", y: "triangles", log_x: false, log_y: false },
+            &tri_line.into_iter().collect::<Vec<_>>(),
+        )?;
+    }
+    walk.note(
+        "Each frame is a whole `Tessellator::frame` from that frame's camera (criterion → resolve → layout → write) \
+         into buffers reused from the last frame; stage cells are median / p95 over the walk. The torus grid is 45 \
+         copies of bench/torus_64x32.patches (92,160 patches), the herd 11 copies of meshes/killeroo_cage.obj as PN \
+         triangles; their walks start at the framing camera (whole scene in view) and dolly in to a third of the \
+         distance while orbiting 40°. Teacups: paper 002's scene and walk (1280×1024), ESC with Lmax = 3.",
+    );
+    first.note(format!("Medians of {repeats} frames at the walk's first camera after a warm-up frame: the real-time issue's single-frame rows."));
+    Ok(vec![walk, first])
+}
