@@ -425,3 +425,27 @@ pub fn demo_picture(set: &SurfaceSet, path: &Path) -> Result<String, Box<dyn std
         drawn.draw_seconds * 1e3
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tessera::pattern::uniform::Uniform;
+
+    #[test]
+    fn the_verdict_sees_a_hole_inside_the_surface() {
+        let file = tessera::io::patches::parse_patches(crate::TEAPOT, Path::new("teapot")).unwrap();
+        let set = SurfaceSet::from_patch_file(&file, Default::default());
+        let plan = Plan::uniform(&set, 4).unwrap();
+        let mut mesh = tessera::engine::tessellate(&set, &plan, &Uniform, Default::default()).unwrap();
+        let v = boundary_verdict(&set, &plan, &Uniform, &mesh).unwrap();
+        assert!(v.watertight(), "{}", v.sentence("the teapot"));
+        assert_eq!((v.open_edges, v.free_curves, v.curves_reached), (16 * 4, 16, 16));
+        // Drop a triangle: at least two of its edges are inside the surface.
+        let t = mesh.triangle_count() / 2;
+        mesh.indices.drain(3 * t..3 * t + 3);
+        let v = boundary_verdict(&set, &plan, &Uniform, &mesh).unwrap();
+        assert!(!v.watertight());
+        assert!(v.sentence("the teapot").starts_with("NOT watertight"));
+        assert!(v.open_edges > v.on_free_curves);
+    }
+}
