@@ -4,6 +4,7 @@ mod gpu;
 mod pattern_file;
 mod plan;
 mod render;
+mod view;
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -55,6 +56,9 @@ enum Command {
     /// Draw a tessellation into a PNG picture (wgpu; the CPU rasteriser where there is no
     /// GPU adapter): shaded, optionally with the wireframe, coloured per patch or per level.
     Render(render::RenderArgs),
+    /// Open a window (X11) that re-tessellates the model every frame from an orbit camera,
+    /// with keys for the scheme, the pixel error, wireframe, level colours and culling.
+    View(view::ViewArgs),
 }
 
 #[derive(Args)]
@@ -146,6 +150,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => run_demo(a),
         Command::Pattern(a) => pattern_file::run(a).map(|()| ExitCode::SUCCESS),
         Command::Render(a) => render::run(a),
+        Command::View(a) => view::run(a),
     };
     match result {
         Ok(code) => code,

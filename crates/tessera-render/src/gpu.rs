@@ -439,47 +439,55 @@ impl Targets {
         self.resolve.as_ref().unwrap_or(&self.colour)
     }
 
-    /// Copies the image back to the CPU (an RGBA8 target). A read-back: waits for the queue.
-    /// Cost: the copy of `4 · width · height` bytes (rows padded to 256 bytes).
+    /// Copies the image back to the CPU. A read-back: waits for the queue. Cost: see
+    /// [`read_texture`].
     pub fn read(&self, ctx: &GpuContext) -> Result<Image, RenderError> {
-        let row = (4 * self.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let size = row as u64 * self.height as u64;
-        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("image read-back"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: self.image_texture(),
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
-            },
-            wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
-        );
-        ctx.queue.submit([encoder.finish()]);
-        let bytes = tessera_gpu::readback::read_bytes(ctx, &buffer, size)?;
-        let mut rgba = Vec::with_capacity(4 * (self.width * self.height) as usize);
-        let bgra = matches!(self.image_texture().format(), wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
-        for y in 0..self.height as usize {
-            let line = &bytes[y * row as usize..][..4 * self.width as usize];
-            if bgra {
-                for px in line.chunks_exact(4) {
-                    rgba.extend_from_slice(&[px[2], px[1], px[0], px[3]]);
-                }
-            } else {
-                rgba.extend_from_slice(line);
-            }
-        }
-        Ok(Image { width: self.width, height: self.height, rgba })
+        read_texture(ctx, self.image_texture())
     }
+}
+
+/// Copies a single-sample 8-bit RGBA or BGRA texture with `COPY_SRC` usage (an image target,
+/// or a surface texture configured with it) back into an RGBA [`Image`]. A read-back: waits
+/// for the queue. Cost: the copy of `4 · width · height` bytes (rows padded to 256 bytes).
+pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image, RenderError> {
+    let (width, height) = (texture.width(), texture.height());
+    let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let size = row as u64 * height as u64;
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("image read-back"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    ctx.queue.submit([encoder.finish()]);
+    let bytes = tessera_gpu::readback::read_bytes(ctx, &buffer, size)?;
+    let mut rgba = Vec::with_capacity(4 * (width * height) as usize);
+    let bgra = matches!(texture.format(), wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+    for y in 0..height as usize {
+        let line = &bytes[y * row as usize..][..4 * width as usize];
+        if bgra {
+            for px in line.chunks_exact(4) {
+                rgba.extend_from_slice(&[px[2], px[1], px[0], px[3]]);
+            }
+        } else {
+            rgba.extend_from_slice(line);
+        }
+    }
+    Ok(Image { width, height, rgba })
 }
 
 /// Draws `geometry` from `camera` (its viewport is the image size) into a new image: a

@@ -26,6 +26,7 @@
 
 pub mod cpu;
 pub mod gpu;
+pub mod overlay;
 pub mod shading;
 
 pub use gpu::{Geometry, MeshBuffers, RenderOptions, Renderer, Targets};
