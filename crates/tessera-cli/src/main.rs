@@ -674,7 +674,9 @@ fn run_demo(a: DemoArgs) -> CliResult {
     println!("max error            {:.6e} (bounding-box diagonal {:.3})", e.max, lo.distance(hi));
     println!("rms error            {:.6e}", e.rms);
     if !verdict.watertight() || w.euler_characteristic != t.euler_characteristic {
-        println!("crack-free           NO: the output has open edges inside the surface or a changed topology");
+        println!(
+            "crack-free           NO: the output has open edges inside the surface or a changed topology"
+        );
         return Ok(ExitCode::from(1));
     }
     println!(

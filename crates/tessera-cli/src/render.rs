@@ -198,7 +198,10 @@ fn draw_gpu_engine(
         ColorMode::Shaded => None,
         _ => {
             let (_, _, offsets) = engine.read_layout(&ctx)?;
-            Some(use_upload(bytemuck::cast_slice(&tessera_render::triangle_patches(&offsets)), "triangle patches"))
+            Some(use_upload(
+                bytemuck::cast_slice(&tessera_render::triangle_patches(&offsets)),
+                "triangle patches",
+            ))
         }
     };
     let level_buffer = use_upload(bytemuck::cast_slice(levels), "patch levels");
@@ -221,7 +224,9 @@ fn draw_gpu_engine(
 pub fn run(a: RenderArgs) -> crate::CliResult {
     let options = crate::build_options(&a.input_args)?;
     if a.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
-        return Err(format!("-o {}: the picture is written as PNG: give a .png name", a.output.display()).into());
+        return Err(
+            format!("-o {}: the picture is written as PNG: give a .png name", a.output.display()).into()
+        );
     }
     if a.msaa != 1 && a.msaa != 4 {
         return Err(format!("--msaa {}: use 1 or 4", a.msaa).into());
@@ -252,7 +257,9 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
     };
     let (drawn, triangles) = if a.engine == "gpu" {
         if a.renderer == RendererArg::Cpu {
-            return Err("--engine gpu draws the GPU engine's buffers: it needs --renderer wgpu or auto".into());
+            return Err(
+                "--engine gpu draws the GPU engine's buffers: it needs --renderer wgpu or auto".into()
+            );
         }
         let pattern = tess.pattern().expect("a frame was planned");
         draw_gpu_engine(&set, plan, pattern, &levels, &camera, &render_options, a.msaa)?

@@ -119,7 +119,12 @@ struct App {
 
 const SAMPLES: u32 = 4;
 
-fn attachments(ctx: &GpuContext, format: wgpu::TextureFormat, w: u32, h: u32) -> (wgpu::Texture, wgpu::Texture) {
+fn attachments(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    w: u32,
+    h: u32,
+) -> (wgpu::Texture, wgpu::Texture) {
     let make = |format| {
         ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("view attachment"),
@@ -231,21 +236,35 @@ impl App {
 
     /// One frame: plan, tessellate, draw, statistics; the screenshot on the last one.
     fn frame(&mut self) -> Result<(), Box<dyn std::error::Error>> {
-        let Some((w, h)) = self.state.as_ref().map(|s| (s.config.width, s.config.height)) else { return Ok(()) };
+        let Some((w, h)) = self.state.as_ref().map(|s| (s.config.width, s.config.height)) else {
+            return Ok(());
+        };
         let camera = self.camera(w, h);
         let state = self.state.as_mut().expect("checked");
         let set = self.set;
         let settings = &self.settings;
         let scheme = SCHEMES[settings.scheme];
         let criterion = Criterion::PixelError(settings.pixel_error);
-        let options = PlanOptions { camera: Some(camera), cull: settings.cull, max_factor: self.args.max_factor, ..Default::default() };
+        let options = PlanOptions {
+            camera: Some(camera),
+            cull: settings.cull,
+            max_factor: self.args.max_factor,
+            ..Default::default()
+        };
         let start = Instant::now();
         // The GPU engine draws the uniform and transition schemes; anything it refuses is
         // tessellated on the CPU this frame.
         let mut on_gpu = false;
         let mut plan_ms = 0.0;
         if settings.gpu_engine && matches!(scheme, Scheme::Uniform | Scheme::Transition) {
-            scheme.plan_into(set, &state.prepared, &criterion, &options, &mut state.scratch, &mut state.planned)?;
+            scheme.plan_into(
+                set,
+                &state.prepared,
+                &criterion,
+                &options,
+                &mut state.scratch,
+                &mut state.planned,
+            )?;
             plan_ms = start.elapsed().as_secs_f64() * 1e3;
             match state.engine.prepare(&state.ctx, set, &state.planned.plan, &state.planned.pattern) {
                 Ok(()) => on_gpu = true,
@@ -309,7 +328,9 @@ impl App {
         let geometry = match &upload {
             Some(buffers) => buffers.geometry(),
             None => {
-                let (Some(vertices), Some(indices)) = (state.engine.vertex_buffer(), state.engine.index_buffer()) else {
+                let (Some(vertices), Some(indices)) =
+                    (state.engine.vertex_buffer(), state.engine.index_buffer())
+                else {
                     return Ok(());
                 };
                 gpu::Geometry {
@@ -325,7 +346,16 @@ impl App {
         };
         let colour = state.msaa.0.create_view(&Default::default());
         let depth = state.msaa.1.create_view(&Default::default());
-        state.renderer.record(&state.ctx, &mut encoder, &colour, Some(&target), &depth, &geometry, &camera, &options);
+        state.renderer.record(
+            &state.ctx,
+            &mut encoder,
+            &colour,
+            Some(&target),
+            &depth,
+            &geometry,
+            &camera,
+            &options,
+        );
         let line1 = self.status.clone();
         // Twice the font size when the longer line fits the window.
         let scale = if (line1.len().max(HELP.len()) as u32 * 12 + 24) < w { 2 } else { 1 };
@@ -372,7 +402,11 @@ impl App {
 }
 
 fn state_culled(on_gpu: bool, state: &State) -> usize {
-    let visible = if on_gpu { &state.planned.plan.visible } else { &state.cpu.as_ref().and_then(|t| t.plan()).map(|p| p.visible.clone()).unwrap_or_default() };
+    let visible = if on_gpu {
+        &state.planned.plan.visible
+    } else {
+        &state.cpu.as_ref().and_then(|t| t.plan()).map(|p| p.visible.clone()).unwrap_or_default()
+    };
     visible.iter().filter(|&&v| v == 0).count()
 }
 
@@ -436,9 +470,16 @@ impl ApplicationHandler for App {
                         "+" | "=" => s.pixel_error = (s.pixel_error / 2.0).max(1.0 / 64.0),
                         "-" => s.pixel_error = (s.pixel_error * 2.0).min(256.0),
                         "w" => s.wireframe = !s.wireframe,
-                        "l" => s.color = if s.color == ColorMode::Level { ColorMode::Shaded } else { ColorMode::Level },
+                        "l" => {
+                            s.color =
+                                if s.color == ColorMode::Level { ColorMode::Shaded } else { ColorMode::Level }
+                        }
                         "p" => {
-                            s.color = if s.color == ColorMode::Patch { ColorMode::Shaded } else { ColorMode::Patch };
+                            s.color = if s.color == ColorMode::Patch {
+                                ColorMode::Shaded
+                            } else {
+                                ColorMode::Patch
+                            };
                             // Patch colours need the triangles' patches: the CPU engine has them.
                             if s.color == ColorMode::Patch {
                                 s.gpu_engine = false;
@@ -494,9 +535,13 @@ pub fn run(a: ViewArgs) -> crate::CliResult {
         return Err(format!("--pixel-error {}: must be a positive number", a.pixel_error).into());
     }
     let size = {
-        let (w, h) = a.size.split_once(['x', 'X']).ok_or_else(|| format!("--size {}: expected WxH", a.size))?;
+        let (w, h) =
+            a.size.split_once(['x', 'X']).ok_or_else(|| format!("--size {}: expected WxH", a.size))?;
         let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|&v| v > 0);
-        (parse(w).ok_or_else(|| format!("--size {}: expected WxH", a.size))?, parse(h).ok_or_else(|| format!("--size {}: expected WxH", a.size))?)
+        (
+            parse(w).ok_or_else(|| format!("--size {}: expected WxH", a.size))?,
+            parse(h).ok_or_else(|| format!("--size {}: expected WxH", a.size))?,
+        )
     };
     let options = crate::build_options(&a.input_args)?;
     // The tessellator borrows the set for the whole run (the event loop owns the app): leaked

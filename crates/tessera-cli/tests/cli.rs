@@ -14,9 +14,11 @@ fn demo_writes_a_watertight_teapot() {
     let stdout = text(&out.stdout);
     // The report leads with the verdict, judged from the mesh's open edges.
     assert!(
-        stdout.lines().next().unwrap_or("").starts_with(
-            "watertight: every open edge lies on one of the teapot's 16 free curves"
-        ),
+        stdout
+            .lines()
+            .next()
+            .unwrap_or("")
+            .starts_with("watertight: every open edge lies on one of the teapot's 16 free curves"),
         "{stdout}"
     );
     assert!(stdout.contains("128 of 128 output edges, on 16 of the curves"), "{stdout}");

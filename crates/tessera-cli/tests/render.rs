@@ -55,11 +55,13 @@ fn reference_coverage(input: &Path, scheme: Scheme, criterion: Criterion) -> usi
         .collect();
     let mut hit = vec![false; (SIZE * SIZE) as usize];
     for t in mesh.indices.chunks_exact(3) {
-        let [Some(a), Some(b), Some(c)] = [screen[t[0] as usize], screen[t[1] as usize], screen[t[2] as usize]]
+        let [Some(a), Some(b), Some(c)] =
+            [screen[t[0] as usize], screen[t[1] as usize], screen[t[2] as usize]]
         else {
             continue;
         };
-        let cross = |o: (f64, f64), p: (f64, f64), x: f64, y: f64| (p.0 - o.0) * (y - o.1) - (p.1 - o.1) * (x - o.0);
+        let cross =
+            |o: (f64, f64), p: (f64, f64), x: f64, y: f64| (p.0 - o.0) * (y - o.1) - (p.1 - o.1) * (x - o.0);
         let area = cross(a, b, c.0, c.1);
         if area == 0.0 {
             continue;
@@ -111,7 +113,10 @@ fn coverage_equals_an_independent_rasteriser_within_one_percent() {
         // A framed model covers a good part of the image: a tiny count would prove nothing.
         assert!(reference > 4000, "{model}: only {reference} pixels covered");
         eprintln!("{model}: rendered {rendered} covered pixels, reference {reference}");
-        assert!(within(rendered, reference, 0.01), "{model}: rendered {rendered} pixels, reference {reference}");
+        assert!(
+            within(rendered, reference, 0.01),
+            "{model}: rendered {rendered} pixels, reference {reference}"
+        );
     }
 }
 
@@ -164,6 +169,9 @@ fn cpu_fallback_rasteriser_covers_what_wgpu_covers() {
             .count();
         let far = (SIZE * SIZE) as usize - close;
         eprintln!("{model}: {far} of {w} covered pixels differ by more than 8/255");
-        assert!(far as f64 <= 0.05 * w as f64, "{model}: {far} of {w} covered pixels differ by more than 8/255");
+        assert!(
+            far as f64 <= 0.05 * w as f64,
+            "{model}: {far} of {w} covered pixels differ by more than 8/255"
+        );
     }
 }

@@ -10,7 +10,8 @@ use std::process::Command;
 
 #[test]
 fn viewer_draws_frames_under_xvfb_and_saves_a_screenshot() {
-    let found = Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
     assert!(found, "xvfb-run is missing: install it (Debian/Ubuntu: apt-get install -y xvfb xauth) to run the viewer test");
     let dir = scratch("viewer-shot");
     let input = data("patches/teapot.patches");
@@ -25,7 +26,8 @@ fn viewer_draws_frames_under_xvfb_and_saves_a_screenshot() {
     assert!(out.status.success(), "tessera view failed: {stderr}");
     assert!(stderr.contains("after 4 frames"), "{stderr}");
     assert!(stderr.contains("TRIS"), "{stderr}");
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("shot.png")).unwrap()));
+    let decoder =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("shot.png")).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
@@ -33,11 +35,15 @@ fn viewer_draws_frames_under_xvfb_and_saves_a_screenshot() {
     let rgb = &buf[..info.buffer_size()];
     let pixel = |x: usize, y: usize| &rgb[3 * (y * 480 + x)..][..3];
     // The model in the middle (not the white background) ...
-    let covered = (0..320).flat_map(|y| (0..480).map(move |x| (x, y))).filter(|&(x, y)| pixel(x, y) != [255, 255, 255]).count();
+    let covered = (0..320)
+        .flat_map(|y| (0..480).map(move |x| (x, y)))
+        .filter(|&(x, y)| pixel(x, y) != [255, 255, 255])
+        .count();
     assert!(covered > 480 * 320 / 20, "only {covered} pixels are not background");
     assert_ne!(pixel(240, 170), [255, 255, 255], "nothing drawn at the centre");
     // ... and the statistics panel at the top left: dark pixels and light glyph pixels.
-    let panel: Vec<&[u8]> = (10..30).flat_map(|y| (10..200).map(move |x| (x, y))).map(|(x, y)| pixel(x, y)).collect();
+    let panel: Vec<&[u8]> =
+        (10..30).flat_map(|y| (10..200).map(move |x| (x, y))).map(|(x, y)| pixel(x, y)).collect();
     assert!(panel.iter().any(|p| p.iter().all(|&c| c < 110)), "no statistics panel");
     assert!(panel.iter().any(|p| p.iter().all(|&c| c > 200)), "no text on the panel");
 }

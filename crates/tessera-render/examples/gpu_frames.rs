@@ -100,7 +100,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let colour = texture(COLOR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
     let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
-    let (colour_view, depth_view) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let (colour_view, depth_view) =
+        (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
     let row = (4 * WIDTH).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let picture = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("picture"),
@@ -142,11 +143,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     view: &colour_view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::WHITE), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -163,10 +170,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             pass.draw_indexed_indirect(engine.indirect_buffer(), 0);
         }
         encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: &colour, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &colour,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
             wgpu::TexelCopyBufferInfo {
                 buffer: &picture,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: None,
+                },
             },
             wgpu::Extent3d { width: WIDTH, height: HEIGHT, depth_or_array_layers: 1 },
         );
@@ -174,7 +190,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
         // A headless app's "present": the picture read back and written as PNG.
         let bytes = tessera_gpu::readback::read_bytes(&ctx, &picture, (row * HEIGHT) as u64)?;
-        let rgba = bytes.chunks_exact(row as usize).flat_map(|line| &line[..4 * WIDTH as usize]).copied().collect();
+        let rgba =
+            bytes.chunks_exact(row as usize).flat_map(|line| &line[..4 * WIDTH as usize]).copied().collect();
         let path = out_dir.join(format!("frame_{frame:03}.png"));
         tessera_render::Image { width: WIDTH, height: HEIGHT, rgba }.write_png(&path)?;
         let (_, _, triangles) = engine.read_status(&ctx)?; // statistics only, for this printout

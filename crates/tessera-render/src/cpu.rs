@@ -67,7 +67,9 @@ pub fn render(mesh: &Mesh, camera: &Camera, options: &RenderOptions, patch_level
         for y in lo_y..hi_y {
             for x in lo_x..hi_x {
                 let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
-                let b = Vec3::new(edge(s[1], s[2], px, py), edge(s[2], s[0], px, py), edge(s[0], s[1], px, py)) / area;
+                let b =
+                    Vec3::new(edge(s[1], s[2], px, py), edge(s[2], s[0], px, py), edge(s[0], s[1], px, py))
+                        / area;
                 if b.min_element() < 0.0 {
                     continue;
                 }

@@ -165,7 +165,11 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
 }
 
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -269,7 +273,12 @@ impl Renderer {
             cache: None,
         });
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
         };
         use wgpu::BufferUsages as U;
         Ok(Renderer {
@@ -277,7 +286,11 @@ impl Renderer {
             layout,
             args_pipeline,
             args_layout,
-            uniform: buffer("draw frame", std::mem::size_of::<FrameUniform>() as u64, U::UNIFORM | U::COPY_DST),
+            uniform: buffer(
+                "draw frame",
+                std::mem::size_of::<FrameUniform>() as u64,
+                U::UNIFORM | U::COPY_DST,
+            ),
             draw_args: buffer("draw indirect", 16, U::STORAGE | U::INDIRECT),
             draw_info: buffer("draw info", 16, U::STORAGE),
             dummy: buffer("draw dummy", 16, U::STORAGE),
@@ -357,7 +370,10 @@ impl Renderer {
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,
@@ -387,7 +403,12 @@ impl Targets {
     /// Textures for `renderer` (its format and sample count) of `width × height`. Errors:
     /// [`RenderError::Invalid`] past the device's texture size limit or for an empty size.
     /// Cost: the allocation.
-    pub fn new(ctx: &GpuContext, renderer: &Renderer, width: u32, height: u32) -> Result<Targets, RenderError> {
+    pub fn new(
+        ctx: &GpuContext,
+        renderer: &Renderer,
+        width: u32,
+        height: u32,
+    ) -> Result<Targets, RenderError> {
         let max = ctx.limits.max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(RenderError::Invalid(format!(
@@ -410,11 +431,20 @@ impl Targets {
         let s = renderer.samples;
         let f = renderer.format;
         let (colour, resolve) = if s > 1 {
-            (texture("colour msaa", f, s, U::RENDER_ATTACHMENT), Some(texture("colour", f, 1, U::RENDER_ATTACHMENT | U::COPY_SRC)))
+            (
+                texture("colour msaa", f, s, U::RENDER_ATTACHMENT),
+                Some(texture("colour", f, 1, U::RENDER_ATTACHMENT | U::COPY_SRC)),
+            )
         } else {
             (texture("colour", f, 1, U::RENDER_ATTACHMENT | U::COPY_SRC), None)
         };
-        Ok(Targets { width, height, colour, resolve, depth: texture("depth", DEPTH_FORMAT, s, U::RENDER_ATTACHMENT) })
+        Ok(Targets {
+            width,
+            height,
+            colour,
+            resolve,
+            depth: texture("depth", DEPTH_FORMAT, s, U::RENDER_ATTACHMENT),
+        })
     }
 
     /// Records `renderer`'s frame into these targets (see [`Renderer::record`]).
@@ -476,7 +506,8 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image, 
     ctx.queue.submit([encoder.finish()]);
     let bytes = tessera_gpu::readback::read_bytes(ctx, &buffer, size)?;
     let mut rgba = Vec::with_capacity(4 * (width * height) as usize);
-    let bgra = matches!(texture.format(), wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+    let bgra =
+        matches!(texture.format(), wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
     for y in 0..height as usize {
         let line = &bytes[y * row as usize..][..4 * width as usize];
         if bgra {

@@ -88,7 +88,10 @@ impl Image {
     /// Writes the image as an 8-bit RGB PNG (the background is opaque). Errors:
     /// [`RenderError::Write`]. Cost: deflate of the pixels.
     pub fn write_png(&self, path: &Path) -> Result<(), RenderError> {
-        let fail = |e: &dyn std::fmt::Display| RenderError::Write { path: path.display().to_string(), reason: e.to_string() };
+        let fail = |e: &dyn std::fmt::Display| RenderError::Write {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        };
         let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
         let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
         encoder.set_color(png::ColorType::Rgb);
@@ -101,16 +104,24 @@ impl Image {
 
     /// Reads an 8-bit RGB or RGBA PNG (as [`Image::write_png`] writes). For tests and tools.
     pub fn read_png(path: &Path) -> Result<Image, RenderError> {
-        let fail = |e: &dyn std::fmt::Display| RenderError::Write { path: path.display().to_string(), reason: e.to_string() };
+        let fail = |e: &dyn std::fmt::Display| RenderError::Write {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        };
         let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
-        let mut reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().map_err(|e| fail(&e))?;
+        let mut reader =
+            png::Decoder::new(std::io::BufReader::new(file)).read_info().map_err(|e| fail(&e))?;
         let mut buf = vec![0; reader.output_buffer_size().unwrap_or(0)];
         let info = reader.next_frame(&mut buf).map_err(|e| fail(&e))?;
         let data = &buf[..info.buffer_size()];
         let rgba = match (info.color_type, info.bit_depth) {
-            (png::ColorType::Rgb, png::BitDepth::Eight) => data.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect(),
+            (png::ColorType::Rgb, png::BitDepth::Eight) => {
+                data.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect()
+            }
             (png::ColorType::Rgba, png::BitDepth::Eight) => data.to_vec(),
-            other => return Err(fail(&format!("unsupported PNG layout {other:?} (8-bit RGB or RGBA expected)"))),
+            other => {
+                return Err(fail(&format!("unsupported PNG layout {other:?} (8-bit RGB or RGBA expected)")))
+            }
         };
         Ok(Image { width: info.width, height: info.height, rgba })
     }

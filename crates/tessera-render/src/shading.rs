@@ -64,7 +64,8 @@ pub fn base_colour(mode: ColorMode, patch: u32, level: f32) -> Vec3 {
         }
         ColorMode::Level => {
             let t = level.clamp(0.0, 1.0);
-            let (a, b, c) = (Vec3::new(0.25, 0.45, 0.85), Vec3::new(0.35, 0.75, 0.35), Vec3::new(0.85, 0.30, 0.25));
+            let (a, b, c) =
+                (Vec3::new(0.25, 0.45, 0.85), Vec3::new(0.35, 0.75, 0.35), Vec3::new(0.85, 0.30, 0.25));
             if t < 0.5 {
                 a.lerp(b, 2.0 * t)
             } else {

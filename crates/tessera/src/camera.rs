@@ -272,7 +272,11 @@ mod tests {
 
     #[test]
     fn view_projection_agrees_with_project() {
-        let c = Camera::parse("eye=3,-4,2,target=0.2,0.1,0.3,fov=40,size=640x360,near=0.5,far=20", &Camera::framing(DVec3::ZERO, DVec3::ONE, 8, 8)).unwrap();
+        let c = Camera::parse(
+            "eye=3,-4,2,target=0.2,0.1,0.3,fov=40,size=640x360,near=0.5,far=20",
+            &Camera::framing(DVec3::ZERO, DVec3::ONE, 8, 8),
+        )
+        .unwrap();
         let m = c.view_projection();
         for p in [DVec3::new(0.2, 0.1, 0.3), DVec3::new(1.0, -0.5, 0.7), DVec3::new(-0.8, 0.9, -0.2)] {
             let clip = m * p.extend(1.0);
