@@ -151,6 +151,16 @@ pub fn draw_mesh(
             Ok(Drawn { image, renderer: wgpu_name(&ctx), draw_seconds: start.elapsed().as_secs_f64() })
         }
         Err(why) => {
+            // WebGPU's default texture limit: past it the rasteriser's buffers (20 bytes a
+            // pixel) would take gigabytes.
+            const MAX_SIDE: u32 = 8192;
+            if camera.width > MAX_SIDE || camera.height > MAX_SIDE {
+                return Err(format!(
+                    "image size {}x{}: the CPU rasteriser draws at most {MAX_SIDE} pixels a side",
+                    camera.width, camera.height
+                )
+                .into());
+            }
             let start = Instant::now();
             let image = tessera_render::cpu::render(mesh, camera, options, levels);
             Ok(Drawn {
