@@ -26,6 +26,7 @@
 
 pub mod cpu;
 pub mod gpu;
+pub mod instanced;
 pub mod overlay;
 pub mod shading;
 
