@@ -24,9 +24,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let data = std::env::var("TESSERA_DATA").unwrap_or_else(|_| "../shared/data".into());
         Path::new(&data).join("patches/teapot.patches")
     });
-    let (w, h) = args.get(2).and_then(|s| s.split_once('x')).map_or(Ok((1280, 720)), |(w, h)| {
-        Ok::<_, std::num::ParseIntError>((w.parse()?, h.parse()?))
-    })?;
+    let (w, h) = args
+        .get(2)
+        .and_then(|s| s.split_once('x'))
+        .map_or(Ok((1280, 720)), |(w, h)| Ok::<_, std::num::ParseIntError>((w.parse()?, h.parse()?)))?;
     let pixel_error: f64 = args.get(3).map_or(Ok(0.5), |s| s.parse())?;
     let frames: usize = args.get(4).map_or(Ok(20), |s| s.parse())?;
     let set = tessera::io::load(&model, Default::default())?;
@@ -65,7 +66,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mesh.triangle_count(),
         ctx.info.name
     );
-    println!("  wgpu draw (MSAA 4, wireframe), submit to finished: {:.1} ms (median of {frames})", median(draw));
+    println!(
+        "  wgpu draw (MSAA 4, wireframe), submit to finished: {:.1} ms (median of {frames})",
+        median(draw)
+    );
     println!("  wgpu draw + image read-back:                     {:.1} ms", median(with_read));
     println!("  CPU fallback rasteriser (1 sample):              {:.1} ms", median(cpu));
     Ok(())

@@ -124,7 +124,7 @@ impl MeshBuffers {
 /// `draw.wgsl`'s `Frame`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct FrameUniform {
+pub(crate) struct FrameUniform {
     view_proj: [f32; 16],
     eye: [f32; 4],
     light: [f32; 4],
@@ -132,7 +132,7 @@ struct FrameUniform {
 }
 
 impl FrameUniform {
-    fn new(camera: &Camera, options: &RenderOptions, has_patches: bool) -> FrameUniform {
+    pub(crate) fn new(camera: &Camera, options: &RenderOptions, has_patches: bool) -> FrameUniform {
         let (r, u, f) = camera.basis();
         let light = shading::light_direction(r.as_vec3(), u.as_vec3(), f.as_vec3());
         let e = camera.eye.as_vec3();
@@ -462,6 +462,13 @@ impl Targets {
         let resolve = self.resolve.as_ref().map(view);
         let depth = view(&self.depth);
         renderer.record(ctx, encoder, &colour, resolve.as_ref(), &depth, geometry, camera, options);
+    }
+
+    /// Views of the colour attachment, the resolve target (with MSAA) and the depth buffer,
+    /// for pipelines other than [`Renderer`]'s that draw into these targets.
+    pub fn views(&self) -> (wgpu::TextureView, Option<wgpu::TextureView>, wgpu::TextureView) {
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        (view(&self.colour), self.resolve.as_ref().map(view), view(&self.depth))
     }
 
     /// The single-sample image texture (the resolve target with MSAA).
