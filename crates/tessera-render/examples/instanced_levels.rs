@@ -46,7 +46,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for _ in 0..frames.max(1) {
             let start = Instant::now();
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            draw.record(&ctx, &mut encoder, &planned.plan, &camera, &look, &colour, resolve.as_ref(), &depth)?;
+            draw.record(
+                &ctx,
+                &mut encoder,
+                &planned.plan,
+                &camera,
+                &look,
+                &colour,
+                resolve.as_ref(),
+                &depth,
+            )?;
             ctx.queue.submit([encoder.finish()]);
             ctx.wait()?;
             times.push(start.elapsed().as_secs_f64() * 1e3);
