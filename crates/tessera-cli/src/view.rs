@@ -1,6 +1,8 @@
 //! `tessera view`: a window (winit, X11) with an orbit camera that re-tessellates the model
 //! every frame from the camera — on the GPU engine where it draws the scheme, else on the CPU
 //! engine, uploaded — and draws it with tessera-render's pipeline, with a statistics line.
+//! The semi-uniform scheme is drawn on the GPU by the instanced path
+//! (`tessera_render::instanced`: render queues on the GPU, one instanced draw per level).
 //!
 //! Keys: S scheme, + / - pixel error ×2 / ÷2, W wireframe, L level colours, P patch colours,
 //! C culling, E engine (gpu / cpu), arrows orbit, Q or Esc quit. Mouse: drag to orbit, wheel to
@@ -25,6 +27,7 @@ use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::tessellator::{PassTimer, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
+use tessera_render::instanced::InstancedDraw;
 use tessera_render::overlay::Overlay;
 use tessera_render::{gpu, ColorMode, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
@@ -101,6 +104,9 @@ struct State {
     planned: Planned,
     cpu: Option<Tessellator<'static>>,
     cpu_key: (usize, u64, bool),
+    /// The instanced semi-uniform draw (paper 000), made on first use; Err once it cannot
+    /// draw this set (mixed domains), then the CPU engine draws semi-uniform.
+    instanced: Option<Result<InstancedDraw, String>>,
 }
 
 struct App {
@@ -209,6 +215,7 @@ impl App {
             planned: Planned::default(),
             cpu: None,
             cpu_key: (usize::MAX, 0, false),
+            instanced: None,
             ctx,
         })
     }
@@ -256,6 +263,26 @@ impl App {
         // tessellated on the CPU this frame.
         let mut on_gpu = false;
         let mut plan_ms = 0.0;
+        // Semi-uniform on the GPU: render queues, level arguments and instanced draws.
+        let mut instanced = false;
+        if let (true, Scheme::SemiUniform { max_level }) = (settings.gpu_engine, scheme) {
+            if state.instanced.is_none() {
+                let made = InstancedDraw::new(&state.ctx, set, max_level, state.config.format, SAMPLES);
+                state.instanced = Some(made.map_err(|e| e.to_string()));
+            }
+            if let Some(Ok(_)) = &state.instanced {
+                scheme.plan_into(
+                    set,
+                    &state.prepared,
+                    &criterion,
+                    &options,
+                    &mut state.scratch,
+                    &mut state.planned,
+                )?;
+                plan_ms = start.elapsed().as_secs_f64() * 1e3;
+                instanced = true;
+            }
+        }
         if settings.gpu_engine && matches!(scheme, Scheme::Uniform | Scheme::Transition) {
             scheme.plan_into(
                 set,
@@ -278,7 +305,12 @@ impl App {
         let triangles;
         let upload;
         let level_buffer;
-        if on_gpu {
+        if instanced {
+            levels = Vec::new();
+            stages = format!("PLAN {plan_ms:.1} (INSTANCED)");
+            triangles = None;
+            upload = None;
+        } else if on_gpu {
             state.engine.record_timed(&mut encoder, state.timer.as_ref());
             levels = tessera_render::patch_levels(&state.planned.plan, self.args.max_factor);
             stages = format!("PLAN {plan_ms:.1}");
@@ -326,14 +358,15 @@ impl App {
             });
         }
         let geometry = match &upload {
-            Some(buffers) => buffers.geometry(),
+            Some(buffers) => Some(buffers.geometry()),
+            None if instanced => None,
             None => {
                 let (Some(vertices), Some(indices)) =
                     (state.engine.vertex_buffer(), state.engine.index_buffer())
                 else {
                     return Ok(());
                 };
-                gpu::Geometry {
+                Some(gpu::Geometry {
                     vertices,
                     indices,
                     indexed_args: state.engine.indirect_buffer(),
@@ -341,21 +374,37 @@ impl App {
                     // every frame (a read-back): they are drawn from the CPU engine instead.
                     triangle_patch: None,
                     patch_level: Some(&level_buffer),
-                }
+                })
             }
         };
         let colour = state.msaa.0.create_view(&Default::default());
         let depth = state.msaa.1.create_view(&Default::default());
-        state.renderer.record(
-            &state.ctx,
-            &mut encoder,
-            &colour,
-            Some(&target),
-            &depth,
-            &geometry,
-            &camera,
-            &options,
-        );
+        match &state.instanced {
+            Some(Ok(draw)) if instanced => draw.record(
+                &state.ctx,
+                &mut encoder,
+                &state.planned.plan,
+                &camera,
+                &options,
+                &colour,
+                Some(&target),
+                &depth,
+            )?,
+            _ => {
+                if let Some(geometry) = &geometry {
+                    state.renderer.record(
+                        &state.ctx,
+                        &mut encoder,
+                        &colour,
+                        Some(&target),
+                        &depth,
+                        geometry,
+                        &camera,
+                        &options,
+                    )
+                }
+            }
+        }
         let line1 = self.status.clone();
         // Twice the font size when the longer line fits the window.
         let scale = if (line1.len().max(HELP.len()) as u32 * 12 + 24) < w { 2 } else { 1 };
@@ -373,9 +422,18 @@ impl App {
         // Statistics for the next frame's line (read back: see the module doc).
         state.ctx.wait()?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
-        let triangles = match triangles {
-            Some(t) => t as u64,
-            None => {
+        let triangles = match (triangles, &state.instanced) {
+            (Some(t), _) => t as u64,
+            // Drawn by the instanced path: the queues' patches times their patterns'
+            // triangles, degenerate ones included (the rasteriser drops those).
+            (None, Some(Ok(draw))) if instanced => {
+                let queues = draw.queues().read(&state.ctx)?;
+                let max = queues.max_level();
+                (0..=max)
+                    .map(|m| (queues.level(m).len() * draw.patterns()[m as usize].triangles.len()) as u64)
+                    .sum()
+            }
+            (None, _) => {
                 if let Some(timer) = &state.timer {
                     for (name, ms) in timer.read(&state.ctx)? {
                         if name != PASSES[0] || settings.cull {
@@ -386,7 +444,7 @@ impl App {
                 state.engine.read_status(&state.ctx)?.2 as u64
             }
         };
-        let culled = state_culled(on_gpu, state);
+        let culled = state_culled(on_gpu || instanced, state);
         self.status = format!(
             "{} {}PX / {} TRIS / {} PATCHES{} / {} ENGINE: {stages} / FRAME {frame_ms:.1} MS",
             scheme.name(),
@@ -394,7 +452,7 @@ impl App {
             triangles,
             set.patches.len(),
             if settings.cull { format!(" ({culled} CULLED)") } else { String::new() },
-            if on_gpu { "GPU" } else { "CPU" },
+            if on_gpu || instanced { "GPU" } else { "CPU" },
         );
         self.frames += 1;
         Ok(())

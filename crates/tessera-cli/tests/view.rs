@@ -47,3 +47,30 @@ fn viewer_draws_frames_under_xvfb_and_saves_a_screenshot() {
     assert!(panel.iter().any(|p| p.iter().all(|&c| c < 110)), "no statistics panel");
     assert!(panel.iter().any(|p| p.iter().all(|&c| c > 200)), "no text on the panel");
 }
+
+#[test]
+fn viewer_draws_semi_uniform_with_the_instanced_path() {
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    assert!(found, "xvfb-run is missing: install it (Debian/Ubuntu: apt-get install -y xvfb xauth) to run the viewer test");
+    let dir = scratch("viewer-instanced");
+    let input = data("meshes/blob.obj");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_tessera"), "view"])
+        .arg(&input)
+        .args(["--scheme", "semi-uniform", "--frames", "3", "--screenshot", "su.png", "--size", "320x240"])
+        .current_dir(&dir)
+        .output()
+        .expect("run xvfb-run");
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "tessera view failed: {stderr}");
+    assert!(stderr.contains("semi-uniform") && stderr.contains("(INSTANCED)"), "{stderr}");
+    let decoder =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("su.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let rgb = &buf[..info.buffer_size()];
+    let covered = rgb.chunks_exact(3).filter(|p| *p != [255, 255, 255]).count();
+    assert!(covered > 320 * 240 / 10, "only {covered} pixels are not background");
+}
