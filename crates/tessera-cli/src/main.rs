@@ -58,6 +58,7 @@ enum Command {
     Render(render::RenderArgs),
     /// Open a window (X11) that re-tessellates the model every frame from an orbit camera,
     /// with keys for the scheme, the pixel error, wireframe, level colours and culling.
+    #[command(after_help = view::KEYS)]
     View(view::ViewArgs),
 }
 

@@ -468,6 +468,12 @@ fn state_culled(on_gpu: bool, state: &State) -> usize {
     visible.iter().filter(|&&v| v == 0).count()
 }
 
+/// The keys, for `tessera view --help`.
+pub const KEYS: &str = "Keys: S scheme (transition, uniform, semi-uniform, fractional-odd, integer), + / - pixel \
+error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
+arrows or mouse drag orbit, wheel zoom, Q or Esc quit. The window needs an X11 display (no Wayland backend; \
+XWayland works); headless: xvfb-run -a tessera view IN --frames N --screenshot OUT.png";
+
 const HELP: &str = "S SCHEME  +/- PIXEL ERROR  W WIRE  L LEVELS  P PATCHES  C CULL  E ENGINE  DRAG/ARROWS ORBIT  WHEEL ZOOM  Q QUIT";
 
 impl ApplicationHandler for App {
