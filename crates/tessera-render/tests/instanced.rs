@@ -104,3 +104,67 @@ fn instanced_draw_equals_the_cpu_instanced_form_and_the_compacted_mesh() {
         }
     }
 }
+
+/// Ten cameras about the model (as in `tests/queues.rs`): round it, at heights and distances
+/// that change the levels.
+fn cameras(lo: glam::DVec3, hi: glam::DVec3) -> Vec<Camera> {
+    let framing = Camera::framing(lo, hi, 640, 480);
+    let radius = lo.distance(hi) * 0.5;
+    (0..10)
+        .map(|k| {
+            let angle = k as f64 * 0.7;
+            let zoom = [0.45, 0.7, 1.0, 1.6, 3.0][k % 5];
+            let offset = glam::DQuat::from_axis_angle(framing.up, angle) * (framing.eye - framing.target);
+            let eye = framing.target + offset * zoom + framing.up * radius * (k as f64 * 0.13 - 0.5);
+            let d = eye.distance(framing.target);
+            Camera { eye, near: (d - radius).max(d * 1e-3), far: d + 2.0 * radius, ..framing }
+        })
+        .collect()
+}
+
+#[test]
+fn instanced_triangles_equal_the_compacted_mesh_on_every_model_and_ten_cameras() {
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
+    let max_level = 5;
+    let scheme = Scheme::SemiUniform { max_level };
+    let models = [
+        "patches/teapot.patches",
+        "patches/teacup.patches",
+        "patches/teapot_teasetorig.patches",
+        "bench/torus_64x32.patches",
+        "meshes/blob.obj",
+        "meshes/spool.obj",
+        "meshes/bunny_res4.obj",
+    ];
+    let renderer = gpu::Renderer::new(&ctx, gpu::IMAGE_FORMAT, 1).unwrap();
+    let targets = gpu::Targets::new(&ctx, &renderer, 64, 64).unwrap();
+    let (colour, resolve, depth) = targets.views();
+    let look = RenderOptions::default();
+    for model in models {
+        let set = tessera::io::load(&data(model), Default::default()).unwrap();
+        let (lo, hi) = set.bounds();
+        let eps = 1e-6 * lo.distance(hi) as f32;
+        let draw = InstancedDraw::new(&ctx, &set, max_level, gpu::IMAGE_FORMAT, 1).unwrap();
+        for (k, camera) in cameras(lo, hi).into_iter().enumerate() {
+            let options = PlanOptions { camera: Some(camera), cull: k % 2 == 1, ..Default::default() };
+            let planned = scheme.plan(&set, &Criterion::PixelError(1.0), &options).unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            draw.record(&ctx, &mut encoder, &planned.plan, &camera, &look, &colour, resolve.as_ref(), &depth)
+                .unwrap();
+            ctx.queue.submit([encoder.finish()]);
+            let queues = draw.queues().read(&ctx).unwrap();
+            let mut drawn = 0;
+            for m in 0..=max_level {
+                let points = draw.expand_level(&ctx, m, queues.level(m).len()).unwrap();
+                let p = &draw.patterns()[m as usize];
+                let per = p.vertices.len();
+                let triangles = (0..queues.level(m).len())
+                    .flat_map(|i| p.triangles.iter().map(move |t| t.map(|v| i * per + v as usize)));
+                drawn += non_degenerate(&points, triangles, eps);
+            }
+            let mesh = tessera::engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default())
+                .unwrap();
+            assert_eq!(drawn, mesh.triangle_count(), "{model}, camera {k}: non-degenerate drawn triangles");
+        }
+    }
+}
