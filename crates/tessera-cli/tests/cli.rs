@@ -12,6 +12,21 @@ fn demo_writes_a_watertight_teapot() {
     let out = tessera(&["demo"], &dir);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
+    // The report leads with the verdict, judged from the mesh's open edges.
+    assert!(
+        stdout
+            .lines()
+            .next()
+            .unwrap_or("")
+            .starts_with("watertight: every open edge lies on one of the teapot's 16 free curves"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("128 of 128 output edges, on 16 of the curves"), "{stdout}");
+    // The picture is drawn (by wgpu here, or the CPU rasteriser without an adapter) and said so.
+    assert!(stdout.contains("picture              teapot.png (1280x720"), "{stdout}");
+    assert!(stdout.contains("drawn by"), "{stdout}");
+    let png = std::fs::read(dir.join("teapot.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
     assert!(stdout.contains("non-manifold edges   0"), "{stdout}");
     assert!(stdout.contains("max error"), "{stdout}");
     let obj = dir.join("teapot.obj");

@@ -1,0 +1,650 @@
+//! `tessera view`: a window (winit, X11) with an orbit camera that re-tessellates the model
+//! every frame from the camera — on the GPU engine where it draws the scheme, else on the CPU
+//! engine, uploaded — and draws it with tessera-render's pipeline, with a statistics line.
+//! The semi-uniform scheme is drawn on the GPU by the instanced path
+//! (`tessera_render::instanced`: render queues on the GPU, one instanced draw per level).
+//!
+//! Keys: S scheme, + / - pixel error ×2 / ÷2, W wireframe, L level colours, P patch colours,
+//! C culling, E engine (gpu / cpu), arrows orbit, Q or Esc quit. Mouse: drag to orbit, wheel to
+//! zoom. `--frames N --screenshot OUT.png` draws N frames (the camera turning by itself),
+//! saves the last one and exits, for headless tests (Xvfb).
+//!
+//! The statistics line reads a few bytes back per frame (the GPU engine's triangle count and,
+//! with timestamp queries, its pass times): a viewer's convenience; an application's frame
+//! loop reads nothing back (see tessera-render's `gpu_frames` example).
+
+use crate::plan;
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Instant;
+use tessera::camera::Camera;
+use tessera::criterion::PlanScratch;
+use tessera::pattern::hardware::Partitioning;
+use tessera::scheme::{Criterion, PlanOptions, Planned, Prepared, Scheme};
+use tessera::surface::SurfaceSet;
+use tessera::tessellator::{Tessellator, TessellatorOptions};
+use tessera_gpu::tessellator::{PassTimer, PASSES};
+use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
+use tessera_render::instanced::InstancedDraw;
+use tessera_render::overlay::Overlay;
+use tessera_render::{gpu, ColorMode, RenderOptions, Renderer};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+#[derive(Args)]
+pub struct ViewArgs {
+    /// Input, as for `tessera mesh`.
+    input: PathBuf,
+    /// Starting screen-space error in pixels (keys + and - change it).
+    #[arg(long, value_name = "P", default_value_t = 1.0)]
+    pixel_error: f64,
+    /// Starting scheme (key S cycles through the schemes that take a pixel error).
+    #[arg(long, value_enum)]
+    scheme: Option<plan::SchemeArg>,
+    /// Window size.
+    #[arg(long, value_name = "WxH", default_value = "1024x640")]
+    size: String,
+    /// Largest factor the criterion may use.
+    #[arg(long, value_name = "N", default_value_t = 64)]
+    max_factor: u32,
+    /// Draw N frames (the camera turning by itself), then exit.
+    #[arg(long, value_name = "N")]
+    frames: Option<u32>,
+    /// With --frames: save the last frame as PNG.
+    #[arg(long, value_name = "OUT.png", requires = "frames")]
+    screenshot: Option<PathBuf>,
+    #[command(flatten)]
+    input_args: crate::InputArgs,
+}
+
+/// The schemes key S cycles through (those that take a pixel error are kept).
+const SCHEMES: [Scheme; 5] = [
+    Scheme::Transition,
+    Scheme::Uniform,
+    Scheme::SemiUniform { max_level: Scheme::DEFAULT_SEMI_UNIFORM_LEVEL },
+    Scheme::Hardware(Partitioning::FractionalOdd),
+    Scheme::Hardware(Partitioning::Integer),
+];
+
+/// What the keys change.
+struct Settings {
+    scheme: usize,
+    pixel_error: f64,
+    wireframe: bool,
+    color: ColorMode,
+    cull: bool,
+    gpu_engine: bool,
+}
+
+/// The orbit camera: yaw and pitch about the model's centre, a distance in radii.
+struct Orbit {
+    yaw: f64,
+    pitch: f64,
+    zoom: f64,
+}
+
+struct State {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    ctx: GpuContext,
+    renderer: Renderer,
+    overlay: Overlay,
+    msaa: (wgpu::Texture, wgpu::Texture),
+    engine: GpuTessellator,
+    timer: Option<PassTimer>,
+    prepared: Prepared,
+    scratch: PlanScratch,
+    planned: Planned,
+    cpu: Option<Tessellator<'static>>,
+    cpu_key: (usize, u64, bool),
+    /// The instanced semi-uniform draw (paper 000), made on first use; Err once it cannot
+    /// draw this set (mixed domains), then the CPU engine draws semi-uniform.
+    instanced: Option<Result<InstancedDraw, String>>,
+}
+
+struct App {
+    set: &'static SurfaceSet,
+    args: ViewArgs,
+    size: (u32, u32),
+    settings: Settings,
+    orbit: Orbit,
+    drag: Option<(f64, f64)>,
+    cursor: (f64, f64),
+    state: Option<State>,
+    frames: u32,
+    error: Option<Box<dyn std::error::Error>>,
+    status: String,
+}
+
+const SAMPLES: u32 = 4;
+
+fn attachments(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    w: u32,
+    h: u32,
+) -> (wgpu::Texture, wgpu::Texture) {
+    let make = |format| {
+        ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("view attachment"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: SAMPLES,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    (make(format), make(gpu::DEPTH_FORMAT))
+}
+
+impl App {
+    /// The window, a device that can present to it (the adapter's own limits, timestamp
+    /// queries when there are any, as `GpuContext::new` asks), the pipelines, the engine.
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<State, Box<dyn std::error::Error>> {
+        let attributes = Window::default_attributes()
+            .with_title(format!("tessera view {}", self.args.input.display()))
+            .with_inner_size(PhysicalSize::new(self.size.0, self.size.1));
+        let window = Arc::new(event_loop.create_window(attributes)?);
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let surface = instance.create_surface(window.clone())?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::NoAdapter { reason: e.to_string() })?;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let features = adapter.features() & wanted;
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("tessera view"),
+            required_features: features,
+            required_limits: limits.clone(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::Device { reason: e.to_string() })?;
+        let ctx = GpuContext {
+            device,
+            queue,
+            info: adapter.get_info(),
+            limits,
+            timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+        };
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or("the window's surface does not work with this adapter")?;
+        let caps = surface.get_capabilities(&adapter);
+        // Display-space shading (tessera_render::shading) wants a non-sRGB format.
+        if let Some(&f) = caps.formats.iter().find(|f| !f.is_srgb()) {
+            config.format = f;
+        }
+        if self.args.screenshot.is_some() {
+            if !caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
+                return Err("--screenshot: this surface cannot be copied from".into());
+            }
+            config.usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        surface.configure(&ctx.device, &config);
+        let renderer = Renderer::new(&ctx, config.format, SAMPLES)?;
+        let overlay = Overlay::new(&ctx, config.format);
+        let msaa = attachments(&ctx, config.format, config.width, config.height);
+        let engine = GpuTessellator::new(&ctx, self.set)?;
+        let timer = PassTimer::new(&ctx);
+        let criterion = Criterion::PixelError(self.settings.pixel_error);
+        Ok(State {
+            window,
+            surface,
+            config,
+            renderer,
+            overlay,
+            msaa,
+            engine,
+            timer,
+            prepared: Prepared::for_criterion(self.set, &criterion),
+            scratch: PlanScratch::default(),
+            planned: Planned::default(),
+            cpu: None,
+            cpu_key: (usize::MAX, 0, false),
+            instanced: None,
+            ctx,
+        })
+    }
+
+    fn camera(&self, width: u32, height: u32) -> Camera {
+        let (lo, hi) = self.set.bounds();
+        let framing = Camera::framing(lo, hi, width, height);
+        let radius = (lo.distance(hi) * 0.5).max(1e-9);
+        let base = framing.eye - framing.target;
+        let distance = base.length() * self.orbit.zoom;
+        let up = framing.up.normalize();
+        let side = base.cross(up).normalize();
+        let dir = glam::DQuat::from_axis_angle(up, self.orbit.yaw)
+            * (glam::DQuat::from_axis_angle(side, self.orbit.pitch) * base.normalize());
+        let eye = framing.target + dir * distance;
+        Camera {
+            eye,
+            width,
+            height,
+            near: (distance - radius).max(distance * 1e-3),
+            far: distance + 2.0 * radius,
+            ..framing
+        }
+    }
+
+    /// One frame: plan, tessellate, draw, statistics; the screenshot on the last one.
+    fn frame(&mut self) -> Result<(), Box<dyn std::error::Error>> {
+        let Some((w, h)) = self.state.as_ref().map(|s| (s.config.width, s.config.height)) else {
+            return Ok(());
+        };
+        let camera = self.camera(w, h);
+        let state = self.state.as_mut().expect("checked");
+        let set = self.set;
+        let settings = &self.settings;
+        let scheme = SCHEMES[settings.scheme];
+        let criterion = Criterion::PixelError(settings.pixel_error);
+        let options = PlanOptions {
+            camera: Some(camera),
+            cull: settings.cull,
+            max_factor: self.args.max_factor,
+            ..Default::default()
+        };
+        let start = Instant::now();
+        // The GPU engine draws the uniform and transition schemes; anything it refuses is
+        // tessellated on the CPU this frame.
+        let mut on_gpu = false;
+        let mut plan_ms = 0.0;
+        // Semi-uniform on the GPU: render queues, level arguments and instanced draws.
+        let mut instanced = false;
+        if let (true, Scheme::SemiUniform { max_level }) = (settings.gpu_engine, scheme) {
+            if state.instanced.is_none() {
+                let made = InstancedDraw::new(&state.ctx, set, max_level, state.config.format, SAMPLES);
+                state.instanced = Some(made.map_err(|e| e.to_string()));
+            }
+            if let Some(Ok(_)) = &state.instanced {
+                scheme.plan_into(
+                    set,
+                    &state.prepared,
+                    &criterion,
+                    &options,
+                    &mut state.scratch,
+                    &mut state.planned,
+                )?;
+                plan_ms = start.elapsed().as_secs_f64() * 1e3;
+                instanced = true;
+            }
+        }
+        if settings.gpu_engine && matches!(scheme, Scheme::Uniform | Scheme::Transition) {
+            scheme.plan_into(
+                set,
+                &state.prepared,
+                &criterion,
+                &options,
+                &mut state.scratch,
+                &mut state.planned,
+            )?;
+            plan_ms = start.elapsed().as_secs_f64() * 1e3;
+            match state.engine.prepare(&state.ctx, set, &state.planned.plan, &state.planned.pattern) {
+                Ok(()) => on_gpu = true,
+                Err(GpuError::Unsupported { .. }) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        let levels;
+        let mut stages;
+        let mut encoder = state.ctx.device.create_command_encoder(&Default::default());
+        let triangles;
+        let upload;
+        let level_buffer;
+        if instanced {
+            levels = Vec::new();
+            stages = format!("PLAN {plan_ms:.1} (INSTANCED)");
+            triangles = None;
+            upload = None;
+        } else if on_gpu {
+            state.engine.record_timed(&mut encoder, state.timer.as_ref());
+            levels = tessera_render::patch_levels(&state.planned.plan, self.args.max_factor);
+            stages = format!("PLAN {plan_ms:.1}");
+            triangles = None;
+            upload = None;
+        } else {
+            let key = (settings.scheme, settings.pixel_error.to_bits(), settings.cull);
+            if state.cpu.is_none() || state.cpu_key != key {
+                let options = TessellatorOptions { plan: options, engine: crate::limits(None, false) };
+                state.cpu = Some(Tessellator::new(set, scheme, criterion, options)?);
+                state.cpu_key = key;
+            }
+            let tess = state.cpu.as_mut().expect("made above");
+            let mesh = tess.frame(Some(&camera))?;
+            let count = mesh.triangle_count();
+            let t = tess.timings();
+            let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+            stages = format!(
+                "CRITERION {:.1} RESOLVE {:.1} LAYOUT {:.1} WRITE {:.1}",
+                ms(t.criterion),
+                ms(t.resolve),
+                ms(t.layout),
+                ms(t.write)
+            );
+            levels = tessera_render::patch_levels(tess.plan().expect("a frame"), self.args.max_factor);
+            upload = Some(gpu::MeshBuffers::upload(&state.ctx, tess.mesh(), &levels));
+            triangles = Some(count);
+        }
+        let frame = match state.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                state.surface.configure(&state.ctx.device, &state.config);
+                return Ok(());
+            }
+            _ => return Ok(()),
+        };
+        let target = frame.texture.create_view(&Default::default());
+        let options = RenderOptions { wireframe: settings.wireframe, color: settings.color };
+        {
+            use wgpu::util::DeviceExt;
+            level_buffer = state.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("levels"),
+                contents: bytemuck::cast_slice(if levels.is_empty() { &[0f32] } else { &levels[..] }),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        }
+        let geometry = match &upload {
+            Some(buffers) => Some(buffers.geometry()),
+            None if instanced => None,
+            None => {
+                let (Some(vertices), Some(indices)) =
+                    (state.engine.vertex_buffer(), state.engine.index_buffer())
+                else {
+                    return Ok(());
+                };
+                Some(gpu::Geometry {
+                    vertices,
+                    indices,
+                    indexed_args: state.engine.indirect_buffer(),
+                    // Patch colours of GPU output would need the engine's triangle offsets
+                    // every frame (a read-back): they are drawn from the CPU engine instead.
+                    triangle_patch: None,
+                    patch_level: Some(&level_buffer),
+                })
+            }
+        };
+        let colour = state.msaa.0.create_view(&Default::default());
+        let depth = state.msaa.1.create_view(&Default::default());
+        match &state.instanced {
+            Some(Ok(draw)) if instanced => draw.record(
+                &state.ctx,
+                &mut encoder,
+                &state.planned.plan,
+                &camera,
+                &options,
+                &colour,
+                Some(&target),
+                &depth,
+            )?,
+            _ => {
+                if let Some(geometry) = &geometry {
+                    state.renderer.record(
+                        &state.ctx,
+                        &mut encoder,
+                        &colour,
+                        Some(&target),
+                        &depth,
+                        geometry,
+                        &camera,
+                        &options,
+                    )
+                }
+            }
+        }
+        let line1 = self.status.clone();
+        // Twice the font size when the longer line fits the window.
+        let scale = if (line1.len().max(HELP.len()) as u32 * 12 + 24) < w { 2 } else { 1 };
+        state.overlay.record(&state.ctx, &mut encoder, &target, &[&line1, HELP], 8, 8, scale);
+        state.ctx.queue.submit([encoder.finish()]);
+        let last = self.args.frames.is_some_and(|n| self.frames + 1 >= n);
+        if last {
+            if let Some(path) = &self.args.screenshot {
+                let image = gpu::read_texture(&state.ctx, &frame.texture)?;
+                image.write_png(path)?;
+            }
+        }
+        state.window.pre_present_notify();
+        state.ctx.queue.present(frame);
+        // Statistics for the next frame's line (read back: see the module doc).
+        state.ctx.wait()?;
+        let frame_ms = start.elapsed().as_secs_f64() * 1e3;
+        let triangles = match (triangles, &state.instanced) {
+            (Some(t), _) => t as u64,
+            // Drawn by the instanced path: the queues' patches times their patterns'
+            // triangles, degenerate ones included (the rasteriser drops those).
+            (None, Some(Ok(draw))) if instanced => {
+                let queues = draw.queues().read(&state.ctx)?;
+                let max = queues.max_level();
+                (0..=max)
+                    .map(|m| (queues.level(m).len() * draw.patterns()[m as usize].triangles.len()) as u64)
+                    .sum()
+            }
+            (None, _) => {
+                if let Some(timer) = &state.timer {
+                    for (name, ms) in timer.read(&state.ctx)? {
+                        if name != PASSES[0] || settings.cull {
+                            stages += &format!(" {} {ms:.2}", name.to_uppercase());
+                        }
+                    }
+                }
+                state.engine.read_status(&state.ctx)?.2 as u64
+            }
+        };
+        let culled = state_culled(on_gpu || instanced, state);
+        self.status = format!(
+            "{} {}PX / {} TRIS / {} PATCHES{} / {} ENGINE: {stages} / FRAME {frame_ms:.1} MS",
+            scheme.name(),
+            settings.pixel_error,
+            triangles,
+            set.patches.len(),
+            if settings.cull { format!(" ({culled} CULLED)") } else { String::new() },
+            if on_gpu || instanced { "GPU" } else { "CPU" },
+        );
+        self.frames += 1;
+        Ok(())
+    }
+}
+
+fn state_culled(on_gpu: bool, state: &State) -> usize {
+    let visible = if on_gpu {
+        &state.planned.plan.visible
+    } else {
+        &state.cpu.as_ref().and_then(|t| t.plan()).map(|p| p.visible.clone()).unwrap_or_default()
+    };
+    visible.iter().filter(|&&v| v == 0).count()
+}
+
+/// The keys, for `tessera view --help`.
+pub const KEYS: &str = "Keys: S scheme (transition, uniform, semi-uniform, fractional-odd, integer), + / - pixel \
+error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
+arrows or mouse drag orbit, wheel zoom, Q or Esc quit. The window needs an X11 display (no Wayland backend; \
+XWayland works); headless: xvfb-run -a tessera view IN --frames N --screenshot OUT.png";
+
+const HELP: &str = "S SCHEME  +/- PIXEL ERROR  W WIRE  L LEVELS  P PATCHES  C CULL  E ENGINE  DRAG/ARROWS ORBIT  WHEEL ZOOM  Q QUIT";
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.state.is_some() {
+            return;
+        }
+        match self.start(event_loop) {
+            Ok(s) => {
+                s.window.request_redraw();
+                self.state = Some(s);
+            }
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let Some(state) = self.state.as_mut() {
+                    if size.width > 0 && size.height > 0 {
+                        state.config.width = size.width;
+                        state.config.height = size.height;
+                        state.surface.configure(&state.ctx.device, &state.config);
+                        state.msaa = attachments(&state.ctx, state.config.format, size.width, size.height);
+                    }
+                }
+            }
+            WindowEvent::RedrawRequested => {
+                if self.args.frames.is_some() {
+                    // Headless runs turn the camera by themselves, so frames differ.
+                    self.orbit.yaw += 0.05;
+                }
+                if let Err(e) = self.frame() {
+                    self.error = Some(e);
+                    event_loop.exit();
+                    return;
+                }
+                if self.args.frames.is_some_and(|n| self.frames >= n) {
+                    event_loop.exit();
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                let s = &mut self.settings;
+                match event.logical_key {
+                    Key::Named(NamedKey::Escape) => event_loop.exit(),
+                    Key::Named(NamedKey::ArrowLeft) => self.orbit.yaw -= 0.1,
+                    Key::Named(NamedKey::ArrowRight) => self.orbit.yaw += 0.1,
+                    Key::Named(NamedKey::ArrowUp) => self.orbit.pitch = (self.orbit.pitch + 0.1).min(1.5),
+                    Key::Named(NamedKey::ArrowDown) => self.orbit.pitch = (self.orbit.pitch - 0.1).max(-1.5),
+                    Key::Character(c) => match c.to_lowercase().as_str() {
+                        "q" => event_loop.exit(),
+                        "s" => s.scheme = (s.scheme + 1) % SCHEMES.len(),
+                        "+" | "=" => s.pixel_error = (s.pixel_error / 2.0).max(1.0 / 64.0),
+                        "-" => s.pixel_error = (s.pixel_error * 2.0).min(256.0),
+                        "w" => s.wireframe = !s.wireframe,
+                        "l" => {
+                            s.color =
+                                if s.color == ColorMode::Level { ColorMode::Shaded } else { ColorMode::Level }
+                        }
+                        "p" => {
+                            s.color = if s.color == ColorMode::Patch {
+                                ColorMode::Shaded
+                            } else {
+                                ColorMode::Patch
+                            };
+                            // Patch colours need the triangles' patches: the CPU engine has them.
+                            if s.color == ColorMode::Patch {
+                                s.gpu_engine = false;
+                            }
+                        }
+                        "c" => s.cull = !s.cull,
+                        "e" => s.gpu_engine = !s.gpu_engine,
+                        _ => {}
+                    },
+                    _ => {}
+                }
+            }
+            WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
+                self.drag = (state == ElementState::Pressed).then_some(self.cursor);
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                self.cursor = (position.x, position.y);
+                if let Some((x, y)) = self.drag {
+                    self.orbit.yaw -= (position.x - x) * 0.01;
+                    self.orbit.pitch = (self.orbit.pitch + (position.y - y) * 0.01).clamp(-1.5, 1.5);
+                    self.drag = Some(self.cursor);
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.orbit.zoom = (self.orbit.zoom * 0.9f64.powf(lines)).clamp(0.05, 10.0);
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        // Live re-tessellation: a new frame as soon as the last one is done.
+        if let Some(state) = &self.state {
+            state.window.request_redraw();
+        }
+    }
+}
+
+pub fn run(a: ViewArgs) -> crate::CliResult {
+    if a.frames == Some(0) {
+        return Err("--frames 0: use 1 or more".into());
+    }
+    if let Some(path) = &a.screenshot {
+        if path.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
+            return Err(format!("--screenshot {}: give a .png name", path.display()).into());
+        }
+    }
+    if !(a.pixel_error.is_finite() && a.pixel_error > 0.0) {
+        return Err(format!("--pixel-error {}: must be a positive number", a.pixel_error).into());
+    }
+    let size = {
+        let (w, h) =
+            a.size.split_once(['x', 'X']).ok_or_else(|| format!("--size {}: expected WxH", a.size))?;
+        let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|&v| v > 0);
+        (
+            parse(w).ok_or_else(|| format!("--size {}: expected WxH", a.size))?,
+            parse(h).ok_or_else(|| format!("--size {}: expected WxH", a.size))?,
+        )
+    };
+    let options = crate::build_options(&a.input_args)?;
+    // The tessellator borrows the set for the whole run (the event loop owns the app): leaked
+    // once, freed at exit.
+    let set: &'static SurfaceSet = Box::leak(Box::new(crate::load_surfaces(&a.input, options)?));
+    let scheme = a.scheme.map(|s| s.scheme(None, false)).unwrap_or(Scheme::Transition);
+    let first = SCHEMES.iter().position(|s| s.name() == scheme.name()).ok_or_else(|| {
+        format!("--scheme {}: the viewer cycles through transition, uniform, semi-uniform, fractional-odd and integer", scheme.name())
+    })?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        format!("cannot open a window ({e}): the viewer needs an X11 display (DISPLAY); headless, run it under xvfb-run")
+    })?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        set,
+        settings: Settings {
+            scheme: first,
+            pixel_error: a.pixel_error,
+            wireframe: true,
+            color: ColorMode::Shaded,
+            cull: false,
+            gpu_engine: true,
+        },
+        args: a,
+        size,
+        orbit: Orbit { yaw: 0.0, pitch: 0.0, zoom: 1.0 },
+        drag: None,
+        cursor: (0.0, 0.0),
+        state: None,
+        frames: 0,
+        error: None,
+        status: "FIRST FRAME".into(),
+    };
+    event_loop.run_app(&mut app)?;
+    if let Some(e) = app.error {
+        return Err(e);
+    }
+    if let Some(path) = &app.args.screenshot {
+        eprintln!("wrote {} after {} frames: {}", path.display(), app.frames, app.status);
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,76 @@
+//! `tessera view --frames N --screenshot`: the viewer opens a window under Xvfb (a virtual X
+//! server), re-tessellates and draws N frames and saves the last one. Needs `xvfb-run`
+//! (Debian: `apt-get install -y xvfb xauth`, as `.ci/run` does) and a GPU adapter
+//! (`mesa-vulkan-drivers libvulkan1`); without them the test fails, saying so.
+
+mod common;
+
+use common::{data, scratch, text};
+use std::process::Command;
+
+#[test]
+fn viewer_draws_frames_under_xvfb_and_saves_a_screenshot() {
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    assert!(found, "xvfb-run is missing: install it (Debian/Ubuntu: apt-get install -y xvfb xauth) to run the viewer test");
+    let dir = scratch("viewer-shot");
+    let input = data("patches/teapot.patches");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_tessera"), "view"])
+        .arg(&input)
+        .args(["--frames", "4", "--screenshot", "shot.png", "--size", "480x320"])
+        .current_dir(&dir)
+        .output()
+        .expect("run xvfb-run");
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "tessera view failed: {stderr}");
+    assert!(stderr.contains("after 4 frames"), "{stderr}");
+    assert!(stderr.contains("TRIS"), "{stderr}");
+    let decoder =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("shot.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (480, 320));
+    let rgb = &buf[..info.buffer_size()];
+    let pixel = |x: usize, y: usize| &rgb[3 * (y * 480 + x)..][..3];
+    // The model in the middle (not the white background) ...
+    let covered = (0..320)
+        .flat_map(|y| (0..480).map(move |x| (x, y)))
+        .filter(|&(x, y)| pixel(x, y) != [255, 255, 255])
+        .count();
+    assert!(covered > 480 * 320 / 20, "only {covered} pixels are not background");
+    assert_ne!(pixel(240, 170), [255, 255, 255], "nothing drawn at the centre");
+    // ... and the statistics panel at the top left: dark pixels and light glyph pixels.
+    let panel: Vec<&[u8]> =
+        (10..30).flat_map(|y| (10..200).map(move |x| (x, y))).map(|(x, y)| pixel(x, y)).collect();
+    assert!(panel.iter().any(|p| p.iter().all(|&c| c < 110)), "no statistics panel");
+    assert!(panel.iter().any(|p| p.iter().all(|&c| c > 200)), "no text on the panel");
+}
+
+#[test]
+fn viewer_draws_semi_uniform_with_the_instanced_path() {
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    assert!(found, "xvfb-run is missing: install it (Debian/Ubuntu: apt-get install -y xvfb xauth) to run the viewer test");
+    let dir = scratch("viewer-instanced");
+    let input = data("meshes/blob.obj");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_tessera"), "view"])
+        .arg(&input)
+        .args(["--scheme", "semi-uniform", "--frames", "3", "--screenshot", "su.png", "--size", "320x240"])
+        .current_dir(&dir)
+        .output()
+        .expect("run xvfb-run");
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "tessera view failed: {stderr}");
+    assert!(stderr.contains("semi-uniform") && stderr.contains("(INSTANCED)"), "{stderr}");
+    let decoder =
+        png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("su.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let rgb = &buf[..info.buffer_size()];
+    let covered = rgb.chunks_exact(3).filter(|p| *p != [255, 255, 255]).count();
+    assert!(covered > 320 * 240 / 10, "only {covered} pixels are not background");
+}
