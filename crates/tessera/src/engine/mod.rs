@@ -25,9 +25,9 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 pub mod layout;
-pub mod render_queues;
 pub(crate) mod pattern_cache;
 pub(crate) mod point_blocks;
+pub mod render_queues;
 pub(crate) mod uniform_quads;
 
 pub(crate) use layout::collapsed_edges;

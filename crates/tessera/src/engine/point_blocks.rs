@@ -73,11 +73,13 @@ const CUBIC: [(usize, usize, usize); 10] = [
 ];
 
 /// The quadratic monomials, in the order of the derivative tables below.
-const QUADRATIC: [(usize, usize, usize); 6] = [(2, 0, 0), (1, 1, 0), (1, 0, 1), (0, 2, 0), (0, 1, 1), (0, 0, 2)];
+const QUADRATIC: [(usize, usize, usize); 6] =
+    [(2, 0, 0), (1, 1, 0), (1, 0, 1), (0, 2, 0), (0, 1, 1), (0, 0, 2)];
 
 /// The PN normal field's monomials, in the order of [`crate::surface::PnTriangle::normals`]:
 /// `λ0², λ1², λ2², λ0λ1, λ1λ2, λ0λ2`.
-const PN_NORMAL: [(usize, usize, usize); 6] = [(2, 0, 0), (0, 2, 0), (0, 0, 2), (1, 1, 0), (0, 1, 1), (1, 0, 1)];
+const PN_NORMAL: [(usize, usize, usize); 6] =
+    [(2, 0, 0), (0, 2, 0), (0, 0, 2), (1, 1, 0), (0, 1, 1), (1, 0, 1)];
 
 fn factorial(n: usize) -> f64 {
     [1.0, 1.0, 2.0, 6.0][n]
@@ -249,7 +251,11 @@ fn to_model<const FMA: bool, const L: usize>(pos: &mut [[f32; L]; 3], origin: &[
 // Index loops mirror the sums over control points (and vectorize over lanes).
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
-fn bicubic_block<const FMA: bool, const L: usize>(patch: &LocalPatch, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+fn bicubic_block<const FMA: bool, const L: usize>(
+    patch: &LocalPatch,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
     let (bu, du) = bernstein_lanes(u);
     let (bv, dv) = bernstein_lanes(v);
     let mut pos = [[0f32; L]; 3];
@@ -314,7 +320,11 @@ fn combine<const FMA: bool, const L: usize, const M: usize>(
 
 /// A cubic Bézier or PN triangle at each lane's `(u, v)`.
 #[inline(always)]
-fn triangle_block<const FMA: bool, const L: usize>(t: &LocalTriangle, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+fn triangle_block<const FMA: bool, const L: usize>(
+    t: &LocalTriangle,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
     // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v).
     let mut powers = [[[1f32; L]; 4]; 3];
     for l in 0..L {
@@ -534,7 +544,10 @@ mod tests {
                         let q = patch.eval(uvs[k]);
                         let dp = (glam::Vec3::from(pos[k]).as_dvec3() - q.position).length();
                         let dn = (glam::Vec3::from(nrm[k]).as_dvec3() - q.normal).length();
-                        assert!(dp <= 1e-6 * size * 2.0 + 1e-7 * q.position.length(), "patch {p} {k}: {dp:e}");
+                        assert!(
+                            dp <= 1e-6 * size * 2.0 + 1e-7 * q.position.length(),
+                            "patch {p} {k}: {dp:e}"
+                        );
                         assert!(dn <= 1e-5, "patch {p} point {k}: normal off by {dn:e}");
                         assert_eq!(uv[k], uvs[k].as_vec2().to_array());
                         assert_eq!(id[k], p as u32);
@@ -549,10 +562,10 @@ mod tests {
     /// of the bounding-box diagonal and normals within 1e-5.
     #[test]
     fn every_scheme_and_surface_kind_matches_the_generic_engine() {
+        use crate::criterion::view::{Mapping, ViewCriterion};
         use crate::engine::{write_with, Layout, TessellateOptions};
         use crate::mesh::Mesh;
         use crate::sampling::Partitioning;
-        use crate::criterion::view::{Mapping, ViewCriterion};
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
         let data = crate::io::patches::test_support::data;
@@ -572,7 +585,8 @@ mod tests {
                 *patch = Patch::BezierTriangle(t.geometry.clone());
             }
         }
-        let models = [("teapot", teapot), ("cow PN", cow), ("cow Bézier", bezier), ("spot PN", pn("meshes/spot.obj"))];
+        let models =
+            [("teapot", teapot), ("cow PN", cow), ("cow Bézier", bezier), ("spot PN", pn("meshes/spot.obj"))];
         let cases = [
             (Scheme::Uniform, Criterion::Factor(5.0)),
             (Scheme::Transition, Criterion::PixelError(0.7)),
@@ -581,8 +595,14 @@ mod tests {
             (Scheme::Sd2 { warp: true }, view(ViewCriterion::Distance(Mapping::Linear), 2.0, 9.0)),
             (Scheme::Hardware(Partitioning::FractionalOdd), Criterion::Factor(6.4)),
             (Scheme::Hardware(Partitioning::FractionalEven), view(ViewCriterion::Silhouetteness, 2.0, 7.5)),
-            (Scheme::Hardware(Partitioning::Integer), view(ViewCriterion::Distance(Mapping::Linear), 1.0, 8.0)),
-            (Scheme::Esc { max_level: 4 }, Criterion::Esc { threshold: crate::criterion::esc::Threshold::High, level: Some(3) }),
+            (
+                Scheme::Hardware(Partitioning::Integer),
+                view(ViewCriterion::Distance(Mapping::Linear), 1.0, 8.0),
+            ),
+            (
+                Scheme::Esc { max_level: 4 },
+                Criterion::Esc { threshold: crate::criterion::esc::Threshold::High, level: Some(3) },
+            ),
         ];
         let (mut compared, mut cached) = (0, 0);
         for (name, set) in &models {
@@ -631,7 +651,10 @@ mod tests {
                     // The f32 kernels ran (rounding differs from the f64 path's somewhere),
                     // rather than the f64 fallback everywhere.
                     let changed = mesh.normals.iter().zip(&reference.normals).filter(|(a, b)| a != b).count();
-                    assert!(changed * 4 > mesh.normals.len(), "{what}: only {changed} normals from the kernels");
+                    assert!(
+                        changed * 4 > mesh.normals.len(),
+                        "{what}: only {changed} normals from the kernels"
+                    );
                     let w = crate::verify::watertight(&mesh);
                     let r = crate::verify::watertight(&reference);
                     assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");

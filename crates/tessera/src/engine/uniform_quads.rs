@@ -630,8 +630,8 @@ mod tests {
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
     use crate::surface::{BuildOptions, Orientation, Patch};
-    use glam::DVec3;
     use crate::verify;
+    use glam::DVec3;
 
     fn load(name: &str) -> SurfaceSet {
         let file = crate::io::patches::read_patches(&crate::io::patches::test_support::data(name))
@@ -858,5 +858,4 @@ mod tests {
         }
         assert!(!FastEvaluator::new(&rational, &plan).grid());
     }
-
 }
