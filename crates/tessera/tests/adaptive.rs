@@ -108,9 +108,9 @@ fn screen_space_bounds_hold_for_random_cameras_on_the_fast_models() {
 }
 
 #[test]
-#[ignore = "slow tier (every model, 40 cameras): scripts/test runs it"]
+#[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
 fn screen_space_bounds_hold_for_random_cameras_on_every_model() {
-    screen_space_bounds_hold(&common::all_surface_models(), 40);
+    screen_space_bounds_hold(&common::all_surface_models(), 20);
 }
 
 fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32) {

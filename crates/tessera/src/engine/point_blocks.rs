@@ -20,7 +20,7 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
-use super::uniform_quads::{LocalPatch, MIN_DERIVATIVE2, MIN_SIN2};
+use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::{BezierTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
@@ -28,6 +28,17 @@ use rayon::prelude::*;
 
 /// Points evaluated together: 8 f32 lanes fill one AVX register (two SSE registers).
 pub(crate) const LANES: usize = 8;
+
+/// Below this squared sine of the angle between `∂S/∂u` and `∂S/∂v`, the f32 cross product
+/// no longer gives the normal to about 1e-5, and the point is evaluated in f64.
+pub(crate) const MIN_SIN2: f32 = 1e-4;
+
+/// Below this squared length of `∂S/∂u` or `∂S/∂v` in the local frame (where the control
+/// points lie within `[-1, 1]³`, so a derivative's f32 rounding is about 1e-6), the
+/// derivative's direction is no longer good to 1e-5, and the point is evaluated in f64: near a
+/// pole of the control net (teapot_teasetorig's lid) a derivative nearly vanishes while the
+/// angle between the two stays wide.
+pub(crate) const MIN_DERIVATIVE2: f32 = 0.04;
 
 /// Below this squared length of a PN triangle's quadratic normal field (whose coefficients are
 /// unit vectors, so its f32 rounding is about 1e-7), the normalised f32 field is no longer good
@@ -180,7 +191,7 @@ struct Block<const L: usize> {
 /// `a · b + c`, fused in the kernels compiled for FMA (elsewhere `mul_add` would be a slow
 /// library call). Fusing changes only the rounding.
 #[inline(always)]
-fn madd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
+pub(crate) fn madd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
     if FMA {
         a.mul_add(b, c)
     } else {
@@ -207,10 +218,13 @@ fn bernstein_lanes<const L: usize>(t: &[f32; L]) -> ([[f32; L]; 4], [[f32; L]; 4
     (b, d)
 }
 
-/// Normals `a × c` (times `sign`), normalised, and the reliability margin of each lane, as the
-/// grid path computes them.
+/// Normals `a × c`, normalised, and the reliability margin of each lane ([`MIN_SIN2`],
+/// [`MIN_DERIVATIVE2`]), for both evaluators.
 #[inline(always)]
-fn cross_normals<const L: usize>(a: &[[f32; L]; 3], c: &[[f32; L]; 3]) -> ([[f32; L]; 3], [f32; L]) {
+pub(crate) fn cross_normals<const L: usize>(
+    a: &[[f32; L]; 3],
+    c: &[[f32; L]; 3],
+) -> ([[f32; L]; 3], [f32; L]) {
     let ([ax, ay, az], [cx, cy, cz]) = (a, c);
     let mut nrm = [[0f32; L]; 3];
     let mut margin = [0f32; L];
@@ -239,7 +253,11 @@ fn cross_normals<const L: usize>(a: &[[f32; L]; 3], c: &[[f32; L]; 3]) -> ([[f32
 
 /// Moves local positions back to the model: `origin + scale · p`.
 #[inline(always)]
-fn to_model<const FMA: bool, const L: usize>(pos: &mut [[f32; L]; 3], origin: &[f32; 3], scale: f32) {
+pub(crate) fn to_model<const FMA: bool, const L: usize>(
+    pos: &mut [[f32; L]; 3],
+    origin: &[f32; 3],
+    scale: f32,
+) {
     for (row, &origin) in pos.iter_mut().zip(origin) {
         for x in row {
             *x = madd::<FMA>(scale, *x, origin);

@@ -22,7 +22,8 @@
 //! curve and its cross derivative once; its points are then evaluated [`LANES`] at a time in
 //! structure-of-arrays form, which the compiler vectorizes. Where the derivatives are nearly
 //! parallel (a pole, or a pinched corner), f32 would lose the normal's direction, so such
-//! points take the generic f64 evaluation instead ([`MIN_SIN2`]).
+//! points take the generic f64 evaluation instead (`point_blocks::cross_normals`, one rule for
+//! both evaluators).
 //!
 //! **Kernels.** The evaluation kernels are written once, generic over whether multiply-adds
 //! are fused, and compiled twice: for the baseline target (SSE2 on x86-64) and, on x86-64 CPUs
@@ -30,7 +31,7 @@
 //! module's only `unsafe`.
 
 use super::pattern_cache::PatternCache;
-use super::point_blocks::{has_avx2_fma, local_frame, PointBlocks};
+use super::point_blocks::{cross_normals, has_avx2_fma, local_frame, madd, to_model, PointBlocks, LANES};
 use super::VertexSlices;
 use crate::criterion::Plan;
 use crate::pattern::{Pattern, PatternInput};
@@ -38,20 +39,6 @@ use crate::sampling::{uniform_param, SamplingKind};
 use crate::surface::{Domain, RationalBicubic, SurfacePoint, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
-
-/// Points evaluated together: 8 f32 lanes fill one AVX register (two SSE registers).
-const LANES: usize = 8;
-
-/// Below this squared sine of the angle between `∂S/∂u` and `∂S/∂v`, the f32 cross product
-/// no longer gives the normal to about 1e-5, and the point is evaluated in f64.
-pub(crate) const MIN_SIN2: f32 = 1e-4;
-
-/// Below this squared length of `∂S/∂u` or `∂S/∂v` in the local frame (where the control
-/// points lie within `[-1, 1]³`, so a derivative's f32 rounding is about 1e-6), the
-/// derivative's direction is no longer good to 1e-5, and the point is evaluated in f64: near a
-/// pole of the control net (teapot_teasetorig's lid) a derivative nearly vanishes while the
-/// angle between the two stays wide.
-pub(crate) const MIN_DERIVATIVE2: f32 = 0.04;
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -224,48 +211,14 @@ impl Line {
                 }
             }
         }
-        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column. Written as
-        // whole-array lane loops, one quantity at a time, so that each becomes SIMD code.
-        let sign = if self.column { -1.0 } else { 1.0 };
-        let ([ax, ay, az], [cx, cy, cz]) = (along, across);
-        let mut nrm = [[0f32; LANES]; 3];
-        let [nx, ny, nz] = &mut nrm;
-        let mut margin = [0f32; LANES];
-        for l in 0..LANES {
-            nx[l] = ay[l] * cz[l] - az[l] * cy[l];
-            ny[l] = az[l] * cx[l] - ax[l] * cz[l];
-            nz[l] = ax[l] * cy[l] - ay[l] * cx[l];
+        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along (the same, negated) on a
+        // column; the reliability margin is the point evaluator's rule.
+        let (mut nrm, margin) = cross_normals(&along, &across);
+        if self.column {
+            nrm.iter_mut().flatten().for_each(|x| *x = -*x);
         }
-        for l in 0..LANES {
-            let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
-            let a2 = ax[l] * ax[l] + ay[l] * ay[l] + az[l] * az[l];
-            let c2 = cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l];
-            // |a × c|² = |a|²|c|² sin²: the angle between the derivatives, scale-free; and
-            // neither derivative so short that rounding turns it.
-            let long = a2 >= MIN_DERIVATIVE2 && c2 >= MIN_DERIVATIVE2;
-            margin[l] = if long { n2 - MIN_SIN2 * (a2 * c2) } else { -1.0 };
-            let inv = sign / n2.sqrt();
-            nx[l] *= inv;
-            ny[l] *= inv;
-            nz[l] *= inv;
-        }
-        for (row, &origin) in pos.iter_mut().zip(&patch.origin) {
-            for x in row {
-                *x = madd::<FMA>(patch.scale, *x, origin);
-            }
-        }
+        to_model::<FMA, LANES>(&mut pos, &patch.origin, patch.scale);
         Block { pos, nrm, margin }
-    }
-}
-
-/// `a · b + c`, fused in the kernels compiled for FMA (elsewhere `mul_add` would be a slow
-/// library call). Fusing changes only the rounding.
-#[inline(always)]
-fn madd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
-    if FMA {
-        a.mul_add(b, c)
-    } else {
-        a * b + c
     }
 }
 
