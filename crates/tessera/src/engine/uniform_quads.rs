@@ -31,7 +31,7 @@
 //! module's only `unsafe`.
 
 use super::pattern_cache::PatternCache;
-use super::point_blocks::{cross_normals, has_avx2_fma, local_frame, madd, to_model, PointBlocks, LANES};
+use super::point_blocks::{has_avx2_fma, local_frame, madd, PointBlocks, LANES, MIN_DERIVATIVE2, MIN_SIN2};
 use super::VertexSlices;
 use crate::criterion::Plan;
 use crate::pattern::{Pattern, PatternInput};
@@ -211,13 +211,38 @@ impl Line {
                 }
             }
         }
-        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along (the same, negated) on a
-        // column; the reliability margin is the point evaluator's rule.
-        let (mut nrm, margin) = cross_normals(&along, &across);
-        if self.column {
-            nrm.iter_mut().flatten().for_each(|x| *x = -*x);
+        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column. Written as
+        // whole-array lane loops, one quantity at a time, so that each becomes SIMD code. The
+        // reliability rule is `point_blocks::cross_normals`'s; calling that function here
+        // measured 1.4× slower in this kernel (torus, factor 16), so the loops stay inline.
+        let sign = if self.column { -1.0 } else { 1.0 };
+        let ([ax, ay, az], [cx, cy, cz]) = (along, across);
+        let mut nrm = [[0f32; LANES]; 3];
+        let [nx, ny, nz] = &mut nrm;
+        let mut margin = [0f32; LANES];
+        for l in 0..LANES {
+            nx[l] = ay[l] * cz[l] - az[l] * cy[l];
+            ny[l] = az[l] * cx[l] - ax[l] * cz[l];
+            nz[l] = ax[l] * cy[l] - ay[l] * cx[l];
         }
-        to_model::<FMA, LANES>(&mut pos, &patch.origin, patch.scale);
+        for l in 0..LANES {
+            let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
+            let a2 = ax[l] * ax[l] + ay[l] * ay[l] + az[l] * az[l];
+            let c2 = cx[l] * cx[l] + cy[l] * cy[l] + cz[l] * cz[l];
+            // |a × c|² = |a|²|c|² sin²: the angle between the derivatives, scale-free; and
+            // neither derivative so short that rounding turns it.
+            let long = a2 >= MIN_DERIVATIVE2 && c2 >= MIN_DERIVATIVE2;
+            margin[l] = if long { n2 - MIN_SIN2 * (a2 * c2) } else { -1.0 };
+            let inv = sign / n2.sqrt();
+            nx[l] *= inv;
+            ny[l] *= inv;
+            nz[l] *= inv;
+        }
+        for (row, &origin) in pos.iter_mut().zip(&patch.origin) {
+            for x in row {
+                *x = madd::<FMA>(patch.scale, *x, origin);
+            }
+        }
         Block { pos, nrm, margin }
     }
 }
