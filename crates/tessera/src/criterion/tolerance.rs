@@ -550,7 +550,12 @@ fn check_patches(
     // The first patterns (admitted by the reservation above) are built once per distinct
     // input, with their local-vertex parameters: neighbours share inputs, and most patches
     // pass on their first pattern. Later rounds of a patch build on the thread instead.
-    if admitted && !limit.pattern.depends_on_patch() {
+    // Tiny patterns (a cell or two, as in a distant view) cost about what a lookup costs, and
+    // the lookups run on one thread: there each task reuses its last pattern instead.
+    let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
+    let worth =
+        cells >= crate::engine::pattern_cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * firsts.len() as u64;
+    if admitted && worth && !limit.pattern.depends_on_patch() {
         let first_input = |i: usize| {
             let (p, (domain, seg, interior)) = (which[i], firsts[i]);
             eps[p].map(|_| input_of(p, domain, seg, interior))

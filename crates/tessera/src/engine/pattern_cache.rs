@@ -87,7 +87,7 @@ const NONE: u32 = u32::MAX;
 
 /// Below this many triangles per visible patch on average, patterns are small enough that
 /// building one costs about what finding it in the table costs, and the cache stays off.
-const MIN_TRIANGLES_PER_PATCH: u32 = 24;
+pub(crate) const MIN_TRIANGLES_PER_PATCH: u32 = 24;
 
 /// The frame's distinct patterns. See the [module documentation](self).
 #[derive(Default)]

@@ -379,8 +379,9 @@ impl<'a> FastEvaluator<'a> {
         // per edge and patch every frame; the tables of factors up to 64 take a few hundred
         // kilobytes. Larger factors (rare, and up to MAX_FACTOR) get tables only where used.
         const DENSE: usize = 64;
-        let max_edge = plan.segments.iter().copied().max().unwrap_or(1);
-        let max_interior = plan.interior.iter().map(|f| f[0].max(f[1])).max().unwrap_or(1);
+        // Folds rather than `Iterator::max`, which does not vectorize.
+        let max_edge = plan.segments.iter().fold(1, |m, &s| m.max(s));
+        let max_interior = plan.interior.iter().fold(1, |m, f| m.max(f[0]).max(f[1]));
         let max = max_edge.max(max_interior).max(3) as usize;
         if max >= self.tables.len() {
             self.tables.resize_with(max + 1, FactorTables::default);
