@@ -457,30 +457,8 @@ impl InstancedDraw {
             pass.set_bind_group(1, &self.args_binds.1, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        let [r, g, b] = crate::shading::BACKGROUND.map(f64::from);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("instanced semi-uniform"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: resolve,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass =
+            crate::gpu::begin_scene_pass(encoder, "instanced semi-uniform", target, resolve, depth);
         pass.set_pipeline(&self.render);
         pass.set_bind_group(0, &self.render_binds.0, &[]);
         pass.set_vertex_buffer(0, self.pattern_vertices.slice(..));
