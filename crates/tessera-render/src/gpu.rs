@@ -247,13 +247,7 @@ impl Renderer {
             },
             // Both sides: open models show their insides (shaded darker).
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: Some(depth_state()),
             multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
             fragment: Some(wgpu::FragmentState {
                 module: &draw,
@@ -556,4 +550,15 @@ pub(crate) fn begin_scene_pass<'e>(
         occlusion_query_set: None,
         multiview_mask: None,
     })
+}
+
+/// The depth test of every scene pipeline (the depth target of [`begin_scene_pass`]).
+pub(crate) fn depth_state() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
 }

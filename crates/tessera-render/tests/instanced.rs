@@ -4,7 +4,9 @@
 //! picture covers what the compacted mesh covers. Bicubic patches and PN triangles. Needs a
 //! GPU adapter (lavapipe in CI).
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::{cameras, data};
 use tessera::camera::Camera;
 use tessera::engine::render_queues;
 use tessera::pattern::semi_uniform::StaticPattern;
@@ -13,15 +15,6 @@ use tessera::surface::Domain;
 use tessera_gpu::GpuContext;
 use tessera_render::instanced::InstancedDraw;
 use tessera_render::{gpu, RenderOptions};
-
-fn data(rel: &str) -> PathBuf {
-    let base = std::env::var("TESSERA_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let p = base.join(rel);
-    assert!(p.exists(), "{} missing: set TESSERA_DATA to the shared data folder", p.display());
-    p
-}
 
 /// Triangles whose three corners are distinct points (at a tolerance far below the mesh's
 /// scale: snapped corners that meet are evaluated at the same domain point).
@@ -103,23 +96,6 @@ fn instanced_draw_equals_the_cpu_instanced_form_and_the_compacted_mesh() {
             assert!(b > 2000 && (a as f64 - b as f64).abs() <= 0.01 * b as f64, "{model}: {a} vs {b} pixels");
         }
     }
-}
-
-/// Ten cameras about the model (as in `tests/queues.rs`): round it, at heights and distances
-/// that change the levels.
-fn cameras(lo: glam::DVec3, hi: glam::DVec3) -> Vec<Camera> {
-    let framing = Camera::framing(lo, hi, 640, 480);
-    let radius = lo.distance(hi) * 0.5;
-    (0..10)
-        .map(|k| {
-            let angle = k as f64 * 0.7;
-            let zoom = [0.45, 0.7, 1.0, 1.6, 3.0][k % 5];
-            let offset = glam::DQuat::from_axis_angle(framing.up, angle) * (framing.eye - framing.target);
-            let eye = framing.target + offset * zoom + framing.up * radius * (k as f64 * 0.13 - 0.5);
-            let d = eye.distance(framing.target);
-            Camera { eye, near: (d - radius).max(d * 1e-3), far: d + 2.0 * radius, ..framing }
-        })
-        .collect()
 }
 
 #[test]
