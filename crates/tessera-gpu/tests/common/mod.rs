@@ -1,0 +1,295 @@
+//! Helpers shared by the GPU test files: the one device and pipeline set per binary, the
+//! shared data, seeded cameras, and the comparison of a GPU frame with the CPU engine's.
+//! Every expected value comes from the CPU library, never from the GPU itself.
+
+#![allow(dead_code)] // each test binary uses a part
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use tessera::criterion::Plan;
+use tessera::engine::{self, Layout, TessellateOptions};
+use tessera::mesh::Mesh;
+use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
+use tessera::surface::{BuildOptions, SurfaceSet};
+use tessera_gpu::tessellator::Pipelines;
+use tessera_gpu::{GpuContext, GpuTessellator};
+
+/// One device for the whole binary (creating one per test costs time on lavapipe).
+pub fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| match GpuContext::new() {
+        Ok(c) => c,
+        Err(e) => panic!("{e}"),
+    })
+}
+
+/// One compiled pipeline set for the whole binary (a dozen WGSL compilations, seconds on
+/// lavapipe).
+pub fn pipelines() -> std::sync::Arc<Pipelines> {
+    static PIPELINES: OnceLock<std::sync::Arc<Pipelines>> = OnceLock::new();
+    PIPELINES.get_or_init(|| std::sync::Arc::new(Pipelines::new(&ctx().device))).clone()
+}
+
+/// A tessellator for `set` on the shared device and pipelines.
+pub fn tessellator(set: &SurfaceSet) -> GpuTessellator {
+    GpuTessellator::with_pipelines(ctx(), set, pipelines()).unwrap()
+}
+
+pub fn data_dir() -> PathBuf {
+    std::env::var_os("TESSERA_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
+}
+
+pub fn load(rel: &str) -> SurfaceSet {
+    let path = data_dir().join(rel);
+    assert!(
+        path.exists(),
+        "test model {} not found: set TESSERA_DATA to the shared data folder",
+        path.display()
+    );
+    if rel.ends_with(".obj") {
+        let mesh = tessera::io::obj::read_obj(&path).unwrap();
+        return SurfaceSet::pn_from_mesh(&mesh, &path, BuildOptions::default()).unwrap();
+    }
+    let file = tessera::io::patches::read_patches(&path).unwrap();
+    SurfaceSet::from_patch_file(&file, BuildOptions::default())
+}
+
+/// Every triangle-mesh model (PN triangles) of the shared data, smallest first.
+pub fn mesh_models() -> Vec<String> {
+    let mut models = Vec::new();
+    for sub in ["meshes", "awkward"] {
+        for entry in
+            std::fs::read_dir(data_dir().join(sub)).unwrap_or_else(|e| panic!("cannot list {sub}: {e}"))
+        {
+            let entry = entry.unwrap();
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.ends_with(".obj") {
+                models.push((entry.metadata().unwrap().len(), format!("{sub}/{name}")));
+            }
+        }
+    }
+    models.sort();
+    assert!(models.len() >= 10, "{models:?}");
+    models.into_iter().map(|(_, m)| m).collect()
+}
+
+/// Every `.patches` model of the shared data (the small ones and the bench torus).
+pub fn patch_models() -> Vec<String> {
+    let mut models = Vec::new();
+    for sub in ["patches", "bench"] {
+        let mut names: Vec<String> = std::fs::read_dir(data_dir().join(sub))
+            .unwrap_or_else(|e| panic!("cannot list {sub}: {e}"))
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".patches"))
+            .map(|n| format!("{sub}/{n}"))
+            .collect();
+        names.sort();
+        models.extend(names);
+    }
+    assert!(models.len() >= 4, "{models:?}");
+    models
+}
+
+/// Tiny LCG: the tests' pseudo-random inputs, seeded.
+pub struct Lcg(pub u64);
+impl Lcg {
+    pub fn next(&mut self) -> u32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 33) as u32
+    }
+}
+
+/// The CPU engine's layout and mesh for `plan`.
+pub fn cpu(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> (Layout, Mesh) {
+    let mut layout = Layout::default();
+    layout.build(set, plan, pattern, &TessellateOptions::default()).unwrap();
+    let mesh = engine::tessellate(set, plan, pattern, TessellateOptions::default()).unwrap();
+    (layout, mesh)
+}
+
+pub fn diagonal(set: &SurfaceSet) -> f64 {
+    let (lo, hi) = set.bounds();
+    (hi - lo).length()
+}
+
+/// The GPU output of `plan` equals the CPU's: the layout's offsets, the triangles (the same
+/// numbering, so index for index), positions within 1e-5 of the diagonal, normals within a
+/// few degrees (a small step off a collapsed corner), the same watertightness report.
+pub fn assert_gpu_equals_cpu(name: &str, set: &SurfaceSet, gpu: &mut GpuTessellator, plan: &Plan) {
+    assert_pattern_equals_cpu(name, set, gpu, plan, &Uniform);
+}
+
+/// [`assert_gpu_equals_cpu`] for `pattern`.
+pub fn assert_pattern_equals_cpu(
+    name: &str,
+    set: &SurfaceSet,
+    gpu: &mut GpuTessellator,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+) {
+    let ctx = ctx();
+    gpu.prepare(ctx, set, plan, pattern).unwrap();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+    assert_gpu_equals_cpu_after_record(name, set, gpu, plan, pattern);
+}
+
+/// The checks of [`assert_gpu_equals_cpu`] on a frame already recorded and submitted.
+pub fn assert_gpu_equals_cpu_after_record(
+    name: &str,
+    set: &SurfaceSet,
+    gpu: &GpuTessellator,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+) {
+    let ctx = ctx();
+    let (overflow, _, _) = gpu.read_status(ctx).unwrap();
+    assert!(!overflow, "{name}: the frame overflowed");
+    let (layout, want) = cpu(set, plan, pattern);
+    let (edge_offsets, interior_offsets, triangle_offsets) = gpu.read_layout(ctx).unwrap();
+    assert_eq!(edge_offsets, layout.edge_offsets, "{name}: edge offsets");
+    assert_eq!(interior_offsets, layout.interior_offsets, "{name}: interior offsets");
+    assert_eq!(triangle_offsets, layout.triangle_offsets, "{name}: triangle offsets");
+    let got = gpu.read_mesh(ctx, set).unwrap();
+    assert_eq!(got.triangle_count(), want.triangle_count(), "{name}: triangles");
+    assert_eq!(got.vertex_count(), want.vertex_count(), "{name}: vertices");
+    // Same numbering rule: the index buffers are equal as they are, so canonically ordered too.
+    if let Some(t) = (0..want.triangle_count()).find(|&t| got.triangle(t) != want.triangle(t)) {
+        panic!("{name}: triangle {t} is {:?}, the CPU's {:?}", got.triangle(t), want.triangle(t));
+    }
+    let tolerance = 1e-5 * diagonal(set);
+    for (v, (g, w)) in got.positions.iter().zip(&want.positions).enumerate() {
+        let d = ((g[0] - w[0]) as f64).hypot((g[1] - w[1]) as f64).hypot((g[2] - w[2]) as f64);
+        assert!(d <= tolerance, "{name}: vertex {v} at {g:?}, the CPU's {w:?} ({d} > {tolerance})");
+    }
+    for (v, (g, w)) in got.normals.iter().zip(&want.normals).enumerate() {
+        let dot = g[0] * w[0] + g[1] * w[1] + g[2] * w[2];
+        assert!(dot > 0.99, "{name}: normal {v} is {g:?}, the CPU's {w:?}");
+    }
+    assert_eq!(got.vertex_patch, want.vertex_patch, "{name}: vertex patches");
+    assert_eq!(got.triangle_patch, want.triangle_patch, "{name}: triangle patches");
+    assert_eq!(got.collapsed_triangles, want.collapsed_triangles, "{name}: collapsed triangles");
+    let (g, w) = (tessera::verify::watertight(&got), tessera::verify::watertight(&want));
+    assert_eq!(
+        (g.boundary_edges, g.nonmanifold_edges, g.misoriented_edges, g.euler_characteristic),
+        (w.boundary_edges, w.nonmanifold_edges, w.misoriented_edges, w.euler_characteristic),
+        "{name}: watertightness {g:?} vs the CPU's {w:?}"
+    );
+}
+
+/// the box, some far), looking near the centre, narrow and wide fields of view.
+pub fn cameras(set: &SurfaceSet, count: usize, seed: u64) -> Vec<tessera::camera::Camera> {
+    use glam::DVec3;
+    let (lo, hi) = set.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    let mut rng = Lcg(seed);
+    let mut unit = || rng.next() as f64 / (1u64 << 31) as f64;
+    (0..count)
+        .map(|_| {
+            let z = 2.0 * unit() - 1.0;
+            let phi = std::f64::consts::TAU * unit();
+            let r = (1.0 - z * z).sqrt();
+            let direction = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+            let distance = radius * (0.6 + 2.4 * unit());
+            let target = centre + (DVec3::new(unit(), unit(), unit()) - 0.5) * radius * 0.8;
+            let up = if direction.z.abs() < 0.9 { DVec3::Z } else { DVec3::Y };
+            tessera::camera::Camera {
+                eye: centre + direction * distance,
+                target,
+                up,
+                fov_y_degrees: 20.0 + 60.0 * unit(),
+                width: 640,
+                height: 480,
+                near: radius * 0.01,
+                far: radius * 10.0,
+            }
+        })
+        .collect()
+}
+
+/// Whether patch `p`'s culling for `camera` is within rounding of the other answer, so
+/// that the GPU (f32) and the CPU (f64) may decide it differently: a frustum plane that
+/// every control point but one is beyond, that one within 1e-5 of the scene's size of it
+/// (`screen::PatchView::culled`'s control-point test), or the normal-cone test
+/// (`screen::PatchView::back_facing`) within 1e-5 of its bound. Only explains differences;
+/// the expected culled set is always the CPU's.
+pub fn near_cull_tie(set: &SurfaceSet, p: usize, camera: &tessera::camera::Camera) -> bool {
+    let view = camera.view();
+    let patch = &set.patches[p];
+    let scale = 1e-5 * (diagonal(set) + (camera.eye - set.bounds().0).length());
+    let t = view.half_tangents;
+    let (nx, ny) = ((1.0 + t.x * t.x).sqrt(), (1.0 + t.y * t.y).sqrt());
+    // Signed distances, positive outside; a plane culls when every point is outside.
+    let plane = |k: usize, c: glam::DVec3| match k {
+        0 => view.near - c.z,
+        1 => c.z - view.far,
+        2 => (c.x - t.x * c.z) / nx,
+        3 => (-c.x - t.x * c.z) / nx,
+        4 => (c.y - t.y * c.z) / ny,
+        _ => (-c.y - t.y * c.z) / ny,
+    };
+    let frustum_tie = (0..6).any(|k| {
+        let least =
+            patch.control_points().iter().map(|&q| plane(k, view.to_camera(q))).fold(f64::INFINITY, f64::min);
+        least.abs() <= scale
+    });
+    let pv = tessera::criterion::screen::PatchView::new(patch);
+    let cone_tie = pv.cone.is_some_and(|(axis, alpha)| {
+        let to_eye = camera.eye - pv.centre;
+        let dist = to_eye.length();
+        let sin_b = (pv.radius / dist).min(1.0);
+        let beta = sin_b.asin();
+        let gamma = axis.dot(to_eye / dist).clamp(-1.0, 1.0).acos();
+        (gamma - (std::f64::consts::FRAC_PI_2 + alpha + beta)).abs() <= 1e-5
+            || (alpha + beta - std::f64::consts::FRAC_PI_2).abs() <= 1e-5
+    });
+    frustum_tie || cone_tie
+}
+
+/// Per-sweep tallies, reported at the end.
+#[derive(Debug, Default)]
+pub struct SweepCounts {
+    pub frames: usize,
+    pub culled: usize,
+    /// Patches the GPU culled unlike the CPU, each a [`near_cull_tie`].
+    pub cull_ties: usize,
+    /// Uniform frames whose GPU factor, and transition edges whose GPU segments, differ from
+    /// the CPU's at a rounding boundary.
+    pub factor_ties: usize,
+    /// Uniform frames whose factor the cap did not decide.
+    pub below_cap: usize,
+    /// Transition frames with more than one edge factor.
+    pub strips: usize,
+}
+
+/// The GPU's culled set against the CPU plan's: equal but for [`near_cull_tie`]s, which
+/// are counted. Returns the GPU's row.
+pub fn check_culling(
+    name: &str,
+    set: &SurfaceSet,
+    gpu: &GpuTessellator,
+    cpu_visible: &[u32],
+    camera: &tessera::camera::Camera,
+    counts: &mut SweepCounts,
+) -> Vec<u32> {
+    let visible = gpu.read_visible(ctx()).unwrap();
+    let differ: Vec<usize> = (0..visible.len()).filter(|&p| visible[p] != cpu_visible[p]).collect();
+    for &p in &differ {
+        assert!(near_cull_tie(set, p, camera), "{name}: patch {p} culled unlike the CPU, and not at a tie");
+    }
+    counts.cull_ties += differ.len();
+    counts.culled += cpu_visible.iter().filter(|&&v| v == 0).count();
+    visible
+}
+
+pub fn all_models() -> Vec<String> {
+    let mut models = patch_models();
+    models.extend(mesh_models());
+    models
+}
