@@ -1,7 +1,7 @@
 //! Per-pass GPU times of the GPU engine on a patch model.
 //!
 //! `cargo run --release -p tessera-gpu --example gpu_frame -- MODEL.patches [FACTOR] [FRAMES]
-//! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition]]
+//! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition [--cpu-plan]]]
 //! [--silhouetteness FMAX]`
 //!
 //! `--copies N` tessellates N copies of the model in a grid (`tessera::scene::patch_grid`;
@@ -10,8 +10,10 @@
 //! By default the frame is the uniform pattern at FACTOR (default 16) from a CPU plan.
 //! `--pixel-error PX` plans the frame on the GPU from that camera alone (culling and the
 //! uniform scheme's pixel-error factor within `--max-factor`, default 16:
-//! `GpuTessellator::prepare_screen`); with `--transition` the CPU plans the transition
-//! scheme for PX once instead, and the GPU culls and draws it every frame.
+//! `GpuTessellator::prepare_screen`); with `--transition` the transition scheme's
+//! (CudaTess's per-edge factors and the a-posteriori check, on the GPU); with `--cpu-plan`
+//! too, the CPU plans the transition scheme for PX once instead, and the GPU culls and draws
+//! it every frame.
 //! `--silhouetteness FMAX` plans the transition scheme on the GPU from the camera alone
 //! (culling, silhouetteness factors in 1..=FMAX, the core rule).
 //! Records FRAMES frames (default 10) and prints, per pass, the median of the
@@ -49,12 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let cull = flag(&mut args, "--cull");
     let transition = flag(&mut args, "--transition");
+    let cpu_plan = flag(&mut args, "--cpu-plan");
     let copies: usize = option(&mut args, "--copies")?.unwrap_or(1);
     let pixels: Option<f64> = option(&mut args, "--pixel-error")?;
     let max_factor: u32 = option(&mut args, "--max-factor")?.unwrap_or(16);
     let silhouetteness: Option<u32> = option(&mut args, "--silhouetteness")?;
     let usage = "usage: gpu_frame MODEL.patches [FACTOR] [FRAMES] [--copies N] [--cull] \
-                 [--pixel-error PX [--max-factor N] [--transition]] [--silhouetteness FMAX]";
+                 [--pixel-error PX [--max-factor N] [--transition [--cpu-plan]]] [--silhouetteness FMAX]";
     let path = args.get(1).ok_or(usage)?;
     let factor: u32 = args.get(2).map_or(Ok(16), |s| s.parse())?;
     let frames: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
@@ -69,7 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if cull {
         gpu.set_cull_camera(&ctx, Some(&camera));
     }
-    let what = match (pixels, transition) {
+    let what = match (pixels, transition && cpu_plan) {
         _ if silhouetteness.is_some() => {
             let fmax = silhouetteness.unwrap_or(1);
             let prepared = Prepared::new(&set, true);
@@ -85,14 +88,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         (Some(px), false) => {
             let prepared = Prepared::new(&set, true);
-            let screen = ScreenCriterion {
-                scheme: Scheme::Uniform,
-                criterion: Criterion::PixelError(px),
-                max_factor,
-                capacity: None,
-            };
+            let scheme = if transition { Scheme::Transition } else { Scheme::Uniform };
+            let screen =
+                ScreenCriterion { scheme, criterion: Criterion::PixelError(px), max_factor, capacity: None };
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
-            format!("uniform, {px} px and cap {max_factor} planned on the GPU, culled on the GPU")
+            format!("{}, {px} px and cap {max_factor} planned on the GPU, culled on the GPU", scheme.name())
         }
         (Some(px), true) => {
             let options = PlanOptions { camera: Some(camera), cull: true, max_factor, ..Default::default() };
@@ -130,6 +130,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         set.patches.len(),
         if overflow { " (OVERFLOW)" } else { "" }
     );
+    let report = gpu.read_screen_report(&ctx)?;
+    if report.rounds > 0 || report.failing_patches > 0 || !report.converged {
+        println!(
+            "  a-posteriori check: {} fix rounds, {} patches at the cap{}",
+            report.rounds,
+            report.failing_patches,
+            if report.converged { "" } else { " (rounds NOT converged)" }
+        );
+    }
     let frame = median(wall.clone());
     if timer.is_some() {
         let mut total = 0.0;

@@ -42,6 +42,19 @@ const CORNER_ROW: u32 = {{CORNER_ROW}}u;
 const CONTROL_POINTS: u32 = {{CONTROL_POINTS}}u;
 const VERTEX_FLOATS: u32 = {{VERTEX_FLOATS}}u;
 
+const MAX_GROUPS_PER_DIMENSION: u32 = {{MAX_GROUPS_PER_DIMENSION}}u;
+
+// Workgroups (x, y) for `threads` invocations, 2D past the per-dimension limit:
+// `shader::grid`; (0, 0) for none.
+fn dispatch_grid(threads: u32) -> vec2<u32> {
+    let groups = (threads + WORKGROUP - 1u) / WORKGROUP;
+    if (threads == 0u) { return vec2<u32>(0u, 0u); }
+    if (groups > MAX_GROUPS_PER_DIMENSION) {
+        return vec2<u32>(MAX_GROUPS_PER_DIMENSION, (groups + MAX_GROUPS_PER_DIMENSION - 1u) / MAX_GROUPS_PER_DIMENSION);
+    }
+    return vec2<u32>(groups, 1u);
+}
+
 // The invocation's index in a dispatch laid out by `shader::grid` (2D past 65,535 groups).
 fn thread_index(wid: vec3<u32>, nwg: vec3<u32>, lid: u32) -> u32 {
     return (wid.y * nwg.x + wid.x) * WORKGROUP + lid;

@@ -1,9 +1,11 @@
 // Screen-space factors from the camera alone, the GPU form of `tessera::scheme::Scheme::
 // plan_into` for two criteria:
 //
-// - `Criterion::PixelError` (the uniform scheme): per visible patch the object-space
-//   tolerance of `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
-//   `uniform_factor` and `curve_factor` from the prepared bounds);
+// - `Criterion::PixelError`: per visible patch the object-space tolerance of
+//   `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
+//   `uniform_factor`, or for the transition scheme's quads `quad_grid`, and `curve_factor`
+//   from the prepared bounds); the transition scheme's interiors then come from the
+//   a-posteriori check (`check.wgsl`);
 // - `Criterion::View` with `ViewCriterion::Silhouetteness` (`view::edge_factors_into`): every
 //   patch proposes each of its edges' silhouetteness factor in [lo, hi];
 //
@@ -54,6 +56,40 @@ fn curve_factor(m_edge: f32, eps: f32) -> f32 {
     return max(ceil(sqrt(m_edge / (8.0 * eps))), 1.0);
 }
 
+// `tolerance::quad_grid`: the grid (nu, nv) with the fewest cells whose cells meet Filip's
+// bound `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, both factors at most `cap`; (cap, cap)
+// when none does (`plan_limited`'s fallback).
+fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
+    var best = vec2<u32>(0u, 0u);
+    var found = false;
+    for (var nu = 1u; nu <= cap; nu = nu + 1u) {
+        let hu = 1.0 / f32(nu);
+        let a = m.z;
+        let b = 2.0 * m.y * hu;
+        let c = m.x * hu * hu - 8.0 * eps;
+        if (c > 0.0) { continue; }
+        var hv = 1.0;
+        if (a > 0.0) {
+            hv = (-b + sqrt(b * b - 4.0 * a * c)) / (2.0 * a);
+        } else if (b > 0.0) {
+            hv = -c / b;
+        }
+        var nv = 1u;
+        if (hv < 1.0) {
+            let cells = ceil(1.0 / hv);
+            if (!(cells <= f32(cap))) { continue; }
+            nv = u32(cells);
+        }
+        if (!found || nu * nv < best.x * best.y) {
+            best = vec2<u32>(nu, nv);
+            found = true;
+        }
+        if (nv == 1u) { break; } // larger nu only adds cells
+    }
+    if (!found) { return vec2<f32>(f32(cap), f32(cap)); }
+    return vec2<f32>(best);
+}
+
 // `view::edge_factors_into`'s silhouetteness factor of edge e: s = 1 where the two normals
 // at the midpoint face opposite ways from the eye, 1 − (c·nL)(c·nR)/β near it (β = 1/4).
 fn silhouetteness_factor(e: u32) -> f32 {
@@ -85,7 +121,7 @@ fn patch_proposals(
     let row = PATCH_VIEW_ROW * p;
     let minimum = patch_views[row + 7u];
     if (view.interior_rule == INTERIOR_GLOBAL) {
-        atomicMax(&global_factor, u32(max(minimum.x, minimum.y)));
+        atomicMax(&state.global_factor, u32(max(minimum.x, minimum.y)));
     }
     var out = vec4<f32>(0.0);
     if (view.criterion == CRITERION_SILHOUETTENESS) {
@@ -95,17 +131,38 @@ fn patch_proposals(
         }
     } else if (visible[p] != 0u) {
         let eps = patch_tolerance(p);
-        let n = uniform_factor(patch_views[row + 5u], eps);
+        let m = patch_views[row + 5u];
+        if (view.interior_rule == INTERIOR_CORE && !patch_is_tri(p)) {
+            // CudaTess's quads: the cheapest grid that meets the bound, its core.
+            let grid = quad_grid(m.xyz, eps, u32(view.cap));
+            out = vec4<f32>(grid.x, grid.y, grid.x, grid.y);
+        } else {
+            let n = uniform_factor(m, eps);
+            for (var l = 0u; l < patch_corner_count(p); l = l + 1u) { out[l] = n; }
+        }
         let curves = patch_views[row + 6u];
         for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
-            out[l] = max(n, curve_factor(curves[l], eps));
+            out[l] = max(out[l], curve_factor(curves[l], eps));
         }
+        checks[p].eps = eps;
+    } else {
+        checks[p].eps = -1.0;
     }
     proposals[p] = out;
 }
 
-// Per edge: `resolve::edges` with `EdgeRule::Integer` — the maximum over its uses, capped,
-// rounded half away from zero as `f64::round`, at least the minimum.
+// `resolve::edges` with `EdgeRule::Integer` for edge e: the maximum of the proposals over
+// its uses, capped, rounded half away from zero as `f64::round`, at least the minimum.
+fn resolved_segments(e: u32) -> u32 {
+    var wanted = 0.0;
+    for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
+        wanted = max(wanted, proposals[use_patch(u)][use_local(u)]);
+    }
+    wanted = min(wanted, view.cap);
+    return max(u32(floor(wanted + 0.5)), max(minimum_segments[e], 1u));
+}
+
+// Per edge: its segments (`resolved_segments`).
 @compute @workgroup_size(WORKGROUP)
 fn edge_segments(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -114,15 +171,10 @@ fn edge_segments(
 ) {
     let e = thread_index(wid, nwg, lid);
     if (e >= params.edges) { return; }
-    var wanted = 0.0;
-    for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
-        wanted = max(wanted, proposals[use_patch(u)][use_local(u)]);
-    }
-    wanted = min(wanted, view.cap);
-    let s = max(u32(floor(wanted + 0.5)), max(minimum_segments[e], 1u));
+    let s = resolved_segments(e);
     segments[e] = s;
     if (view.interior_rule == INTERIOR_GLOBAL) {
-        atomicMax(&global_factor, s);
+        atomicMax(&state.global_factor, s);
     }
 }
 
@@ -137,7 +189,7 @@ fn interiors(
 ) {
     let x = thread_index(wid, nwg, lid);
     if (view.interior_rule == INTERIOR_GLOBAL) {
-        let n = atomicLoad(&global_factor);
+        let n = atomicLoad(&state.global_factor);
         if (x < params.edges) { segments[x] = n; }
         if (x < params.patches) { interior[x] = vec2<u32>(n, n); }
         return;

@@ -25,20 +25,11 @@ struct Status {
 @group(1) @binding(1) var<storage, read_write> dispatch: array<u32, 12>;
 @group(1) @binding(2) var<storage, read_write> status: Status;
 
-const MAX_GROUPS_PER_DIMENSION: u32 = {{MAX_GROUPS_PER_DIMENSION}}u;
-
-// Workgroups for `threads` invocations, 2D past the per-dimension limit: `shader::grid`.
+// Dispatch `slot`'s workgroups for `threads` invocations (`dispatch_grid`).
 fn set_grid(slot: u32, threads: u32) {
-    let groups = (threads + WORKGROUP - 1u) / WORKGROUP;
-    var x = groups;
-    var y = 1u;
-    if (groups > MAX_GROUPS_PER_DIMENSION) {
-        x = MAX_GROUPS_PER_DIMENSION;
-        y = (groups + MAX_GROUPS_PER_DIMENSION - 1u) / MAX_GROUPS_PER_DIMENSION;
-    }
-    if (threads == 0u) { x = 0u; y = 0u; }
-    dispatch[3u * slot] = x;
-    dispatch[3u * slot + 1u] = y;
+    let grid = dispatch_grid(threads);
+    dispatch[3u * slot] = grid.x;
+    dispatch[3u * slot + 1u] = grid.y;
     dispatch[3u * slot + 2u] = 1u;
 }
 

@@ -87,6 +87,12 @@ fn tri_layout(s: vec4<u32>, interior_factor: u32, c: u32) -> QuadLayout {
 
 // `engine::layout::pattern_input` for patch p, with its local bases.
 fn patch_input(p: u32) -> PatchInput {
+    return pattern_input(p, interior[p]);
+}
+
+// `engine::layout::pattern_input` for patch p with interior factors `interior_factors` (the
+// check tries several before the plan has one).
+fn pattern_input(p: u32, interior_factors: vec2<u32>) -> PatchInput {
     let nc = patch_corner_count(p);
     var s = vec4<u32>(0u);
     var collapsed = 0u;
@@ -102,9 +108,9 @@ fn patch_input(p: u32) -> PatchInput {
     }
     var core: QuadLayout;
     if (nc == 3u) {
-        core = tri_layout(s, interior[p].x, collapsed);
+        core = tri_layout(s, interior_factors.x, collapsed);
     } else {
-        core = quad_layout(s, interior[p], collapsed);
+        core = quad_layout(s, interior_factors, collapsed);
     }
     return PatchInput(p, nc, s, collapsed, base, b, core);
 }
@@ -224,22 +230,49 @@ fn local_collapse_id(input: PatchInput, l: u32) -> vec2<u32> {
     return vec2<u32>(0u, l);
 }
 
-// Takes pattern triangle `tri` (local indices): left out if it degenerates at a collapsed
-// curve, else counted and, with `write`, written as output triangle `first + *kept`.
-fn emit(input: PatchInput, tri: vec3<u32>, write: bool, first: u32, kept: ptr<function, u32>) {
+// What a pattern build does with each triangle: count it, write it, or bound its error
+// (the a-posteriori check, `check.wgsl`).
+const SINK_COUNT: u32 = 0u;
+const SINK_WRITE: u32 = 1u;
+const SINK_CHECK: u32 = 2u;
+
+// A build's triangle sink: its mode, the first output triangle (SINK_WRITE), the triangles
+// taken, and for SINK_CHECK the largest error bound so far and the patch's bound data.
+struct Sink {
+    mode: u32,
+    first: u32,
+    kept: u32,
+    worst: f32,
+    errors: TriangleErrors,
+}
+
+fn sink(mode: u32, first: u32) -> Sink {
+    return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)));
+}
+
+// Takes pattern triangle `tri` (local indices; ta, tb, tc its domain positions). Counting
+// and writing leave out a triangle that degenerates at a collapsed curve, else count it and
+// with SINK_WRITE write it as output triangle `first + kept`; the check bounds every
+// triangle of the pattern, as `tolerance::params_bound` does over the built pattern.
+fn emit(input: PatchInput, tri: vec3<u32>, ta: vec2<f32>, tb: vec2<f32>, tc: vec2<f32>, out: ptr<function, Sink>) {
+    if ((*out).mode == SINK_CHECK) {
+        (*out).worst = max((*out).worst, triangle_error((*out).errors, ta, tb, tc));
+        (*out).kept = (*out).kept + 1u;
+        return;
+    }
     if (patch_repeated_corner(input.p)) {
         let a = local_collapse_id(input, tri.x);
         let b = local_collapse_id(input, tri.y);
         let c = local_collapse_id(input, tri.z);
         if (all(a == b) || all(b == c) || all(a == c)) { return; }
     }
-    if (write) {
-        let t = first + *kept;
+    if ((*out).mode == SINK_WRITE) {
+        let t = (*out).first + (*out).kept;
         indices[3u * t] = local_vertex(input, tri.x);
         indices[3u * t + 1u] = local_vertex(input, tri.y);
         indices[3u * t + 2u] = local_vertex(input, tri.z);
     }
-    *kept = *kept + 1u;
+    (*out).kept = (*out).kept + 1u;
 }
 
 // Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
@@ -247,9 +280,15 @@ fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
     return domain_edge_point(input.p, e, f32(k) / f32(input.s[e]));
 }
 
+// Domain position of core grid point (i, j): `(i·(1/nu), j·(1/nv))`, as the CPU builds the
+// interior (`QuadLayout::build`, `TriLayout::build`).
+fn grid_position(input: PatchInput, i: u32, j: u32) -> vec2<f32> {
+    return vec2<f32>(f32(i) * (1.0 / f32(input.core.nu)), f32(j) * (1.0 / f32(input.core.nv)));
+}
+
 fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
     let g = inner_point(input, e, t);
-    return vec2<f32>(f32(g.x) * (1.0 / f32(input.core.nu)), f32(g.y) * (1.0 / f32(input.core.nv)));
+    return grid_position(input, g.x, g.y);
 }
 
 fn inner_local(input: PatchInput, e: u32, t: u32) -> u32 {
@@ -264,7 +303,7 @@ const TIE_TOLERANCE: f32 = 1e-5;
 
 // `transition::walk`: the strip along edge e between its s outer segments and the m inner
 // ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification).
-fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, u32>) {
+fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
     let l = input.core;
     let s = input.s[e];
     let m = inner_segments(input, e);
@@ -301,13 +340,17 @@ fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, 
             }
         }
         if (advance_outer) {
-            emit(input, vec3<u32>(o0, o1, n0), write, first, kept);
+            let at = outer_position(input, e, i);
+            let next = outer_position(input, e, i + 1u);
+            emit(input, vec3<u32>(o0, o1, n0), at, next, inner_position(input, e, j), out);
             i = i + 1u;
             if (j < m && i < s) { d = d + 2 * span; }
             o0 = o1;
             if (i < s) { o1 = boundary_local(input, e, i + 1u); }
         } else {
-            emit(input, vec3<u32>(o0, n1, n0), write, first, kept);
+            let at = inner_position(input, e, j);
+            let next = inner_position(input, e, j + 1u);
+            emit(input, vec3<u32>(o0, n1, n0), outer_position(input, e, i), next, at, out);
             j = j + 1u;
             if (j < m && i < s) { d = d - 2 * s32; }
             n0 = n1;
@@ -318,8 +361,7 @@ fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, 
 
 // `TriLayout::build`'s triangles: the core in the uniform pattern's loop and vertex order,
 // shifted to the core's corner, then each strip's walk. Returns the triangles kept.
-fn build_tri_transition(input: PatchInput, write: bool, first: u32) -> u32 {
-    var kept = 0u;
+fn build_tri_transition(input: PatchInput, out: ptr<function, Sink>) {
     let l = input.core;
     let i0 = l.i_lo;
     let j0 = l.j_lo;
@@ -329,24 +371,28 @@ fn build_tri_transition(input: PatchInput, write: bool, first: u32) -> u32 {
             let a = grid_local(input, i0 + i, j0 + j);
             let b = grid_local(input, i0 + i + 1u, j0 + j);
             let d = grid_local(input, i0 + i, j0 + j + 1u);
-            emit(input, vec3<u32>(a, b, d), write, first, &kept);
+            let ta = grid_position(input, i0 + i, j0 + j);
+            let tb = grid_position(input, i0 + i + 1u, j0 + j);
+            let td = grid_position(input, i0 + i, j0 + j + 1u);
+            emit(input, vec3<u32>(a, b, d), ta, tb, td, out);
             if (i + j + 2u <= m) {
-                emit(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), write, first, &kept);
+                let c = grid_local(input, i0 + i + 1u, j0 + j + 1u);
+                emit(input, vec3<u32>(b, c, d), tb, grid_position(input, i0 + i + 1u, j0 + j + 1u), td, out);
             }
         }
     }
     for (var e = 0u; e < 3u; e = e + 1u) {
-        if (bit(l.strips, e) != 0u) { walk(input, e, write, first, &kept); }
+        if (bit(l.strips, e) != 0u) { walk(input, e, out); }
     }
-    return kept;
 }
 
 // `QuadLayout::build`'s triangles: the core cells row after row, then each strip's walk
-// (`build_tri_transition` on triangles). Returns the triangles kept. Cost: O(pattern
-// triangles), serial.
-fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
-    if (input.nc == 3u) { return build_tri_transition(input, write, first); }
-    var kept = 0u;
+// (`build_tri_transition` on triangles), into `out`. Cost: O(pattern triangles), serial.
+fn build_transition(input: PatchInput, out: ptr<function, Sink>) {
+    if (input.nc == 3u) {
+        build_tri_transition(input, out);
+        return;
+    }
     let l = input.core;
     for (var j = l.j_lo; j < l.j_hi; j = j + 1u) {
         for (var i = l.i_lo; i < l.i_hi; i = i + 1u) {
@@ -354,14 +400,15 @@ fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
             let b = grid_local(input, i + 1u, j);
             let c = grid_local(input, i + 1u, j + 1u);
             let d = grid_local(input, i, j + 1u);
-            emit(input, vec3<u32>(a, b, c), write, first, &kept);
-            emit(input, vec3<u32>(a, c, d), write, first, &kept);
+            let ta = grid_position(input, i, j);
+            let tc = grid_position(input, i + 1u, j + 1u);
+            emit(input, vec3<u32>(a, b, c), ta, grid_position(input, i + 1u, j), tc, out);
+            emit(input, vec3<u32>(a, c, d), ta, tc, grid_position(input, i, j + 1u), out);
         }
     }
     for (var e = 0u; e < 4u; e = e + 1u) {
-        if (bit(l.strips, e) != 0u) { walk(input, e, write, first, &kept); }
+        if (bit(l.strips, e) != 0u) { walk(input, e, out); }
     }
-    return kept;
 }
 
 // Counts of the transition pattern for the count pass (`count.wgsl`): a visible patch's
@@ -370,7 +417,9 @@ fn patch_counts(p: u32) -> vec2<u32> {
     let input = patch_input(p);
     var counts = transition_counts(input);
     if (patch_repeated_corner(p)) {
-        counts.y = build_transition(input, false, 0u);
+        var out = sink(SINK_COUNT, 0u);
+        build_transition(input, &out);
+        counts.y = out.kept;
     }
     return counts;
 }
@@ -384,5 +433,6 @@ fn write_patch_triangles(
 ) {
     let p = thread_index(wid, nwg, lid);
     if (p >= params.patches || visible[p] == 0u) { return; }
-    build_transition(patch_input(p), true, triangle_offsets[p]);
+    var out = sink(SINK_WRITE, triangle_offsets[p]);
+    build_transition(patch_input(p), &out);
 }

@@ -14,7 +14,8 @@ struct View {
     tan_x: f32,
     tan_y: f32,
     // `Camera::focal_pixels`, the pixel error, the factor cap (`PlanOptions::max_factor`),
-    // the interior rule (INTERIOR_GLOBAL or INTERIOR_CORE).
+    // the interior rule (INTERIOR_GLOBAL or INTERIOR_CORE; with a pixel error, INTERIOR_CORE
+// means the a-posteriori check of `check.wgsl` decides the interiors).
     focal: f32,
     pixels: f32,
     cap: f32,
@@ -40,9 +41,35 @@ struct View {
 @group(1) @binding(2) var<storage, read_write> minimum_segments: array<u32>;
 // Per patch, the factor it proposes for each local edge (0 for culled patches).
 @group(1) @binding(3) var<storage, read_write> proposals: array<vec4<f32>>;
-// The largest segment count and minimum interior of the frame (the global factor of
-// `InteriorRule::Global`); zeroed before the factor passes.
-@group(1) @binding(4) var<storage, read_write> global_factor: atomic<u32>;
+// The frame's planning state, zeroed before the factor passes.
+struct FrameState {
+    // The largest segment count and minimum interior of the frame (the global factor of
+    // `InteriorRule::Global`).
+    global_factor: atomic<u32>,
+    // The a-posteriori check's rounds (`check.wgsl`): patches whose bound the last check
+    // missed, whether the last resolve changed an edge, whether the rounds ended (1) and
+    // how many fix rounds ran.
+    failing: atomic<u32>,
+    changed: atomic<u32>,
+    done: atomic<u32>,
+    rounds: atomic<u32>,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+@group(1) @binding(4) var<storage, read_write> state: FrameState;
+
+// Per patch, the a-posteriori check's row (`check.wgsl`): the object-space tolerance (< 0:
+// culled), the guaranteed bound of the last check, flags (bit 0: the bound is missed), 0.
+struct CheckRow {
+    eps: f32,
+    bound: f32,
+    flags: u32,
+    _pad: u32,
+}
+@group(1) @binding(5) var<storage, read_write> checks: array<CheckRow>;
+// The check's rounds: per patch whether a changed edge asks for its check again.
+@group(1) @binding(6) var<storage, read_write> round_rows: array<atomic<u32>>;
 
 const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
 const INTERIOR_GLOBAL: u32 = 0u;

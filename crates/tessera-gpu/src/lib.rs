@@ -47,4 +47,4 @@ pub mod upload;
 
 pub use context::{GpuContext, SOFTWARE_DRIVER_PACKAGES};
 pub use error::{GpuError, Result};
-pub use tessellator::{GpuTessellator, VERTEX_LAYOUT};
+pub use tessellator::{GpuTessellator, ScreenReport, VERTEX_LAYOUT};

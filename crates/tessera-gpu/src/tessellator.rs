@@ -6,7 +6,10 @@
 //!
 //! 0. **cull** (`cull.wgsl`, with a culling camera) and **factors** (`factors.wgsl`, after
 //!    [`GpuTessellator::prepare_screen`]): the visibility row and the plan's segments and
-//!    interior factors from the camera alone, from view-independent rows uploaded once;
+//!    interior factors from the camera alone, from view-independent rows uploaded once; for
+//!    the transition scheme's pixel error also the a-posteriori check (`check.wgsl`,
+//!    `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds that size
+//!    themselves on the GPU raise interiors and edges until the bounds hold;
 //! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`): per edge and per patch, the counts
 //!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
@@ -76,13 +79,20 @@ const CULL: &str = include_str!("../shaders/cull.wgsl");
 const VIEW: &str = include_str!("../shaders/view.wgsl");
 const FACTORS: &str = include_str!("../shaders/factors.wgsl");
 const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
+const BOUNDS: &str = include_str!("../shaders/bounds.wgsl");
+const CHECK: &str = include_str!("../shaders/check.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
 /// Storage buffers in group 1 of the args pass (its outputs).
 const ARGS_STORAGE: u32 = 3;
 /// Storage buffers in group 1 of the view passes (`view.wgsl`).
-const VIEW_STORAGE: u32 = 4;
+const VIEW_STORAGE: u32 = 6;
+/// Rounds of the a-posteriori check a frame records (`check.wgsl`). The CPU's loop runs up
+/// to 256 but ends after a few: across every model in the shared data at 0.25–4 px, the most
+/// it took was 8 fix rounds (a close view of the drag knob). A round that is not needed
+/// dispatches no work; a plan that needs more is reported ([`ScreenReport::converged`]).
+pub const MAX_ROUNDS: u32 = 64;
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
 const PATCH_VIEW_ROW: u32 = 8;
 
@@ -151,6 +161,8 @@ pub struct Pipelines {
     patch_proposals: wgpu::ComputePipeline,
     edge_segments: wgpu::ComputePipeline,
     interiors: wgpu::ComputePipeline,
+    check: CheckPipelines,
+    rounds_layout: wgpu::BindGroupLayout,
     scan: ScanPipelines,
     args: wgpu::ComputePipeline,
     uniform: PatternPipelines,
@@ -169,6 +181,7 @@ impl Pipelines {
         let mut view = vec![Uniform];
         view.extend(std::iter::repeat_n(Write, VIEW_STORAGE as usize));
         let view_layout = shader::layout(device, &view);
+        let rounds_layout = shader::layout(device, &[Write]);
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -179,6 +192,7 @@ impl Pipelines {
         let one = pipeline_layout(&[Some(&main_layout)]);
         let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
         let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
+        let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&view_layout), Some(&rounds_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -211,11 +225,11 @@ impl Pipelines {
             }
         };
         let transition = {
-            let pattern = module(device, "transition", &[COMMON, TRANSITION, COUNT]);
+            let pattern = module(device, "transition", &[COMMON, BOUNDS, TRANSITION, COUNT]);
             let vertices = module(
                 device,
                 "vertices transition",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, TRANSITION, WRITE_VERTICES],
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, BOUNDS, TRANSITION, WRITE_VERTICES],
             );
             PatternPipelines {
                 count: make(&one, &pattern, "count"),
@@ -226,7 +240,19 @@ impl Pipelines {
                 collapsed_triangles: None,
             }
         };
+        let check = {
+            let m = module(device, "check", &[COMMON, VIEW, CULL, FACTORS, BOUNDS, TRANSITION, CHECK]);
+            CheckPipelines {
+                check_all: make(&with_view, &m, "check_all"),
+                open: make(&with_rounds, &m, "round_open"),
+                resolve: make(&with_view, &m, "round_resolve"),
+                close: make(&with_rounds, &m, "round_close"),
+                recheck: make(&with_view, &m, "round_check"),
+            }
+        };
         Pipelines {
+            check,
+            rounds_layout,
             cull: make(&with_view, &cull, "cull"),
             patch_proposals: make(&with_view, &factors, "patch_proposals"),
             edge_segments: make(&with_view, &factors, "edge_segments"),
@@ -240,6 +266,17 @@ impl Pipelines {
             view_layout,
         }
     }
+}
+
+/// The a-posteriori check's pipelines (`check.wgsl`): the first check, then per round the
+/// opening decision, the resolve, the closing decision and the re-check.
+#[derive(Debug)]
+struct CheckPipelines {
+    check_all: wgpu::ComputePipeline,
+    open: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+    close: wgpu::ComputePipeline,
+    recheck: wgpu::ComputePipeline,
 }
 
 /// `common.wgsl`'s `Params`.
@@ -361,7 +398,8 @@ impl GpuTessellator {
         set: &SurfaceSet,
         pipelines: std::sync::Arc<Pipelines>,
     ) -> Result<GpuTessellator> {
-        let needed = MAIN_STORAGE + ARGS_STORAGE.max(VIEW_STORAGE);
+        // The check rounds' decisions bind one more (their dispatch arguments, group 2).
+        let needed = MAIN_STORAGE + ARGS_STORAGE.max(VIEW_STORAGE + 1);
         if ctx.limits.max_storage_buffers_per_shader_stage < needed {
             return Err(GpuError::Unsupported {
                 what: format!(
@@ -385,7 +423,7 @@ impl GpuTessellator {
         let dispatch_args = buffer(device, "write dispatches", 48, U::STORAGE | U::INDIRECT);
         let status = buffer(device, "status", 16, U::STORAGE | U::COPY_SRC);
         let args = shader::bind(device, &pipelines.args_layout, &[&draw_args, &dispatch_args, &status]);
-        let view = ViewBuffers::new(device, &pipelines.view_layout, set);
+        let view = ViewBuffers::new(device, &pipelines.view_layout, &pipelines.rounds_layout, set);
         Ok(GpuTessellator {
             params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
             segments: buffer(device, "segments", 4 * e, plan_usage),
@@ -479,10 +517,12 @@ impl GpuTessellator {
     /// tests).
     ///
     /// On the GPU: [`Criterion::PixelError`] with [`Scheme::Uniform`] (the global factor:
-    /// the largest over the visible patches), and [`Criterion::View`] with
+    /// the largest over the visible patches) or [`Scheme::Transition`] (CudaTess: per-edge
+    /// factors and the a-posteriori check of `check.wgsl`, which raises interiors and, round
+    /// by round, edges until every visible patch's bound holds; see
+    /// [`GpuTessellator::read_screen_report`]), and [`Criterion::View`] with
     /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
-    /// (per-edge factors, CudaTess's core rule). The transition scheme's pixel-error plans
-    /// (a-posteriori checks that raise factors round by round) are CPU-only. The output is
+    /// (per-edge factors, CudaTess's core rule). The output is
     /// sized for the worst case, every patch at `max_factor` (or at the largest minimum
     /// when that is higher), within the device's buffer limits, or as `criterion.capacity`
     /// says; a frame that needs more draws nothing and is reported
@@ -517,7 +557,7 @@ impl GpuTessellator {
         };
         let cap = max_factor as f64;
         let (kind, pixels, lo, hi) = match (scheme, criterion) {
-            (Scheme::Uniform, Criterion::PixelError(px)) => {
+            (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(px)) => {
                 if !(px.is_finite() && px > 0.0) {
                     return invalid("pixel error", format!("{px}: must be a positive number"));
                 }
@@ -741,7 +781,7 @@ impl GpuTessellator {
         }
         let screen = self.screen.is_some() && self.camera.is_some();
         if screen {
-            encoder.clear_buffer(&self.view.global, 0, None);
+            encoder.clear_buffer(&self.view.state, 0, None);
         }
         {
             let mut c = begin_pass(encoder, timer, 1);
@@ -754,9 +794,13 @@ impl GpuTessellator {
                 c.set_pipeline(&p.edge_segments);
                 let (x, y) = grid(e);
                 c.dispatch_workgroups(x, y, 1);
-                c.set_pipeline(&p.interiors);
-                let (x, y) = grid(e.max(patches));
-                c.dispatch_workgroups(x, y, 1);
+                if self.screen.is_some_and(|s| s.checked()) {
+                    self.record_check(&mut c);
+                } else {
+                    c.set_pipeline(&p.interiors);
+                    let (x, y) = grid(e.max(patches));
+                    c.dispatch_workgroups(x, y, 1);
+                }
             }
         }
         let k = match self.pattern {
@@ -817,6 +861,52 @@ impl GpuTessellator {
         if let Some(t) = timer {
             encoder.resolve_query_set(&t.queries, 0..2 * PASSES.len() as u32, &t.resolved, 0);
         }
+    }
+
+    /// Records the a-posteriori check of a pixel-error transition plan into the factors pass
+    /// (`check.wgsl`): the first check of every patch, then [`MAX_ROUNDS`] rounds whose
+    /// passes the GPU sizes itself (no work once the rounds have ended). Groups 0 and 1 are
+    /// bound by the caller.
+    fn record_check(&self, c: &mut wgpu::ComputePass<'_>) {
+        let k = &self.pipelines.check;
+        let (x, y) = shader::grid(self.set.patches.div_ceil(shader::WORKGROUP));
+        c.set_pipeline(&k.check_all);
+        c.dispatch_workgroups(x, y, 1);
+        let args = &self.view.round_args;
+        for _ in 0..MAX_ROUNDS {
+            // The decisions bind the dispatch arguments as storage (group 2); the passes they
+            // size read them as indirect arguments and leave group 2 out of their layout.
+            c.set_pipeline(&k.open);
+            c.set_bind_group(2, &self.view.rounds, &[]);
+            c.dispatch_workgroups(1, 1, 1);
+            c.set_pipeline(&k.resolve);
+            c.dispatch_workgroups_indirect(args, 12);
+            c.set_pipeline(&k.close);
+            c.dispatch_workgroups(1, 1, 1);
+            c.set_pipeline(&k.recheck);
+            c.dispatch_workgroups_indirect(args, 0);
+        }
+    }
+
+    /// Reads the last frame's a-posteriori check back (after
+    /// [`GpuTessellator::prepare_screen`] with a pixel error and the transition scheme; the
+    /// other frames report no rounds and no failing patch): for statistics and tests, never
+    /// in a frame loop. Cost: a queue wait.
+    pub fn read_screen_report(&self, ctx: &GpuContext) -> Result<ScreenReport> {
+        let state: Vec<u32> = readback::read(ctx, &self.view.state, 8)?;
+        let checked = self.screen.is_some_and(|s| s.checked()) && self.camera.is_some();
+        if !checked {
+            return Ok(ScreenReport { rounds: 0, failing_patches: 0, converged: true });
+        }
+        Ok(ScreenReport { rounds: state[4], failing_patches: state[1], converged: state[3] != 0 })
+    }
+
+    /// Reads the check's guaranteed bound per patch back (0 for culled patches; meaningful
+    /// after a checked frame, see [`GpuTessellator::read_screen_report`]). For tests. Cost:
+    /// a queue wait.
+    pub fn read_check_bounds(&self, ctx: &GpuContext) -> Result<Vec<f32>> {
+        let rows: Vec<[f32; 4]> = readback::read(ctx, &self.view.checks, self.set.patches as usize)?;
+        Ok(rows.iter().map(|r| r[1]).collect())
     }
 
     /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
@@ -980,7 +1070,7 @@ impl GpuTessellator {
 pub struct ScreenCriterion {
     /// The scheme: [`Scheme::Uniform`] or [`Scheme::Transition`].
     pub scheme: Scheme,
-    /// [`Criterion::PixelError`] (uniform scheme) or [`Criterion::View`] with
+    /// [`Criterion::PixelError`] or [`Criterion::View`] with
     /// [`ViewCriterion::Silhouetteness`].
     pub criterion: Criterion,
     /// The factor cap, `1..=MAX_FACTOR`.
@@ -1011,14 +1101,45 @@ struct Screen {
     interior: u32,
 }
 
+impl Screen {
+    /// Whether the frame's interiors come from the a-posteriori check (a pixel error with
+    /// the transition scheme's core rule).
+    fn checked(&self) -> bool {
+        self.criterion == CRITERION_PIXEL_ERROR && self.interior == INTERIOR_CORE
+    }
+}
+
+/// What the a-posteriori check of a pixel-error transition frame achieved
+/// ([`GpuTessellator::read_screen_report`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScreenReport {
+    /// Fix rounds run after the first check (the CPU's loop iterations that changed edges).
+    pub rounds: u32,
+    /// Visible patches whose bound the plan misses: at the factor cap, as
+    /// `tolerance::PlanReport::capped_patches` counts them on the CPU, or left failing when
+    /// the rounds did not converge.
+    pub failing_patches: u32,
+    /// Whether the rounds ended within [`MAX_ROUNDS`] as the CPU's would (no failing patch,
+    /// or a round that changed no edge). When false the plan is still crack-free, but the
+    /// failing patches' bounds are missed.
+    pub converged: bool,
+}
+
 /// The view passes' buffers (`view.wgsl`'s group 1) and their bind group.
 #[derive(Debug)]
 struct ViewBuffers {
     uniform: wgpu::Buffer,
     patch_views: wgpu::Buffer,
     minimum_segments: wgpu::Buffer,
-    global: wgpu::Buffer,
+    /// `view.wgsl`'s `FrameState`.
+    state: wgpu::Buffer,
+    /// The check rows (`view.wgsl`'s `CheckRow`, per patch).
+    checks: wgpu::Buffer,
     bind: wgpu::BindGroup,
+    /// The check rounds' dispatch arguments (`check.wgsl`'s `round_args`) and their bind
+    /// group (group 2 of the rounds' decisions).
+    round_args: wgpu::Buffer,
+    rounds: wgpu::BindGroup,
     /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
     /// device.
     bounds_uploaded: bool,
@@ -1027,17 +1148,39 @@ struct ViewBuffers {
 impl ViewBuffers {
     /// The buffers for `set`, the culling rows filled (the bounds come with
     /// [`GpuTessellator::prepare_screen`]). Cost: O(P) cone computations, one upload.
-    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, set: &SurfaceSet) -> ViewBuffers {
+    fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        rounds_layout: &wgpu::BindGroupLayout,
+        set: &SurfaceSet,
+    ) -> ViewBuffers {
         use wgpu::BufferUsages as U;
+        let (edges, patches) = (set.topology.edges.len() as u64, set.patches.len() as u64);
         let uniform = buffer(device, "view", 112, U::UNIFORM | U::COPY_DST);
         let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
-        let minimum_segments =
-            buffer(device, "minimum segments", 4 * set.topology.edges.len() as u64, U::STORAGE | U::COPY_DST);
-        let proposals = buffer(device, "proposals", 16 * set.patches.len() as u64, U::STORAGE);
-        let global = buffer(device, "global factor", 4, U::STORAGE | U::COPY_DST);
-        let bind =
-            shader::bind(device, layout, &[&uniform, &patch_views, &minimum_segments, &proposals, &global]);
-        ViewBuffers { uniform, patch_views, minimum_segments, global, bind, bounds_uploaded: false }
+        let minimum_segments = buffer(device, "minimum segments", 4 * edges, U::STORAGE | U::COPY_DST);
+        let proposals = buffer(device, "proposals", 16 * patches, U::STORAGE);
+        let state = buffer(device, "frame state", 32, U::STORAGE | U::COPY_DST | U::COPY_SRC);
+        let checks = buffer(device, "check rows", 16 * patches, U::STORAGE | U::COPY_SRC);
+        let round_rows = buffer(device, "check round marks", 4 * patches, U::STORAGE);
+        let bind = shader::bind(
+            device,
+            layout,
+            &[&uniform, &patch_views, &minimum_segments, &proposals, &state, &checks, &round_rows],
+        );
+        let round_args = buffer(device, "check round dispatches", 24, U::STORAGE | U::INDIRECT);
+        let rounds = shader::bind(device, rounds_layout, &[&round_args]);
+        ViewBuffers {
+            uniform,
+            patch_views,
+            minimum_segments,
+            state,
+            checks,
+            bind,
+            round_args,
+            rounds,
+            bounds_uploaded: false,
+        }
     }
 }
 

@@ -8,6 +8,7 @@ mod common;
 use common::*;
 use tessera::criterion::Plan;
 use tessera::engine::{Layout, TessellateOptions};
+use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::{BuildOptions, SurfaceSet};
 use tessera_gpu::scan::{Scan, ScanPipelines};
@@ -411,11 +412,12 @@ fn uniform_pixel_error_root(
 ///   factors) equal `Scheme::Uniform`'s pixel-error plan on the CPU, but for the counted
 ///   rounding ties ([`near_cull_tie`]; a factor one off where the CPU's root is within
 ///   1e-5 relative of an integer);
-/// - **transition**, odd cameras **from the camera alone**: the GPU culls and computes
+/// - **transition, from the camera alone**: odd cameras, the GPU culls and computes
 ///   silhouetteness factors (per edge, maximum over the edge's patches, the core rule);
 ///   its plan equals `Scheme::Transition`'s on the CPU but for counted rounding ties;
-///   even cameras: the CPU's pixel-error plan (CudaTess's per-edge factors, checked a
-///   posteriori) uploaded, the GPU culling; the culled set equals the CPU's but for ties.
+///   even cameras, the pixel error: CudaTess's per-edge factors and the a-posteriori check
+///   on the GPU ([`checked_transition_frame`]: the plan, the rounds and the capped patches
+///   equal the CPU's but for counted ties, and every bound verified in f64).
 ///
 /// Then the whole output equals the CPU engine's for the plan the GPU drew
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
@@ -487,9 +489,8 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             counts.below_cap += (got.unwrap() < cap) as usize;
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &Uniform);
 
-            // Transition, odd cameras: the GPU plans the frame from the camera (silhouetteness
-            // factors); even cameras: the CPU's pixel-error plan (CudaTess's own per-edge
-            // factors, a-posteriori checked) uploaded, the GPU culling.
+            // Transition, from the camera on the GPU: odd cameras silhouetteness factors, even
+            // cameras a pixel error (CudaTess's per-edge factors, checked a posteriori).
             let options = transition_options(camera);
             let (name, plan, pattern) = if c % 2 == 1 {
                 let name = format!("{model} camera {c} transition from the camera");
@@ -527,19 +528,19 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 }
                 (name, drawn, planned.pattern)
             } else {
-                let name = format!("{model} camera {c} transition");
-                let criterion = Criterion::PixelError(pixels);
-                let planned =
-                    Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
-                let mut plan = planned.plan.clone();
-                plan.visible.fill(1);
-                gpu.set_cull_camera(ctx, Some(&camera));
-                gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap();
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                gpu.record(&mut encoder);
-                ctx.queue.submit([encoder.finish()]);
-                plan.visible = check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
-                (name, plan, planned.pattern)
+                let name = format!("{model} camera {c} transition {pixels} px");
+                let cap = options.max_factor;
+                let plan = checked_transition_frame(
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    cap,
+                    &mut counts,
+                );
+                (name, plan, tessera::scheme::SchemePattern::Transition(Transition))
             };
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
             let s = &plan.segments;
@@ -585,6 +586,10 @@ fn acceptance_sweep_on_every_model_20_cameras() {
     counts.cull_ties += more.cull_ties;
     counts.factor_ties += more.factor_ties;
     counts.below_cap += more.below_cap;
+    counts.check_ties += more.check_ties;
+    counts.check_rounds += more.check_rounds;
+    assert!(counts.check_rounds > 0, "no pixel-error transition frame needed a fix round: {counts:?}");
+    assert!(100 * counts.check_ties <= counts.frames, "{counts:?}");
     assert!(counts.below_cap > 0, "no uniform frame below the cap: the GPU factor was never tested");
     // Rounding ties must stay rare: at most one frame or patch in a hundred.
     assert!(100 * counts.factor_ties <= counts.frames, "{counts:?}");

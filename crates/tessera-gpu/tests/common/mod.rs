@@ -266,6 +266,12 @@ pub struct SweepCounts {
     pub below_cap: usize,
     /// Transition frames with more than one edge factor.
     pub strips: usize,
+    /// Pixel-error transition frames (planned on the GPU with the a-posteriori check) whose
+    /// plan differs from the CPU's with the same culled set: a decision at f32 rounding of its
+    /// boundary (the GPU plan's bounds are verified in f64 all the same).
+    pub check_ties: usize,
+    /// Pixel-error transition frames that needed fix rounds after the first check.
+    pub check_rounds: usize,
 }
 
 /// The GPU's culled set against the CPU plan's: equal but for [`near_cull_tie`]s, which
@@ -292,4 +298,84 @@ pub fn all_models() -> Vec<String> {
     let mut models = patch_models();
     models.extend(mesh_models());
     models
+}
+
+/// The transition scheme's pixel-error frame for `camera`, planned on the GPU from the camera
+/// alone (culling, CudaTess's per-edge factors, the a-posteriori check of `check.wgsl`) and
+/// recorded, against `Scheme::Transition`'s plan on the CPU with the same options:
+///
+/// - the culled set equals the CPU's but for counted [`near_cull_tie`]s ([`check_culling`]);
+/// - the rounds converged within `MAX_ROUNDS`;
+/// - every visible patch of the GPU's plan meets its tolerance, its bound computed in f64 by
+///   the CPU library on that plan (`tolerance::patch_bound`), but for at most the patches
+///   the GPU reports failing (at the cap, as the CPU reports them);
+/// - with the same culled set, the plan (segments, interior factors), the fix rounds and the
+///   capped patches equal the CPU's; a plan that differs is a counted `check_ties` frame.
+///
+/// Returns the GPU's plan, for comparing its output with the CPU engine's.
+#[allow(clippy::too_many_arguments)]
+pub fn checked_transition_frame(
+    name: &str,
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    gpu: &mut GpuTessellator,
+    camera: &tessera::camera::Camera,
+    pixels: f64,
+    cap: u32,
+    counts: &mut SweepCounts,
+) -> Plan {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let criterion = Criterion::PixelError(pixels);
+    let options = PlanOptions { camera: Some(*camera), cull: true, max_factor: cap, ..Default::default() };
+    let cpu = Scheme::Transition.plan_prepared(set, prepared, &criterion, &options).unwrap();
+    let cpu_report = cpu.report.unwrap();
+    let screen = tessera_gpu::tessellator::ScreenCriterion {
+        scheme: Scheme::Transition,
+        criterion,
+        max_factor: cap,
+        capacity: None,
+    };
+    gpu.prepare_screen(ctx, set, prepared, camera, screen).unwrap();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+    let visible = check_culling(name, set, gpu, &cpu.plan.visible, camera, counts);
+    let drawn = gpu.read_plan(ctx).unwrap();
+    assert_eq!(drawn.visible, visible);
+    let report = gpu.read_screen_report(ctx).unwrap();
+    assert!(report.converged, "{name}: the check's rounds did not converge ({report:?})");
+    let view = camera.view();
+    let views = prepared.views(set);
+    let mut scratch = tessera::pattern::LocalTessellation::default();
+    let missed = (0..set.patches.len())
+        .filter(|&p| drawn.is_visible(p))
+        .filter(|&p| {
+            let eps = views[p].tolerance(&set.patches[p], &view, pixels, false).unwrap();
+            let input = tessera::engine::layout::pattern_input(set, &drawn, p);
+            let bound = tessera::criterion::tolerance::patch_bound(
+                &prepared.hessians[p],
+                &input,
+                &tessera::pattern::transition::Transition,
+                &mut scratch,
+            );
+            bound > eps * (1.0 + 1e-4)
+        })
+        .count();
+    assert!(
+        missed <= report.failing_patches as usize,
+        "{name}: {missed} patches miss their bound, the GPU reports {}",
+        report.failing_patches
+    );
+    if visible == cpu.plan.visible {
+        if drawn.segments == cpu.plan.segments && drawn.interior == cpu.plan.interior {
+            assert_eq!(report.rounds as usize, cpu_report.rounds, "{name}: fix rounds");
+            assert_eq!(report.failing_patches as usize, cpu_report.capped_patches, "{name}: capped patches");
+        } else {
+            counts.check_ties += 1;
+            eprintln!("{name}: the GPU's check decided unlike the CPU's (counted as a rounding tie)");
+        }
+    }
+    counts.check_rounds += (report.rounds > 0) as usize;
+    drawn
 }

@@ -28,6 +28,9 @@ pub struct PlanReport {
     pub worst_ratio: f64,
     /// Largest guaranteed object-space bound over visible patches.
     pub worst_bound: f64,
+    /// Rounds that raised edges after the first check (patches whose strips missed the
+    /// bound asking for finer edges; each change can move the problem to a neighbour).
+    pub rounds: usize,
 }
 
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
@@ -343,6 +346,7 @@ pub(crate) fn plan_limited(
         }
         std::mem::swap(&mut plan.segments, next_segments);
         std::mem::swap(&mut plan.factors, next_factors);
+        report.rounds += 1;
         check(&plan.segments, proposals, which, rechecked);
         for (i, &p) in which.iter().enumerate() {
             results[p] = rechecked[i];

@@ -1,0 +1,65 @@
+//! The transition scheme's pixel-error frame planned on the GPU from the camera alone
+//! (CudaTess's pipeline with the a-posteriori check, `check.wgsl`) against the CPU's
+//! `Scheme::Transition` pixel-error plan, where the check works hardest: fine pixel errors
+//! under a low factor cap, where patches at the cap miss their bound and the fix rounds
+//! spread from patch to patch along the mesh (41 rounds on the spool's camera 1 below). The
+//! acceptance sweep (`tests/gpu.rs`) runs the same comparison on every model. Every expected
+//! value comes from the CPU library.
+
+mod common;
+
+use common::*;
+use tessera::pattern::transition::Transition;
+use tessera::scheme::Prepared;
+
+#[test]
+fn pixel_error_transition_planned_on_the_gpu_equals_the_cpu_plan_through_many_rounds() {
+    let mut counts = SweepCounts::default();
+    let mut most_rounds = 0;
+    for model in ["patches/teapot.patches", "meshes/spool.obj", "meshes/dragknob.obj"] {
+        let set = load(model);
+        let prepared = Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, 3, 11).into_iter().enumerate() {
+            for pixels in [0.5, 4.0] {
+                let name = format!("{model} camera {c} {pixels} px");
+                let plan = checked_transition_frame(
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    16,
+                    &mut counts,
+                );
+                most_rounds = most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
+            }
+        }
+    }
+    eprintln!("{counts:?}, most fix rounds {most_rounds}");
+    assert!(most_rounds > 16, "no frame needed many fix rounds: the rounds were not tested");
+    assert_eq!(counts.check_ties, 0, "{counts:?}");
+}
+
+#[test]
+fn frames_without_a_check_report_no_rounds() {
+    // A uniform pixel-error frame and an uploaded plan have no a-posteriori check on the GPU.
+    let set = load("patches/teacup.patches");
+    let prepared = Prepared::new(&set, true);
+    let mut gpu = tessellator(&set);
+    let camera = cameras(&set, 1, 3)[0];
+    let screen = tessera_gpu::tessellator::ScreenCriterion {
+        scheme: tessera::scheme::Scheme::Uniform,
+        criterion: tessera::scheme::Criterion::PixelError(1.0),
+        max_factor: 8,
+        capacity: None,
+    };
+    gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap();
+    let mut encoder = ctx().device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx().queue.submit([encoder.finish()]);
+    let report = gpu.read_screen_report(ctx()).unwrap();
+    assert_eq!((report.rounds, report.failing_patches, report.converged), (0, 0, true));
+}
