@@ -95,10 +95,18 @@ fn check_patch(p: u32) -> bool {
     var bound = 0.0;
     var missed = false;
     loop {
-        var out = sink(SINK_CHECK, 0u);
-        out.errors = errors;
-        build_transition(pattern_input(p, factors), &out);
-        bound = out.worst;
+        let input = pattern_input(p, factors);
+        if (input.core.strips == 0u) {
+            // A pure grid (`Pattern::grid_cells`): one cell's triangle bounds every triangle
+            // (`tolerance::grid_bound`), no walk.
+            let cell = vec2<f32>(1.0 / f32(input.core.nu), 1.0 / f32(input.core.nv));
+            bound = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+        } else {
+            var out = sink(SINK_CHECK, 0u);
+            out.errors = errors;
+            build_transition(input, &out);
+            bound = out.worst;
+        }
         if (bound <= eps) { break; }
         // No progress means the worst triangles follow the edges, not the core.
         let stuck = bound >= previous;

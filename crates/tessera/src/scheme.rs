@@ -171,6 +171,9 @@ impl Pattern for SchemePattern {
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
         self.inner().interior_grid(input)
     }
+    fn grid_cells(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        self.inner().grid_cells(input)
+    }
     fn depends_on_patch(&self) -> bool {
         self.inner().depends_on_patch()
     }

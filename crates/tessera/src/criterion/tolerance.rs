@@ -117,6 +117,15 @@ fn params_bound(m: &HessianBound, built: &LocalTessellation, params: &[glam::DVe
     built.triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(0.0, f64::max)
 }
 
+/// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
+/// ([`Pattern::grid_cells`]): that of one of them, `(0, 0), (1/nu, 0), (0, 1/nv)`. Every
+/// such triangle has the same bound (it depends only on the differences of the corners), so
+/// no pattern is built. Cost: O(1).
+fn grid_bound(m: &HessianBound, [nu, nv]: [u32; 2]) -> f64 {
+    let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+    m.triangle_error([glam::DVec2::ZERO, glam::DVec2::new(hu, 0.0), glam::DVec2::new(0.0, hv)])
+}
+
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:
 /// two distinct curves between the same two corners need 2 (else both become the same chord),
 /// a curve that starts and ends at one point needs 3.
@@ -590,11 +599,14 @@ fn check_patches(
                     return (interior, f64::INFINITY, true);
                 }
                 let cached = patterns.params(i).filter(|_| interior == first);
-                let bound = match cached {
-                    Some((_, built, params)) => params_bound(&hessians[p], built, params),
+                let grid = limit.pattern.grid_cells(&input);
+                let bound = match (grid, cached) {
+                    // A pure grid (no strips): one cell's triangle bounds them all, no build.
+                    (Some(cells), _) => grid_bound(&hessians[p], cells),
+                    (None, Some((_, built, params))) => params_bound(&hessians[p], built, params),
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
-                    None => crate::engine::with_scratch(generation, |s| {
+                    (None, None) => crate::engine::with_scratch(generation, |s| {
                         let (built, params) = s.built(limit.pattern, &input);
                         built_pattern_bound(&hessians[p], &input, built, params)
                     }),

@@ -147,6 +147,16 @@ pub trait Pattern: Sync {
         None
     }
 
+    /// `Some([nu, nv])` when every triangle [`Pattern::build`] gives for `input` is half a
+    /// cell of the `nu × nv` grid of the domain: a right triangle with legs `1/nu` along `u`
+    /// and `1/nv` along `v` (triangle domains: `nu = nv = n`, the `n`-fold grid). Every
+    /// triangle then has the same error bound, so a bound over the pattern is that of one
+    /// cell's triangle (the a-posteriori check of `criterion::tolerance` takes it instead of
+    /// building the pattern). None (the default) promises nothing. Cost: O(1).
+    fn grid_cells(&self, _input: &PatternInput) -> Option<[u32; 2]> {
+        None
+    }
+
     /// True when [`Pattern::build`] depends on `input.patch` (patterns holding per-patch
     /// decisions); false lets the engine reuse one build for every patch with the same
     /// input otherwise.

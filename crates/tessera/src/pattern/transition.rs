@@ -452,6 +452,21 @@ impl Pattern for Transition {
         }
     }
 
+    /// The core alone when no edge has a strip (every edge cut like the core along it): the
+    /// uniform grid of the core factors.
+    fn grid_cells(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        match input.domain {
+            Domain::Quad => {
+                let layout = QuadLayout::new(input);
+                (layout.strip == [false; 4]).then_some([layout.nu, layout.nv])
+            }
+            Domain::Tri => {
+                let layout = TriLayout::new(input);
+                (layout.strip == [false; 3]).then_some([layout.n, layout.n])
+            }
+        }
+    }
+
     /// Quads: the core's grid, `(i/nu, j/nv)` row after row over every interior point (the
     /// strips add no interior vertex), with the core factors as raised for the strips.
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {

@@ -60,6 +60,12 @@ impl Pattern for Uniform {
         (input.domain == Domain::Quad).then_some(input.interior)
     }
 
+    /// The `n`-grid, `n = interior[0]`, on both domains.
+    fn grid_cells(&self, input: &PatternInput) -> Option<[u32; 2]> {
+        let n = input.interior[0];
+        Some([n, n])
+    }
+
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let n = input.interior[0];
         match input.domain {
