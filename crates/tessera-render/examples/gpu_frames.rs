@@ -3,19 +3,21 @@
 //! `cargo run --release -p tessera-render --example gpu_frames -- [MODEL.patches] [FRAMES]
 //! [OUT_DIR]` (defaults: `$TESSERA_DATA/patches/teapot.patches`, 8 frames, `frames/`).
 //!
-//! The model is uploaded to the GPU engine once. Every frame, from a camera orbiting the
-//! model: the CPU plans the factors for a 1-pixel screen-space error (the transition scheme;
-//! O(patches), reusing its buffers), the GPU engine counts, scans and writes vertices and
-//! indices into its own buffers, and the application's own render pipeline (`embed.wgsl`)
-//! binds those buffers as vertex and index buffers and draws them with
-//! `draw_indexed_indirect` from the engine's indirect buffer. Tessellation and draw are one
-//! command buffer; nothing is read back except the finished picture, written as
-//! `OUT_DIR/frame_NNN.png` (a headless app's stand-in for presenting it).
+//! The model and its view-independent bounds are uploaded to the GPU engine once, with the
+//! criterion: a 1-pixel screen-space error, the transition scheme (CudaTess). Every frame the
+//! CPU only hands the engine the camera orbiting the model (a 112-byte upload); the GPU culls
+//! the patches, computes every edge's factor from the camera, checks the patterns' error
+//! bounds, counts, scans and writes vertices and indices into its own buffers, and the
+//! application's own render pipeline (`embed.wgsl`) binds those buffers as vertex and index
+//! buffers and draws them with `draw_indexed_indirect` from the engine's indirect buffer.
+//! Tessellation and draw are one command buffer; nothing is read back except the finished
+//! picture, written as `OUT_DIR/frame_NNN.png` (a headless app's stand-in for presenting it),
+//! and the triangle count printed beside it.
 
 use std::path::{Path, PathBuf};
 use tessera::camera::Camera;
-use tessera::criterion::PlanScratch;
-use tessera::scheme::{Criterion, PlanOptions, Planned, Prepared, Scheme};
+use tessera::scheme::{Criterion, Prepared, Scheme};
+use tessera_gpu::tessellator::ScreenCriterion;
 use tessera_gpu::{GpuContext, GpuTessellator, VERTEX_LAYOUT};
 use wgpu::util::DeviceExt;
 
@@ -34,13 +36,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out_dir = PathBuf::from(args.get(3).map_or("frames", String::as_str));
     std::fs::create_dir_all(&out_dir)?;
 
-    // Once: the model, the GPU engine with the model uploaded, the planner's view-independent data.
+    // Once: the model, the GPU engine with the model uploaded, the view-independent bounds
+    // and the criterion (the output sized for its worst case, every factor at the cap).
     let set = tessera::io::load(&model, Default::default())?;
     let ctx = GpuContext::new()?; // a typed error naming the driver packages when there is no adapter
     let mut engine = GpuTessellator::new(&ctx, &set)?;
-    let (scheme, criterion) = (Scheme::Transition, Criterion::PixelError(1.0));
-    let prepared = Prepared::for_criterion(&set, &criterion);
-    let (mut scratch, mut planned) = (PlanScratch::default(), Planned::default());
+    let prepared = Prepared::new(&set, true);
+    let (lo, hi) = set.bounds();
+    let framing = Camera::framing(lo, hi, WIDTH, HEIGHT);
+    let criterion = ScreenCriterion {
+        scheme: Scheme::Transition,
+        criterion: Criterion::PixelError(1.0),
+        max_factor: 64,
+        capacity: None,
+    };
+    engine.prepare_screen(&ctx, &set, &prepared, &framing, criterion)?;
 
     // Once: the application's pipeline, reading the engine's vertex layout.
     let device = &ctx.device;
@@ -109,8 +119,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
     });
 
-    let (lo, hi) = set.bounds();
-    let framing = Camera::framing(lo, hi, WIDTH, HEIGHT);
     for frame in 0..frames {
         // The moving camera: an orbit about the model's vertical axis, closing in.
         let angle = frame as f64 / frames.max(1) as f64 * std::f64::consts::TAU;
@@ -122,11 +130,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let near = (distance - radius).max(distance * 1e-3);
         let camera = Camera { eye, near, ..framing };
 
-        // Per frame, CPU: the factors for this camera (O(patches), buffers reused).
-        let options = PlanOptions { camera: Some(camera), ..Default::default() };
-        scheme.plan_into(&set, &prepared, &criterion, &options, &mut scratch, &mut planned)?;
-        // Per frame, GPU: the plan's arrays uploaded (the output grows only when needed) ...
-        engine.prepare(&ctx, &set, &planned.plan, &planned.pattern)?;
+        // Per frame, CPU: only the camera, for the engine and for the application's draw ...
+        engine.set_cull_camera(&ctx, Some(&camera));
         let (r, u, f) = camera.basis();
         let light = (-f + 0.45 * u - 0.35 * r).normalize().as_vec3();
         let mut view = camera.view_projection().as_mat4().to_cols_array().to_vec();
@@ -161,7 +166,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 multiview_mask: None,
             });
             let (Some(vertices), Some(indices)) = (engine.vertex_buffer(), engine.index_buffer()) else {
-                unreachable!("prepare made the output buffers")
+                unreachable!("prepare_screen made the output buffers")
             };
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &bind, &[]);
