@@ -113,9 +113,10 @@ struct MeshArgs {
     /// (per level: patch id and edge levels).
     #[arg(long, value_name = "JSON")]
     instanced: Option<PathBuf>,
-    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu; for now the uniform and the
-    /// transition scheme on every surface kind, from the CPU's plan; --stats adds per-pass
-    /// GPU times).
+    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform and the transition
+    /// scheme on every surface kind; with --cull and --pixel-error or silhouetteness the GPU
+    /// plans the frame from the camera itself, else it draws the CPU's plan; --stats adds
+    /// per-pass GPU times).
     #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
     engine: String,
     #[command(flatten)]
@@ -379,7 +380,15 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             );
         }
         let pattern = tess.pattern().expect("a frame was planned");
-        gpu_run = Some(gpu::tessellate(&set, plan, pattern, a.repeat, &mut gpu_mesh, &mut gpu_times)?);
+        let (cull, cap) = (chosen.options.cull, chosen.options.max_factor);
+        let camera = chosen.options.camera;
+        gpu_run = Some(match (camera, gpu::screen_criterion(chosen.scheme, &chosen.criterion, cull, cap)) {
+            // The whole frame from the camera on the GPU (it equals the CPU's plan; tests/gpu.rs).
+            (Some(camera), Some(screen)) => {
+                gpu::tessellate_from_camera(&set, &camera, screen, a.repeat, &mut gpu_mesh, &mut gpu_times)?
+            }
+            _ => gpu::tessellate(&set, plan, pattern, a.repeat, &mut gpu_mesh, &mut gpu_times)?,
+        });
     }
     let mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
     let mut output_file = None;
@@ -455,6 +464,11 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         if let Some(run) = &gpu_run {
             stats["engine"] = "gpu".into();
             stats["adapter"] = run.adapter.clone().into();
+            stats["planned_on"] = if run.screen.is_some() { "gpu" } else { "cpu" }.into();
+            if let Some(check) = &run.screen {
+                stats["gpu_check_rounds"] = check.rounds.into();
+                stats["gpu_capped_patches"] = check.failing_patches.into();
+            }
             stats["gpu_pass_ms"] = run
                 .passes_ms
                 .iter()

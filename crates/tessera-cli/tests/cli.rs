@@ -656,6 +656,18 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
         assert_eq!(g[key], c[key], "PN transition: {key}");
     }
+    // The whole frame from the camera on the GPU (culling, factors, the a-posteriori check).
+    let args = ["mesh", input, "--scheme", "transition", "--pixel-error", "0.5", "--cull", "--stats"];
+    let cpu = tessera(&args, &dir);
+    let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
+    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+    assert_eq!(g["planned_on"], "gpu", "{g}");
+    assert!(g["gpu_pass_ms"].is_null() || g["gpu_pass_ms"]["factors"].is_number(), "{g}");
+    for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
+        assert_eq!(g[key], c[key], "planned on the GPU: {key}");
+    }
+    assert_eq!(g["gpu_capped_patches"], c["capped_patches"], "{g}");
     let refused =
         tessera(&["mesh", input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--engine", "gpu"], &dir);
     assert!(!refused.status.success());
