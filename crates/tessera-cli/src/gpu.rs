@@ -30,14 +30,14 @@ pub fn screen_criterion(
     cull: bool,
     max_factor: u32,
 ) -> Option<ScreenCriterion> {
-    let on_gpu = match (scheme, criterion) {
-        (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(_)) => true,
-        (
-            Scheme::Uniform | Scheme::Transition,
-            Criterion::View { criterion: ViewCriterion::Silhouetteness, .. },
-        ) => true,
-        _ => false,
-    };
+    let on_gpu = matches!(
+        (scheme, criterion),
+        (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(_))
+            | (
+                Scheme::Uniform | Scheme::Transition,
+                Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
+            )
+    );
     (cull && on_gpu).then_some(ScreenCriterion { scheme, criterion: *criterion, max_factor, capacity: None })
 }
 
