@@ -63,3 +63,38 @@ fn frames_without_a_check_report_no_rounds() {
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert_eq!((report.rounds, report.failing_patches, report.converged), (0, 0, true));
 }
+
+#[test]
+#[ignore = "slow tier: fine pixel errors at the factor cap 64, cores of 4,096 cells"]
+fn pixel_error_transition_at_cap_64_equals_the_cpu_plan() {
+    let mut counts = SweepCounts::default();
+    let mut largest = 0;
+    for model in ["patches/teapot.patches", "patches/teacup.patches", "meshes/spool.obj"] {
+        let set = load(model);
+        let prepared = Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, 4, 5).into_iter().enumerate() {
+            for pixels in [0.05, 0.2] {
+                let name = format!("{model} camera {c} {pixels} px");
+                let plan = checked_transition_frame(
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    64,
+                    &mut counts,
+                );
+                let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
+                largest =
+                    (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(core).fold(largest, u32::max);
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
+            }
+        }
+    }
+    eprintln!("{counts:?}");
+    assert_eq!(largest, 64 * 64, "no core reached the cap");
+    assert!(counts.check_rounds > 0, "{counts:?}");
+    assert_eq!(counts.check_ties, 0, "{counts:?}");
+}
