@@ -19,19 +19,11 @@ struct QuadLayout {
     m: u32,
 }
 
-// One patch's pattern input and local numbering bases (`PatternInput::edge_base`); nc is
-// the domain's corner count (3 for a triangle domain).
+// One patch's pattern input: its local numbering (`local.wgsl`) and its core.
 struct PatchInput {
-    p: u32,
-    nc: u32,
-    s: vec4<u32>,
-    collapsed: u32,
-    base: vec4<u32>,
-    interior_base: u32,
+    local: LocalNumbering,
     core: QuadLayout,
 }
-
-fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
 
 // `transition::strips_at_collapsed_edges` for N edges (3 or 4), updating in place as the
 // CPU does.
@@ -85,28 +77,16 @@ fn tri_layout(s: vec4<u32>, interior_factor: u32, c: u32) -> QuadLayout {
     return QuadLayout(1u, 1u, 0u, 0u, 0u, 0u, 0u, 1u);
 }
 
-// `engine::layout::pattern_input` for patch p, with its local bases.
+// `engine::layout::pattern_input` for patch p, with its local bases and core.
 fn patch_input(p: u32) -> PatchInput {
-    let nc = patch_corner_count(p);
-    var s = vec4<u32>(0u);
-    var collapsed = 0u;
-    for (var e = 0u; e < nc; e = e + 1u) {
-        s[e] = segments[patch_edge(p, e)];
-        if (patch_edge_collapsed(p, e)) { collapsed = collapsed | (1u << e); }
-    }
-    var base = vec4<u32>(0u);
-    var b = nc;
-    for (var e = 0u; e < nc; e = e + 1u) {
-        base[e] = b;
-        b = b + s[e] - 1u;
-    }
+    let local = local_numbering(p);
     var core: QuadLayout;
-    if (nc == 3u) {
-        core = tri_layout(s, interior[p].x, collapsed);
+    if (local.nc == 3u) {
+        core = tri_layout(local.s, interior[p].x, local.collapsed);
     } else {
-        core = quad_layout(s, interior[p], collapsed);
+        core = quad_layout(local.s, interior[p], local.collapsed);
     }
-    return PatchInput(p, nc, s, collapsed, base, b, core);
+    return PatchInput(local, core);
 }
 
 // The pattern's core factors, read by the interior vertex pass: on a quad the interior grid
@@ -120,17 +100,17 @@ fn interior_grid(p: u32) -> vec2<u32> {
 // `QuadLayout::counts` and `TriLayout::counts`: interior vertices and pattern triangles.
 fn transition_counts(input: PatchInput) -> vec2<u32> {
     let l = input.core;
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         var triangles = l.m * l.m;
         for (var e = 0u; e < 3u; e = e + 1u) {
-            if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + l.m; }
+            if (bit(l.strips, e) != 0u) { triangles = triangles + input.local.s[e] + l.m; }
         }
         let n = l.nu;
         return vec2<u32>(select(0u, (n - 1u) * (n - 2u) / 2u, n >= 2u), triangles);
     }
     var triangles = 2u * (l.i_hi - l.i_lo) * (l.j_hi - l.j_lo);
     for (var e = 0u; e < 4u; e = e + 1u) {
-        if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + inner_segments(input, e); }
+        if (bit(l.strips, e) != 0u) { triangles = triangles + input.local.s[e] + inner_segments(input, e); }
     }
     return vec2<u32>((l.nu - 1u) * (l.nv - 1u), triangles);
 }
@@ -138,7 +118,7 @@ fn transition_counts(input: PatchInput) -> vec2<u32> {
 // `QuadLayout::inner_segments`; a triangle's core sides all have m segments.
 fn inner_segments(input: PatchInput, e: u32) -> u32 {
     let l = input.core;
-    if (input.nc == 3u) { return l.m; }
+    if (input.local.nc == 3u) { return l.m; }
     if (e % 2u == 0u) { return l.i_hi - l.i_lo; }
     return l.j_hi - l.j_lo;
 }
@@ -146,7 +126,7 @@ fn inner_segments(input: PatchInput, e: u32) -> u32 {
 // `QuadLayout::inner` and `TriLayout::inner`: grid point t of the core side facing edge e.
 fn inner_point(input: PatchInput, e: u32, t: u32) -> vec2<u32> {
     let l = input.core;
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         switch e {
             case 0u: { return vec2<u32>(l.i_lo + t, l.j_lo); }
             case 1u: { return vec2<u32>(l.i_lo + l.m - t, l.j_lo + t); }
@@ -163,17 +143,17 @@ fn inner_point(input: PatchInput, e: u32, t: u32) -> vec2<u32> {
 
 // `QuadLayout::local` and `TriLayout::local`: local index of core grid point (i, j).
 fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         let n = input.core.nu;
         if (i == 0u && j == 0u) { return 0u; }
         if (i == n && j == 0u) { return 1u; }
         if (i == 0u && j == n) { return 2u; }
-        if (j == 0u) { return input.base[0] + i - 1u; }
-        if (i + j == n) { return input.base[1] + j - 1u; }
-        if (i == 0u) { return input.base[2] + (n - j) - 1u; }
+        if (j == 0u) { return input.local.base[0] + i - 1u; }
+        if (i + j == n) { return input.local.base[1] + j - 1u; }
+        if (i == 0u) { return input.local.base[2] + (n - j) - 1u; }
         // Interior rows 1 … j − 1 before this one hold n − 1 − r points each.
         let before = (j - 1u) * (n - 1u) - (j - 1u) * j / 2u;
-        return input.interior_base + before + (i - 1u);
+        return input.local.interior_base + before + (i - 1u);
     }
     let nu = input.core.nu;
     let nv = input.core.nv;
@@ -181,70 +161,16 @@ fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
     if (i == nu && j == 0u) { return 1u; }
     if (i == nu && j == nv) { return 2u; }
     if (i == 0u && j == nv) { return 3u; }
-    if (j == 0u) { return input.base[0] + i - 1u; }
-    if (i == nu) { return input.base[1] + j - 1u; }
-    if (j == nv) { return input.base[2] + (nu - i) - 1u; }
-    if (i == 0u) { return input.base[3] + (nv - j) - 1u; }
-    return input.interior_base + (j - 1u) * (nu - 1u) + (i - 1u);
-}
-
-// `PatternInput::boundary_vertex`.
-fn boundary_local(input: PatchInput, e: u32, k: u32) -> u32 {
-    if (k == 0u) { return e; }
-    if (k == input.s[e]) { return (e + 1u) % input.nc; }
-    return input.base[e] + k - 1u;
-}
-
-// The local edge whose inner samples hold local index l (4 ≤ l < interior_base).
-fn local_edge(input: PatchInput, l: u32) -> u32 {
-    var e = 0u;
-    for (var f = 1u; f < input.nc; f = f + 1u) {
-        if (l >= input.base[f]) { e = f; }
-    }
-    return e;
-}
-
-// `LocalMap::vertex`: the output vertex of local index l.
-fn local_vertex(input: PatchInput, l: u32) -> u32 {
-    if (l < input.nc) { return patch_corner_entry(input.p, l); }
-    if (l < input.interior_base) {
-        let e = local_edge(input, l);
-        return edge_sample_vertex(input.p, e, l - input.base[e] + 1u);
-    }
-    return vertex_offsets[params.edges + input.p] + (l - input.interior_base);
-}
-
-// The identity `degenerate_after_collapse` compares for local index l.
-fn local_collapse_id(input: PatchInput, l: u32) -> vec2<u32> {
-    if (l < input.nc) { return vec2<u32>(1u, patch_corner_entry(input.p, l)); }
-    if (l < input.interior_base) {
-        let e = local_edge(input, l);
-        if (bit(input.collapsed, e) != 0u) { return vec2<u32>(1u, patch_corner_entry(input.p, e)); }
-    }
-    return vec2<u32>(0u, l);
-}
-
-// Takes pattern triangle `tri` (local indices): left out if it degenerates at a collapsed
-// curve, else counted and, with `write`, written as output triangle `first + *kept`.
-fn emit(input: PatchInput, tri: vec3<u32>, write: bool, first: u32, kept: ptr<function, u32>) {
-    if (patch_repeated_corner(input.p)) {
-        let a = local_collapse_id(input, tri.x);
-        let b = local_collapse_id(input, tri.y);
-        let c = local_collapse_id(input, tri.z);
-        if (all(a == b) || all(b == c) || all(a == c)) { return; }
-    }
-    if (write) {
-        let t = first + *kept;
-        indices[3u * t] = local_vertex(input, tri.x);
-        indices[3u * t + 1u] = local_vertex(input, tri.y);
-        indices[3u * t + 2u] = local_vertex(input, tri.z);
-    }
-    *kept = *kept + 1u;
+    if (j == 0u) { return input.local.base[0] + i - 1u; }
+    if (i == nu) { return input.local.base[1] + j - 1u; }
+    if (j == nv) { return input.local.base[2] + (nu - i) - 1u; }
+    if (i == 0u) { return input.local.base[3] + (nv - j) - 1u; }
+    return input.local.interior_base + (j - 1u) * (nu - 1u) + (i - 1u);
 }
 
 // Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
 fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
-    return domain_edge_point(input.p, e, f32(k) / f32(input.s[e]));
+    return domain_edge_point(input.local.p, e, f32(k) / f32(input.local.s[e]));
 }
 
 fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
@@ -266,17 +192,17 @@ const TIE_TOLERANCE: f32 = 1e-5;
 // ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification).
 fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, u32>) {
     let l = input.core;
-    let s = input.s[e];
+    let s = input.local.s[e];
     let m = inner_segments(input, e);
-    let lead = bit(l.strips, (e + input.nc - 1u) % input.nc);
-    let trail = bit(l.strips, (e + 1u) % input.nc);
+    let lead = bit(l.strips, (e + input.local.nc - 1u) % input.local.nc);
+    let trail = bit(l.strips, (e + 1u) % input.local.nc);
     let span = i32(m + lead + trail);
     let s32 = i32(s);
     var d = span - (2 * i32(lead) + 1) * s32;
     var i = 0u;
     var j = 0u;
-    var o0 = boundary_local(input, e, 0u);
-    var o1 = boundary_local(input, e, 1u);
+    var o0 = boundary_local(input.local, e, 0u);
+    var o1 = boundary_local(input.local, e, 1u);
     var n0 = inner_local(input, e, 0u);
     var n1 = select(n0, inner_local(input, e, 1u), m > 0u);
     while (i < s || j < m) {
@@ -301,13 +227,13 @@ fn walk(input: PatchInput, e: u32, write: bool, first: u32, kept: ptr<function, 
             }
         }
         if (advance_outer) {
-            emit(input, vec3<u32>(o0, o1, n0), write, first, kept);
+            emit(input.local, vec3<u32>(o0, o1, n0), write, first, kept);
             i = i + 1u;
             if (j < m && i < s) { d = d + 2 * span; }
             o0 = o1;
-            if (i < s) { o1 = boundary_local(input, e, i + 1u); }
+            if (i < s) { o1 = boundary_local(input.local, e, i + 1u); }
         } else {
-            emit(input, vec3<u32>(o0, n1, n0), write, first, kept);
+            emit(input.local, vec3<u32>(o0, n1, n0), write, first, kept);
             j = j + 1u;
             if (j < m && i < s) { d = d - 2 * s32; }
             n0 = n1;
@@ -329,9 +255,9 @@ fn build_tri_transition(input: PatchInput, write: bool, first: u32) -> u32 {
             let a = grid_local(input, i0 + i, j0 + j);
             let b = grid_local(input, i0 + i + 1u, j0 + j);
             let d = grid_local(input, i0 + i, j0 + j + 1u);
-            emit(input, vec3<u32>(a, b, d), write, first, &kept);
+            emit(input.local, vec3<u32>(a, b, d), write, first, &kept);
             if (i + j + 2u <= m) {
-                emit(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), write, first, &kept);
+                emit(input.local, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), write, first, &kept);
             }
         }
     }
@@ -345,7 +271,7 @@ fn build_tri_transition(input: PatchInput, write: bool, first: u32) -> u32 {
 // (`build_tri_transition` on triangles). Returns the triangles kept. Cost: O(pattern
 // triangles), serial.
 fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
-    if (input.nc == 3u) { return build_tri_transition(input, write, first); }
+    if (input.local.nc == 3u) { return build_tri_transition(input, write, first); }
     var kept = 0u;
     let l = input.core;
     for (var j = l.j_lo; j < l.j_hi; j = j + 1u) {
@@ -354,8 +280,8 @@ fn build_transition(input: PatchInput, write: bool, first: u32) -> u32 {
             let b = grid_local(input, i + 1u, j);
             let c = grid_local(input, i + 1u, j + 1u);
             let d = grid_local(input, i, j + 1u);
-            emit(input, vec3<u32>(a, b, c), write, first, &kept);
-            emit(input, vec3<u32>(a, c, d), write, first, &kept);
+            emit(input.local, vec3<u32>(a, b, c), write, first, &kept);
+            emit(input.local, vec3<u32>(a, c, d), write, first, &kept);
         }
     }
     for (var e = 0u; e < 4u; e = e + 1u) {
