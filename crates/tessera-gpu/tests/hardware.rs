@@ -358,3 +358,197 @@ fn the_hardware_worst_case_bounds_every_frame() {
         }
     }
 }
+
+/// What the camera sweeps saw, reported at the end.
+#[derive(Debug, Default)]
+struct FactorCounts {
+    frames: usize,
+    edges: usize,
+    /// Edges whose GPU factor is not the CPU's bit for bit (silhouetteness strictly between
+    /// 0 and 1 only: f32 data on the GPU, f64 on the CPU).
+    rounding: usize,
+    /// Of those, edges whose segments differ from the CPU's.
+    segment_ties: usize,
+    /// The largest relative difference of a real factor.
+    worst_relative: f64,
+    /// Edges at intermediate silhouetteness, where a difference may arise.
+    intermediate: usize,
+}
+
+/// Output size of a sweep frame: factors chosen so that no frame exceeds about this many
+/// triangles (lavapipe and the CPU comparison stay fast).
+const SWEEP_TRIANGLES: usize = 25_000;
+
+/// Relative difference of a real silhouetteness factor computed from f32 copies of the CPU's
+/// f64 midpoints and normals: `1 − 4·(c·nL)(c·nR)` loses about 8 f32 roundings of the
+/// products (≈ 1e-6 of the factor range), well within this bound.
+const ROUNDING: f64 = 1e-5;
+
+/// The hardware frame from the camera alone on `models`, `cameras_per_model` seeded cameras
+/// each, two frames per camera, each against the CPU library: silhouetteness factors in
+/// `1..=cap − ¼` and a fixed real factor, the partitionings taking turns. The GPU culls and
+/// resolves the factors (`GpuTessellator::prepare_screen`); its culled set equals the CPU
+/// plan's (`Scheme::Hardware(p).plan_prepared`) but for counted [`near_cull_tie`]s; its real
+/// factors equal the CPU's bit for bit, but for silhouetteness strictly between 0 and 1,
+/// where they may differ by rounding (counted, at most [`ROUNDING`] relative); its segments
+/// are `edge_segments` of its own factors, so they differ from the CPU's only where its
+/// factor does (counted); its interiors are `resolve::interiors` of its segments. Then the
+/// output equals the CPU engine's for the plan the GPU drew, every `mesh_every`-th frame.
+fn hardware_from_the_camera(
+    models: &[String],
+    cameras_per_model: usize,
+    seed: u64,
+    mesh_every: usize,
+) -> (SweepCounts, FactorCounts) {
+    let ctx = ctx();
+    let mut sweep = SweepCounts::default();
+    let mut counts = FactorCounts::default();
+    for model in models {
+        let start = std::time::Instant::now();
+        let set = load(model);
+        let prepared = Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        // The factor cap from the size: about 2f² triangles a quad at factor f, at least 2
+        // (fractional_even's smallest factor).
+        let per_patch = SWEEP_TRIANGLES / set.patches.len();
+        let cap = (2..=16u32).rev().find(|f| 2 * (f * f) as usize <= per_patch).unwrap_or(2);
+        let culled_before = sweep.culled;
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            for k in 0..2 {
+                let p = PARTITIONINGS[(2 * c + k + seed as usize) % 4];
+                let (criterion, what) = if k == 0 {
+                    let fmax = cap as f64 - 0.25;
+                    let c = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
+                    (c, format!("silhouetteness 1:{fmax}"))
+                } else {
+                    let f = (cap as f64 - 0.3).max(1.0);
+                    (Criterion::Factor(f), format!("factor {f}"))
+                };
+                let name = format!("{model} camera {c} {} {what}", p.name());
+                let options =
+                    PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+                let scheme = Scheme::Hardware(p);
+                let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut sweep);
+                let drawn = gpu.read_plan(ctx).unwrap();
+                assert_eq!(drawn.visible, visible, "{name}");
+                assert_eq!(drawn.kind, cpu.kind, "{name}");
+                compare_factors(&name, &set, &camera, &criterion, cap, &cpu, &drawn, &mut counts);
+                let mut interior = Vec::new();
+                let caps = prepared.caps(cap as f64);
+                resolve::interiors(&set, &drawn.segments, InteriorRule::MaxEdge, &caps, &mut interior);
+                assert_eq!(drawn.interior, interior, "{name}: interior factors");
+                if drawn.segments == cpu.segments {
+                    assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
+                }
+                counts.frames += 1;
+                sweep.frames += 1;
+                if (2 * c + k) % mesh_every == 0 {
+                    let pattern = Hardware { partitioning: p };
+                    assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &pattern);
+                }
+            }
+        }
+        assert!(sweep.culled > culled_before, "{model}: the cameras culled nothing, the sweep proves little");
+        eprintln!("{model}: cap {cap}, {:.1} s", start.elapsed().as_secs_f64());
+    }
+    eprintln!("{sweep:?}\n{counts:?}");
+    (sweep, counts)
+}
+
+/// The GPU's factors and segments against the CPU plan's (see [`hardware_from_the_camera`]).
+#[allow(clippy::too_many_arguments)]
+fn compare_factors(
+    name: &str,
+    set: &SurfaceSet,
+    camera: &tessera::camera::Camera,
+    criterion: &Criterion,
+    cap: u32,
+    cpu: &Plan,
+    drawn: &Plan,
+    counts: &mut FactorCounts,
+) {
+    let p = partitioning_of(cpu).unwrap();
+    // The silhouetteness before resolving, as `Scheme::plan_into` bounds the range.
+    let real = match *criterion {
+        Criterion::View { criterion, fmin, fmax } => {
+            let fmax = fmax.min(Scheme::Hardware(p).factor_cap().min(cap as f64));
+            Some((
+                tessera::criterion::view::edge_factors(set, camera, criterion, fmin.min(fmax), fmax),
+                fmin,
+                fmax,
+            ))
+        }
+        _ => None,
+    };
+    for e in 0..cpu.segments.len() {
+        let (g, w) = (drawn.factors[e], cpu.factors[e]);
+        assert_eq!(
+            drawn.segments[e],
+            edge_segments(g as f64, p),
+            "{name}: edge {e}: segments unlike its factor {g}"
+        );
+        counts.edges += 1;
+        let intermediate = real.as_ref().is_some_and(|(real, lo, hi)| real[e] > lo.max(1.0) && real[e] < *hi);
+        counts.intermediate += intermediate as usize;
+        if g.to_bits() == w.to_bits() {
+            assert_eq!(drawn.segments[e], cpu.segments[e], "{name}: edge {e}");
+            continue;
+        }
+        let relative = ((g - w) as f64 / w as f64).abs();
+        assert!(
+            intermediate && relative <= ROUNDING,
+            "{name}: edge {e} has the factor {g}, the CPU's {w} (silhouetteness factor {:?})",
+            real.as_ref().map(|r| r.0[e])
+        );
+        counts.rounding += 1;
+        counts.worst_relative = counts.worst_relative.max(relative);
+        counts.segment_ties += (drawn.segments[e] != cpu.segments[e]) as usize;
+    }
+}
+
+/// The rounding differences must stay what they are: a few last bits on intermediate edges,
+/// and segments one count boundary apart only rarely.
+fn check_factor_counts(counts: &FactorCounts) {
+    assert!(counts.intermediate > 0, "no intermediate silhouetteness: the real factors were never tested");
+    assert!(1000 * counts.segment_ties <= counts.edges, "{counts:?}");
+}
+
+#[test]
+fn hardware_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
+    // The fast tier: the small patch models and the meshes under 15 kB, 2 cameras each.
+    let models: Vec<String> = all_models()
+        .into_iter()
+        .filter(|m| {
+            m.starts_with("patches/") || std::fs::metadata(data_dir().join(m)).unwrap().len() < 15_000
+        })
+        .collect();
+    let (_, counts) = hardware_from_the_camera(&models, 2, 3, 1);
+    check_factor_counts(&counts);
+}
+
+#[test]
+#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each (10 on the three meshes over 40,000 patches), every partitioning"]
+fn hardware_from_the_camera_on_every_model_20_cameras() {
+    let (large, rest): (Vec<String>, Vec<String>) = all_models()
+        .into_iter()
+        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    let (mut sweep, mut counts) = hardware_from_the_camera(&rest, 20, 2026, 4);
+    let (more_sweep, more) = hardware_from_the_camera(&large, 10, 2026, 4);
+    sweep.cull_ties += more_sweep.cull_ties;
+    sweep.culled += more_sweep.culled;
+    counts.frames += more.frames;
+    counts.edges += more.edges;
+    counts.rounding += more.rounding;
+    counts.segment_ties += more.segment_ties;
+    counts.intermediate += more.intermediate;
+    counts.worst_relative = counts.worst_relative.max(more.worst_relative);
+    eprintln!("total: {sweep:?}\n{counts:?}");
+    check_factor_counts(&counts);
+    assert!(100 * sweep.cull_ties <= sweep.culled.max(100), "{sweep:?}");
+}
