@@ -33,10 +33,15 @@ fn d3d_edge(nc: u32, e: u32) -> u32 {
 // capped at 3). The plan's interior factors are not read, as on the CPU.
 fn hardware_factors(p: u32) -> HardwareFactors {
     let nc = patch_corner_count(p);
-    var edges = vec4<f32>(1.0);
-    for (var e = 0u; e < nc; e = e + 1u) {
-        edges[d3d_edge(nc, e)] = edge_factor(patch_edge(p, e));
-    }
+    let f = vec4<f32>(
+        edge_factor(patch_edge(p, 0u)),
+        edge_factor(patch_edge(p, 1u)),
+        edge_factor(patch_edge(p, 2u)),
+        select(1.0, edge_factor(patch_edge(p, 3u)), nc == 4u),
+    );
+    // Direct3D edge d3d_edge(e) = (e + 1) mod nc is tessera edge e.
+    var edges = vec4<f32>(f.z, f.x, f.y, 1.0);
+    if (nc == 4u) { edges = vec4<f32>(f.w, f.x, f.y, f.z); }
     var inside: vec2<f32>;
     if (nc == 4u) {
         inside = vec2<f32>(max(edges[1], edges[3]), max(edges[0], edges[2]));
@@ -63,51 +68,71 @@ struct Processed {
 }
 
 // `Processed::new` for positive edge factors (tessera's are at least 1, so the hardware never
-// culls here).
+// culls here). Arrays and vectors are indexed by constants only (see `pick4`).
 fn processed(nc: u32, mode: u32, factors: HardwareFactors) -> Processed {
     let range = partitioning_range(mode);
-    var e = vec4<f32>(1.0);
-    var frame = false;
+    let quad = nc == 4u;
+    let raw = factors.edges;
+    let e = vec4<f32>(
+        clamp_factor(raw.x, range.x, range.y, mode),
+        clamp_factor(raw.y, range.x, range.y, mode),
+        clamp_factor(raw.z, range.x, range.y, mode),
+        select(1.0, clamp_factor(raw.w, range.x, range.y, mode), quad),
+    );
     let frame_threshold = 1.0 + FIXED_EPSILON / 2.0;
-    for (var k = 0u; k < nc; k = k + 1u) {
-        e[k] = clamp_factor(factors.edges[k], range.x, range.y, mode);
-        frame = frame || e[k] > frame_threshold;
-    }
-    let inside_count = select(1u, 2u, nc == 4u);
+    var frame = e.x > frame_threshold || e.y > frame_threshold || e.z > frame_threshold
+        || (quad && e.w > frame_threshold);
     // Quads also look at the raw inside factors; triangles have only one.
-    if (nc == 4u) {
+    if (quad) {
         frame = frame || factors.inside.x > frame_threshold || factors.inside.y > frame_threshold;
     }
     frame = frame && mode == PARTITIONING_FRACTIONAL_ODD;
     let inside_lo = select(range.x, 1.0 + FIXED_EPSILON, frame);
-    var i = vec2<f32>(0.0);
-    for (var k = 0u; k < inside_count; k = k + 1u) {
-        i[k] = clamp_factor(factors.inside[k], inside_lo, range.y, mode);
-    }
-    var minimum = partitioning_is_integer(mode) || mode == PARTITIONING_FRACTIONAL_ODD;
-    for (var k = 0u; k < nc; k = k + 1u) {
-        minimum = minimum && to_fixed(e[k]) == FIXED_ONE;
-    }
-    for (var k = 0u; k < inside_count; k = k + 1u) {
-        minimum = minimum && to_fixed(i[k]) == FIXED_ONE;
-    }
+    let iu = clamp_factor(factors.inside.x, inside_lo, range.y, mode);
+    // A triangle's one inside factor serves both.
+    let iv = select(iu, clamp_factor(factors.inside.y, inside_lo, range.y, mode), quad);
+    let one = vec4<u32>(FIXED_ONE);
+    let fixed_edges = vec4<u32>(to_fixed(e.x), to_fixed(e.y), to_fixed(e.z), select(FIXED_ONE, to_fixed(e.w), quad));
+    let minimum = (partitioning_is_integer(mode) || mode == PARTITIONING_FRACTIONAL_ODD)
+        && all(fixed_edges == one) && to_fixed(iu) == FIXED_ONE && to_fixed(iv) == FIXED_ONE;
     var pre: Processed;
     pre.nc = nc;
     pre.minimum = minimum;
-    for (var k = 0u; k < 4u; k = k + 1u) {
-        pre.outer[k] = axis_new(FIXED_ONE, true);
-    }
-    for (var k = 0u; k < nc; k = k + 1u) {
-        pre.outer[k] = axis_new(to_fixed(e[k]), parity_odd(e[k], mode, false));
-    }
-    for (var k = 0u; k < 2u; k = k + 1u) {
-        let f = i[min(k, inside_count - 1u)];
-        var a = axis_new(to_fixed(f), parity_odd(f, mode, true));
-        // Fewer points would leave no interior: the transition regions degenerate instead.
-        a.points = max(a.points, select(3u, 4u, a.odd));
-        pre.inside[k] = a;
-    }
+    pre.outer[0] = axis_new(fixed_edges.x, parity_odd(e.x, mode, false));
+    pre.outer[1] = axis_new(fixed_edges.y, parity_odd(e.y, mode, false));
+    pre.outer[2] = axis_new(fixed_edges.z, parity_odd(e.z, mode, false));
+    pre.outer[3] = axis_new(fixed_edges.w, select(true, parity_odd(e.w, mode, false), quad));
+    pre.inside[0] = inside_axis_new(iu, mode);
+    pre.inside[1] = inside_axis_new(iv, mode);
     return pre;
+}
+
+// An inside partition: at least 4 points (odd) or 3 (even); fewer would leave no interior,
+// and the transition regions degenerate instead.
+fn inside_axis_new(f: f32, mode: u32) -> Axis {
+    var a = axis_new(to_fixed(f), parity_odd(f, mode, true));
+    a.points = max(a.points, select(3u, 4u, a.odd));
+    return a;
+}
+
+// `pre.outer[e]` (Direct3D edge e) and `pre.inside[k]`, by constant indices.
+fn outer_axis(pre: Processed, e: u32) -> Axis {
+    switch e {
+        case 0u: { return pre.outer[0]; }
+        case 1u: { return pre.outer[1]; }
+        case 2u: { return pre.outer[2]; }
+        default: { return pre.outer[3]; }
+    }
+}
+
+fn inside_axis(pre: Processed, k: u32) -> Axis {
+    if (k == 0u) { return pre.inside[0]; }
+    return pre.inside[1];
+}
+
+// Points on each Direct3D edge.
+fn edge_points(pre: Processed) -> vec4<u32> {
+    return vec4<u32>(pre.outer[0].points, pre.outer[1].points, pre.outer[2].points, pre.outer[3].points);
 }
 
 // Patch p's processed factors.
@@ -118,7 +143,8 @@ fn patch_processed(p: u32) -> Processed {
 // `Processed::outer_points`: points of the outer ring.
 fn outer_points(pre: Processed) -> u32 {
     var n = 0u;
-    for (var e = 0u; e < pre.nc; e = e + 1u) { n = n + pre.outer[e].points - 1u; }
+    let points = edge_points(pre);
+    for (var e = 0u; e < pre.nc; e = e + 1u) { n = n + pick4(points, e) - 1u; }
     return n;
 }
 
@@ -152,7 +178,7 @@ fn processed_counts(pre: Processed) -> vec2<u32> {
                 // Side e of ring r has n[axis(e)] − 2r points; axis(e) = (e + 1) & 1.
                 let n = select(n1, n0, (e & 1u) == 1u);
                 var out = n - 2u * (r - 1u);
-                if (r == 1u) { out = pre.outer[e].points; }
+                if (r == 1u) { out = pick4(edge_points(pre), e); }
                 tris = tris + (n - 2u * r) + out - 2u;
             }
         }
@@ -167,7 +193,7 @@ fn processed_counts(pre: Processed) -> vec2<u32> {
     for (var r = 1u; r < rings; r = r + 1u) {
         for (var e = 0u; e < 3u; e = e + 1u) {
             var out = n - 2u * (r - 1u);
-            if (r == 1u) { out = pre.outer[e].points; }
+            if (r == 1u) { out = pick4(edge_points(pre), e); }
             tris = tris + (n - 2u * r) + out - 2u;
         }
     }
@@ -202,9 +228,9 @@ struct Side {
 }
 
 fn ring_side(ring: Ring, e: u32, reversed: bool) -> Side {
-    var offset = 0u;
-    for (var f = 0u; f < e; f = f + 1u) { offset = offset + ring.sides[f] - 1u; }
-    return Side(ring, offset, ring.sides[e], reversed);
+    let s = ring.sides - vec4<u32>(1u);
+    let offset = select(0u, s.x, e >= 1u) + select(0u, s.y, e >= 2u) + select(0u, s.z, e >= 3u);
+    return Side(ring, offset, pick4(ring.sides, e), reversed);
 }
 
 // Point j of a side.
@@ -216,8 +242,8 @@ fn side_point(side: Side, j: u32) -> u32 {
 
 // The outer ring (`outer_ring`): each edge's points but its last.
 fn outer_ring(pre: Processed) -> Ring {
-    var sides = vec4<u32>(1u);
-    for (var e = 0u; e < pre.nc; e = e + 1u) { sides[e] = pre.outer[e].points; }
+    var sides = edge_points(pre);
+    if (pre.nc == 3u) { sides.w = 1u; }
     return Ring(0u, outer_points(pre), 0u, sides);
 }
 
@@ -282,38 +308,50 @@ fn d3d_edge_reversed(nc: u32, d: u32) -> bool {
 // vertex.
 fn hardware_local(input: LocalNumbering, edge_points: vec4<u32>, h: u32) -> u32 {
     let nc = input.nc;
-    var rest = h;
-    for (var d = 0u; d < nc; d = d + 1u) {
-        let end = edge_points[d] - 1u;
-        if (rest < end) {
-            var q = rest;
-            if (d3d_edge_reversed(nc, d)) { q = end - rest; }
-            var e = (d + 2u) % 3u;
-            var against = e >= 1u;
-            if (nc == 4u) {
-                e = (d + 3u) % 4u;
-                against = e >= 2u;
-            }
-            var k = q;
-            if (against) { k = end - q; }
-            return boundary_local(input, e, k);
-        }
-        rest = rest - end;
+    // Where each Direct3D edge's points start on the outer ring, and where the ring ends.
+    let ends = edge_points - vec4<u32>(1u);
+    let start1 = ends.x;
+    let start2 = start1 + ends.y;
+    let start3 = start2 + ends.z;
+    let outer = select(start3, start3 + ends.w, nc == 4u);
+    if (h >= outer) { return input.interior_base + (h - outer); }
+    // No loop (see `local_edge`): the edge by comparisons.
+    let d = select(0u, 1u, h >= start1) + select(0u, 1u, h >= start2) + select(0u, 1u, nc == 4u && h >= start3);
+    let rest = h - pick4(vec4<u32>(0u, start1, start2, start3), d);
+    let end = pick4(ends, d);
+    var q = rest;
+    if (d3d_edge_reversed(nc, d)) { q = end - rest; }
+    var e = (d + 2u) % 3u;
+    var against = e >= 1u;
+    if (nc == 4u) {
+        e = (d + 3u) % 4u;
+        against = e >= 2u;
     }
-    return input.interior_base + rest;
+    var k = q;
+    if (against) { k = end - q; }
+    return boundary_local(input, e, k);
 }
 
-// `stitch.rs`'s FINAL_POINT_POSITION: where vertex i of the half edge ends up at the largest
-// factor, in ruler-function split order.
-var<private> FINAL_POINT_POSITION: array<u32, 33> = array<u32, 33>(
-    0u, 32u, 16u, 8u, 17u, 4u, 18u, 9u, 19u, 2u, 20u, 10u, 21u, 5u, 22u, 11u, 23u, 1u, 24u, 12u,
-    25u, 6u, 26u, 13u, 27u, 3u, 28u, 14u, 29u, 7u, 30u, 15u, 31u,
-);
+// `stitch.rs`'s FINAL_POINT_POSITION[i] (0 ≤ i ≤ 32): where vertex i of the half edge ends up
+// at the largest factor, in ruler-function split order — the table 0, 32, 16, 8, 17, 4, 18, 9,
+// 19, 2, 20, 10, 21, 5, 22, 11, 23, 1, 24, 12, 25, 6, 26, 13, 27, 3, 28, 14, 29, 7, 30, 15, 31
+// in closed form (an array indexed by a variable would be a stack copy at every use, see
+// `pick4`): even i ≥ 2 gives 15 + i/2; odd i ≥ 3 with z trailing zeros in i − 1 gives
+// 16/2^z + (i − 1)/2^(z+1); 0 and 1 give 0 and 32.
+fn final_point_position(i: u32) -> u32 {
+    if (i == 0u) { return 0u; }
+    if (i == 1u) { return 32u; }
+    if ((i & 1u) == 0u) { return 15u + i / 2u; }
+    let z = countTrailingZeros(i - 1u);
+    return (16u >> z) + ((i - 1u) >> (z + 1u));
+}
 
 // The stitches of `stitch.rs`, each run as a generator of triangles (`stitch_step`), so that
 // the walk has one place that emits a triangle: the GPU compiler inlines every call, and a
 // walk calling `emit` from each of the CPU's emission sites compiles to a shader many times
-// larger (tens of seconds to compile on lavapipe, and slower to run).
+// larger (tens of seconds to compile on lavapipe, and slower to run). Nothing the walk calls
+// per triangle loops (`local_edge`): lavapipe ends all loops of an invocation after 65,535
+// iterations in all, and a patch at factor 64 has 8,192 triangles.
 const STITCH_TRANSITION: u32 = 0u;
 const STITCH_REGULAR: u32 = 1u;
 // One or two fixed triangles: (inner 0, inner 1, outer 1), then (inner 1, outer 0, outer 1).
@@ -380,10 +418,10 @@ fn transition_step(st: ptr<function, Stitch>) -> vec3<u32> {
                 (*st).phase = 1u;
                 (*st).x = 1u;
                 (*st).sub = 0u;
-                if (FINAL_POINT_POSITION[0] < (*st).outer_half) { return advance_outer(st); }
+                if (final_point_position(0u) < (*st).outer_half) { return advance_outer(st); }
             }
             case 1u: {
-                let position = FINAL_POINT_POSITION[min((*st).x, 32u)];
+                let position = final_point_position(min((*st).x, 32u));
                 if ((*st).x == 33u) {
                     (*st).phase = 2u;
                     (*st).sub = 0u;
@@ -430,7 +468,7 @@ fn transition_step(st: ptr<function, Stitch>) -> vec3<u32> {
                 }
             }
             case 3u: {
-                let position = FINAL_POINT_POSITION[(*st).x];
+                let position = final_point_position((*st).x);
                 if ((*st).x == 0u) {
                     (*st).phase = 4u;
                 } else if ((*st).sub == 0u) {
@@ -444,7 +482,7 @@ fn transition_step(st: ptr<function, Stitch>) -> vec3<u32> {
             }
             case 4u: {
                 (*st).phase = 5u;
-                if (FINAL_POINT_POSITION[0] < (*st).outer_half) { return advance_outer(st); }
+                if (final_point_position(0u) < (*st).outer_half) { return advance_outer(st); }
             }
             default: { return vec3<u32>(DONE); }
         }
@@ -529,6 +567,12 @@ fn stitch_step(st: ptr<function, Stitch>) -> vec3<u32> {
     return fixed_step(st);
 }
 
+// The hardware point a stitch's row reference names.
+fn row_point(st: Stitch, r: u32) -> u32 {
+    if ((r & OUTER_ROW) != 0u) { return side_point(st.outer, r & ~OUTER_ROW); }
+    return side_point(st.inner, r);
+}
+
 // Ring r of the patch (`quad_ring` or `tri_ring`).
 fn patch_ring(pre: Processed, r: u32) -> Ring {
     if (pre.nc == 4u) { return quad_ring(pre, r); }
@@ -577,8 +621,8 @@ fn stitch_at(pre: Processed, s: u32) -> Stitch {
         if (r == 1u) {
             // The transition from the outer edges (`inside(e)` the partition along side e).
             var st = stitch_new(STITCH_TRANSITION, inner, outer);
-            let inner_axis = pre.inside[select(0u, (e + 1u) & 1u, nc == 4u)];
-            let outer_axis = pre.outer[e];
+            let inner_axis = inside_axis(pre, select(0u, (e + 1u) & 1u, nc == 4u));
+            let outer_axis = outer_axis(pre, e);
             st.inner_half = inner_axis.half_points - select(0u, 1u, inner_axis.odd);
             st.outer_half = outer_axis.half_points - select(0u, 1u, outer_axis.odd);
             st.inner_odd = inner_axis.odd;
@@ -614,7 +658,7 @@ fn stitch_at(pre: Processed, s: u32) -> Stitch {
 fn build_hardware(p: u32, write: bool, first: u32) -> u32 {
     let pre = patch_processed(p);
     let input = local_numbering(p);
-    let edge_points = vec4<u32>(pre.outer[0].points, pre.outer[1].points, pre.outer[2].points, pre.outer[3].points);
+    let edge_points = edge_points(pre);
     var kept = 0u;
     let stitches = stitch_count(pre);
     for (var s = 0u; s < stitches; s = s + 1u) {
@@ -624,13 +668,11 @@ fn build_hardware(p: u32, write: bool, first: u32) -> u32 {
             if (refs.x == DONE) { break; }
             // Rows to hardware points (`Emit::tri`'s order, Direct3D's clockwise, which is
             // counter-clockwise in (u, v)) to local indices.
-            var tri = vec3<u32>(0u);
-            for (var c = 0u; c < 3u; c = c + 1u) {
-                let r = refs[c];
-                var side = st.inner;
-                if ((r & OUTER_ROW) != 0u) { side = st.outer; }
-                tri[c] = hardware_local(input, edge_points, side_point(side, r & ~OUTER_ROW));
-            }
+            let tri = vec3<u32>(
+                hardware_local(input, edge_points, row_point(st, refs.x)),
+                hardware_local(input, edge_points, row_point(st, refs.y)),
+                hardware_local(input, edge_points, row_point(st, refs.z)),
+            );
             emit(input, tri, write, first, &kept);
         }
     }
@@ -672,15 +714,16 @@ fn quad_interior_point(pre: Processed, j: u32) -> vec2<f32> {
         for (var e = 0u; e < 4u; e = e + 1u) {
             let across = e & 1u;
             let along = (e + 1u) & 1u;
-            let count = n[along] - 1u - 2u * r;
+            let along_v = along == 1u;
+            let count = select(n.x, n.y, along_v) - 1u - 2u * r;
             if (rest < count) {
                 let q0 = r + rest;
-                var q = end[along] - (q0 - r);
+                var q = select(end.x, end.y, along_v) - (q0 - r);
                 if (e == 1u || e == 2u) { q = q0; }
-                var perp_point = end[across];
+                var perp_point = select(end.x, end.y, across == 1u);
                 if (e < 2u) { perp_point = r; }
-                let perp = axis_place(pre.inside[across], perp_point);
-                let x = axis_place(pre.inside[along], q);
+                let perp = axis_place(inside_axis(pre, across), perp_point);
+                let x = axis_place(inside_axis(pre, along), q);
                 if (along == 1u) { return fixed_point(perp, x); }
                 return fixed_point(x, perp);
             }

@@ -20,38 +20,46 @@ struct LocalNumbering {
 
 fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
 
+// Component i of v, by selects: a vector indexed by a variable may become a memory copy on
+// some drivers, at every use in a long serial walk.
+fn pick4(v: vec4<u32>, i: u32) -> u32 {
+    return select(select(select(v.x, v.y, i == 1u), v.z, i == 2u), v.w, i == 3u);
+}
+
 // `engine::layout::pattern_input` for patch p, as far as the numbering reads it.
 fn local_numbering(p: u32) -> LocalNumbering {
     let nc = patch_corner_count(p);
-    var s = vec4<u32>(0u);
+    let quad = nc == 4u;
+    let s = vec4<u32>(
+        segments[patch_edge(p, 0u)],
+        segments[patch_edge(p, 1u)],
+        segments[patch_edge(p, 2u)],
+        select(0u, segments[patch_edge(p, 3u)], quad),
+    );
     var collapsed = 0u;
     for (var e = 0u; e < nc; e = e + 1u) {
-        s[e] = segments[patch_edge(p, e)];
         if (patch_edge_collapsed(p, e)) { collapsed = collapsed | (1u << e); }
     }
-    var base = vec4<u32>(0u);
-    var b = nc;
-    for (var e = 0u; e < nc; e = e + 1u) {
-        base[e] = b;
-        b = b + s[e] - 1u;
-    }
-    return LocalNumbering(p, nc, s, collapsed, base, b);
+    let b1 = nc + s.x - 1u;
+    let b2 = b1 + s.y - 1u;
+    let b3 = b2 + s.z - 1u;
+    let interior_base = select(b3, b3 + s.w - 1u, quad);
+    return LocalNumbering(p, nc, s, collapsed, vec4<u32>(nc, b1, b2, b3), interior_base);
 }
 
 // `PatternInput::boundary_vertex`: the local index of boundary point k of edge e.
 fn boundary_local(input: LocalNumbering, e: u32, k: u32) -> u32 {
     if (k == 0u) { return e; }
-    if (k == input.s[e]) { return (e + 1u) % input.nc; }
-    return input.base[e] + k - 1u;
+    if (k == pick4(input.s, e)) { return (e + 1u) % input.nc; }
+    return pick4(input.base, e) + k - 1u;
 }
 
-// The local edge whose inner samples hold local index l (nc ≤ l < interior_base).
+// The local edge whose inner samples hold local index l (nc ≤ l < interior_base). Without a
+// loop: lavapipe (llvmpipe) stops every loop of an invocation once its loops have iterated
+// 65,535 times in all, and a per-patch walk calls this for every triangle corner.
 fn local_edge(input: LocalNumbering, l: u32) -> u32 {
-    var e = 0u;
-    for (var f = 1u; f < input.nc; f = f + 1u) {
-        if (l >= input.base[f]) { e = f; }
-    }
-    return e;
+    return select(0u, 1u, l >= input.base.y) + select(0u, 1u, l >= input.base.z)
+        + select(0u, 1u, input.nc == 4u && l >= input.base.w);
 }
 
 // `LocalMap::vertex`: the output vertex of local index l.
@@ -59,7 +67,7 @@ fn local_vertex(input: LocalNumbering, l: u32) -> u32 {
     if (l < input.nc) { return patch_corner_entry(input.p, l); }
     if (l < input.interior_base) {
         let e = local_edge(input, l);
-        return edge_sample_vertex(input.p, e, l - input.base[e] + 1u);
+        return edge_sample_vertex(input.p, e, l - pick4(input.base, e) + 1u);
     }
     return vertex_offsets[params.edges + input.p] + (l - input.interior_base);
 }
