@@ -487,11 +487,13 @@ struct Output {
 /// frame into device buffers that a render pipeline binds directly (see the module doc for
 /// the passes).
 ///
-/// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
-/// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
-/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on every
-/// patch kind (any per-edge segments and core factors, as `Scheme::Transition` plans);
-/// anything else is refused with [`GpuError::Unsupported`].
+/// Supported now, on every patch kind (bicubic, Bézier triangles, PN triangles):
+/// [`SamplingKind::Uniform`] plans for the uniform pattern (every edge of a visible patch cut
+/// into its interior factor, as `Scheme::Uniform` plans are) and the transition pattern (any
+/// per-edge segments and core factors, as `Scheme::Transition` plans); and
+/// `SamplingKind::Fractional(Spacing::Hardware(p))` plans for the Direct3D 11 pattern of
+/// partitioning `p` (real per-edge factors, as `Scheme::Hardware(p)` plans). Anything else is
+/// refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
