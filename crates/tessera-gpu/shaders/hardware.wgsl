@@ -23,11 +23,6 @@ struct HardwareFactors {
     inside: vec2<f32>,
 }
 
-// `pattern::hardware::d3d_edge`: Direct3D's edge of tessera edge e.
-fn d3d_edge(nc: u32, e: u32) -> u32 {
-    return (e + 1u) % nc;
-}
-
 // `Hardware::factors`: the plan's edge factors in Direct3D's order and the inside factors by
 // Direct3D's `max` reduction (for fractional_odd quads each raised to at least the other's,
 // capped at 3). The plan's interior factors are not read, as on the CPU.
@@ -39,7 +34,7 @@ fn hardware_factors(p: u32) -> HardwareFactors {
         edge_factor(patch_edge(p, 2u)),
         select(1.0, edge_factor(patch_edge(p, 3u)), nc == 4u),
     );
-    // Direct3D edge d3d_edge(e) = (e + 1) mod nc is tessera edge e.
+    // Direct3D edge (e + 1) mod nc is tessera edge e (`pattern::hardware::d3d_edge`).
     var edges = vec4<f32>(f.z, f.x, f.y, 1.0);
     if (nc == 4u) { edges = vec4<f32>(f.w, f.x, f.y, f.z); }
     var inside: vec2<f32>;

@@ -98,6 +98,14 @@ const PATCH_VIEW_ROW: u32 = 8;
 const PARTITIONINGS: [Partitioning; 4] =
     [Partitioning::Integer, Partitioning::Pow2, Partitioning::FractionalOdd, Partitioning::FractionalEven];
 
+/// The CPU pattern of each partitioning, in the same order.
+static HARDWARE_PATTERNS: [Hardware; 4] = [
+    Hardware { partitioning: PARTITIONINGS[0] },
+    Hardware { partitioning: PARTITIONINGS[1] },
+    Hardware { partitioning: PARTITIONINGS[2] },
+    Hardware { partitioning: PARTITIONINGS[3] },
+];
+
 /// `Params::partitioning`'s code of `p` (`hardware_partition.wgsl`'s PARTITIONING_*).
 fn partitioning_code(p: Partitioning) -> u32 {
     PARTITIONINGS.iter().position(|&q| q == p).expect("every partitioning is listed") as u32
@@ -173,14 +181,7 @@ impl GpuPattern {
         match self {
             GpuPattern::Uniform => &Uniform,
             GpuPattern::Transition => &Transition,
-            GpuPattern::Hardware(Partitioning::Integer) => &Hardware { partitioning: Partitioning::Integer },
-            GpuPattern::Hardware(Partitioning::Pow2) => &Hardware { partitioning: Partitioning::Pow2 },
-            GpuPattern::Hardware(Partitioning::FractionalOdd) => {
-                &Hardware { partitioning: Partitioning::FractionalOdd }
-            }
-            GpuPattern::Hardware(Partitioning::FractionalEven) => {
-                &Hardware { partitioning: Partitioning::FractionalEven }
-            }
+            GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
         }
     }
 
@@ -433,7 +434,7 @@ fn hardware_worst_case(
 }
 
 /// The hardware plan with `factor` on every edge, every patch visible. Cost: O(E + P).
-pub fn hardware_uniform_plan(set: &SurfaceSet, partitioning: Partitioning, factor: f64) -> Plan {
+fn hardware_uniform_plan(set: &SurfaceSet, partitioning: Partitioning, factor: f64) -> Plan {
     let segments = tessera::pattern::hardware::edge_segments(factor, partitioning);
     let (edges, patches) = (set.topology.edges.len(), set.patches.len());
     Plan {

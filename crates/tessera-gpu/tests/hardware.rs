@@ -16,7 +16,7 @@ use tessera::pattern::{Pattern, PatternInput};
 use tessera::sampling::{SamplingKind, Spacing};
 use tessera::scheme::{Criterion, PlanOptions, Prepared, Scheme};
 use tessera::surface::{BuildOptions, Domain, SurfaceSet};
-use tessera_gpu::tessellator::ScreenCriterion;
+use tessera_gpu::tessellator::{Capacity, ScreenCriterion};
 use tessera_gpu::{GpuError, GpuTessellator};
 
 const PARTITIONINGS: [Partitioning; 4] =
@@ -435,6 +435,7 @@ fn hardware_from_the_camera(
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             gpu.record(&mut encoder);
             ctx.queue.submit([encoder.finish()]);
+            assert!(!gpu.read_status(ctx).unwrap().0, "{name}: the frame overflowed its worst case");
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut sweep);
             let drawn = gpu.read_plan(ctx).unwrap();
             assert_eq!(drawn.visible, visible, "{name}");
@@ -551,4 +552,66 @@ fn hardware_from_the_camera_on_every_model_20_cameras() {
     eprintln!("total: {sweep:?}\n{counts:?}");
     check_factor_counts(&counts);
     assert!(100 * sweep.cull_ties <= sweep.culled.max(100), "{sweep:?}");
+}
+
+/// The output room of a hardware frame planned on the GPU, at the top of the hardware's
+/// range from a camera inside the model: the default room (the worst case) holds the frame,
+/// and a frame started with room for 16 triangles overflows (drawing nothing), grows and,
+/// drawn again, equals the CPU engine's output for the plan the GPU drew. A fixed factor
+/// (fractional_odd 62.5) and silhouetteness (fractional_even up to 64).
+#[test]
+fn hardware_capacity_holds_the_worst_frame_or_grows() {
+    let ctx = ctx();
+    let set = load("patches/teapot.patches");
+    let prepared = Prepared::new(&set, true);
+    let (lo, hi) = set.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    let camera = tessera::camera::Camera {
+        eye: centre + glam::DVec3::new(0.3, -0.5, 0.4) * radius,
+        target: centre,
+        up: glam::DVec3::Z,
+        fov_y_degrees: 70.0,
+        width: 1280,
+        height: 1024,
+        near: radius * 1e-3,
+        far: radius * 10.0,
+    };
+    let silhouettes = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax: 64.0 };
+    for (p, criterion) in
+        [(Partitioning::FractionalOdd, Criterion::Factor(62.5)), (Partitioning::FractionalEven, silhouettes)]
+    {
+        let scheme = Scheme::Hardware(p);
+        let options = PlanOptions { camera: Some(camera), cull: true, max_factor: 64, ..Default::default() };
+        let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+        let tiny = Capacity { vertices: 16, triangles: 16 };
+        for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {
+            let name = format!("{} {criterion:?}, {start}", p.name());
+            let mut gpu = tessellator(&set);
+            let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity };
+            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+            let mut grown = 0;
+            loop {
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                gpu.record(&mut encoder);
+                ctx.queue.submit([encoder.finish()]);
+                if !gpu.grow_if_overflowed(ctx).unwrap() {
+                    break;
+                }
+                grown += 1;
+                assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
+            }
+            assert_eq!(grown > 0, capacity.is_some(), "{name}: grown {grown} times");
+            let drawn = gpu.read_plan(ctx).unwrap();
+            assert_eq!(drawn.visible, cpu.visible, "{name}: culled set");
+            if matches!(criterion, Criterion::Factor(_)) {
+                assert_eq!(drawn.factors, cpu.factors, "{name}: factors");
+            }
+            assert!(
+                drawn.segments.iter().any(|&s| s >= 62),
+                "{name}: the frame is not at the top of the range"
+            );
+            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &Hardware { partitioning: p });
+        }
+    }
 }
