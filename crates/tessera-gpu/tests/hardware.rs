@@ -541,6 +541,7 @@ fn hardware_from_the_camera_on_every_model_20_cameras() {
         .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
     let (mut sweep, mut counts) = hardware_from_the_camera(&rest, 20, 2026, 3);
     let (more_sweep, more) = hardware_from_the_camera(&large, 10, 2026, 3);
+    sweep.frames += more_sweep.frames;
     sweep.cull_ties += more_sweep.cull_ties;
     sweep.culled += more_sweep.culled;
     counts.frames += more.frames;
