@@ -110,7 +110,7 @@ fn inside_axis_new(f: f32, mode: u32) -> Axis {
     return a;
 }
 
-// `pre.outer[e]` (Direct3D edge e) and `pre.inside[k]`, by constant indices.
+// `pre.outer[e]` (Direct3D edge e), by constant indices (see `pick4`).
 fn outer_axis(pre: Processed, e: u32) -> Axis {
     switch e {
         case 0u: { return pre.outer[0]; }
@@ -120,6 +120,7 @@ fn outer_axis(pre: Processed, e: u32) -> Axis {
     }
 }
 
+// `pre.inside[k]`.
 fn inside_axis(pre: Processed, k: u32) -> Axis {
     if (k == 0u) { return pre.inside[0]; }
     return pre.inside[1];
@@ -222,6 +223,7 @@ struct Side {
     reversed: bool,
 }
 
+// Side e of a ring (`Ring::side_into`): it starts where the sides before it end.
 fn ring_side(ring: Ring, e: u32, reversed: bool) -> Side {
     let s = ring.sides - vec4<u32>(1u);
     let offset = select(0u, s.x, e >= 1u) + select(0u, s.y, e >= 2u) + select(0u, s.z, e >= 3u);
@@ -385,17 +387,20 @@ struct Stitch {
     o: u32,
 }
 
+// A stitch of `kind` between the rows `inner` and `outer`, at its start.
 fn stitch_new(kind: u32, inner: Side, outer: Side) -> Stitch {
     return Stitch(kind, inner, outer, 0u, 0u, false, false, false, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
 }
 
-// `Emit::transition`'s "advance outer" and "advance inner" triangles.
+// `Emit::transition`'s "advance outer" triangle (also each end of `Emit::regular`'s
+// trapezoid): outer points o, o + 1 and inner point i.
 fn advance_outer(st: ptr<function, Stitch>) -> vec3<u32> {
     let o = (*st).o;
     (*st).o = o + 1u;
     return vec3<u32>(OUTER_ROW | o, OUTER_ROW | (o + 1u), (*st).i);
 }
 
+// `Emit::transition`'s "advance inner" triangle: inner points i, i + 1 and outer point o.
 fn advance_inner(st: ptr<function, Stitch>) -> vec3<u32> {
     let i = (*st).i;
     (*st).i = i + 1u;
@@ -547,7 +552,8 @@ fn regular_step(st: ptr<function, Stitch>) -> vec3<u32> {
     return vec3<u32>(DONE);
 }
 
-// The next fixed triangle.
+// The next fixed triangle (`Emit::tri` in `tessellate_into`'s minimum case and `tri`'s
+// centre).
 fn fixed_step(st: ptr<function, Stitch>) -> vec3<u32> {
     let t = (*st).x;
     (*st).x = t + 1u;
@@ -556,6 +562,7 @@ fn fixed_step(st: ptr<function, Stitch>) -> vec3<u32> {
     return vec3<u32>(1u, OUTER_ROW, OUTER_ROW | 1u);
 }
 
+// The next triangle of any stitch (`Emit::transition`, `Emit::regular`, `Emit::tri`).
 fn stitch_step(st: ptr<function, Stitch>) -> vec3<u32> {
     if ((*st).kind == STITCH_TRANSITION) { return transition_step(st); }
     if ((*st).kind == STITCH_REGULAR) { return regular_step(st); }
@@ -694,6 +701,7 @@ fn edge_param(e: u32, k: u32) -> f32 {
     return hardware_edge_param(edge_factor(e), params.partitioning, k);
 }
 
+// A fixed-point domain point as f32, exactly (`sampling::hardware::to_f64`).
 fn fixed_point(u: u32, v: u32) -> vec2<f32> {
     return vec2<f32>(f32(u), f32(v)) * (1.0 / f32(FIXED_ONE));
 }
@@ -768,7 +776,8 @@ fn interior_point(p: u32, j: u32) -> vec2<f32> {
     return tri_interior_point(pre, j);
 }
 
-// Triangle pass: one invocation per visible patch writes its pattern.
+// Triangle pass: one invocation per visible patch writes its pattern (the engine's
+// `Writer::patch` with `Hardware::build`).
 @compute @workgroup_size(WORKGROUP)
 fn write_patch_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,

@@ -57,6 +57,7 @@ fn to_fixed(x: f32) -> u32 {
     return u32(round(x * f32(FIXED_ONE)));
 }
 
+// `sampling::hardware::fixed_floor` and `fixed_ceil`.
 fn fixed_floor(x: u32) -> u32 { return x & ~(FIXED_ONE - 1u); }
 
 fn fixed_ceil(x: u32) -> u32 {

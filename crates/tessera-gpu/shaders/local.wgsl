@@ -18,6 +18,7 @@ struct LocalNumbering {
     interior_base: u32,
 }
 
+// Bit e of `mask`.
 fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
 
 // Component i of v, by selects: a vector indexed by a variable may become a memory copy on

@@ -326,8 +326,8 @@ impl Pipelines {
     }
 
     /// The hardware pattern's pipelines (`hardware.wgsl`), compiled on the first call.
-    /// Cost: the first call two WGSL compilations (about a second on lavapipe); later calls
-    /// nothing.
+    /// Cost: the first call two WGSL compilations (lavapipe finishes them at their first
+    /// dispatch: about 5 s, once per device); later calls nothing.
     fn hardware(&self, device: &wgpu::Device) -> &PatternPipelines {
         self.hardware.get_or_init(|| {
             let make = |module: &wgpu::ShaderModule, entry: &str| {
