@@ -23,7 +23,9 @@ pub struct GpuRun {
 }
 
 /// The frame the GPU plans from `camera` alone for `scheme` under `criterion`, if it can:
-/// culling on (the GPU always culls what it plans) and a pairing `prepare_screen` takes.
+/// culling on (the GPU always culls what it plans) and a pairing `prepare_screen` takes (a
+/// pixel error with the uniform or transition scheme, silhouetteness with those or a hardware
+/// partitioning, a fixed real factor with a hardware partitioning).
 pub fn screen_criterion(
     scheme: Scheme,
     criterion: &Criterion,
@@ -34,9 +36,10 @@ pub fn screen_criterion(
         (scheme, criterion),
         (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(_))
             | (
-                Scheme::Uniform | Scheme::Transition,
+                Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
                 Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
             )
+            | (Scheme::Hardware(_), Criterion::Factor(_))
     );
     (cull && on_gpu).then_some(ScreenCriterion { scheme, criterion: *criterion, max_factor, capacity: None })
 }

@@ -113,10 +113,10 @@ struct MeshArgs {
     /// (per level: patch id and edge levels).
     #[arg(long, value_name = "JSON")]
     instanced: Option<PathBuf>,
-    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform and the transition
-    /// scheme on every surface kind; with --cull and --pixel-error or silhouetteness the GPU
-    /// plans the frame from the camera itself, else it draws the CPU's plan; --stats adds
-    /// per-pass GPU times).
+    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform, transition,
+    /// integer, pow2, fractional-odd and fractional-even schemes on every surface kind; with
+    /// --cull and a pixel error or silhouetteness the GPU plans the frame from the camera
+    /// itself, else it draws the CPU's plan; --stats adds per-pass GPU times).
     #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
     engine: String,
     #[command(flatten)]

@@ -668,6 +668,17 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
         assert_eq!(g[key], c[key], "planned on the GPU: {key}");
     }
     assert_eq!(g["gpu_capped_patches"], c["capped_patches"], "{g}");
+    // The hardware schemes from the camera too (silhouetteness: real factors on the GPU).
+    let args =
+        ["mesh", blob.to_str().unwrap(), "--scheme", "fractional-odd", "--silhouette", "2:9.5", "--cull"];
+    let cpu = tessera(&[&args[..], &["--stats"]].concat(), &dir);
+    let gpu = tessera(&[&args[..], &["--stats", "--engine", "gpu"]].concat(), &dir);
+    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+    assert_eq!(g["planned_on"], "gpu", "{g}");
+    for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
+        assert_eq!(g[key], c[key], "fractional-odd planned on the GPU: {key}");
+    }
     let refused =
         tessera(&["mesh", input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--engine", "gpu"], &dir);
     assert!(!refused.status.success());

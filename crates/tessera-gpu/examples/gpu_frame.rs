@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release -p tessera-gpu --example gpu_frame -- MODEL.patches [FACTOR] [FRAMES]
 //! [--copies N] [--cull] [--pixel-error PX [--max-factor N] [--transition [--cpu-plan]]]
-//! [--silhouetteness FMAX]`
+//! [--silhouetteness FMAX] [--hardware PARTITIONING]`
 //!
 //! `--copies N` tessellates N copies of the model in a grid (`tessera::scene::patch_grid`;
 //! 45 copies of `bench/torus_64x32.patches` are the 92,160-patch scene of the real-time CPU
@@ -16,6 +16,10 @@
 //! it every frame.
 //! `--silhouetteness FMAX` plans the transition scheme on the GPU from the camera alone
 //! (culling, silhouetteness factors in 1..=FMAX, the core rule).
+//! `--hardware PARTITIONING` (`integer`, `pow2`, `fractional_odd`, `fractional_even`) draws
+//! the Direct3D 11 pattern instead: by default `Scheme::Hardware`'s CPU plan of the real
+//! FACTOR (e.g. 15.3), drawn (and with `--cull` culled) by the GPU; with `--silhouetteness
+//! FMAX` planned on the GPU from the camera (real factors 1 to FMAX).
 //! Records FRAMES frames (default 10) and prints, per pass, the median of the
 //! timestamp-query times when the adapter has them; otherwise the median wall time of a
 //! whole frame around `submit` + `poll(wait)`. Statistics are read back after each frame,
@@ -23,6 +27,7 @@
 
 use std::time::Instant;
 use tessera::criterion::Plan;
+use tessera::pattern::hardware::Partitioning;
 use tessera::scheme::{Criterion, PlanOptions, Prepared, Scheme};
 use tessera::surface::{BuildOptions, SurfaceSet};
 use tessera_gpu::tessellator::{PassTimer, ScreenCriterion, PASSES};
@@ -55,11 +60,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let copies: usize = option(&mut args, "--copies")?.unwrap_or(1);
     let pixels: Option<f64> = option(&mut args, "--pixel-error")?;
     let max_factor: u32 = option(&mut args, "--max-factor")?.unwrap_or(16);
-    let silhouetteness: Option<u32> = option(&mut args, "--silhouetteness")?;
+    let silhouetteness: Option<f64> = option(&mut args, "--silhouetteness")?;
+    let hardware: Option<String> = option(&mut args, "--hardware")?;
     let usage = "usage: gpu_frame MODEL.patches [FACTOR] [FRAMES] [--copies N] [--cull] \
-                 [--pixel-error PX [--max-factor N] [--transition [--cpu-plan]]] [--silhouetteness FMAX]";
+                 [--pixel-error PX [--max-factor N] [--transition [--cpu-plan]]] [--silhouetteness FMAX] \
+                 [--hardware integer|pow2|fractional_odd|fractional_even]";
     let path = args.get(1).ok_or(usage)?;
-    let factor: u32 = args.get(2).map_or(Ok(16), |s| s.parse())?;
+    let factor: f64 = args.get(2).map_or(Ok(16.0), |s| s.parse())?;
+    let partitioning = match hardware.as_deref().map(|h| h.replace('-', "_")) {
+        None => None,
+        Some(name) => Some(
+            [
+                Partitioning::Integer,
+                Partitioning::Pow2,
+                Partitioning::FractionalOdd,
+                Partitioning::FractionalEven,
+            ]
+            .into_iter()
+            .find(|p| p.name() == name)
+            .ok_or(format!("--hardware {name}: use integer, pow2, fractional_odd or fractional_even"))?,
+        ),
+    };
     let frames: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let file = tessera::io::patches::read_patches(std::path::Path::new(path))?;
     let file = if copies > 1 { tessera::scene::patch_grid(&file, copies) } else { file };
@@ -73,8 +94,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gpu.set_cull_camera(&ctx, Some(&camera));
     }
     let what = match (pixels, transition && cpu_plan) {
+        _ if partitioning.is_some() && pixels.is_some() => {
+            return Err(
+                "--hardware takes a factor or --silhouetteness: the hardware schemes have no pixel error"
+                    .into(),
+            );
+        }
+        _ if partitioning.is_some() => {
+            let p = partitioning.expect("checked");
+            let scheme = Scheme::Hardware(p);
+            if let Some(fmax) = silhouetteness {
+                let prepared = Prepared::new(&set, true);
+                let criterion = Criterion::View {
+                    criterion: tessera::criterion::view::ViewCriterion::Silhouetteness,
+                    fmin: 1.0,
+                    fmax,
+                };
+                let cap = scheme.factor_cap().min(fmax.ceil()) as u32;
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
+                format!(
+                    "{}, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU",
+                    p.name()
+                )
+            } else {
+                let planned = scheme.plan(&set, &Criterion::Factor(factor), &PlanOptions::default())?;
+                gpu.prepare(&ctx, &set, &planned.plan, &planned.pattern)?;
+                format!("{} factor {factor}{}", p.name(), if cull { ", culled on the GPU" } else { "" })
+            }
+        }
         _ if silhouetteness.is_some() => {
-            let fmax = silhouetteness.unwrap_or(1);
+            let fmax = silhouetteness.unwrap_or(1.0).round().max(1.0) as u32;
             let prepared = Prepared::new(&set, true);
             let criterion = Criterion::View {
                 criterion: tessera::criterion::view::ViewCriterion::Silhouetteness,
@@ -104,6 +154,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             format!("transition, {px} px and cap {max_factor} planned once on the CPU, culled on the GPU")
         }
         (None, _) => {
+            if factor.fract() != 0.0 || factor < 1.0 {
+                return Err(format!(
+                    "factor {factor}: the uniform pattern takes an integer (real factors: --hardware)"
+                )
+                .into());
+            }
+            let factor = factor as u32;
             gpu.prepare(&ctx, &set, &Plan::uniform(&set, factor)?, &tessera::pattern::uniform::Uniform)?;
             format!("uniform factor {factor}{}", if cull { ", culled on the GPU" } else { "" })
         }

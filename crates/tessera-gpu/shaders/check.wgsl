@@ -95,18 +95,21 @@ fn check_patch(p: u32) -> bool {
     var bound = 0.0;
     var missed = false;
     loop {
+        // Every core triangle is half a grid cell: one cell's triangle bounds them all
+        // (`Pattern::grid_cells`, `tolerance::grid_bound`); the walk takes the strips. The
+        // core is never walked, which also keeps a check within lavapipe's 65,535 loop
+        // iterations an invocation (`local.wgsl`): a strip has at most 2 · 64 steps.
         let input = pattern_input(p, factors);
-        if (input.core.strips == 0u) {
-            // A pure grid (`Pattern::grid_cells`): one cell's triangle bounds every triangle
-            // (`tolerance::grid_bound`), no walk.
-            let cell = vec2<f32>(1.0 / f32(input.core.nu), 1.0 / f32(input.core.nv));
-            bound = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
-        } else {
-            var out = sink(SINK_CHECK, 0u);
-            out.errors = errors;
-            build_transition(input, &out);
-            bound = out.worst;
+        let l = input.core;
+        var out = sink(SINK_CHECK, 0u);
+        out.errors = errors;
+        let core_cells = select((l.i_hi - l.i_lo) * (l.j_hi - l.j_lo), l.m, input.local.nc == 3u);
+        if (core_cells > 0u) {
+            let cell = vec2<f32>(1.0 / f32(l.nu), 1.0 / f32(l.nv));
+            out.worst = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
         }
+        build_transition(input, &out);
+        bound = out.worst;
         if (bound <= eps) { break; }
         // No progress means the worst triangles follow the edges, not the core.
         let stuck = bound >= previous;

@@ -9,7 +9,9 @@ struct Params {
     // Room in the output buffers: the args pass refuses a frame past them (status.overflow).
     vertex_capacity: u32,
     triangle_capacity: u32,
-    _pad0: u32,
+    // The hardware pattern's partitioning (`hardware_partition.wgsl`'s PARTITIONING_*); 0 for
+    // the other patterns.
+    partitioning: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -21,7 +23,9 @@ struct Params {
 @group(0) @binding(3) var<storage, read_write> edge_rows: array<u32>;
 @group(0) @binding(4) var<storage, read_write> edge_uses: array<u32>;
 @group(0) @binding(5) var<storage, read_write> corner_rows: array<u32>;
-// The plan: `tessera::criterion::Plan::{segments, interior, visible}` byte for byte.
+// The plan: `tessera::criterion::Plan::{segments, interior, visible}` byte for byte;
+// `segments[E..2E]` holds `Plan::factors` (the f32 bits, `edge_factor`), which only the
+// hardware pattern reads (one buffer for both keeps the frame within 16 storage buffers).
 @group(0) @binding(6) var<storage, read_write> segments: array<u32>;
 @group(0) @binding(7) var<storage, read_write> interior: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read_write> visible: array<u32>;
@@ -72,6 +76,9 @@ fn patch_has_pn_normals(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u
 fn patch_corner_count(p: u32) -> u32 { return select(4u, 3u, patch_is_tri(p)); }
 // Control points of the patch's geometry (the rest of its 16 slots hold PN normals).
 fn patch_point_count(p: u32) -> u32 { return select(16u, 10u, patch_is_tri(p)); }
+
+// The plan's real factor of edge e (`Plan::factors`).
+fn edge_factor(e: u32) -> f32 { return bitcast<f32>(segments[params.edges + e]); }
 
 // Edge rows and uses.
 fn edge_first_use(e: u32) -> u32 { return edge_rows[e * EDGE_ROW]; }

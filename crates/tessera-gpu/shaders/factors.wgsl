@@ -1,5 +1,5 @@
 // Screen-space factors from the camera alone, the GPU form of `tessera::scheme::Scheme::
-// plan_into` for two criteria:
+// plan_into` for three criteria:
 //
 // - `Criterion::PixelError`: per visible patch the object-space tolerance of
 //   `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
@@ -8,16 +8,24 @@
 //   a-posteriori check (`check.wgsl`);
 // - `Criterion::View` with `ViewCriterion::Silhouetteness` (`view::edge_factors_into`): every
 //   patch proposes each of its edges' silhouetteness factor in [lo, hi];
+// - `Criterion::Factor` for the hardware schemes (`view::EdgeFactors::Fixed`): every patch
+//   proposes the factor for each of its edges;
 //
 // then per edge the maximum over the patches sharing it, read through the topology's edge
-// uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer`),
-// then the interiors (`resolve::interiors`): the global factor on every edge and patch
-// (`InteriorRule::Global`) or CudaTess's core rule (`InteriorRule::Core`).
+// uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer` or,
+// for the hardware schemes, `EdgeRule::Fractional(Spacing::Hardware(_))`: the hull shader's
+// pow2 rounding and `settled_factor`, segments by the partition), then the interiors
+// (`resolve::interiors`): the global factor on every edge and patch (`InteriorRule::Global`),
+// CudaTess's core rule (`InteriorRule::Core`) or the largest edge (`InteriorRule::MaxEdge`).
 //
 // f32 where the CPU computes in f64: a pixel-error factor is `ceil` of a square root, a
 // silhouetteness factor is rounded, so the two can differ by one where that value lies within
 // f32 rounding (about 1e-6 relative) of an integer (of a half-integer). The tests count such
-// cases and allow no other difference.
+// cases and allow no other difference. The hardware schemes keep the real factor: where the
+// silhouetteness lies strictly between 0 and 1 it is computed from f32 copies of the CPU's
+// f64 midpoints and normals, so its last bits may differ from the CPU's f32 factor (the tests
+// count and bound these); at silhouetteness 0 or 1, and for a fixed factor, the factor is
+// the CPU's bit for bit.
 
 // `screen::PatchView::tolerance` for the view's pixel error.
 fn patch_tolerance(p: u32) -> f32 {
@@ -105,6 +113,8 @@ fn silhouetteness_factor(e: u32) -> f32 {
     let product = dot(c, nl) * dot(c, nr);
     var s = 1.0;
     if (product > 0.0) { s = clamp(1.0 - product / 0.25, 0.0, 1.0); }
+    // At s = 1 the CPU's f64 lo + (hi − lo) rounds to hi; in f32 it might not.
+    if (s == 1.0) { return view.hi; }
     return clamp(view.lo + s * (view.hi - view.lo), view.lo, view.hi);
 }
 
@@ -124,7 +134,10 @@ fn patch_proposals(
         atomicMax(&state.global_factor, u32(max(minimum.x, minimum.y)));
     }
     var out = vec4<f32>(0.0);
-    if (view.criterion == CRITERION_SILHOUETTENESS) {
+    if (view.criterion == CRITERION_FIXED) {
+        // Every patch, culled or not, proposes the factor (`from_edge_factors`).
+        out = vec4<f32>(view.lo);
+    } else if (view.criterion == CRITERION_SILHOUETTENESS) {
         // Every patch, culled or not, proposes its edges' factors (`from_edge_factors`).
         for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
             out[l] = silhouetteness_factor(patch_edge(p, l));
@@ -151,18 +164,25 @@ fn patch_proposals(
     proposals[p] = out;
 }
 
-// `resolve::edges` with `EdgeRule::Integer` for edge e: the maximum of the proposals over
-// its uses, capped, rounded half away from zero as `f64::round`, at least the minimum.
-fn resolved_segments(e: u32) -> u32 {
+// `resolve::edges`' wish for edge e: the maximum of the proposals over its uses, capped.
+fn wanted_factor(e: u32) -> f32 {
     var wanted = 0.0;
     for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
         wanted = max(wanted, proposals[use_patch(u)][use_local(u)]);
     }
-    wanted = min(wanted, view.cap);
-    return max(u32(floor(wanted + 0.5)), max(minimum_segments[e], 1u));
+    return min(wanted, view.cap);
 }
 
-// Per edge: its segments (`resolved_segments`).
+// `resolve::edges` with `EdgeRule::Integer` for edge e: its wish rounded half away from zero
+// as `f64::round`, at least the minimum.
+fn resolved_segments(e: u32) -> u32 {
+    return max(u32(floor(wanted_factor(e) + 0.5)), max(minimum_segments[e], 1u));
+}
+
+// Per edge: `resolve::edges` — the maximum over its uses, capped; then `EdgeRule::Integer`
+// (`resolved_segments`), or `EdgeRule::Fractional(Spacing::Hardware(_))`: at least the
+// minimum, the hull shader's rounding (`hull_factor`), settled (`settled_factor`), the real
+// factor kept in the plan's factor row and its segments by the partition (`edge_segments`).
 @compute @workgroup_size(WORKGROUP)
 fn edge_segments(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -171,6 +191,14 @@ fn edge_segments(
 ) {
     let e = thread_index(wid, nwg, lid);
     if (e >= params.edges) { return; }
+    if (view.edge_rule == EDGE_RULE_HARDWARE) {
+        let mode = params.partitioning;
+        let minimum = f32(max(minimum_segments[e], 1u));
+        let f = settled_factor(hull_factor(max(wanted_factor(e), minimum), mode), mode);
+        segments[e] = hardware_edge_segments(f, mode);
+        segments[params.edges + e] = bitcast<u32>(f);
+        return;
+    }
     let s = resolved_segments(e);
     segments[e] = s;
     if (view.interior_rule == INTERIOR_GLOBAL) {
@@ -181,6 +209,8 @@ fn edge_segments(
 // `resolve::interiors`. `InteriorRule::Global`: the frame's largest factor on every edge and
 // patch interior. `InteriorRule::Core`: a quad takes the smaller segments of its two edges
 // along each direction (at least its minimum), a triangle its largest edge.
+// `InteriorRule::MaxEdge`: every patch its largest edge (the hardware pattern itself reads
+// only the edges' factors).
 @compute @workgroup_size(WORKGROUP)
 fn interiors(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -198,6 +228,11 @@ fn interiors(
     let s0 = segments[patch_edge(x, 0u)];
     let s1 = segments[patch_edge(x, 1u)];
     let s2 = segments[patch_edge(x, 2u)];
+    if (view.interior_rule == INTERIOR_MAX_EDGE && !patch_is_tri(x)) {
+        let n = max(max(s0, s1), max(s2, segments[patch_edge(x, 3u)]));
+        interior[x] = vec2<u32>(n, n);
+        return;
+    }
     if (patch_is_tri(x)) {
         let n = max(s0, max(s1, s2));
         interior[x] = vec2<u32>(n, n);

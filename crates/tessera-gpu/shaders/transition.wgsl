@@ -2,7 +2,8 @@
 // and triangles (`TriLayout`), with its strip walk (`walk`), on the CPU's local vertex
 // numbering (`tessera::pattern::PatternInput`), mapped to output vertices by the layout's
 // rule (`engine` `LocalMap::vertex`). One invocation builds one patch, in the CPU's triangle
-// order, so counting and writing agree with the CPU triangle for triangle.
+// order, so counting and writing agree with the CPU triangle for triangle; the a-posteriori
+// check (`check.wgsl`) walks the same strips to bound their triangles.
 
 // The core of either layout: the (possibly raised) core factors, which edges have strips
 // (bit e) and the core's extent in grid indices. Quads (`QuadLayout`): the rectangle
@@ -19,19 +20,11 @@ struct QuadLayout {
     m: u32,
 }
 
-// One patch's pattern input and local numbering bases (`PatternInput::edge_base`); nc is
-// the domain's corner count (3 for a triangle domain).
+// One patch's pattern input: its local numbering (`local.wgsl`) and its core.
 struct PatchInput {
-    p: u32,
-    nc: u32,
-    s: vec4<u32>,
-    collapsed: u32,
-    base: vec4<u32>,
-    interior_base: u32,
+    local: LocalNumbering,
     core: QuadLayout,
 }
-
-fn bit(mask: u32, e: u32) -> u32 { return (mask >> e) & 1u; }
 
 // `transition::strips_at_collapsed_edges` for N edges (3 or 4), updating in place as the
 // CPU does.
@@ -85,7 +78,7 @@ fn tri_layout(s: vec4<u32>, interior_factor: u32, c: u32) -> QuadLayout {
     return QuadLayout(1u, 1u, 0u, 0u, 0u, 0u, 0u, 1u);
 }
 
-// `engine::layout::pattern_input` for patch p, with its local bases.
+// `engine::layout::pattern_input` for patch p, with its local bases and core.
 fn patch_input(p: u32) -> PatchInput {
     return pattern_input(p, interior[p]);
 }
@@ -93,26 +86,14 @@ fn patch_input(p: u32) -> PatchInput {
 // `engine::layout::pattern_input` for patch p with interior factors `interior_factors` (the
 // check tries several before the plan has one).
 fn pattern_input(p: u32, interior_factors: vec2<u32>) -> PatchInput {
-    let nc = patch_corner_count(p);
-    var s = vec4<u32>(0u);
-    var collapsed = 0u;
-    for (var e = 0u; e < nc; e = e + 1u) {
-        s[e] = segments[patch_edge(p, e)];
-        if (patch_edge_collapsed(p, e)) { collapsed = collapsed | (1u << e); }
-    }
-    var base = vec4<u32>(0u);
-    var b = nc;
-    for (var e = 0u; e < nc; e = e + 1u) {
-        base[e] = b;
-        b = b + s[e] - 1u;
-    }
+    let local = local_numbering(p);
     var core: QuadLayout;
-    if (nc == 3u) {
-        core = tri_layout(s, interior_factors.x, collapsed);
+    if (local.nc == 3u) {
+        core = tri_layout(local.s, interior_factors.x, local.collapsed);
     } else {
-        core = quad_layout(s, interior_factors, collapsed);
+        core = quad_layout(local.s, interior_factors, local.collapsed);
     }
-    return PatchInput(p, nc, s, collapsed, base, b, core);
+    return PatchInput(local, core);
 }
 
 // The pattern's core factors, read by the interior vertex pass: on a quad the interior grid
@@ -126,17 +107,17 @@ fn interior_grid(p: u32) -> vec2<u32> {
 // `QuadLayout::counts` and `TriLayout::counts`: interior vertices and pattern triangles.
 fn transition_counts(input: PatchInput) -> vec2<u32> {
     let l = input.core;
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         var triangles = l.m * l.m;
         for (var e = 0u; e < 3u; e = e + 1u) {
-            if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + l.m; }
+            if (bit(l.strips, e) != 0u) { triangles = triangles + input.local.s[e] + l.m; }
         }
         let n = l.nu;
         return vec2<u32>(select(0u, (n - 1u) * (n - 2u) / 2u, n >= 2u), triangles);
     }
     var triangles = 2u * (l.i_hi - l.i_lo) * (l.j_hi - l.j_lo);
     for (var e = 0u; e < 4u; e = e + 1u) {
-        if (bit(l.strips, e) != 0u) { triangles = triangles + input.s[e] + inner_segments(input, e); }
+        if (bit(l.strips, e) != 0u) { triangles = triangles + input.local.s[e] + inner_segments(input, e); }
     }
     return vec2<u32>((l.nu - 1u) * (l.nv - 1u), triangles);
 }
@@ -144,7 +125,7 @@ fn transition_counts(input: PatchInput) -> vec2<u32> {
 // `QuadLayout::inner_segments`; a triangle's core sides all have m segments.
 fn inner_segments(input: PatchInput, e: u32) -> u32 {
     let l = input.core;
-    if (input.nc == 3u) { return l.m; }
+    if (input.local.nc == 3u) { return l.m; }
     if (e % 2u == 0u) { return l.i_hi - l.i_lo; }
     return l.j_hi - l.j_lo;
 }
@@ -152,7 +133,7 @@ fn inner_segments(input: PatchInput, e: u32) -> u32 {
 // `QuadLayout::inner` and `TriLayout::inner`: grid point t of the core side facing edge e.
 fn inner_point(input: PatchInput, e: u32, t: u32) -> vec2<u32> {
     let l = input.core;
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         switch e {
             case 0u: { return vec2<u32>(l.i_lo + t, l.j_lo); }
             case 1u: { return vec2<u32>(l.i_lo + l.m - t, l.j_lo + t); }
@@ -169,17 +150,17 @@ fn inner_point(input: PatchInput, e: u32, t: u32) -> vec2<u32> {
 
 // `QuadLayout::local` and `TriLayout::local`: local index of core grid point (i, j).
 fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         let n = input.core.nu;
         if (i == 0u && j == 0u) { return 0u; }
         if (i == n && j == 0u) { return 1u; }
         if (i == 0u && j == n) { return 2u; }
-        if (j == 0u) { return input.base[0] + i - 1u; }
-        if (i + j == n) { return input.base[1] + j - 1u; }
-        if (i == 0u) { return input.base[2] + (n - j) - 1u; }
+        if (j == 0u) { return input.local.base[0] + i - 1u; }
+        if (i + j == n) { return input.local.base[1] + j - 1u; }
+        if (i == 0u) { return input.local.base[2] + (n - j) - 1u; }
         // Interior rows 1 … j − 1 before this one hold n − 1 − r points each.
         let before = (j - 1u) * (n - 1u) - (j - 1u) * j / 2u;
-        return input.interior_base + before + (i - 1u);
+        return input.local.interior_base + before + (i - 1u);
     }
     let nu = input.core.nu;
     let nv = input.core.nv;
@@ -187,51 +168,31 @@ fn grid_local(input: PatchInput, i: u32, j: u32) -> u32 {
     if (i == nu && j == 0u) { return 1u; }
     if (i == nu && j == nv) { return 2u; }
     if (i == 0u && j == nv) { return 3u; }
-    if (j == 0u) { return input.base[0] + i - 1u; }
-    if (i == nu) { return input.base[1] + j - 1u; }
-    if (j == nv) { return input.base[2] + (nu - i) - 1u; }
-    if (i == 0u) { return input.base[3] + (nv - j) - 1u; }
-    return input.interior_base + (j - 1u) * (nu - 1u) + (i - 1u);
+    if (j == 0u) { return input.local.base[0] + i - 1u; }
+    if (i == nu) { return input.local.base[1] + j - 1u; }
+    if (j == nv) { return input.local.base[2] + (nu - i) - 1u; }
+    if (i == 0u) { return input.local.base[3] + (nv - j) - 1u; }
+    return input.local.interior_base + (j - 1u) * (nu - 1u) + (i - 1u);
 }
 
-// `PatternInput::boundary_vertex`.
-fn boundary_local(input: PatchInput, e: u32, k: u32) -> u32 {
-    if (k == 0u) { return e; }
-    if (k == input.s[e]) { return (e + 1u) % input.nc; }
-    return input.base[e] + k - 1u;
+// Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
+fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
+    return domain_edge_point(input.local.p, e, f32(k) / f32(input.local.s[e]));
 }
 
-// The local edge whose inner samples hold local index l (4 ≤ l < interior_base).
-fn local_edge(input: PatchInput, l: u32) -> u32 {
-    var e = 0u;
-    for (var f = 1u; f < input.nc; f = f + 1u) {
-        if (l >= input.base[f]) { e = f; }
-    }
-    return e;
+// Domain position of core grid point (i, j): `(i·(1/nu), j·(1/nv))`, as the CPU builds the
+// interior (`QuadLayout::build`, `TriLayout::build`).
+fn grid_position(input: PatchInput, i: u32, j: u32) -> vec2<f32> {
+    return vec2<f32>(f32(i) * (1.0 / f32(input.core.nu)), f32(j) * (1.0 / f32(input.core.nv)));
 }
 
-// `LocalMap::vertex`: the output vertex of local index l.
-fn local_vertex(input: PatchInput, l: u32) -> u32 {
-    if (l < input.nc) { return patch_corner_entry(input.p, l); }
-    if (l < input.interior_base) {
-        let e = local_edge(input, l);
-        return edge_sample_vertex(input.p, e, l - input.base[e] + 1u);
-    }
-    return vertex_offsets[params.edges + input.p] + (l - input.interior_base);
+fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
+    let g = inner_point(input, e, t);
+    return grid_position(input, g.x, g.y);
 }
 
-// The identity `degenerate_after_collapse` compares for local index l.
-fn local_collapse_id(input: PatchInput, l: u32) -> vec2<u32> {
-    if (l < input.nc) { return vec2<u32>(1u, patch_corner_entry(input.p, l)); }
-    if (l < input.interior_base) {
-        let e = local_edge(input, l);
-        if (bit(input.collapsed, e) != 0u) { return vec2<u32>(1u, patch_corner_entry(input.p, e)); }
-    }
-    return vec2<u32>(0u, l);
-}
-
-// What a pattern build does with each triangle: count it, write it, or bound its error
-// (the a-posteriori check, `check.wgsl`).
+// What a pattern build does with each triangle: count it, write it (`emit`), or bound its
+// error (the a-posteriori check, `check.wgsl`).
 const SINK_COUNT: u32 = 0u;
 const SINK_WRITE: u32 = 1u;
 const SINK_CHECK: u32 = 2u;
@@ -250,45 +211,21 @@ fn sink(mode: u32, first: u32) -> Sink {
     return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)));
 }
 
-// Takes pattern triangle `tri` (local indices; ta, tb, tc its domain positions). Counting
-// and writing leave out a triangle that degenerates at a collapsed curve, else count it and
-// with SINK_WRITE write it as output triangle `first + kept`; the check bounds every
-// triangle of the pattern, as `tolerance::params_bound` does over the built pattern.
-fn emit(input: PatchInput, tri: vec3<u32>, ta: vec2<f32>, tb: vec2<f32>, tc: vec2<f32>, out: ptr<function, Sink>) {
+// Takes pattern triangle `tri` (local indices; ta, tb, tc its domain positions): counted or
+// written by `emit`, or, for the check, its error bound taken — every triangle of the
+// pattern, those a collapsed curve degenerates included, as `tolerance::params_bound` takes
+// them over the built pattern.
+fn take(input: PatchInput, tri: vec3<u32>, ta: vec2<f32>, tb: vec2<f32>, tc: vec2<f32>, out: ptr<function, Sink>) {
     if ((*out).mode == SINK_CHECK) {
         (*out).worst = max((*out).worst, triangle_error((*out).errors, ta, tb, tc));
         (*out).kept = (*out).kept + 1u;
         return;
     }
-    if (patch_repeated_corner(input.p)) {
-        let a = local_collapse_id(input, tri.x);
-        let b = local_collapse_id(input, tri.y);
-        let c = local_collapse_id(input, tri.z);
-        if (all(a == b) || all(b == c) || all(a == c)) { return; }
-    }
-    if ((*out).mode == SINK_WRITE) {
-        let t = (*out).first + (*out).kept;
-        indices[3u * t] = local_vertex(input, tri.x);
-        indices[3u * t + 1u] = local_vertex(input, tri.y);
-        indices[3u * t + 2u] = local_vertex(input, tri.z);
-    }
-    (*out).kept = (*out).kept + 1u;
-}
-
-// Domain position of outer point k of edge e (`Domain::edge_point(e, k / s)`), for ties only.
-fn outer_position(input: PatchInput, e: u32, k: u32) -> vec2<f32> {
-    return domain_edge_point(input.p, e, f32(k) / f32(input.s[e]));
-}
-
-// Domain position of core grid point (i, j): `(i·(1/nu), j·(1/nv))`, as the CPU builds the
-// interior (`QuadLayout::build`, `TriLayout::build`).
-fn grid_position(input: PatchInput, i: u32, j: u32) -> vec2<f32> {
-    return vec2<f32>(f32(i) * (1.0 / f32(input.core.nu)), f32(j) * (1.0 / f32(input.core.nv)));
-}
-
-fn inner_position(input: PatchInput, e: u32, t: u32) -> vec2<f32> {
-    let g = inner_point(input, e, t);
-    return grid_position(input, g.x, g.y);
+    // Through a local: naga 30's SPIR-V writer cannot pass a pointer to a member of a
+    // pointed-to struct ("expression is not cached").
+    var kept = (*out).kept;
+    emit(input.local, tri, (*out).mode == SINK_WRITE, (*out).first, &kept);
+    (*out).kept = kept;
 }
 
 fn inner_local(input: PatchInput, e: u32, t: u32) -> u32 {
@@ -305,17 +242,17 @@ const TIE_TOLERANCE: f32 = 1e-5;
 // ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification).
 fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
     let l = input.core;
-    let s = input.s[e];
+    let s = input.local.s[e];
     let m = inner_segments(input, e);
-    let lead = bit(l.strips, (e + input.nc - 1u) % input.nc);
-    let trail = bit(l.strips, (e + 1u) % input.nc);
+    let lead = bit(l.strips, (e + input.local.nc - 1u) % input.local.nc);
+    let trail = bit(l.strips, (e + 1u) % input.local.nc);
     let span = i32(m + lead + trail);
     let s32 = i32(s);
     var d = span - (2 * i32(lead) + 1) * s32;
     var i = 0u;
     var j = 0u;
-    var o0 = boundary_local(input, e, 0u);
-    var o1 = boundary_local(input, e, 1u);
+    var o0 = boundary_local(input.local, e, 0u);
+    var o1 = boundary_local(input.local, e, 1u);
     var n0 = inner_local(input, e, 0u);
     var n1 = select(n0, inner_local(input, e, 1u), m > 0u);
     while (i < s || j < m) {
@@ -342,15 +279,15 @@ fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
         if (advance_outer) {
             let at = outer_position(input, e, i);
             let next = outer_position(input, e, i + 1u);
-            emit(input, vec3<u32>(o0, o1, n0), at, next, inner_position(input, e, j), out);
+            take(input, vec3<u32>(o0, o1, n0), at, next, inner_position(input, e, j), out);
             i = i + 1u;
             if (j < m && i < s) { d = d + 2 * span; }
             o0 = o1;
-            if (i < s) { o1 = boundary_local(input, e, i + 1u); }
+            if (i < s) { o1 = boundary_local(input.local, e, i + 1u); }
         } else {
             let at = inner_position(input, e, j);
             let next = inner_position(input, e, j + 1u);
-            emit(input, vec3<u32>(o0, n1, n0), outer_position(input, e, i), next, at, out);
+            take(input, vec3<u32>(o0, n1, n0), outer_position(input, e, i), next, at, out);
             j = j + 1u;
             if (j < m && i < s) { d = d - 2 * s32; }
             n0 = n1;
@@ -360,24 +297,22 @@ fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
 }
 
 // `TriLayout::build`'s triangles: the core in the uniform pattern's loop and vertex order,
-// shifted to the core's corner, then each strip's walk. Returns the triangles kept.
+// shifted to the core's corner, then each strip's walk, into `out`. The check takes the
+// strips only: every core triangle is half a grid cell, bounded once (`check.wgsl`).
 fn build_tri_transition(input: PatchInput, out: ptr<function, Sink>) {
     let l = input.core;
     let i0 = l.i_lo;
     let j0 = l.j_lo;
-    let m = l.m;
+    let m = select(l.m, 0u, (*out).mode == SINK_CHECK);
     for (var j = 0u; j < m; j = j + 1u) {
         for (var i = 0u; i < m - j; i = i + 1u) {
             let a = grid_local(input, i0 + i, j0 + j);
             let b = grid_local(input, i0 + i + 1u, j0 + j);
             let d = grid_local(input, i0 + i, j0 + j + 1u);
-            let ta = grid_position(input, i0 + i, j0 + j);
-            let tb = grid_position(input, i0 + i + 1u, j0 + j);
-            let td = grid_position(input, i0 + i, j0 + j + 1u);
-            emit(input, vec3<u32>(a, b, d), ta, tb, td, out);
+            let z = vec2<f32>(0.0); // positions: the check takes no core triangle
+            take(input, vec3<u32>(a, b, d), z, z, z, out);
             if (i + j + 2u <= m) {
-                let c = grid_local(input, i0 + i + 1u, j0 + j + 1u);
-                emit(input, vec3<u32>(b, c, d), tb, grid_position(input, i0 + i + 1u, j0 + j + 1u), td, out);
+                take(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), z, z, z, out);
             }
         }
     }
@@ -387,23 +322,24 @@ fn build_tri_transition(input: PatchInput, out: ptr<function, Sink>) {
 }
 
 // `QuadLayout::build`'s triangles: the core cells row after row, then each strip's walk
-// (`build_tri_transition` on triangles), into `out`. Cost: O(pattern triangles), serial.
+// (`build_tri_transition` on triangles), into `out`; the check takes the strips only (see
+// there). Cost: O(pattern triangles), serial.
 fn build_transition(input: PatchInput, out: ptr<function, Sink>) {
-    if (input.nc == 3u) {
+    if (input.local.nc == 3u) {
         build_tri_transition(input, out);
         return;
     }
     let l = input.core;
-    for (var j = l.j_lo; j < l.j_hi; j = j + 1u) {
+    let j_end = select(l.j_hi, l.j_lo, (*out).mode == SINK_CHECK);
+    for (var j = l.j_lo; j < j_end; j = j + 1u) {
         for (var i = l.i_lo; i < l.i_hi; i = i + 1u) {
             let a = grid_local(input, i, j);
             let b = grid_local(input, i + 1u, j);
             let c = grid_local(input, i + 1u, j + 1u);
             let d = grid_local(input, i, j + 1u);
-            let ta = grid_position(input, i, j);
-            let tc = grid_position(input, i + 1u, j + 1u);
-            emit(input, vec3<u32>(a, b, c), ta, grid_position(input, i + 1u, j), tc, out);
-            emit(input, vec3<u32>(a, c, d), ta, tc, grid_position(input, i, j + 1u), out);
+            let z = vec2<f32>(0.0); // positions: the check takes no core triangle
+            take(input, vec3<u32>(a, b, c), z, z, z, out);
+            take(input, vec3<u32>(a, c, d), z, z, z, out);
         }
     }
     for (var e = 0u; e < 4u; e = e + 1u) {

@@ -14,18 +14,21 @@ struct View {
     tan_x: f32,
     tan_y: f32,
     // `Camera::focal_pixels`, the pixel error, the factor cap (`PlanOptions::max_factor`),
-    // the interior rule (INTERIOR_GLOBAL or INTERIOR_CORE; with a pixel error, INTERIOR_CORE
-// means the a-posteriori check of `check.wgsl` decides the interiors).
+    // the interior rule (INTERIOR_GLOBAL, INTERIOR_CORE or INTERIOR_MAX_EDGE; with a pixel
+    // error, INTERIOR_CORE means the a-posteriori check of `check.wgsl` decides the
+    // interiors).
     focal: f32,
     pixels: f32,
     cap: f32,
     interior_rule: u32,
-    // The criterion (CRITERION_PIXEL_ERROR or CRITERION_SILHOUETTENESS) and the view
-    // criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap applied).
+    // The criterion (CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS or CRITERION_FIXED) and
+    // the view criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap
+    // applied; a fixed factor is lo = hi); the edge rule (EDGE_RULE_INTEGER or
+    // EDGE_RULE_HARDWARE, whose partitioning is `params.partitioning`).
     criterion: u32,
     lo: f32,
     hi: f32,
-    _pad: u32,
+    edge_rule: u32,
 }
 
 @group(1) @binding(0) var<uniform> view: View;
@@ -74,6 +77,10 @@ struct CheckRow {
 const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
 const INTERIOR_GLOBAL: u32 = 0u;
 const INTERIOR_CORE: u32 = 1u;
+const INTERIOR_MAX_EDGE: u32 = 2u;
 const CRITERION_PIXEL_ERROR: u32 = 0u;
 const CRITERION_SILHOUETTENESS: u32 = 1u;
+const CRITERION_FIXED: u32 = 2u;
+const EDGE_RULE_INTEGER: u32 = 0u;
+const EDGE_RULE_HARDWARE: u32 = 1u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;

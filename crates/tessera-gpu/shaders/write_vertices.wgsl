@@ -31,8 +31,9 @@ fn use_of_variant(e: u32, variant: u32) -> u32 {
 }
 
 // Edge vertex corners + x: `engine::write_edge`. Sample k of variant v of edge e, evaluated by
-// the first use of variant v (its normal and uv) at the canonical parameter
-// `uniform_param(segments, k)` mirrored for a reversed use; its position is variant 0's.
+// the first use of variant v (its normal and uv) at the canonical parameter the pattern's file
+// gives (`edge_param(e, k)`, `Plan::param`) mirrored for a reversed use; its position is
+// variant 0's.
 @compute @workgroup_size(WORKGROUP)
 fn write_edge_vertices(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -46,7 +47,7 @@ fn write_edge_vertices(
     let local = v - vertex_offsets[e];
     let variant = local / (s - 1u);
     let k = local % (s - 1u) + 1u;
-    let t = uniform_param(s, k);
+    let t = edge_param(e, k);
     let owner = edge_first_use(e);
     let u = use_of_variant(e, variant);
     let uv = edge_use_point(u, t);
@@ -62,9 +63,8 @@ fn edge_use_point(u: u32, t: f32) -> vec2<f32> {
     return domain_edge_point(use_patch(u), use_local(u), local_t);
 }
 
-// Interior vertex j of patch p (`vertex_offsets[E + p] + j`): on a quad, grid point
-// (j mod (nu − 1) + 1, j div (nu − 1) + 1) at `(i · (1 / nu), j · (1 / nv))`, as the
-// uniform and transition patterns place their grids (`interior_grid` is the pattern's).
+// Interior vertex j of patch p (`vertex_offsets[E + p] + j`), at the pattern's
+// `interior_point(p, j)`: the engine's `Writer::patch`.
 @compute @workgroup_size(WORKGROUP)
 fn write_interior_vertices(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -75,25 +75,7 @@ fn write_interior_vertices(
     let v = vertex_offsets[edges] + thread_index(wid, nwg, lid);
     if (v >= vertex_offsets[edges + params.patches]) { return; }
     let p = find_vertex_range(edges, edges + params.patches, v) - edges;
-    let j = v - vertex_offsets[edges + p];
-    let grid = interior_grid(p);
-    var uv = vec2<f32>(
-        f32(j % (grid.x - 1u) + 1u) * (1.0 / f32(grid.x)),
-        f32(j / (grid.x - 1u) + 1u) * (1.0 / f32(grid.y)),
-    );
-    if (patch_is_tri(p)) {
-        // The triangle grid's interior rows r = 1 … n − 2 hold n − 1 − r points each
-        // (`uniform::grid`). Cost: O(n) to find the row.
-        let n = grid.x;
-        var row = 1u;
-        var first = 0u;
-        while (j >= first + (n - 1u - row)) {
-            first = first + (n - 1u - row);
-            row = row + 1u;
-        }
-        let step = 1.0 / f32(n);
-        uv = vec2<f32>(f32(j - first + 1u) * step, f32(row) * step);
-    }
+    let uv = interior_point(p, v - vertex_offsets[edges + p]);
     let point = eval_patch(p, uv);
     store_vertex(v, point.position, point.normal, uv);
 }

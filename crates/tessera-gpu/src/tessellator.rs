@@ -5,13 +5,14 @@
 //! [`PassTimer`] when the adapter has timestamp queries):
 //!
 //! 0. **cull** (`cull.wgsl`, with a culling camera) and **factors** (`factors.wgsl`, after
-//!    [`GpuTessellator::prepare_screen`]): the visibility row and the plan's segments and
-//!    interior factors from the camera alone, from view-independent rows uploaded once; for
-//!    the transition scheme's pixel error also the a-posteriori check (`check.wgsl`,
-//!    `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds that size
-//!    themselves on the GPU raise interiors and edges until the bounds hold;
-//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`): per edge and per patch, the counts
-//!    `tessera::engine::Layout::build` scans, in place in the offset buffers;
+//!    [`GpuTessellator::prepare_screen`]): the visibility row and the plan's segments, real
+//!    factors and interior factors from the camera alone, from view-independent rows
+//!    uploaded once; for the transition scheme's pixel error also the a-posteriori check
+//!    (`check.wgsl`, `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds
+//!    that size themselves on the GPU raise interiors and edges until the bounds hold;
+//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `hardware.wgsl`): per edge and per
+//!    patch, the counts `tessera::engine::Layout::build` scans, in place in the offset
+//!    buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
 //!    vertex scan over `E + P + 1` entries starting at the corner count (edge offsets, then
 //!    interior offsets), the triangle scan over `P + 1`;
@@ -21,8 +22,9 @@
 //!    interior vertices;
 //! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
 //!    triangle; transition (`transition.wgsl`) one invocation per patch walking its core
-//!    and strips in the CPU's order (parallel over patches only: the next step is a
-//!    per-triangle form).
+//!    and strips in the CPU's order; the Direct3D 11 partitionings (`hardware.wgsl`) one
+//!    invocation per patch walking its rings and stitches in the CPU's order (parallel over
+//!    patches only: the next step is a per-triangle form).
 //!
 //! **No read-back in the frame path, by construction**: [`GpuTessellator::record`] only
 //! records compute passes; the buffers it writes are read by the GPU (indirect dispatch and
@@ -40,10 +42,11 @@ use tessera::camera::Camera;
 use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
+use tessera::pattern::hardware::{Hardware, Partitioning};
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
-use tessera::sampling::SamplingKind;
+use tessera::sampling::{SamplingKind, Spacing};
 use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 
@@ -81,6 +84,10 @@ const FACTORS: &str = include_str!("../shaders/factors.wgsl");
 const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
 const BOUNDS: &str = include_str!("../shaders/bounds.wgsl");
 const CHECK: &str = include_str!("../shaders/check.wgsl");
+const LOCAL: &str = include_str!("../shaders/local.wgsl");
+const GRID_VERTICES: &str = include_str!("../shaders/grid_vertices.wgsl");
+const HARDWARE_PARTITION: &str = include_str!("../shaders/hardware_partition.wgsl");
+const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
@@ -89,15 +96,43 @@ const ARGS_STORAGE: u32 = 3;
 /// Storage buffers in group 1 of the view passes (`view.wgsl`).
 const VIEW_STORAGE: u32 = 6;
 /// Rounds of the a-posteriori check a frame records (`check.wgsl`). The CPU's loop runs up
-/// to 256 but ends after a few: across every model in the shared data at 0.25–4 px, the most
-/// it took was 8 fix rounds (a close view of the drag knob). A round that is not needed
+/// to 256 rounds but ends after a few: across every model in the shared data, 8 seeded
+/// cameras at 0.25, 1 and 4 px and caps 16 and 64, the most it took was 34 (the spool at cap
+/// 16, where patches at the cap miss their bound and each round moves the problem one patch
+/// along the mesh; 41 on another camera in `tests/check.rs`). A round that is not needed
 /// dispatches no work; a plan that needs more is reported ([`ScreenReport::converged`]).
 pub const MAX_ROUNDS: u32 = 64;
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
 const PATCH_VIEW_ROW: u32 = 8;
 
-/// Constants the tessellation shaders share with this crate.
+/// The Direct3D 11 partitionings, in the order of their codes ([`partitioning_code`]).
+const PARTITIONINGS: [Partitioning; 4] =
+    [Partitioning::Integer, Partitioning::Pow2, Partitioning::FractionalOdd, Partitioning::FractionalEven];
+
+/// The CPU pattern of each partitioning, in the same order.
+static HARDWARE_PATTERNS: [Hardware; 4] = [
+    Hardware { partitioning: PARTITIONINGS[0] },
+    Hardware { partitioning: PARTITIONINGS[1] },
+    Hardware { partitioning: PARTITIONINGS[2] },
+    Hardware { partitioning: PARTITIONINGS[3] },
+];
+
+/// `Params::partitioning`'s code of `p` (`hardware_partition.wgsl`'s PARTITIONING_*).
+fn partitioning_code(p: Partitioning) -> u32 {
+    PARTITIONINGS.iter().position(|&q| q == p).expect("every partitioning is listed") as u32
+}
+
+/// Constants the tessellation shaders share with this crate (and with the CPU library: the
+/// partitionings' ranges and the settling gap are `tessera::sampling::hardware`'s own).
 fn constants() -> Vec<(&'static str, u32)> {
+    let range = |p: Partitioning, hi: bool| {
+        let (lo, top) = p.range();
+        let x = if hi { top } else { lo };
+        debug_assert_eq!(x.fract(), 0.0, "the hardware's factor ranges end on integers");
+        x as u32
+    };
+    let gap_inverse = 1.0 / tessera::sampling::hardware::OUTPUT_GAP;
+    debug_assert_eq!(gap_inverse.fract(), 0.0, "the settling gap is 1/n");
     vec![
         ("PATCH_ROW", upload::PATCH_ROW),
         ("EDGE_ROW", upload::EDGE_ROW),
@@ -107,6 +142,17 @@ fn constants() -> Vec<(&'static str, u32)> {
         ("VERTEX_FLOATS", VERTEX_FLOATS),
         ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
         ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
+        ("PARTITIONING_INTEGER", partitioning_code(Partitioning::Integer)),
+        ("PARTITIONING_POW2", partitioning_code(Partitioning::Pow2)),
+        ("PARTITIONING_FRACTIONAL_ODD", partitioning_code(Partitioning::FractionalOdd)),
+        ("PARTITIONING_FRACTIONAL_EVEN", partitioning_code(Partitioning::FractionalEven)),
+        ("INTEGER_LO", range(Partitioning::Integer, false)),
+        ("INTEGER_HI", range(Partitioning::Integer, true)),
+        ("FRACTIONAL_ODD_LO", range(Partitioning::FractionalOdd, false)),
+        ("FRACTIONAL_ODD_HI", range(Partitioning::FractionalOdd, true)),
+        ("FRACTIONAL_EVEN_LO", range(Partitioning::FractionalEven, false)),
+        ("FRACTIONAL_EVEN_HI", range(Partitioning::FractionalEven, true)),
+        ("OUTPUT_GAP_INVERSE", gap_inverse as u32),
     ]
 }
 
@@ -122,6 +168,10 @@ pub enum GpuPattern {
     /// [`tessera::pattern::transition::Transition`] on quads and triangles (CudaTess): one
     /// invocation per patch builds its core and strips serially.
     Transition,
+    /// [`tessera::pattern::hardware::Hardware`], the Direct3D 11 tessellator with one of its
+    /// partitionings (`integer`, `pow2`, `fractional_odd`, `fractional_even`) on quads and
+    /// triangles: one invocation per patch walks its rings and stitches serially.
+    Hardware(Partitioning),
 }
 
 impl GpuPattern {
@@ -130,7 +180,27 @@ impl GpuPattern {
         match pattern.name() {
             n if n == Uniform.name() => Some(GpuPattern::Uniform),
             n if n == Transition.name() => Some(GpuPattern::Transition),
-            _ => None,
+            n => PARTITIONINGS
+                .into_iter()
+                .find(|&p| Hardware { partitioning: p }.name() == n)
+                .map(GpuPattern::Hardware),
+        }
+    }
+
+    /// The CPU pattern this draws (for counts read back, [`GpuTessellator::read_mesh`]).
+    fn cpu_pattern(self) -> &'static dyn Pattern {
+        match self {
+            GpuPattern::Uniform => &Uniform,
+            GpuPattern::Transition => &Transition,
+            GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
+        }
+    }
+
+    /// `Params::partitioning`: the partitioning's code, 0 for the integer patterns.
+    fn partitioning_code(self) -> u32 {
+        match self {
+            GpuPattern::Hardware(p) => partitioning_code(p),
+            _ => 0,
         }
     }
 }
@@ -144,7 +214,7 @@ struct PatternPipelines {
     edge_vertices: wgpu::ComputePipeline,
     interior_vertices: wgpu::ComputePipeline,
     /// Uniform: one invocation per triangle (indirect), then the collapsed-corner patches.
-    /// Transition: one invocation per patch.
+    /// Transition and hardware: one invocation per patch.
     triangles: wgpu::ComputePipeline,
     collapsed_triangles: Option<wgpu::ComputePipeline>,
 }
@@ -167,6 +237,26 @@ pub struct Pipelines {
     args: wgpu::ComputePipeline,
     uniform: PatternPipelines,
     transition: PatternPipelines,
+    /// The hardware pattern's, compiled on first use ([`Pipelines::hardware`]): a frame of
+    /// the integer patterns does not wait for them.
+    hardware: std::sync::OnceLock<PatternPipelines>,
+    main_pipeline_layout: wgpu::PipelineLayout,
+}
+
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
 }
 
 impl Pipelines {
@@ -194,24 +284,17 @@ impl Pipelines {
         let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
         let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&view_layout), Some(&rounds_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(layout),
-                module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+            compute_pipeline(device, layout, module, entry)
         };
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
-        let factors = module(device, "factors", &[COMMON, VIEW, CULL, FACTORS]);
+        let factors = module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS]);
         let uniform = {
             let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]);
             let vertices = module(
                 device,
                 "vertices uniform",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, WRITE_VERTICES],
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
             );
             let triangles =
                 module(device, "triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
@@ -225,11 +308,11 @@ impl Pipelines {
             }
         };
         let transition = {
-            let pattern = module(device, "transition", &[COMMON, BOUNDS, TRANSITION, COUNT]);
+            let pattern = module(device, "transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]);
             let vertices = module(
                 device,
                 "vertices transition",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, BOUNDS, TRANSITION, WRITE_VERTICES],
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, LOCAL, BOUNDS, TRANSITION, GRID_VERTICES, WRITE_VERTICES],
             );
             PatternPipelines {
                 count: make(&one, &pattern, "count"),
@@ -241,7 +324,8 @@ impl Pipelines {
             }
         };
         let check = {
-            let m = module(device, "check", &[COMMON, VIEW, CULL, FACTORS, BOUNDS, TRANSITION, CHECK]);
+            let parts = [COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS, LOCAL, BOUNDS, TRANSITION, CHECK];
+            let m = module(device, "check", &parts);
             CheckPipelines {
                 check_all: make(&with_view, &m, "check_all"),
                 open: make(&with_rounds, &m, "round_open"),
@@ -261,9 +345,46 @@ impl Pipelines {
             args: make(&two, &args, "write_args"),
             uniform,
             transition,
+            hardware: std::sync::OnceLock::new(),
+            main_pipeline_layout: one,
             main_layout,
             args_layout,
             view_layout,
+        }
+    }
+
+    /// The hardware pattern's pipelines (`hardware.wgsl`), compiled on the first call.
+    /// Cost: the first call two WGSL compilations (lavapipe finishes them at their first
+    /// dispatch: about 5 s, once per device); later calls nothing.
+    fn hardware(&self, device: &wgpu::Device) -> &PatternPipelines {
+        self.hardware.get_or_init(|| {
+            let make = |module: &wgpu::ShaderModule, entry: &str| {
+                compute_pipeline(device, &self.main_pipeline_layout, module, entry)
+            };
+            let pattern = module(device, "hardware", &[COMMON, HARDWARE_PARTITION, LOCAL, HARDWARE, COUNT]);
+            let vertices = module(
+                device,
+                "vertices hardware",
+                &[COMMON, BICUBIC, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
+            );
+            PatternPipelines {
+                count: make(&pattern, "count"),
+                corners: make(&vertices, "write_corners"),
+                edge_vertices: make(&vertices, "write_edge_vertices"),
+                interior_vertices: make(&vertices, "write_interior_vertices"),
+                triangles: make(&pattern, "write_patch_triangles"),
+                collapsed_triangles: None,
+            }
+        })
+    }
+
+    /// The pipelines of `pattern`; None for the hardware pattern before
+    /// [`Pipelines::hardware`] compiled them.
+    fn of(&self, pattern: GpuPattern) -> Option<&PatternPipelines> {
+        match pattern {
+            GpuPattern::Uniform => Some(&self.uniform),
+            GpuPattern::Transition => Some(&self.transition),
+            GpuPattern::Hardware(_) => self.hardware.get(),
         }
     }
 }
@@ -288,7 +409,8 @@ struct Params {
     corners: u32,
     vertex_capacity: u32,
     triangle_capacity: u32,
-    _pad: [u32; 3],
+    partitioning: u32,
+    _pad: [u32; 2],
 }
 
 /// The worst-case output of a plan, known before the frame.
@@ -324,6 +446,74 @@ impl Capacity {
     }
 }
 
+/// The largest output a hardware frame planned on the GPU can have: every edge at the largest
+/// factor `resolve::edges` can give it — the cap, or the largest minimum when that is higher,
+/// through the hull shader's rounding (`Partitioning::hull_factor`), within the
+/// partitioning's range — drawn by [`Hardware`] ([`Capacity::of_plan`], every patch visible).
+///
+/// An upper bound because the pattern's output grows with its factors: an edge's segments
+/// grow with its factor, the interior points with the inside factors (the largest edge
+/// factors), and a triangulation of the domain with B boundary and I interior points has
+/// `B + 2I − 2` triangles (the test `the_hardware_worst_case_bounds_every_frame` checks this
+/// on random factors). Cost: O(E + P) pattern counts.
+fn hardware_worst_case(
+    set: &SurfaceSet,
+    prepared: &Prepared,
+    partitioning: Partitioning,
+    cap: f64,
+) -> Capacity {
+    let minimum = prepared.minimum_segments.iter().copied().max().unwrap_or(1) as f64;
+    let factor = partitioning.hull_factor(cap.max(minimum)).min(partitioning.range().1 as f64);
+    Capacity::of_plan(
+        set,
+        &hardware_uniform_plan(set, partitioning, factor),
+        &Hardware { partitioning },
+        true,
+    )
+}
+
+/// The hardware plan with `factor` on every edge, every patch visible. Cost: O(E + P).
+fn hardware_uniform_plan(set: &SurfaceSet, partitioning: Partitioning, factor: f64) -> Plan {
+    let segments = tessera::pattern::hardware::edge_segments(factor, partitioning);
+    let (edges, patches) = (set.topology.edges.len(), set.patches.len());
+    Plan {
+        kind: SamplingKind::Fractional(Spacing::Hardware(partitioning)),
+        segments: vec![segments; edges],
+        factors: vec![factor as f32; edges],
+        depths: Vec::new(),
+        lattice_offsets: Vec::new(),
+        lattice: Vec::new(),
+        interior: vec![[segments, segments]; patches],
+        visible: vec![1; patches],
+    }
+}
+
+/// Checks a hardware plan against what the factor processing on the GPU (and the CPU
+/// pattern) assumes: every factor a finite positive number (WGSL may assume no NaN or
+/// infinity; the CPU pattern refuses a factor that is not positive), every edge cut into
+/// [`tessera::pattern::hardware::edge_segments`] of its factor (the CPU pattern's
+/// precondition). Cost: O(E).
+fn check_hardware_plan(plan: &Plan, partitioning: Partitioning) -> Result<()> {
+    for (e, (&s, &f)) in plan.segments.iter().zip(&plan.factors).enumerate() {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(GpuError::Unsupported {
+                what: format!("edge {e}'s factor {f} (the hardware patterns take finite positive factors)"),
+            });
+        }
+        let cut = tessera::pattern::hardware::edge_segments(f as f64, partitioning);
+        if s != cut {
+            return Err(tessera::Error::PlanMismatch {
+                what: format!(
+                    "edge {e}: {s} segments for the factor {f}, which {} cuts into {cut}",
+                    partitioning.name()
+                ),
+            }
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// Buffers whose size depends on the output capacity, and their bind groups.
 #[derive(Debug)]
 struct Output {
@@ -337,11 +527,13 @@ struct Output {
 /// frame into device buffers that a render pipeline binds directly (see the module doc for
 /// the passes).
 ///
-/// Supported now: [`SamplingKind::Uniform`] plans, for the uniform pattern on every patch
-/// kind (bicubic, Bézier triangles, PN triangles; every edge of a visible patch cut into its
-/// interior factor, as `Scheme::Uniform` plans are) and the transition pattern on every
-/// patch kind (any per-edge segments and core factors, as `Scheme::Transition` plans);
-/// anything else is refused with [`GpuError::Unsupported`].
+/// Supported now, on every patch kind (bicubic, Bézier triangles, PN triangles):
+/// [`SamplingKind::Uniform`] plans for the uniform pattern (every edge of a visible patch cut
+/// into its interior factor, as `Scheme::Uniform` plans are) and the transition pattern (any
+/// per-edge segments and core factors, as `Scheme::Transition` plans); and
+/// `SamplingKind::Fractional(Spacing::Hardware(p))` plans for the Direct3D 11 pattern of
+/// partitioning `p` (real per-edge factors, as `Scheme::Hardware(p)` plans). Anything else is
+/// refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
@@ -426,7 +618,8 @@ impl GpuTessellator {
         let view = ViewBuffers::new(device, &pipelines.view_layout, &pipelines.rounds_layout, set);
         Ok(GpuTessellator {
             params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
-            segments: buffer(device, "segments", 4 * e, plan_usage),
+            // The plan's segments, then its factors (`common.wgsl`'s `edge_factor`).
+            segments: buffer(device, "segments and factors", 8 * e, plan_usage),
             interior: buffer(device, "interior", 8 * p, plan_usage),
             visible: buffer(device, "visible", 4 * p, plan_usage),
             vertex_offsets,
@@ -448,17 +641,23 @@ impl GpuTessellator {
         })
     }
 
-    /// Uploads `plan` (made for `pattern`, the uniform or the transition pattern) for the
-    /// next [`GpuTessellator::record`] (ending [`GpuTessellator::prepare_screen`]'s own
-    /// planning), growing the output buffers
-    /// to its worst case ([`Capacity::of_plan`]) when they are too small.
+    /// Uploads `plan` (made for `pattern`: the uniform, the transition or a hardware pattern)
+    /// for the next [`GpuTessellator::record`] (ending [`GpuTessellator::prepare_screen`]'s
+    /// own planning), growing the output buffers to its worst case ([`Capacity::of_plan`])
+    /// when they are too small.
     ///
     /// Preconditions: `plan` was made for `set`, the set given to [`GpuTessellator::new`].
-    /// Errors: [`tessera::Error::PlanMismatch`] for a plan of another set;
-    /// [`GpuError::Unsupported`] for another pattern or a plan that is not uniform per patch;
+    /// Errors: [`tessera::Error::PlanMismatch`] for a plan of another set, or a hardware plan
+    /// whose segments are not its factors' (`tessera::pattern::hardware::edge_segments`, the
+    /// CPU pattern's precondition); [`GpuError::Unsupported`] for another pattern, a plan
+    /// that is not uniform per patch (uniform pattern), a sampling kind that is not the
+    /// pattern's ([`SamplingKind::Uniform`] for the integer patterns,
+    /// `SamplingKind::Fractional(Spacing::Hardware(p))` of the pattern's own partitioning for
+    /// a hardware pattern) or a factor that is not a finite positive number;
     /// [`GpuError::OutputTooLarge`] when the worst case exceeds the u32 index range or the
-    /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the
-    /// plan's arrays (16 bytes a patch, 4 an edge); a reallocation when the output grows.
+    /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the plan's
+    /// arrays (16 bytes a patch, 8 an edge); a reallocation when the output grows; on the
+    /// first hardware plan, the compilation of its pipelines.
     pub fn prepare(
         &mut self,
         ctx: &GpuContext,
@@ -469,7 +668,11 @@ impl GpuTessellator {
         plan.check(set)?;
         let Some(kind) = GpuPattern::of(pattern) else {
             return Err(GpuError::Unsupported {
-                what: format!("the {} pattern (uniform and transition are on the GPU)", pattern.name()),
+                what: format!(
+                    "the {} pattern (uniform, transition and the Direct3D 11 partitionings integer, \
+                     pow2, fractional_odd and fractional_even are on the GPU)",
+                    pattern.name()
+                ),
             });
         };
         if set.patches.len() as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
@@ -477,8 +680,17 @@ impl GpuTessellator {
                 tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
             );
         }
-        if plan.kind != SamplingKind::Uniform {
-            return Err(GpuError::Unsupported { what: format!("{:?} samplings", plan.kind) });
+        let expected_kind = match kind {
+            GpuPattern::Hardware(p) => SamplingKind::Fractional(Spacing::Hardware(p)),
+            _ => SamplingKind::Uniform,
+        };
+        if plan.kind != expected_kind {
+            return Err(GpuError::Unsupported {
+                what: format!("{:?} samplings with the {} pattern", plan.kind, pattern.name()),
+            });
+        }
+        if let GpuPattern::Hardware(p) = kind {
+            check_hardware_plan(plan, p)?;
         }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
@@ -495,12 +707,17 @@ impl GpuTessellator {
         }
         let capacity = Capacity::of_plan(set, plan, pattern, self.camera.is_some());
         self.reserve(ctx, capacity)?;
+        if let GpuPattern::Hardware(_) = kind {
+            self.pipelines.hardware(&ctx.device);
+        }
         self.screen = None;
+        self.pattern = kind;
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
+        queue.write_buffer(&self.segments, 4 * self.set.edges as u64, bytemuck::cast_slice(&plan.factors));
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
-        self.pattern = kind;
+        self.write_params(ctx);
         Ok(())
     }
 
@@ -520,19 +737,28 @@ impl GpuTessellator {
     /// the largest over the visible patches) or [`Scheme::Transition`] (CudaTess: per-edge
     /// factors and the a-posteriori check of `check.wgsl`, which raises interiors and, round
     /// by round, edges until every visible patch's bound holds; see
-    /// [`GpuTessellator::read_screen_report`]), and [`Criterion::View`] with
+    /// [`GpuTessellator::read_screen_report`]); [`Criterion::View`] with
     /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
-    /// (per-edge factors, CudaTess's core rule). The output is
-    /// sized for the worst case, every patch at `max_factor` (or at the largest minimum
-    /// when that is higher), within the device's buffer limits, or as `criterion.capacity`
-    /// says; a frame that needs more draws nothing and is reported
-    /// ([`GpuTessellator::grow_if_overflowed`]).
+    /// (per-edge factors, CudaTess's core rule) or a [`Scheme::Hardware`] partitioning (real
+    /// per-edge factors by `EdgeRule::Fractional`: the cap, the minimum segments, the hull
+    /// shader's pow2 rounding and `settled_factor`; Direct3D's `max` inside reduction in the
+    /// pattern); and [`Criterion::Factor`] with a [`Scheme::Hardware`] partitioning (one real
+    /// factor, resolved the same way, with the GPU's culling). A silhouetteness strictly
+    /// between 0 and 1 is computed in f32 from f32 copies of the CPU's data, so such an edge's
+    /// real factor may differ from the CPU's in its last bits (`factors.wgsl`). The distance
+    /// and vertex-silhouette criteria are planned on the CPU (their plans draw on the GPU
+    /// through [`GpuTessellator::prepare`]). The output is sized for the worst case, every
+    /// patch at the cap (or at the largest minimum when that is higher), within the device's
+    /// buffer limits, or as `criterion.capacity` says; a frame that needs more draws nothing
+    /// and is reported ([`GpuTessellator::grow_if_overflowed`]).
     ///
     /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
     /// Errors: [`GpuError::Unsupported`] for another scheme or criterion or a `prepared`
     /// without bounds; [`tessera::Error::InvalidParameter`] for a pixel error that is not a
-    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` in integers, or a
-    /// `max_factor` outside `1..=MAX_FACTOR` (the checks of [`Scheme::plan`]);
+    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` (in integers for the
+    /// integer schemes), or a `max_factor` outside `1..=MAX_FACTOR`, and
+    /// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks
+    /// of [`Scheme::plan`]);
     /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
     /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
     /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
@@ -555,7 +781,19 @@ impl GpuTessellator {
         let invalid = |name: &'static str, reason: String| {
             Err(GpuError::from(tessera::Error::InvalidParameter { name, reason }))
         };
-        let cap = max_factor as f64;
+        if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
+            return invalid(
+                "max factor",
+                format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR),
+            );
+        }
+        // The scheme's own cap and `max_factor`, as `Scheme::plan_into` caps (the hardware's
+        // range for its partitionings).
+        let cap = scheme.factor_cap().min(max_factor as f64);
+        let hardware = match scheme {
+            Scheme::Hardware(p) => Some(p),
+            _ => None,
+        };
         let (kind, pixels, lo, hi) = match (scheme, criterion) {
             (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(px)) => {
                 if !(px.is_finite() && px > 0.0) {
@@ -564,21 +802,42 @@ impl GpuTessellator {
                 (CRITERION_PIXEL_ERROR, px, 1.0, 1.0)
             }
             (
-                Scheme::Uniform | Scheme::Transition,
+                Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
                 Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax },
             ) => {
-                let valid = |f: f64| f.is_finite() && f >= 1.0 && f.fract() == 0.0;
+                // Real factors for the hardware schemes, integers for the others.
+                let integer = hardware.is_none();
+                let valid = |f: f64| f.is_finite() && f >= 1.0 && (!integer || f.fract() == 0.0);
                 if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
-                    return invalid("factor range", format!("{fmin}:{fmax}: use integers 1 ≤ FMIN ≤ FMAX"));
+                    let what = if integer { "integers" } else { "numbers" };
+                    return invalid("factor range", format!("{fmin}:{fmax}: use {what} 1 ≤ FMIN ≤ FMAX"));
                 }
                 // As `Scheme::plan_into` and `view::edge_factors_into` bound the range.
                 let fmax = fmax.min(cap);
                 let lo = fmin.min(fmax).max(1.0);
                 (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
             }
+            (Scheme::Hardware(p), Criterion::Factor(f)) => {
+                if !(f.is_finite() && f >= 1.0 && f <= cap) {
+                    return Err(tessera::Error::FactorOutOfRange {
+                        scheme: scheme.name(),
+                        factor: f,
+                        expected: format!(
+                            "a number from 1 to {cap} (the {} range and the max factor)",
+                            p.name()
+                        ),
+                    }
+                    .into());
+                }
+                (CRITERION_FIXED, 1.0, f, f)
+            }
             _ => return unsupported(),
         };
-        let interior = if scheme == Scheme::Uniform { INTERIOR_GLOBAL } else { INTERIOR_CORE };
+        let interior = match scheme {
+            Scheme::Uniform => INTERIOR_GLOBAL,
+            Scheme::Hardware(_) => INTERIOR_MAX_EDGE,
+            _ => INTERIOR_CORE,
+        };
         let patches = set.patches.len();
         if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
             return Err(
@@ -594,12 +853,6 @@ impl GpuTessellator {
                 what: "a Prepared without the error bounds (make it with Prepared::new(set, true))".into(),
             });
         }
-        if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
-            return invalid(
-                "max factor",
-                format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR),
-            );
-        }
         // The largest global factor a frame can reach: the cap, or a minimum above it.
         let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
         let worst = minimum.copied().fold(max_factor, u32::max);
@@ -611,6 +864,9 @@ impl GpuTessellator {
             let w = worst.max(3) as u64;
             worst_case = Capacity::of_plan(set, &Plan::uniform(set, w as u32)?, &Uniform, true);
             worst_case.triangles += 8 * w * patches as u64;
+        }
+        if let Some(p) = hardware {
+            worst_case = hardware_worst_case(set, prepared, p, cap);
         }
         let worst = worst_case;
         // The scans count in u32: a set whose worst frame could pass that range is refused
@@ -643,8 +899,17 @@ impl GpuTessellator {
             );
             self.view.bounds_uploaded = true;
         }
-        self.screen = Some(Screen { criterion: kind, pixels, lo, hi, max_factor, interior });
-        self.pattern = if scheme == Scheme::Uniform { GpuPattern::Uniform } else { GpuPattern::Transition };
+        let edge_rule = if hardware.is_some() { EDGE_RULE_HARDWARE } else { EDGE_RULE_INTEGER };
+        self.screen = Some(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule });
+        self.pattern = match scheme {
+            Scheme::Uniform => GpuPattern::Uniform,
+            Scheme::Hardware(p) => {
+                self.pipelines.hardware(&ctx.device);
+                GpuPattern::Hardware(p)
+            }
+            _ => GpuPattern::Transition,
+        };
+        self.write_params(ctx);
         self.set_cull_camera(ctx, Some(camera));
         Ok(())
     }
@@ -722,15 +987,6 @@ impl GpuTessellator {
         let usage = U::STORAGE | U::COPY_SRC;
         let vertices = buffer(device, "tessera vertices", vertex_bytes, usage | U::VERTEX);
         let indices = buffer(device, "tessera indices", index_bytes, usage | U::INDEX);
-        let params = Params {
-            edges: self.set.edges,
-            patches: self.set.patches,
-            corners: self.set.corners,
-            vertex_capacity: capacity.vertices as u32,
-            triangle_capacity: capacity.triangles as u32,
-            _pad: [0; 3],
-        };
-        ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let s = &self.set;
         let main = shader::bind(
             device,
@@ -752,7 +1008,24 @@ impl GpuTessellator {
             ],
         );
         self.output = Some(Output { capacity, vertices, indices, main });
+        self.write_params(ctx);
         Ok(())
+    }
+
+    /// Writes `common.wgsl`'s `Params` for the output capacity and the pattern. Cost: a
+    /// 32-byte upload.
+    fn write_params(&self, ctx: &GpuContext) {
+        let capacity = self.capacity().unwrap_or_default();
+        let params = Params {
+            edges: self.set.edges,
+            patches: self.set.patches,
+            corners: self.set.corners,
+            vertex_capacity: capacity.vertices as u32,
+            triangle_capacity: capacity.triangles as u32,
+            partitioning: self.pattern.partitioning_code(),
+            _pad: [0; 2],
+        };
+        ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
     }
 
     /// Records the frame's passes for the last prepared plan into `encoder`. Reads nothing
@@ -766,6 +1039,8 @@ impl GpuTessellator {
     pub fn record_timed(&self, encoder: &mut wgpu::CommandEncoder, timer: Option<&PassTimer>) {
         let Some(out) = &self.output else { return };
         let p = &self.pipelines;
+        // Compiled by the `prepare` that chose the pattern.
+        let Some(k) = p.of(self.pattern) else { return };
         let (e, patches, corners) = (self.set.edges, self.set.patches, self.set.corners);
         let grid = |n: u32| shader::grid(n.div_ceil(shader::WORKGROUP));
         {
@@ -803,10 +1078,6 @@ impl GpuTessellator {
                 }
             }
         }
-        let k = match self.pattern {
-            GpuPattern::Uniform => &p.uniform,
-            GpuPattern::Transition => &p.transition,
-        };
         {
             let mut c = begin_pass(encoder, timer, 2);
             c.set_pipeline(&k.count);
@@ -936,28 +1207,29 @@ impl GpuTessellator {
             pixels: 1.0,
             lo: 1.0,
             hi: 1.0,
-            max_factor: 1,
+            cap: 1.0,
             interior: INTERIOR_GLOBAL,
+            edge_rule: EDGE_RULE_INTEGER,
         });
-        words[20..24].copy_from_slice(&[
-            f(view.focal_pixels),
-            f(s.pixels),
-            f(s.max_factor as f64),
-            s.interior,
-        ]);
-        words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), 0]);
+        words[20..24].copy_from_slice(&[f(view.focal_pixels), f(s.pixels), f(s.cap), s.interior]);
+        words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), s.edge_rule]);
         ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::cast_slice(&words));
     }
 
     /// Reads the plan the last frame drew back from the device: the uploaded one, or the
     /// GPU's own after [`GpuTessellator::prepare_screen`] (segments, interior factors and
-    /// visibility; `factors` are the segments). For tests and statistics. Cost: a queue
-    /// wait.
+    /// visibility; for the hardware patterns the real factors and the
+    /// `SamplingKind::Fractional` kind, for the others `factors` are the segments). For
+    /// tests and statistics. Cost: a queue wait.
     pub fn read_plan(&self, ctx: &GpuContext) -> Result<Plan> {
         let (e, p) = (self.set.edges as usize, self.set.patches as usize);
-        let segments: Vec<u32> = readback::read(ctx, &self.segments, e)?;
+        let rows: Vec<u32> = readback::read(ctx, &self.segments, 2 * e)?;
         let interior: Vec<[u32; 2]> = readback::read(ctx, &self.interior, p)?;
-        let mut plan = Plan::integer(segments, interior, p);
+        let mut plan = Plan::integer(rows[..e].to_vec(), interior, p);
+        if let GpuPattern::Hardware(partitioning) = self.pattern {
+            plan.kind = SamplingKind::Fractional(Spacing::Hardware(partitioning));
+            plan.factors = rows[e..].iter().map(|&bits| f32::from_bits(bits)).collect();
+        }
         plan.visible = self.read_visible(ctx)?;
         Ok(plan)
     }
@@ -1051,10 +1323,7 @@ impl GpuTessellator {
         }
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
         let plan = self.read_plan(ctx)?;
-        let kind: &dyn Pattern = match self.pattern {
-            GpuPattern::Uniform => &Uniform,
-            GpuPattern::Transition => &Transition,
-        };
+        let kind = self.pattern.cpu_pattern();
         let pattern: u64 = (0..set.patches.len())
             .filter(|&p| plan.is_visible(p))
             .map(|p| kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64)
@@ -1068,10 +1337,10 @@ impl GpuTessellator {
 /// with `PlanOptions::max_factor = max_factor`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScreenCriterion {
-    /// The scheme: [`Scheme::Uniform`] or [`Scheme::Transition`].
+    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`] or [`Scheme::Hardware`].
     pub scheme: Scheme,
-    /// [`Criterion::PixelError`] or [`Criterion::View`] with
-    /// [`ViewCriterion::Silhouetteness`].
+    /// [`Criterion::PixelError`] (uniform and transition schemes), [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`], or [`Criterion::Factor`] (hardware schemes).
     pub criterion: Criterion,
     /// The factor cap, `1..=MAX_FACTOR`.
     pub max_factor: u32,
@@ -1082,11 +1351,15 @@ pub struct ScreenCriterion {
     pub capacity: Option<Capacity>,
 }
 
-/// `view.wgsl`'s interior rules and criteria.
+/// `view.wgsl`'s interior rules, criteria and edge rules.
 const INTERIOR_GLOBAL: u32 = 0;
 const INTERIOR_CORE: u32 = 1;
+const INTERIOR_MAX_EDGE: u32 = 2;
 const CRITERION_PIXEL_ERROR: u32 = 0;
 const CRITERION_SILHOUETTENESS: u32 = 1;
+const CRITERION_FIXED: u32 = 2;
+const EDGE_RULE_INTEGER: u32 = 0;
+const EDGE_RULE_HARDWARE: u32 = 1;
 /// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
 const EDGE_VIEW_ROW: usize = 3;
 
@@ -1097,8 +1370,10 @@ struct Screen {
     pixels: f64,
     lo: f64,
     hi: f64,
-    max_factor: u32,
+    /// The factor cap (`Scheme`'s own and `max_factor`).
+    cap: f64,
     interior: u32,
+    edge_rule: u32,
 }
 
 impl Screen {
