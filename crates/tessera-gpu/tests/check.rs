@@ -56,10 +56,7 @@ fn frames_without_a_check_report_no_rounds() {
         max_factor: 8,
         capacity: None,
     };
-    gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap();
-    let mut encoder = ctx().device.create_command_encoder(&Default::default());
-    gpu.record(&mut encoder);
-    ctx().queue.submit([encoder.finish()]);
+    screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert_eq!((report.rounds, report.failing_patches, report.converged), (0, 0, true));
 }

@@ -175,9 +175,7 @@ fn culling_equals_the_cpu(cameras_per_model: usize, seed: u64) {
             let uncull = Plan::uniform(&set, n).unwrap();
             gpu.set_cull_camera(ctx, Some(&camera));
             gpu.prepare(ctx, &set, &uncull, &tessera::pattern::uniform::Uniform).unwrap();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
+            record_frame(&gpu);
             let visible = gpu.read_visible(ctx).unwrap();
             let differ: Vec<usize> = (0..expected.len()).filter(|&p| visible[p] != expected[p]).collect();
             let why: Vec<bool> = differ
@@ -313,20 +311,6 @@ fn uniform_bezier_triangles_equal_the_cpu_engine() {
     }
 }
 
-/// `set` with its PN triangles replaced by their cubic Bézier geometry (normals then come
-/// from the derivatives).
-fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
-    let patches = pn
-        .patches
-        .iter()
-        .map(|p| match p {
-            tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
-            other => other.clone(),
-        })
-        .collect();
-    SurfaceSet::from_patches(patches, BuildOptions::default())
-}
-
 #[test]
 fn transition_on_triangle_patches_equals_the_cpu_engine() {
     // CudaTess's triangle regions (strips, raised cores, the two-region modification) on PN
@@ -460,10 +444,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 max_factor: cap,
                 capacity: None,
             };
-            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
+            screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
             let drawn = gpu.read_plan(ctx).unwrap();
             assert_eq!(drawn.visible, visible);
@@ -504,10 +485,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                     max_factor: options.max_factor,
                     capacity: None,
                 };
-                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                gpu.record(&mut encoder);
-                ctx.queue.submit([encoder.finish()]);
+                screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
                 let drawn = gpu.read_plan(ctx).unwrap();
                 if drawn.segments != planned.plan.segments {
@@ -649,9 +627,7 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let mut grown = 0;
         loop {
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
+            record_frame(&gpu);
             if !gpu.grow_if_overflowed(ctx).unwrap() {
                 break;
             }
@@ -698,10 +674,7 @@ fn capacity_at_the_cap_on_the_torus() {
         max_factor: 256,
         capacity: None,
     };
-    gpu.prepare_screen(ctx, &set, &prepared, &close_camera(&set), screen).unwrap();
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    gpu.record(&mut encoder);
-    ctx.queue.submit([encoder.finish()]);
+    screen_frame(&mut gpu, &set, &prepared, &close_camera(&set), screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
     assert_eq!(draw[0], 0, "an overflowing frame drew {} indices", draw[0]);
     match gpu.grow_if_overflowed(ctx) {
@@ -739,10 +712,7 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                     max_factor: cap,
                     capacity: None,
                 };
-                gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                gpu.record(&mut encoder);
-                ctx.queue.submit([encoder.finish()]);
+                screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let got = gpu.read_plan(ctx).unwrap();
                 frames += 1;
                 if got.visible != cpu.visible {
@@ -810,10 +780,7 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
             let cpu = &planned.plan;
             let screen =
                 ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
-            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
+            screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
                 assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");

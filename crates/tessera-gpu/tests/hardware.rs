@@ -15,7 +15,7 @@ use tessera::pattern::hardware::{edge_segments, Hardware, Partitioning};
 use tessera::pattern::{Pattern, PatternInput};
 use tessera::sampling::{SamplingKind, Spacing};
 use tessera::scheme::{Criterion, PlanOptions, Prepared, Scheme};
-use tessera::surface::{BuildOptions, Domain, SurfaceSet};
+use tessera::surface::{Domain, SurfaceSet};
 use tessera_gpu::tessellator::{Capacity, ScreenCriterion};
 use tessera_gpu::{GpuError, GpuTessellator};
 
@@ -141,20 +141,6 @@ fn hardware_plans_equal_the_cpu_engine_on_every_patch_model() {
     }
 }
 
-/// `set` with its PN triangles replaced by their cubic Bézier geometry (normals then come
-/// from the derivatives).
-fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
-    let patches = pn
-        .patches
-        .iter()
-        .map(|p| match p {
-            tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
-            other => other.clone(),
-        })
-        .collect();
-    SurfaceSet::from_patches(patches, BuildOptions::default())
-}
-
 #[test]
 fn hardware_plans_equal_the_cpu_engine_on_triangle_patches() {
     // PN triangles: the meshes under 40 kB (the blob, the knob, the non-manifold and the
@@ -257,9 +243,7 @@ fn hardware_view_plans_with_gpu_culling_equal_the_cpu_engine() {
                 plan.visible.fill(1);
                 gpu.set_cull_camera(ctx, Some(&camera));
                 gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap();
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                gpu.record(&mut encoder);
-                ctx.queue.submit([encoder.finish()]);
+                record_frame(&gpu);
                 let name = format!("{model} camera {c} {} {view:?}", p.name());
                 plan.visible = check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
                 assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &planned.pattern);
@@ -431,10 +415,7 @@ fn hardware_from_the_camera(
             let scheme = Scheme::Hardware(p);
             let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
             let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
-            gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            gpu.record(&mut encoder);
-            ctx.queue.submit([encoder.finish()]);
+            screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             assert!(!gpu.read_status(ctx).unwrap().0, "{name}: the frame overflowed its worst case");
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut sweep);
             let drawn = gpu.read_plan(ctx).unwrap();
@@ -593,9 +574,7 @@ fn hardware_capacity_holds_the_worst_frame_or_grows() {
             gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
             let mut grown = 0;
             loop {
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                gpu.record(&mut encoder);
-                ctx.queue.submit([encoder.finish()]);
+                record_frame(&gpu);
                 if !gpu.grow_if_overflowed(ctx).unwrap() {
                     break;
                 }

@@ -336,10 +336,7 @@ pub fn checked_transition_frame(
         max_factor: cap,
         capacity: None,
     };
-    gpu.prepare_screen(ctx, set, prepared, camera, screen).unwrap();
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    gpu.record(&mut encoder);
-    ctx.queue.submit([encoder.finish()]);
+    screen_frame(gpu, set, prepared, camera, screen);
     let visible = check_culling(name, set, gpu, &cpu.plan.visible, camera, counts);
     let drawn = gpu.read_plan(ctx).unwrap();
     assert_eq!(drawn.visible, visible);
@@ -378,4 +375,38 @@ pub fn checked_transition_frame(
     }
     counts.check_rounds += (report.rounds > 0) as usize;
     drawn
+}
+
+/// Records one frame of `gpu`'s prepared work and submits it.
+pub fn record_frame(gpu: &GpuTessellator) {
+    let ctx = ctx();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    gpu.record(&mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+}
+
+/// Plans `screen` on the GPU from `camera` (`prepare_screen`) and records that frame.
+pub fn screen_frame(
+    gpu: &mut GpuTessellator,
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    camera: &tessera::camera::Camera,
+    screen: tessera_gpu::tessellator::ScreenCriterion,
+) {
+    gpu.prepare_screen(ctx(), set, prepared, camera, screen).unwrap();
+    record_frame(gpu);
+}
+
+/// `set` with its PN triangles replaced by their cubic Bézier geometry (normals then come
+/// from the derivatives).
+pub fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
+    let patches = pn
+        .patches
+        .iter()
+        .map(|p| match p {
+            tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
+            other => other.clone(),
+        })
+        .collect();
+    SurfaceSet::from_patches(patches, BuildOptions::default())
 }
