@@ -196,3 +196,41 @@ fn flipping_reverses_the_normal_and_keeps_the_surface() {
     let b = f.eval(DVec2::new(0.3, 0.2));
     assert!(a.position.distance(b.position) < 1e-12 && a.normal.dot(b.normal) < -0.999);
 }
+
+/// The engine's f32 kernels on the exact rational conics: every output vertex on the sphere or
+/// cylinder to f32 precision, every normal radial to 1e-5 (the sphere's pole, where the f32
+/// kernels fall back, its limit normal), for a uniform grid (the grid kernels) and a
+/// transition plan (the point kernels on its strips); the cylinder's tube closed but for its
+/// two rims, without welding.
+#[test]
+fn tessellated_rational_conics_stay_exact() {
+    use tessera::engine::{tessellate, TessellateOptions};
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    use tessera::surface::SurfaceSet;
+    let sphere = SurfaceSet::from_patches(vec![Patch::Bicubic(sphere_octant())], Default::default());
+    let cylinder = SurfaceSet::from_patch_file(&tessera::scene::cylinder(2.0), Default::default());
+    let cases = [(Scheme::Uniform, Criterion::Factor(9.0)), (Scheme::Transition, Criterion::Tolerance(1e-4))];
+    for (scheme, criterion) in cases {
+        for (name, set) in [("sphere", &sphere), ("cylinder", &cylinder)] {
+            let planned = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
+            let mesh =
+                tessellate(set, &planned.plan, &planned.pattern, TessellateOptions::default()).unwrap();
+            let what = format!("{name} {scheme:?} {criterion:?}");
+            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+                let (p, n) = (glam::Vec3::from(*p).as_dvec3(), glam::Vec3::from(*n).as_dvec3());
+                let radial = if name == "sphere" { p } else { p.with_z(0.0) };
+                assert!((radial.length() - 1.0).abs() < 1e-6, "{what}: {p} off the surface");
+                assert!((n - radial.normalize()).length() < 1e-5, "{what}: normal {n} at {p}");
+            }
+            if name == "cylinder" {
+                let w = tessera::verify::watertight(&mesh);
+                assert_eq!(w.nonmanifold_edges + w.misoriented_edges, 0, "{what}");
+                let rims = 2
+                    * (0..4)
+                        .map(|p| planned.plan.segments(set.topology.patch_edges[p][0].edge as usize))
+                        .sum::<u32>();
+                assert_eq!(w.boundary_edges, rims as usize, "{what}");
+            }
+        }
+    }
+}

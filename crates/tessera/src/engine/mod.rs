@@ -9,11 +9,12 @@
 //!
 //! Two specialisations of evaluation change how positions are computed, never which vertices
 //! and triangles there are (the tests compare each with the generic f64 evaluation):
-//! polynomial bicubic patches whose pattern interior is a uniform grid, and edges of integer
-//! factors, are evaluated row by row (`uniform_quads`); every other point of a polynomial
-//! patch — any scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
-//! (`point_blocks`). Rational patches keep the generic evaluation. Patterns that repeat within
-//! a frame are built once (`pattern_cache`).
+//! bicubic patches (polynomial or rational) whose pattern interior is a uniform grid, and edges
+//! of integer factors, are evaluated row by row (`uniform_quads`); every other point — any
+//! scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
+//! (`point_blocks`). Only rational patches whose weights span more than f32 keeps reliable
+//! (`uniform_quads::MIN_WEIGHT_RATIO`) keep the generic evaluation throughout. Patterns that
+//! repeat within a frame are built once (`pattern_cache`).
 
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
@@ -104,9 +105,9 @@ pub fn tessellate_into(
 
 /// Writes the tessellation `layout` describes into `out`, reusing its buffers: the one writer
 /// every CPU path uses. Vertices are evaluated by `uniform_quads::FastEvaluator` where it
-/// applies (polynomial bicubic patches whose pattern interior is a uniform grid) and by the
-/// generic f64 evaluation elsewhere; the numbering, the triangles and every other array do
-/// not depend on which.
+/// applies (f32 kernels: grids of bicubic patches, blocks of points elsewhere) and by the
+/// generic f64 evaluation where it does not; the numbering, the triangles and every other
+/// array do not depend on which.
 ///
 /// Preconditions: `layout` was built for `set`, `plan` and `pattern`
 /// ([`Layout::build`]). Cost: O(output), parallel.
