@@ -14,7 +14,9 @@
 //! scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
 //! (`point_blocks`). Only rational patches whose weights span more than f32 keeps reliable
 //! (`uniform_quads::MIN_WEIGHT_RATIO`) keep the generic evaluation throughout. Patterns that
-//! repeat within a frame are built once (`pattern_cache`).
+//! repeat within a frame are built once (`pattern_cache`). One specialisation of writing: a
+//! frame of triangle patches at one uniform factor (a mesh's PN triangles) skips the
+//! per-patch bookkeeping and maps its triangles by addition (`uniform_triangles`).
 
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
@@ -30,6 +32,7 @@ pub(crate) mod pattern_cache;
 pub(crate) mod point_blocks;
 pub mod render_queues;
 pub(crate) mod uniform_quads;
+pub(crate) mod uniform_triangles;
 
 pub(crate) use layout::collapsed_edges;
 pub use layout::Layout;
@@ -169,7 +172,10 @@ pub(crate) fn write_with(
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || writer.patches(0..set.patches.len(), patch_part),
+        || match fast.filter(|f| f.triangles().active() && !options.corner_params) {
+            Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part),
+            None => writer.patches(0..set.patches.len(), patch_part),
+        },
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -346,6 +352,9 @@ impl Writer<'_> {
             }
             match self.fast {
                 Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
+                Some(f) if f.triangles().active() && self.set.topology.edges[e].variants == 1 => {
+                    f.triangles().edge(self.set, f.points(), e, part)
+                }
                 fast => with_scratch(self.generation, |scratch| {
                     let points = fast.map(|f| f.points());
                     write_edge(self.set, self.plan, e, part, points, &mut scratch.params64)

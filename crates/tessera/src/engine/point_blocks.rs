@@ -784,6 +784,19 @@ mod tests {
             SurfaceSet::pn_from_mesh(&mesh, &data(name), Default::default()).unwrap()
         };
         let cow = pn("meshes/cow.obj");
+        // The cow with every seventh face flat-shaded: split normals at their vertices and
+        // creases (edges of two normal variants) around them.
+        let creased = {
+            let path = data("meshes/cow.obj");
+            let mut mesh = crate::io::obj::read_obj(&path).unwrap();
+            for face in mesh.faces.iter_mut().step_by(7) {
+                let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[face.positions[k] as usize]);
+                mesh.normals.push((b - a).cross(c - a).normalize());
+                face.normals = Some(vec![mesh.normals.len() as u32 - 1; face.positions.len()]);
+            }
+            SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap()
+        };
+        assert!(creased.topology.edges.iter().any(|e| e.variants > 1));
         // The cow's PN geometry as plain Bézier triangles: normals from the derivatives.
         let mut bezier = cow.clone();
         for patch in &mut bezier.patches {
@@ -803,6 +816,7 @@ mod tests {
             ("cow PN", cow),
             ("cow Bézier", bezier),
             ("spot PN", pn("meshes/spot.obj")),
+            ("cow PN creased", creased),
             ("teapot rational", patches("patches/teapot.patches", true)),
             ("torus rational", patches("bench/torus_64x32.patches", true)),
             ("sphere octant", sphere),
@@ -811,8 +825,9 @@ mod tests {
         let rational = |set: &SurfaceSet| {
             set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if !b.is_polynomial()))
         };
-        assert!(models[4..].iter().all(|(_, set)| rational(set)));
+        assert!(models[5..].iter().all(|(_, set)| rational(set)));
         let cases = [
+            (Scheme::Uniform, Criterion::Factor(4.0)),
             (Scheme::Uniform, Criterion::Factor(5.0)),
             (Scheme::Transition, Criterion::PixelError(0.7)),
             (Scheme::SemiUniform { max_level: 5 }, Criterion::PixelError(1.0)),
@@ -829,7 +844,7 @@ mod tests {
                 Criterion::Esc { threshold: crate::criterion::esc::Threshold::High, level: Some(3) },
             ),
         ];
-        let (mut compared, mut cached) = (0, 0);
+        let (mut compared, mut cached, mut uniform_triangles) = (0, 0, 0);
         for (name, set) in &models {
             let (lo, hi) = set.bounds();
             let size = lo.distance(hi);
@@ -855,6 +870,7 @@ mod tests {
                     // writer instead of its per-patch builds, which the reference makes.
                     evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                     cached += usize::from(evaluator.patterns().distinct() > 0);
+                    uniform_triangles += usize::from(evaluator.triangles().active());
                     let mut mesh = Mesh::default();
                     write_with(set, plan, pattern, &layout, opts, &mut mesh, Some(&evaluator)).unwrap();
                     let mut reference = Mesh::default();
@@ -887,8 +903,12 @@ mod tests {
                 compared += 1;
             }
         }
-        // SD-2 skips the five quad models, ESC the three triangle ones; the rest run everywhere.
+        // SD-2 skips the five quad models, ESC the four triangle ones; the rest run everywhere.
         assert!(cached >= 10, "the pattern cache served only {cached} cases");
-        assert_eq!(compared, 8 * 9 - 5 * 2 - 3, "only {compared} model × scheme cases planned");
+        assert_eq!(compared, 9 * 10 - 5 * 2 - 4, "only {compared} model × scheme cases planned");
+        // The uniform triangle writer wrote both uniform cases of the four triangle models
+        // (creases among them: their edges take the generic edge writer), with both kernels,
+        // and nothing else.
+        assert_eq!(uniform_triangles, 4 * 2 * 2, "the uniform triangle writer ran {uniform_triangles} times");
     }
 }

@@ -43,6 +43,7 @@ use super::point_blocks::{
     cross_normals, has_avx2_fma, local_frame, madd, rational_quotient, to_model, GridPatch, PointBlocks,
     LANES, MIN_DERIVATIVE2, MIN_SIN2,
 };
+use super::uniform_triangles::UniformTriangles;
 use super::VertexSlices;
 use crate::criterion::Plan;
 use crate::pattern::{Pattern, PatternInput};
@@ -400,6 +401,9 @@ pub(crate) struct FastEvaluator<'a> {
     points: PointBlocks,
     /// The current plan's distinct patterns ([`FastEvaluator::fill_patterns`]).
     patterns: PatternCache,
+    /// The writer of triangle meshes at one uniform factor, where the current plan is one
+    /// ([`FastEvaluator::fill_patterns`]).
+    triangles: UniformTriangles,
     /// The grid kernels apply to the current plan: every patch a bicubic with a local form
     /// (polynomial, or rational within [`MIN_WEIGHT_RATIO`]), integer samplings
     /// ([`FastEvaluator::retarget`]).
@@ -434,6 +438,7 @@ impl<'a> FastEvaluator<'a> {
             tables: Vec::new(),
             points: PointBlocks::for_set(set, avx2_fma),
             patterns: PatternCache::default(),
+            triangles: UniformTriangles::for_set(set),
             grid: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         }
@@ -444,6 +449,8 @@ impl<'a> FastEvaluator<'a> {
     /// kernels apply to the plan (bicubic patches with a local form, integer samplings). Cost:
     /// O(E + P), plus O(n) for each factor not seen before.
     pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
+        // Until `fill_patterns` sees the plan's pattern.
+        self.triangles.deactivate();
         self.grid = plan.kind == SamplingKind::Uniform && self.points.all_bicubic();
         if !self.grid {
             return false;
@@ -476,10 +483,21 @@ impl<'a> FastEvaluator<'a> {
         true
     }
 
-    /// Builds the distinct patterns of `plan` (see [`PatternCache::fill`]; `triangles` is the
-    /// layout's count), for the writer to read instead of building one per patch.
+    /// Prepares the writer's per-frame patterns for `plan` and `pattern` (`triangles`: the
+    /// layout's count): the one pattern of a uniform triangle plan ([`UniformTriangles`]), or
+    /// else the distinct patterns ([`PatternCache::fill`]), for the writer to read instead of
+    /// building one per patch. Precondition: [`FastEvaluator::retarget`] saw `plan`.
     pub(crate) fn fill_patterns(&mut self, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
-        self.patterns.fill(self.set, plan, pattern, triangles);
+        if self.triangles.retarget(self.set, plan, pattern) {
+            self.patterns.clear();
+        } else {
+            self.patterns.fill(self.set, plan, pattern, triangles);
+        }
+    }
+
+    /// The writer of uniform triangle plans.
+    pub(crate) fn triangles(&self) -> &UniformTriangles {
+        &self.triangles
     }
 
     /// The current plan's distinct patterns.
