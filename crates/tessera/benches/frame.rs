@@ -9,6 +9,11 @@
 //! - `torus_64x32/uniform_16`: the one torus at uniform factor 16 (1,048,576 triangles);
 //! - `torus_64x32/tolerance_0.001%`: the torus under a guaranteed object-space error of
 //!   0.001 % of its diagonal (transition);
+//! - `torus_64x32_rational/…`: the same two rows on the torus made rational (each control
+//!   point's weight a function of its position, within [0.5, 2]:
+//!   [`tessera::scene::position_weights`]), for the rational kernels beside the polynomial
+//!   ones in the same run (the tolerance row has more triangles: a rational bound divides by
+//!   the smallest weight);
 //! - `cow/…`: the cow as PN triangles with paper 001's silhouette criteria (transition 4:7,
 //!   semi-uniform 4:8) and the fractional-odd partitioning at factor 6.4;
 //! - `{elephant_refined,bunny,armadillo}/pn_uniform_4`: PN triangles at uniform factor 4.
@@ -74,6 +79,11 @@ fn frames(c: &mut Criterion) {
     let tolerance = scheme::Criterion::Tolerance(1e-5 * lo.distance(hi));
     bench_frames(c, "torus_64x32/tolerance_0.001%", &one, Scheme::Transition, tolerance, false);
     drop(one);
+    let rational = SurfaceSet::from_patch_file(&tessera::scene::position_weights(&torus), Default::default());
+    let sixteen = scheme::Criterion::Factor(16.0);
+    bench_frames(c, "torus_64x32_rational/uniform_16", &rational, Scheme::Uniform, sixteen, false);
+    bench_frames(c, "torus_64x32_rational/tolerance_0.001%", &rational, Scheme::Transition, tolerance, false);
+    drop(rational);
 
     let pn = |rel: &str| {
         let path = data_dir().join(rel);

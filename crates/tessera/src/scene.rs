@@ -2,10 +2,15 @@
 //! measurements use (45 copies of the 2,048-patch torus make the 92,160-patch scene; 11
 //! copies of a mesh cage make a herd of PN triangles). Nothing here is stored on disk, so a
 //! benchmark states its scene by the model and the number of copies.
+//!
+//! No model of the shared data is rational, so the rational paths get theirs here too: any
+//! patch model with weights that are a function of position ([`position_weights`]), and
+//! the exact conics of revolution ([`sphere_octant`], [`cylinder`]).
 
 use crate::io::obj::{ObjFace, ObjMesh};
 use crate::io::patches::PatchFile;
-use glam::DVec3;
+use crate::surface::RationalBicubic;
+use glam::{DVec2, DVec3};
 
 /// Offsets of `copies` copies of a box `lo..hi` laid out in a near-square grid in the box's
 /// two largest dimensions, a fifth of the box apart. Cost: O(copies).
@@ -62,6 +67,83 @@ pub fn mesh_grid(mesh: &ObjMesh, copies: usize) -> ObjMesh {
         out.normals.extend_from_slice(&mesh.normals);
     }
     out
+}
+
+/// The patches of `file` made rational: each control point's weight is
+/// `2^sin(8 (3x + 2y − z) / d)`, within `[0.5, 2]`, with `d` the points' bounding-box diagonal.
+/// Being a function of position, a weight is the same wherever its point is shared (by index
+/// or by position), so boundary curves stay shared and the model as watertight as the input;
+/// it varies within a patch (on the 2,048-patch torus, by up to about 1.6×), so every patch
+/// is genuinely rational. Cost: O(points).
+pub fn position_weights(file: &PatchFile) -> PatchFile {
+    let (lo, hi) = point_bounds(&file.points);
+    let scale = 8.0 / lo.distance(hi).max(f64::MIN_POSITIVE);
+    let weights = file.points.iter().map(|p| (scale * (3.0 * p.x + 2.0 * p.y - p.z)).sin().exp2()).collect();
+    PatchFile { weights, ..file.clone() }
+}
+
+/// A quarter of the unit circle from `(1, 0)` to `(0, 1)`, exact: the rational quadratic with
+/// weights `1, √½, 1` raised to degree 3. Returns the four control points and weights.
+pub fn quarter_circle() -> ([DVec2; 4], [f64; 4]) {
+    let (p, w) = ([DVec2::X, DVec2::ONE, DVec2::Y], [1.0, 0.5f64.sqrt(), 1.0]);
+    let w1 = (w[0] + 2.0 * w[1]) / 3.0;
+    let w2 = (2.0 * w[1] + w[2]) / 3.0;
+    let q1 = (p[0] * w[0] + p[1] * (2.0 * w[1])) / (3.0 * w1);
+    let q2 = (p[1] * (2.0 * w[1]) + p[2] * w[2]) / (3.0 * w2);
+    ([p[0], q1, q2, p[2]], [w[0], w1, w2, w[2]])
+}
+
+/// The octant `x, y, z ≥ 0` of the unit sphere, exact, as a rational bicubic surface of
+/// revolution: `u` turns around `z`, `v` climbs the meridian from the equator to the pole
+/// (control row `j = 3` collapses to the pole). Cost: O(1).
+pub fn sphere_octant() -> RationalBicubic {
+    let (c, wc) = quarter_circle();
+    let mut points = [DVec3::ZERO; 16];
+    let mut weights = [0.0; 16];
+    for i in 0..4 {
+        for j in 0..4 {
+            // Meridian point j: (radius, height) = (c[j].x, c[j].y).
+            points[4 * i + j] = DVec3::new(c[i].x * c[j].x, c[i].y * c[j].x, c[j].y);
+            weights[4 * i + j] = wc[i] * wc[j];
+        }
+    }
+    RationalBicubic { points, weights }
+}
+
+/// The unit-radius cylinder around `z`, from `z = 0` to `z = height`, exact: four rational
+/// quarter pieces (`u` around, `v` up) that share their seams by index, open at both ends.
+/// Cost: O(1).
+pub fn cylinder(height: f64) -> PatchFile {
+    let (c, wc) = quarter_circle();
+    let mut file = PatchFile::default();
+    // Quarter q is the first turned by q right angles (exact: coordinates swap and negate).
+    let turn = |q: usize, p: DVec2| match q {
+        0 => p,
+        1 => DVec2::new(-p.y, p.x),
+        2 => -p,
+        _ => DVec2::new(p.y, -p.x),
+    };
+    for q in 0..4 {
+        for i in 0..3 {
+            for j in 0..4 {
+                let p = turn(q, c[i]);
+                file.points.push(DVec3::new(p.x, p.y, j as f64 / 3.0 * height));
+                file.weights.push(wc[i]);
+            }
+        }
+    }
+    // Point (q, i, j) is 12 q + 4 i + j; the end column i = 3 of a quarter is the next one's
+    // first.
+    let index = |q: usize, i: usize, j: usize| {
+        let (q, i) = if i == 3 { ((q + 1) % 4, 0) } else { (q, i) };
+        (12 * q + 4 * i + j) as u32
+    };
+    for q in 0..4 {
+        file.patches.push(std::array::from_fn(|k| index(q, k / 4, k % 4)));
+        // The line the patch would have in a written file.
+        file.lines.push(q + 2);
+    }
+    file
 }
 
 #[cfg(test)]

@@ -75,6 +75,30 @@ fn tolerance_bounds_hold(models: &[std::path::PathBuf]) {
     }
 }
 
+/// Rational models (the teapot and the torus with weights a function of position,
+/// [`tessera::scene::position_weights`], so shared curves keep theirs): the rational bound
+/// (derivatives of the numerator and the weight over the smallest weight) holds when measured
+/// on the output of the f32 rational kernels, and the output has the input's topology.
+#[test]
+fn tolerance_bounds_hold_on_rational_models() {
+    for rel in ["patches/teapot.patches", "bench/torus_64x32.patches"] {
+        let file = tessera::io::patches::read_patches(&common::model(rel)).unwrap();
+        let set = SurfaceSet::from_patch_file(&tessera::scene::position_weights(&file), Default::default());
+        let name = format!("{rel} rational");
+        for share in [1e-2, 1e-3] {
+            let eps = share * diagonal(&set);
+            for scheme in [Scheme::Transition, Scheme::Uniform] {
+                let (plan, pattern, report) = plan(&set, scheme, Criterion::Tolerance(eps), None, false);
+                assert_eq!(report.capped_patches, 0, "{name}");
+                let mesh = run(&set, &plan, &pattern);
+                let err = verify::approximation_error(&mesh, &set, 5).unwrap();
+                assert!(err.max <= eps, "{name} {scheme:?} {share}: measured {:.3e} > {eps:.3e}", err.max);
+                common::expect_topology(&set, &plan, &mesh, &name);
+            }
+        }
+    }
+}
+
 /// Largest projected distance, in pixels, between a mesh point and the surface point at the
 /// same parameters, over points whose both projections are inside the view.
 fn projected_error(mesh: &Mesh, set: &SurfaceSet, camera: &Camera) -> f64 {

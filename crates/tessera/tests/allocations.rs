@@ -1,7 +1,7 @@
 //! A per-frame loop allocates nothing once its buffers have grown: the same camera walk run
 //! twice, the second time counted by a global allocator, for the error-bounded and the view
 //! criteria with the integer, transition, semi-uniform and hardware schemes (SD-2 and ESC
-//! still build a pattern object per frame). Runs without the test harness
+//! still build a pattern object per frame), on the teapot and on the teapot made rational. Runs without the test harness
 //! (`harness = false`) so that nothing else allocates while it counts, and in a one-thread
 //! rayon pool so that which thread builds which pattern, and so which thread's buffers grow,
 //! is the same in both walks.
@@ -20,13 +20,16 @@ use counting::{allocations, Counting};
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn load(relative: &str) -> SurfaceSet {
+/// The patch model at `relative`; `rational`: with weights a function of position
+/// ([`tessera::scene::position_weights`]), for the rational kernels.
+fn load(relative: &str, rational: bool) -> SurfaceSet {
     let data = std::env::var("TESSERA_DATA").map(std::path::PathBuf::from).unwrap_or_else(|_| {
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
     });
     let path = data.join(relative);
     let file = tessera::io::patches::read_patches(&path)
         .unwrap_or_else(|e| panic!("test model {}: {e} (set TESSERA_DATA)", path.display()));
+    let file = if rational { tessera::scene::position_weights(&file) } else { file };
     SurfaceSet::from_patch_file(&file, Default::default())
 }
 
@@ -67,7 +70,8 @@ fn view(criterion: ViewCriterion, fmin: f64, fmax: f64) -> Criterion {
 
 fn main() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("rayon pool");
-    let teapot = load("patches/teapot.patches");
+    let teapots = [("teapot", false), ("teapot rational", true)]
+        .map(|(name, r)| (name, load("patches/teapot.patches", r)));
     let cases = [
         (Scheme::Transition, Criterion::PixelError(1.0), false),
         (Scheme::Transition, Criterion::PixelError(0.5), true),
@@ -85,10 +89,12 @@ fn main() {
         (Scheme::Hardware(Partitioning::Integer), view(ViewCriterion::Silhouetteness, 1.0, 12.0), false),
     ];
     let mut failed = false;
-    for (scheme, criterion, cull) in cases {
-        let n = pool.install(|| second_walk_allocations(&teapot, scheme, criterion, cull));
-        println!("{scheme:?} {criterion:?} cull {cull}: {n} allocations in the second walk");
-        failed |= n != 0;
+    for (name, teapot) in &teapots {
+        for (scheme, criterion, cull) in cases {
+            let n = pool.install(|| second_walk_allocations(teapot, scheme, criterion, cull));
+            println!("{name} {scheme:?} {criterion:?} cull {cull}: {n} allocations in the second walk");
+            failed |= n != 0;
+        }
     }
     assert!(!failed, "a per-frame loop allocated after its buffers had grown (see above)");
     println!("test allocations ... ok");

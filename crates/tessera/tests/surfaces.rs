@@ -3,6 +3,7 @@
 
 use glam::{DVec2, DVec3, DVec4};
 use proptest::prelude::*;
+use tessera::scene::sphere_octant;
 use tessera::surface::{BezierTriangle, Patch, PnTriangle, RationalBicubic};
 
 /// Rational de Casteljau in homogeneous coordinates: rows in v first, then the column in u.
@@ -134,33 +135,6 @@ proptest! {
     }
 }
 
-/// A quarter circle as a rational quadratic (weights 1, √½, 1), degree-elevated to cubic:
-/// returns the four 2D points and weights.
-fn quarter_circle() -> ([DVec2; 4], [f64; 4]) {
-    let (p, w) = ([DVec2::X, DVec2::ONE, DVec2::Y], [1.0, 0.5f64.sqrt(), 1.0]);
-    let w1 = (w[0] + 2.0 * w[1]) / 3.0;
-    let w2 = (2.0 * w[1] + w[2]) / 3.0;
-    let q1 = (p[0] * w[0] + p[1] * (2.0 * w[1])) / (3.0 * w1);
-    let q2 = (p[1] * (2.0 * w[1]) + p[2] * w[2]) / (3.0 * w2);
-    ([p[0], q1, q2, p[2]], [w[0], w1, w2, w[2]])
-}
-
-/// An octant of the unit sphere as a rational bicubic surface of revolution: u turns around
-/// z, v climbs the meridian from the equator to the pole (row j = 3 collapses to the pole).
-fn sphere_octant() -> RationalBicubic {
-    let (c, wc) = quarter_circle();
-    let mut points = [DVec3::ZERO; 16];
-    let mut weights = [0.0; 16];
-    for i in 0..4 {
-        for j in 0..4 {
-            // Meridian point j: (radius, height) = (c[j].x, c[j].y).
-            points[4 * i + j] = DVec3::new(c[i].x * c[j].x, c[i].y * c[j].x, c[j].y);
-            weights[4 * i + j] = wc[i] * wc[j];
-        }
-    }
-    RationalBicubic { points, weights }
-}
-
 #[test]
 fn rational_sphere_octant_is_exact_and_has_limit_normal_at_pole() {
     let s = sphere_octant();
@@ -185,26 +159,25 @@ fn rational_sphere_octant_is_exact_and_has_limit_normal_at_pole() {
 }
 
 #[test]
-fn rational_cylinder_piece_is_exact() {
-    let (c, wc) = quarter_circle();
-    let mut points = [DVec3::ZERO; 16];
-    let mut weights = [0.0; 16];
-    for i in 0..4 {
-        for j in 0..4 {
-            points[4 * i + j] = DVec3::new(c[i].x, c[i].y, j as f64 / 3.0 * 2.0);
-            weights[4 * i + j] = wc[i];
+fn rational_cylinder_pieces_are_exact() {
+    let file = tessera::scene::cylinder(2.0);
+    let set = tessera::surface::SurfaceSet::from_patch_file(&file, Default::default());
+    for patch in &set.patches {
+        for i in 0..=16 {
+            for j in 0..=16 {
+                let uv = DVec2::new(i as f64 / 16.0, j as f64 / 16.0);
+                let p = patch.eval(uv);
+                assert!((p.position.truncate().length() - 1.0).abs() < 1e-6);
+                assert!((p.position.z - 2.0 * uv.y).abs() < 1e-12);
+                assert!(p.normal.z.abs() < 1e-9 && (p.normal.truncate().length() - 1.0).abs() < 1e-9);
+                // Outward: the normal is the radial direction.
+                assert!(p.normal.truncate().dot(p.position.truncate()) > 1.0 - 1e-6, "{uv}");
+            }
         }
     }
-    let cyl = RationalBicubic { points, weights };
-    for i in 0..=16 {
-        for j in 0..=16 {
-            let uv = DVec2::new(i as f64 / 16.0, j as f64 / 16.0);
-            let p = cyl.eval(uv);
-            assert!((p.position.truncate().length() - 1.0).abs() < 1e-6);
-            assert!((p.position.z - 2.0 * uv.y).abs() < 1e-12);
-            assert!(p.normal.z.abs() < 1e-9 && (p.normal.truncate().length() - 1.0).abs() < 1e-9);
-        }
-    }
+    // The seams are shared: a closed tube, open only at its two rims.
+    assert_eq!(set.topology.report.boundary_edges, 8);
+    assert_eq!(set.topology.report.nonmanifold_edges, 0);
 }
 
 #[test]
@@ -222,4 +195,42 @@ fn flipping_reverses_the_normal_and_keeps_the_surface() {
     let a = pn.eval(DVec2::new(0.2, 0.3));
     let b = f.eval(DVec2::new(0.3, 0.2));
     assert!(a.position.distance(b.position) < 1e-12 && a.normal.dot(b.normal) < -0.999);
+}
+
+/// The engine's f32 kernels on the exact rational conics: every output vertex on the sphere or
+/// cylinder to f32 precision, every normal radial to 1e-5 (the sphere's pole, where the f32
+/// kernels fall back, its limit normal), for a uniform grid (the grid kernels) and a
+/// transition plan (the point kernels on its strips); the cylinder's tube closed but for its
+/// two rims, without welding.
+#[test]
+fn tessellated_rational_conics_stay_exact() {
+    use tessera::engine::{tessellate, TessellateOptions};
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    use tessera::surface::SurfaceSet;
+    let sphere = SurfaceSet::from_patches(vec![Patch::Bicubic(sphere_octant())], Default::default());
+    let cylinder = SurfaceSet::from_patch_file(&tessera::scene::cylinder(2.0), Default::default());
+    let cases = [(Scheme::Uniform, Criterion::Factor(9.0)), (Scheme::Transition, Criterion::Tolerance(1e-4))];
+    for (scheme, criterion) in cases {
+        for (name, set) in [("sphere", &sphere), ("cylinder", &cylinder)] {
+            let planned = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
+            let mesh =
+                tessellate(set, &planned.plan, &planned.pattern, TessellateOptions::default()).unwrap();
+            let what = format!("{name} {scheme:?} {criterion:?}");
+            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+                let (p, n) = (glam::Vec3::from(*p).as_dvec3(), glam::Vec3::from(*n).as_dvec3());
+                let radial = if name == "sphere" { p } else { p.with_z(0.0) };
+                assert!((radial.length() - 1.0).abs() < 1e-6, "{what}: {p} off the surface");
+                assert!((n - radial.normalize()).length() < 1e-5, "{what}: normal {n} at {p}");
+            }
+            if name == "cylinder" {
+                let w = tessera::verify::watertight(&mesh);
+                assert_eq!(w.nonmanifold_edges + w.misoriented_edges, 0, "{what}");
+                let rims = 2
+                    * (0..4)
+                        .map(|p| planned.plan.segments(set.topology.patch_edges[p][0].edge as usize))
+                        .sum::<u32>();
+                assert_eq!(w.boundary_edges, rims as usize, "{what}");
+            }
+        }
+    }
 }

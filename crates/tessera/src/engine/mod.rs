@@ -9,11 +9,14 @@
 //!
 //! Two specialisations of evaluation change how positions are computed, never which vertices
 //! and triangles there are (the tests compare each with the generic f64 evaluation):
-//! polynomial bicubic patches whose pattern interior is a uniform grid, and edges of integer
-//! factors, are evaluated row by row (`uniform_quads`); every other point of a polynomial
-//! patch — any scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
-//! (`point_blocks`). Rational patches keep the generic evaluation. Patterns that repeat within
-//! a frame are built once (`pattern_cache`).
+//! bicubic patches (polynomial or rational) whose pattern interior is a uniform grid, and edges
+//! of integer factors, are evaluated row by row (`uniform_quads`); every other point — any
+//! scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
+//! (`point_blocks`). Only rational patches whose weights span more than f32 keeps reliable
+//! (`uniform_quads::MIN_WEIGHT_RATIO`) keep the generic evaluation throughout. Patterns that
+//! repeat within a frame are built once (`pattern_cache`). One specialisation of writing: a
+//! frame of triangle patches at one uniform factor (a mesh's PN triangles) skips the
+//! per-patch bookkeeping and maps its triangles by addition (`uniform_triangles`).
 
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
@@ -29,6 +32,7 @@ pub(crate) mod pattern_cache;
 pub(crate) mod point_blocks;
 pub mod render_queues;
 pub(crate) mod uniform_quads;
+pub(crate) mod uniform_triangles;
 
 pub(crate) use layout::collapsed_edges;
 pub use layout::Layout;
@@ -104,9 +108,9 @@ pub fn tessellate_into(
 
 /// Writes the tessellation `layout` describes into `out`, reusing its buffers: the one writer
 /// every CPU path uses. Vertices are evaluated by `uniform_quads::FastEvaluator` where it
-/// applies (polynomial bicubic patches whose pattern interior is a uniform grid) and by the
-/// generic f64 evaluation elsewhere; the numbering, the triangles and every other array do
-/// not depend on which.
+/// applies (f32 kernels: grids of bicubic patches, blocks of points elsewhere) and by the
+/// generic f64 evaluation where it does not; the numbering, the triangles and every other
+/// array do not depend on which.
 ///
 /// Preconditions: `layout` was built for `set`, `plan` and `pattern`
 /// ([`Layout::build`]). Cost: O(output), parallel.
@@ -168,7 +172,10 @@ pub(crate) fn write_with(
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || writer.patches(0..set.patches.len(), patch_part),
+        || match fast.filter(|f| f.triangles().active() && !options.corner_params) {
+            Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part),
+            None => writer.patches(0..set.patches.len(), patch_part),
+        },
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -345,6 +352,9 @@ impl Writer<'_> {
             }
             match self.fast {
                 Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
+                Some(f) if f.triangles().active() && self.set.topology.edges[e].variants == 1 => {
+                    f.triangles().edge(self.set, f.points(), e, part)
+                }
                 fast => with_scratch(self.generation, |scratch| {
                     let points = fast.map(|f| f.points());
                     write_edge(self.set, self.plan, e, part, points, &mut scratch.params64)

@@ -1,6 +1,6 @@
 //! A specialisation of *evaluation*: any list of parameters on one patch, evaluated
-//! [`LANES`] points at a time in f32, for polynomial bicubic patches, cubic Bézier triangles
-//! and PN triangles.
+//! [`LANES`] points at a time in f32, for bicubic patches (polynomial or rational), cubic
+//! Bézier triangles and PN triangles.
 //!
 //! Where [`super::uniform_quads`] exploits a grid (a row reduced to a curve once), this
 //! evaluator takes parameters as a pattern or an edge sampling chose them — transition strips,
@@ -15,7 +15,12 @@
 //! Where a normal would lose its direction in f32 (derivatives nearly parallel or very short,
 //! or a PN normal field that nearly vanishes) the point takes the generic f64 evaluation. The
 //! parameters written (`uvs`) and the patch ids are the generic path's own, so only positions
-//! and normals differ, by rounding. Rational bicubic patches keep the generic path.
+//! and normals differ, by rounding.
+//!
+//! **Rational bicubic patches** are evaluated in homogeneous form: the numerator `H = Σ w p B B`
+//! and the weight `W = Σ w B B` as a fourth component of the same sums, then the quotient
+//! ([`rational_quotient`], which says how the normal avoids a division and why the polynomial
+//! reliability rule holds for it unchanged).
 //!
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
@@ -155,9 +160,19 @@ impl LocalTriangle {
 /// A patch prepared for block evaluation.
 enum Local {
     Bicubic(LocalPatch),
+    /// Boxed: rarer and larger than a polynomial patch, which keeps the table dense.
+    Rational(Box<LocalPatch<4>>),
     Triangle(Box<LocalTriangle>),
-    /// A rational bicubic: the generic f64 evaluation.
+    /// A rational bicubic whose weights span more than f32 carries
+    /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
     Generic,
+}
+
+/// A bicubic patch in the form the grid kernels take.
+#[derive(Clone, Copy)]
+pub(crate) enum GridPatch<'a> {
+    Polynomial(&'a LocalPatch),
+    Rational(&'a LocalPatch<4>),
 }
 
 /// Every patch of a set in its local frame, made once per set. Cost: O(P) to build, about 250
@@ -265,27 +280,28 @@ pub(crate) fn to_model<const FMA: bool, const L: usize>(
     }
 }
 
-/// A polynomial bicubic at each lane's `(u, v)`.
+/// The tensor-product sums of each lane's `(u, v)` over the control points `by_v` (see
+/// [`LocalPatch`]): per component, the value and its `u` and `v` derivatives.
 // Index loops mirror the sums over control points (and vectorize over lanes).
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
-fn bicubic_block<const FMA: bool, const L: usize>(
-    patch: &LocalPatch,
+fn tensor_sums<const FMA: bool, const L: usize, const C: usize>(
+    by_v: &[[[f32; 4]; 4]; C],
     u: &[f32; L],
     v: &[f32; L],
-) -> Block<L> {
+) -> [[[f32; L]; C]; 3] {
     let (bu, du) = bernstein_lanes(u);
     let (bv, dv) = bernstein_lanes(v);
-    let mut pos = [[0f32; L]; 3];
-    let mut su = [[0f32; L]; 3];
-    let mut sv = [[0f32; L]; 3];
-    for c in 0..3 {
+    let mut pos = [[0f32; L]; C];
+    let mut su = [[0f32; L]; C];
+    let mut sv = [[0f32; L]; C];
+    for c in 0..C {
         for i in 0..4 {
             // The curve of constant u's control point i and its v-derivative's, per lane.
             let mut ci = [0f32; L];
             let mut di = [0f32; L];
             for j in 0..4 {
-                let q = patch.by_v[c][j][i];
+                let q = by_v[c][j][i];
                 for l in 0..L {
                     ci[l] = madd::<FMA>(bv[j][l], q, ci[l]);
                     di[l] = madd::<FMA>(dv[j][l], q, di[l]);
@@ -298,6 +314,76 @@ fn bicubic_block<const FMA: bool, const L: usize>(
             }
         }
     }
+    [pos, su, sv]
+}
+
+/// A polynomial bicubic at each lane's `(u, v)`.
+#[inline(always)]
+fn bicubic_block<const FMA: bool, const L: usize>(
+    patch: &LocalPatch,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let [mut pos, su, sv] = tensor_sums::<FMA, L, 3>(&patch.by_v, u, v);
+    let (nrm, margin) = cross_normals(&su, &sv);
+    to_model::<FMA, L>(&mut pos, &patch.origin, patch.scale);
+    Block { pos, nrm, margin }
+}
+
+/// A rational surface's position `S = H / W` and its derivatives multiplied by the weight,
+/// `W·S_u = H_u − W_u·S` and `W·S_v = H_v − W_v·S`, of each lane, from the homogeneous
+/// sums `h = (H, W)` and their derivatives `hu`, `hv` (weights scaled so that the largest is
+/// 1, as [`LocalPatch::rational`] stores them).
+///
+/// Why this form of the quotient rule: `W > 0`, so `W·S_u × W·S_v` points along the normal
+/// `S_u × S_v`, and needs no division beyond the one reciprocal the position takes, and three
+/// multiply-adds per derivative. The textbook `(H_u W − H W_u) / W²` needs a second division
+/// (or, left undivided, scales with `W²`, so that a small weight would sink a derivative's
+/// square toward f32's underflow); the homogeneous cross-product form
+/// `W (H_u × H_v) − W_v (H_u × H) − W_u (H × H_v)` takes three cross products.
+///
+/// Why the polynomial reliability rule ([`cross_normals`]) holds for it unchanged: each f32 sum
+/// errs by a few units of 1 (the control points lie within `[-1, 1]³` and the weights within
+/// `(0, 1]`), whatever the weights, so `W·S_u` errs by a bounded *absolute* amount, as a
+/// polynomial `S_u` does; a direction is then good where `|W·S_u|² ≥ MIN_DERIVATIVE2` and the
+/// angle is wide. A weight tiny relative to the others needs no rule of its own at a point:
+/// where it dominates, `W` is small and so is `W·S_u` (unless the surface moves fast there,
+/// which is as precise), and the point falls back to f64. (A patch whose weights span more
+/// than [`super::uniform_quads::MIN_WEIGHT_RATIO`] keeps f64 throughout, for a reason of its
+/// own given there.)
+#[inline(always)]
+pub(crate) fn rational_quotient<const FMA: bool, const L: usize>(
+    h: &[[f32; L]; 4],
+    hu: &[[f32; L]; 4],
+    hv: &[[f32; L]; 4],
+) -> [[[f32; L]; 3]; 3] {
+    let mut pos = [[0f32; L]; 3];
+    let mut su = [[0f32; L]; 3];
+    let mut sv = [[0f32; L]; 3];
+    let mut inv = [0f32; L];
+    for l in 0..L {
+        inv[l] = 1.0 / h[3][l];
+    }
+    for c in 0..3 {
+        for l in 0..L {
+            let p = h[c][l] * inv[l];
+            pos[c][l] = p;
+            su[c][l] = madd::<FMA>(-hu[3][l], p, hu[c][l]);
+            sv[c][l] = madd::<FMA>(-hv[3][l], p, hv[c][l]);
+        }
+    }
+    [pos, su, sv]
+}
+
+/// A rational bicubic at each lane's `(u, v)`.
+#[inline(always)]
+fn rational_block<const FMA: bool, const L: usize>(
+    patch: &LocalPatch<4>,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let [h, hu, hv] = tensor_sums::<FMA, L, 4>(&patch.by_v, u, v);
+    let [mut pos, su, sv] = rational_quotient::<FMA, L>(&h, &hu, &hv);
     let (nrm, margin) = cross_normals(&su, &sv);
     to_model::<FMA, L>(&mut pos, &patch.origin, patch.scale);
     Block { pos, nrm, margin }
@@ -388,7 +474,9 @@ impl PointBlocks {
             .with_min_len(64)
             .map(|p| match p {
                 Patch::Bicubic(b) if b.is_polynomial() => Local::Bicubic(LocalPatch::new(b)),
-                Patch::Bicubic(_) => Local::Generic,
+                Patch::Bicubic(b) => {
+                    LocalPatch::rational(b).map_or(Local::Generic, |r| Local::Rational(Box::new(r)))
+                }
                 Patch::BezierTriangle(t) => Local::Triangle(Box::new(LocalTriangle::new(t, None))),
                 Patch::Pn(t) => Local::Triangle(Box::new(LocalTriangle::new(&t.geometry, Some(&t.normals)))),
             })
@@ -396,17 +484,19 @@ impl PointBlocks {
         PointBlocks { locals, avx2_fma: avx2_fma && has_avx2_fma() }
     }
 
-    /// Patch `p`'s local bicubic form, where it is a polynomial bicubic.
-    pub(crate) fn bicubic(&self, p: usize) -> Option<&LocalPatch> {
+    /// Patch `p`'s local bicubic form, where it is a bicubic that has one.
+    pub(crate) fn grid_patch(&self, p: usize) -> Option<GridPatch<'_>> {
         match &self.locals[p] {
-            Local::Bicubic(local) => Some(local),
+            Local::Bicubic(local) => Some(GridPatch::Polynomial(local)),
+            Local::Rational(local) => Some(GridPatch::Rational(local)),
             _ => None,
         }
     }
 
-    /// Whether every patch is a polynomial bicubic (the grid evaluator's precondition).
+    /// Whether every patch is a bicubic with a local form, polynomial or rational (the grid
+    /// evaluator's precondition).
     pub(crate) fn all_bicubic(&self) -> bool {
-        self.locals.iter().all(|l| matches!(l, Local::Bicubic(_)))
+        self.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)))
     }
 
     /// Evaluates patch `p` of `set` at `uvs` into `out` (one vertex each: position, normal,
@@ -471,6 +561,7 @@ impl PointBlocks {
             }
             let block = match local {
                 Local::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
+                Local::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
                 Local::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
                 Local::Generic => unreachable!("handled by the caller"),
             };
@@ -529,18 +620,32 @@ mod tests {
             let (i, j) = ((k / 4) as f64, (k % 4) as f64);
             *q = DVec3::new(i - 5e3, j, 0.3 * (i * j).sin());
         }
+        // Rational: weights within [0.5, 2] varying across the patch; one inner weight, then a
+        // corner's, a hundredth of the others (W·S_u nearly vanishes near it, so the points
+        // there test the fallback); weights spanning more than MIN_WEIGHT_RATIO (the generic
+        // path throughout); the exact sphere octant, whose pole row collapses.
+        let rational = |weight: &dyn Fn(usize) -> f64| {
+            Patch::Bicubic(RationalBicubic { points: grid, weights: std::array::from_fn(weight) })
+        };
         let patches = vec![
             Patch::BezierTriangle(tri),
             Patch::Pn(PnTriangle::new(corners, normals)),
             Patch::Bicubic(RationalBicubic::polynomial(grid)),
+            rational(&|k| (k as f64 * 0.9).sin().exp2()),
+            rational(&|k| if k == 5 { 0.02 } else { 1.0 + 0.1 * k as f64 }),
+            rational(&|k| if k == 0 { 0.02 } else { 1.0 + 0.1 * k as f64 }),
+            rational(&|k| if k == 10 { 1e-3 } else { 1.0 }),
+            Patch::Bicubic(crate::scene::sphere_octant()),
         ];
         let options = crate::surface::BuildOptions {
             orientation: crate::surface::Orientation::AsGiven,
             ..Default::default()
         };
         let set = SurfaceSet::from_patches(patches, options);
+        let (mut from_kernels, mut rational_points) = (0, 0);
         for avx2_fma in [false, true] {
             let blocks = PointBlocks::for_set(&set, avx2_fma);
+            assert!(matches!(blocks.locals[6], Local::Generic), "weights spanning 1000×");
             for (p, patch) in set.patches.iter().enumerate() {
                 for count in [1, 3, 4, 5, 7, 8, 9, 23] {
                     let uvs: Vec<DVec2> = (0..count)
@@ -569,10 +674,91 @@ mod tests {
                         assert!(dn <= 1e-5, "patch {p} point {k}: normal off by {dn:e}");
                         assert_eq!(uv[k], uvs[k].as_vec2().to_array());
                         assert_eq!(id[k], p as u32);
+                        if matches!(blocks.locals[p], Local::Rational(_)) {
+                            rational_points += 1;
+                            let exact = q.normal.as_vec3().to_array();
+                            from_kernels += usize::from(nrm[k] != exact);
+                        }
                     }
                 }
             }
         }
+        // The rational kernels ran (rounding differs from the f64 path's), not the fallback
+        // everywhere.
+        assert!(from_kernels * 2 > rational_points, "{from_kernels} of {rational_points} from the kernels");
+    }
+
+    /// The rational kernel on random nets whose weights span up to [`MIN_WEIGHT_RATIO`]:
+    /// every point it keeps (margin positive) within 1e-5 of the f64 normal, and most kept.
+    #[test]
+    fn rational_kernels_hold_the_normal_bound_on_random_nets() {
+        use crate::engine::uniform_quads::MIN_WEIGHT_RATIO;
+        use crate::surface::RationalBicubic;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut random = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut kept, mut total) = (0, 0);
+        for span in [1.0, 2.0, 4.0, 8.0, 1.0 / MIN_WEIGHT_RATIO] {
+            for _ in 0..1000 {
+                // A wavy near-grid net far from the origin; weights within [1/span, 1].
+                let points = std::array::from_fn(|k| {
+                    let (i, j) = ((k / 4) as f64, (k % 4) as f64);
+                    DVec3::new(i + 0.4 * random(), j + 0.4 * random(), 0.8 * random()) * 3.0 + 100.0
+                });
+                let weights = std::array::from_fn(|_| span.powf(-random()));
+                let patch = RationalBicubic { points, weights };
+                let local = LocalPatch::rational(&patch).expect("weights within the ratio");
+                let (u, v) =
+                    (std::array::from_fn(|_| random() as f32), std::array::from_fn(|_| random() as f32));
+                for fma in [false, true] {
+                    let block = if fma && has_avx2_fma() {
+                        // SAFETY: the CPU has AVX2 and FMA.
+                        unsafe { rational_block_avx2_fma(&local, &u, &v) }
+                    } else {
+                        rational_block::<false, LANES>(&local, &u, &v)
+                    };
+                    for l in 0..LANES {
+                        total += 1;
+                        if block.margin[l] > 0.0 {
+                            kept += 1;
+                            let q = patch.eval(DVec2::new(u[l] as f64, v[l] as f64));
+                            let n = DVec3::new(
+                                block.nrm[0][l] as f64,
+                                block.nrm[1][l] as f64,
+                                block.nrm[2][l] as f64,
+                            );
+                            let p = DVec3::new(
+                                block.pos[0][l] as f64,
+                                block.pos[1][l] as f64,
+                                block.pos[2][l] as f64,
+                            );
+                            let dn = (n - q.normal).length();
+                            assert!(dn <= 1e-5, "span {span}: normal off by {dn:e}");
+                            // As the scattered points: 1e-6 of the patch, and the output's rounding.
+                            let bound = 2e-6 * local_frame(&patch.points).1 + 1e-7 * q.position.length();
+                            assert!(p.distance(q.position) <= bound, "span {span}: {p} vs {}", q.position);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(kept * 2 > total, "only {kept} of {total} points kept by the kernel");
+    }
+
+    /// [`rational_block`] compiled for AVX2 and FMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn rational_block_avx2_fma(
+        patch: &LocalPatch<4>,
+        u: &[f32; LANES],
+        v: &[f32; LANES],
+    ) -> Block<LANES> {
+        rational_block::<true, LANES>(patch, u, v)
     }
 
     /// Every scheme on every surface kind: the engine with the block evaluator writes the
@@ -587,15 +773,30 @@ mod tests {
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
         let data = crate::io::patches::test_support::data;
-        let teapot = {
-            let file = crate::io::patches::read_patches(&data("patches/teapot.patches")).unwrap();
+        let patches = |name: &str, rational: bool| {
+            let file = crate::io::patches::read_patches(&data(name)).unwrap();
+            let file = if rational { crate::scene::position_weights(&file) } else { file };
             SurfaceSet::from_patch_file(&file, Default::default())
         };
+        let teapot = patches("patches/teapot.patches", false);
         let pn = |name: &str| {
             let mesh = crate::io::obj::read_obj(&data(name)).unwrap();
             SurfaceSet::pn_from_mesh(&mesh, &data(name), Default::default()).unwrap()
         };
         let cow = pn("meshes/cow.obj");
+        // The cow with every seventh face flat-shaded: split normals at their vertices and
+        // creases (edges of two normal variants) around them.
+        let creased = {
+            let path = data("meshes/cow.obj");
+            let mut mesh = crate::io::obj::read_obj(&path).unwrap();
+            for face in mesh.faces.iter_mut().step_by(7) {
+                let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[face.positions[k] as usize]);
+                mesh.normals.push((b - a).cross(c - a).normalize());
+                face.normals = Some(vec![mesh.normals.len() as u32 - 1; face.positions.len()]);
+            }
+            SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap()
+        };
+        assert!(creased.topology.edges.iter().any(|e| e.variants > 1));
         // The cow's PN geometry as plain Bézier triangles: normals from the derivatives.
         let mut bezier = cow.clone();
         for patch in &mut bezier.patches {
@@ -603,9 +804,30 @@ mod tests {
                 *patch = Patch::BezierTriangle(t.geometry.clone());
             }
         }
-        let models =
-            [("teapot", teapot), ("cow PN", cow), ("cow Bézier", bezier), ("spot PN", pn("meshes/spot.obj"))];
+        // Rational: weights a function of position (shared curves keep theirs), and the exact
+        // sphere octant and cylinder.
+        let sphere = SurfaceSet::from_patches(
+            vec![Patch::Bicubic(crate::scene::sphere_octant())],
+            crate::surface::BuildOptions::default(),
+        );
+        let cylinder = SurfaceSet::from_patch_file(&crate::scene::cylinder(2.0), Default::default());
+        let models = [
+            ("teapot", teapot),
+            ("cow PN", cow),
+            ("cow Bézier", bezier),
+            ("spot PN", pn("meshes/spot.obj")),
+            ("cow PN creased", creased),
+            ("teapot rational", patches("patches/teapot.patches", true)),
+            ("torus rational", patches("bench/torus_64x32.patches", true)),
+            ("sphere octant", sphere),
+            ("cylinder", cylinder),
+        ];
+        let rational = |set: &SurfaceSet| {
+            set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if !b.is_polynomial()))
+        };
+        assert!(models[5..].iter().all(|(_, set)| rational(set)));
         let cases = [
+            (Scheme::Uniform, Criterion::Factor(4.0)),
             (Scheme::Uniform, Criterion::Factor(5.0)),
             (Scheme::Transition, Criterion::PixelError(0.7)),
             (Scheme::SemiUniform { max_level: 5 }, Criterion::PixelError(1.0)),
@@ -622,7 +844,7 @@ mod tests {
                 Criterion::Esc { threshold: crate::criterion::esc::Threshold::High, level: Some(3) },
             ),
         ];
-        let (mut compared, mut cached) = (0, 0);
+        let (mut compared, mut cached, mut uniform_triangles) = (0, 0, 0);
         for (name, set) in &models {
             let (lo, hi) = set.bounds();
             let size = lo.distance(hi);
@@ -648,6 +870,7 @@ mod tests {
                     // writer instead of its per-patch builds, which the reference makes.
                     evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                     cached += usize::from(evaluator.patterns().distinct() > 0);
+                    uniform_triangles += usize::from(evaluator.triangles().active());
                     let mut mesh = Mesh::default();
                     write_with(set, plan, pattern, &layout, opts, &mut mesh, Some(&evaluator)).unwrap();
                     let mut reference = Mesh::default();
@@ -680,8 +903,12 @@ mod tests {
                 compared += 1;
             }
         }
-        // SD-2 skips the teapot, ESC the triangles; the rest run everywhere.
+        // SD-2 skips the five quad models, ESC the four triangle ones; the rest run everywhere.
         assert!(cached >= 10, "the pattern cache served only {cached} cases");
-        assert_eq!(compared, 4 * 9 - 2 - 3, "only {compared} model × scheme cases planned");
+        assert_eq!(compared, 9 * 10 - 5 * 2 - 4, "only {compared} model × scheme cases planned");
+        // The uniform triangle writer wrote both uniform cases of the four triangle models
+        // (creases among them: their edges take the generic edge writer), with both kernels,
+        // and nothing else.
+        assert_eq!(uniform_triangles, 4 * 2 * 2, "the uniform triangle writer ran {uniform_triangles} times");
     }
 }
