@@ -12,35 +12,47 @@ use common::*;
 use tessera::pattern::transition::Transition;
 use tessera::scheme::Prepared;
 
-#[test]
-fn pixel_error_transition_planned_on_the_gpu_equals_the_cpu_plan_through_many_rounds() {
-    let mut counts = SweepCounts::default();
-    let mut most_rounds = 0;
-    for model in ["patches/teapot.patches", "meshes/spool.obj", "meshes/dragknob.obj"] {
+/// What a sweep of [`checked_transition_frame`]s saw: the tallies, the most fix rounds of a
+/// frame and the largest core (cells) of a visible patch.
+struct Sweep {
+    counts: SweepCounts,
+    most_rounds: u32,
+    largest_core: u32,
+}
+
+/// [`checked_transition_frame`] on `models`, `cameras_per_model` seeded cameras each, every
+/// pixel error of `pixel_errors`, factor cap `cap`; each frame's output against the CPU
+/// engine's for the plan the GPU drew.
+fn sweep(models: &[&str], cameras_per_model: usize, seed: u64, pixel_errors: &[f64], cap: u32) -> Sweep {
+    let mut sweep = Sweep { counts: SweepCounts::default(), most_rounds: 0, largest_core: 0 };
+    for model in models {
         let set = load(model);
         let prepared = Prepared::new(&set, true);
         let mut gpu = tessellator(&set);
-        for (c, camera) in cameras(&set, 3, 11).into_iter().enumerate() {
-            for pixels in [0.5, 4.0] {
+        for (c, camera) in cameras(&set, cameras_per_model, seed).into_iter().enumerate() {
+            for &pixels in pixel_errors {
                 let name = format!("{model} camera {c} {pixels} px");
-                let plan = checked_transition_frame(
-                    &name,
-                    &set,
-                    &prepared,
-                    &mut gpu,
-                    &camera,
-                    pixels,
-                    16,
-                    &mut counts,
-                );
-                most_rounds = most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
+                let counts = &mut sweep.counts;
+                let plan =
+                    checked_transition_frame(&name, &set, &prepared, &mut gpu, &camera, pixels, cap, counts);
+                sweep.most_rounds = sweep.most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
+                let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
+                let visible = (0..set.patches.len()).filter(|&p| plan.is_visible(p));
+                sweep.largest_core = visible.map(core).fold(sweep.largest_core, u32::max);
                 assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
             }
         }
     }
-    eprintln!("{counts:?}, most fix rounds {most_rounds}");
-    assert!(most_rounds > 16, "no frame needed many fix rounds: the rounds were not tested");
-    assert_eq!(counts.check_ties, 0, "{counts:?}");
+    eprintln!("{:?}, most fix rounds {}", sweep.counts, sweep.most_rounds);
+    sweep
+}
+
+#[test]
+fn pixel_error_transition_planned_on_the_gpu_equals_the_cpu_plan_through_many_rounds() {
+    let models = ["patches/teapot.patches", "meshes/spool.obj", "meshes/dragknob.obj"];
+    let sweep = sweep(&models, 3, 11, &[0.5, 4.0], 16);
+    assert!(sweep.most_rounds > 16, "no frame needed many fix rounds: the rounds were not tested");
+    assert_eq!(sweep.counts.check_ties, 0, "{:?}", sweep.counts);
 }
 
 #[test]
@@ -64,34 +76,9 @@ fn frames_without_a_check_report_no_rounds() {
 #[test]
 #[ignore = "slow tier: fine pixel errors at the factor cap 64, cores of 4,096 cells"]
 fn pixel_error_transition_at_cap_64_equals_the_cpu_plan() {
-    let mut counts = SweepCounts::default();
-    let mut largest = 0;
-    for model in ["patches/teapot.patches", "patches/teacup.patches", "meshes/spool.obj"] {
-        let set = load(model);
-        let prepared = Prepared::new(&set, true);
-        let mut gpu = tessellator(&set);
-        for (c, camera) in cameras(&set, 4, 5).into_iter().enumerate() {
-            for pixels in [0.05, 0.2] {
-                let name = format!("{model} camera {c} {pixels} px");
-                let plan = checked_transition_frame(
-                    &name,
-                    &set,
-                    &prepared,
-                    &mut gpu,
-                    &camera,
-                    pixels,
-                    64,
-                    &mut counts,
-                );
-                let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
-                largest =
-                    (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(core).fold(largest, u32::max);
-                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
-            }
-        }
-    }
-    eprintln!("{counts:?}");
-    assert_eq!(largest, 64 * 64, "no core reached the cap");
-    assert!(counts.check_rounds > 0, "{counts:?}");
-    assert_eq!(counts.check_ties, 0, "{counts:?}");
+    let models = ["patches/teapot.patches", "patches/teacup.patches", "meshes/spool.obj"];
+    let sweep = sweep(&models, 4, 5, &[0.05, 0.2], 64);
+    assert_eq!(sweep.largest_core, 64 * 64, "no core reached the cap");
+    assert!(sweep.counts.check_rounds > 0, "{:?}", sweep.counts);
+    assert_eq!(sweep.counts.check_ties, 0, "{:?}", sweep.counts);
 }

@@ -10,7 +10,7 @@ use tessera::criterion::Plan;
 use tessera::engine::{Layout, TessellateOptions};
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
-use tessera::surface::{BuildOptions, SurfaceSet};
+use tessera::surface::SurfaceSet;
 use tessera_gpu::scan::{Scan, ScanPipelines};
 use tessera_gpu::tessellator::{Capacity, ScreenCriterion};
 use tessera_gpu::{readback, GpuError, GpuTessellator};
@@ -293,16 +293,7 @@ fn transition_on_random_factors(models: &[&str], rounds: u32, max: u32, seed: u6
 fn uniform_bezier_triangles_equal_the_cpu_engine() {
     // Cubic Bézier triangles (normals from the derivatives): the PN geometry of two meshes.
     for model in ["meshes/blob.obj", "awkward/teapot_tri_nonmanifold.obj"] {
-        let pn = load(model);
-        let patches = pn
-            .patches
-            .iter()
-            .map(|p| match p {
-                tessera::surface::Patch::Pn(t) => tessera::surface::Patch::BezierTriangle(t.geometry.clone()),
-                other => other.clone(),
-            })
-            .collect();
-        let set = SurfaceSet::from_patches(patches, BuildOptions::default());
+        let set = as_bezier_triangles(&load(model));
         let mut gpu = tessellator(&set);
         for n in [1, 3, 6] {
             let plan = Plan::uniform(&set, n).unwrap();
@@ -625,15 +616,7 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
             capacity,
         };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-        let mut grown = 0;
-        loop {
-            record_frame(&gpu);
-            if !gpu.grow_if_overflowed(ctx).unwrap() {
-                break;
-            }
-            grown += 1;
-            assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
-        }
+        let grown = record_until_complete(&mut gpu, &name);
         assert!(capacity.is_none() || grown > 0, "{name}: 16 triangles of room and no overflow");
         let (overflow, _, triangles) = gpu.read_status(ctx).unwrap();
         assert!(!overflow, "{name}");

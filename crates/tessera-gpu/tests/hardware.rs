@@ -572,15 +572,7 @@ fn hardware_capacity_holds_the_worst_frame_or_grows() {
             let mut gpu = tessellator(&set);
             let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity };
             gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
-            let mut grown = 0;
-            loop {
-                record_frame(&gpu);
-                if !gpu.grow_if_overflowed(ctx).unwrap() {
-                    break;
-                }
-                grown += 1;
-                assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
-            }
+            let grown = record_until_complete(&mut gpu, &name);
             assert_eq!(grown > 0, capacity.is_some(), "{name}: grown {grown} times");
             let drawn = gpu.read_plan(ctx).unwrap();
             assert_eq!(drawn.visible, cpu.visible, "{name}: culled set");

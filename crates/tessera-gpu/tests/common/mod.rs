@@ -410,3 +410,17 @@ pub fn as_bezier_triangles(pn: &SurfaceSet) -> SurfaceSet {
         .collect();
     SurfaceSet::from_patches(patches, BuildOptions::default())
 }
+
+/// Records `gpu`'s frame until it fits: after an overflow, `grow_if_overflowed` grows the
+/// output and the frame is recorded again (at most twice). Returns how often it grew.
+pub fn record_until_complete(gpu: &mut GpuTessellator, name: &str) -> u32 {
+    let mut grown = 0;
+    loop {
+        record_frame(gpu);
+        if !gpu.grow_if_overflowed(ctx()).unwrap() {
+            return grown;
+        }
+        grown += 1;
+        assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
+    }
+}
