@@ -70,7 +70,8 @@ pub fn tessellate_from_camera(
     Ok(run)
 }
 
-/// Records `repeat` frames of `gpu`'s prepared work, timing each.
+/// Records `repeat` frames of `gpu`'s prepared work, timing each; with more than one, after
+/// an untimed warm-up frame (drivers compile pipelines and fault buffers in at first use).
 fn frames(
     ctx: &GpuContext,
     gpu: &mut GpuTessellator,
@@ -78,6 +79,12 @@ fn frames(
     times: &mut Vec<f64>,
 ) -> Result<GpuRun, GpuError> {
     times.clear();
+    if repeat > 1 {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        gpu.record(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait()?;
+    }
     let timer = PassTimer::new(ctx);
     let mut per_pass = vec![Vec::new(); PASSES.len()];
     for _ in 0..repeat.max(1) {

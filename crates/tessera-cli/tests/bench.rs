@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Rows every quick run must have, per table: (table, column, values that must appear).
-const EXPECTED_ROWS: [(&str, &str, &[&str]); 11] = [
+const EXPECTED_ROWS: [(&str, &str, &[&str]); 12] = [
     ("speed_uniform", "model", &["torus_64x32", "teapot", "spot"]),
     ("speed_schemes", "scheme", &["transition"]),
     ("adaptive_ratio", "model", &["teapot", "teacup", "helmet"]),
@@ -20,6 +20,7 @@ const EXPECTED_ROWS: [(&str, &str, &[&str]); 11] = [
     ),
     ("frame_walk", "scene", &["torus grid", "killeroo herd", "teacups"]),
     ("frame_first", "scene", &["torus grid", "killeroo herd", "teacups"]),
+    ("frame_gpu", "scene", &["torus grid", "killeroo herd"]),
     (
         "paper000_table1",
         "method",

@@ -561,6 +561,8 @@ pub struct GpuTessellator {
     screen: Option<Screen>,
     /// The largest buffer the device binds or allocates.
     buffer_limit: u64,
+    /// Fix rounds of the a-posteriori check a frame records ([`MAX_ROUNDS`] unless set).
+    check_rounds: u32,
 }
 
 fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
@@ -636,6 +638,7 @@ impl GpuTessellator {
             camera: None,
             screen: None,
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
+            check_rounds: MAX_ROUNDS,
             set: gpu_set,
             pipelines,
         })
@@ -1144,7 +1147,7 @@ impl GpuTessellator {
         c.set_pipeline(&k.check_all);
         c.dispatch_workgroups(x, y, 1);
         let args = &self.view.round_args;
-        for _ in 0..MAX_ROUNDS {
+        for _ in 0..self.check_rounds {
             // The decisions bind the dispatch arguments as storage (group 2); the passes they
             // size read them as indirect arguments and leave group 2 out of their layout.
             c.set_pipeline(&k.open);
@@ -1159,6 +1162,17 @@ impl GpuTessellator {
         }
     }
 
+    /// Sets how many fix rounds of the a-posteriori check every following frame records
+    /// (default [`MAX_ROUNDS`]). A round that is not needed dispatches no work, but still
+    /// costs its four dispatches (about 70 µs on lavapipe, a few µs on a hardware GPU), so a
+    /// real-time loop whose scenes converge in fewer rounds may record fewer and watch
+    /// [`ScreenReport::converged`] now and then (a read-back, on request). A frame whose plan
+    /// needs more rounds is still crack-free; its failing patches miss their bound and are
+    /// counted. Cost: none until the next frame.
+    pub fn set_check_rounds(&mut self, rounds: u32) {
+        self.check_rounds = rounds;
+    }
+
     /// Reads the last frame's a-posteriori check back (after
     /// [`GpuTessellator::prepare_screen`] with a pixel error and the transition scheme; the
     /// other frames report no rounds and no failing patch): for statistics and tests, never
@@ -1169,7 +1183,9 @@ impl GpuTessellator {
         if !checked {
             return Ok(ScreenReport { rounds: 0, failing_patches: 0, converged: true });
         }
-        Ok(ScreenReport { rounds: state[4], failing_patches: state[1], converged: state[3] != 0 })
+        // Done, or nothing left failing (the next round would have found that and ended).
+        let converged = state[3] != 0 || state[1] == 0;
+        Ok(ScreenReport { rounds: state[4], failing_patches: state[1], converged })
     }
 
     /// Reads the check's guaranteed bound per patch back (0 for culled patches; meaningful
@@ -1394,9 +1410,10 @@ pub struct ScreenReport {
     /// `tolerance::PlanReport::capped_patches` counts them on the CPU, or left failing when
     /// the rounds did not converge.
     pub failing_patches: u32,
-    /// Whether the rounds ended within [`MAX_ROUNDS`] as the CPU's would (no failing patch,
-    /// or a round that changed no edge). When false the plan is still crack-free, but the
-    /// failing patches' bounds are missed.
+    /// Whether the rounds ended within the recorded ones ([`MAX_ROUNDS`], or as
+    /// [`GpuTessellator::set_check_rounds`] set) as the CPU's would (no failing patch, or a
+    /// round that changed no edge). When false the plan is still crack-free, but the failing
+    /// patches' bounds are missed.
     pub converged: bool,
 }
 

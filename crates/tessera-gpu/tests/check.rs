@@ -82,3 +82,32 @@ fn pixel_error_transition_at_cap_64_equals_the_cpu_plan() {
     assert!(sweep.counts.check_rounds > 0, "{:?}", sweep.counts);
     assert_eq!(sweep.counts.check_ties, 0, "{:?}", sweep.counts);
 }
+
+#[test]
+fn too_few_rounds_are_reported_and_the_plan_stays_crack_free() {
+    // The spool's camera 1 at 0.5 px and cap 16 needs 41 fix rounds on the CPU; with 2 the
+    // GPU must say it did not converge, and its plan must still tessellate watertight, as
+    // the CPU engine tessellates that same plan.
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let set = load("meshes/spool.obj");
+    let prepared = Prepared::new(&set, true);
+    let camera = cameras(&set, 3, 11)[1];
+    let options = PlanOptions { camera: Some(camera), cull: true, max_factor: 16, ..Default::default() };
+    let cpu =
+        Scheme::Transition.plan_prepared(&set, &prepared, &Criterion::PixelError(0.5), &options).unwrap();
+    assert!(cpu.report.unwrap().rounds > 2, "the case no longer needs many rounds");
+    let mut gpu = tessellator(&set);
+    gpu.set_check_rounds(2);
+    let screen = tessera_gpu::tessellator::ScreenCriterion {
+        scheme: Scheme::Transition,
+        criterion: Criterion::PixelError(0.5),
+        max_factor: 16,
+        capacity: None,
+    };
+    screen_frame(&mut gpu, &set, &prepared, &camera, screen);
+    let report = gpu.read_screen_report(ctx()).unwrap();
+    assert!(!report.converged && report.rounds == 2 && report.failing_patches > 0, "{report:?}");
+    let plan = gpu.read_plan(ctx()).unwrap();
+    assert_ne!(plan.segments, cpu.plan.segments, "two rounds gave the converged plan");
+    assert_gpu_equals_cpu_after_record("spool, 2 rounds", &set, &gpu, &plan, &Transition);
+}

@@ -86,7 +86,7 @@ pub fn scenes(ctx: &Ctx) -> BenchResult<Vec<Scene>> {
 
 pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     let repeats = if ctx.quick { 2 } else { 9 };
-    ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64);
+    ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64 + if ctx.gpu { 2 } else { 0 });
     let mut walk = Table::new(
         "frame_walk",
         "frame: camera walks, ms per stage over the walk (median / p95)",
@@ -211,5 +211,71 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
          distance while orbiting 40°. Teacups: paper 002's scene and walk (1280×1024), ESC with Lmax = 3.",
     );
     first.note(format!("Medians of {repeats} frames at the walk's first camera after a warm-up frame: the real-time issue's single-frame rows."));
-    Ok(vec![walk, first])
+    let mut tables = vec![walk, first];
+    if ctx.gpu {
+        if let Some(table) = gpu_first_frames(ctx, &all, repeats)? {
+            tables.push(table);
+        }
+    }
+    Ok(tables)
+}
+
+/// The first frames of the scenes the GPU plans itself (the torus grid and the herd: the
+/// transition scheme's pixel error), from the camera alone on the GPU — culling, factors, the
+/// a-posteriori check, counts, scans and writes — with the GPU's per-pass times; None (and a
+/// note) without an adapter.
+fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<Option<Table>> {
+    let Some(adapter) = super::speed::gpu_adapter(ctx) else { return Ok(None) };
+    let passes = tessera_gpu::tessellator::PASSES;
+    let mut columns: Vec<String> =
+        ["scene", "patches", "scheme", "triangles", "fix rounds", "capped patches"]
+            .map(String::from)
+            .to_vec();
+    columns.extend(passes.iter().map(|p| format!("{p} ms")));
+    columns.extend(["GPU ms", "frame ms"].map(String::from));
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let title = format!("frame: the walk's first frame planned and tessellated on the GPU ({adapter})");
+    let mut table = Table::new("frame_gpu", &title, &names);
+    for scene in scenes {
+        let Some(screen) = crate::gpu::screen_criterion(scene.scheme, &scene.criterion, scene.cull, 64)
+        else {
+            continue;
+        };
+        ctx.step(&format!("frame: {} first frame on the GPU", scene.name));
+        let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
+        let run = crate::gpu::tessellate_from_camera(
+            &scene.set,
+            &scene.cameras[0],
+            screen,
+            repeats as u32,
+            &mut mesh,
+            &mut times,
+        )?;
+        let check = run.screen.expect("planned from the camera");
+        let mut row: Vec<super::table::Cell> = vec![
+            scene.name.into(),
+            scene.set.patches.len().into(),
+            format!("{}, planned on the GPU", scene.describe()).into(),
+            mesh.triangle_count().into(),
+            (check.rounds as usize).into(),
+            (check.failing_patches as usize).into(),
+        ];
+        let gpu_ms: f64 = run.passes_ms.iter().map(|&(_, ms)| ms).sum();
+        if run.passes_ms.is_empty() {
+            row.extend(passes.iter().map(|_| "-".into()));
+            row.push("-".into());
+        } else {
+            row.extend(run.passes_ms.iter().map(|&(_, ms)| num(ms, 2)));
+            row.push(num(gpu_ms, 2));
+        }
+        row.push(num(median_p95(&times).0 * 1e3, 2));
+        table.row(row);
+    }
+    table.note(format!(
+        "Medians of {repeats} frames at the walk's first camera (1280×1024), each a whole GPU frame from the camera: \
+         the plan never comes back to the CPU. Per-pass times from timestamp queries; frame = submit to finished \
+         (wall clock). The software driver (lavapipe) is for correctness, not speed; the scenes' teacups (ESC) \
+         have no GPU form."
+    ));
+    Ok(Some(table))
 }

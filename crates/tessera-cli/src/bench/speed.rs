@@ -284,7 +284,7 @@ fn schemes_table(ctx: &Ctx, runs: usize) -> BenchResult<Table> {
 
 /// The adapter's name when the GPU rows can run; otherwise a printed note and None (the bench
 /// is not a test: a machine without a GPU gets CPU figures).
-fn gpu_adapter(ctx: &Ctx) -> Option<String> {
+pub(super) fn gpu_adapter(ctx: &Ctx) -> Option<String> {
     match tessera_gpu::GpuContext::new() {
         Ok(gpu) => Some(gpu.info.name.clone()),
         Err(e) => {
