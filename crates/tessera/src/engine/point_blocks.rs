@@ -767,8 +767,7 @@ mod tests {
     #[test]
     fn every_scheme_and_surface_kind_matches_the_generic_engine() {
         use crate::criterion::view::{Mapping, ViewCriterion};
-        use crate::engine::{write_with, Layout, TessellateOptions};
-        use crate::mesh::Mesh;
+        use crate::engine::{Layout, TessellateOptions};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
@@ -871,34 +870,8 @@ mod tests {
                     evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                     cached += usize::from(evaluator.patterns().distinct() > 0);
                     uniform_triangles += usize::from(evaluator.triangles().active());
-                    let mut mesh = Mesh::default();
-                    write_with(set, plan, pattern, &layout, opts, &mut mesh, Some(&evaluator)).unwrap();
-                    let mut reference = Mesh::default();
-                    write_with(set, plan, pattern, &layout, opts, &mut reference, None).unwrap();
                     let what = format!("{name} {scheme:?} {criterion:?} avx2_fma={avx2_fma}");
-                    assert_eq!(mesh.indices, reference.indices, "{what}");
-                    assert_eq!(mesh.uvs, reference.uvs, "{what}");
-                    assert_eq!(mesh.vertex_patch, reference.vertex_patch, "{what}");
-                    let diff = |a: &[[f32; 3]], b: &[[f32; 3]]| {
-                        a.iter()
-                            .zip(b)
-                            .map(|(a, b)| (glam::Vec3::from(*a) - glam::Vec3::from(*b)).length() as f64)
-                            .fold(0.0, f64::max)
-                    };
-                    let dp = diff(&mesh.positions, &reference.positions) / size;
-                    let dn = diff(&mesh.normals, &reference.normals);
-                    assert!(dp <= 1e-6, "{what}: positions differ by {dp:e} of the diagonal");
-                    assert!(dn <= 1e-5, "{what}: normals differ by {dn:e}");
-                    // The f32 kernels ran (rounding differs from the f64 path's somewhere),
-                    // rather than the f64 fallback everywhere.
-                    let changed = mesh.normals.iter().zip(&reference.normals).filter(|(a, b)| a != b).count();
-                    assert!(
-                        changed * 4 > mesh.normals.len(),
-                        "{what}: only {changed} normals from the kernels"
-                    );
-                    let w = crate::verify::watertight(&mesh);
-                    let r = crate::verify::watertight(&reference);
-                    assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");
+                    assert_fast_equals_generic(&what, set, plan, pattern, &layout, &evaluator, size, true);
                 }
                 compared += 1;
             }
@@ -910,5 +883,134 @@ mod tests {
         // (creases among them: their edges take the generic edge writer), with both kernels,
         // and nothing else.
         assert_eq!(uniform_triangles, 4 * 2 * 2, "the uniform triangle writer ran {uniform_triangles} times");
+    }
+
+    /// The fast paths' output of `plan` (through `evaluator`) against the generic engine's:
+    /// indices, uvs and vertex patches identical, positions within 1e-6 of `size` (the
+    /// diagonal), normals within 1e-5, the same boundary edges; with `kernels_ran`, more
+    /// than a quarter of the normals differ from the f64 path's in their rounding (so the
+    /// f32 kernels, not their f64 fallback, made them).
+    #[allow(clippy::too_many_arguments)]
+    fn assert_fast_equals_generic(
+        what: &str,
+        set: &SurfaceSet,
+        plan: &crate::criterion::Plan,
+        pattern: &dyn crate::pattern::Pattern,
+        layout: &crate::engine::Layout,
+        evaluator: &super::super::uniform_quads::FastEvaluator<'_>,
+        size: f64,
+        kernels_ran: bool,
+    ) {
+        use crate::engine::{write_with, TessellateOptions};
+        use crate::mesh::Mesh;
+        let opts = TessellateOptions::default();
+        let mut mesh = Mesh::default();
+        write_with(set, plan, pattern, layout, opts, &mut mesh, Some(evaluator)).unwrap();
+        let mut reference = Mesh::default();
+        write_with(set, plan, pattern, layout, opts, &mut reference, None).unwrap();
+        assert_eq!(mesh.indices, reference.indices, "{what}");
+        assert_eq!(mesh.uvs, reference.uvs, "{what}");
+        assert_eq!(mesh.vertex_patch, reference.vertex_patch, "{what}");
+        let diff = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| (glam::Vec3::from(*a) - glam::Vec3::from(*b)).length() as f64)
+                .fold(0.0, f64::max)
+        };
+        let dp = diff(&mesh.positions, &reference.positions) / size;
+        let dn = diff(&mesh.normals, &reference.normals);
+        assert!(dp <= 1e-6, "{what}: positions differ by {dp:e} of the diagonal");
+        assert!(dn <= 1e-5, "{what}: normals differ by {dn:e}");
+        if kernels_ran {
+            // The f32 kernels ran (rounding differs from the f64 path's somewhere), rather
+            // than the f64 fallback everywhere. Corners are written in closed form with the
+            // f64 path's bits, so only the edge and interior vertices count.
+            let changed = mesh.normals.iter().zip(&reference.normals).filter(|(a, b)| a != b).count();
+            let evaluated = mesh.normals.len() - layout.corners as usize;
+            assert!(
+                changed * 4 > evaluated,
+                "{what}: only {changed} of {evaluated} normals from the kernels"
+            );
+        }
+        let w = crate::verify::watertight(&mesh);
+        let r = crate::verify::watertight(&reference);
+        assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");
+    }
+
+    #[test]
+    #[ignore = "slow tier: every model of the shared data × every scheme, fast paths against the generic engine"]
+    fn fast_paths_equal_the_generic_engine_on_every_model_and_scheme() {
+        use crate::criterion::view::{Mapping, ViewCriterion};
+        use crate::engine::{Layout, TessellateOptions};
+        use crate::sampling::Partitioning;
+        use crate::scheme::{Criterion, PlanOptions, Scheme};
+        let data = crate::io::patches::test_support::data;
+        let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
+        let mut models = Vec::new();
+        // Every patch model and every triangle mesh (bench/ also holds the torus as a quad
+        // mesh, for comparisons with subdivision libraries; tessera reads triangles only).
+        for (folder, ext) in
+            [("patches", "patches"), ("bench", "patches"), ("meshes", "obj"), ("awkward", "obj")]
+        {
+            let mut names: Vec<_> = std::fs::read_dir(data(folder))
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|x| x == ext))
+                .collect();
+            names.sort();
+            models.extend(names);
+        }
+        assert!(models.len() >= 20, "{models:?}");
+        let cases = [
+            (Scheme::Uniform, Criterion::Factor(3.0)),
+            (Scheme::Transition, Criterion::PixelError(1.5)),
+            (Scheme::SemiUniform { max_level: 4 }, Criterion::PixelError(2.0)),
+            (Scheme::Sd2 { warp: true }, view(ViewCriterion::Distance(Mapping::Linear), 1.5, 6.0)),
+            (Scheme::Hardware(Partitioning::FractionalOdd), Criterion::Factor(3.4)),
+            (Scheme::Hardware(Partitioning::FractionalEven), view(ViewCriterion::Silhouetteness, 2.0, 5.5)),
+            (Scheme::Hardware(Partitioning::Pow2), view(ViewCriterion::Distance(Mapping::Linear), 1.0, 6.0)),
+            (
+                Scheme::Esc { max_level: 3 },
+                Criterion::Esc { threshold: crate::criterion::esc::Threshold::Medium, level: None },
+            ),
+        ];
+        let (mut compared, mut refused) = (0, 0);
+        for path in &models {
+            let set = match crate::io::load(path, Default::default()) {
+                Ok(set) => set,
+                Err(e) => panic!("{}: {e}", path.display()),
+            };
+            let (lo, hi) = set.bounds();
+            let camera = crate::camera::Camera::framing(lo, hi, 1280, 720);
+            for (scheme, criterion) in &cases {
+                let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+                let what = format!("{} {scheme:?} {criterion:?}", path.display());
+                // Schemes refuse patch kinds they do not take (SD-2 quads, ESC triangles).
+                let Ok(planned) = scheme.plan(&set, criterion, &options) else {
+                    refused += 1;
+                    continue;
+                };
+                let (plan, pattern) = (&planned.plan, &planned.pattern);
+                let mut layout = Layout::default();
+                layout.build(&set, plan, pattern, &TessellateOptions::default()).unwrap();
+                let mut evaluator = super::super::uniform_quads::FastEvaluator::new(&set, plan);
+                evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                // A few hundred evaluated points can fall mostly on the f64 fallback.
+                let kernels = layout.interior_offsets[set.patches.len()] - layout.corners > 2_000;
+                assert_fast_equals_generic(
+                    &what,
+                    &set,
+                    plan,
+                    pattern,
+                    &layout,
+                    &evaluator,
+                    lo.distance(hi),
+                    kernels,
+                );
+                compared += 1;
+            }
+        }
+        eprintln!("{compared} model × scheme cases compared, {refused} refused by their scheme");
+        assert!(compared >= models.len() * 6, "only {compared} cases compared");
     }
 }
