@@ -41,7 +41,15 @@ pub fn screen_criterion(
             )
             | (Scheme::Hardware(_), Criterion::Factor(_))
     );
-    (cull && on_gpu).then_some(ScreenCriterion { scheme, criterion: *criterion, max_factor, capacity: None })
+    // The GPU's a-posteriori check takes caps up to CHECK_MAX_FACTOR; the CPU plans the rest.
+    let checked = scheme == Scheme::Transition && matches!(criterion, Criterion::PixelError(_));
+    let within = !checked || max_factor <= tessera_gpu::tessellator::CHECK_MAX_FACTOR;
+    (cull && on_gpu && within).then_some(ScreenCriterion {
+        scheme,
+        criterion: *criterion,
+        max_factor,
+        capacity: None,
+    })
 }
 
 /// Plans and tessellates the frame of `camera` on the GPU `repeat` times (frames, from the

@@ -115,8 +115,9 @@ struct MeshArgs {
     instanced: Option<PathBuf>,
     /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform, transition,
     /// integer, pow2, fractional-odd and fractional-even schemes on every surface kind; with
-    /// --cull and a pixel error or silhouetteness the GPU plans the frame from the camera
-    /// itself, else it draws the CPU's plan; --stats adds per-pass GPU times).
+    /// --cull and a pixel error (uniform, transition; --max-factor up to 64), silhouetteness,
+    /// or a hardware scheme's --factor, the GPU plans the frame from the camera itself, else
+    /// it draws the CPU's plan; --stats adds per-pass GPU times).
     #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
     engine: String,
     #[command(flatten)]
@@ -390,6 +391,12 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             _ => gpu::tessellate(&set, plan, pattern, a.repeat, &mut gpu_mesh, &mut gpu_times)?,
         });
     }
+    if let Some(check) = gpu_run.as_ref().and_then(|r| r.screen).filter(|c| c.checked && !c.converged) {
+        eprintln!(
+            "warning: the GPU's a-posteriori check needed more than its {} fix rounds: {} patches miss the bound (the mesh is still crack-free)",
+            check.rounds, check.failing_patches
+        );
+    }
     let mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
     let mut output_file = None;
     if let Some(out) = &a.output {
@@ -465,8 +472,9 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             stats["engine"] = "gpu".into();
             stats["adapter"] = run.adapter.clone().into();
             stats["planned_on"] = if run.screen.is_some() { "gpu" } else { "cpu" }.into();
-            if let Some(check) = &run.screen {
+            if let Some(check) = run.screen.filter(|c| c.checked) {
                 stats["gpu_check_rounds"] = check.rounds.into();
+                stats["gpu_check_converged"] = check.converged.into();
                 stats["gpu_capped_patches"] = check.failing_patches.into();
             }
             stats["gpu_pass_ms"] = run

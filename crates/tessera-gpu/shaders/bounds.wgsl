@@ -51,35 +51,44 @@ fn enclosing_radius(a: vec2<f32>, b: vec2<f32>, c: vec2<f32>) -> f32 {
 }
 
 // Relative skew below which a side counts as following an axis. The CPU's 1e-12 tells f64
-// parameters k/n along an edge from i·(1/n) inside; f32 parameters differ by up to ~1e-7,
-// and a side of any pattern here either follows an axis exactly or is skewed by at least
-// 1/64 of its length (samples are k/n with n ≤ 64), so 1e-4 classifies as exact arithmetic.
+// parameters k/n along an edge from i·(1/n) inside; f32 parameters differ by up to ~1e-7
+// (about 1e-5 of a side of 1/64). A side that does not follow an axis is skewed by at
+// least 1/(64·64) of its length in a pattern whose factors are at most 64 (a strip triangle
+// joins a sample k/s of an edge to a grid point i/n one row inside), which the check's
+// frames keep to (`CHECK_MAX_FACTOR` in `tessellator.rs`): 1e-4 classifies as exact
+// arithmetic does.
 const AXIS_SKEW: f32 = 1e-4;
 
 fn follows_axis(x: f32, side: f32) -> bool {
     return abs(x) <= AXIS_SKEW * abs(side);
 }
 
-// `HessianBound::axis_aligned_error`: Filip's bound for a right triangle whose legs follow
-// the u and v axes; a negative value for other triangles.
-fn axis_aligned_error(m: vec3<f32>, t0: vec2<f32>, t1: vec2<f32>, t2: vec2<f32>) -> f32 {
-    let t = array<vec2<f32>, 3>(t0, t1, t2);
-    for (var c = 0u; c < 3u; c = c + 1u) {
-        let a = t[(c + 1u) % 3u] - t[c];
-        let b = t[(c + 2u) % 3u] - t[c];
-        var legs = vec2<f32>(-1.0);
-        if (follows_axis(a.y, a.x) && follows_axis(b.x, b.y)) {
-            legs = vec2<f32>(a.x, b.y);
-        } else if (follows_axis(a.x, a.y) && follows_axis(b.y, b.x)) {
-            legs = vec2<f32>(b.x, a.y);
-        }
-        if (legs.x != -1.0) {
-            let hu = abs(legs.x);
-            let hv = abs(legs.y);
-            return (hu * hu * m.x + 2.0 * hu * hv * m.y + hv * hv * m.z) / 8.0;
-        }
+// Filip's bound when the legs from corner o, along a and b, follow the u and v axes (either
+// way round); a negative value otherwise.
+fn axis_legs_error(m: vec3<f32>, a: vec2<f32>, b: vec2<f32>) -> f32 {
+    var legs = vec2<f32>(-1.0);
+    if (follows_axis(a.y, a.x) && follows_axis(b.x, b.y)) {
+        legs = vec2<f32>(a.x, b.y);
+    } else if (follows_axis(a.x, a.y) && follows_axis(b.y, b.x)) {
+        legs = vec2<f32>(b.x, a.y);
+    } else {
+        return -1.0;
     }
-    return -1.0;
+    let hu = abs(legs.x);
+    let hv = abs(legs.y);
+    return (hu * hu * m.x + 2.0 * hu * hv * m.y + hv * hv * m.z) / 8.0;
+}
+
+// `HessianBound::axis_aligned_error`: Filip's bound for a right triangle whose legs follow
+// the u and v axes, tried at each corner in turn; a negative value for other triangles.
+// Without a loop: lavapipe stops every loop of an invocation after 65,535 iterations in all
+// (`local.wgsl`), and the check calls this for every strip triangle.
+fn axis_aligned_error(m: vec3<f32>, t0: vec2<f32>, t1: vec2<f32>, t2: vec2<f32>) -> f32 {
+    let e0 = axis_legs_error(m, t1 - t0, t2 - t0);
+    if (e0 >= 0.0) { return e0; }
+    let e1 = axis_legs_error(m, t2 - t1, t0 - t1);
+    if (e1 >= 0.0) { return e1; }
+    return axis_legs_error(m, t0 - t2, t1 - t2);
 }
 
 // `TriangleErrors::error`: the bound over the parameter triangle (t0, t1, t2).

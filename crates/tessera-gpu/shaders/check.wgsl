@@ -28,7 +28,9 @@
 // either way.
 
 // Dispatch arguments of the round's two passes: per patch (x, y, z), then per edge (x, y, z).
-@group(2) @binding(0) var<storage, read_write> round_args: array<u32, 6>;
+// Bound only in the rounds' decisions (`round_open`, `round_close`), whose group 1 holds
+// just the frame state and these: the passes they size read them as indirect arguments.
+@group(1) @binding(5) var<storage, read_write> round_args: array<u32, 6>;
 
 fn write_round_args(run: bool) {
     var per_patch = dispatch_grid(params.patches);
@@ -158,7 +160,7 @@ fn check_all(
 ) {
     let p = thread_index(wid, nwg, lid);
     if (p >= params.patches) { return; }
-    atomicStore(&round_rows[p], 0u);
+    atomicStore(&checks[p].marked, 0u);
     if (check_patch(p)) { atomicAdd(&state.failing, 1u); }
 }
 
@@ -186,7 +188,7 @@ fn round_resolve(
     segments[e] = s;
     atomicStore(&state.changed, 1u);
     for (var u = edge_first_use(e); u < edge_end_use(e); u = u + 1u) {
-        atomicStore(&round_rows[use_patch(u)], 1u);
+        atomicStore(&checks[use_patch(u)].marked, 1u);
     }
 }
 
@@ -216,8 +218,8 @@ fn round_check(
 ) {
     let p = thread_index(wid, nwg, lid);
     if (p >= params.patches) { return; }
-    let marked = atomicLoad(&round_rows[p]) != 0u;
+    let marked = atomicLoad(&checks[p].marked) != 0u;
     if (!marked && (checks[p].flags & 1u) == 0u) { return; }
-    atomicStore(&round_rows[p], 0u);
+    atomicStore(&checks[p].marked, 0u);
     if (check_patch(p)) { atomicAdd(&state.failing, 1u); }
 }

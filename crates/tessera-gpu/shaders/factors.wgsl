@@ -82,6 +82,7 @@ fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
         } else if (b > 0.0) {
             hv = -c / b;
         }
+        if (!(hv > 0.0)) { continue; } // hu alone takes the whole budget (`quad_grid`)
         var nv = 1u;
         if (hv < 1.0) {
             let cells = ceil(1.0 / hv);
@@ -176,7 +177,7 @@ fn wanted_factor(e: u32) -> f32 {
 // `resolve::edges` with `EdgeRule::Integer` for edge e: its wish rounded half away from zero
 // as `f64::round`, at least the minimum.
 fn resolved_segments(e: u32) -> u32 {
-    return max(u32(floor(wanted_factor(e) + 0.5)), max(minimum_segments[e], 1u));
+    return max(u32(floor(wanted_factor(e) + 0.5)), max(minimum_segments(e), 1u));
 }
 
 // Per edge: `resolve::edges` — the maximum over its uses, capped; then `EdgeRule::Integer`
@@ -193,7 +194,7 @@ fn edge_segments(
     if (e >= params.edges) { return; }
     if (view.edge_rule == EDGE_RULE_HARDWARE) {
         let mode = params.partitioning;
-        let minimum = f32(max(minimum_segments[e], 1u));
+        let minimum = f32(max(minimum_segments(e), 1u));
         let f = settled_factor(hull_factor(max(wanted_factor(e), minimum), mode), mode);
         segments[e] = hardware_edge_segments(f, mode);
         segments[params.edges + e] = bitcast<u32>(f);

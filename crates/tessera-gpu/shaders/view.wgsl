@@ -37,13 +37,12 @@ struct View {
 // points' box lo and hi (`screen::PatchView`); the second-derivative bound (uu, uv, vv, 0)
 // (`Prepared::hessians`); the boundary curves' bounds (`Prepared::curves`); the minimum
 // interior factors (`Prepared::minimum_interior`, as f32), 0, 0. After the P patch rows,
-// EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it, the normals there of
-// its first and its last patch (`Prepared::edge_midpoints`).
+// EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it with the edge's
+// minimum segments in w (`minimum_segments`), the normals there of its first and its last
+// patch (`Prepared::edge_midpoints`).
 @group(1) @binding(1) var<storage, read_write> patch_views: array<vec4<f32>>;
-// `Prepared::minimum_segments`, per edge.
-@group(1) @binding(2) var<storage, read_write> minimum_segments: array<u32>;
 // Per patch, the factor it proposes for each local edge (0 for culled patches).
-@group(1) @binding(3) var<storage, read_write> proposals: array<vec4<f32>>;
+@group(1) @binding(2) var<storage, read_write> proposals: array<vec4<f32>>;
 // The frame's planning state, zeroed before the factor passes.
 struct FrameState {
     // The largest segment count and minimum interior of the frame (the global factor of
@@ -60,19 +59,19 @@ struct FrameState {
     _pad1: u32,
     _pad2: u32,
 }
-@group(1) @binding(4) var<storage, read_write> state: FrameState;
+@group(1) @binding(3) var<storage, read_write> state: FrameState;
 
 // Per patch, the a-posteriori check's row (`check.wgsl`): the object-space tolerance (< 0:
-// culled), the guaranteed bound of the last check, flags (bit 0: the bound is missed), 0.
+// culled), the guaranteed bound of the last check, flags (bit 0: the bound is missed), and
+// whether a changed edge asks for the patch's check again (set by any of its edges' resolve
+// invocations, hence atomic).
 struct CheckRow {
     eps: f32,
     bound: f32,
     flags: u32,
-    _pad: u32,
+    marked: atomic<u32>,
 }
-@group(1) @binding(5) var<storage, read_write> checks: array<CheckRow>;
-// The check's rounds: per patch whether a changed edge asks for its check again.
-@group(1) @binding(6) var<storage, read_write> round_rows: array<atomic<u32>>;
+@group(1) @binding(4) var<storage, read_write> checks: array<CheckRow>;
 
 const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
 const INTERIOR_GLOBAL: u32 = 0u;
@@ -84,3 +83,9 @@ const CRITERION_FIXED: u32 = 2u;
 const EDGE_RULE_INTEGER: u32 = 0u;
 const EDGE_RULE_HARDWARE: u32 = 1u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
+
+// `Prepared::minimum_segments` of edge e, kept in the w of its first edge row (a whole
+// number, exact in f32).
+fn minimum_segments(e: u32) -> u32 {
+    return u32(patch_views[PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * e].w);
+}

@@ -65,11 +65,17 @@ pub enum Binding {
 /// The bind group layout of group 0 with `bindings` at 0, 1, 2, … (compute stage). Explicit
 /// layouts, unlike derived ones, are shared by every pipeline made with them.
 pub fn layout(device: &wgpu::Device, bindings: &[Binding]) -> wgpu::BindGroupLayout {
+    let numbered: Vec<(u32, Binding)> = bindings.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+    layout_at(device, &numbered)
+}
+
+/// A bind group layout with each binding at the number given (compute stage): a pass that
+/// needs only some of a group's variables binds just those, by their numbers in the shader.
+pub fn layout_at(device: &wgpu::Device, bindings: &[(u32, Binding)]) -> wgpu::BindGroupLayout {
     let entries: Vec<wgpu::BindGroupLayoutEntry> = bindings
         .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupLayoutEntry {
-            binding: i as u32,
+        .map(|&(binding, b)| wgpu::BindGroupLayoutEntry {
+            binding,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: match b {
@@ -125,10 +131,20 @@ pub fn bind(
     layout: &wgpu::BindGroupLayout,
     buffers: &[&wgpu::Buffer],
 ) -> wgpu::BindGroup {
+    let numbered: Vec<(u32, &wgpu::Buffer)> =
+        buffers.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+    bind_at(device, layout, &numbered)
+}
+
+/// A bind group of `layout` (made by [`layout_at`]) with each buffer at the binding given.
+pub fn bind_at(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
 }

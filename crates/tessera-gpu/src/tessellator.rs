@@ -94,7 +94,26 @@ const MAIN_STORAGE: u32 = 12;
 /// Storage buffers in group 1 of the args pass (its outputs).
 const ARGS_STORAGE: u32 = 3;
 /// Storage buffers in group 1 of the view passes (`view.wgsl`).
-const VIEW_STORAGE: u32 = 6;
+const VIEW_STORAGE: u32 = 4;
+/// Storage buffers in group 1 of the check rounds' decisions (the frame state and the rounds'
+/// dispatch arguments, at the frame state's binding and one of their own).
+const ROUND_STORAGE: u32 = 2;
+/// `view.wgsl`'s binding of the frame state, and `check.wgsl`'s of the rounds' arguments.
+const STATE_BINDING: u32 = 3;
+const ROUND_ARGS_BINDING: u32 = 5;
+
+/// Storage buffers per shader stage a frame needs: group 0's and the largest group 1. Within
+/// 16, what most adapters give (not the WebGPU default of 8, which no GPU engine of this
+/// shape fits: the prepared set, the plan, the layout and the outputs are 12 on their own).
+pub const STORAGE_BUFFERS: u32 = MAIN_STORAGE + max_u32(ARGS_STORAGE, max_u32(VIEW_STORAGE, ROUND_STORAGE));
+
+const fn max_u32(a: u32, b: u32) -> u32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
 /// Rounds of the a-posteriori check a frame records (`check.wgsl`). The CPU's loop runs up
 /// to 256 rounds but ends after a few: across every model in the shared data, 8 seeded
 /// cameras at 0.25, 1 and 4 px and caps 16 and 64, the most it took was 34 (the spool at cap
@@ -102,6 +121,18 @@ const VIEW_STORAGE: u32 = 6;
 /// along the mesh; 41 on another camera in `tests/check.rs`). A round that is not needed
 /// dispatches no work; a plan that needs more is reported ([`ScreenReport::converged`]).
 pub const MAX_ROUNDS: u32 = 64;
+
+/// The largest factor cap of a frame whose a-posteriori check runs on the GPU (the CPU's
+/// default cap). Its shaders rely on it: a check walks strips of at most 2 · 64 steps, so the
+/// loops of one invocation stay well within the 65,535 iterations lavapipe allows an
+/// invocation in all (about 21,000 at the worst: 39 interior steps of four strips), and
+/// `bounds.wgsl`'s test for sides along an axis tells exact arithmetic's answer in f32 only
+/// while factors are at most 64.
+pub const CHECK_MAX_FACTOR: u32 = 64;
+
+/// The most fix rounds a frame may record ([`GpuTessellator::set_check_rounds`]), as many as
+/// the CPU's loop runs.
+pub const MOST_ROUNDS: u32 = 256;
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
 const PATCH_VIEW_ROW: u32 = 8;
 
@@ -260,6 +291,22 @@ fn compute_pipeline(
 }
 
 impl Pipelines {
+    /// Whether `ctx`'s device can make the pipelines: [`GpuError::Unsupported`] for fewer
+    /// than [`STORAGE_BUFFERS`] storage buffers per shader stage. [`Pipelines::new`] on such
+    /// a device would fail wgpu's validation (a panic under wgpu's default error handler), so
+    /// call this first. Cost: O(1).
+    pub fn check_limits(ctx: &GpuContext) -> Result<()> {
+        let have = ctx.limits.max_storage_buffers_per_shader_stage;
+        if have < STORAGE_BUFFERS {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "an adapter with {have} storage buffers per shader stage ({STORAGE_BUFFERS} needed)"
+                ),
+            });
+        }
+        Ok(())
+    }
+
     /// Compiles every shader of the frame on `device`. Cost: about a dozen WGSL compilations
     /// (a second or more on lavapipe).
     pub fn new(device: &wgpu::Device) -> Pipelines {
@@ -271,7 +318,7 @@ impl Pipelines {
         let mut view = vec![Uniform];
         view.extend(std::iter::repeat_n(Write, VIEW_STORAGE as usize));
         let view_layout = shader::layout(device, &view);
-        let rounds_layout = shader::layout(device, &[Write]);
+        let rounds_layout = shader::layout_at(device, &[(STATE_BINDING, Write), (ROUND_ARGS_BINDING, Write)]);
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -282,7 +329,7 @@ impl Pipelines {
         let one = pipeline_layout(&[Some(&main_layout)]);
         let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
         let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
-        let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&view_layout), Some(&rounds_layout)]);
+        let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&rounds_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
             compute_pipeline(device, layout, module, entry)
         };
@@ -577,11 +624,12 @@ fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsag
 impl GpuTessellator {
     /// Uploads `set` (see [`crate::upload`]) and compiles the frame's pipelines.
     ///
-    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than 16 storage buffers
-    /// per shader stage. Cost: O(P + E) packing, one upload, and [`Pipelines::new`]'s
-    /// compilations (a second or more on lavapipe; [`GpuTessellator::with_pipelines`]
-    /// shares them instead).
+    /// Errors: [`GpuError::Unsupported`] for an adapter with fewer than [`STORAGE_BUFFERS`]
+    /// storage buffers per shader stage (checked before any pipeline is made). Cost: O(P + E)
+    /// packing, one upload, and [`Pipelines::new`]'s compilations (a second or more on
+    /// lavapipe; [`GpuTessellator::with_pipelines`] shares them instead).
     pub fn new(ctx: &GpuContext, set: &SurfaceSet) -> Result<GpuTessellator> {
+        Pipelines::check_limits(ctx)?;
         Self::with_pipelines(ctx, set, std::sync::Arc::new(Pipelines::new(&ctx.device)))
     }
 
@@ -592,16 +640,7 @@ impl GpuTessellator {
         set: &SurfaceSet,
         pipelines: std::sync::Arc<Pipelines>,
     ) -> Result<GpuTessellator> {
-        // The check rounds' decisions bind one more (their dispatch arguments, group 2).
-        let needed = MAIN_STORAGE + ARGS_STORAGE.max(VIEW_STORAGE + 1);
-        if ctx.limits.max_storage_buffers_per_shader_stage < needed {
-            return Err(GpuError::Unsupported {
-                what: format!(
-                    "an adapter with {} storage buffers per shader stage ({needed} needed)",
-                    ctx.limits.max_storage_buffers_per_shader_stage
-                ),
-            });
-        }
+        Pipelines::check_limits(ctx)?;
         let device = &ctx.device;
         let gpu_set = GpuSet::new(device, set)?;
         let (e, p) = (gpu_set.edges as u64, gpu_set.patches as u64);
@@ -762,6 +801,8 @@ impl GpuTessellator {
     /// integer schemes), or a `max_factor` outside `1..=MAX_FACTOR`, and
     /// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks
     /// of [`Scheme::plan`]);
+    /// [`GpuError::Unsupported`] too for the transition scheme's pixel error with a
+    /// `max_factor` above [`CHECK_MAX_FACTOR`];
     /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
     /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
     /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
@@ -841,6 +882,14 @@ impl GpuTessellator {
             Scheme::Hardware(_) => INTERIOR_MAX_EDGE,
             _ => INTERIOR_CORE,
         };
+        if kind == CRITERION_PIXEL_ERROR && interior == INTERIOR_CORE && max_factor > CHECK_MAX_FACTOR {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "the a-posteriori check on the GPU with a factor cap of {max_factor} (it takes caps up \
+                     to {CHECK_MAX_FACTOR}; plan this frame on the CPU)"
+                ),
+            });
+        }
         let patches = set.patches.len();
         if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
             return Err(
@@ -895,11 +944,6 @@ impl GpuTessellator {
             // View-independent and the same for every `Prepared` of the set: uploaded once.
             let rows = patch_view_rows(set, Some(prepared));
             queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
-            queue.write_buffer(
-                &self.view.minimum_segments,
-                0,
-                bytemuck::cast_slice(&prepared.minimum_segments),
-            );
             self.view.bounds_uploaded = true;
         }
         let edge_rule = if hardware.is_some() { EDGE_RULE_HARDWARE } else { EDGE_RULE_INTEGER };
@@ -1147,16 +1191,20 @@ impl GpuTessellator {
         c.set_pipeline(&k.check_all);
         c.dispatch_workgroups(x, y, 1);
         let args = &self.view.round_args;
-        for _ in 0..self.check_rounds {
-            // The decisions bind the dispatch arguments as storage (group 2); the passes they
-            // size read them as indirect arguments and leave group 2 out of their layout.
-            c.set_pipeline(&k.open);
-            c.set_bind_group(2, &self.view.rounds, &[]);
+        // The decisions bind the dispatch arguments as storage (their group 1: the frame state
+        // and the arguments); the passes they size read them as indirect arguments, with the
+        // view group, which leaves them out.
+        let decide = |c: &mut wgpu::ComputePass<'_>, pipeline: &wgpu::ComputePipeline| {
+            c.set_pipeline(pipeline);
+            c.set_bind_group(1, &self.view.rounds, &[]);
             c.dispatch_workgroups(1, 1, 1);
+            c.set_bind_group(1, &self.view.bind, &[]);
+        };
+        for _ in 0..self.check_rounds {
+            decide(c, &k.open);
             c.set_pipeline(&k.resolve);
             c.dispatch_workgroups_indirect(args, 12);
-            c.set_pipeline(&k.close);
-            c.dispatch_workgroups(1, 1, 1);
+            decide(c, &k.close);
             c.set_pipeline(&k.recheck);
             c.dispatch_workgroups_indirect(args, 0);
         }
@@ -1166,11 +1214,12 @@ impl GpuTessellator {
     /// (default [`MAX_ROUNDS`]). A round that is not needed dispatches no work, but still
     /// costs its four dispatches (about 70 µs on lavapipe, a few µs on a hardware GPU), so a
     /// real-time loop whose scenes converge in fewer rounds may record fewer and watch
-    /// [`ScreenReport::converged`] now and then (a read-back, on request). A frame whose plan
+    /// [`ScreenReport::converged`] now and then (a read-back, on request); at most
+    /// [`MOST_ROUNDS`] (more are clamped to it). A frame whose plan
     /// needs more rounds is still crack-free; its failing patches miss their bound and are
     /// counted. Cost: none until the next frame.
     pub fn set_check_rounds(&mut self, rounds: u32) {
-        self.check_rounds = rounds;
+        self.check_rounds = rounds.min(MOST_ROUNDS);
     }
 
     /// Reads the last frame's a-posteriori check back (after
@@ -1181,11 +1230,11 @@ impl GpuTessellator {
         let state: Vec<u32> = readback::read(ctx, &self.view.state, 8)?;
         let checked = self.screen.is_some_and(|s| s.checked()) && self.camera.is_some();
         if !checked {
-            return Ok(ScreenReport { rounds: 0, failing_patches: 0, converged: true });
+            return Ok(ScreenReport { checked: false, rounds: 0, failing_patches: 0, converged: true });
         }
         // Done, or nothing left failing (the next round would have found that and ended).
         let converged = state[3] != 0 || state[1] == 0;
-        Ok(ScreenReport { rounds: state[4], failing_patches: state[1], converged })
+        Ok(ScreenReport { checked: true, rounds: state[4], failing_patches: state[1], converged })
     }
 
     /// Reads the check's guaranteed bound per patch back (0 for culled patches; meaningful
@@ -1404,6 +1453,10 @@ impl Screen {
 /// ([`GpuTessellator::read_screen_report`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ScreenReport {
+    /// Whether the frame had an a-posteriori check on the GPU (a pixel error with the
+    /// transition scheme, planned by [`GpuTessellator::prepare_screen`]); the other fields are
+    /// 0, 0 and true otherwise.
+    pub checked: bool,
     /// Fix rounds run after the first check (the CPU's loop iterations that changed edges).
     pub rounds: u32,
     /// Visible patches whose bound the plan misses: at the factor cap, as
@@ -1422,7 +1475,6 @@ pub struct ScreenReport {
 struct ViewBuffers {
     uniform: wgpu::Buffer,
     patch_views: wgpu::Buffer,
-    minimum_segments: wgpu::Buffer,
     /// `view.wgsl`'s `FrameState`.
     state: wgpu::Buffer,
     /// The check rows (`view.wgsl`'s `CheckRow`, per patch).
@@ -1447,32 +1499,20 @@ impl ViewBuffers {
         set: &SurfaceSet,
     ) -> ViewBuffers {
         use wgpu::BufferUsages as U;
-        let (edges, patches) = (set.topology.edges.len() as u64, set.patches.len() as u64);
+        let patches = set.patches.len() as u64;
         let uniform = buffer(device, "view", 112, U::UNIFORM | U::COPY_DST);
         let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
-        let minimum_segments = buffer(device, "minimum segments", 4 * edges, U::STORAGE | U::COPY_DST);
         let proposals = buffer(device, "proposals", 16 * patches, U::STORAGE);
         let state = buffer(device, "frame state", 32, U::STORAGE | U::COPY_DST | U::COPY_SRC);
         let checks = buffer(device, "check rows", 16 * patches, U::STORAGE | U::COPY_SRC);
-        let round_rows = buffer(device, "check round marks", 4 * patches, U::STORAGE);
-        let bind = shader::bind(
-            device,
-            layout,
-            &[&uniform, &patch_views, &minimum_segments, &proposals, &state, &checks, &round_rows],
-        );
+        let bind = shader::bind(device, layout, &[&uniform, &patch_views, &proposals, &state, &checks]);
         let round_args = buffer(device, "check round dispatches", 24, U::STORAGE | U::INDIRECT);
-        let rounds = shader::bind(device, rounds_layout, &[&round_args]);
-        ViewBuffers {
-            uniform,
-            patch_views,
-            minimum_segments,
-            state,
-            checks,
-            bind,
-            round_args,
-            rounds,
-            bounds_uploaded: false,
-        }
+        let rounds = shader::bind_at(
+            device,
+            rounds_layout,
+            &[(STATE_BINDING, &state), (ROUND_ARGS_BINDING, &round_args)],
+        );
+        ViewBuffers { uniform, patch_views, state, checks, bind, round_args, rounds, bounds_uploaded: false }
     }
 }
 
@@ -1482,8 +1522,9 @@ impl ViewBuffers {
 /// `(sin α, cos α, has cone, 0)`, the control-point box's lo and hi; then from `prepared`
 /// (zero without it) the second-derivative bound `(uu, uv, vv, 0)`, the four boundary
 /// curves' bounds and the minimum interior factors; after the patches, [`EDGE_VIEW_ROW`]
-/// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, the
-/// normals of its first and last patch). View-independent: computed once. Cost: O(P) cone
+/// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, with
+/// the edge's `Prepared::minimum_segments` in w; the normals of its first and last patch).
+/// View-independent: computed once. Cost: O(P) cone
 /// computations, the midpoints' evaluations when `prepared` has none yet.
 fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
     let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
@@ -1510,8 +1551,9 @@ fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4
     let edges = set.topology.edges.len();
     match prepared {
         Some(prepared) => {
-            for [(mid, nl), (_, nr)] in prepared.edge_midpoints(set) {
-                out.extend([v4(*mid, 0.0), v4(*nl, 0.0), v4(*nr, 0.0)]);
+            let minimum = &prepared.minimum_segments;
+            for (e, [(mid, nl), (_, nr)]) in prepared.edge_midpoints(set).iter().enumerate() {
+                out.extend([v4(*mid, minimum[e] as f64), v4(*nl, 0.0), v4(*nr, 0.0)]);
             }
         }
         None => out.resize(out.len() + EDGE_VIEW_ROW * edges, [0.0; 4]),

@@ -70,7 +70,10 @@ fn frames_without_a_check_report_no_rounds() {
     };
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
-    assert_eq!((report.rounds, report.failing_patches, report.converged), (0, 0, true));
+    assert_eq!(
+        (report.checked, report.rounds, report.failing_patches, report.converged),
+        (false, 0, 0, true)
+    );
 }
 
 #[test]
@@ -110,4 +113,40 @@ fn too_few_rounds_are_reported_and_the_plan_stays_crack_free() {
     let plan = gpu.read_plan(ctx()).unwrap();
     assert_ne!(plan.segments, cpu.plan.segments, "two rounds gave the converged plan");
     assert_gpu_equals_cpu_after_record("spool, 2 rounds", &set, &gpu, &plan, &Transition);
+    // Crack-free: every open edge of the mesh lies on a curve that one visible patch alone
+    // uses (the culled region's rim, the model's own boundary), as many as that curve's
+    // segments; a crack would open more. And no edge is non-manifold.
+    let topo = &set.topology;
+    let rim: u32 = (0..topo.edges.len())
+        .filter(|&e| !topo.edges[e].collapsed)
+        .filter(|&e| topo.edge_uses(e).iter().filter(|u| plan.is_visible(u.patch as usize)).count() == 1)
+        .map(|e| plan.segments[e])
+        .sum();
+    let w = tessera::verify::watertight(&gpu.read_mesh(ctx(), &set).unwrap());
+    assert_eq!((w.boundary_edges, w.nonmanifold_edges), (rim as usize, 0), "{w:?}");
+    let converged = tessera::engine::tessellate(&set, &cpu.plan, &Transition, Default::default()).unwrap();
+    assert_eq!(w.euler_characteristic, tessera::verify::watertight(&converged).euler_characteristic);
+}
+
+#[test]
+fn checked_frames_past_the_check_cap_are_refused_not_truncated() {
+    // Caps above CHECK_MAX_FACTOR would take the check's loops past what lavapipe runs and its
+    // axis test past f32's reach: refused with a typed error, never drawn wrong.
+    use tessera::scheme::{Criterion, Scheme};
+    let set = load("patches/teapot.patches");
+    let prepared = Prepared::new(&set, true);
+    let mut gpu = tessellator(&set);
+    let camera = cameras(&set, 1, 3)[0];
+    let cap = tessera_gpu::tessellator::CHECK_MAX_FACTOR + 1;
+    let screen = tessera_gpu::tessellator::ScreenCriterion {
+        scheme: Scheme::Transition,
+        criterion: Criterion::PixelError(0.5),
+        max_factor: cap,
+        capacity: None,
+    };
+    let err = gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap_err();
+    assert!(matches!(err, tessera_gpu::GpuError::Unsupported { .. }), "{err}");
+    // The uniform scheme's pixel error has no check and takes the cap.
+    let screen = tessera_gpu::tessellator::ScreenCriterion { scheme: Scheme::Uniform, ..screen };
+    gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap();
 }

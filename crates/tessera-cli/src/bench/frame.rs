@@ -86,7 +86,7 @@ pub fn scenes(ctx: &Ctx) -> BenchResult<Vec<Scene>> {
 
 pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     let repeats = if ctx.quick { 2 } else { 9 };
-    ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64 + if ctx.gpu { 2 } else { 0 });
+    ctx.plan_steps(3 + 3 * 2 * ctx.threads.len() as u64);
     let mut walk = Table::new(
         "frame_walk",
         "frame: camera walks, ms per stage over the walk (median / p95)",
@@ -226,6 +226,14 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
 /// note) without an adapter.
 fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<Option<Table>> {
     let Some(adapter) = super::speed::gpu_adapter(ctx) else { return Ok(None) };
+    let screens: Vec<_> = scenes
+        .iter()
+        .filter_map(|scene| {
+            let cap = scene.options().plan.max_factor;
+            crate::gpu::screen_criterion(scene.scheme, &scene.criterion, scene.cull, cap).map(|s| (scene, s))
+        })
+        .collect();
+    ctx.plan_steps(screens.len() as u64);
     let passes = tessera_gpu::tessellator::PASSES;
     let mut columns: Vec<String> =
         ["scene", "patches", "scheme", "triangles", "fix rounds", "capped patches"]
@@ -236,11 +244,7 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();
     let title = format!("frame: the walk's first frame planned and tessellated on the GPU ({adapter})");
     let mut table = Table::new("frame_gpu", &title, &names);
-    for scene in scenes {
-        let Some(screen) = crate::gpu::screen_criterion(scene.scheme, &scene.criterion, scene.cull, 64)
-        else {
-            continue;
-        };
+    for (scene, screen) in screens {
         ctx.step(&format!("frame: {} first frame on the GPU", scene.name));
         let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
         let run = crate::gpu::tessellate_from_camera(

@@ -50,6 +50,9 @@ fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
         } else {
             1.0
         };
+        if hv <= 0.0 {
+            continue; // hu alone takes the whole budget (c = 0): no cell height is left
+        }
         let nv = if hv >= 1.0 { 1 } else { (1.0 / hv).ceil() as u64 };
         if nv > cap as u64 {
             continue;
