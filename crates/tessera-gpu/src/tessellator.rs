@@ -610,6 +610,24 @@ pub struct GpuTessellator {
     buffer_limit: u64,
     /// Fix rounds of the a-posteriori check a frame records ([`MAX_ROUNDS`] unless set).
     check_rounds: u32,
+    /// Whether the adapter's shader compiler stops long loops ([`loop_limited`]).
+    loop_limited: bool,
+}
+
+/// The loop iterations one invocation gets in all on Mesa's llvmpipe (lavapipe): its compiler
+/// ends every loop of an invocation once their iterations add up to this (a guard against
+/// endless loops), whatever the shader says.
+pub const LOOP_LIMIT: u32 = 65_535;
+
+/// The largest transition factor whose pattern one invocation walks within [`LOOP_LIMIT`]
+/// (`n² + 9n` iterations at factor `n`, with room to spare).
+pub const LOOP_LIMITED_TRANSITION_FACTOR: u32 = 240;
+
+/// Whether `info` is an adapter that limits loops to [`LOOP_LIMIT`] iterations an invocation:
+/// Mesa's software drivers (llvmpipe, which lavapipe is). Hardware drivers run loops to the
+/// end.
+pub fn loop_limited(info: &wgpu::AdapterInfo) -> bool {
+    info.name.contains("llvmpipe") || info.driver.contains("llvmpipe")
 }
 
 fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
@@ -678,6 +696,7 @@ impl GpuTessellator {
             screen: None,
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
             check_rounds: MAX_ROUNDS,
+            loop_limited: loop_limited(&ctx.info),
             set: gpu_set,
             pipelines,
         })
@@ -746,6 +765,10 @@ impl GpuTessellator {
                     ),
                 });
             }
+        }
+        if kind == GpuPattern::Transition {
+            let largest = plan.segments.iter().chain(plan.interior.iter().flatten()).copied().max();
+            self.check_loop_budget(largest.unwrap_or(1))?;
         }
         let capacity = Capacity::of_plan(set, plan, pattern, self.camera.is_some());
         self.reserve(ctx, capacity)?;
@@ -882,6 +905,9 @@ impl GpuTessellator {
             Scheme::Hardware(_) => INTERIOR_MAX_EDGE,
             _ => INTERIOR_CORE,
         };
+        if scheme == Scheme::Transition {
+            self.check_loop_budget(max_factor)?;
+        }
         if kind == CRITERION_PIXEL_ERROR && interior == INTERIOR_CORE && max_factor > CHECK_MAX_FACTOR {
             return Err(GpuError::Unsupported {
                 what: format!(
@@ -958,6 +984,23 @@ impl GpuTessellator {
         };
         self.write_params(ctx);
         self.set_cull_camera(ctx, Some(camera));
+        Ok(())
+    }
+
+    /// Refuses transition factors past [`LOOP_LIMITED_TRANSITION_FACTOR`] on an adapter that
+    /// stops loops ([`loop_limited`]): one invocation walks a patch's whole transition pattern
+    /// (about `n² + 9n` loop iterations at factor `n`), and such a driver would silently
+    /// leave the rest of the pattern unwritten. Cost: O(1).
+    fn check_loop_budget(&self, largest_factor: u32) -> Result<()> {
+        if self.loop_limited && largest_factor > LOOP_LIMITED_TRANSITION_FACTOR {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "transition factors up to {largest_factor} on this adapter: its shader compiler stops \
+                     every loop of an invocation after {LOOP_LIMIT} iterations in all, which a patch past \
+                     factor {LOOP_LIMITED_TRANSITION_FACTOR} needs (use a lower --max-factor or a hardware GPU)"
+                ),
+            });
+        }
         Ok(())
     }
 

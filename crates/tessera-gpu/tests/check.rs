@@ -150,3 +150,27 @@ fn checked_frames_past_the_check_cap_are_refused_not_truncated() {
     let screen = tessera_gpu::tessellator::ScreenCriterion { scheme: Scheme::Uniform, ..screen };
     gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap();
 }
+
+#[test]
+fn transition_factors_past_a_loop_limited_drivers_budget_are_refused() {
+    // Mesa's software driver ends an invocation's loops after 65,535 iterations in all; a
+    // transition patch past factor 240 would need more, and be left half written. There such
+    // plans are refused; a hardware driver takes them.
+    use tessera_gpu::tessellator::{loop_limited, LOOP_LIMITED_TRANSITION_FACTOR};
+    let set = load("patches/teapot.patches");
+    let mut gpu = tessellator(&set);
+    let plan_at = |n: u32| {
+        tessera::criterion::Plan::integer(
+            vec![n; set.topology.edges.len()],
+            vec![[n, n]; set.patches.len()],
+            set.patches.len(),
+        )
+    };
+    gpu.prepare(ctx(), &set, &plan_at(LOOP_LIMITED_TRANSITION_FACTOR), &Transition).unwrap();
+    let past = gpu.prepare(ctx(), &set, &plan_at(LOOP_LIMITED_TRANSITION_FACTOR + 1), &Transition);
+    if loop_limited(&ctx().info) {
+        assert!(matches!(past, Err(tessera_gpu::GpuError::Unsupported { .. })), "{past:?}");
+    } else {
+        past.unwrap();
+    }
+}
