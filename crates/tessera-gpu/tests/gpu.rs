@@ -568,24 +568,6 @@ fn acceptance_sweep_on_every_model_20_cameras() {
     assert!(100 * counts.cull_ties <= counts.culled.max(100), "{counts:?}");
 }
 
-/// A camera inside the model's box looking at its centre: close patches drive a fine
-/// pixel error to the cap.
-fn close_camera(set: &SurfaceSet) -> tessera::camera::Camera {
-    let (lo, hi) = set.bounds();
-    let centre = (lo + hi) * 0.5;
-    let radius = (hi - lo).length() * 0.5;
-    tessera::camera::Camera {
-        eye: centre + glam::DVec3::new(0.3, -0.5, 0.4) * radius,
-        target: centre,
-        up: glam::DVec3::Z,
-        fov_y_degrees: 70.0,
-        width: 1280,
-        height: 1024,
-        near: radius * 1e-3,
-        far: radius * 10.0,
-    }
-}
-
 /// The capacity test on `model` at factor cap `cap`: a close camera and a fine pixel error
 /// drive the GPU's factor to the cap (checked on the CPU plan). Started with the default
 /// room (the worst case within the device's limits) the frame fits or reports an overflow

@@ -546,19 +546,7 @@ fn hardware_capacity_holds_the_worst_frame_or_grows() {
     let ctx = ctx();
     let set = load("patches/teapot.patches");
     let prepared = Prepared::new(&set, true);
-    let (lo, hi) = set.bounds();
-    let centre = (lo + hi) * 0.5;
-    let radius = (hi - lo).length() * 0.5;
-    let camera = tessera::camera::Camera {
-        eye: centre + glam::DVec3::new(0.3, -0.5, 0.4) * radius,
-        target: centre,
-        up: glam::DVec3::Z,
-        fov_y_degrees: 70.0,
-        width: 1280,
-        height: 1024,
-        near: radius * 1e-3,
-        far: radius * 10.0,
-    };
+    let camera = close_camera(&set);
     let silhouettes = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax: 64.0 };
     for (p, criterion) in
         [(Partitioning::FractionalOdd, Criterion::Factor(62.5)), (Partitioning::FractionalEven, silhouettes)]

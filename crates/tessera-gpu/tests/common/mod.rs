@@ -425,3 +425,21 @@ pub fn record_until_complete(gpu: &mut GpuTessellator, name: &str) -> u32 {
         assert!(grown <= 2, "{name}: still overflowing after {grown} growths");
     }
 }
+
+/// A camera inside the model's box looking at its centre: close patches drive a fine
+/// pixel error to the cap.
+pub fn close_camera(set: &SurfaceSet) -> tessera::camera::Camera {
+    let (lo, hi) = set.bounds();
+    let centre = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    tessera::camera::Camera {
+        eye: centre + glam::DVec3::new(0.3, -0.5, 0.4) * radius,
+        target: centre,
+        up: glam::DVec3::Z,
+        fov_y_degrees: 70.0,
+        width: 1280,
+        height: 1024,
+        near: radius * 1e-3,
+        far: radius * 10.0,
+    }
+}
