@@ -546,18 +546,9 @@ fn acceptance_sweep_on_the_small_models() {
 fn acceptance_sweep_on_every_model_20_cameras() {
     // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).
-    let (large, rest): (Vec<String>, Vec<String>) = all_models()
-        .into_iter()
-        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    let (rest, large) = models_by_size();
     let mut counts = acceptance_sweep(&rest, 20, 2026);
-    let more = acceptance_sweep(&large, 10, 2026);
-    counts.frames += more.frames;
-    counts.culled += more.culled;
-    counts.cull_ties += more.cull_ties;
-    counts.factor_ties += more.factor_ties;
-    counts.below_cap += more.below_cap;
-    counts.check_ties += more.check_ties;
-    counts.check_rounds += more.check_rounds;
+    counts.add(&acceptance_sweep(&large, 10, 2026));
     assert!(counts.check_rounds > 0, "no pixel-error transition frame needed a fix round: {counts:?}");
     // The check's decisions met no f32 rounding tie in these frames: none is allowed, so a
     // difference is a bug until shown to be a tie.

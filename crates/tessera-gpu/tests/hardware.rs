@@ -517,14 +517,10 @@ fn hardware_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
 #[test]
 #[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each (10 on the three meshes over 40,000 patches), every partitioning"]
 fn hardware_from_the_camera_on_every_model_20_cameras() {
-    let (large, rest): (Vec<String>, Vec<String>) = all_models()
-        .into_iter()
-        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    let (rest, large) = models_by_size();
     let (mut sweep, mut counts) = hardware_from_the_camera(&rest, 20, 2026, 3);
     let (more_sweep, more) = hardware_from_the_camera(&large, 10, 2026, 3);
-    sweep.frames += more_sweep.frames;
-    sweep.cull_ties += more_sweep.cull_ties;
-    sweep.culled += more_sweep.culled;
+    sweep.add(&more_sweep);
     counts.frames += more.frames;
     counts.edges += more.edges;
     counts.rounding += more.rounding;

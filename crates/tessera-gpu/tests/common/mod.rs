@@ -443,3 +443,26 @@ pub fn close_camera(set: &SurfaceSet) -> tessera::camera::Camera {
         far: radius * 10.0,
     }
 }
+
+/// Every model (`all_models`), split into those up to 1.5 MB and the three meshes past it
+/// (over 40,000 patches), which the slow sweeps run with fewer cameras: `(rest, large)`.
+pub fn models_by_size() -> (Vec<String>, Vec<String>) {
+    let (large, rest): (Vec<String>, Vec<String>) = all_models()
+        .into_iter()
+        .partition(|m| std::fs::metadata(data_dir().join(m)).unwrap().len() > 1_500_000);
+    (rest, large)
+}
+
+impl SweepCounts {
+    /// Adds the tallies of `other`, another part of the same sweep.
+    pub fn add(&mut self, other: &SweepCounts) {
+        self.frames += other.frames;
+        self.culled += other.culled;
+        self.cull_ties += other.cull_ties;
+        self.factor_ties += other.factor_ties;
+        self.below_cap += other.below_cap;
+        self.strips += other.strips;
+        self.check_ties += other.check_ties;
+        self.check_rounds += other.check_rounds;
+    }
+}
