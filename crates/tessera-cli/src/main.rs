@@ -456,6 +456,8 @@ fn run_mesh(a: MeshArgs) -> CliResult {
                 "resolve": stage(|t| t.resolve),
                 "layout": stage(|t| t.layout),
                 "write": stage(|t| t.write),
+                "write_vertices": stage(|t| t.write_vertices),
+                "write_indices": stage(|t| t.write_indices),
                 "output_file": output_file,
             },
             "repairs": repairs,

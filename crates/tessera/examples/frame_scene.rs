@@ -53,12 +53,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), options)?
     };
     println!("prepared in {:.0} ms", ms(start));
-    let mut stages: [Vec<f64>; 5] = Default::default();
+    let mut stages: [Vec<f64>; 6] = Default::default();
     let mut triangles = 0;
     for _ in 0..frames {
         triangles = tess.frame(Some(&camera))?.triangle_count();
         let t = tess.timings();
-        for (s, d) in stages.iter_mut().zip([t.criterion, t.resolve, t.layout, t.write, t.total()]) {
+        for (s, d) in stages.iter_mut().zip([
+            t.criterion,
+            t.resolve,
+            t.layout,
+            t.write_vertices,
+            t.write_indices,
+            t.total(),
+        ]) {
             s.push(d.as_secs_f64() * 1000.0);
         }
     }
@@ -66,10 +73,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    let [c, r, l, w, total] = stages.each_mut().map(median);
+    let [c, r, l, v, i, total] = stages.each_mut().map(median);
     println!(
         "{triangles} triangles; median frame {total:.2} ms over {frames} frames on {} threads: \
-         criterion {c:.2}, resolve {r:.2}, layout {l:.2}, write {w:.2} ms",
+         criterion {c:.2}, resolve {r:.2}, layout {l:.2}, write vertices {v:.2}, write indices {i:.2} ms",
         rayon::current_num_threads()
     );
     Ok(())

@@ -48,8 +48,12 @@ pub struct FrameTimings {
     pub resolve: Duration,
     /// The output layout (counts and offsets).
     pub layout: Duration,
-    /// Vertex and index writes.
+    /// Vertex and index writes: `write_vertices + write_indices`, within timer resolution.
     pub write: Duration,
+    /// The write's first pass: every vertex record (corners, edge samples, interiors).
+    pub write_vertices: Duration,
+    /// The write's second pass: every triangle (and the strips, when asked for).
+    pub write_indices: Duration,
 }
 
 impl FrameTimings {
@@ -193,15 +197,28 @@ impl<'a> Tessellator<'a> {
         let start = Instant::now();
         self.fast.retarget(&planned.plan);
         self.fast.fill_patterns(&planned.plan, &planned.pattern, self.layout.triangle_count() as u64);
+        let filled = start.elapsed();
         let fast = Some(&self.fast);
         let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
-        engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, &mut self.mesh, fast)?;
+        let written = engine::write_with(
+            self.set,
+            plan,
+            pattern,
+            layout_ref,
+            self.options.engine,
+            &mut self.mesh,
+            fast,
+        )?;
+        let write = start.elapsed();
         self.timings = FrameTimings {
+            // The pattern cache's fill counts with the vertices, whose pass uses it first.
+            write_vertices: filled + written.vertices,
+            write_indices: written.indices,
             criterion,
             // Whatever planning did besides the criterion counts as resolving.
             resolve: planning.saturating_sub(criterion).max(resolve),
             layout,
-            write: start.elapsed(),
+            write,
         };
         Ok(&self.mesh)
     }

@@ -256,6 +256,8 @@ pub struct StageSeries {
     pub resolve: Vec<f64>,
     pub layout: Vec<f64>,
     pub write: Vec<f64>,
+    pub write_vertices: Vec<f64>,
+    pub write_indices: Vec<f64>,
     pub total: Vec<f64>,
     pub triangles: Vec<usize>,
     pub vertices: Vec<usize>,
@@ -270,6 +272,8 @@ impl StageSeries {
         self.resolve.push(ms(t.resolve));
         self.layout.push(ms(t.layout));
         self.write.push(ms(t.write));
+        self.write_vertices.push(ms(t.write_vertices));
+        self.write_indices.push(ms(t.write_indices));
         self.total.push(ms(t.total()));
         self.triangles.push(triangles);
         self.vertices.push(vertices);

@@ -123,6 +123,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                 Cell::None,
                 Cell::None,
                 Cell::None,
+                Cell::None,
                 num(total, 3),
                 num(p95, 3),
                 num(mtri, 1),
@@ -189,7 +190,8 @@ fn stage_cells(series: &StageSeries) -> (Vec<Cell>, f64) {
         med(&series.criterion),
         med(&series.resolve),
         med(&series.layout),
-        med(&series.write),
+        med(&series.write_vertices),
+        med(&series.write_indices),
         num(total, 3),
         num(p95, 3),
         num(mtri, 1),
@@ -199,13 +201,14 @@ fn stage_cells(series: &StageSeries) -> (Vec<Cell>, f64) {
 }
 
 /// The columns after a row's labels ([`stage_cells`]).
-const STAGE_COLUMNS: [&str; 10] = [
+const STAGE_COLUMNS: [&str; 11] = [
     "triangles",
     "vertices",
     "criterion ms",
     "resolve ms",
     "layout ms",
-    "write ms",
+    "vertices ms",
+    "indices ms",
     "frame ms",
     "frame p95 ms",
     "Mtri/s",

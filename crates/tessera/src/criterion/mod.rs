@@ -204,6 +204,22 @@ impl Plan {
         }
     }
 
+    /// `Some((n, interior))` when every edge has `n` segments of a uniform sampling, every
+    /// patch the interior factors `interior`, and every patch is visible: then patches of one
+    /// domain share one pattern input (the uniform writers' and the arithmetic layout's
+    /// precondition). Cost: O(E + P), vectorized folds.
+    pub fn one_factor(&self) -> Option<(u32, [u32; 2])> {
+        if self.kind != SamplingKind::Uniform {
+            return None;
+        }
+        let (&n, &interior) = (self.segments.first()?, self.interior.first()?);
+        // Folds rather than `all`, which stops early and does not vectorize.
+        let same = self.segments.iter().fold(true, |all, &s| all & (s == n))
+            && self.interior.iter().fold(true, |all, f| all & (*f == interior))
+            && self.visible.iter().fold(true, |all, &v| all & (v != 0));
+        same.then_some((n, interior))
+    }
+
     /// Number of edges the plan covers.
     pub fn edge_count(&self) -> usize {
         self.segments.len()

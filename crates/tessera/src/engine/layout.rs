@@ -89,6 +89,9 @@ impl Layout {
         plan.check(set)?;
         let topo = &set.topology;
         self.corners = topo.corner_entries.len() as u32;
+        if let (Some(_), Some(_), false) = (topo.one_shape, plan.one_factor(), pattern.depends_on_patch()) {
+            return self.build_one_input(set, plan, pattern, options);
+        }
         // Edges: inner samples per variant; none for collapsed edges or edges seen by no
         // visible patch (nothing refers to them).
         // Counts in parallel (segments ≤ MAX_FACTOR and ≤ 255 variants: a count fits u32),
@@ -165,6 +168,44 @@ impl Layout {
         self.interior_offsets.push(vertices);
         self.triangle_offsets.push(triangles);
         self.collapsed_triangles = upper - triangles as u64;
+        Ok(())
+    }
+}
+
+impl Layout {
+    /// [`Layout::build`] where every patch has the same pattern input (one domain, distinct
+    /// corners, a one-factor plan with every patch visible, a pattern that ignores the patch
+    /// id): one count, and offsets by arithmetic — the same numbers the general build scans,
+    /// without a pattern input per patch. Cost: O(E + P), one pattern count.
+    fn build_one_input(
+        &mut self,
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        options: &TessellateOptions,
+    ) -> Result<()> {
+        let topo = &set.topology;
+        let patches = set.patches.len();
+        let (vertices, triangles) = pattern.counts(&pattern_input(set, plan, 0));
+        let inner = plan.segments(0) - 1;
+        // Every edge is seen by a visible patch and none is collapsed.
+        self.edge_offsets.clear();
+        self.edge_offsets.reserve(topo.edges.len() + 1);
+        let mut total = self.corners as u64;
+        for edge in &topo.edges {
+            self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
+            total += inner as u64 * edge.variants as u64;
+        }
+        self.edge_offsets.push(total.min(u32::MAX as u64) as u32);
+        let all_triangles = triangles as u64 * patches as u64;
+        check_size(total + vertices as u64 * patches as u64, all_triangles, options)?;
+        // Both totals fit u32 now (check_size).
+        let (base, vertices) = (total as u32, vertices);
+        self.interior_offsets.clear();
+        self.interior_offsets.extend((0..=patches as u32).map(|p| base + p * vertices));
+        self.triangle_offsets.clear();
+        self.triangle_offsets.extend((0..=patches as u32).map(|p| p * triangles));
+        self.collapsed_triangles = 0;
         Ok(())
     }
 }

@@ -124,11 +124,26 @@ pub fn write(
 ) -> Result<()> {
     let mut fast = uniform_quads::FastEvaluator::new(set, plan);
     fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
-    write_with(set, plan, pattern, layout, options, out, Some(&fast))
+    write_with(set, plan, pattern, layout, options, out, Some(&fast)).map(|_| ())
+}
+
+/// Wall time of the two passes of [`write_with`].
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WriteTimes {
+    /// Corners, edge samples and patch interiors: every vertex record.
+    pub vertices: std::time::Duration,
+    /// Triangles (and strips, when asked for).
+    pub indices: std::time::Duration,
 }
 
 /// [`write`] with the evaluator chosen by the caller (None: the generic f64 evaluation
 /// everywhere), so that tests can compare the two.
+///
+/// Two passes, each parallel: every vertex record, then every triangle. A patch whose pattern
+/// the frame's cache does not hold leaves its pattern's own triangles (local indices, those
+/// that survive a collapsed corner) in its index range in the first pass, and the second maps
+/// them in place; a cached pattern is read again instead. So no pattern is built twice, and
+/// each pass's time is the stage `--stats` reports.
 pub(crate) fn write_with(
     set: &SurfaceSet,
     plan: &Plan,
@@ -137,7 +152,8 @@ pub(crate) fn write_with(
     options: TessellateOptions,
     out: &mut Mesh,
     fast: Option<&uniform_quads::FastEvaluator<'_>>,
-) -> Result<()> {
+) -> Result<WriteTimes> {
+    let start = std::time::Instant::now();
     let topo = &set.topology;
     let (vertices, triangles) = (layout.vertex_count(), layout.triangle_count());
     reuse(&mut out.positions, vertices, [0.0; 3]);
@@ -156,6 +172,8 @@ pub(crate) fn write_with(
         &mut no_params
     };
     out.collapsed_triangles = layout.collapsed_triangles as usize;
+    let uniform = fast.filter(|f| f.triangles().active() && !options.corner_params);
+    let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
     let mut all = VertexSlices {
         pos: &mut out.positions,
@@ -166,15 +184,21 @@ pub(crate) fn write_with(
     let corner_part = all.take_front(layout.corners as usize);
     let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
     let patch_part = PatchOut { verts: all, idx: &mut out.indices, tp: &mut out.triangle_patch, params };
-    let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
     rayon::join(
         || {
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || match fast.filter(|f| f.triangles().active() && !options.corner_params) {
-            Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part),
-            None => writer.patches(0..set.patches.len(), patch_part),
+        || match uniform {
+            Some(f) => f.triangles().patches(
+                set,
+                f.points(),
+                layout,
+                0..set.patches.len(),
+                patch_part,
+                Pass::Vertices,
+            ),
+            None => writer.patches(0..set.patches.len(), patch_part, Pass::Vertices),
         },
     );
     // Split-normal entries take the position bits of their vertex's first entry.
@@ -183,8 +207,34 @@ pub(crate) fn write_with(
             out.positions[i] = out.positions[entry.position_entry as usize];
         }
     }
+    let vertices_done = std::time::Instant::now();
+
+    let mut all = VertexSlices {
+        pos: &mut out.positions,
+        nrm: &mut out.normals,
+        uv: &mut out.uvs,
+        patch: &mut out.vertex_patch,
+    };
+    all.take_front(layout.interior_offsets[0] as usize);
+    let params = out.corner_params.as_deref_mut().unwrap_or(&mut []);
+    let patch_part = PatchOut { verts: all, idx: &mut out.indices, tp: &mut out.triangle_patch, params };
+    match uniform {
+        Some(f) => {
+            f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part, Pass::Indices)
+        }
+        None => writer.patches(0..set.patches.len(), patch_part, Pass::Indices),
+    }
     out.strips = if options.strips { Some(strips_of(set, plan, pattern, layout)?) } else { None };
-    Ok(())
+    Ok(WriteTimes { vertices: vertices_done - start, indices: vertices_done.elapsed() })
+}
+
+/// Which of [`write_with`]'s passes a patch writer runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Pass {
+    /// Interior vertices (and, for patterns the cache does not hold, the local triangles).
+    Vertices,
+    /// Triangles and triangle patches.
+    Indices,
 }
 
 /// Makes `v` hold `len` elements, every one of which the writer then overwrites.
@@ -363,47 +413,65 @@ impl Writer<'_> {
         }
     }
 
-    /// The interiors and triangles of `patches`, split like [`Writer::edges`].
-    fn patches(&self, patches: std::ops::Range<usize>, mut out: PatchOut<'_>) {
+    /// Pass `pass` of the interiors and triangles of `patches`, split like [`Writer::edges`].
+    fn patches(&self, patches: std::ops::Range<usize>, mut out: PatchOut<'_>, pass: Pass) {
         let tris = &self.layout.triangle_offsets;
         let verts = &self.layout.interior_offsets;
         let size = (tris[patches.end] - tris[patches.start]) + (verts[patches.end] - verts[patches.start]);
         if patches.len() > 1 && size > GRAIN {
             let mid = split_point(tris, patches.clone());
             let left = out.split_off_front(mid, self.layout, patches.start);
-            rayon::join(|| self.patches(patches.start..mid, left), || self.patches(mid..patches.end, out));
+            rayon::join(
+                || self.patches(patches.start..mid, left, pass),
+                || self.patches(mid..patches.end, out, pass),
+            );
             return;
         }
-        for p in patches {
-            let part = out.split_off_front(p + 1, self.layout, p);
-            if self.plan.is_visible(p) {
-                with_scratch(self.generation, |scratch| self.patch(p, part, scratch));
+        with_scratch(self.generation, |scratch| {
+            for p in patches {
+                let part = out.split_off_front(p + 1, self.layout, p);
+                if self.plan.is_visible(p) {
+                    match pass {
+                        Pass::Vertices => self.patch_vertices(p, part, scratch),
+                        Pass::Indices => self.patch_indices(p, part, scratch),
+                    }
+                }
             }
-        }
+        });
     }
 
-    /// One visible patch: its pattern (reused from the last patch of the same input where the
-    /// pattern allows), its interior vertices and its triangles through the local → output
-    /// table.
-    fn patch(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
-        let PatchOut { mut verts, idx, tp, params } = out;
+    /// Patch `p`'s pattern from the frame's cache, if it holds it, with the positions of its
+    /// boundary indices.
+    fn cached(&self, p: usize) -> Option<(PatternInput, &LocalTessellation, &[u32])> {
+        let (input, local, boundary) = self.fast.and_then(|f| f.patterns().get(p))?;
+        Some((PatternInput { patch: p as u32, ..*input }, local, boundary))
+    }
+
+    /// Whether patch `p`'s triangles take the general form: some may drop out at a repeated
+    /// corner, or parameters go along.
+    fn general(&self, p: usize, params: &[[f32; 2]]) -> bool {
+        layout::has_repeated_corner(self.set, p) || !params.is_empty()
+    }
+
+    /// The first pass for one visible patch: its pattern (cached, or built and reused from
+    /// the last patch of the same input where the pattern allows), its interior vertices, its
+    /// corner parameters, and — unless the second pass can read the pattern from the cache —
+    /// its kept triangles as local indices, left in its index range for the second pass.
+    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
+        let PatchOut { mut verts, idx, params, .. } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
-        let cached = self.fast.and_then(|f| f.patterns().get(p));
-        let input = match cached {
-            Some((input, _)) => PatternInput { patch: p as u32, ..*input },
-            None => layout::pattern_input(set, plan, p),
-        };
-        let map = LocalMap { set, plan, layout, input, patch: p };
+        let cached = self.cached(p);
+        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, ..)| input);
         let local = match cached {
-            Some((_, local)) => local,
+            Some((_, local, _)) => local,
             None => {
-                scratch.build(self.pattern, &map.input);
+                scratch.build(self.pattern, &input);
                 &scratch.local
             }
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !local.interior.is_empty());
-        match fast.map(|f| (f, f.covers_patch(self.pattern, &map.input))) {
+        match fast.map(|f| (f, f.covers_patch(self.pattern, &input))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),
             Some((f, None)) => f.points().eval(set, p, &local.interior, verts),
             None => {
@@ -412,40 +480,58 @@ impl Writer<'_> {
                 }
             }
         }
-        map.vertex_table(local.interior.len(), &mut scratch.vertex);
+        let general = self.general(p, params);
         if !params.is_empty() {
+            let map = LocalMap { set, plan, layout, input, patch: p };
             map.param_table(local, &mut scratch.param);
         }
-        if layout::has_repeated_corner(set, p) || !params.is_empty() {
-            // The general form: triangles may drop out, parameters go along.
-            let mut t = 0;
-            for tri in &local.triangles {
-                if layout::degenerate_after_collapse(set, &map.input, p, tri) {
-                    continue;
-                }
-                for c in 0..3 {
-                    idx[3 * t + c] = scratch.vertex[tri[c] as usize];
-                    if !params.is_empty() {
-                        params[3 * t + c] = scratch.param[tri[c] as usize];
-                    }
-                }
-                t += 1;
+        if cached.is_some() && !general {
+            return;
+        }
+        let mut t = 0;
+        for tri in &local.triangles {
+            if general && layout::degenerate_after_collapse(set, &input, p, tri) {
+                continue;
             }
-            debug_assert_eq!(t, tp.len());
-        } else {
-            // Every triangle is kept. Interior vertices are numbered in the same order locally
-            // and in the output, so a triangle of interior vertices only (most of a fine
-            // pattern) maps by one addition instead of three table reads.
-            let first = map.input.interior_base();
-            let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
-            let table = &scratch.vertex[..];
-            for (out, tri) in idx.chunks_exact_mut(3).zip(&local.triangles) {
-                let mapped = if tri[0].min(tri[1]).min(tri[2]) >= first {
-                    tri.map(|l| l.wrapping_add(delta))
-                } else {
-                    tri.map(|l| table[l as usize])
-                };
-                out.copy_from_slice(&mapped);
+            idx[3 * t..3 * t + 3].copy_from_slice(tri);
+            if !params.is_empty() {
+                for c in 0..3 {
+                    params[3 * t + c] = scratch.param[tri[c] as usize];
+                }
+            }
+            t += 1;
+        }
+        debug_assert_eq!(3 * t, idx.len());
+    }
+
+    /// The second pass for one visible patch: its triangles mapped to output vertices by the
+    /// numbering rule. Interior vertices are numbered in the same order locally and in the
+    /// output, so every index maps by one addition (vectorized) and only boundary indices go
+    /// through the patch's table.
+    fn patch_indices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
+        let PatchOut { idx, tp, params, .. } = out;
+        let (set, plan, layout) = (self.set, self.plan, self.layout);
+        let cached = self.cached(p).filter(|_| !self.general(p, params));
+        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, ..)| input);
+        let map = LocalMap { set, plan, layout, input, patch: p };
+        map.vertex_table(0, &mut scratch.vertex);
+        let first = input.interior_base();
+        let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
+        match cached {
+            // The cache knows where the boundary indices are.
+            Some((_, local, boundary)) => {
+                let local = local.triangles.as_flattened();
+                idx.iter_mut().zip(local).for_each(|(out, &l)| *out = l.wrapping_add(delta));
+                for &i in boundary {
+                    idx[i as usize] = scratch.vertex[local[i as usize] as usize];
+                }
+            }
+            // The first pass left the local indices here.
+            None => {
+                let table = &scratch.vertex[..];
+                for l in idx.iter_mut() {
+                    *l = if *l >= first { l.wrapping_add(delta) } else { table[*l as usize] };
+                }
             }
         }
         tp.fill(p as u32);

@@ -100,6 +100,9 @@ pub(crate) struct PatternCache {
     slots: Vec<LocalTessellation>,
     /// Each patch's slot, or [`NONE`]; empty when the cache is off for the frame.
     of_patch: Vec<u32>,
+    /// Per slot, the positions in the flat index list (`triangles.as_flattened()`) of the
+    /// pattern's boundary vertices (corners and edge samples); see [`boundary_positions`].
+    boundary: Vec<Vec<u32>>,
     /// Per slot, the parameters of the pattern's local vertices (filled on request).
     params: Vec<Vec<DVec2>>,
     /// `params` holds this fill's tables.
@@ -120,6 +123,18 @@ pub(crate) fn local_params(input: &PatternInput, built: &LocalTessellation, para
         params.extend((1..n).map(|k| d.edge_point(e, k as f64 / n as f64)));
     }
     params.extend_from_slice(&built.interior);
+}
+
+/// The positions in `built`'s flat index list whose local vertex is a boundary vertex (below
+/// `input.interior_base()`). A writer maps every index by one addition — interior vertices
+/// are numbered alike locally and in the output — and then corrects only these positions
+/// through the patch's table: the addition vectorizes, and a fine pattern has few boundary
+/// indices. Cost: O(triangles).
+pub(crate) fn boundary_positions(input: &PatternInput, built: &LocalTessellation, out: &mut Vec<u32>) {
+    let first = input.interior_base();
+    out.clear();
+    let flat = built.triangles.as_flattened();
+    out.extend((0..flat.len() as u32).filter(|&i| flat[i as usize] < first));
 }
 
 impl PatternCache {
@@ -178,26 +193,36 @@ impl PatternCache {
         if self.slots.len() < used {
             self.slots.resize_with(used, LocalTessellation::default);
         }
+        if self.boundary.len() < used {
+            self.boundary.resize_with(used, Vec::new);
+        }
         if params && self.params.len() < used {
             self.params.resize_with(used, Vec::new);
         }
-        let built = self.slots[..used].par_iter_mut().zip(&self.inputs);
+        let built = self.slots[..used].par_iter_mut().zip(&self.inputs).zip(&mut self.boundary[..used]);
         if params {
-            built.zip(&mut self.params[..used]).with_min_len(4).for_each(|((local, input), params)| {
-                pattern.build(input, local);
-                local_params(input, local, params);
-            });
+            built.zip(&mut self.params[..used]).with_min_len(4).for_each(
+                |(((local, input), boundary), params)| {
+                    pattern.build(input, local);
+                    boundary_positions(input, local, boundary);
+                    local_params(input, local, params);
+                },
+            );
         } else {
-            built.with_min_len(4).for_each(|(local, input)| pattern.build(input, local));
+            built.with_min_len(4).for_each(|((local, input), boundary)| {
+                pattern.build(input, local);
+                boundary_positions(input, local, boundary);
+            });
         }
         self.with_params = params;
     }
 
-    /// Patch `p`'s pattern input and pattern, when the cache holds them for this frame (the
-    /// input's `patch` is the first patch's of that input: set it to `p`).
-    pub(crate) fn get(&self, p: usize) -> Option<(&PatternInput, &LocalTessellation)> {
+    /// Patch `p`'s pattern input, pattern and the pattern's [`boundary_positions`], when the
+    /// cache holds them for this frame (the input's `patch` is the first patch's of that
+    /// input: set it to `p`).
+    pub(crate) fn get(&self, p: usize) -> Option<(&PatternInput, &LocalTessellation, &[u32])> {
         let slot = *self.of_patch.get(p)? as usize;
-        (slot != NONE as usize).then(|| (&self.inputs[slot], &self.slots[slot]))
+        (slot != NONE as usize).then(|| (&self.inputs[slot], &self.slots[slot], &self.boundary[slot][..]))
     }
 
     /// Item `i`'s input, pattern and local-vertex parameters, when the last

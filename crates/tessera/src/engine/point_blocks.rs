@@ -448,15 +448,16 @@ fn triangle_block<const FMA: bool, const L: usize>(
         }
         Some(field) => {
             let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
-            let mut margin = [0f32; L];
-            let [nx, ny, nz] = &mut n;
-            for l in 0..L {
-                let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
-                margin[l] = n2 - MIN_PN_NORMAL2;
-                let inv = 1.0 / n2.sqrt();
-                nx[l] *= inv;
-                ny[l] *= inv;
-                nz[l] *= inv;
+            // Lane loops of one operation each, so that each becomes one vector instruction
+            // (as one loop, the square root stayed scalar).
+            let n2: [f32; L] =
+                std::array::from_fn(|l| n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]);
+            let margin = n2.map(|x| x - MIN_PN_NORMAL2);
+            let inv = n2.map(|x| 1.0 / x.sqrt());
+            for row in &mut n {
+                for l in 0..L {
+                    row[l] *= inv[l];
+                }
             }
             (n, margin)
         }

@@ -17,12 +17,12 @@
 //! This changes how the output is written, never what it is: the tests compare it with the
 //! generic writer's index for index. Evaluation is [`PointBlocks`]' as elsewhere.
 
-use super::layout::{has_repeated_corner, pattern_input, Layout};
+use super::layout::{pattern_input, Layout};
 use super::point_blocks::PointBlocks;
-use super::{PatchOut, VertexSlices};
+use super::{Pass, PatchOut, VertexSlices};
 use crate::criterion::Plan;
 use crate::pattern::{LocalTessellation, Pattern, Slot};
-use crate::sampling::{uniform_param, SamplingKind};
+use crate::sampling::uniform_param;
 use crate::surface::{Domain, SurfaceSet};
 use glam::DVec2;
 
@@ -59,13 +59,12 @@ pub(crate) struct UniformTriangles {
 }
 
 impl UniformTriangles {
-    /// The writer for `set`, not yet active. Cost: O(P).
+    /// The writer for `set`, not yet active. Cost: O(1).
     pub(crate) fn for_set(set: &SurfaceSet) -> UniformTriangles {
-        let topo = &set.topology;
-        let eligible = !set.patches.is_empty()
-            && (0..set.patches.len())
-                .all(|p| topo.patch_domains[p] == Domain::Tri && !has_repeated_corner(set, p));
-        UniformTriangles { eligible, ..UniformTriangles::default() }
+        UniformTriangles {
+            eligible: set.topology.one_shape == Some(Domain::Tri),
+            ..UniformTriangles::default()
+        }
     }
 
     /// Makes the tables for `plan` and `pattern` and says whether this writer applies: an
@@ -74,17 +73,10 @@ impl UniformTriangles {
     /// (vectorized folds), plus one pattern build.
     pub(crate) fn retarget(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> bool {
         self.active = false;
-        if !self.eligible || plan.kind != SamplingKind::Uniform || pattern.depends_on_patch() {
+        if !self.eligible || pattern.depends_on_patch() {
             return false;
         }
-        let (n, interior) = (plan.segments[0], plan.interior[0]);
-        // Folds rather than `all`, which stops early and does not vectorize.
-        let same = plan.segments.iter().fold(true, |all, &s| all & (s == n))
-            && plan.interior.iter().fold(true, |all, f| all & (*f == interior))
-            && plan.visible.iter().fold(true, |all, &v| all & (v != 0));
-        if !same {
-            return false;
-        }
+        let Some((n, _)) = plan.one_factor() else { return false };
         let input = pattern_input(set, plan, 0);
         pattern.build(&input, &mut self.local);
         self.codes.clear();
@@ -129,9 +121,9 @@ impl UniformTriangles {
         points.eval(set, owner.patch as usize, uvs, out);
     }
 
-    /// Writes the interiors and triangles of `patches` into `out` (their share of the output,
-    /// from the first's). Precondition: [`UniformTriangles::active`]; `layout` was built for
-    /// the plan, without corner parameters. Cost: O(output), parallel.
+    /// Pass `pass` of the interiors and triangles of `patches` into `out` (their share of the
+    /// output, from the first's). Precondition: [`UniformTriangles::active`]; `layout` was
+    /// built for the plan, without corner parameters. Cost: O(output), parallel.
     pub(super) fn patches(
         &self,
         set: &SurfaceSet,
@@ -139,6 +131,7 @@ impl UniformTriangles {
         layout: &Layout,
         patches: std::ops::Range<usize>,
         mut out: PatchOut<'_>,
+        pass: Pass,
     ) {
         debug_assert!(self.active && out.params.is_empty());
         // Every patch has the same share of the output; a pattern has at least one triangle.
@@ -147,26 +140,33 @@ impl UniformTriangles {
             let mid = patches.start + patches.len() / 2;
             let left = out.take_front(mid - patches.start, vertices, triangles);
             rayon::join(
-                || self.patches(set, points, layout, patches.start..mid, left),
-                || self.patches(set, points, layout, mid..patches.end, out),
+                || self.patches(set, points, layout, patches.start..mid, left, pass),
+                || self.patches(set, points, layout, mid..patches.end, out, pass),
             );
             return;
         }
         let PatchOut { verts, idx, tp, .. } = out;
-        let chunks = idx.chunks_exact_mut(3 * triangles).zip(tp.chunks_exact_mut(triangles));
-        for (i, (p, (idx, tp))) in patches.zip(chunks).enumerate() {
-            if vertices > 0 {
-                let r = i * vertices..(i + 1) * vertices;
-                let part = VertexSlices {
-                    pos: &mut verts.pos[r.clone()],
-                    nrm: &mut verts.nrm[r.clone()],
-                    uv: &mut verts.uv[r.clone()],
-                    patch: &mut verts.patch[r],
-                };
-                points.eval(set, p, &self.local.interior, part);
+        match pass {
+            Pass::Vertices if vertices > 0 => {
+                for (i, p) in patches.enumerate() {
+                    let r = i * vertices..(i + 1) * vertices;
+                    let part = VertexSlices {
+                        pos: &mut verts.pos[r.clone()],
+                        nrm: &mut verts.nrm[r.clone()],
+                        uv: &mut verts.uv[r.clone()],
+                        patch: &mut verts.patch[r],
+                    };
+                    points.eval(set, p, &self.local.interior, part);
+                }
             }
-            self.triangles(set, layout, p, idx);
-            tp.fill(p as u32);
+            Pass::Vertices => {}
+            Pass::Indices => {
+                let chunks = idx.chunks_exact_mut(3 * triangles).zip(tp.chunks_exact_mut(triangles));
+                for (p, (idx, tp)) in patches.zip(chunks) {
+                    self.triangles(set, layout, p, idx);
+                    tp.fill(p as u32);
+                }
+            }
         }
     }
 

@@ -119,6 +119,11 @@ pub struct Topology {
     pub patch_domains: Vec<Domain>,
     pub corner_entries: Vec<CornerEntry>,
     pub report: TopologyReport,
+    /// `Some(domain)` when every patch has this domain and distinct corners (so no edge is
+    /// collapsed and no pattern triangle degenerates): then patches with the same edge
+    /// segments and interior factors have the same output counts, and a one-factor plan's
+    /// layout is arithmetic (`engine::layout`). Decided once, here.
+    pub one_shape: Option<Domain>,
 }
 
 fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
@@ -247,7 +252,14 @@ impl Topology {
 
         report.vertices = vertex_ids.len();
         report.euler_characteristic = report.vertices as i64 - report.edges as i64 + report.patches as i64;
+        let one_shape = keys.first().map(|k| k.domain).filter(|&d| {
+            keys.iter().zip(&patch_corners).all(|(k, c)| {
+                let c = &c[..d.corner_count()];
+                k.domain == d && (0..c.len()).all(|i| !c[i + 1..].contains(&c[i]))
+            }) && edges.iter().all(|e| !e.collapsed)
+        });
         Topology {
+            one_shape,
             vertex_count: vertex_ids.len() as u32,
             edges,
             uses,
