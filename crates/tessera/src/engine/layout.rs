@@ -92,6 +92,18 @@ impl Layout {
         if let (Some(_), Some(_), false) = (topo.one_shape, plan.one_factor(), pattern.depends_on_patch()) {
             return self.build_one_input(set, plan, pattern, options);
         }
+        self.build_general(set, plan, pattern, options)
+    }
+
+    /// [`Layout::build`] for any plan: a count per visible patch, then the scans.
+    fn build_general(
+        &mut self,
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        options: &TessellateOptions,
+    ) -> Result<()> {
+        let topo = &set.topology;
         // Edges: inner samples per variant; none for collapsed edges or edges seen by no
         // visible patch (nothing refers to them).
         // Counts in parallel (segments ≤ MAX_FACTOR and ≤ 255 variants: a count fits u32),
@@ -343,6 +355,44 @@ mod tests {
                 assert_eq!(layout.edge_offsets[e + 1], layout.edge_offsets[e], "edge {e}");
             }
         }
+    }
+
+    /// The arithmetic layout of a one-factor plan gives the numbers the general count and scan
+    /// give, on a set of each domain, for the uniform and the transition pattern.
+    #[test]
+    fn one_input_layouts_equal_the_general_build() {
+        let path = crate::io::patches::test_support::data("meshes/cow.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        let cow = SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap();
+        let options = TessellateOptions::default();
+        for set in [strip(5, false), cow] {
+            assert!(set.topology.one_shape.is_some());
+            for n in [1, 2, 7] {
+                let plan = Plan::uniform(&set, n).unwrap();
+                assert!(plan.one_factor().is_some());
+                let patterns: [&dyn Pattern; 2] = [&Uniform, &Transition];
+                for pattern in patterns {
+                    let (mut fast, mut general) = (Layout::default(), Layout::default());
+                    fast.build(&set, &plan, pattern, &options).unwrap();
+                    general.corners = fast.corners;
+                    general.build_general(&set, &plan, pattern, &options).unwrap();
+                    assert_eq!(fast.edge_offsets, general.edge_offsets);
+                    assert_eq!(fast.interior_offsets, general.interior_offsets);
+                    assert_eq!(fast.triangle_offsets, general.triangle_offsets);
+                    assert_eq!(fast.collapsed_triangles, general.collapsed_triangles);
+                }
+            }
+        }
+        // A collapsed curve makes the set two-shaped: the general build alone applies.
+        assert!(strip(2, true).topology.one_shape.is_none());
+        let small = TessellateOptions { max_triangles: Some(100), ..Default::default() };
+        let err = Layout::default().build(
+            &strip(5, false),
+            &Plan::uniform(&strip(5, false), 4).unwrap(),
+            &Uniform,
+            &small,
+        );
+        assert!(matches!(err, Err(crate::Error::OutputTooLarge { triangles: 160, .. })), "{err:?}");
     }
 
     #[test]

@@ -744,3 +744,99 @@ pub fn uniform_triangles(domain: Domain, n: u32) -> u64 {
         Domain::Tri => n as u64 * n as u64,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pattern::transition::Transition;
+    use crate::pattern::uniform::Uniform;
+
+    fn teapot() -> SurfaceSet {
+        let path = crate::io::patches::test_support::data("patches/teapot.patches");
+        SurfaceSet::from_patch_file(&crate::io::patches::read_patches(&path).unwrap(), Default::default())
+    }
+
+    fn cow() -> SurfaceSet {
+        let path = crate::io::patches::test_support::data("meshes/cow.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap()
+    }
+
+    /// Each visible patch's pattern under `plan`, mapped index by index by the numbering rule
+    /// (`LocalMap::vertex`, the strip writer's mapping), minus the triangles that degenerate
+    /// at a collapsed curve: an oracle for the writers' faster mappings.
+    fn numbered(
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        layout: &Layout,
+    ) -> (Vec<u32>, Vec<u32>) {
+        let (mut indices, mut patches) = (Vec::new(), Vec::new());
+        let mut local = LocalTessellation::default();
+        for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+            let input = layout::pattern_input(set, plan, p);
+            pattern.build(&input, &mut local);
+            let map = LocalMap { set, plan, layout, input, patch: p };
+            for tri in &local.triangles {
+                if !layout::degenerate_after_collapse(set, &input, p, tri) {
+                    indices.extend(tri.map(|l| map.vertex(l)));
+                    patches.push(p as u32);
+                }
+            }
+        }
+        (indices, patches)
+    }
+
+    /// The two-pass writer's triangles are the numbering rule's ([`numbered`]) with the
+    /// pattern cache on (fine patterns) and off (coarse ones, staged as local indices between
+    /// the passes), with and without corner parameters, on a set with collapsed curves and on
+    /// a PN mesh, some patches culled.
+    #[test]
+    fn triangles_follow_the_numbering_rule_index_by_index() {
+        for set in [teapot(), cow()] {
+            for (lowest, spread) in [(1, 4), (9, 6)] {
+                let mut plan = Plan::uniform(&set, 1).unwrap();
+                for (e, s) in plan.segments.iter_mut().enumerate() {
+                    *s = lowest + (e as u32 * 7) % spread;
+                }
+                plan.factors = plan.segments.iter().map(|&s| s as f32).collect();
+                for (p, (interior, visible)) in plan.interior.iter_mut().zip(&mut plan.visible).enumerate() {
+                    *interior = [lowest + p as u32 % spread, lowest + (p as u32 / 3) % spread];
+                    *visible = u32::from(p % 7 != 3);
+                }
+                for corner_params in [false, true] {
+                    let options = TessellateOptions { corner_params, ..Default::default() };
+                    let mut layout = Layout::default();
+                    layout.build(&set, &plan, &Transition, &options).unwrap();
+                    let mut fast = uniform_quads::FastEvaluator::new(&set, &plan);
+                    fast.fill_patterns(&plan, &Transition, layout.triangle_count() as u64);
+                    assert_eq!(
+                        fast.patterns().distinct() > 0,
+                        lowest > 1,
+                        "the cache is on for fine patterns only"
+                    );
+                    let mut mesh = Mesh::default();
+                    write_with(&set, &plan, &Transition, &layout, options, &mut mesh, Some(&fast)).unwrap();
+                    let (indices, patches) = numbered(&set, &plan, &Transition, &layout);
+                    assert_eq!(mesh.indices, indices, "lowest {lowest}, corner params {corner_params}");
+                    assert_eq!(mesh.triangle_patch, patches);
+                }
+            }
+        }
+    }
+
+    /// A uniform frame runs the uniform writers (triangles by addition on the PN mesh, the
+    /// grid path on the teapot); their triangles are the numbering rule's too.
+    #[test]
+    fn uniform_frames_follow_the_numbering_rule() {
+        for set in [cow(), teapot()] {
+            let plan = Plan::uniform(&set, 5).unwrap();
+            let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+            let mut layout = Layout::default();
+            layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap();
+            let (indices, patches) = numbered(&set, &plan, &Uniform, &layout);
+            assert_eq!(mesh.indices, indices);
+            assert_eq!(mesh.triangle_patch, patches);
+        }
+    }
+}
