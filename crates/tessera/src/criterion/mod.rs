@@ -39,6 +39,7 @@ pub struct Prepared {
     /// empty unless asked for.
     pub curves: Vec<[f64; 4]>,
     views: std::sync::OnceLock<Vec<screen::PatchView>>,
+    triangle_errors: std::sync::OnceLock<Vec<bounds::TriangleErrors>>,
     vertex_data: std::sync::OnceLock<Vec<(glam::DVec3, glam::DVec3)>>,
     edge_midpoints: std::sync::OnceLock<Vec<[(glam::DVec3, glam::DVec3); 2]>>,
 }
@@ -58,9 +59,19 @@ impl Prepared {
             },
             curves: if with_bounds { tolerance::curve_bounds(set) } else { Vec::new() },
             views: Default::default(),
+            triangle_errors: Default::default(),
             vertex_data: Default::default(),
             edge_midpoints: Default::default(),
         }
+    }
+
+    /// Every patch's [`bounds::TriangleErrors`] (what the a-posteriori check's triangle bound
+    /// needs of the patch's [`bounds::HessianBound`]: scalings and eigenvalues, a dozen square
+    /// roots), computed on the first call and kept; empty where the bounds were not asked for.
+    /// Cost: the first call O(P), parallel; later calls nothing.
+    pub fn triangle_errors(&self) -> &[bounds::TriangleErrors] {
+        use rayon::prelude::*;
+        self.triangle_errors.get_or_init(|| self.hessians.par_iter().map(|h| h.triangle_errors()).collect())
     }
 
     /// Every patch's [`screen::PatchView`] (box, sphere, normal cone), computed on the first

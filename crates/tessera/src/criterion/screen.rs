@@ -95,19 +95,9 @@ impl PatchView {
         ];
         // Rounding of the transforms is far below this margin.
         let margin = self.radius + 1e-9 * (self.radius + c.length() + view.far);
-        let outside = |plane: usize, p: DVec3| match plane {
-            0 => p.z < view.near,
-            1 => p.z > view.far,
-            2 => p.x > t.x * p.z,
-            3 => p.x < -t.x * p.z,
-            4 => p.y > t.y * p.z,
-            _ => p.y < -t.y * p.z,
-        };
         for (plane, &d) in distances.iter().enumerate() {
-            if d < -margin {
-                continue; // every control point is inside this plane
-            }
-            if patch.control_points().iter().all(|&p| outside(plane, view.to_camera(p))) {
+            // Where d < −margin every control point is inside this plane.
+            if d >= -margin && all_outside(patch, view, plane) {
                 return true;
             }
         }
@@ -135,6 +125,24 @@ impl PatchView {
         let cos_g = axis.dot(to_eye / dist).clamp(-1.0, 1.0);
         cos_g < -sin_t - 1e-12
     }
+}
+
+/// Whether every control point of `patch` lies outside frustum plane `plane` of `view` (the
+/// order of [`PatchView::culled`]'s distances). Not inlined: the patch itself (hundreds of
+/// bytes) is read only here, for the few patches whose sphere reaches a plane; inlined, the
+/// compiler read it for every patch ahead of the test, a cache miss per patch per frame.
+#[inline(never)]
+fn all_outside(patch: &Patch, view: &View, plane: usize) -> bool {
+    let t = view.half_tangents;
+    let outside = |p: DVec3| match plane {
+        0 => p.z < view.near,
+        1 => p.z > view.far,
+        2 => p.x > t.x * p.z,
+        3 => p.x < -t.x * p.z,
+        4 => p.y > t.y * p.z,
+        _ => p.y < -t.y * p.z,
+    };
+    patch.control_points().iter().all(|&p| outside(view.to_camera(p)))
 }
 
 /// The object-space tolerance for patch `p` seen by `camera` at `pixels` of error, or None

@@ -7,7 +7,7 @@
 //! proposal already covers the edge curve's own bound, so the maximum satisfies all of them.
 //! Interior factors are private to a patch and may be raised freely.
 
-use super::bounds::{self, HessianBound};
+use super::bounds::{self, HessianBound, TriangleErrors};
 use super::resolve::{self, EdgeRule, InteriorRule};
 use super::{Plan, Prepared};
 use crate::error::{Error, Result};
@@ -98,13 +98,13 @@ pub fn patch_bound(
     scratch: &mut LocalTessellation,
 ) -> f64 {
     pattern.build(input, scratch);
-    built_pattern_bound(m, input, scratch, &mut Vec::new())
+    built_pattern_bound(&m.triangle_errors(), input, scratch, &mut Vec::new())
 }
 
 /// [`patch_bound`] of a pattern already built for `input`; `params` is a buffer for the
 /// parameters of its local vertices (computed once each, not once per triangle corner).
 fn built_pattern_bound(
-    m: &HessianBound,
+    m: &TriangleErrors,
     input: &PatternInput,
     built: &LocalTessellation,
     params: &mut Vec<glam::DVec2>,
@@ -115,8 +115,7 @@ fn built_pattern_bound(
 
 /// The bound of the pattern `built` over its local-vertex parameters `params`
 /// ([`crate::engine::pattern_cache::local_params`]): the largest triangle error.
-fn params_bound(m: &HessianBound, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
-    let errors = m.triangle_errors();
+fn params_bound(errors: &TriangleErrors, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
     built.triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(0.0, f64::max)
 }
 
@@ -124,9 +123,9 @@ fn params_bound(m: &HessianBound, built: &LocalTessellation, params: &[glam::DVe
 /// ([`Pattern::grid_cells`]): that of one of them, `(0, 0), (1/nu, 0), (0, 1/nv)`. Every
 /// such triangle has the same bound (it depends only on the differences of the corners), so
 /// no pattern is built. Cost: O(1).
-fn grid_bound(m: &HessianBound, [nu, nv]: [u32; 2]) -> f64 {
+fn grid_bound(m: &TriangleErrors, [nu, nv]: [u32; 2]) -> f64 {
     let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
-    m.triangle_error([glam::DVec2::ZERO, glam::DVec2::new(hu, 0.0), glam::DVec2::new(0.0, hv)])
+    m.error([glam::DVec2::ZERO, glam::DVec2::new(hu, 0.0), glam::DVec2::new(0.0, hv)])
 }
 
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:
@@ -260,6 +259,13 @@ pub(crate) fn plan_limited(
         computed_hessians = set.patches.par_iter().map(bounds::hessian).collect::<Vec<_>>();
         &computed_hessians
     };
+    let computed_errors;
+    let errors: &[TriangleErrors] = if prepared.hessians.len() == patches {
+        prepared.triangle_errors()
+    } else {
+        computed_errors = hessians.par_iter().map(|h| h.triangle_errors()).collect::<Vec<_>>();
+        &computed_errors
+    };
     let curves: &[[f64; 4]] = if prepared.curves.len() == patches {
         &prepared.curves
     } else {
@@ -321,7 +327,7 @@ pub(crate) fn plan_limited(
     which.clear();
     which.extend(0..patches);
     let mut check = |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>| {
-        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, hessians };
+        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors };
         check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, patterns, out)
     };
     check(&plan.segments, proposals, which, results);
@@ -488,7 +494,7 @@ struct CheckInputs<'a> {
     layout: InteriorRule,
     cap: u32,
     minimum: &'a [[u32; 2]],
-    hessians: &'a [HessianBound],
+    errors: &'a [TriangleErrors],
 }
 
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
@@ -508,7 +514,7 @@ fn check_patches(
     patterns: &mut crate::engine::pattern_cache::PatternCache,
     out: &mut Vec<Check>,
 ) {
-    let CheckInputs { set, eps, layout, cap, minimum, hessians } = *inputs;
+    let CheckInputs { set, eps, layout, cap, minimum, errors } = *inputs;
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
     // The engine's input, collapsed edges included, so the bound is that of the output.
@@ -605,13 +611,13 @@ fn check_patches(
                 let grid = limit.pattern.grid_cells(&input);
                 let bound = match (grid, cached) {
                     // A pure grid (no strips): one cell's triangle bounds them all, no build.
-                    (Some(cells), _) => grid_bound(&hessians[p], cells),
-                    (None, Some((_, built, params))) => params_bound(&hessians[p], built, params),
+                    (Some(cells), _) => grid_bound(&errors[p], cells),
+                    (None, Some((_, built, params))) => params_bound(&errors[p], built, params),
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
                     (None, None) => crate::engine::with_scratch(generation, |s| {
                         let (built, params) = s.built(limit.pattern, &input);
-                        built_pattern_bound(&hessians[p], &input, built, params)
+                        built_pattern_bound(&errors[p], &input, built, params)
                     }),
                 };
                 if bound <= e * (1.0 + 1e-9) {

@@ -225,16 +225,16 @@ impl Layout {
 /// What the pattern of patch `p` gets from the plan: its edges' segments and factors, its
 /// interior factors and which of its edges are collapsed. Public so that the GPU engine
 /// (tessera-gpu) sizes its output with the same pattern counts. Cost: O(1).
+#[inline]
 pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.topology.patch_domains[p];
-    let mut segments = [1; 4];
-    let mut factors = [1.0; 4];
-    for e in 0..domain.corner_count() {
-        let edge = set.topology.patch_edges[p][e].edge as usize;
+    let (mut segments, mut factors, mut collapsed) = ([1; 4], [1.0; 4], [false; 4]);
+    for (e, pe) in set.topology.patch_edges[p][..domain.corner_count()].iter().enumerate() {
+        let edge = pe.edge as usize;
         segments[e] = plan.segments(edge);
         factors[e] = plan.factor(edge);
+        collapsed[e] = pe.collapsed;
     }
-    let collapsed = collapsed_edges(set, p);
     PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32, collapsed }
 }
 

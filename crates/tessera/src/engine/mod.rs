@@ -270,6 +270,16 @@ impl<'a> VertexSlices<'a> {
         }
     }
 
+    /// Vertices `r`, borrowed.
+    fn range(&mut self, r: std::ops::Range<usize>) -> VertexSlices<'_> {
+        VertexSlices {
+            pos: &mut self.pos[r.clone()],
+            nrm: &mut self.nrm[r.clone()],
+            uv: &mut self.uv[r.clone()],
+            patch: &mut self.patch[r],
+        }
+    }
+
     /// Vertex `k`: patch `patch` evaluated at `uv` (f64, rounded once).
     fn set(&mut self, k: usize, set: &SurfaceSet, patch: u32, uv: DVec2) {
         let p = set.patches[patch as usize].eval(uv);
@@ -287,8 +297,56 @@ pub(crate) fn take_front<'a, T>(s: &mut &'a mut [T], k: usize) -> &'a mut [T] {
     head
 }
 
-/// Every corner entry, evaluated at its owner's corner.
-fn write_corners(
+/// Every corner entry, evaluated at its owner's corner. Corners do not depend on the view or
+/// the plan: with an evaluator they are evaluated once per set (and kernel) and copied in
+/// every later frame.
+fn write_corners(set: &SurfaceSet, fast: Option<&uniform_quads::FastEvaluator<'_>>, out: VertexSlices<'_>) {
+    match fast {
+        Some(f) => f.corner_records().copy_to(out),
+        None => evaluate_corners(set, None, out),
+    }
+}
+
+/// The vertex records of every corner entry, kept from frame to frame.
+#[derive(Debug, Default)]
+pub(crate) struct CornerRecords {
+    pos: Vec<[f32; 3]>,
+    nrm: Vec<[f32; 3]>,
+    uv: Vec<[f32; 2]>,
+    patch: Vec<u32>,
+}
+
+impl CornerRecords {
+    /// Every corner entry of `set`, evaluated as `fast` evaluates them. Cost: O(corners).
+    pub(crate) fn evaluate(set: &SurfaceSet, fast: &uniform_quads::FastEvaluator<'_>) -> CornerRecords {
+        let n = set.topology.corner_entries.len();
+        let mut records = CornerRecords {
+            pos: vec![[0.0; 3]; n],
+            nrm: vec![[0.0; 3]; n],
+            uv: vec![[0.0; 2]; n],
+            patch: vec![0; n],
+        };
+        let out = VertexSlices {
+            pos: &mut records.pos,
+            nrm: &mut records.nrm,
+            uv: &mut records.uv,
+            patch: &mut records.patch,
+        };
+        evaluate_corners(set, Some(fast), out);
+        records
+    }
+
+    fn copy_to(&self, out: VertexSlices<'_>) {
+        out.pos.copy_from_slice(&self.pos);
+        out.nrm.copy_from_slice(&self.nrm);
+        out.uv.copy_from_slice(&self.uv);
+        out.patch.copy_from_slice(&self.patch);
+    }
+}
+
+/// Evaluates every corner entry: on the grid kernels where they apply, by the closed form of
+/// a PN corner or the generic evaluation elsewhere.
+fn evaluate_corners(
     set: &SurfaceSet,
     fast: Option<&uniform_quads::FastEvaluator<'_>>,
     mut out: VertexSlices<'_>,
@@ -427,14 +485,25 @@ impl Writer<'_> {
             );
             return;
         }
+        // Each patch's part by its offsets from the first's (culled patches have none).
+        let (t0, v0) = (tris[patches.start], verts[patches.start]);
         with_scratch(self.generation, |scratch| {
-            for p in patches {
-                let part = out.split_off_front(p + 1, self.layout, p);
-                if self.plan.is_visible(p) {
-                    match pass {
-                        Pass::Vertices => self.patch_vertices(p, part, scratch),
-                        Pass::Indices => self.patch_indices(p, part, scratch),
-                    }
+            for p in patches.filter(|&p| self.plan.is_visible(p)) {
+                let t = (tris[p] - t0) as usize..(tris[p + 1] - t0) as usize;
+                let v = (verts[p] - v0) as usize..(verts[p + 1] - v0) as usize;
+                let part = PatchOut {
+                    verts: out.verts.range(v),
+                    idx: &mut out.idx[3 * t.start..3 * t.end],
+                    tp: &mut out.tp[t.clone()],
+                    params: if out.params.is_empty() {
+                        &mut []
+                    } else {
+                        &mut out.params[3 * t.start..3 * t.end]
+                    },
+                };
+                match pass {
+                    Pass::Vertices => self.patch_vertices(p, part, scratch),
+                    Pass::Indices => self.patch_indices(p, part, scratch),
                 }
             }
         });

@@ -179,6 +179,9 @@ pub(crate) enum GridPatch<'a> {
 /// bytes a patch.
 pub(crate) struct PointBlocks {
     locals: Vec<Local>,
+    /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
+    /// once: the locals are large, and a walk over them costs a frame a pass over memory.
+    all_bicubic: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
@@ -481,8 +484,9 @@ impl PointBlocks {
                 Patch::BezierTriangle(t) => Local::Triangle(Box::new(LocalTriangle::new(t, None))),
                 Patch::Pn(t) => Local::Triangle(Box::new(LocalTriangle::new(&t.geometry, Some(&t.normals)))),
             })
-            .collect();
-        PointBlocks { locals, avx2_fma: avx2_fma && has_avx2_fma() }
+            .collect::<Vec<_>>();
+        let all_bicubic = locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
+        PointBlocks { locals, all_bicubic, avx2_fma: avx2_fma && has_avx2_fma() }
     }
 
     /// Patch `p`'s local bicubic form, where it is a bicubic that has one.
@@ -497,7 +501,7 @@ impl PointBlocks {
     /// Whether every patch is a bicubic with a local form, polynomial or rational (the grid
     /// evaluator's precondition).
     pub(crate) fn all_bicubic(&self) -> bool {
-        self.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)))
+        self.all_bicubic
     }
 
     /// Evaluates patch `p` of `set` at `uvs` into `out` (one vertex each: position, normal,

@@ -44,7 +44,7 @@ use super::point_blocks::{
     LANES, MIN_DERIVATIVE2, MIN_SIN2,
 };
 use super::uniform_triangles::UniformTriangles;
-use super::VertexSlices;
+use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
 use crate::pattern::{Pattern, PatternInput};
 use crate::sampling::{uniform_param, SamplingKind};
@@ -52,6 +52,7 @@ use crate::surface::{Domain, RationalBicubic, SurfacePoint, SurfaceSet};
 use crate::topology::EdgeUse;
 use glam::DVec2;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -411,6 +412,9 @@ pub(crate) struct FastEvaluator<'a> {
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
+    /// Every corner entry's vertex record, evaluated on first use, without and with the grid
+    /// kernels (which evaluate corners in their own way): 36 bytes a corner.
+    corners: [OnceLock<CornerRecords>; 2],
 }
 
 impl<'a> FastEvaluator<'a> {
@@ -441,7 +445,14 @@ impl<'a> FastEvaluator<'a> {
             triangles: UniformTriangles::for_set(set),
             grid: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
+            corners: Default::default(),
         }
+    }
+
+    /// Every corner entry's vertex record as the current plan's kernels evaluate it, evaluated
+    /// once per set and kernel. Cost: O(corners) the first time, then O(1).
+    pub(crate) fn corner_records(&self) -> &CornerRecords {
+        self.corners[usize::from(self.grid)].get_or_init(|| CornerRecords::evaluate(self.set, self))
     }
 
     /// Makes the tables of every factor `plan` uses (edge segments, interior factors, and
