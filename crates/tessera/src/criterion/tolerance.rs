@@ -616,8 +616,8 @@ fn check_patches(
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
                     (None, None) => crate::engine::with_scratch(generation, |s| {
-                        let (built, params) = s.built(limit.pattern, &input);
-                        built_pattern_bound(&errors[p], &input, built, params)
+                        let (built, params) = s.pattern_with_params(limit.pattern, &input);
+                        params_bound(&errors[p], built, params)
                     }),
                 };
                 if bound <= e * (1.0 + 1e-9) {

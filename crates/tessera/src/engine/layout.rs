@@ -161,7 +161,7 @@ impl Layout {
                 }
                 let input = pattern_input(set, plan, p);
                 super::with_scratch(generation, |scratch| {
-                    let triangles = &scratch.build_once(pattern, &input).triangles;
+                    let triangles = &scratch.pattern(pattern, &input).triangles;
                     triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
                         as u32
                 })

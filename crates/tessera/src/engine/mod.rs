@@ -388,7 +388,7 @@ fn write_edge(
     let VertexSlices { pos, nrm, uv, patch } = out;
     for variant in 0..topo.edges[e].variants as usize {
         let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
-        let d = set.patches[u.patch as usize].domain();
+        let d = topo.patch_domains[u.patch as usize];
         uvs.clear();
         uvs.extend((1..=inner).map(|k| {
             let t = plan.param(e, k as u32);
@@ -465,7 +465,7 @@ impl Writer<'_> {
                 }
                 fast => with_scratch(self.generation, |scratch| {
                     let points = fast.map(|f| f.points());
-                    write_edge(self.set, self.plan, e, part, points, &mut scratch.params64)
+                    write_edge(self.set, self.plan, e, part, points, &mut scratch.edge_params)
                 }),
             }
         }
@@ -533,10 +533,7 @@ impl Writer<'_> {
         let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, ..)| input);
         let local = match cached {
             Some((_, local, _)) => local,
-            None => {
-                scratch.build(self.pattern, &input);
-                &scratch.local
-            }
+            None => &scratch.patterns.get(self.generation, self.pattern, &input, false).local,
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !local.interior.is_empty());
@@ -635,46 +632,96 @@ impl<'a> PatchOut<'a> {
     }
 }
 
-/// A thread's pattern and tables, kept from call to call so that a steady loop allocates
+/// A thread's patterns and tables, kept from call to call so that a steady loop allocates
 /// nothing. Patterns that do not depend on the patch (all but ESC's and the warped SD-2's)
-/// are built once per distinct input within a call.
+/// are kept by input ([`RecentPatterns`]): an adaptive frame of small patterns has a few
+/// hundred distinct inputs over tens of thousands of patches.
 #[derive(Default)]
 pub(crate) struct PatchScratch {
-    local: LocalTessellation,
-    /// The call and input `local` was built for, when the pattern ignores the patch id.
-    built: Option<(u64, PatternInput)>,
+    patterns: RecentPatterns,
     generation: u64,
     vertex: Vec<u32>,
     param: Vec<[f32; 2]>,
-    /// Parameters of every local vertex, for the error checks.
-    params64: Vec<glam::DVec2>,
+    /// Parameters of an edge's inner samples.
+    edge_params: Vec<glam::DVec2>,
 }
 
 impl PatchScratch {
-    /// Builds `input`'s pattern for a use that does not keep it (the cache is dropped).
-    pub(crate) fn build_once(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
-        pattern.build(input, &mut self.local);
-        self.built = None;
-        &self.local
+    /// `input`'s pattern, built unless this thread built it earlier in the same call.
+    pub(crate) fn pattern(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
+        &self.patterns.get(self.generation, pattern, input, false).local
     }
 
-    /// `input`'s pattern, rebuilt only when it differs from the last one this scratch built
-    /// in the same generation.
-    pub(crate) fn built(
+    /// [`PatchScratch::pattern`] with the parameters of every local vertex
+    /// ([`pattern_cache::local_params`]), for the error checks.
+    pub(crate) fn pattern_with_params(
         &mut self,
         pattern: &dyn Pattern,
         input: &PatternInput,
-    ) -> (&LocalTessellation, &mut Vec<glam::DVec2>) {
-        self.build(pattern, input);
-        (&self.local, &mut self.params64)
+    ) -> (&LocalTessellation, &[glam::DVec2]) {
+        let slot = self.patterns.get(self.generation, pattern, input, true);
+        (&slot.local, &slot.params)
     }
+}
 
-    fn build(&mut self, pattern: &dyn Pattern, input: &PatternInput) {
-        let key = (self.generation, PatternInput { patch: 0, ..*input });
-        if pattern.depends_on_patch() || self.built != Some(key) {
-            pattern.build(input, &mut self.local);
-            self.built = (!pattern.depends_on_patch()).then_some(key);
+/// Slots of [`RecentPatterns`]: a power of two.
+const RECENT_PATTERNS: usize = 64;
+
+/// The patterns a thread built recently, in a direct-mapped table by input hash: a build is
+/// replaced only by one of another input with the same slot. Written by hand: a cache of
+/// this shape (fixed size, no eviction policy, buffers kept per slot) is a few lines, and
+/// the crates of the field with caches allocate per entry.
+#[derive(Default)]
+struct RecentPatterns {
+    slots: Vec<RecentPattern>,
+    /// The slot of the last request: neighbouring patches often share an input, and a
+    /// comparison costs less than the hash.
+    last: usize,
+}
+
+#[derive(Default)]
+struct RecentPattern {
+    /// The call and input (its patch 0) `local` was built for; None when it holds nothing
+    /// reusable (never built, or built for a pattern that depends on the patch).
+    key: Option<(u64, PatternInput)>,
+    local: LocalTessellation,
+    /// `local`'s local-vertex parameters, valid when `with_params`.
+    params: Vec<glam::DVec2>,
+    with_params: bool,
+}
+
+impl RecentPatterns {
+    /// The slot holding `input`'s pattern for call `generation` (and its parameters, with
+    /// `params`), built into it unless it is there already.
+    fn get(
+        &mut self,
+        generation: u64,
+        pattern: &dyn Pattern,
+        input: &PatternInput,
+        params: bool,
+    ) -> &RecentPattern {
+        if self.slots.is_empty() {
+            self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
         }
+        let reusable = !pattern.depends_on_patch();
+        let key = (generation, PatternInput { patch: 0, ..*input });
+        let index = match reusable {
+            true if self.slots[self.last].key == Some(key) => self.last,
+            true => pattern_cache::input_hash(input) as usize % RECENT_PATTERNS,
+            false => 0,
+        };
+        self.last = index;
+        let slot = &mut self.slots[index];
+        if !reusable || slot.key != Some(key) {
+            pattern.build(input, &mut slot.local);
+            slot.key = reusable.then_some(key);
+            slot.with_params = false;
+        }
+        if params && !slot.with_params {
+            pattern_cache::local_params(input, &slot.local, &mut slot.params);
+            slot.with_params = true;
+        }
+        slot
     }
 }
 

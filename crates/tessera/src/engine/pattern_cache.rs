@@ -33,6 +33,13 @@ struct Key {
     flags: u8,
 }
 
+/// A hash of the bits of `input` a pattern may read (not the patch), for tables keyed by
+/// pattern input ([`PatternCache`], the threads' recent builds in `engine::PatchScratch`).
+pub(crate) fn input_hash(input: &PatternInput) -> u64 {
+    use std::hash::{BuildHasher, BuildHasherDefault};
+    BuildHasherDefault::<WordHasher>::default().hash_one(Key::of(input))
+}
+
 impl Key {
     fn of(input: &PatternInput) -> Key {
         let collapsed = input.collapsed.iter().enumerate().fold(0u8, |m, (e, &c)| m | (u8::from(c) << e));
