@@ -174,6 +174,9 @@ impl Pattern for SchemePattern {
     fn grid_cells(&self, input: &PatternInput) -> Option<[u32; 2]> {
         self.inner().grid_cells(input)
     }
+    fn core_cells(&self, input: &PatternInput) -> Option<([u32; 2], u32)> {
+        self.inner().core_cells(input)
+    }
     fn depends_on_patch(&self) -> bool {
         self.inner().depends_on_patch()
     }

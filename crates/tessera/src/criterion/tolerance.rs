@@ -36,12 +36,12 @@ pub struct PlanReport {
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
 /// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
 fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
-    let mut best: Option<(u32, u32)> = None;
-    for nu in 1..=cap {
+    // The rows `nv` that columns `nu` need, None where `hu` alone exceeds the budget.
+    let rows = |nu: u32| -> Option<u64> {
         let hu = 1.0 / nu as f64;
         let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
         if c > 0.0 {
-            continue;
+            return None;
         }
         let hv = if a > 0.0 {
             (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a)
@@ -51,9 +51,19 @@ fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
             1.0
         };
         if hv <= 0.0 {
-            continue; // hu alone takes the whole budget (c = 0): no cell height is left
+            return None; // hu alone takes the whole budget (c = 0): no cell height is left
         }
-        let nv = if hv >= 1.0 { 1 } else { (1.0 / hv).ceil() as u64 };
+        Some(if hv >= 1.0 { 1 } else { (1.0 / hv).ceil() as u64 })
+    };
+    // `rows` only shrinks as `nu` grows, so no grid of `nu` or more columns has fewer than
+    // `nu · rows(cap)` cells: the search stops there (one row less, against rounding).
+    let fewest_rows = rows(cap)?.saturating_sub(1).max(1);
+    let mut best: Option<(u32, u32)> = None;
+    for nu in 1..=cap {
+        if best.is_some_and(|(bu, bv)| nu as u64 * fewest_rows >= bu as u64 * bv as u64) {
+            break;
+        }
+        let Some(nv) = rows(nu) else { continue };
         if nv > cap as u64 {
             continue;
         }
@@ -116,7 +126,35 @@ fn built_pattern_bound(
 /// The bound of the pattern `built` over its local-vertex parameters `params`
 /// ([`crate::engine::pattern_cache::local_params`]): the largest triangle error.
 fn params_bound(errors: &TriangleErrors, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
-    built.triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(0.0, f64::max)
+    triangles_bound(errors, &built.triangles, params, 0.0)
+}
+
+/// The largest triangle error of `triangles` over `params`, and `at_least`.
+fn triangles_bound(
+    errors: &TriangleErrors,
+    triangles: &[[u32; 3]],
+    params: &[glam::DVec2],
+    at_least: f64,
+) -> f64 {
+    triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(at_least, f64::max)
+}
+
+/// [`params_bound`] of a pattern whose first triangles are core cells
+/// ([`Pattern::core_cells`]): one cell's bound for them all ([`grid_bound`]), the rest one by
+/// one.
+fn core_params_bound(
+    errors: &TriangleErrors,
+    core: Option<([u32; 2], u32)>,
+    built: &LocalTessellation,
+    params: &[glam::DVec2],
+) -> f64 {
+    match core {
+        Some((cells, count)) if count > 0 && count as usize <= built.triangles.len() => {
+            let rest = &built.triangles[count as usize..];
+            triangles_bound(errors, rest, params, grid_bound(errors, cells))
+        }
+        _ => params_bound(errors, built, params),
+    }
 }
 
 /// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
@@ -612,12 +650,14 @@ fn check_patches(
                 let bound = match (grid, cached) {
                     // A pure grid (no strips): one cell's triangle bounds them all, no build.
                     (Some(cells), _) => grid_bound(&errors[p], cells),
-                    (None, Some((_, built, params))) => params_bound(&errors[p], built, params),
+                    (None, Some((_, built, params))) => {
+                        core_params_bound(&errors[p], limit.pattern.core_cells(&input), built, params)
+                    }
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
                     (None, None) => crate::engine::with_scratch(generation, |s| {
                         let (built, params) = s.pattern_with_params(limit.pattern, &input);
-                        params_bound(&errors[p], built, params)
+                        core_params_bound(&errors[p], limit.pattern.core_cells(&input), built, params)
                     }),
                 };
                 if bound <= e * (1.0 + 1e-9) {
@@ -654,5 +694,65 @@ mod tests {
         assert!(quad_grid(&m, eps, 3).is_none());
         let flat = HessianBound::default();
         assert_eq!(quad_grid(&flat, eps, 10), Some((1, 1)));
+    }
+
+    /// The search that stops early finds the grid that trying every column count finds (the
+    /// search before it stopped early, kept here as the oracle), on bounds from flat to
+    /// strongly anisotropic.
+    #[test]
+    fn quad_grid_stops_where_no_grid_can_be_smaller() {
+        let every_column_count = |m: &HessianBound, eps: f64, cap: u32| {
+            let mut best: Option<(u32, u32)> = None;
+            for nu in 1..=cap {
+                let hu = 1.0 / nu as f64;
+                let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
+                if c > 0.0 {
+                    continue;
+                }
+                let hv = if a > 0.0 {
+                    (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a)
+                } else if b > 0.0 {
+                    -c / b
+                } else {
+                    1.0
+                };
+                if hv <= 0.0 {
+                    continue;
+                }
+                let nv = if hv >= 1.0 { 1 } else { (1.0 / hv).ceil() as u64 };
+                if nv > cap as u64 {
+                    continue;
+                }
+                let nv = nv as u32;
+                if best.is_none_or(|(bu, bv)| (nu as u64 * nv as u64) < (bu as u64 * bv as u64)) {
+                    best = Some((nu, nv));
+                }
+                if nv == 1 {
+                    break;
+                }
+            }
+            best
+        };
+        let mut anisotropic = 0;
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let scale = 10f64.powf(4.0 * next() - 2.0);
+            let m = HessianBound {
+                uu: scale * next(),
+                uv: scale * next() * 0.3,
+                vv: scale * next() * 10f64.powf(2.0 * next() - 1.0),
+            };
+            let eps = 10f64.powf(-4.0 * next());
+            for cap in [1, 7, 64] {
+                let found = quad_grid(&m, eps, cap);
+                assert_eq!(found, every_column_count(&m, eps, cap), "{m:?} eps {eps} cap {cap}");
+                anisotropic += usize::from(found.is_some_and(|(nu, nv)| nu > 1 && nv > 1 && nu != nv));
+            }
+        }
+        assert!(anisotropic > 500, "the bounds reach real grids: {anisotropic}");
     }
 }

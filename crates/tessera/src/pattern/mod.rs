@@ -157,6 +157,15 @@ pub trait Pattern: Sync {
         None
     }
 
+    /// `Some((cells, count))` when the first `count` triangles [`Pattern::build`] gives for
+    /// `input` are halves of cells of the `cells[0] × cells[1]` grid, as in
+    /// [`Pattern::grid_cells`] (a core grid before transition strips): they share one error
+    /// bound, and the a-posteriori check bounds only the triangles after them one by one.
+    /// None (the default) promises nothing. Cost: O(1).
+    fn core_cells(&self, _input: &PatternInput) -> Option<([u32; 2], u32)> {
+        None
+    }
+
     /// True when [`Pattern::build`] depends on `input.patch` (patterns holding per-patch
     /// decisions); false lets the engine reuse one build for every patch with the same
     /// input otherwise.

@@ -467,6 +467,21 @@ impl Pattern for Transition {
         }
     }
 
+    /// The core's cells come first in [`Pattern::build`]: two triangles per cell of the core
+    /// rectangle (quads), the `m²` triangles of the core triangle (triangles).
+    fn core_cells(&self, input: &PatternInput) -> Option<([u32; 2], u32)> {
+        match input.domain {
+            Domain::Quad => {
+                let l = QuadLayout::new(input);
+                Some(([l.nu, l.nv], 2 * (l.i_hi - l.i_lo) * (l.j_hi - l.j_lo)))
+            }
+            Domain::Tri => {
+                let l = TriLayout::new(input);
+                Some(([l.n, l.n], l.m * l.m))
+            }
+        }
+    }
+
     /// Quads: the core's grid, `(i/nu, j/nv)` row after row over every interior point (the
     /// strips add no interior vertex), with the core factors as raised for the strips.
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
@@ -519,8 +534,34 @@ mod tests {
         let (vi, t) = Transition.counts(input);
         assert_eq!(out.interior.len() as u32, vi, "{input:?}: interior count");
         assert_eq!(out.triangles.len() as u32, t, "{input:?}: triangle count");
-        super::super::assert_tiles(input, &out, &local_params(input, &out), 1e-12);
+        let params = local_params(input, &out);
+        super::super::assert_tiles(input, &out, &params, 1e-12);
+        // The promised core cells come first and are halves of grid cells.
+        let (cells, count) = Transition.core_cells(input).expect("transition promises its core");
+        assert!(count <= t, "{input:?}: core of {count} triangles in {t}");
+        for tri in &out.triangles[..count as usize] {
+            assert!(
+                half_cell(tri.map(|l| params[l as usize]), cells),
+                "{input:?}: {tri:?} is no half cell of {cells:?}"
+            );
+        }
+        if let Some(grid) = Transition.grid_cells(input) {
+            assert_eq!((grid, count), (cells, t), "{input:?}: a pure grid is all core");
+        }
         out.triangles.len()
+    }
+
+    /// Whether `t` is a right triangle with legs `1/cells[0]` along u and `1/cells[1]` along v.
+    fn half_cell(t: [DVec2; 3], cells: [u32; 2]) -> bool {
+        let h = DVec2::new(1.0 / cells[0] as f64, 1.0 / cells[1] as f64);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12;
+        (0..3).any(|c| {
+            let (a, b) = (t[(c + 1) % 3] - t[c], t[(c + 2) % 3] - t[c]);
+            let legs = |u: DVec2, v: DVec2| {
+                close(u.x.abs(), h.x) && close(u.y, 0.0) && close(v.x, 0.0) && close(v.y.abs(), h.y)
+            };
+            legs(a, b) || legs(b, a)
+        })
     }
 
     fn quad(segments: [u32; 4], interior: [u32; 2]) -> PatternInput {
