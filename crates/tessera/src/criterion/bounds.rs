@@ -111,6 +111,25 @@ impl TriangleErrors {
     }
 }
 
+impl TriangleErrors {
+    /// [`TriangleErrors::error`] of a half cell of a grid — a right triangle with legs `hu`
+    /// along `u` and `hv` along `v` — in closed form: its smallest enclosing disc in every
+    /// scaling is the one on its hypotenuse, and Filip's bound applies. Equal to `error` on
+    /// such a triangle up to rounding (the a-posteriori check's margin is 1e-9 of the bound;
+    /// this differs in the last bits), without the three square roots. Cost: O(1).
+    #[inline]
+    pub fn cell_error(&self, hu: f64, hv: f64) -> f64 {
+        let mut general = f64::INFINITY;
+        for (s, lambda) in self.scales.iter().zip(self.lambdas) {
+            let (a, b) = (s.x * hu, s.y * hv);
+            // λ·r²/2 with r² = (a² + b²)/4.
+            general = general.min(lambda * (a * a + b * b) / 8.0);
+        }
+        let m = &self.bound;
+        general.min((hu * hu * m.uu + 2.0 * hu * hv * m.uv + hv * hv * m.vv) / 8.0)
+    }
+}
+
 /// Radius of the smallest disc containing a triangle: half the longest side when the triangle
 /// is right or obtuse, else its circumradius.
 pub fn enclosing_radius(t: [DVec2; 3]) -> f64 {
@@ -308,6 +327,32 @@ pub fn curve_second_derivative(points: [DVec3; 4], weights: [f64; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The closed form of a half cell's bound is the general bound of that triangle (both
+    /// orientations of the cell's diagonal), to rounding, on bounds and cells of every shape.
+    #[test]
+    fn cell_error_is_the_triangle_error_of_a_half_cell() {
+        let mut seed = 11u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..5000 {
+            let scale = 10f64.powf(6.0 * next() - 3.0);
+            let m = HessianBound { uu: scale * next(), uv: scale * next() * next(), vv: scale * next() };
+            let errors = m.triangle_errors();
+            let (nu, nv) = (1 + (next() * 64.0) as u32, 1 + (next() * 64.0) as u32);
+            let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+            let (i, j) = ((next() * nu as f64).floor() * hu, (next() * nv as f64).floor() * hv);
+            let corner = DVec2::new(i, j);
+            let (du, dv) = (DVec2::new(hu, 0.0), DVec2::new(0.0, hv));
+            let closed = errors.cell_error(hu, hv);
+            for t in [[corner, corner + du, corner + du + dv], [corner, corner + du + dv, corner + dv]] {
+                let general = errors.error(t);
+                assert!((closed - general).abs() <= 1e-12 * general, "{m:?} {nu}×{nv}: {closed} against {general}");
+            }
+        }
+    }
 
     #[test]
     fn split_bounds_are_valid_and_tighter() {

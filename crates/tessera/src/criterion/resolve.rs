@@ -56,6 +56,15 @@ pub struct Caps<'a> {
     pub minimum_interior: &'a [[u32; 2]],
 }
 
+/// `x.round() as u32` for `0 ≤ x < 2³²` (half away from zero), without the library call that
+/// `f64::round` is on the baseline x86-64 target: once per edge per frame, it was a visible
+/// part of resolving a large frame.
+#[inline]
+fn round_factor(x: f64) -> u32 {
+    let t = x as u32;
+    t.saturating_add(u32::from(x - t as f64 >= 0.5))
+}
+
 /// Resolves per-use proposals into per-edge segments and factors (written into `segments`
 /// and `factors`, cleared first). Cost: O(E) plus the edge uses, parallel.
 pub fn edges(
@@ -87,7 +96,7 @@ pub fn edges(
             let minimum = caps.minimum_segments[e].max(1);
             (*s, *f) = match rule {
                 EdgeRule::Integer => {
-                    let s = (wanted.round() as u32).max(minimum);
+                    let s = round_factor(wanted).max(minimum);
                     (s, s as f32)
                 }
                 EdgeRule::PowerOfTwo => {
@@ -172,6 +181,20 @@ mod tests {
     use super::*;
     use crate::surface::{Patch, RationalBicubic};
     use glam::DVec3;
+
+    #[test]
+    fn round_factor_is_the_library_rounding() {
+        let halves = (0..2000).map(|k| k as f64 * 0.5);
+        let near = (0..2000).flat_map(|k| {
+            let x = k as f64 * 0.5;
+            // The neighbouring doubles (the crate's minimum Rust has no next_up/next_down).
+            [f64::from_bits(x.to_bits().saturating_sub(u64::from(x > 0.0))), f64::from_bits(x.to_bits() + 1)]
+        });
+        let odd = [0.0, 0.49999999999999994, 1e-300, 64.0, 4294967294.5, 4294967295.0, 1e12, f64::MAX];
+        for x in halves.chain(near).chain(odd) {
+            assert_eq!(round_factor(x), x.round() as u32, "{x:e}");
+        }
+    }
 
     /// Two flat bicubic patches side by side, sharing the curve `x = 3`.
     fn pair() -> SurfaceSet {

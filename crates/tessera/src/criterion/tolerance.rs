@@ -162,8 +162,7 @@ fn core_params_bound(
 /// such triangle has the same bound (it depends only on the differences of the corners), so
 /// no pattern is built. Cost: O(1).
 fn grid_bound(m: &TriangleErrors, [nu, nv]: [u32; 2]) -> f64 {
-    let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
-    m.error([glam::DVec2::ZERO, glam::DVec2::new(hu, 0.0), glam::DVec2::new(0.0, hv)])
+    m.cell_error(1.0 / nu as f64, 1.0 / nv as f64)
 }
 
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:

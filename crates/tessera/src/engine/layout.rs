@@ -152,21 +152,27 @@ impl Layout {
         let upper: u64 = self.counts.iter().map(|c| c.1 as u64).sum();
         check_size(total + interior, upper, options)?;
         let generation = super::next_generation();
-        self.counts
-            .par_iter()
-            .enumerate()
-            .map(|(p, &(_, t))| {
-                if t == 0 || !has_repeated_corner(set, p) {
-                    return t;
-                }
-                let input = pattern_input(set, plan, p);
-                super::with_scratch(generation, |scratch| {
-                    let triangles = &scratch.pattern(pattern, &input).triangles;
-                    triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
-                        as u32
+        self.kept.clear();
+        if topo.one_shape.is_some() {
+            // No patch has a repeated corner: every triangle is kept.
+            self.kept.extend(self.counts.iter().map(|c| c.1));
+        } else {
+            self.counts
+                .par_iter()
+                .enumerate()
+                .map(|(p, &(_, t))| {
+                    if t == 0 || !has_repeated_corner(set, p) {
+                        return t;
+                    }
+                    let input = pattern_input(set, plan, p);
+                    super::with_scratch(generation, |scratch| {
+                        let triangles = &scratch.pattern(pattern, &input).triangles;
+                        triangles.iter().filter(|tri| !degenerate_after_collapse(set, &input, p, tri)).count()
+                            as u32
+                    })
                 })
-            })
-            .collect_into_vec(&mut self.kept);
+                .collect_into_vec(&mut self.kept);
+        }
         // Scan: both totals fit u32 now (check_size).
         self.interior_offsets.clear();
         self.triangle_offsets.clear();
