@@ -101,6 +101,7 @@ impl Camera {
             near: self.near,
             far: self.far,
             half_tangents: self.half_tangents(),
+            side_norms: self.half_tangents().map(|t| (1.0 + t * t).sqrt()),
             focal_pixels: self.focal_pixels(),
         }
     }
@@ -241,6 +242,9 @@ pub struct View {
     pub far: f64,
     /// [`Camera::half_tangents`].
     pub half_tangents: DVec2,
+    /// `√(1 + t²)` of each half tangent `t`: the norms of the side planes' normals
+    /// `(±1, 0, −t)` (x) and `(0, ±1, −t)` (y), computed once per view rather than per patch.
+    pub side_norms: DVec2,
     /// [`Camera::focal_pixels`].
     pub focal_pixels: f64,
 }

@@ -349,7 +349,10 @@ mod tests {
             let closed = errors.cell_error(hu, hv);
             for t in [[corner, corner + du, corner + du + dv], [corner, corner + du + dv, corner + dv]] {
                 let general = errors.error(t);
-                assert!((closed - general).abs() <= 1e-12 * general, "{m:?} {nu}×{nv}: {closed} against {general}");
+                assert!(
+                    (closed - general).abs() <= 1e-12 * general,
+                    "{m:?} {nu}×{nv}: {closed} against {general}"
+                );
             }
         }
     }

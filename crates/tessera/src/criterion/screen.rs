@@ -84,7 +84,7 @@ impl PatchView {
         let c = view.to_camera(self.centre);
         // Signed distances to the six planes, positive outside; the side planes pass through
         // the eye with normals (±1, 0, −t)/√(1+t²) in camera space.
-        let (nx, ny) = ((1.0 + t.x * t.x).sqrt(), (1.0 + t.y * t.y).sqrt());
+        let (nx, ny) = (view.side_norms.x, view.side_norms.y);
         let distances = [
             view.near - c.z,
             c.z - view.far,

@@ -453,11 +453,9 @@ impl Writer<'_> {
             rayon::join(|| self.edges(edges.start..mid, left), || self.edges(mid..edges.end, out));
             return;
         }
-        for e in edges {
+        // Most edges of a distant view have no inner sample: skipped without a split.
+        for e in edges.filter(|&e| offsets[e + 1] > offsets[e]) {
             let part = out.take_front((offsets[e + 1] - offsets[e]) as usize);
-            if part.pos.is_empty() {
-                continue;
-            }
             match self.fast {
                 Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
                 Some(f) if f.triangles().active() && self.set.topology.edges[e].variants == 1 => {
@@ -519,7 +517,8 @@ impl Writer<'_> {
     /// Whether patch `p`'s triangles take the general form: some may drop out at a repeated
     /// corner, or parameters go along.
     fn general(&self, p: usize, params: &[[f32; 2]]) -> bool {
-        layout::has_repeated_corner(self.set, p) || !params.is_empty()
+        !params.is_empty()
+            || (self.set.topology.one_shape.is_none() && layout::has_repeated_corner(self.set, p))
     }
 
     /// The first pass for one visible patch: its pattern (cached, or built and reused from
