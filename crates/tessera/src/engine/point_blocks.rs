@@ -157,14 +157,32 @@ impl LocalTriangle {
     }
 }
 
-/// A patch prepared for block evaluation.
+/// Which form a patch was prepared in, and its index among the forms of that kind
+/// ([`PointBlocks`]' vectors). Eight bytes, so that the per-patch table stays in cache and
+/// each kind's forms lie densely in patch order: a frame's passes stream them.
+#[derive(Clone, Copy)]
 enum Local {
-    Bicubic(LocalPatch),
-    /// Boxed: rarer and larger than a polynomial patch, which keeps the table dense.
-    Rational(Box<LocalPatch<4>>),
-    Triangle(Box<LocalTriangle>),
+    Bicubic(u32),
+    Rational(u32),
+    Triangle(u32),
     /// A rational bicubic whose weights span more than f32 carries
     /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
+    Generic,
+}
+
+/// A patch's local form, borrowed.
+#[derive(Clone, Copy)]
+enum FormRef<'a> {
+    Bicubic(&'a LocalPatch),
+    Rational(&'a LocalPatch<4>),
+    Triangle(&'a LocalTriangle),
+}
+
+/// A patch's local form while a set is prepared.
+enum Form {
+    Bicubic(LocalPatch),
+    Rational(LocalPatch<4>),
+    Triangle(LocalTriangle),
     Generic,
 }
 
@@ -175,10 +193,13 @@ pub(crate) enum GridPatch<'a> {
     Rational(&'a LocalPatch<4>),
 }
 
-/// Every patch of a set in its local frame, made once per set. Cost: O(P) to build, about 250
-/// bytes a patch.
+/// Every patch of a set in its local frame, made once per set: a table of eight bytes a
+/// patch and each kind's forms in patch order. Cost: O(P) to build, 200–400 bytes a patch.
 pub(crate) struct PointBlocks {
     locals: Vec<Local>,
+    bicubics: Vec<LocalPatch>,
+    rationals: Vec<LocalPatch<4>>,
+    triangles: Vec<LocalTriangle>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -472,28 +493,44 @@ fn triangle_block<const FMA: bool, const L: usize>(
 impl PointBlocks {
     /// Every patch of `set` in its local frame. Cost: O(P), parallel.
     pub(crate) fn for_set(set: &SurfaceSet, avx2_fma: bool) -> PointBlocks {
-        let locals = set
+        let forms = set
             .patches
             .par_iter()
             .with_min_len(64)
             .map(|p| match p {
-                Patch::Bicubic(b) if b.is_polynomial() => Local::Bicubic(LocalPatch::new(b)),
-                Patch::Bicubic(b) => {
-                    LocalPatch::rational(b).map_or(Local::Generic, |r| Local::Rational(Box::new(r)))
-                }
-                Patch::BezierTriangle(t) => Local::Triangle(Box::new(LocalTriangle::new(t, None))),
-                Patch::Pn(t) => Local::Triangle(Box::new(LocalTriangle::new(&t.geometry, Some(&t.normals)))),
+                Patch::Bicubic(b) if b.is_polynomial() => Form::Bicubic(LocalPatch::new(b)),
+                Patch::Bicubic(b) => LocalPatch::rational(b).map_or(Form::Generic, Form::Rational),
+                Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
+                Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
             })
             .collect::<Vec<_>>();
-        let all_bicubic = locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
-        PointBlocks { locals, all_bicubic, avx2_fma: avx2_fma && has_avx2_fma() }
+        let mut blocks = PointBlocks {
+            locals: Vec::with_capacity(forms.len()),
+            bicubics: Vec::new(),
+            rationals: Vec::new(),
+            triangles: Vec::new(),
+            all_bicubic: false,
+            avx2_fma: avx2_fma && has_avx2_fma(),
+        };
+        for form in forms {
+            let local = match form {
+                Form::Bicubic(b) => Local::Bicubic(push(&mut blocks.bicubics, b)),
+                Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
+                Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
+                Form::Generic => Local::Generic,
+            };
+            blocks.locals.push(local);
+        }
+        blocks.all_bicubic =
+            blocks.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
+        blocks
     }
 
     /// Patch `p`'s local bicubic form, where it is a bicubic that has one.
     pub(crate) fn grid_patch(&self, p: usize) -> Option<GridPatch<'_>> {
-        match &self.locals[p] {
-            Local::Bicubic(local) => Some(GridPatch::Polynomial(local)),
-            Local::Rational(local) => Some(GridPatch::Rational(local)),
+        match self.locals[p] {
+            Local::Bicubic(i) => Some(GridPatch::Polynomial(&self.bicubics[i as usize])),
+            Local::Rational(i) => Some(GridPatch::Rational(&self.rationals[i as usize])),
             _ => None,
         }
     }
@@ -553,7 +590,13 @@ impl PointBlocks {
         uvs: &[DVec2],
         out: VertexSlices<'_>,
     ) {
-        let local = &self.locals[p];
+        // The patch's form, looked up once for all its blocks.
+        let form = match self.locals[p] {
+            Local::Bicubic(i) => FormRef::Bicubic(&self.bicubics[i as usize]),
+            Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
+            Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
+            Local::Generic => unreachable!("handled by the caller"),
+        };
         let chunks = uvs.chunks(L).zip(out.pos.chunks_mut(L).zip(out.nrm.chunks_mut(L)));
         for (uv, (pos, nrm)) in chunks {
             // Spare lanes repeat the last point: a real point, so its margin is meaningful.
@@ -564,11 +607,10 @@ impl PointBlocks {
                 u[l] = q.x as f32;
                 v[l] = q.y as f32;
             }
-            let block = match local {
-                Local::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
-                Local::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
-                Local::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
-                Local::Generic => unreachable!("handled by the caller"),
+            let block = match form {
+                FormRef::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
+                FormRef::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
+                FormRef::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 if block.margin[l] > 0.0 {
@@ -584,6 +626,12 @@ impl PointBlocks {
         out.uv.iter_mut().zip(uvs).for_each(|(x, uv)| *x = uv.as_vec2().to_array());
         out.patch.fill(p as u32);
     }
+}
+
+/// Appends `x` to `v` and returns its index.
+fn push<T>(v: &mut Vec<T>, x: T) -> u32 {
+    v.push(x);
+    (v.len() - 1) as u32
 }
 
 /// The generic f64 evaluation, for the rare points f32 cannot resolve.
