@@ -469,6 +469,11 @@ impl<'a> Limit<'a> {
         }
         let t = self.pattern.counts(input).1 as u64;
         let previous = self.per_patch[p].load(Ordering::Relaxed);
+        if t == previous {
+            // Already counted (the first pattern, reserved with its neighbours): the shared
+            // total would not change, and leaving it alone spares a contended atomic a patch.
+            return true;
+        }
         let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
             let n = u - previous + t;
             (n <= self.max_triangles).then_some(n)
