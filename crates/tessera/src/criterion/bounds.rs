@@ -332,11 +332,8 @@ mod tests {
     /// orientations of the cell's diagonal), to rounding, on bounds and cells of every shape.
     #[test]
     fn cell_error_is_the_triangle_error_of_a_half_cell() {
-        let mut seed = 11u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::io::patches::test_support::Lcg(11);
+        let mut next = || rng.unit();
         for _ in 0..5000 {
             let scale = 10f64.powf(6.0 * next() - 3.0);
             let m = HessianBound { uu: scale * next(), uv: scale * next() * next(), vv: scale * next() };

@@ -738,11 +738,8 @@ mod tests {
             best
         };
         let mut anisotropic = 0;
-        let mut seed = 7u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::io::patches::test_support::Lcg(7);
+        let mut next = || rng.unit();
         for _ in 0..2000 {
             let scale = 10f64.powf(4.0 * next() - 2.0);
             let m = HessianBound {

@@ -464,6 +464,11 @@ pub(crate) mod test_support {
         pub fn below(&mut self, n: usize) -> usize {
             self.next() as usize % n
         }
+
+        /// A pseudo-random number in `[0, 1)`.
+        pub fn unit(&mut self) -> f64 {
+            self.next() as f64 / (1u64 << 31) as f64
+        }
     }
 }
 
