@@ -472,16 +472,15 @@ fn triangle_block<const FMA: bool, const L: usize>(
         }
         Some(field) => {
             let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
-            // Lane loops of one operation each, so that each becomes one vector instruction
-            // (as one loop, the square root stayed scalar).
-            let n2: [f32; L] =
-                std::array::from_fn(|l| n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]);
-            let margin = n2.map(|x| x - MIN_PN_NORMAL2);
-            let inv = n2.map(|x| 1.0 / x.sqrt());
-            for row in &mut n {
-                for l in 0..L {
-                    row[l] *= inv[l];
-                }
+            let mut margin = [0f32; L];
+            let [nx, ny, nz] = &mut n;
+            for l in 0..L {
+                let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
+                margin[l] = n2 - MIN_PN_NORMAL2;
+                let inv = 1.0 / n2.sqrt();
+                nx[l] *= inv;
+                ny[l] *= inv;
+                nz[l] *= inv;
             }
             (n, margin)
         }
@@ -528,11 +527,21 @@ impl PointBlocks {
 
     /// Patch `p`'s local bicubic form, where it is a bicubic that has one.
     pub(crate) fn grid_patch(&self, p: usize) -> Option<GridPatch<'_>> {
-        match self.locals[p] {
-            Local::Bicubic(i) => Some(GridPatch::Polynomial(&self.bicubics[i as usize])),
-            Local::Rational(i) => Some(GridPatch::Rational(&self.rationals[i as usize])),
-            _ => None,
+        match self.form(p)? {
+            FormRef::Bicubic(local) => Some(GridPatch::Polynomial(local)),
+            FormRef::Rational(local) => Some(GridPatch::Rational(local)),
+            FormRef::Triangle(_) => None,
         }
+    }
+
+    /// Patch `p`'s local form; None for a patch on the generic evaluation.
+    fn form(&self, p: usize) -> Option<FormRef<'_>> {
+        Some(match self.locals[p] {
+            Local::Bicubic(i) => FormRef::Bicubic(&self.bicubics[i as usize]),
+            Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
+            Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
+            Local::Generic => return None,
+        })
     }
 
     /// Whether every patch is a bicubic with a local form, polynomial or rational (the grid
@@ -591,12 +600,7 @@ impl PointBlocks {
         out: VertexSlices<'_>,
     ) {
         // The patch's form, looked up once for all its blocks.
-        let form = match self.locals[p] {
-            Local::Bicubic(i) => FormRef::Bicubic(&self.bicubics[i as usize]),
-            Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
-            Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
-            Local::Generic => unreachable!("handled by the caller"),
-        };
+        let form = self.form(p).expect("generic patches are handled by the caller");
         let chunks = uvs.chunks(L).zip(out.pos.chunks_mut(L).zip(out.nrm.chunks_mut(L)));
         for (uv, (pos, nrm)) in chunks {
             // Spare lanes repeat the last point: a real point, so its margin is meaningful.
