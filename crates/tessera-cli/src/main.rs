@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 use tessera::criterion::Plan;
 use tessera::engine::render_queues::{self, RenderQueues};
 use tessera::engine::{self, TessellateOptions};
+use tessera::io::glb::UriScope;
 use tessera::mesh::Mesh;
 use tessera::pattern::semi_uniform::StaticPattern;
 use tessera::pattern::uniform::Uniform;
@@ -79,6 +80,10 @@ struct InputArgs {
     /// Keep the input's orientation instead of orienting closed inputs outward.
     #[arg(long)]
     keep_orientation: bool,
+    /// Let a .gltf's buffer URIs name files outside its folder (by default they must resolve,
+    /// links followed, to regular files inside it).
+    #[arg(long)]
+    allow_outside_uris: bool,
 }
 
 #[derive(Args)]
@@ -191,6 +196,7 @@ fn build_options(a: &InputArgs) -> Result<BuildOptions, Box<dyn std::error::Erro
         weld,
         orientation: if a.keep_orientation { Orientation::AsGiven } else { Orientation::Outward },
         flip: a.flip_normals,
+        uri_scope: if a.allow_outside_uris { UriScope::Anywhere } else { UriScope::ModelFolder },
     })
 }
 

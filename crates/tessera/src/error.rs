@@ -32,6 +32,16 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// A file that an input refers to (a glTF buffer's URI) could not be read: `file` is the
+    /// input, `referenced` the file its reference names, `what` which reference it is.
+    #[error("{}: {what}: {}: {source}", .file.display(), .referenced.display())]
+    Referenced {
+        file: PathBuf,
+        referenced: PathBuf,
+        what: String,
+        #[source]
+        source: std::io::Error,
+    },
     /// The input is malformed: syntax, counts, indices or non-finite numbers.
     #[error("{at}: {reason}")]
     Parse { at: Location, reason: String },

@@ -177,7 +177,7 @@ pub fn check_bezt(data: &[u8]) {
 /// only the GLB's own buffer and `data:` URIs). A parsed mesh must have its indices in range
 /// and finite numbers, and must build PN triangles or refuse them with an error.
 pub fn check_gltf(data: &[u8]) {
-    let Ok(mesh) = glb::parse_gltf_triangles(data, label(), None) else { return };
+    let Ok(mesh) = glb::parse_gltf_triangles(data, label(), None, Default::default()) else { return };
     assert_obj_invariants(&mesh);
     if let Ok(set) = SurfaceSet::pn_from_mesh(&mesh, label(), BuildOptions::default()) {
         if set.patches.len() <= ENGINE_PATCH_LIMIT {
@@ -483,7 +483,7 @@ pub fn decode_engine_case(data: &[u8]) -> EngineCase {
         _ => Weld::Exact,
     };
     let orientation = if d.one_in(2) { Orientation::Outward } else { Orientation::AsGiven };
-    let build = BuildOptions { weld, orientation, flip: d.one_in(4) };
+    let build = BuildOptions { weld, orientation, flip: d.one_in(4), ..Default::default() };
     let camera = (!d.one_in(3)).then(|| {
         let mut spec = format!(
             "eye={},{},{},target={},{},{},fov={},size={}x{}",

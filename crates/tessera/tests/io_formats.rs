@@ -203,7 +203,7 @@ fn gltf_text_files_with_external_or_embedded_buffers_and_transforms() {
         let path = dir.join("quad.gltf");
         std::fs::write(&path, json).unwrap();
         std::fs::write(dir.join("buffer.bin"), &bin).unwrap();
-        let mesh = glb::read_gltf_triangles(&path).unwrap();
+        let mesh = glb::read_gltf_triangles(&path, Default::default()).unwrap();
         assert_eq!(mesh.positions.len(), 8, "two instances of 4 vertices");
         assert_eq!(mesh.faces.len(), 4);
         // Node 0 is translated; node 1 mirrored in x, so its normals stay +z after the
@@ -227,6 +227,9 @@ fn located(e: Error) -> (PathBuf, String) {
     match e {
         Error::Parse { at, reason } | Error::Unsupported { at, reason } => (at.file, reason),
         Error::Io { path, source } => (path, source.to_string()),
+        Error::Referenced { file, referenced, what, source } => {
+            (file, format!("{what}: {}: {source}", referenced.display()))
+        }
         other => panic!("expected an error naming the file, got {other:?}"),
     }
 }
@@ -270,9 +273,12 @@ fn malformed_inputs_give_typed_errors_naming_the_file() {
         let err = io::load(&path, BuildOptions::default()).unwrap_err();
         let message = err.to_string();
         let (file, reason) = located(err);
-        let expected = if name == "g.gltf" { dir.join("missing.bin") } else { path.clone() };
-        assert_eq!(file, expected, "{name}: {message}");
-        assert!(message.contains(&expected.display().to_string()), "{message}");
+        assert_eq!(file, path, "{name}: {message}");
+        assert!(message.contains(&path.display().to_string()), "{message}");
+        if name == "g.gltf" {
+            // A buffer's error names the buffer's file too.
+            assert!(message.contains(&dir.join("missing.bin").display().to_string()), "{message}");
+        }
         assert!(reason.contains(needle), "{name}: {reason:?} lacks {needle:?}");
     }
     let err = io::load(&dir.join("x.txt"), BuildOptions::default()).unwrap_err();

@@ -29,7 +29,7 @@
 //! meshes and nodes) are read as PN-triangle input by [`read_gltf_triangles`], which does use
 //! the `gltf` crate, after the same checks.
 
-use std::io::{self, Write};
+use std::io::{self, Read, Write};
 use std::path::Path;
 
 use gltf::accessor::{DataType, Dimensions};
@@ -449,23 +449,26 @@ impl<'a> Glb<'a> {
 ///
 /// # Errors
 ///
-/// [`Error::Io`] when the file or an external buffer cannot be read; [`Error::Parse`] naming
-/// `path` and the reason for invalid JSON or GLB, a glTF validation error, an accessor that
+/// [`Error::Io`] when the file cannot be read and [`Error::Referenced`] (naming both files)
+/// when an external buffer cannot; [`Error::Unsupported`] for a buffer URI that `scope`
+/// refuses (outside the model's folder, not a regular file, not local); [`Error::Parse`]
+/// naming `path` and the reason for a buffer file shorter than its `byteLength` for invalid JSON or GLB, a glTF validation error, an accessor that
 /// does not fit its buffer view, a position or normal that is not a finite `f32` `VEC3`, an
 /// index out of range, an index count that is not a multiple of 3, or a node that appears
 /// twice in the hierarchy; [`Error::Unsupported`] for sparse or normalized accessors, triangle
 /// strips and fans, accessors without a buffer view, a singular node transform, a scene that
 /// instances more than 2^27 vertices, and a file without any triangle.
 ///
-/// Cost: reads the file and its buffers into memory, then O(file size + instanced triangles).
-pub fn read_gltf_triangles(path: &Path) -> Result<ObjMesh> {
-    let data = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    parse_gltf_triangles(&data, path, path.parent())
+/// Cost: reads the file and at most each buffer's `byteLength` of its buffer files into
+/// memory, then O(file size + instanced triangles).
+pub fn read_gltf_triangles(path: &Path, scope: UriScope) -> Result<ObjMesh> {
+    let data = super::read_input(path)?;
+    parse_gltf_triangles(&data, path, path.parent(), scope)
 }
 
 /// Parses glTF `data` (GLB or JSON) as [`read_gltf_triangles`] does; `file` labels errors and
-/// `dir`, when given, is where relative buffer URIs are resolved (without it, only the GLB's
-/// own buffer and `data:` URIs can be read).
+/// `dir`, when given, is where relative buffer URIs are resolved, under `scope` (without it,
+/// only the GLB's own buffer and `data:` URIs can be read).
 ///
 /// Preconditions: none; any bytes give a mesh or an error, never a panic: every accessor is
 /// checked against its view and buffer (with overflow-checked arithmetic) before the `gltf`
@@ -473,7 +476,7 @@ pub fn read_gltf_triangles(path: &Path) -> Result<ObjMesh> {
 /// and assumes the component type.
 ///
 /// Cost: O(`data.len()` + buffers + instanced triangles).
-pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Result<ObjMesh> {
+pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope: UriScope) -> Result<ObjMesh> {
     let err = |reason: String| Error::parse(file, 0, reason);
     // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
     // (an overflow panic with overflow checks on), so a shorter length is refused here.
@@ -520,7 +523,9 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>) -> Res
                     )))
                 }
             },
-            gltf::buffer::Source::Uri(uri) => resolve_uri(uri, file, dir)?,
+            gltf::buffer::Source::Uri(uri) => {
+                resolve_uri(uri, buffer.index(), buffer.length(), file, dir, scope)?
+            }
         };
         if bytes.len() < buffer.length() {
             return Err(err(format!(
@@ -740,24 +745,94 @@ fn check_accessor(
     Ok(count)
 }
 
-/// The bytes of a buffer URI: a base64 `data:` URI, or a relative path (percent-decoded)
-/// resolved against `dir`.
-fn resolve_uri(uri: &str, file: &Path, dir: Option<&Path>) -> Result<Vec<u8>> {
+/// Where the external files a `.gltf` names (its buffer URIs) may be.
+///
+/// glTF lets a buffer's `uri` be any relative path, and readers that follow it blindly read
+/// whatever it names: `../../etc/passwd`, `/dev/zero`, a 3 GB file for a 96-byte buffer. So
+/// by default a URI must resolve (symbolic links followed) to a regular file inside the
+/// folder of the `.gltf`; `Anywhere` lifts the folder rule for models whose buffers are kept
+/// elsewhere on purpose (`--allow-outside-uris`). Either way only regular files are read,
+/// and never more than the buffer's `byteLength`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UriScope {
+    /// Only files inside the folder of the `.gltf` (the default).
+    #[default]
+    ModelFolder,
+    /// Any regular file the process may read.
+    Anywhere,
+}
+
+/// The bytes of buffer `index`: a base64 `data:` URI, or a relative path (percent-decoded)
+/// resolved against `dir` under `scope`, of which at most `byte_length` bytes are read.
+/// Errors name the `.gltf` (`file`) and the file the URI names.
+fn resolve_uri(
+    uri: &str,
+    index: usize,
+    byte_length: usize,
+    file: &Path,
+    dir: Option<&Path>,
+    scope: UriScope,
+) -> Result<Vec<u8>> {
+    let refuse = |reason: String| Error::unsupported(file, 0, format!("buffer {index}: {reason}"));
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
-            return Err(Error::unsupported(file, 0, "a buffer data: URI that is not base64"));
+            return Err(refuse("a data: URI that is not base64".into()));
         };
         return decode_base64(payload)
-            .ok_or_else(|| Error::parse(file, 0, "a buffer data: URI holds invalid base64"));
+            .ok_or_else(|| Error::parse(file, 0, format!("buffer {index}: a data: URI holds invalid base64")));
     }
     if uri.contains("://") {
-        return Err(Error::unsupported(file, 0, format!("buffer URI `{uri}` is not a local file")));
+        return Err(refuse(format!("URI `{uri}` is not a local file")));
     }
     let Some(dir) = dir else {
-        return Err(Error::unsupported(file, 0, format!("buffer URI `{uri}` needs the file's folder")));
+        return Err(refuse(format!("URI `{uri}` needs the file's folder")));
     };
-    let path = dir.join(percent_decode(uri));
-    std::fs::read(&path).map_err(|source| Error::Io { path, source })
+    let named = dir.join(percent_decode(uri));
+    let cannot = |what: &str, source: io::Error| Error::Referenced {
+        file: file.to_path_buf(),
+        referenced: named.clone(),
+        what: format!("buffer {index} (URI `{uri}`): {what}"),
+        source,
+    };
+    // Resolved before anything is opened, so a link inside the folder to a file outside it
+    // is judged by where it leads.
+    let resolved = named.canonicalize().map_err(|e| cannot("cannot find it", e))?;
+    if scope == UriScope::ModelFolder {
+        let folder = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+        let folder = folder.canonicalize().map_err(|e| cannot("cannot resolve the model's folder", e))?;
+        if !resolved.starts_with(&folder) {
+            return Err(refuse(format!(
+                "URI `{uri}` names {}, outside the model's folder {} (--allow-outside-uris reads it)",
+                resolved.display(),
+                folder.display()
+            )));
+        }
+    }
+    let metadata = std::fs::metadata(&resolved).map_err(|e| cannot("cannot read it", e))?;
+    if !metadata.is_file() {
+        return Err(refuse(format!(
+            "URI `{uri}` names {}, which is not a regular file",
+            resolved.display()
+        )));
+    }
+    if metadata.len() < byte_length as u64 {
+        return Err(Error::parse(
+            file,
+            0,
+            format!(
+                "buffer {index} declares {byte_length} bytes but {} has {}",
+                resolved.display(),
+                metadata.len()
+            ),
+        ));
+    }
+    // `take` bounds the read by the declared length whatever the file grows to meanwhile;
+    // the capacity is bounded by the file's size checked above.
+    let mut bytes = Vec::with_capacity(byte_length);
+    std::fs::File::open(&resolved)
+        .and_then(|f| f.take(byte_length as u64).read_to_end(&mut bytes))
+        .map_err(|e| cannot("cannot read it", e))?;
+    Ok(bytes)
 }
 
 /// Decodes `%XX` escapes (URIs in glTF are percent-encoded); invalid escapes stay as they are.
@@ -1163,14 +1238,14 @@ mod tests {
     #[test]
     fn gltf_reader_reads_tessera_output_and_refuses_short_headers() {
         let mesh = grid(3, true);
-        let read = parse_gltf_triangles(&bytes(|w| write_glb(&mesh, w)), label(), None).unwrap();
+        let read = parse_gltf_triangles(&bytes(|w| write_glb(&mesh, w)), label(), None, UriScope::ModelFolder).unwrap();
         let positions: Vec<[f32; 3]> = read.positions.iter().map(|p| p.as_vec3().to_array()).collect();
         assert_eq!(positions, mesh.positions);
         let indices: Vec<u32> = read.faces.iter().flat_map(|f| f.positions.clone()).collect();
         assert_eq!(indices, mesh.indices);
         assert!(read.faces.iter().all(|f| f.normals.as_ref() == Some(&f.positions)));
         for short in [&b"glTF"[..], b"glTF\x02\0\0\0\x05\0\0\0", b"glTF\x02\0\0\0\0\0\0\0JSON"] {
-            let e = parse_gltf_triangles(short, label(), None).unwrap_err();
+            let e = parse_gltf_triangles(short, label(), None, UriScope::ModelFolder).unwrap_err();
             assert!(e.to_string().contains("invalid glTF"), "{e}");
         }
     }

@@ -75,6 +75,7 @@ pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gl
 /// Cost: one read of the file, the parse (O(file size)), and building the set (O(patches)
 /// hashing).
 pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
+    refuse_folder(path)?;
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let set = match ext.as_deref() {
         Some("patches") => SurfaceSet::from_patch_file(&patches::read_patches(path)?, options),
@@ -83,7 +84,7 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         Some("ply" | "stl") => {
             SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?
         }
-        Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path)?, path, options)?,
+        Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path, options.uri_scope)?, path, options)?,
         other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };
     if set.patches.is_empty() {
@@ -122,6 +123,7 @@ const SUPPORTED_MESHES: &str = ".obj, .ply, .stl, .glb";
 /// Cost: reads the whole file into memory, then O(file size) time; STL welding adds a hash map
 /// of the distinct positions.
 pub fn read_mesh(path: &Path) -> Result<Mesh> {
+    refuse_folder(path)?;
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let parse: fn(&[u8], &Path) -> Result<Mesh> = match ext.as_deref() {
         Some("obj") => {
@@ -133,8 +135,42 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
         Some("glb") => glb::parse_glb,
         other => return Err(unknown(path, "mesh", other, SUPPORTED_MESHES)),
     };
-    let data = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let data = read_input(path)?;
     parse(&data, path)
+}
+
+/// The bytes of the input file at `path`, which must be a regular file: a folder or a device
+/// (`/dev/zero` never ends) is refused before it is read.
+///
+/// # Errors
+///
+/// [`Error::Io`] when `path` cannot be read; [`Error::Unsupported`] naming `path` when it is
+/// a folder or not a regular file.
+///
+/// Cost: one `stat` and one read of the file.
+pub(crate) fn read_input(path: &Path) -> Result<Vec<u8>> {
+    check_input_file(path)?;
+    std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })
+}
+
+/// Refuses an input `path` that is a folder; called before the extension is looked at, so a
+/// folder is not reported as a file without an extension. A path that does not exist passes
+/// here (its extension is judged first, then reading it fails).
+fn refuse_folder(path: &Path) -> Result<()> {
+    match std::fs::metadata(path) {
+        Ok(metadata) if metadata.is_dir() => Err(Error::unsupported(path, 0, "is a folder, not an input file")),
+        _ => Ok(()),
+    }
+}
+
+/// Refuses an input `path` that is not a regular file (see [`read_input`]).
+fn check_input_file(path: &Path) -> Result<()> {
+    refuse_folder(path)?;
+    let metadata = std::fs::metadata(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    if !metadata.is_file() {
+        return Err(Error::unsupported(path, 0, "is not a regular file (a device, pipe or socket)"));
+    }
+    Ok(())
 }
 
 /// The error for a file name whose extension `role` files cannot have.

@@ -395,11 +395,11 @@ fn parse_point_line(
 ///
 /// # Errors
 ///
-/// [`Error::Io`] when the file cannot be read.
+/// As [`read_input`](super::read_input).
 ///
 /// Cost: one read of the file.
 pub(super) fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_input(path)?;
     Ok(String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
 }
 

@@ -32,6 +32,9 @@ pub struct BuildOptions {
     pub orientation: Orientation,
     /// Reverse the orientation after `orientation` was applied (`--flip-normals`).
     pub flip: bool,
+    /// Where a `.gltf` input's buffer files may be ([`io::load`](crate::io::load) reads them;
+    /// `--allow-outside-uris`).
+    pub uri_scope: crate::io::glb::UriScope,
 }
 
 /// What the builder changed in the input, so the CLI can report it.
