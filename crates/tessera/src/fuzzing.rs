@@ -186,6 +186,78 @@ pub fn check_gltf(data: &[u8]) {
     }
 }
 
+/// The hostile folder [`check_gltf_folder`] reads buffers from, made once per process: in
+/// `model/`, a valid one-triangle buffer `ok.bin` (44 bytes), `short.bin` (4 bytes),
+/// `empty.bin`, `big.bin` (the valid buffer, then sparse up to 256 MiB), a folder `sub`, and
+/// on Unix links to `/dev/zero`, to a file outside `model/`, and to themselves.
+fn hostile_folder() -> &'static Path {
+    static FOLDER: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    FOLDER.get_or_init(|| {
+        let root = std::env::temp_dir().join(format!("tessera-fuzz-gltf-{}", std::process::id()));
+        let model = root.join("model");
+        std::fs::create_dir_all(model.join("sub")).expect("a temporary folder");
+        let ok = one_triangle_buffer();
+        let write = |name: &str, bytes: &[u8]| std::fs::write(model.join(name), bytes).expect("a temporary file");
+        write("ok.bin", &ok);
+        write("short.bin", &ok[..4]);
+        write("empty.bin", &[]);
+        write("big.bin", &ok);
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(model.join("big.bin"))
+            .and_then(|f| f.set_len(256 << 20))
+            .expect("a sparse file");
+        std::fs::write(root.join("outside.bin"), &ok).expect("a temporary file");
+        #[cfg(unix)]
+        for (link, target) in [("zero.bin", "/dev/zero"), ("out.bin", "../outside.bin"), ("loop.bin", "loop.bin")] {
+            let _ = std::os::unix::fs::symlink(target, model.join(link));
+        }
+        model
+    })
+}
+
+/// Three positions and three `u16` indices (one padding index): a one-triangle buffer of 44
+/// bytes, positions at 0 and indices at 36.
+pub fn one_triangle_buffer() -> Vec<u8> {
+    let mut bin = Vec::new();
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        bin.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+    }
+    for i in [0u16, 1, 2, 0] {
+        bin.extend(i.to_le_bytes());
+    }
+    bin
+}
+
+/// A `.gltf` whose one triangle's buffer (of `byteLength` 44, as
+/// [`one_triangle_buffer`]) is `uri`: the seed [`check_gltf_folder`]'s inputs mutate.
+pub fn one_triangle_gltf(uri: &str) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"buffers":[{{"byteLength":44,"uri":"{uri}"}}],"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#
+    )
+}
+
+/// Checks the outside-glTF reader on a `.gltf` file (the bytes) inside a folder of hostile
+/// buffer files ([`hostile_folder`]: short, empty, sparse-huge, a folder, links to a device,
+/// outside the folder and to themselves), read with [`glb::read_gltf_triangles`] under the
+/// default [`UriScope`](glb::UriScope): it must refuse or parse, never panic, hang on a
+/// device, or read past a buffer's `byteLength`. A parsed mesh must pass the same invariants
+/// as [`check_gltf`]'s.
+pub fn check_gltf_folder(data: &[u8]) {
+    // A file per thread, so parallel tests do not read each other's half-written inputs.
+    let path = hostile_folder().join(format!("input-{:?}.gltf", std::thread::current().id()).replace(['(', ')'], ""));
+    std::fs::write(&path, data).expect("a temporary file");
+    let read = glb::read_gltf_triangles(&path, glb::UriScope::ModelFolder);
+    let _ = std::fs::remove_file(&path);
+    let Ok(mesh) = read else { return };
+    assert_obj_invariants(&mesh);
+    if let Ok(set) = SurfaceSet::pn_from_mesh(&mesh, label(), BuildOptions::default()) {
+        if set.patches.len() <= ENGINE_PATCH_LIMIT {
+            tessellate_small(&set);
+        }
+    }
+}
+
 /// Uniform factor 2 through the engine's fast path and factor 3 through the generic path:
 /// enough to reach every patch and edge of an arbitrary parsed input, little enough to keep
 /// the parser targets fast.

@@ -31,11 +31,12 @@ type Check = fn(&[u8]);
 
 /// Each fuzz target's name (its `fuzz_targets/<name>.rs` and `fuzz/regressions/<name>/`) and
 /// the check it runs.
-const TARGETS: [(&str, Check); 9] = [
+const TARGETS: [(&str, Check); 10] = [
     ("obj", fuzzing::check_obj),
     ("patches", fuzzing::check_patches),
     ("bezt", fuzzing::check_bezt),
     ("gltf", fuzzing::check_gltf),
+    ("gltf_folder", fuzzing::check_gltf_folder),
     ("ply", fuzzing::check_ply),
     ("stl", fuzzing::check_stl),
     ("glb", fuzzing::check_glb),
@@ -281,6 +282,22 @@ const FLAT_BEZT: &str = "2
 3,2,0
 ";
 
+/// The buffer URIs the `gltf_folder` seeds name: each file of the hostile folder, a path
+/// out of it, a device and an absolute path.
+const GLTF_FOLDER_URIS: [&str; 11] = [
+    "ok.bin",
+    "short.bin",
+    "empty.bin",
+    "big.bin",
+    "sub",
+    "zero.bin",
+    "out.bin",
+    "loop.bin",
+    "../outside.bin",
+    "/dev/zero",
+    "/etc/passwd",
+];
+
 #[test]
 fn parser_checks_survive_mutated_real_files() {
     check_mutations("obj", "catmark_cube", &model_bytes("cages/catmark_cube.obj"), 64);
@@ -295,6 +312,9 @@ fn parser_checks_survive_mutated_real_files() {
     check_mutations("glb", "dragknob", &written(|out| write_glb(&mesh, out)), 64);
     check_mutations("gltf", "dragknob", &written(|out| write_glb(&mesh, out)), 64);
     check_mutations("bezt", "flat", FLAT_BEZT.as_bytes(), 48);
+    for uri in GLTF_FOLDER_URIS {
+        check_mutations("gltf_folder", uri, fuzzing::one_triangle_gltf(uri).as_bytes(), 12);
+    }
     let spec = "eye=10,-4.5,2,target=0,0.25,0,up=0,0,1,fov=30,size=640x480,near=0.5,far=100";
     check_mutations("camera", "full spec", spec.as_bytes(), 64);
     check_mutations("camera", "one key", b"fov=30", 32);
