@@ -125,6 +125,9 @@ struct MeshArgs {
     /// it draws the CPU's plan; --stats adds per-pass GPU times).
     #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
     engine: String,
+    /// Let -o name the input file itself (it is replaced once the new mesh is complete).
+    #[arg(long)]
+    force: bool,
     #[command(flatten)]
     input_args: InputArgs,
 }
@@ -309,6 +312,13 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     }
     if let Some(out) = &a.output {
         tessera::io::check_output_path(out)?;
+        if !a.force && same_file(out, &a.input) {
+            return Err(format!(
+                "-o {}: that is the input; write elsewhere, or add --force to replace it",
+                out.display()
+            )
+            .into());
+        }
     }
     let pb = spinner(&format!("reading {}", a.input.display()));
     let set = load_surfaces(&a.input, options)?;
@@ -337,8 +347,12 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     let mut frames = Vec::new();
     // The GPU engine takes the first frame's plan; only it repeats.
     let cpu_frames = if a.engine == "gpu" { 1 } else { a.repeat.max(1) };
-    for _ in 0..cpu_frames {
-        tess.frame(chosen.options.camera.as_ref()).map_err(explain)?;
+    for frame in 0..cpu_frames {
+        let layout = tess.plan_frame(chosen.options.camera.as_ref()).map_err(explain)?;
+        if frame == 0 {
+            announce_large_output(layout, &opts, a.output.as_deref());
+        }
+        tess.write_frame().map_err(explain)?;
         frames.push(tess.timings());
     }
     let plan = tess.plan().expect("a frame was planned");
@@ -403,12 +417,22 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             check.rounds, check.failing_patches
         );
     }
-    let mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
+    let mut mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
+    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
+    // The numbering rule gives culled patches' corners (and their edges' normal variants)
+    // vertices no triangle uses; what is written and counted holds only the used ones.
+    let compacted;
+    if culled > 0 {
+        let mut copy = mesh.clone();
+        copy.drop_unused_vertices();
+        compacted = copy;
+        mesh = &compacted;
+    }
     let mut output_file = None;
     if let Some(out) = &a.output {
-        pb.set_message(format!("writing {}", out.display()));
+        pb.finish_and_clear();
         let start = Instant::now();
-        tessera::io::write_mesh(mesh, out)?;
+        write_with_bar(mesh, out, opts.corner_params)?;
         output_file = Some(start.elapsed().as_secs_f64());
     }
     pb.finish_and_clear();
@@ -421,7 +445,6 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             mesh.vertex_count()
         );
     }
-    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
     if culled > 0 {
         eprintln!(
             "note: --cull left out {culled} of {} patches (outside the view or facing away): the mesh is open there",
@@ -513,6 +536,66 @@ fn run_mesh(a: MeshArgs) -> CliResult {
         eprintln!("warning: {p}");
     }
     Ok(if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Whether `a` and `b` name one file (links and `..` resolved); false when either does not
+/// exist.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Outputs above this many triangles take more than about a second to write (tessellating
+/// runs at 100–500 Mtri/s, formatting and writing a file at 50–500 MB/s): they are announced
+/// with their size before the work starts.
+const ANNOUNCED_TRIANGLES: u64 = 20_000_000;
+
+/// Says on stderr, before the frame is written, how large a large output will be: its counts,
+/// its memory and (with `-o`) about its file size, so a run that will take a while and a lot
+/// of disk never starts without a word.
+fn announce_large_output(layout: &tessera::engine::layout::Layout, opts: &TessellateOptions, out: Option<&Path>) {
+    let (vertices, triangles) = (layout.vertex_count() as u64, layout.triangle_count() as u64);
+    if triangles < ANNOUNCED_TRIANGLES {
+        return;
+    }
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    let memory = engine::output_bytes(vertices, triangles, opts.corner_params);
+    let file = out
+        .and_then(|o| {
+            let bytes = tessera::io::estimated_file_bytes(o, vertices, triangles, opts.corner_params)?;
+            Some(format!(", about {:.1} GiB as {}", gib(bytes), o.display()))
+        })
+        .unwrap_or_default();
+    eprintln!(
+        "note: a large output: {triangles} triangles and {vertices} vertices, {:.1} GiB in memory{file}; this takes a while",
+        gib(memory)
+    );
+}
+
+/// Writes `mesh` to `out` with a progress bar in bytes (on a terminal; hidden otherwise).
+fn write_with_bar(mesh: &Mesh, out: &Path, corner_params: bool) -> Result<(), tessera::Error> {
+    let total = tessera::io::estimated_file_bytes(
+        out,
+        mesh.vertex_count() as u64,
+        mesh.triangle_count() as u64,
+        corner_params && mesh.corner_params.is_some(),
+    )
+    .unwrap_or(0);
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("writing {msg} {wide_bar} {bytes}/~{total_bytes} [{elapsed}]")
+            .expect("static template"),
+    );
+    bar.set_message(out.display().to_string());
+    let written = tessera::io::write_mesh_with_progress(mesh, out, &mut |bytes| {
+        // The OBJ estimate is a typical line length: never let the bar run past its end.
+        bar.set_length(bar.length().unwrap_or(0).max(bytes));
+        bar.set_position(bytes);
+    });
+    bar.finish_and_clear();
+    written
 }
 
 /// What is wrong with the output that was not wrong with the input. Culled patches leave

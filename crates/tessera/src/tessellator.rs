@@ -134,8 +134,12 @@ pub struct Tessellator<'a> {
     /// The last frame's plan, valid when `planned_ok`; its buffers are reused.
     planned: Planned,
     planned_ok: bool,
+    /// A frame was planned and laid out and not written yet.
+    laid_out: bool,
     scratch: PlanScratch,
     timings: FrameTimings,
+    /// The planning stages' times of the frame being planned, until it is written.
+    pending: FrameTimings,
     mesh: Mesh,
     /// The vectorized evaluation's per-set tables, kept from frame to frame.
     fast: FastEvaluator<'a>,
@@ -165,8 +169,10 @@ impl<'a> Tessellator<'a> {
             layout: Layout::default(),
             planned: Planned::default(),
             planned_ok: false,
+            laid_out: false,
             scratch: PlanScratch::default(),
             timings: FrameTimings::default(),
+            pending: FrameTimings::default(),
             mesh: Mesh::default(),
             fast,
         })
@@ -174,11 +180,22 @@ impl<'a> Tessellator<'a> {
 
     /// Tessellates one frame seen from `camera` (None for criteria and options that need no
     /// camera) into the tessellator's own buffers, reused from the last frame, and returns
-    /// them. Cost: the plan's (see [`Scheme::plan`]) plus O(output), parallel.
+    /// them: [`Tessellator::plan_frame`] then [`Tessellator::write_frame`]. Cost: the plan's
+    /// (see [`Scheme::plan`]) plus O(output), parallel.
     pub fn frame(&mut self, camera: Option<&Camera>) -> Result<&Mesh> {
+        self.plan_frame(camera)?;
+        self.write_frame()
+    }
+
+    /// The first half of [`Tessellator::frame`]: plans the frame from `camera` and lays out
+    /// its output, so a caller knows the exact vertex and triangle counts (and can say how
+    /// long the write will take, or refuse it) before anything of the output's size exists.
+    /// Cost: the plan's plus the layout's (O(E + P)).
+    pub fn plan_frame(&mut self, camera: Option<&Camera>) -> Result<&Layout> {
         let options = PlanOptions { camera: camera.copied(), ..self.options.plan };
         let start = Instant::now();
         self.planned_ok = false;
+        self.laid_out = false;
         self.scheme.plan_into(
             self.set,
             &self.prepared,
@@ -193,8 +210,28 @@ impl<'a> Tessellator<'a> {
         let planning = start.elapsed();
         let start = Instant::now();
         self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
-        let layout = start.elapsed();
+        self.laid_out = true;
+        self.pending = FrameTimings {
+            criterion,
+            // Whatever planning did besides the criterion counts as resolving.
+            resolve: planning.saturating_sub(criterion).max(resolve),
+            layout: start.elapsed(),
+            ..FrameTimings::default()
+        };
+        Ok(&self.layout)
+    }
+
+    /// The second half of [`Tessellator::frame`]: writes the frame that
+    /// [`Tessellator::plan_frame`] laid out into the tessellator's buffers and returns them.
+    ///
+    /// Errors: [`crate::Error::PlanMismatch`] when no frame was planned and laid out since the
+    /// last write; the engine's otherwise. Cost: O(output), parallel.
+    pub fn write_frame(&mut self) -> Result<&Mesh> {
+        if !std::mem::take(&mut self.laid_out) {
+            return Err(crate::Error::PlanMismatch { what: "write_frame without a planned frame".into() });
+        }
         let start = Instant::now();
+        let planned = &self.planned;
         self.fast.retarget(&planned.plan);
         self.fast.fill_patterns(&planned.plan, &planned.pattern, self.layout.triangle_count() as u64);
         let filled = start.elapsed();
@@ -209,16 +246,12 @@ impl<'a> Tessellator<'a> {
             &mut self.mesh,
             fast,
         )?;
-        let write = start.elapsed();
         self.timings = FrameTimings {
             // The pattern cache's fill counts with the vertices, whose pass uses it first.
             write_vertices: filled + written.vertices,
             write_indices: written.indices,
-            criterion,
-            // Whatever planning did besides the criterion counts as resolving.
-            resolve: planning.saturating_sub(criterion).max(resolve),
-            layout,
-            write,
+            write: start.elapsed(),
+            ..self.pending
         };
         Ok(&self.mesh)
     }

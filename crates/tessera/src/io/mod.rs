@@ -220,44 +220,81 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 /// triangle patch per triangle, `corner_params` parallel to `indices`, indices in range, finite
 /// numbers); otherwise [`Error::InvalidMesh`], checked before the file is created. An
 /// unknown or missing extension is [`Error::UnknownFormat`] naming it and the supported list.
-/// I/O failures are [`Error::Write`] naming `path`; a failure part-way leaves a partial file.
+/// I/O failures are [`Error::Write`] naming `path`.
 ///
-/// An existing regular file is overwritten in place and then cut to the new length, rather
-/// than emptied first: on tmpfs, freeing and allocating the pages again made writing a
-/// 60 MB file over itself several times slower than the copy.
+/// The file appears whole or not at all: the bytes go to a hidden temporary file beside
+/// `path` (`.NAME.tessera-partial-PID`), renamed over `path` once complete, so a failure
+/// part-way (a full disk, an error) leaves `path` as it was and removes the temporary file.
+/// A run killed part-way leaves its temporary file, never a truncated `path`. A `path` that
+/// exists and is a device or a pipe (`/dev/null`) is written directly.
 ///
 /// Cost: O(vertices + triangles) time, formatted in parallel on the rayon threads (the bytes
 /// do not depend on the thread count); memory: a 64 KiB buffer and a few MiB of chunk buffers,
 /// plus the GLB JSON (a few KiB, independent of the mesh size).
 pub fn write_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
+    write_mesh_with_progress(mesh, path, &mut |_| {})
+}
+
+/// [`write_mesh`], calling `progress` with the bytes written so far after every buffered
+/// write (every 64 KiB or so), for a progress bar; [`estimated_file_bytes`] is the total to
+/// expect. Cost: as [`write_mesh`].
+pub fn write_mesh_with_progress(mesh: &Mesh, path: &Path, progress: &mut dyn FnMut(u64)) -> Result<()> {
     let format = Format::from_path(path)?;
     let prepared = prepare(mesh, format)?;
     let write_error = |source| Error::Write { path: path.to_path_buf(), source };
-    let file = std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(path)
-        .map_err(write_error)?;
-    let mut counted = Counted { inner: &file, bytes: 0 };
-    emit(mesh, &prepared, &mut counted).map_err(write_error)?;
-    // Only a regular file has a length to cut (not a pipe or a device).
-    if file.metadata().map_err(write_error)?.is_file() {
-        file.set_len(counted.bytes).map_err(write_error)?;
+    // A device or pipe cannot be renamed over; a folder is left to the rename to refuse.
+    let direct = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    let target = if direct { path.to_path_buf() } else { partial_path(path) };
+    let written = (|| {
+        let file = std::fs::OpenOptions::new().write(true).create(true).truncate(!direct).open(&target)?;
+        let mut counted = Counted { inner: &file, bytes: 0, progress };
+        emit(mesh, &prepared, &mut counted)
+    })();
+    let finished = written.and_then(|()| if direct { Ok(()) } else { std::fs::rename(&target, path) });
+    if finished.is_err() && !direct {
+        let _ = std::fs::remove_file(&target);
     }
-    Ok(())
+    finished.map_err(write_error)
 }
 
-/// A writer that counts the bytes it passes on.
-struct Counted<W> {
+/// The hidden temporary file [`write_mesh`] writes before renaming it to `path`: in the same
+/// folder, so the rename never crosses a file system.
+fn partial_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.tessera-partial-{}", std::process::id()))
+}
+
+/// About how many bytes [`write_mesh`] writes for a mesh of `vertices` and `triangles` (with
+/// corner parameters when `corner_params`) to `path`, by the extension: exact up to the
+/// headers for the binary formats, a typical line length for OBJ text. For messages and
+/// progress bars, not for allocation. Unknown extensions give `None`. Cost: O(1).
+pub fn estimated_file_bytes(path: &Path, vertices: u64, triangles: u64, corner_params: bool) -> Option<u64> {
+    let params = if corner_params { 1 } else { 0 };
+    let (per_vertex, per_triangle) = match Format::from_path(path).ok()? {
+        // "v x y z", "vn x y z", "vt u v" with ~9 significant digits, "f a//a b//b c//c".
+        Format::Obj => (100, 40),
+        // position, normal, uv (f32) and patch (u32); count byte, 3 indices, patch, patch_uv.
+        Format::Ply => (36, 17 + params * 25),
+        // normal, 3 corners and the attribute count.
+        Format::Stl => (0, 50),
+        // POSITION, NORMAL, _PATCH_UV, _PATCH; indices, triangle patch, corner params.
+        Format::Glb => (36, 16 + params * 24),
+    };
+    Some(vertices * per_vertex + triangles * per_triangle)
+}
+
+/// A writer that counts the bytes it passes on and reports them.
+struct Counted<'p, W> {
     inner: W,
     bytes: u64,
+    progress: &'p mut dyn FnMut(u64),
 }
 
-impl<W: Write> Write for Counted<W> {
+impl<W: Write> Write for Counted<'_, W> {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         let n = self.inner.write(buf)?;
         self.bytes += n as u64;
+        (self.progress)(self.bytes);
         Ok(n)
     }
     fn flush(&mut self) -> io::Result<()> {

@@ -51,6 +51,88 @@ impl Mesh {
     pub fn triangle(&self, t: usize) -> [u32; 3] {
         [self.indices[3 * t], self.indices[3 * t + 1], self.indices[3 * t + 2]]
     }
+
+    /// Removes the vertices no triangle (and no strip) refers to, keeping the others in
+    /// their order, and renumbers `indices` and `strips`; returns how many were removed.
+    ///
+    /// The engine's numbering rule gives every corner of the set a vertex and every edge a
+    /// patch sees its samples (see [`crate::engine::layout`]), so a frame that culls patches
+    /// keeps the corners (and normal variants) only culled patches use: harmless to a
+    /// renderer, but a written file should hold only what it draws, and its vertex count
+    /// should be what other tools count. Call this before writing a culled mesh.
+    ///
+    /// Preconditions: indices in range (strips' [`strips::RESTART`] markers aside).
+    ///
+    /// Cost: O(vertices + indices) time, one `u32` per vertex of scratch; nothing is moved
+    /// when every vertex is used.
+    pub fn drop_unused_vertices(&mut self) -> usize {
+        let n = self.positions.len();
+        let mut new_index = vec![u32::MAX; n];
+        let strip_indices = self.strips.iter().flatten().filter(|&&i| i != strips::RESTART);
+        for &i in self.indices.iter().chain(strip_indices) {
+            new_index[i as usize] = 0;
+        }
+        let mut kept = 0u32;
+        for slot in new_index.iter_mut().filter(|slot| **slot == 0) {
+            *slot = kept;
+            kept += 1;
+        }
+        let removed = n - kept as usize;
+        if removed == 0 {
+            return 0;
+        }
+        fn keep<T: Copy>(values: &mut Vec<T>, new_index: &[u32]) {
+            let mut next = 0;
+            for old in 0..values.len().min(new_index.len()) {
+                if new_index[old] != u32::MAX {
+                    values[next] = values[old];
+                    next += 1;
+                }
+            }
+            values.truncate(next);
+        }
+        keep(&mut self.positions, &new_index);
+        keep(&mut self.normals, &new_index);
+        keep(&mut self.uvs, &new_index);
+        keep(&mut self.vertex_patch, &new_index);
+        for i in self.indices.iter_mut() {
+            *i = new_index[*i as usize];
+        }
+        for i in self.strips.iter_mut().flatten().filter(|i| **i != strips::RESTART) {
+            *i = new_index[*i as usize];
+        }
+        removed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drop_unused_vertices_keeps_order_attributes_and_strips() {
+        let mut mesh = Mesh {
+            positions: (0..6).map(|i| [i as f32, 0.0, 0.0]).collect(),
+            normals: (0..6).map(|i| [0.0, i as f32, 1.0]).collect(),
+            uvs: (0..6).map(|i| [i as f32, 1.0]).collect(),
+            vertex_patch: vec![0, 1, 2, 3, 4, 5],
+            indices: vec![1, 3, 4, 4, 3, 5],
+            triangle_patch: vec![7, 8],
+            strips: Some(vec![1, 3, 4, 5, strips::RESTART, 4, 3, 5]),
+            ..Default::default()
+        };
+        assert_eq!(mesh.drop_unused_vertices(), 2);
+        assert_eq!(mesh.positions, vec![[1.0, 0.0, 0.0], [3.0, 0.0, 0.0], [4.0, 0.0, 0.0], [5.0, 0.0, 0.0]]);
+        assert_eq!(mesh.normals[1], [0.0, 3.0, 1.0]);
+        assert_eq!(mesh.uvs[3], [5.0, 1.0]);
+        assert_eq!(mesh.vertex_patch, vec![1, 3, 4, 5]);
+        assert_eq!(mesh.indices, vec![0, 1, 2, 2, 1, 3]);
+        assert_eq!(mesh.strips, Some(vec![0, 1, 2, 3, strips::RESTART, 2, 1, 3]));
+        assert_eq!(mesh.triangle_patch, vec![7, 8]);
+        let before = mesh.clone();
+        assert_eq!(mesh.drop_unused_vertices(), 0);
+        assert_eq!(mesh, before);
+    }
 }
 
 pub mod strips;
