@@ -16,7 +16,7 @@ use tessera::mesh::Mesh;
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
-use tessera_render::{gpu, ColorMode, Image, RenderOptions};
+use tessera_render::{gpu, ColorMode, Drawing, Image, RenderError, RenderOptions, UncapturedErrors};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
@@ -69,6 +69,10 @@ pub struct RenderArgs {
     /// Renderer.
     #[arg(long, value_enum, default_value = "auto")]
     renderer: RendererArg,
+    /// Caps each storage binding of the uploaded mesh at N bytes (below the adapter's own
+    /// limit), so the split into parts can be tested on a small mesh.
+    #[arg(long, value_name = "N", hide = true)]
+    max_binding_bytes: Option<u64>,
     #[command(flatten)]
     input_args: crate::InputArgs,
 }
@@ -114,12 +118,27 @@ pub struct Drawn {
     pub draw_seconds: f64,
 }
 
-/// Opens a GPU adapter for `choice`: None for the CPU rasteriser, with the reason.
-fn context(choice: RendererArg) -> Result<Result<GpuContext, String>, GpuError> {
+/// A device for the wgpu renderer, with the errors wgpu reports outside the renderer's error
+/// scopes recorded instead of panicking (checked after each picture).
+pub struct Device {
+    pub ctx: GpuContext,
+    errors: UncapturedErrors,
+}
+
+impl Device {
+    fn new() -> Result<Device, GpuError> {
+        let ctx = GpuContext::new()?;
+        let errors = UncapturedErrors::install(&ctx.device);
+        Ok(Device { ctx, errors })
+    }
+}
+
+/// Opens a GPU adapter for `choice`: Err for the CPU rasteriser, with the reason.
+fn context(choice: RendererArg) -> Result<Result<Device, String>, GpuError> {
     match choice {
         RendererArg::Cpu => Ok(Err("--renderer cpu".into())),
-        RendererArg::Wgpu => GpuContext::new().map(Ok),
-        RendererArg::Auto => Ok(GpuContext::new().map_err(|e| match e {
+        RendererArg::Wgpu => Device::new().map(Ok),
+        RendererArg::Auto => Ok(Device::new().map_err(|e| match e {
             GpuError::NoAdapter { .. } => format!(
                 "no GPU adapter on this machine; `{}` installs a software one",
                 tessera_gpu::SOFTWARE_DRIVER_PACKAGES
@@ -129,53 +148,89 @@ fn context(choice: RendererArg) -> Result<Result<GpuContext, String>, GpuError> 
     }
 }
 
+/// Refuses an image size the renderer that will draw it cannot take (the adapter's texture
+/// limit, the memory caps: `tessera_render::check_image_size`, which `tessera view` calls
+/// too), before the tessellation and before anything of that size is allocated.
+fn check_size(camera: &Camera, device: &Result<Device, String>, samples: u32) -> Result<(), RenderError> {
+    let drawing = match device {
+        Ok(d) => Drawing::Gpu { limits: &d.ctx.limits, samples },
+        Err(_) => Drawing::Cpu,
+    };
+    tessera_render::check_image_size(camera.width, camera.height, drawing).map(|_| ())
+}
+
 fn wgpu_name(ctx: &GpuContext) -> String {
     format!("the wgpu renderer on {} ({:?})", ctx.info.name, ctx.info.backend)
 }
 
-/// Draws a CPU mesh: uploaded to the wgpu renderer, or rasterised on the CPU.
-pub fn draw_mesh(
+/// Uploads `mesh` (in parts where it exceeds a binding) and draws it with the wgpu renderer.
+fn draw_uploaded(
+    device: &Device,
+    mesh: &Mesh,
+    levels: &[f32],
+    camera: &Camera,
+    options: &RenderOptions,
+    samples: u32,
+    max_binding: u64,
+) -> Result<Drawn, RenderError> {
+    let ctx = &device.ctx;
+    let buffers = gpu::MeshBuffers::upload_within(ctx, mesh, levels, max_binding)?;
+    ctx.wait()?;
+    let start = Instant::now();
+    let image = gpu::render(ctx, &buffers.geometries(), camera, options, samples)?;
+    device.errors.check()?;
+    let parts = match buffers.part_count() {
+        1 => String::new(),
+        n => format!(", the mesh in {n} parts within the adapter's binding limit"),
+    };
+    Ok(Drawn {
+        image,
+        renderer: format!("{}{parts}", wgpu_name(ctx)),
+        draw_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Draws a CPU mesh: uploaded to the wgpu renderer on `device`, or rasterised on the CPU
+/// (no device, for the reason given; or under `--renderer auto` when the wgpu renderer fails,
+/// saying so). `max_binding` caps each storage binding of the upload (u64::MAX: the
+/// adapter's limits).
+#[allow(clippy::too_many_arguments)]
+fn draw_mesh(
+    device: &Result<Device, String>,
     mesh: &Mesh,
     levels: &[f32],
     camera: &Camera,
     options: &RenderOptions,
     samples: u32,
     choice: RendererArg,
+    max_binding: u64,
 ) -> Result<Drawn, Box<dyn std::error::Error>> {
-    match context(choice)? {
-        Ok(ctx) => {
-            let buffers = gpu::MeshBuffers::upload(&ctx, mesh, levels);
-            ctx.wait()?;
-            let start = Instant::now();
-            let image = gpu::render(&ctx, &buffers.geometry(), camera, options, samples)?;
-            Ok(Drawn { image, renderer: wgpu_name(&ctx), draw_seconds: start.elapsed().as_secs_f64() })
-        }
-        Err(why) => {
-            // WebGPU's default texture limit: past it the rasteriser's buffers (20 bytes a
-            // pixel) would take gigabytes.
-            const MAX_SIDE: u32 = 8192;
-            if camera.width > MAX_SIDE || camera.height > MAX_SIDE {
-                return Err(format!(
-                    "image size {}x{}: the CPU rasteriser draws at most {MAX_SIDE} pixels a side",
-                    camera.width, camera.height
-                )
-                .into());
+    let why = match device {
+        Ok(device) => match draw_uploaded(device, mesh, levels, camera, options, samples, max_binding) {
+            Ok(drawn) => return Ok(drawn),
+            Err(e @ RenderError::Wgpu { .. }) if choice == RendererArg::Auto => {
+                eprintln!("warning: {e}; drawing with the CPU rasteriser instead (--renderer auto)");
+                format!("the wgpu renderer failed: {e}")
             }
-            let start = Instant::now();
-            let image = tessera_render::cpu::render(mesh, camera, options, levels);
-            Ok(Drawn {
-                image,
-                renderer: format!("tessera's CPU rasteriser ({why})"),
-                draw_seconds: start.elapsed().as_secs_f64(),
-            })
-        }
-    }
+            Err(e) => return Err(e.into()),
+        },
+        Err(why) => why.clone(),
+    };
+    let start = Instant::now();
+    let image = tessera_render::cpu::render(mesh, camera, options, levels)?;
+    Ok(Drawn {
+        image,
+        renderer: format!("tessera's CPU rasteriser ({why})"),
+        draw_seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// Tessellates `plan` on the GPU and draws the engine's buffers directly (`--engine gpu`).
 /// Patch and level colours read the triangles' patches back once (the engine keeps no
 /// per-triangle patch buffer); the shaded picture reads nothing back before the image.
+#[allow(clippy::too_many_arguments)]
 fn draw_gpu_engine(
+    device: &Device,
     set: &SurfaceSet,
     plan: &Plan,
     pattern: &dyn tessera::pattern::Pattern,
@@ -184,13 +239,22 @@ fn draw_gpu_engine(
     options: &RenderOptions,
     samples: u32,
 ) -> Result<(Drawn, usize), Box<dyn std::error::Error>> {
-    let ctx = GpuContext::new()?;
-    let mut engine = GpuTessellator::new(&ctx, set)?;
-    engine.prepare(&ctx, set, plan, pattern)?;
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    engine.record(&mut encoder);
-    ctx.queue.submit([encoder.finish()]);
-    let (overflow, _, triangles) = engine.read_status(&ctx)?;
+    let ctx = &device.ctx;
+    let scoped =
+        |what, f: &mut dyn FnMut() -> Result<(), GpuError>| -> Result<(), Box<dyn std::error::Error>> {
+            tessera_render::scoped(&ctx.device, what, f)??;
+            Ok(())
+        };
+    let mut engine =
+        tessera_render::scoped(&ctx.device, "making the GPU engine", || GpuTessellator::new(ctx, set))??;
+    scoped("preparing the GPU engine", &mut || engine.prepare(ctx, set, plan, pattern))?;
+    scoped("tessellating on the GPU", &mut || {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        engine.record(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    })?;
+    let (overflow, _, triangles) = engine.read_status(ctx)?;
     if overflow {
         return Err("the GPU engine's output overflowed its buffers".into());
     }
@@ -198,23 +262,25 @@ fn draw_gpu_engine(
         use wgpu::util::DeviceExt;
         let mut data = data.to_vec();
         data.resize(data.len().max(16), 0);
-        ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: &data,
-            usage: wgpu::BufferUsages::STORAGE,
+        tessera_render::scoped(&ctx.device, "uploading the patches", || {
+            ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &data,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
         })
     };
     let patches = match options.color {
         ColorMode::Shaded => None,
         _ => {
-            let (_, _, offsets) = engine.read_layout(&ctx)?;
+            let (_, _, offsets) = engine.read_layout(ctx)?;
             Some(use_upload(
                 bytemuck::cast_slice(&tessera_render::triangle_patches(&offsets)),
                 "triangle patches",
-            ))
+            )?)
         }
     };
-    let level_buffer = use_upload(bytemuck::cast_slice(levels), "patch levels");
+    let level_buffer = use_upload(bytemuck::cast_slice(levels), "patch levels")?;
     let (Some(vertices), Some(indices)) = (engine.vertex_buffer(), engine.index_buffer()) else {
         return Err("the GPU engine has no output buffers".into());
     };
@@ -226,8 +292,9 @@ fn draw_gpu_engine(
         patch_level: Some(&level_buffer),
     };
     let start = Instant::now();
-    let image = gpu::render(&ctx, &geometry, camera, options, samples)?;
-    let drawn = Drawn { image, renderer: wgpu_name(&ctx), draw_seconds: start.elapsed().as_secs_f64() };
+    let image = gpu::render(ctx, &[geometry], camera, options, samples)?;
+    device.errors.check()?;
+    let drawn = Drawn { image, renderer: wgpu_name(ctx), draw_seconds: start.elapsed().as_secs_f64() };
     Ok((drawn, triangles as usize))
 }
 
@@ -246,6 +313,11 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
     let mut chosen = plan::choose(&a.criterion, &set, engine_options.max_triangles.unwrap_or(u64::MAX))?;
     let camera = camera(&a, &set)?;
     chosen.options.camera = Some(camera);
+    if a.engine == "gpu" && a.renderer == RendererArg::Cpu {
+        return Err("--engine gpu draws the GPU engine's buffers: it needs --renderer wgpu or auto".into());
+    }
+    let device = if a.engine == "gpu" { Ok(Device::new()?) } else { context(a.renderer)? };
+    check_size(&camera, &device, a.msaa)?;
     let start = Instant::now();
     let mut tess = Tessellator::new(
         &set,
@@ -265,17 +337,18 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
             ColorArg::Level => ColorMode::Level,
         },
     };
-    let (drawn, triangles) = if a.engine == "gpu" {
-        if a.renderer == RendererArg::Cpu {
-            return Err(
-                "--engine gpu draws the GPU engine's buffers: it needs --renderer wgpu or auto".into()
-            );
+    let (drawn, triangles) = match &device {
+        Ok(device) if a.engine == "gpu" => {
+            let pattern = tess.pattern().expect("a frame was planned");
+            draw_gpu_engine(device, &set, plan, pattern, &levels, &camera, &render_options, a.msaa)?
         }
-        let pattern = tess.pattern().expect("a frame was planned");
-        draw_gpu_engine(&set, plan, pattern, &levels, &camera, &render_options, a.msaa)?
-    } else {
-        let mesh = tess.mesh();
-        (draw_mesh(mesh, &levels, &camera, &render_options, a.msaa, a.renderer)?, mesh.triangle_count())
+        _ => {
+            let mesh = tess.mesh();
+            let max_binding = a.max_binding_bytes.unwrap_or(u64::MAX);
+            let drawn =
+                draw_mesh(&device, mesh, &levels, &camera, &render_options, a.msaa, a.renderer, max_binding)?;
+            (drawn, mesh.triangle_count())
+        }
     };
     drawn.image.write_png(&a.output)?;
     eprintln!(
@@ -429,7 +502,8 @@ pub fn demo_picture(set: &SurfaceSet, path: &Path) -> Result<String, Box<dyn std
     tess.frame(Some(&camera))?;
     let mesh = tess.mesh();
     let render_options = RenderOptions { wireframe: true, color: ColorMode::Shaded };
-    let drawn = draw_mesh(mesh, &[], &camera, &render_options, 4, RendererArg::Auto)?;
+    let device = context(RendererArg::Auto)?;
+    let drawn = draw_mesh(&device, mesh, &[], &camera, &render_options, 4, RendererArg::Auto, u64::MAX)?;
     drawn.image.write_png(path)?;
     Ok(format!(
         "{} ({}x{}, {} triangles, {}, adaptive at 0.5 px from the default camera), drawn by {} in {:.0} ms",

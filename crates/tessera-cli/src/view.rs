@@ -2,7 +2,9 @@
 //! every frame from the camera — on the GPU engine where it draws the scheme, else on the CPU
 //! engine, uploaded — and draws it with tessera-render's pipeline, with a statistics line.
 //! The semi-uniform scheme is drawn on the GPU by the instanced path
-//! (`tessera_render::instanced`: render queues on the GPU, one instanced draw per level).
+//! (`tessera_render::instanced`: render queues on the GPU, one instanced draw per level); the
+//! hardware schemes (fractional-odd, integer), which take no pixel error, at the factor the
+//! uniform scheme needs for it.
 //!
 //! Keys: S scheme, + / - pixel error ×2 / ÷2, W wireframe, L level colours, P patch colours,
 //! C culling, E engine (gpu / cpu), arrows orbit, Q or Esc quit. Mouse: drag to orbit, wheel to
@@ -29,7 +31,7 @@ use tessera_gpu::tessellator::{PassTimer, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
 use tessera_render::instanced::InstancedDraw;
 use tessera_render::overlay::Overlay;
-use tessera_render::{gpu, ColorMode, RenderOptions, Renderer};
+use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, Renderer, UncapturedErrors};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -44,7 +46,9 @@ pub struct ViewArgs {
     /// Starting screen-space error in pixels (keys + and - change it).
     #[arg(long, value_name = "P", default_value_t = 1.0)]
     pixel_error: f64,
-    /// Starting scheme (key S cycles through the schemes that take a pixel error).
+    /// Starting scheme, one of those key S cycles through: transition, uniform, semi-uniform
+    /// (adaptive to the pixel error), fractional-odd, integer (the hardware tessellator at one
+    /// factor: the uniform scheme's for the pixel error).
     #[arg(long, value_enum)]
     scheme: Option<plan::SchemeArg>,
     /// Window size.
@@ -63,7 +67,8 @@ pub struct ViewArgs {
     input_args: crate::InputArgs,
 }
 
-/// The schemes key S cycles through (those that take a pixel error are kept).
+/// The schemes key S cycles through and `--scheme` starts in: those taking a pixel error, and
+/// the hardware tessellator at the factor derived from it ([`criterion_for`]).
 const SCHEMES: [Scheme; 5] = [
     Scheme::Transition,
     Scheme::Uniform,
@@ -103,7 +108,10 @@ struct State {
     scratch: PlanScratch,
     planned: Planned,
     cpu: Option<Tessellator<'static>>,
+    /// The scheme, the criterion's bits and culling the CPU tessellator was made for.
     cpu_key: (usize, u64, bool),
+    /// wgpu errors outside the renderer's scopes, recorded instead of panicking.
+    errors: UncapturedErrors,
     /// The instanced semi-uniform draw (paper 000), made on first use; Err once it cannot
     /// draw this set (mixed domains), then the CPU engine draws semi-uniform.
     instanced: Option<Result<InstancedDraw, String>>,
@@ -111,6 +119,7 @@ struct State {
 
 struct App {
     set: &'static SurfaceSet,
+    instance: wgpu::Instance,
     args: ViewArgs,
     size: (u32, u32),
     settings: Settings,
@@ -125,12 +134,14 @@ struct App {
 
 const SAMPLES: u32 = 4;
 
+/// The window's multisampled colour and depth attachments. Errors: [`RenderError::Wgpu`]
+/// when the device cannot make them (the size was checked by [`check_size`]).
 fn attachments(
     ctx: &GpuContext,
     format: wgpu::TextureFormat,
     w: u32,
     h: u32,
-) -> (wgpu::Texture, wgpu::Texture) {
+) -> Result<(wgpu::Texture, wgpu::Texture), RenderError> {
     let make = |format| {
         ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("view attachment"),
@@ -143,7 +154,23 @@ fn attachments(
             view_formats: &[],
         })
     };
-    (make(format), make(gpu::DEPTH_FORMAT))
+    tessera_render::scoped(&ctx.device, "making the window's attachments", || {
+        (make(format), make(gpu::DEPTH_FORMAT))
+    })
+}
+
+/// Refuses a window size the renderer cannot draw on this device: the one check `tessera
+/// render` makes too (`tessera_render::check_image_size`), before anything of that size
+/// (the window included) is made.
+fn check_size(limits: &wgpu::Limits, width: u32, height: u32, screenshot: bool) -> Result<(), RenderError> {
+    let drawing = Drawing::Window { limits, samples: SAMPLES, screenshot };
+    tessera_render::check_image_size(width, height, drawing).map(|_| ())
+}
+
+/// The error for a machine where wgpu finds no adapter or cannot make a surface on any
+/// backend: it names the packages of the software driver, as `render` and `mesh` do.
+fn no_adapter(e: &dyn std::fmt::Display) -> GpuError {
+    GpuError::NoAdapter { reason: e.to_string() }
 }
 
 impl App {
@@ -154,14 +181,14 @@ impl App {
             .with_title(format!("tessera view {}", self.args.input.display()))
             .with_inner_size(PhysicalSize::new(self.size.0, self.size.1));
         let window = Arc::new(event_loop.create_window(attributes)?);
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let surface = instance.create_surface(window.clone())?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        // No surface on any backend means no Vulkan driver (the only backend built in).
+        let surface = self.instance.create_surface(window.clone()).map_err(|e| no_adapter(&e))?;
+        let adapter = pollster::block_on(self.instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: Some(&surface),
             ..Default::default()
         }))
-        .map_err(|e| GpuError::NoAdapter { reason: e.to_string() })?;
+        .map_err(|e| no_adapter(&e))?;
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
         let limits = adapter.limits();
@@ -179,7 +206,9 @@ impl App {
             limits,
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
         };
+        let errors = UncapturedErrors::install(&ctx.device);
         let size = window.inner_size();
+        check_size(&ctx.limits, size.width, size.height, self.args.screenshot.is_some())?;
         let mut config = surface
             .get_default_config(&adapter, size.width.max(1), size.height.max(1))
             .ok_or("the window's surface does not work with this adapter")?;
@@ -194,11 +223,16 @@ impl App {
             }
             config.usage |= wgpu::TextureUsages::COPY_SRC;
         }
-        surface.configure(&ctx.device, &config);
+        tessera_render::scoped(&ctx.device, "configuring the window's surface", || {
+            surface.configure(&ctx.device, &config)
+        })?;
         let renderer = Renderer::new(&ctx, config.format, SAMPLES)?;
-        let overlay = Overlay::new(&ctx, config.format);
-        let msaa = attachments(&ctx, config.format, config.width, config.height);
-        let engine = GpuTessellator::new(&ctx, self.set)?;
+        let overlay =
+            tessera_render::scoped(&ctx.device, "making the overlay", || Overlay::new(&ctx, config.format))?;
+        let msaa = attachments(&ctx, config.format, config.width, config.height)?;
+        let engine = tessera_render::scoped(&ctx.device, "making the GPU engine", || {
+            GpuTessellator::new(&ctx, self.set)
+        })??;
         let timer = PassTimer::new(&ctx);
         let criterion = Criterion::PixelError(self.settings.pixel_error);
         Ok(State {
@@ -215,6 +249,7 @@ impl App {
             planned: Planned::default(),
             cpu: None,
             cpu_key: (usize::MAX, 0, false),
+            errors,
             instanced: None,
             ctx,
         })
@@ -251,7 +286,6 @@ impl App {
         let set = self.set;
         let settings = &self.settings;
         let scheme = SCHEMES[settings.scheme];
-        let criterion = Criterion::PixelError(settings.pixel_error);
         let options = PlanOptions {
             camera: Some(camera),
             cull: settings.cull,
@@ -259,6 +293,7 @@ impl App {
             ..Default::default()
         };
         let start = Instant::now();
+        let criterion = criterion_for(scheme, settings.pixel_error, set, state, &options)?;
         // The GPU engine draws the uniform and transition schemes; anything it refuses is
         // tessellated on the CPU this frame.
         let mut on_gpu = false;
@@ -317,7 +352,11 @@ impl App {
             triangles = None;
             upload = None;
         } else {
-            let key = (settings.scheme, settings.pixel_error.to_bits(), settings.cull);
+            let bits = match criterion {
+                Criterion::Factor(f) => f.to_bits(),
+                _ => settings.pixel_error.to_bits(),
+            };
+            let key = (settings.scheme, bits, settings.cull);
             if state.cpu.is_none() || state.cpu_key != key {
                 let options = TessellatorOptions { plan: options, engine: crate::limits(None, false) };
                 state.cpu = Some(Tessellator::new(set, scheme, criterion, options)?);
@@ -336,7 +375,7 @@ impl App {
                 ms(t.write)
             );
             levels = tessera_render::patch_levels(tess.plan().expect("a frame"), self.args.max_factor);
-            upload = Some(gpu::MeshBuffers::upload(&state.ctx, tess.mesh(), &levels));
+            upload = Some(gpu::MeshBuffers::upload(&state.ctx, tess.mesh(), &levels)?);
             triangles = Some(count);
         }
         let frame = match state.surface.get_current_texture() {
@@ -357,8 +396,8 @@ impl App {
                 usage: wgpu::BufferUsages::STORAGE,
             });
         }
-        let geometry = match &upload {
-            Some(buffers) => Some(buffers.geometry()),
+        let parts = match &upload {
+            Some(buffers) => Some(buffers.geometries()),
             None if instanced => None,
             None => {
                 let (Some(vertices), Some(indices)) =
@@ -366,7 +405,7 @@ impl App {
                 else {
                     return Ok(());
                 };
-                Some(gpu::Geometry {
+                Some(vec![gpu::Geometry {
                     vertices,
                     indices,
                     indexed_args: state.engine.indirect_buffer(),
@@ -374,7 +413,7 @@ impl App {
                     // every frame (a read-back): they are drawn from the CPU engine instead.
                     triangle_patch: None,
                     patch_level: Some(&level_buffer),
-                })
+                }])
             }
         };
         let colour = state.msaa.0.create_view(&Default::default());
@@ -391,17 +430,17 @@ impl App {
                 &depth,
             )?,
             _ => {
-                if let Some(geometry) = &geometry {
+                if let Some(parts) = &parts {
                     state.renderer.record(
                         &state.ctx,
                         &mut encoder,
                         &colour,
                         Some(&target),
                         &depth,
-                        geometry,
+                        parts,
                         &camera,
                         &options,
-                    )
+                    )?
                 }
             }
         }
@@ -421,6 +460,7 @@ impl App {
         state.ctx.queue.present(frame);
         // Statistics for the next frame's line (read back: see the module doc).
         state.ctx.wait()?;
+        state.errors.check()?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
         let triangles = match (triangles, &state.instanced) {
             (Some(t), _) => t as u64,
@@ -446,9 +486,13 @@ impl App {
         };
         let culled = state_culled(on_gpu || instanced, state);
         self.status = format!(
-            "{} {}PX / {} TRIS / {} PATCHES{} / {} ENGINE: {stages} / FRAME {frame_ms:.1} MS",
+            "{} {}PX{} / {} TRIS / {} PATCHES{} / {} ENGINE: {stages} / FRAME {frame_ms:.1} MS",
             scheme.name(),
             settings.pixel_error,
+            match criterion {
+                Criterion::Factor(f) => format!(" (FACTOR {f})"),
+                _ => String::new(),
+            },
             triangles,
             set.patches.len(),
             if settings.cull { format!(" ({culled} CULLED)") } else { String::new() },
@@ -457,6 +501,33 @@ impl App {
         self.frames += 1;
         Ok(())
     }
+}
+
+/// The criterion `scheme` is drawn with at `pixel_error`: the pixel error itself for the
+/// schemes that take one; for the hardware tessellator, which takes a factor and no error
+/// bound, the factor the uniform scheme needs for that pixel error from this camera (within
+/// the hardware's range and --max-factor), so + and - still refine and coarsen it.
+fn criterion_for(
+    scheme: Scheme,
+    pixel_error: f64,
+    set: &SurfaceSet,
+    state: &mut State,
+    options: &PlanOptions,
+) -> Result<Criterion, tessera::Error> {
+    let criterion = Criterion::PixelError(pixel_error);
+    if !matches!(scheme, Scheme::Hardware(_)) {
+        return Ok(criterion);
+    }
+    Scheme::Uniform.plan_into(
+        set,
+        &state.prepared,
+        &criterion,
+        options,
+        &mut state.scratch,
+        &mut state.planned,
+    )?;
+    let factor = state.planned.plan.segments.iter().copied().max().unwrap_or(1) as f64;
+    Ok(Criterion::Factor(factor.clamp(1.0, scheme.factor_cap().min(options.max_factor as f64))))
 }
 
 fn state_culled(on_gpu: bool, state: &State) -> usize {
@@ -469,8 +540,8 @@ fn state_culled(on_gpu: bool, state: &State) -> usize {
 }
 
 /// The keys, for `tessera view --help`.
-pub const KEYS: &str = "Keys: S scheme (transition, uniform, semi-uniform, fractional-odd, integer), + / - pixel \
-error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
+pub const KEYS: &str = "Keys: S scheme (transition, uniform, semi-uniform; fractional-odd, integer at the factor \
+the pixel error needs), + / - pixel error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
 arrows or mouse drag orbit, wheel zoom, Q or Esc quit. The window needs an X11 display (no Wayland backend; \
 XWayland works); headless: xvfb-run -a tessera view IN --frames N --screenshot OUT.png";
 
@@ -499,10 +570,25 @@ impl ApplicationHandler for App {
             WindowEvent::Resized(size) => {
                 if let Some(state) = self.state.as_mut() {
                     if size.width > 0 && size.height > 0 {
-                        state.config.width = size.width;
-                        state.config.height = size.height;
-                        state.surface.configure(&state.ctx.device, &state.config);
-                        state.msaa = attachments(&state.ctx, state.config.format, size.width, size.height);
+                        let screenshot = self.args.screenshot.is_some();
+                        let resized = check_size(&state.ctx.limits, size.width, size.height, screenshot)
+                            .and_then(|()| {
+                                state.config.width = size.width;
+                                state.config.height = size.height;
+                                tessera_render::scoped(
+                                    &state.ctx.device,
+                                    "resizing the window's surface",
+                                    || state.surface.configure(&state.ctx.device, &state.config),
+                                )?;
+                                attachments(&state.ctx, state.config.format, size.width, size.height)
+                            });
+                        match resized {
+                            Ok(msaa) => state.msaa = msaa,
+                            Err(e) => {
+                                self.error = Some(e.into());
+                                event_loop.exit();
+                            }
+                        }
                     }
                 }
             }
@@ -613,14 +699,25 @@ pub fn run(a: ViewArgs) -> crate::CliResult {
     let set: &'static SurfaceSet = Box::leak(Box::new(crate::load_surfaces(&a.input, options)?));
     let scheme = a.scheme.map(|s| s.scheme(None, false)).unwrap_or(Scheme::Transition);
     let first = SCHEMES.iter().position(|s| s.name() == scheme.name()).ok_or_else(|| {
-        format!("--scheme {}: the viewer cycles through transition, uniform, semi-uniform, fractional-odd and integer", scheme.name())
+        let names: Vec<&str> = SCHEMES.iter().map(|s| s.name()).collect();
+        format!("--scheme {}: the viewer shows {}", scheme.name(), names.join(", "))
     })?;
+    // The adapter's limits before any window exists: a refused size never reaches winit or
+    // wgpu (the surface's adapter is asked for again once there is a window to present to).
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let probe = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        ..Default::default()
+    }))
+    .map_err(|e| no_adapter(&e))?;
+    check_size(&probe.limits(), size.0, size.1, a.screenshot.is_some())?;
     let event_loop = EventLoop::new().map_err(|e| {
         format!("cannot open a window ({e}): the viewer needs an X11 display (DISPLAY); headless, run it under xvfb-run")
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         set,
+        instance,
         settings: Settings {
             scheme: first,
             pixel_error: a.pixel_error,

@@ -41,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut tess = Tessellator::new(&set, Scheme::default_for(&criterion), criterion, options)?;
     let mesh = tess.frame(Some(&camera))?.clone();
     let ctx = tessera_gpu::GpuContext::new()?;
-    let buffers = gpu::MeshBuffers::upload(&ctx, &mesh, &[]);
+    let buffers = gpu::MeshBuffers::upload(&ctx, &mesh, &[])?;
     let renderer = gpu::Renderer::new(&ctx, gpu::IMAGE_FORMAT, 4)?;
     let targets = gpu::Targets::new(&ctx, &renderer, w, h)?;
     let look = RenderOptions { wireframe: true, color: tessera_render::ColorMode::Shaded };
@@ -49,7 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..frames.max(1) {
         let start = Instant::now();
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        targets.draw(&ctx, &renderer, &mut encoder, &buffers.geometry(), &camera, &look);
+        targets.draw(&ctx, &renderer, &mut encoder, &buffers.geometries(), &camera, &look)?;
         ctx.queue.submit([encoder.finish()]);
         ctx.wait()?;
         draw.push(start.elapsed().as_secs_f64() * 1e3);

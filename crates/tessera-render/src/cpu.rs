@@ -10,17 +10,29 @@
 //! is, whenever an adapter exists.
 
 use crate::shading;
-use crate::{Image, RenderOptions};
+use crate::{Image, RenderError, RenderOptions};
 use glam::{Vec3, Vec4};
 use tessera::camera::Camera;
 use tessera::mesh::Mesh;
 
+/// The longest side the rasteriser draws: WebGPU's default texture limit. It is one thread,
+/// and its buffers take 20 bytes a pixel, so larger pictures would take minutes and
+/// gigabytes.
+pub const MAX_SIDE: u32 = 8192;
+
 /// Draws `mesh` seen from `camera` (its viewport is the image size) with `options`;
 /// `patch_level` gives each patch's level for [`crate::ColorMode::Level`] (may be empty).
 /// A pixel is covered when its centre lies inside a triangle (top-left rule not needed for
-/// a picture; shared edges may be drawn twice, with the nearer depth winning). Cost:
-/// O(V + Σ bounding-box pixels of the triangles), single-threaded.
-pub fn render(mesh: &Mesh, camera: &Camera, options: &RenderOptions, patch_level: &[f32]) -> Image {
+/// a picture; shared edges may be drawn twice, with the nearer depth winning). Errors:
+/// [`RenderError::ImageTooLarge`] from [`crate::check_image_size`], before any buffer is
+/// made. Cost: O(V + Σ bounding-box pixels of the triangles), single-threaded.
+pub fn render(
+    mesh: &Mesh,
+    camera: &Camera,
+    options: &RenderOptions,
+    patch_level: &[f32],
+) -> Result<Image, RenderError> {
+    crate::check_image_size(camera.width, camera.height, crate::Drawing::Cpu)?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let m = camera.view_projection().as_mat4();
     let (r, u, f) = camera.basis();
@@ -109,5 +121,5 @@ pub fn render(mesh: &Mesh, camera: &Camera, options: &RenderOptions, patch_level
             [q(c.x), q(c.y), q(c.z), 255]
         })
         .collect();
-    Image { width: camera.width, height: camera.height, rgba }
+    Ok(Image { width: camera.width, height: camera.height, rgba })
 }

@@ -65,30 +65,107 @@ pub struct Geometry<'a> {
 
 /// A CPU [`Mesh`] uploaded in the GPU engine's layout, with its own indexed draw arguments,
 /// so that [`Renderer`] draws it exactly as it draws the GPU engine's output.
+///
+/// A mesh whose vertices or indices would exceed one storage binding
+/// (`max_storage_buffer_binding_size`, or `max_buffer_size` where smaller) is uploaded in
+/// parts: runs of consecutive triangles, each with the vertices it uses renumbered from 0, so
+/// each part's buffers fit a binding wherever its triangles' vertices lie in the mesh. Drawn
+/// in order in one pass ([`MeshBuffers::geometries`]), the parts give the picture of the whole
+/// mesh pixel for pixel: the same triangles in the same order, the same per-triangle patches.
 #[derive(Debug)]
 pub struct MeshBuffers {
-    /// Vertices, [`tessera_gpu::VERTEX_LAYOUT`].
-    pub vertices: wgpu::Buffer,
-    /// Indices.
-    pub indices: wgpu::Buffer,
-    /// `[3 T, 1, 0, 0, 0]`.
-    pub indexed_args: wgpu::Buffer,
-    /// `mesh.triangle_patch`.
-    pub triangle_patch: wgpu::Buffer,
-    /// The patch levels given.
-    pub patch_level: wgpu::Buffer,
+    parts: Vec<MeshPart>,
+    patch_level: wgpu::Buffer,
+}
+
+/// One part of [`MeshBuffers`].
+#[derive(Debug)]
+struct MeshPart {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    /// `[3 T, 1, 0, 0, 0]` for the part's T triangles.
+    indexed_args: wgpu::Buffer,
+    triangle_patch: wgpu::Buffer,
+}
+
+/// Bytes of one vertex in [`tessera_gpu::VERTEX_LAYOUT`].
+const VERTEX_BYTES: u64 = 32;
+
+/// One part of a split mesh, as [`split`] makes it: triangles `[first, end)`; for a mesh that
+/// fits whole, no renumbering (`renumbered` is None).
+struct SplitPart {
+    first: usize,
+    end: usize,
+    /// The part's vertices (global numbers, in first use) and its indices into them.
+    renumbered: Option<(Vec<u32>, Vec<u32>)>,
+}
+
+/// Splits `mesh` so that no part has more than `max_vertices` vertices or `max_triangles`
+/// triangles. Greedy in triangle order, with a stamp per vertex reset for what each part
+/// touched, so the whole split costs O(V + T).
+fn split(mesh: &Mesh, max_vertices: usize, max_triangles: usize) -> Vec<SplitPart> {
+    let (v, t) = (mesh.vertex_count(), mesh.triangle_count());
+    if v <= max_vertices && t <= max_triangles {
+        return vec![SplitPart { first: 0, end: t, renumbered: None }];
+    }
+    let mut local = vec![u32::MAX; v];
+    let mut parts = Vec::new();
+    let (mut used, mut indices): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
+    let mut first = 0;
+    for tri in 0..t {
+        let corners = mesh.triangle(tri);
+        let fresh = (0..3)
+            .filter(|&k| local[corners[k] as usize] == u32::MAX && !corners[..k].contains(&corners[k]))
+            .count();
+        if used.len() + fresh > max_vertices || tri - first >= max_triangles {
+            for &g in &used {
+                local[g as usize] = u32::MAX;
+            }
+            let renumbered = (std::mem::take(&mut used), std::mem::take(&mut indices));
+            parts.push(SplitPart { first, end: tri, renumbered: Some(renumbered) });
+            first = tri;
+        }
+        for c in corners {
+            if local[c as usize] == u32::MAX {
+                local[c as usize] = used.len() as u32;
+                used.push(c);
+            }
+            indices.push(local[c as usize]);
+        }
+    }
+    parts.push(SplitPart { first, end: t, renumbered: Some((used, indices)) });
+    parts
 }
 
 impl MeshBuffers {
     /// Uploads `mesh` (interleaved into [`tessera_gpu::VERTEX_LAYOUT`]) and `patch_level`
-    /// (one per patch; may be empty). Cost: O(V + T) packing and one upload.
-    pub fn upload(ctx: &GpuContext, mesh: &Mesh, patch_level: &[f32]) -> MeshBuffers {
-        let mut interleaved = Vec::with_capacity(8 * mesh.vertex_count());
-        for i in 0..mesh.vertex_count() {
-            interleaved.extend_from_slice(&mesh.positions[i]);
-            interleaved.extend_from_slice(mesh.normals.get(i).unwrap_or(&[0.0; 3]));
-            interleaved.extend_from_slice(mesh.uvs.get(i).unwrap_or(&[0.0; 2]));
+    /// (one per patch; may be empty), in parts where the device's binding limits require it.
+    /// Errors: [`RenderError::Wgpu`] when the device cannot hold the buffers (out of memory).
+    /// Cost: O(V + T) packing (plus renumbering when split) and one upload.
+    pub fn upload(ctx: &GpuContext, mesh: &Mesh, patch_level: &[f32]) -> Result<MeshBuffers, RenderError> {
+        Self::upload_within(ctx, mesh, patch_level, u64::MAX)
+    }
+
+    /// [`MeshBuffers::upload`] with every buffer of a part at most `max_binding_bytes` (and
+    /// within the device's limits): for tests of the split on small meshes, and callers that
+    /// want smaller buffers. Errors: as [`MeshBuffers::upload`], and [`RenderError::Invalid`]
+    /// for a cap below one triangle's vertices (96 bytes).
+    pub fn upload_within(
+        ctx: &GpuContext,
+        mesh: &Mesh,
+        patch_level: &[f32],
+        max_binding_bytes: u64,
+    ) -> Result<MeshBuffers, RenderError> {
+        let limit =
+            max_binding_bytes.min(ctx.limits.max_storage_buffer_binding_size).min(ctx.limits.max_buffer_size);
+        if limit < 3 * VERTEX_BYTES {
+            return Err(RenderError::Invalid(format!(
+                "a binding of {limit} bytes cannot hold one triangle's vertices"
+            )));
         }
+        let max_vertices = usize::try_from(limit / VERTEX_BYTES).unwrap_or(usize::MAX);
+        let max_triangles = usize::try_from(limit / 12).unwrap_or(usize::MAX);
+        let parts = split(mesh, max_vertices, max_triangles);
         let storage = |label: &str, bytes: &[u8]| {
             // Zero-sized buffers cannot be bound: keep 16 bytes at least.
             let mut data = bytes.to_vec();
@@ -99,25 +176,64 @@ impl MeshBuffers {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
-        let args = [mesh.indices.len() as u32, 1, 0, 0, 0];
-        MeshBuffers {
-            vertices: storage("mesh vertices", bytemuck::cast_slice(&interleaved)),
-            indices: storage("mesh indices", bytemuck::cast_slice(&mesh.indices)),
-            indexed_args: storage("mesh draw args", bytemuck::cast_slice(&args)),
-            triangle_patch: storage("mesh triangle patches", bytemuck::cast_slice(&mesh.triangle_patch)),
-            patch_level: storage("mesh patch levels", bytemuck::cast_slice(patch_level)),
-        }
+        let vertex = |out: &mut Vec<f32>, i: usize| {
+            out.extend_from_slice(&mesh.positions[i]);
+            out.extend_from_slice(mesh.normals.get(i).unwrap_or(&[0.0; 3]));
+            out.extend_from_slice(mesh.uvs.get(i).unwrap_or(&[0.0; 2]));
+        };
+        crate::scoped(&ctx.device, "uploading the mesh", || {
+            let parts = parts
+                .into_iter()
+                .map(|SplitPart { first, end, renumbered }| {
+                    let (interleaved, indices) = match renumbered {
+                        None => {
+                            let mut interleaved = Vec::with_capacity(8 * mesh.vertex_count());
+                            (0..mesh.vertex_count()).for_each(|i| vertex(&mut interleaved, i));
+                            (interleaved, mesh.indices.clone())
+                        }
+                        Some((used, indices)) => {
+                            let mut interleaved = Vec::with_capacity(8 * used.len());
+                            used.iter().for_each(|&g| vertex(&mut interleaved, g as usize));
+                            (interleaved, indices)
+                        }
+                    };
+                    let patches = mesh.triangle_patch.get(first..end.min(mesh.triangle_patch.len()));
+                    let args = [indices.len() as u32, 1, 0, 0, 0];
+                    MeshPart {
+                        vertices: storage("mesh vertices", bytemuck::cast_slice(&interleaved)),
+                        indices: storage("mesh indices", bytemuck::cast_slice(&indices)),
+                        indexed_args: storage("mesh draw args", bytemuck::cast_slice(&args)),
+                        triangle_patch: storage(
+                            "mesh triangle patches",
+                            bytemuck::cast_slice(patches.unwrap_or(&[])),
+                        ),
+                    }
+                })
+                .collect();
+            MeshBuffers {
+                parts,
+                patch_level: storage("mesh patch levels", bytemuck::cast_slice(patch_level)),
+            }
+        })
     }
 
-    /// The buffers as [`Geometry`].
-    pub fn geometry(&self) -> Geometry<'_> {
-        Geometry {
-            vertices: &self.vertices,
-            indices: &self.indices,
-            indexed_args: &self.indexed_args,
-            triangle_patch: Some(&self.triangle_patch),
-            patch_level: Some(&self.patch_level),
-        }
+    /// How many parts the mesh was uploaded in (1 unless it exceeded a binding).
+    pub fn part_count(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// The parts as [`Geometry`], to draw together in this order ([`Renderer::record`]).
+    pub fn geometries(&self) -> Vec<Geometry<'_>> {
+        self.parts
+            .iter()
+            .map(|p| Geometry {
+                vertices: &p.vertices,
+                indices: &p.indices,
+                indexed_args: &p.indexed_args,
+                triangle_patch: Some(&p.triangle_patch),
+                patch_level: Some(&self.patch_level),
+            })
+            .collect()
     }
 }
 
@@ -185,12 +301,17 @@ fn storage_entry(
 impl Renderer {
     /// Compiles the pipelines for colour targets of `format` with `samples` samples per pixel
     /// (1 or 4: the counts every WebGPU adapter supports for [`IMAGE_FORMAT`] and
-    /// [`DEPTH_FORMAT`]). Errors: [`RenderError::Invalid`] for another count. Cost: two shader
-    /// compilations (tens of ms on lavapipe).
+    /// [`DEPTH_FORMAT`]). Errors: [`RenderError::Invalid`] for another count,
+    /// [`RenderError::Wgpu`] when wgpu refuses the pipelines (e.g. a format that cannot be
+    /// rendered to). Cost: two shader compilations (tens of ms on lavapipe).
     pub fn new(ctx: &GpuContext, format: wgpu::TextureFormat, samples: u32) -> Result<Renderer, RenderError> {
         if samples != 1 && samples != 4 {
             return Err(RenderError::Invalid(format!("--msaa {samples}: use 1 or 4 samples per pixel")));
         }
+        crate::scoped(&ctx.device, "compiling the renderer's pipelines", || Self::make(ctx, format, samples))
+    }
+
+    fn make(ctx: &GpuContext, format: wgpu::TextureFormat, samples: u32) -> Renderer {
         let device = &ctx.device;
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -275,7 +396,7 @@ impl Renderer {
             })
         };
         use wgpu::BufferUsages as U;
-        Ok(Renderer {
+        Renderer {
             pipeline,
             layout,
             args_pipeline,
@@ -290,7 +411,7 @@ impl Renderer {
             dummy: buffer("draw dummy", 16, U::STORAGE),
             format,
             samples,
-        })
+        }
     }
 
     /// The colour format the pipeline draws to.
@@ -304,11 +425,14 @@ impl Renderer {
     }
 
     /// Records one frame: the args pass, then a render pass that clears `target` to
-    /// [`shading::BACKGROUND`] and draws `geometry` seen from `camera` (its viewport should
-    /// be the target's size). `target` is the colour attachment (multisampled when the
-    /// renderer is, then resolved into `resolve`), `depth` a [`DEPTH_FORMAT`] view of the
-    /// same size and sample count. Writes the frame uniform with `queue.write_buffer`, so
-    /// one renderer draws one frame per submission. Reads nothing back.
+    /// [`shading::BACKGROUND`] and draws `parts` in order (one mesh: one geometry, or the
+    /// parts of [`MeshBuffers::geometries`]) seen from `camera` (its viewport should be the
+    /// target's size). `target` is the colour attachment (multisampled when the renderer is,
+    /// then resolved into `resolve`), `depth` a [`DEPTH_FORMAT`] view of the same size and
+    /// sample count. Writes the frame uniform with `queue.write_buffer`, so one renderer draws
+    /// one frame per submission. Reads nothing back. Errors: [`RenderError::Wgpu`] when wgpu
+    /// refuses a binding (e.g. a buffer past the device's binding limit); nothing is recorded
+    /// for a refused part.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -317,43 +441,98 @@ impl Renderer {
         target: &wgpu::TextureView,
         resolve: Option<&wgpu::TextureView>,
         depth: &wgpu::TextureView,
-        geometry: &Geometry<'_>,
+        parts: &[Geometry<'_>],
         camera: &Camera,
         options: &RenderOptions,
-    ) {
+    ) -> Result<(), RenderError> {
         let device = &ctx.device;
-        let frame = FrameUniform::new(camera, options, geometry.triangle_patch.is_some());
+        let has_patches = parts.iter().any(|g| g.triangle_patch.is_some());
+        let frame = FrameUniform::new(camera, options, has_patches);
         ctx.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&frame));
-        let args_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("draw args"),
-            layout: &self.args_layout,
-            entries: &[entry(0, geometry.indexed_args), entry(1, &self.draw_args), entry(2, &self.draw_info)],
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("draw"),
-            layout: &self.layout,
-            entries: &[
-                entry(0, &self.uniform),
-                entry(1, geometry.vertices),
-                entry(2, geometry.indices),
-                entry(3, geometry.triangle_patch.unwrap_or(&self.dummy)),
-                entry(4, geometry.patch_level.unwrap_or(&self.dummy)),
-                entry(5, &self.draw_info),
-            ],
-        });
+        // One slot of draw arguments and draw info per part, at the storage offset alignment
+        // (the renderer's own one-slot buffers when there is one part).
+        let stride = (ctx.limits.min_storage_buffer_offset_alignment as u64).max(16);
+        let slots = crate::scoped(device, "making the draw buffers", || {
+            (parts.len() > 1).then(|| {
+                let size = stride * parts.len() as u64;
+                let make = |label, usage| {
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(label),
+                        size,
+                        usage,
+                        mapped_at_creation: false,
+                    })
+                };
+                use wgpu::BufferUsages as U;
+                (make("draw indirect parts", U::STORAGE | U::INDIRECT), make("draw info parts", U::STORAGE))
+            })
+        })?;
+        let (draw_args, draw_info) = match &slots {
+            Some((a, i)) => (a, i),
+            None => (&self.draw_args, &self.draw_info),
+        };
+        let slot = |buffer, k: usize| wgpu::BufferBinding {
+            buffer,
+            offset: k as u64 * stride,
+            size: wgpu::BufferSize::new(16),
+        };
+        let binds = crate::scoped(device, "binding the mesh", || {
+            parts
+                .iter()
+                .enumerate()
+                .map(|(k, geometry)| {
+                    let args = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("draw args"),
+                        layout: &self.args_layout,
+                        entries: &[
+                            entry(0, geometry.indexed_args),
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::Buffer(slot(draw_args, k)),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 2,
+                                resource: wgpu::BindingResource::Buffer(slot(draw_info, k)),
+                            },
+                        ],
+                    });
+                    let draw = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("draw"),
+                        layout: &self.layout,
+                        entries: &[
+                            entry(0, &self.uniform),
+                            entry(1, geometry.vertices),
+                            entry(2, geometry.indices),
+                            entry(3, geometry.triangle_patch.unwrap_or(&self.dummy)),
+                            entry(4, geometry.patch_level.unwrap_or(&self.dummy)),
+                            wgpu::BindGroupEntry {
+                                binding: 5,
+                                resource: wgpu::BindingResource::Buffer(slot(draw_info, k)),
+                            },
+                        ],
+                    });
+                    (args, draw)
+                })
+                .collect::<Vec<_>>()
+        })?;
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("draw args"),
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.args_pipeline);
-            pass.set_bind_group(0, &args_bind, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
+            for (args, _) in &binds {
+                pass.set_bind_group(0, args, &[]);
+                pass.dispatch_workgroups(1, 1, 1);
+            }
         }
         let mut pass = begin_scene_pass(encoder, "tessera draw", target, resolve, depth);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.draw_indirect(&self.draw_args, 0);
+        for (k, (_, draw)) in binds.iter().enumerate() {
+            pass.set_bind_group(0, draw, &[]);
+            pass.draw_indirect(draw_args, k as u64 * stride);
+        }
+        Ok(())
     }
 }
 
@@ -372,20 +551,22 @@ pub struct Targets {
 
 impl Targets {
     /// Textures for `renderer` (its format and sample count) of `width × height`. Errors:
-    /// [`RenderError::Invalid`] past the device's texture size limit or for an empty size.
-    /// Cost: the allocation.
+    /// [`RenderError::ImageTooLarge`] from [`crate::check_image_size`] (a side past the
+    /// device's texture limit, targets past the memory caps), checked before anything is
+    /// allocated; [`RenderError::Wgpu`] when the device still cannot make them. Cost: the
+    /// allocation.
     pub fn new(
         ctx: &GpuContext,
         renderer: &Renderer,
         width: u32,
         height: u32,
     ) -> Result<Targets, RenderError> {
-        let max = ctx.limits.max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(RenderError::Invalid(format!(
-                "image size {width}x{height}: each side must be 1 to {max} pixels on this adapter"
-            )));
-        }
+        let drawing = crate::Drawing::Gpu { limits: &ctx.limits, samples: renderer.samples };
+        crate::check_image_size(width, height, drawing)?;
+        crate::scoped(&ctx.device, "making the render targets", || Self::make(ctx, renderer, width, height))
+    }
+
+    fn make(ctx: &GpuContext, renderer: &Renderer, width: u32, height: u32) -> Targets {
         let texture = |label: &str, format, samples, usage| {
             ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -409,30 +590,31 @@ impl Targets {
         } else {
             (texture("colour", f, 1, U::RENDER_ATTACHMENT | U::COPY_SRC), None)
         };
-        Ok(Targets {
+        Targets {
             width,
             height,
             colour,
             resolve,
             depth: texture("depth", DEPTH_FORMAT, s, U::RENDER_ATTACHMENT),
-        })
+        }
     }
 
-    /// Records `renderer`'s frame into these targets (see [`Renderer::record`]).
+    /// Records `renderer`'s frame of `parts` into these targets (see [`Renderer::record`],
+    /// and its errors).
     pub fn draw(
         &self,
         ctx: &GpuContext,
         renderer: &Renderer,
         encoder: &mut wgpu::CommandEncoder,
-        geometry: &Geometry<'_>,
+        parts: &[Geometry<'_>],
         camera: &Camera,
         options: &RenderOptions,
-    ) {
+    ) -> Result<(), RenderError> {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let colour = view(&self.colour);
         let resolve = self.resolve.as_ref().map(view);
         let depth = view(&self.depth);
-        renderer.record(ctx, encoder, &colour, resolve.as_ref(), &depth, geometry, camera, options);
+        renderer.record(ctx, encoder, &colour, resolve.as_ref(), &depth, parts, camera, options)
     }
 
     /// Views of the colour attachment, the resolve target (with MSAA) and the depth buffer,
@@ -456,32 +638,23 @@ impl Targets {
 
 /// Copies a single-sample 8-bit RGBA or BGRA texture with `COPY_SRC` usage (an image target,
 /// or a surface texture configured with it) back into an RGBA [`Image`]. A read-back: waits
-/// for the queue. Cost: the copy of `4 · width · height` bytes (rows padded to 256 bytes).
+/// for the queue. Errors: [`RenderError::Wgpu`] when the device cannot make the read-back
+/// buffer or refuses the copy; [`RenderError::Gpu`] for a failed map. Cost: the copy of
+/// `4 · width · height` bytes (rows padded to 256 bytes).
 pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image, RenderError> {
     let (width, height) = (texture.width(), texture.height());
     let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let size = row as u64 * height as u64;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("image read-back"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    ctx.queue.submit([encoder.finish()]);
+    let buffer = crate::scoped(&ctx.device, "reading the image back", || {
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("image read-back"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        copy_to(ctx, texture, &buffer, row);
+        buffer
+    })?;
     let bytes = tessera_gpu::readback::read_bytes(ctx, &buffer, size)?;
     let mut rgba = Vec::with_capacity(4 * (width * height) as usize);
     let bgra =
@@ -499,21 +672,48 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image, 
     Ok(Image { width, height, rgba })
 }
 
-/// Draws `geometry` from `camera` (its viewport is the image size) into a new image: a
-/// renderer, targets, one frame and a read-back. For one-off pictures; a frame loop keeps a
-/// [`Renderer`] and [`Targets`]. Cost: two shader compilations, the frame, the read-back.
+/// Records and submits the copy of `texture` into `buffer` (rows of `row` bytes).
+fn copy_to(ctx: &GpuContext, texture: &wgpu::Texture, buffer: &wgpu::Buffer, row: u32) {
+    let (width, height) = (texture.width(), texture.height());
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: None },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    ctx.queue.submit([encoder.finish()]);
+}
+
+/// Draws `parts` (one mesh: see [`Renderer::record`]) from `camera` (its viewport is the image
+/// size) into a new image: a renderer, targets, one frame and a read-back. For one-off
+/// pictures; a frame loop keeps a [`Renderer`] and [`Targets`]. Every wgpu call is in an
+/// error scope: errors are [`RenderError`]s (the size checked first, see [`Targets::new`]),
+/// never wgpu's panic. Cost: two shader compilations, the frame, the read-back.
 pub fn render(
     ctx: &GpuContext,
-    geometry: &Geometry<'_>,
+    parts: &[Geometry<'_>],
     camera: &Camera,
     options: &RenderOptions,
     samples: u32,
 ) -> Result<Image, RenderError> {
+    let drawing = crate::Drawing::Gpu { limits: &ctx.limits, samples };
+    crate::check_image_size(camera.width, camera.height, drawing)?;
     let renderer = Renderer::new(ctx, IMAGE_FORMAT, samples)?;
     let targets = Targets::new(ctx, &renderer, camera.width, camera.height)?;
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    targets.draw(ctx, &renderer, &mut encoder, geometry, camera, options);
-    ctx.queue.submit([encoder.finish()]);
+    crate::scoped(&ctx.device, "drawing the frame", || {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let drawn = targets.draw(ctx, &renderer, &mut encoder, parts, camera, options);
+        ctx.queue.submit([encoder.finish()]);
+        drawn
+    })??;
     targets.read(ctx)
 }
 

@@ -86,8 +86,8 @@ fn instanced_draw_equals_the_cpu_instanced_form_and_the_compacted_mesh() {
                 .unwrap();
             assert_eq!(drawn, mesh.triangle_count(), "{model}: non-degenerate drawn triangles");
             // The picture covers what the compacted mesh covers.
-            let buffers = gpu::MeshBuffers::upload(&ctx, &mesh, &[]);
-            let compacted = gpu::render(&ctx, &buffers.geometry(), &camera, &look, 1).unwrap();
+            let buffers = gpu::MeshBuffers::upload(&ctx, &mesh, &[]).unwrap();
+            let compacted = gpu::render(&ctx, &buffers.geometries(), &camera, &look, 1).unwrap();
             let (a, b) = (instanced_image.covered_pixels(), compacted.covered_pixels());
             eprintln!(
                 "{model} ({domain:?}), {pixel_error} px: {} instances, {drawn} triangles, {a} vs {b} covered pixels",
