@@ -268,6 +268,7 @@ fn ratio(x: f64) -> String {
 fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
     let r = &set.repairs;
     let lines = [
+        (r.split_polygons, "input polygons split into triangles (fans from their first corner) for PN triangles"),
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
         (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
@@ -292,6 +293,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         "dropped_duplicate_faces": r.dropped_duplicate_faces,
         "dropped_zero_area_faces": r.dropped_zero_area_faces,
         "dropped_collapsed_patches": r.dropped_collapsed_patches,
+        "split_polygons": r.split_polygons,
         "collapsed_triangles": mesh.collapsed_triangles,
         "flipped": r.flipped,
     })

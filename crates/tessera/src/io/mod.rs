@@ -59,9 +59,11 @@ pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gl
 ///   [`SurfaceSet::from_patch_file`]);
 /// - `.bezt`: cubic Bézier triangles ([`bezt::read_bezt`],
 ///   [`SurfaceSet::from_bezier_triangle_file`]);
-/// - `.obj`, `.ply`, `.stl`, `.glb`, `.gltf`: a triangle mesh, made into PN triangles
+/// - `.obj`, `.ply`, `.stl`, `.glb`, `.gltf`: a polygon mesh, made into PN triangles
 ///   ([`SurfaceSet::pn_from_mesh`]) with the file's normals where every corner of a face has a
-///   non-zero one. `.obj` is read by [`obj::read_obj`], `.ply` and `.stl` by [`read_mesh`], and
+///   non-zero one. Faces of more than three corners, in OBJ and PLY alike, are split into
+///   triangle fans from their first corner ([`obj::ObjMesh::split_polygons`]) and counted in
+///   [`Repairs::split_polygons`](crate::surface::Repairs::split_polygons). `.obj` is read by [`obj::read_obj`], `.ply` and `.stl` by [`read_mesh`], and
 ///   glTF by [`glb::read_gltf_triangles`] (every triangle primitive of the default scene, in
 ///   world coordinates), so a `.glb` from any tool works, tessera's own included.
 ///
@@ -80,10 +82,16 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
     let set = match ext.as_deref() {
         Some("patches") => SurfaceSet::from_patch_file(&patches::read_patches(path)?, options),
         Some("bezt") => SurfaceSet::from_bezier_triangle_file(&bezt::read_bezt(path)?, options),
-        Some("obj") => SurfaceSet::pn_from_mesh(&obj::read_obj(path)?, path, options)?,
-        Some("ply" | "stl") => {
-            SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?
+        Some("obj") => {
+            let mut mesh = obj::read_obj(path)?;
+            let split = mesh.split_polygons();
+            with_split(SurfaceSet::pn_from_mesh(&mesh, path, options)?, split)
         }
+        Some("ply") => {
+            let (mesh, split) = ply::parse_ply_counting_polygons(&read_input(path)?, path)?;
+            with_split(SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&mesh), path, options)?, split)
+        }
+        Some("stl") => SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?,
         Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path, options.uri_scope)?, path, options)?,
         other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };
@@ -102,6 +110,12 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         ));
     }
     Ok(set)
+}
+
+/// `set` with `split` polygons of its input recorded among its repairs.
+fn with_split(mut set: SurfaceSet, split: usize) -> SurfaceSet {
+    set.repairs.split_polygons = split;
+    set
 }
 
 /// The extensions [`read_mesh`] understands, for error messages.

@@ -82,18 +82,53 @@ impl ObjMesh {
     }
 }
 
+/// The triangles a polygon of `n ≥ 3` corners is split into, as corner numbers: the fan
+/// `(0, k, k + 1)` from its first corner, which keeps the polygon's orientation and is exact
+/// for the convex (and planar) polygons mesh writers emit. The one rule every reader applies
+/// to polygons ([`ObjMesh::split_polygons`] for OBJ, the PLY reader).
+pub(crate) fn fan(n: usize) -> impl Iterator<Item = [usize; 3]> {
+    (1..n.saturating_sub(1)).map(|k| [0, k, k + 1])
+}
+
 impl ObjMesh {
+    /// Splits every face of more than three corners into triangles ([`fan`]: from its first
+    /// corner, corner normals alike, each keeping the face's line) and returns how many faces
+    /// were split: the input of PN triangles, which need triangles, gets every format's
+    /// polygons the same way, reported as a repair.
+    ///
+    /// Cost: O(corners); nothing moves when every face is a triangle.
+    pub fn split_polygons(&mut self) -> usize {
+        let split = self.faces.iter().filter(|f| f.positions.len() > 3).count();
+        if split == 0 {
+            return 0;
+        }
+        let faces = std::mem::take(&mut self.faces);
+        for face in faces {
+            let pick = |c: &[u32], t: [usize; 3]| t.map(|k| c[k]).to_vec();
+            for t in fan(face.positions.len()) {
+                self.faces.push(ObjFace {
+                    positions: pick(&face.positions, t),
+                    normals: face.normals.as_deref().map(|n| pick(n, t)),
+                    line: face.line,
+                });
+            }
+        }
+        split
+    }
+
     /// The mesh as a triangle [`Mesh`] (for checking, not tessellating): positions rounded to
-    /// `f32`, zero normals and uvs, patch 0 everywhere.
+    /// `f32`, zero normals and uvs, patch 0 everywhere, polygons split as
+    /// [`ObjMesh::split_polygons`] does (as the PLY reader splits them).
     ///
     /// # Errors
     ///
-    /// As [`ObjMesh::triangles`]: [`Error::Unsupported`] at the first face that is not a
-    /// triangle.
+    /// None today (kept a `Result` for the readers' uniform signature).
     ///
     /// Cost: O(vertices + faces).
     pub fn to_mesh(&self, file: &Path) -> Result<Mesh> {
-        let tris = self.triangles(file)?;
+        let mut split = self.clone();
+        split.split_polygons();
+        let tris = split.triangles(file)?;
         let n = self.positions.len();
         Ok(Mesh {
             positions: self.positions.iter().map(|p| p.as_vec3().to_array()).collect(),

@@ -28,6 +28,7 @@ use std::path::Path;
 use super::binary::{
     all_finite, fill_missing, le_floats, le_words, put_u32, to_u32, write_chunks, BIN_CHUNK,
 };
+use super::obj::fan;
 use super::Format;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -41,12 +42,20 @@ use crate::mesh::Mesh;
 /// Cost: O(`data.len()`) time; memory proportional to the mesh, never to header counts that
 /// the data cannot back.
 pub fn parse_ply(data: &[u8], file: &Path) -> Result<Mesh> {
+    parse_ply_counting_polygons(data, file).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_ply`], also returning how many faces had more than three corners (split into
+/// triangles by [`fan`](super::obj::fan), the rule of every reader), for the repair report.
+/// Cost: as [`parse_ply`].
+pub fn parse_ply_counting_polygons(data: &[u8], file: &Path) -> Result<(Mesh, usize)> {
     let header = PlyHeader::parse(data, file)?;
+    let mut polygons = 0;
     let body = &data[header.body_start..];
     match header.encoding {
         Encoding::Ascii => {
             let mut src = AsciiSource { text: body, pos: 0, line: header.body_line, file };
-            read_ply_body(&header, &mut src, file)
+            read_ply_body(&header, &mut src, file, &mut polygons).map(|mesh| (mesh, polygons))
         }
         Encoding::BinaryLe | Encoding::BinaryBe => {
             let mut src = BinarySource {
@@ -55,7 +64,7 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<Mesh> {
                 big_endian: header.encoding == Encoding::BinaryBe,
                 file,
             };
-            read_ply_body(&header, &mut src, file)
+            read_ply_body(&header, &mut src, file, &mut polygons).map(|mesh| (mesh, polygons))
         }
     }
 }
@@ -414,7 +423,7 @@ enum FaceRole {
     Skip,
 }
 
-fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path) -> Result<Mesh> {
+fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path, polygons: &mut usize) -> Result<Mesh> {
     let Some(vertex) = header.elements.iter().find(|e| e.name == "vertex") else {
         return Err(Error::parse(file, 0, "PLY header declares no vertex element"));
     };
@@ -443,7 +452,8 @@ fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path) -> Resu
         match element.name.as_str() {
             "vertex" => read_ply_vertices(element, header.encoding, src, file, &mut mesh)?,
             "face" => {
-                corner_params = read_ply_faces(element, header.encoding, vertex_count, src, file, &mut mesh)?;
+                corner_params =
+                    read_ply_faces(element, header.encoding, vertex_count, src, file, &mut mesh, polygons)?;
             }
             "tristrips" => read_ply_strips(element, vertex_count, src, &mut mesh)?,
             _ => {
@@ -615,6 +625,7 @@ fn read_ply_faces(
     src: &mut impl Source,
     file: &Path,
     mesh: &mut Mesh,
+    polygons: &mut usize,
 ) -> Result<Option<Vec<[f32; 2]>>> {
     let mut roles = Vec::with_capacity(element.props.len());
     let mut has_indices = false;
@@ -703,14 +714,14 @@ fn read_ply_faces(
                 return Err(src.error(format!("face {i} has a non-finite {params_name}")));
             } else {
                 let corner = |k: usize| [texcoord[2 * k], texcoord[2 * k + 1]];
-                for k in 1..n - 1 {
-                    out.extend([corner(0), corner(k), corner(k + 1)]);
+                for t in fan(n) {
+                    out.extend(t.map(corner));
                 }
             }
         }
-        // A fan keeps the polygon's orientation; exact for the convex polygons PLY writers emit.
-        for k in 1..n - 1 {
-            mesh.indices.extend([polygon[0], polygon[k], polygon[k + 1]]);
+        *polygons += usize::from(n > 3);
+        for t in fan(n) {
+            mesh.indices.extend(t.map(|k| polygon[k]));
             mesh.triangle_patch.push(patch);
         }
     }

@@ -7,7 +7,7 @@ use crate::io::bezt::BezierTriangleFile;
 use crate::io::obj::ObjMesh;
 use crate::io::patches::PatchFile;
 use crate::surface::RationalBicubic;
-use crate::topology::weld::{weld, Weld};
+use crate::topology::weld::{collapse_unresolved_curves, weld, Weld};
 use crate::topology::{PatchKeys, Topology, NONE};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -53,6 +53,9 @@ pub struct Repairs {
     /// Patches dropped because all their control points are one point (after welding): they
     /// have no surface, and their triangles would all degenerate.
     pub dropped_collapsed_patches: usize,
+    /// Input faces of more than three corners split into triangles (fans from their first
+    /// corner; OBJ and PLY alike), since PN triangles need triangles.
+    pub split_polygons: usize,
     /// The orientation was reversed (by `Outward` or by `flip`).
     pub flipped: bool,
 }
@@ -156,7 +159,16 @@ impl SurfaceSet {
                 _ => weights.extend(std::iter::repeat_n(1.0, p.control_points().len())),
             }
         }
-        let welded = weld(&points, &weights, options.weld);
+        let mut welded = weld(&points, &weights, options.weld);
+        if !matches!(options.weld, Weld::Off) {
+            let mut base = 0;
+            let curves = patches.iter().flat_map(|p| {
+                let b = base;
+                base += p.control_points().len();
+                corner_and_edge_points(p.domain()).1.iter().map(move |e| e.map(|c| b + c))
+            });
+            welded.merged += collapse_unresolved_curves(&points, curves, &mut welded.ids);
+        }
         repairs.welded_points = welded.merged;
         let mut keys = Vec::with_capacity(patches.len());
         let mut kept = Vec::with_capacity(patches.len());

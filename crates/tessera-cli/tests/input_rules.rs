@@ -1,0 +1,54 @@
+//! One rule for every input format, and inputs refused with the reason rather than misread:
+//! polygons are split into triangles the same way for OBJ and PLY and reported as a repair.
+
+mod common;
+
+use common::{scratch, tessera, text};
+
+/// A unit cube of six quads (outward), as OBJ and as ASCII PLY.
+fn cube(dir: &std::path::Path) -> (String, String) {
+    let v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]];
+    let f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 6\nproperty list uchar int vertex_indices\nend_header\n"
+    );
+    for p in v {
+        obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        ply += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for q in f {
+        obj += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+        ply += &format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    std::fs::write(dir.join("cube.ply"), ply).unwrap();
+    ("cube.obj".into(), "cube.ply".into())
+}
+
+#[test]
+fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
+    let dir = scratch("polygon-rule");
+    let (obj, ply) = cube(&dir);
+    let mut results = Vec::new();
+    for input in [&obj, &ply] {
+        let out = tessera(&["mesh", input, "--factor", "3", "--stats", "-o", "out.ply"], &dir);
+        assert!(out.status.success(), "{input}: {}", text(&out.stderr));
+        let stderr = text(&out.stderr);
+        assert!(
+            stderr.contains("repair: 6 input polygons split into triangles"),
+            "{input}: no repair line: {stderr}"
+        );
+        let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+        assert_eq!(v["repairs"]["split_polygons"], 6, "{input}");
+        assert_eq!(v["patches"], 12, "{input}");
+        assert_eq!(v["boundary_edges"], 0, "{input}: the split cube is not closed");
+        results.push((v["triangles"].clone(), v["vertices"].clone(), std::fs::read(dir.join("out.ply")).unwrap()));
+    }
+    assert_eq!(results[0], results[1], "OBJ and PLY quads gave different meshes");
+    // The checker reads OBJ polygons by the same rule.
+    let check = tessera(&["check", &obj], &dir);
+    assert!(check.status.success(), "{}", text(&check.stderr));
+    assert!(text(&check.stdout).contains("boundary edges       0"), "{}", text(&check.stdout));
+}
