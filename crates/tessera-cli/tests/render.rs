@@ -175,3 +175,56 @@ fn cpu_fallback_rasteriser_covers_what_wgpu_covers() {
         );
     }
 }
+
+#[test]
+fn a_mesh_split_to_fit_a_low_binding_cap_draws_the_same_picture() {
+    // Armadillo at --factor 16 (6.6 M vertices) passed lavapipe's 128 MiB storage binding
+    // and panicked in wgpu; the hidden cap makes the teapot split the same way, fast.
+    let dir = scratch("render-split");
+    let input = data("patches/teapot.patches");
+    for flags in [&["--factor", "8", "--wireframe", "--color", "patch"][..], &["--pixel-error", "1"][..]] {
+        let (whole_covered, whole) = render(&input, &dir, "whole.png", flags);
+        let mut split_flags = flags.to_vec();
+        split_flags.extend(["--max-binding-bytes", "4096"]);
+        let size = format!("{SIZE}x{SIZE}");
+        let mut args = vec!["render", input.to_str().unwrap(), "-o", "split.png", "--size", &size];
+        args.extend_from_slice(&split_flags);
+        let out = tessera(&args, &dir);
+        let stderr = text(&out.stderr);
+        assert!(out.status.success(), "{flags:?}: {stderr}");
+        assert!(stderr.contains(" parts within the adapter's binding limit"), "{flags:?}: {stderr}");
+        let (split_covered, split) = covered(&dir.join("split.png"));
+        assert!(whole_covered > 4000, "{flags:?}: {whole_covered}");
+        assert_eq!(split_covered, whole_covered, "{flags:?}");
+        assert!(split == whole, "{flags:?}: the split picture differs from the whole one");
+    }
+}
+
+#[test]
+fn sizes_the_adapter_or_the_memory_caps_cannot_take_are_refused_before_any_work() {
+    let dir = scratch("render-sizes");
+    let input = data("patches/teapot.patches");
+    let input = input.to_str().unwrap();
+    // Each of these passed the old check and then panicked in wgpu (out of memory, rc 101),
+    // or would have taken the CPU rasteriser gigabytes.
+    let cases: [(&[&str], &str); 6] = [
+        (&["--size", "12000x12000"], "MAX_ALLOCATION_BYTES"),
+        (&["--size", "16384x16384"], "MAX_ALLOCATION_BYTES"),
+        (&["--size", "12000x12000", "--engine", "gpu"], "MAX_ALLOCATION_BYTES"),
+        (&["--size", "20000x100"], "max_texture_dimension_2d"),
+        (&["--size", "100000x100000", "--msaa", "1"], "max_texture_dimension_2d"),
+        (&["--size", "9000x9000", "--renderer", "cpu"], "the CPU rasteriser's limit"),
+    ];
+    for (flags, limit) in cases {
+        let mut args = vec!["render", input, "-o", "big.png"];
+        args.extend_from_slice(flags);
+        let out = tessera(&args, &dir);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{flags:?}: {stderr}");
+        let size = flags[1];
+        assert!(stderr.contains(&format!("error: image size {size}: ")), "{flags:?}: {stderr}");
+        assert!(stderr.contains(limit), "{flags:?}: {stderr}");
+        assert!(!dir.join("big.png").exists(), "{flags:?}: a picture was written");
+    }
+}

@@ -74,3 +74,78 @@ fn viewer_draws_semi_uniform_with_the_instanced_path() {
     let covered = rgb.chunks_exact(3).filter(|p| *p != [255, 255, 255]).count();
     assert!(covered > 320 * 240 / 10, "only {covered} pixels are not background");
 }
+
+/// Runs `tessera view IN ARGS` under `xvfb-run` with extra environment, returning the output.
+fn view(input: &str, args: &[&str], env: &[(&str, &str)], dir: &std::path::Path) -> std::process::Output {
+    let found =
+        Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
+    assert!(found, "xvfb-run is missing: install it (Debian/Ubuntu: apt-get install -y xvfb xauth) to run the viewer test");
+    let mut command = Command::new("xvfb-run");
+    command
+        .args(["-a", "-s", "-screen 0 1024x768x24", env!("CARGO_BIN_EXE_tessera"), "view"])
+        .arg(data(input))
+        .args(args)
+        .current_dir(dir);
+    for (k, v) in env {
+        command.env(k, v);
+    }
+    command.output().expect("run xvfb-run")
+}
+
+#[test]
+fn viewer_refuses_sizes_it_cannot_draw_before_opening_a_window() {
+    // Each panicked in wgpu or winit; now the check `tessera render` makes refuses them.
+    let dir = scratch("viewer-sizes");
+    for (size, limit) in [
+        ("16384x16384", "MAX_ALLOCATION_BYTES"),
+        ("20000x100", "max_texture_dimension_2d"),
+        ("100000x100000", "max_texture_dimension_2d"),
+    ] {
+        let out = view("patches/teapot.patches", &["--size", size, "--frames", "1"], &[], &dir);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{size}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{size}: {stderr}");
+        assert!(stderr.contains(&format!("error: image size {size}: ")), "{size}: {stderr}");
+        assert!(stderr.contains(limit), "{size}: {stderr}");
+    }
+}
+
+#[test]
+fn viewer_starts_in_every_scheme_its_help_and_errors_list() {
+    let dir = scratch("viewer-schemes");
+    let schemes = ["transition", "uniform", "semi-uniform", "fractional-odd", "integer"];
+    let help = common::tessera(&["view", "--help"], &dir);
+    let help = text(&help.stdout);
+    // A scheme the viewer does not show: its error names exactly the ones it does.
+    let out = view("meshes/blob.obj", &["--scheme", "sd2", "--frames", "1"], &[], &dir);
+    let refusal = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{refusal}");
+    assert!(refusal.contains(&format!("the viewer shows {}", schemes.join(", "))), "{refusal}");
+    for scheme in schemes {
+        assert!(help.contains(scheme), "--help does not name {scheme}: {help}");
+        let out = view(
+            "meshes/blob.obj",
+            &["--scheme", scheme, "--frames", "2", "--screenshot", "s.png", "--size", "160x120"],
+            &[],
+            &dir,
+        );
+        let stderr = text(&out.stderr);
+        assert!(out.status.success(), "--scheme {scheme}: {stderr}");
+        assert!(stderr.contains(&format!("after 2 frames: {scheme} ")), "{scheme}: {stderr}");
+        if scheme == "fractional-odd" || scheme == "integer" {
+            // The hardware tessellator takes a factor: the one derived from the pixel error.
+            assert!(stderr.contains("(FACTOR "), "{scheme}: {stderr}");
+        }
+    }
+}
+
+#[test]
+fn viewer_without_an_adapter_names_the_driver_packages() {
+    // No Vulkan driver to load: what a machine without mesa-vulkan-drivers sees.
+    let dir = scratch("viewer-no-adapter");
+    let hide = [("VK_ICD_FILENAMES", "/nonexistent/icd.json"), ("VK_DRIVER_FILES", "/nonexistent/icd.json")];
+    let out = view("patches/teapot.patches", &["--frames", "1"], &hide, &dir);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("mesa-vulkan-drivers libvulkan1"), "{stderr}");
+}
