@@ -19,7 +19,7 @@ use tessera::io::glb::UriScope;
 use tessera::mesh::Mesh;
 use tessera::pattern::semi_uniform::StaticPattern;
 use tessera::pattern::uniform::Uniform;
-use tessera::scheme::Scheme;
+use tessera::scheme::{Criterion, Scheme};
 use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
 use tessera::tessellator::{FrameTimings, Tessellator, TessellatorOptions};
@@ -330,6 +330,9 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     let opts = TessellateOptions { strips: a.strips, ..limits(a.max_triangles, wants_params) };
     let max_triangles = opts.max_triangles.unwrap_or(u64::MAX);
     let chosen = plan::choose(&a.criterion, &set, max_triangles)?;
+    if chosen.options.cull || !matches!(chosen.criterion, Criterion::Factor(_) | Criterion::Tolerance(_)) {
+        plan::note_up_axis(a.criterion.camera.as_deref(), &a.input);
+    }
     // Plan and engine errors alike: about a patch, they name the file; about size, they say
     // which limit.
     let explain = |e: tessera::Error| -> Box<dyn std::error::Error> {

@@ -161,13 +161,29 @@ pub fn parse_tolerance(text: &str, diagonal: f64) -> Result<f64, String> {
     Ok(if relative { v / 100.0 * diagonal } else { v })
 }
 
+/// The criterion's camera: `--camera` on the default framing camera, whose up axis is the
+/// model's (its format's convention, [`tessera::io::up_axis_of`]).
 pub fn camera(args: &CriterionArgs, set: &SurfaceSet) -> Result<Camera, tessera::Error> {
     let (lo, hi) = set.bounds();
-    let default = Camera::framing(lo, hi, 1280, 720);
+    let default = Camera::framing_up(lo, hi, 1280, 720, set.up);
     match &args.camera {
         Some(spec) => Camera::parse(spec, &default),
         None => Ok(default),
     }
+}
+
+/// Says on stderr which way is up for a default camera (`--camera` without `up=`), since the
+/// view depends on it and the convention is the format's guess: `input` names the model.
+pub fn note_up_axis(spec: Option<&str>, input: &std::path::Path) {
+    if spec.is_some_and(|s| s.split(',').any(|kv| kv.trim_start().starts_with("up="))) {
+        return;
+    }
+    let (up, why) = tessera::io::up_axis_of(input);
+    let (axis, other) = match up {
+        tessera::camera::UpAxis::Y => ("+Y", "up=0,0,1"),
+        tessera::camera::UpAxis::Z => ("+Z", "up=0,1,0"),
+    };
+    eprintln!("note: the camera takes {axis} as up ({why}); give --camera {other} if the model's up differs");
 }
 
 impl SchemeArg {

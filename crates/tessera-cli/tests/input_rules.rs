@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{scratch, tessera, text};
+use common::{data, scratch, tessera, text};
 
 /// A unit cube of six quads (outward), as OBJ and as ASCII PLY.
 fn cube(dir: &std::path::Path) -> (String, String) {
@@ -51,4 +51,23 @@ fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
     let check = tessera(&["check", &obj], &dir);
     assert!(check.status.success(), "{}", text(&check.stderr));
     assert!(text(&check.stdout).contains("boundary edges       0"), "{}", text(&check.stdout));
+}
+
+#[test]
+fn the_default_camera_takes_the_formats_up_axis_and_says_so() {
+    let dir = scratch("up-axis");
+    for (model, note) in [
+        ("meshes/spot.obj", "note: the camera takes +Y as up (the usual OBJ convention)"),
+        ("patches/teapot.patches", "note: the camera takes +Z as up"),
+    ] {
+        let input = data(model);
+        let out = tessera(&["mesh", input.to_str().unwrap(), "--pixel-error", "4"], &dir);
+        assert!(out.status.success(), "{model}: {}", text(&out.stderr));
+        assert!(text(&out.stderr).contains(note), "{model}: {}", text(&out.stderr));
+        // A camera with its own up says nothing; a factor needs no camera.
+        for args in [&["--pixel-error", "4", "--camera", "up=0,0,1"][..], &["--factor", "2"][..]] {
+            let out = tessera(&[&["mesh", input.to_str().unwrap()][..], args].concat(), &dir);
+            assert!(!text(&out.stderr).contains("as up"), "{model} {args:?}: {}", text(&out.stderr));
+        }
+    }
 }

@@ -6,6 +6,28 @@ use glam::{DVec2, DVec3};
 
 /// A perspective camera. Camera space: `x` right, `y` up, `z` the distance along the viewing
 /// direction (positive in front of the eye).
+/// Which axis points up in a model, for default cameras: a property of the file format's
+/// convention (glTF says +Y, OBJ and PLY tools mostly write +Y, Newell's patches and STL's
+/// 3D-printing world are +Z), chosen by [`crate::io::up_axis_of`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum UpAxis {
+    /// +Z up.
+    #[default]
+    Z,
+    /// +Y up.
+    Y,
+}
+
+impl UpAxis {
+    /// The axis as a unit vector.
+    pub fn vector(self) -> DVec3 {
+        match self {
+            UpAxis::Z => DVec3::Z,
+            UpAxis::Y => DVec3::Y,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     pub eye: DVec3,
@@ -50,9 +72,18 @@ impl Camera {
         Ok(())
     }
 
-    /// A camera that frames the box `[lo, hi]`: looking at its centre from the +x, −y, +z
-    /// octant (a three-quarter view), far enough that the bounding sphere fits the view.
+    /// A camera that frames the box `[lo, hi]` of a Z-up model: looking at its centre from
+    /// the +x, −y, +z octant (a three-quarter view), far enough that the bounding sphere fits
+    /// the view. [`Camera::framing_up`] with [`UpAxis::Z`].
     pub fn framing(lo: DVec3, hi: DVec3, width: u32, height: u32) -> Camera {
+        Camera::framing_up(lo, hi, width, height, UpAxis::Z)
+    }
+
+    /// A camera that frames the box `[lo, hi]` of a model whose up axis is `up`: the same
+    /// three-quarter view from the front-right and above whichever axis is up (for Z-up,
+    /// from the +x, −y, +z octant; for Y-up, from +x, +y, +z, glTF's front being +z), far
+    /// enough that the bounding sphere fits the view. Cost: O(1).
+    pub fn framing_up(lo: DVec3, hi: DVec3, width: u32, height: u32, up: UpAxis) -> Camera {
         let centre = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-9);
         let fov_y_degrees: f64 = 45.0;
@@ -60,9 +91,10 @@ impl Camera {
         let half =
             (fov_y_degrees.to_radians() / 2.0).tan().min((fov_y_degrees.to_radians() / 2.0).tan() * aspect);
         let distance = radius / half.atan().sin();
-        let direction = DVec3::new(1.0, -1.5, 0.8).normalize();
-        // Pick the up axis least aligned with the view: z for z-up models, else y.
-        let up = if direction.z.abs() < 0.9 { DVec3::Z } else { DVec3::Y };
+        let (direction, up) = match up {
+            UpAxis::Z => (DVec3::new(1.0, -1.5, 0.8).normalize(), DVec3::Z),
+            UpAxis::Y => (DVec3::new(1.0, 0.8, 1.5).normalize(), DVec3::Y),
+        };
         Camera {
             eye: centre + direction * distance,
             target: centre,
@@ -260,6 +292,23 @@ impl View {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn framing_looks_down_on_the_model_along_its_up_axis() {
+        let (lo, hi) = (DVec3::new(-1.0, -2.0, -3.0), DVec3::new(1.0, 2.0, 3.0));
+        for (up, axis) in [(UpAxis::Z, DVec3::Z), (UpAxis::Y, DVec3::Y)] {
+            let c = Camera::framing_up(lo, hi, 640, 480, up);
+            assert_eq!(c.up, axis);
+            let centre = (lo + hi) * 0.5;
+            // From above, and not along the up axis (a three-quarter view).
+            let view = (c.eye - centre).normalize();
+            assert!(view.dot(axis) > 0.2 && view.dot(axis) < 0.8, "{up:?}: {view}");
+            let (_, u, _) = c.basis();
+            assert!(u.dot(axis) > 0.5, "{up:?}: the image's up is not the model's");
+        }
+        assert_eq!(Camera::framing(lo, hi, 640, 480), Camera::framing_up(lo, hi, 640, 480, UpAxis::Z));
+    }
+
     use super::*;
 
     #[test]

@@ -95,6 +95,8 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path, options.uri_scope)?, path, options)?,
         other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };
+    let mut set = set;
+    set.up = up_axis_of(path).0;
     if set.patches.is_empty() {
         let weld = match options.weld {
             Weld::Within(eps) => format!(" (welding within {eps} merged them: use a smaller distance)"),
@@ -110,6 +112,22 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         ));
     }
     Ok(set)
+}
+
+/// The up axis of the model in `path` by its format's convention, and that convention in
+/// words (for the note a default camera prints): +Y for glTF (its specification), OBJ and
+/// PLY (what most modelling and scanning tools write: the Stanford bunny, spot); +Z for
+/// Newell's `.patches` (the teapot), `.bezt` and STL (3D printing's build axis). Cost: O(1).
+pub fn up_axis_of(path: &Path) -> (crate::camera::UpAxis, &'static str) {
+    use crate::camera::UpAxis;
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("glb" | "gltf") => (UpAxis::Y, "glTF's convention"),
+        Some("obj") => (UpAxis::Y, "the usual OBJ convention"),
+        Some("ply") => (UpAxis::Y, "the usual PLY convention"),
+        Some("stl") => (UpAxis::Z, "the usual STL convention"),
+        _ => (UpAxis::Z, "the convention of Newell's patch data"),
+    }
 }
 
 /// `set` with `split` polygons of its input recorded among its repairs.

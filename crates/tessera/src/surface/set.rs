@@ -67,6 +67,9 @@ pub struct SurfaceSet {
     pub keys: Vec<PatchKeys>,
     pub topology: Topology,
     pub repairs: Repairs,
+    /// The model's up axis, for default cameras: +Z unless the loader knows the format's
+    /// convention ([`crate::io::load`] sets it by [`crate::io::up_axis_of`]).
+    pub up: crate::camera::UpAxis,
 }
 
 /// Control-point indices of each corner and each edge (corner `e` → `e+1`) of a patch kind.
@@ -204,7 +207,7 @@ impl SurfaceSet {
         }
         let patches = kept;
         let topology = Topology::build(&keys);
-        SurfaceSet { patches, keys, topology, repairs }
+        SurfaceSet { patches, keys, topology, repairs, up: Default::default() }
     }
 
     /// Builds bicubic rational patches from a parsed patch file.
@@ -419,7 +422,7 @@ impl SurfaceSet {
                 Patch::Pn(PnTriangle::from_edge_points(p, n, e))
             })
             .collect();
-        Ok(SurfaceSet { patches, keys, topology, repairs })
+        Ok(SurfaceSet { patches, keys, topology, repairs, up: Default::default() })
     }
 
     /// Axis-aligned bounds of all control points (the surface lies inside them).
