@@ -269,6 +269,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
     let r = &set.repairs;
     let lines = [
         (r.split_polygons, "input polygons split into triangles (fans from their first corner) for PN triangles"),
+        (r.skipped_primitives, "glTF primitives left out: POINTS or LINES, not surfaces"),
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
         (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
@@ -294,6 +295,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         "dropped_zero_area_faces": r.dropped_zero_area_faces,
         "dropped_collapsed_patches": r.dropped_collapsed_patches,
         "split_polygons": r.split_polygons,
+        "skipped_primitives": r.skipped_primitives,
         "collapsed_triangles": mesh.collapsed_triangles,
         "flipped": r.flipped,
     })
@@ -771,6 +773,10 @@ fn run_check(a: CheckArgs) -> CliResult {
 fn run_demo(a: DemoArgs) -> CliResult {
     tessera::io::check_output_path(&a.output)?;
     let picture = a.picture.clone().unwrap_or_else(|| a.output.with_extension("png"));
+    // The picture is PNG bytes: a name that promises another format is refused, as render does.
+    if picture.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
+        return Err(format!("--picture {}: the picture is written as PNG: give a .png name", picture.display()).into());
+    }
     let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
     let plan = Plan::uniform(&set, a.factor)?;

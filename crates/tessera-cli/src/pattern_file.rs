@@ -44,7 +44,7 @@ pub struct PatternArgs {
     /// transition as its core factors. Default: Direct3D's max reduction of the edge factors.
     #[arg(long, value_name = "I0[,I1]", value_delimiter = ',')]
     inside: Vec<f64>,
-    /// esc: the level L (L + 1 segments per coarse edge).
+    /// esc: the level L, 0 to 6 (L + 1 segments per coarse edge; 0: the 18 coarse triangles).
     #[arg(long, value_name = "L", default_value_t = 2)]
     level: u32,
     /// esc: the insertion mask, a string of 0s and 1s applied in turn to the candidates on the
@@ -239,8 +239,9 @@ pub fn build(a: &PatternArgs) -> CmdResult<DomainPattern> {
             if domain != Domain::Quad {
                 return Err("--scheme esc is defined on bicubic (quad) patches: use --domain quad".into());
             }
-            if a.level == 0 || a.level > ESC_MAX_LEVEL {
-                return Err(format!("--level {}: use 1 to {ESC_MAX_LEVEL}", a.level).into());
+            // Level 0 is the 18 coarse triangles alone, as `tessera mesh --level 0` draws them.
+            if a.level > ESC_MAX_LEVEL {
+                return Err(format!("--level {}: use 0 to {ESC_MAX_LEVEL}", a.level).into());
             }
             if a.mask.is_empty() || !a.mask.chars().all(|c| c == '0' || c == '1') {
                 return Err(format!("--mask {:?}: use a string of 0s and 1s", a.mask).into());

@@ -257,6 +257,16 @@ fn malformed_inputs_give_typed_errors_naming_the_file() {
         ("f.gltf", json.replace("\"nodes\":[0,1]", "\"nodes\":[0,0]").into_bytes(), "appears twice"),
         ("g.gltf", json.replace("buffer%2Ebin", "missing.bin").into_bytes(), "No such file"),
         ("h.gltf", json.replace("5123", "5126").into_bytes(), "expected one of"),
+        (
+            "q.gltf",
+            json.replace("\"translation\":[10,0,0]", "\"rotation\":[0,0,0,0]").into_bytes(),
+            "glTF rotations are unit quaternions",
+        ),
+        (
+            "p.gltf",
+            json.replace("\"translation\":[10,0,0]", "\"matrix\":[1,0,0,1,0,1,0,0,0,0,1,0,0,0,0,1]").into_bytes(),
+            "projective matrix",
+        ),
         ("i.bezt", b"1\n1,2,3\n".to_vec(), "expected 10 comma-separated indices"),
         ("j.patches", b"1\n1,2\n".to_vec(), "expected 16 comma-separated indices"),
         ("k.obj", b"v 0 0 0\nf 1 2 3\n".to_vec(), "out of range"),
@@ -286,5 +296,26 @@ fn malformed_inputs_give_typed_errors_naming_the_file() {
         matches!(&err, Error::UnknownFormat { supported, .. } if supported.contains(".bezt") && supported.contains(".gltf")),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn gltf_primitives_that_are_no_surface_are_counted_not_dropped_silently() {
+    let dir = scratch("gltf-lines");
+    let (json, bin) = gltf_text(false);
+    std::fs::write(dir.join("buffer.bin"), &bin).unwrap();
+    let with_lines = json.replace(
+        "\"indices\":2}]",
+        "\"indices\":2},{\"attributes\":{\"POSITION\":0},\"indices\":2,\"mode\":1}]",
+    );
+    assert_ne!(with_lines, json, "the edit did not apply");
+    for (name, text, skipped) in [("plain.gltf", &json, 0), ("lines.gltf", &with_lines, 1)] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        // Two nodes instance the mesh: its LINES primitive counts once.
+        let set = io::load(&path, BuildOptions::default()).unwrap();
+        assert_eq!(set.repairs.skipped_primitives, skipped, "{name}");
+        assert_eq!(set.patches.len(), 4, "{name}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

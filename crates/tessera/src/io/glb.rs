@@ -444,7 +444,7 @@ impl<'a> Glb<'a> {
 /// without scenes, every mesh untransformed) are instanced with their transforms; normals,
 /// where a primitive has `NORMAL`, go through the inverse transpose, and mirroring transforms
 /// reverse the winding so that the front side stays the front. Primitives in `POINTS` or
-/// `LINES` modes are skipped; every other attribute (texture coordinates, colours, tessera's
+/// `LINES` modes are skipped and counted in [`ObjMesh::skipped_primitives`]; every other attribute (texture coordinates, colours, tessera's
 /// `_PATCH`) is ignored. Every face gets line 0 (binary data has no lines).
 ///
 /// # Errors
@@ -456,7 +456,8 @@ impl<'a> Glb<'a> {
 /// does not fit its buffer view, a position or normal that is not a finite `f32` `VEC3`, an
 /// index out of range, an index count that is not a multiple of 3, or a node that appears
 /// twice in the hierarchy; [`Error::Unsupported`] for sparse or normalized accessors, triangle
-/// strips and fans, accessors without a buffer view, a singular node transform, a scene that
+/// strips and fans, accessors without a buffer view, a singular node transform, a rotation
+/// that is not a unit quaternion, a projective node matrix, a scene that
 /// instances more than 2^27 vertices, and a file without any triangle.
 ///
 /// Cost: reads the file and at most each buffer's `byteLength` of its buffer files into
@@ -550,6 +551,7 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope:
                 if std::mem::replace(&mut visited[node.index()], true) {
                     return Err(err(format!("node {} appears twice in the scene hierarchy", node.index())));
                 }
+                check_node_transform(&node, file)?;
                 let local = glam::Mat4::from_cols_array_2d(&node.transform().matrix()).as_dmat4();
                 let world = parent * local;
                 if let Some(mesh) = node.mesh() {
@@ -563,6 +565,7 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope:
 
     let meshes: Vec<gltf::Mesh> = gltf.meshes().collect();
     let mut out = ObjMesh::default();
+    let mut skipped = std::collections::HashSet::new();
     for (mesh_index, world) in instances {
         let linear = glam::DMat3::from_mat4(world);
         let det = linear.determinant();
@@ -579,7 +582,13 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope:
             let what = format!("mesh {mesh_index} primitive {}", primitive.index());
             match primitive.mode() {
                 Mode::Triangles => {}
-                Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => continue,
+                Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => {
+                    // Counted once however many nodes instance its mesh.
+                    if skipped.insert((mesh_index, primitive.index())) {
+                        out.skipped_primitives += 1;
+                    }
+                    continue;
+                }
                 other => {
                     return Err(Error::unsupported(
                         file,
@@ -671,6 +680,43 @@ pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope:
         ));
     }
     Ok(out)
+}
+
+/// Refuses a node transform glTF does not allow and the reader would otherwise take silently:
+/// a rotation that is not a unit quaternion (a zero one turns into the identity) and a matrix
+/// whose last row is not `0 0 0 1` (a projective one: glTF node matrices must decompose into
+/// translation, rotation and scale). Cost: O(1).
+fn check_node_transform(node: &gltf::Node, file: &Path) -> Result<()> {
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => {
+            let last_row = [matrix[0][3], matrix[1][3], matrix[2][3], matrix[3][3]];
+            if last_row != [0.0, 0.0, 0.0, 1.0] {
+                return Err(Error::unsupported(
+                    file,
+                    0,
+                    format!(
+                        "node {} has a projective matrix (last row {last_row:?}, not [0, 0, 0, 1]); glTF node matrices are affine",
+                        node.index()
+                    ),
+                ));
+            }
+        }
+        gltf::scene::Transform::Decomposed { rotation, .. } => {
+            let length = rotation.iter().map(|&c| f64::from(c) * f64::from(c)).sum::<f64>().sqrt();
+            // Exporters round unit quaternions to f32; anything further off is not one.
+            if !(length.is_finite() && (length - 1.0).abs() <= 1e-3) {
+                return Err(Error::unsupported(
+                    file,
+                    0,
+                    format!(
+                        "node {} has the rotation {rotation:?} of length {length}; glTF rotations are unit quaternions",
+                        node.index()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The most vertices [`parse_gltf_triangles`] instantiates (2^27: 3 GiB of positions), far

@@ -92,7 +92,12 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
             with_split(SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&mesh), path, options)?, split)
         }
         Some("stl") => SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?,
-        Some("glb" | "gltf") => SurfaceSet::pn_from_mesh(&glb::read_gltf_triangles(path, options.uri_scope)?, path, options)?,
+        Some("glb" | "gltf") => {
+            let mesh = glb::read_gltf_triangles(path, options.uri_scope)?;
+            let mut set = SurfaceSet::pn_from_mesh(&mesh, path, options)?;
+            set.repairs.skipped_primitives = mesh.skipped_primitives;
+            set
+        }
         other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };
     let mut set = set;

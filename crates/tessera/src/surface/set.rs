@@ -56,6 +56,8 @@ pub struct Repairs {
     /// Input faces of more than three corners split into triangles (fans from their first
     /// corner; OBJ and PLY alike), since PN triangles need triangles.
     pub split_polygons: usize,
+    /// glTF primitives left out because they are no surface (`POINTS`, `LINES`).
+    pub skipped_primitives: usize,
     /// The orientation was reversed (by `Outward` or by `flip`).
     pub flipped: bool,
 }
