@@ -116,6 +116,23 @@ fn quick_bench_writes_every_table_and_counts_repeat() {
     let teapot = ratio.iter().find(|r| r["model"] == "teapot" && r["target / diagonal"] == "1e-3").unwrap();
     let share = teapot["transition"].as_f64().unwrap();
     assert!(share > 30.0 && share < 70.0, "teapot transition at 1e-3: {share} % of uniform");
+    // A scheme that met a target has a figure in the ratio table, whether or not uniform
+    // met it too (a share of uniform's, or its own count), and the fewest-triangles column
+    // names only schemes with a figure.
+    for e in first["adaptive_equal_error"]["rows"].as_array().unwrap() {
+        if e["scheme"] == "uniform" || e["triangles"].is_null() {
+            continue;
+        }
+        let row = ratio
+            .iter()
+            .find(|r| r["model"] == e["model"] && r["target / diagonal"] == e["target / diagonal"])
+            .unwrap();
+        let scheme = e["scheme"].as_str().unwrap();
+        assert!(!row[scheme].is_null(), "adaptive_ratio {row}: {scheme} met the target but shows no figure");
+        for winner in row["fewest triangles"].as_str().unwrap_or("").split(" = ").filter(|w| !w.is_empty()) {
+            assert!(!row[winner].is_null() || winner == "uniform", "{row}: winner {winner} has no figure");
+        }
+    }
 
     // Plots: SVG documents with drawn lines.
     for svg in [

@@ -71,3 +71,41 @@ fn the_default_camera_takes_the_formats_up_axis_and_says_so() {
         }
     }
 }
+
+#[test]
+fn small_inconsistencies_are_gone() {
+    let dir = scratch("small-inconsistencies");
+    // demo's picture is PNG, so a .jpg name is refused as render refuses it.
+    let out = tessera(&["demo", "--picture", "p.jpg"], &dir);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("give a .png name"), "{}", text(&out.stderr));
+    assert!(!dir.join("p.jpg").exists());
+    // ESC level 0 (the 18 coarse triangles) is a pattern as it is a mesh level.
+    let out = tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "0", "-o", "e.json"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("e.json")).unwrap()).unwrap();
+    assert_eq!(json["triangles"].as_array().unwrap().len(), 18);
+    let out = tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "7", "-o", "e.json"], &dir);
+    assert!(text(&out.stderr).contains("use 0 to 6"), "{}", text(&out.stderr));
+    // A folder is no file "without an extension".
+    std::fs::create_dir_all(dir.join("models")).unwrap();
+    let out = tessera(&["mesh", "models"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("is a folder, not an input file"), "{}", text(&out.stderr));
+    // An index too long for any integer type is out of range, not "not an integer".
+    std::fs::write(dir.join("big.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n").unwrap();
+    let out = tessera(&["mesh", "big.obj"], &dir);
+    assert!(text(&out.stderr).contains("big.obj:4"), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("out of range"), "{}", text(&out.stderr));
+}
+
+#[test]
+fn gpu_ply_output_says_it_has_no_corner_parameters() {
+    let dir = scratch("gpu-ply");
+    let input = data("patches/teapot.patches");
+    let out = tessera(&["mesh", input.to_str().unwrap(), "--factor", "2", "--engine", "gpu", "-o", "g.ply"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("g.ply has no patch_uv"), "{}", text(&out.stderr));
+    let check = tessera(&["check", "g.ply", "--against", input.to_str().unwrap()], &dir);
+    assert!(text(&check.stdout).contains("--engine cpu"), "{}", text(&check.stdout));
+}

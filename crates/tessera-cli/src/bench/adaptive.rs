@@ -352,7 +352,13 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                     share_of_uniform.map_or(Cell::None, |r| num(r, 1)),
                 ]);
                 if j > 0 {
-                    row.push(share_of_uniform.map_or(Cell::None, |r| num(r, 1)));
+                    // Where uniform misses the target there is no share to give, but a scheme
+                    // that meets it still has its count: shown as such, not as a dash.
+                    row.push(match (share_of_uniform, p) {
+                        (Some(r), _) => num(r, 1),
+                        (None, Some(p)) => Cell::text(format!("{} tri", p.triangles)),
+                        (None, None) => Cell::None,
+                    });
                 }
             }
             // Every scheme with the fewest triangles (ties, e.g. the untessellated base mesh,
@@ -382,7 +388,8 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         "For each target (a share of the model's bounding-box diagonal): uniform = the smallest factor whose measured \
          max error meets it; each other scheme = its cheapest measured tessellation that meets it (knob grid, then {} \
          bisection steps near the target); — = the scheme does not apply (SD-2: triangles only; ESC: bicubic only) or \
-         does not reach the target below {} triangles. Knobs: transition, semi-uniform (M = 8): the guaranteed \
+         does not reach the target below {} triangles; where uniform does not reach it, the others give their \
+         triangle counts (\"N tri\") instead of a share. Knobs: transition, semi-uniform (M = 8): the guaranteed \
          tolerance; SD-2, fractional-odd: f_max of the distance level function from the framing camera (f_min = \
          f_max/2, no error bound); ESC: levels 1–6 × a grid of ρ. Errors: tessera::verify::approximation_error, order 5.",
         sz.bisections, sz.max_triangles
