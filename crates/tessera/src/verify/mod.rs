@@ -423,6 +423,198 @@ pub struct ErrorReport {
     pub samples: usize,
 }
 
+/// One way a mesh's topology differs from the input it is checked against.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum TopologyMismatch {
+    /// A triangle names a patch the input does not have.
+    ForeignPatch {
+        patch: u32,
+        input_patches: usize,
+    },
+    /// The mesh carries patch ids, but of a different number of patches than the input has.
+    PatchCount {
+        mesh: usize,
+        input: usize,
+    },
+    /// The input is closed, the mesh open or non-manifold.
+    Opened,
+    /// The input is manifold, the mesh has non-manifold edges.
+    NonManifold {
+        edges: usize,
+    },
+    EulerCharacteristic {
+        mesh: i64,
+        input: i64,
+    },
+    /// Connected components (pieces joined at a vertex count as one).
+    Components {
+        mesh: usize,
+        input: usize,
+    },
+    /// Boundary loops: the connected pieces of the boundary edges (of the free curves).
+    BoundaryLoops {
+        mesh: usize,
+        input: usize,
+    },
+}
+
+impl std::fmt::Display for TopologyMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TopologyMismatch::ForeignPatch { patch, input_patches } => write!(
+                f,
+                "the mesh refers to patch {patch} but the input has {input_patches} patches: it was not made from this input"
+            ),
+            TopologyMismatch::PatchCount { mesh, input } => {
+                write!(f, "the mesh has triangles of {mesh} patches, the input has {input} patches")
+            }
+            TopologyMismatch::Opened => write!(f, "the input is closed but the mesh is open or non-manifold"),
+            TopologyMismatch::NonManifold { edges } => {
+                write!(f, "the input is manifold but the mesh has {edges} non-manifold edges")
+            }
+            TopologyMismatch::EulerCharacteristic { mesh, input } => {
+                write!(f, "the mesh's Euler characteristic is {mesh}, the input's {input}")
+            }
+            TopologyMismatch::Components { mesh, input } => {
+                write!(f, "the mesh has {mesh} connected components, the input {input}")
+            }
+            TopologyMismatch::BoundaryLoops { mesh, input } => {
+                write!(f, "the mesh has {mesh} boundary loops, the input {input}")
+            }
+        }
+    }
+}
+
+/// Union-find with path halving; the components are counted over the elements marked used.
+struct Components {
+    parent: Vec<u32>,
+    used: Vec<bool>,
+}
+
+impl Components {
+    fn new(n: usize) -> Self {
+        Components { parent: (0..n as u32).collect(), used: vec![false; n] }
+    }
+
+    fn root(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let grand = self.parent[self.parent[x as usize] as usize];
+            self.parent[x as usize] = grand;
+            x = grand;
+        }
+        x
+    }
+
+    fn join(&mut self, a: u32, b: u32) {
+        self.used[a as usize] = true;
+        self.used[b as usize] = true;
+        let (a, b) = (self.root(a), self.root(b));
+        self.parent[a.max(b) as usize] = a.min(b);
+    }
+
+    fn count(&mut self) -> usize {
+        (0..self.parent.len() as u32).filter(|&x| self.used[x as usize] && self.root(x) == x).count()
+    }
+}
+
+/// Connected components and boundary loops of `mesh` after welding bit-identical positions
+/// (as [`watertight`] does); a boundary edge is a side of one non-collapsed triangle.
+/// Cost: O(V + T) hashing, on one thread (`tessera check` calls it once).
+pub fn mesh_components_and_boundary_loops(mesh: &Mesh) -> (usize, usize) {
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.positions.len());
+    let welded: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|&p| {
+            let next = ids.len() as u32;
+            *ids.entry(position_key(p)).or_insert(next)
+        })
+        .collect();
+    let mut pieces = Components::new(ids.len());
+    let mut sides: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.indices.len());
+    for corners in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| welded[corners[k] as usize]);
+        pieces.join(a, b);
+        pieces.join(b, c);
+        if a == b || b == c || a == c {
+            continue;
+        }
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            *sides.entry((x.min(y), x.max(y))).or_insert(0) += 1;
+        }
+    }
+    let mut loops = Components::new(ids.len());
+    for (&(x, y), _) in sides.iter().filter(|(_, &n)| n == 1) {
+        loops.join(x, y);
+    }
+    (pieces.count(), loops.count())
+}
+
+/// Connected components and boundary loops of `set`'s input topology, counted as
+/// [`mesh_components_and_boundary_loops`] counts them on a mesh: patches joined at their corners,
+/// and the free (single-use, not collapsed) curves joined at their ends.
+pub fn input_components_and_boundary_loops(set: &SurfaceSet) -> (usize, usize) {
+    let topo = &set.topology;
+    let n = topo.vertex_count as usize;
+    let mut pieces = Components::new(n);
+    for (corners, domain) in topo.patch_corners.iter().zip(&topo.patch_domains) {
+        let c = &corners[..domain.corner_count()];
+        for k in 0..c.len() {
+            pieces.join(c[k], c[(k + 1) % c.len()]);
+        }
+    }
+    let mut loops = Components::new(n);
+    for (e, edge) in topo.edges.iter().enumerate() {
+        if !edge.collapsed && topo.edge_uses(e).len() == 1 {
+            loops.join(edge.ends[0], edge.ends[1]);
+        }
+    }
+    (pieces.count(), loops.count())
+}
+
+/// Every way `mesh` (with its [`watertight`] report `w`) differs in topology from `set`, the
+/// input it is said to come from: patch ids it does not have or a different number of them
+/// (where the mesh carries patch ids: any nonzero one), a closed or manifold input made open
+/// or non-manifold, the Euler characteristic, the connected components and the boundary
+/// loops. Empty when the mesh has the input's topology. Cost: that of
+/// [`mesh_components_and_boundary_loops`].
+pub fn topology_mismatches(mesh: &Mesh, w: &WatertightReport, set: &SurfaceSet) -> Vec<TopologyMismatch> {
+    let t = set.topology.report;
+    let mut found = Vec::new();
+    if let Some(&patch) = mesh.triangle_patch.iter().max() {
+        if patch as usize >= t.patches {
+            found.push(TopologyMismatch::ForeignPatch { patch, input_patches: t.patches });
+        } else if patch > 0 {
+            let mut seen = vec![false; t.patches];
+            mesh.triangle_patch.iter().for_each(|&p| seen[p as usize] = true);
+            let used = seen.iter().filter(|&&s| s).count();
+            if used != t.patches {
+                found.push(TopologyMismatch::PatchCount { mesh: used, input: t.patches });
+            }
+        }
+    }
+    if t.is_closed() && !w.is_closed() {
+        found.push(TopologyMismatch::Opened);
+    } else if t.nonmanifold_edges == 0 && w.nonmanifold_edges > 0 {
+        found.push(TopologyMismatch::NonManifold { edges: w.nonmanifold_edges });
+    }
+    if w.euler_characteristic != t.euler_characteristic {
+        found.push(TopologyMismatch::EulerCharacteristic {
+            mesh: w.euler_characteristic,
+            input: t.euler_characteristic,
+        });
+    }
+    let (mesh_pieces, mesh_loops) = mesh_components_and_boundary_loops(mesh);
+    let (input_pieces, input_loops) = input_components_and_boundary_loops(set);
+    if mesh_pieces != input_pieces {
+        found.push(TopologyMismatch::Components { mesh: mesh_pieces, input: input_pieces });
+    }
+    if mesh_loops != input_loops {
+        found.push(TopologyMismatch::BoundaryLoops { mesh: mesh_loops, input: input_loops });
+    }
+    found
+}
+
 /// Measures the approximation error: inside every triangle, at the points of an order-`order`
 /// barycentric grid (vertices excluded, `order ≥ 2`), the distance between the triangle's
 /// linear interpolation and the exact surface of the triangle's patch at the interpolated
