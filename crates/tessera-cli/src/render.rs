@@ -94,7 +94,7 @@ fn camera(args: &RenderArgs, set: &SurfaceSet) -> Result<Camera, Box<dyn std::er
     let Some(size) = &args.size else { return Ok(plan::camera(&args.criterion, set)?) };
     let (w, h) = parse_size(size)?;
     let (lo, hi) = set.bounds();
-    let default = Camera::framing(lo, hi, w, h);
+    let default = Camera::framing_up(lo, hi, w, h, set.up);
     let camera = match &args.criterion.camera {
         Some(spec) => Camera::parse(spec, &default)?,
         None => default,
@@ -310,6 +310,7 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
     }
     let set = crate::load_surfaces(&a.input, options)?;
     let engine_options = crate::limits(None, false);
+    plan::note_up_axis(a.criterion.camera.as_deref(), &a.input);
     let mut chosen = plan::choose(&a.criterion, &set, engine_options.max_triangles.unwrap_or(u64::MAX))?;
     let camera = camera(&a, &set)?;
     chosen.options.camera = Some(camera);

@@ -257,7 +257,7 @@ impl App {
 
     fn camera(&self, width: u32, height: u32) -> Camera {
         let (lo, hi) = self.set.bounds();
-        let framing = Camera::framing(lo, hi, width, height);
+        let framing = Camera::framing_up(lo, hi, width, height, self.set.up);
         let radius = (lo.distance(hi) * 0.5).max(1e-9);
         let base = framing.eye - framing.target;
         let distance = base.length() * self.orbit.zoom;

@@ -36,7 +36,7 @@ fn covered(png: &Path) -> (usize, Vec<u8>) {
 fn reference_coverage(input: &Path, scheme: Scheme, criterion: Criterion) -> usize {
     let set = tessera::io::load(input, BuildOptions::default()).unwrap();
     let (lo, hi) = set.bounds();
-    let camera = Camera::framing(lo, hi, SIZE, SIZE);
+    let camera = Camera::framing_up(lo, hi, SIZE, SIZE, set.up);
     let options = TessellatorOptions {
         plan: PlanOptions { camera: Some(camera), ..Default::default() },
         engine: Default::default(),
