@@ -10,9 +10,9 @@ fn cube(dir: &std::path::Path) -> (String, String) {
     let v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]];
     let f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]];
     let mut obj = String::new();
-    let mut ply = format!(
+    let mut ply = String::from(
         "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n\
-         element face 6\nproperty list uchar int vertex_indices\nend_header\n"
+         element face 6\nproperty list uchar int vertex_indices\nend_header\n",
     );
     for p in v {
         obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
