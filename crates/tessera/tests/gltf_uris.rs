@@ -45,29 +45,7 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
-/// One triangle's buffer: three positions and three `u16` indices (42 bytes, padded to 44).
-fn triangle_bin() -> Vec<u8> {
-    let mut bin = Vec::new();
-    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
-        bin.extend(p.iter().flat_map(|c| c.to_le_bytes()));
-    }
-    for i in [0u16, 1, 2, 0] {
-        bin.extend(i.to_le_bytes());
-    }
-    bin
-}
-
-/// A `.gltf` with one triangle whose one buffer is `uri`, of `byteLength` 44.
-fn gltf_with_uri(uri: &str) -> String {
-    format!(
-        r#"{{"asset":{{"version":"2.0"}},
-        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
-        "buffers":[{{"byteLength":44,"uri":"{uri}"}}],
-        "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
-        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
-                     {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#
-    )
-}
+use tessera::fuzzing::{one_triangle_buffer as triangle_bin, one_triangle_gltf as gltf_with_uri};
 
 fn load(path: &Path, uri_scope: UriScope) -> tessera::Result<tessera::surface::SurfaceSet> {
     io::load(path, BuildOptions { uri_scope, ..Default::default() })

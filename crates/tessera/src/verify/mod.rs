@@ -364,12 +364,11 @@ fn weld(positions: &[[f32; 3]]) -> Vec<AtomicU32> {
     welded
 }
 
-/// [`watertight`] with hash maps: for meshes of 2³¹ vertices or more, which the packed
-/// keys of the parallel version cannot hold, and as the tests' reference.
-/// Cost: O(T) hashing.
-fn watertight_hashed(mesh: &Mesh) -> WatertightReport {
+/// Every vertex's id after welding bit-identical positions, numbered in first-seen order, and
+/// the number of distinct positions. Cost: O(V) hashing, on one thread.
+fn weld_hashed(mesh: &Mesh) -> (Vec<u32>, usize) {
     let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.positions.len());
-    let welded: Vec<u32> = mesh
+    let welded = mesh
         .positions
         .iter()
         .map(|&p| {
@@ -377,10 +376,18 @@ fn watertight_hashed(mesh: &Mesh) -> WatertightReport {
             *ids.entry(position_key(p)).or_insert(next)
         })
         .collect();
+    (welded, ids.len())
+}
+
+/// [`watertight`] with hash maps: for meshes of 2³¹ vertices or more, which the packed
+/// keys of the parallel version cannot hold, and as the tests' reference.
+/// Cost: O(T) hashing.
+fn watertight_hashed(mesh: &Mesh) -> WatertightReport {
+    let (welded, distinct) = weld_hashed(mesh);
     let mut report = WatertightReport { triangles: mesh.triangle_count(), ..Default::default() };
     // Directed edge counts: (a, b) with a < b → (forward, backward).
     let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(mesh.indices.len());
-    let mut used = vec![false; ids.len()];
+    let mut used = vec![false; distinct];
     for t in 0..mesh.triangle_count() {
         let v = mesh.triangle(t).map(|i| welded[i as usize]);
         if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
@@ -521,16 +528,8 @@ impl Components {
 /// (as [`watertight`] does); a boundary edge is a side of one non-collapsed triangle.
 /// Cost: O(V + T) hashing, on one thread (`tessera check` calls it once).
 pub fn mesh_components_and_boundary_loops(mesh: &Mesh) -> (usize, usize) {
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.positions.len());
-    let welded: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|&p| {
-            let next = ids.len() as u32;
-            *ids.entry(position_key(p)).or_insert(next)
-        })
-        .collect();
-    let mut pieces = Components::new(ids.len());
+    let (welded, distinct) = weld_hashed(mesh);
+    let mut pieces = Components::new(distinct);
     let mut sides: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.indices.len());
     for corners in mesh.indices.chunks_exact(3) {
         let [a, b, c] = [0, 1, 2].map(|k| welded[corners[k] as usize]);
@@ -543,7 +542,7 @@ pub fn mesh_components_and_boundary_loops(mesh: &Mesh) -> (usize, usize) {
             *sides.entry((x.min(y), x.max(y))).or_insert(0) += 1;
         }
     }
-    let mut loops = Components::new(ids.len());
+    let mut loops = Components::new(distinct);
     for (&(x, y), _) in sides.iter().filter(|(_, &n)| n == 1) {
         loops.join(x, y);
     }
