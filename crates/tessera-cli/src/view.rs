@@ -189,23 +189,7 @@ impl App {
             ..Default::default()
         }))
         .map_err(|e| no_adapter(&e))?;
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        let features = adapter.features() & wanted;
-        let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("tessera view"),
-            required_features: features,
-            required_limits: limits.clone(),
-            ..Default::default()
-        }))
-        .map_err(|e| GpuError::Device { reason: e.to_string() })?;
-        let ctx = GpuContext {
-            device,
-            queue,
-            info: adapter.get_info(),
-            limits,
-            timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
-        };
+        let ctx = pollster::block_on(GpuContext::for_adapter(&adapter, "tessera view"))?;
         let errors = UncapturedErrors::install(&ctx.device);
         let size = window.inner_size();
         check_size(&ctx.limits, size.width, size.height, self.args.screenshot.is_some())?;

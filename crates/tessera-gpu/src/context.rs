@@ -1,5 +1,7 @@
 //! Acquiring a device: one adapter, its own limits requested, a typed error when there is none.
 
+use std::sync::{Arc, Mutex};
+
 use crate::error::{GpuError, Result};
 
 /// The packages that give a Linux machine without a GPU a software Vulkan adapter
@@ -20,6 +22,10 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     /// Whether timestamp queries inside compute passes are available (for per-pass times).
     pub timestamps: bool,
+    /// Errors wgpu reported outside any error scope, recorded by the handler
+    /// [`GpuContext::for_adapter`] installs instead of wgpu's default one, which panics;
+    /// [`GpuContext::wait`] turns the first into [`GpuError::Device`].
+    errors: Arc<Mutex<Vec<String>>>,
 }
 
 impl GpuContext {
@@ -44,11 +50,22 @@ impl GpuContext {
             .request_adapter(&options)
             .await
             .map_err(|e| GpuError::NoAdapter { reason: e.to_string() })?;
+        Self::for_adapter(&adapter, "tessera-gpu").await
+    }
+
+    /// A device on `adapter` (labelled `label`) with the adapter's own limits and, when it
+    /// has them, timestamp queries: what [`GpuContext::new`] makes, for a caller that chose
+    /// the adapter itself (a window's surface must be compatible with it). wgpu errors raised
+    /// outside an error scope are recorded, not panicked on, and reported by
+    /// [`GpuContext::wait`].
+    ///
+    /// Errors: [`GpuError::Device`] when the device cannot be created. Cost: driver start-up.
+    pub async fn for_adapter(adapter: &wgpu::Adapter, label: &str) -> Result<GpuContext> {
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
         let limits = adapter.limits();
         let descriptor = wgpu::DeviceDescriptor {
-            label: Some("tessera-gpu"),
+            label: Some(label),
             required_features: features,
             required_limits: limits.clone(),
             ..Default::default()
@@ -57,20 +74,39 @@ impl GpuContext {
             .request_device(&descriptor)
             .await
             .map_err(|e| GpuError::Device { reason: e.to_string() })?;
+        let errors: Arc<Mutex<Vec<String>>> = Arc::default();
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut log) = sink.lock() {
+                log.push(e.to_string().trim_end().to_string());
+            }
+        }));
         Ok(GpuContext {
             device,
             queue,
             info: adapter.get_info(),
             limits,
             timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            errors,
         })
     }
 
+    /// Err with the first wgpu error recorded outside an error scope since the last call
+    /// (the rest dropped), as [`GpuError::Device`]. Cost: O(1).
+    pub fn check_errors(&self) -> Result<()> {
+        let mut log = self.errors.lock().unwrap_or_else(|p| p.into_inner());
+        let first = log.drain(..).next();
+        first.map_or(Ok(()), |reason| Err(GpuError::Device { reason }))
+    }
+
     /// Waits until the queue has finished everything submitted so far. Cost: the GPU work.
+    /// A wgpu error recorded since the last check (see [`GpuContext::check_errors`]) is
+    /// returned as [`GpuError::Device`].
     pub fn wait(&self) -> Result<()> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| GpuError::Device { reason: e.to_string() })
+            .map_err(|e| GpuError::Device { reason: e.to_string() })?;
+        self.check_errors()
     }
 }
