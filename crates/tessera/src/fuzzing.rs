@@ -238,7 +238,7 @@ pub fn one_triangle_gltf(uri: &str) -> String {
 }
 
 /// Checks the outside-glTF reader on a `.gltf` file (the bytes) inside a folder of hostile
-/// buffer files ([`hostile_folder`]: short, empty, sparse-huge, a folder, links to a device,
+/// buffer files (`hostile_folder`: short, empty, sparse-huge, a folder, links to a device,
 /// outside the folder and to themselves), read with [`glb::read_gltf_triangles`] under the
 /// default [`UriScope`](glb::UriScope): it must refuse or parse, never panic, hang on a
 /// device, or read past a buffer's `byteLength`. A parsed mesh must pass the same invariants

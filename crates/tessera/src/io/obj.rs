@@ -94,7 +94,7 @@ pub(crate) fn fan(n: usize) -> impl Iterator<Item = [usize; 3]> {
 }
 
 impl ObjMesh {
-    /// Splits every face of more than three corners into triangles ([`fan`]: from its first
+    /// Splits every face of more than three corners into triangles (a fan from its first
     /// corner, corner normals alike, each keeping the face's line) and returns how many faces
     /// were split: the input of PN triangles, which need triangles, gets every format's
     /// polygons the same way, reported as a repair.

@@ -46,7 +46,7 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<Mesh> {
 }
 
 /// [`parse_ply`], also returning how many faces had more than three corners (split into
-/// triangles by [`fan`](super::obj::fan), the rule of every reader), for the repair report.
+/// triangles, fans from their first corner: the rule of every reader), for the repair report.
 /// Cost: as [`parse_ply`].
 pub fn parse_ply_counting_polygons(data: &[u8], file: &Path) -> Result<(Mesh, usize)> {
     let header = PlyHeader::parse(data, file)?;
