@@ -13,6 +13,7 @@
 
 use crate::shading::{self, ColorMode};
 use crate::{Image, RenderError};
+use std::borrow::Cow;
 use tessera::camera::Camera;
 use tessera::mesh::Mesh;
 use tessera_gpu::GpuContext;
@@ -189,19 +190,19 @@ impl MeshBuffers {
                         None => {
                             let mut interleaved = Vec::with_capacity(8 * mesh.vertex_count());
                             (0..mesh.vertex_count()).for_each(|i| vertex(&mut interleaved, i));
-                            (interleaved, mesh.indices.clone())
+                            (interleaved, Cow::Borrowed(&mesh.indices[..]))
                         }
                         Some((used, indices)) => {
                             let mut interleaved = Vec::with_capacity(8 * used.len());
                             used.iter().for_each(|&g| vertex(&mut interleaved, g as usize));
-                            (interleaved, indices)
+                            (interleaved, Cow::Owned(indices))
                         }
                     };
                     let patches = mesh.triangle_patch.get(first..end.min(mesh.triangle_patch.len()));
                     let args = [indices.len() as u32, 1, 0, 0, 0];
                     MeshPart {
                         vertices: storage("mesh vertices", bytemuck::cast_slice(&interleaved)),
-                        indices: storage("mesh indices", bytemuck::cast_slice(&indices)),
+                        indices: storage("mesh indices", bytemuck::cast_slice(&indices[..])),
                         indexed_args: storage("mesh draw args", bytemuck::cast_slice(&args)),
                         triangle_patch: storage(
                             "mesh triangle patches",
