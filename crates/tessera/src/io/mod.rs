@@ -262,7 +262,8 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 /// The file appears whole or not at all: the bytes go to a hidden temporary file beside
 /// `path` (`.NAME.tessera-partial-PID`), renamed over `path` once complete, so a failure
 /// part-way (a full disk, an error) leaves `path` as it was and removes the temporary file.
-/// A run killed part-way leaves its temporary file, never a truncated `path`. A `path` that
+/// A run killed part-way leaves its temporary file, never a truncated `path`; the next write
+/// of the same `path` removes the temporary files of processes that no longer exist. A `path` that
 /// exists and is a device or a pipe (`/dev/null`) is written directly.
 ///
 /// Cost: O(vertices + triangles) time, formatted in parallel on the rayon threads (the bytes
@@ -282,6 +283,9 @@ pub fn write_mesh_with_progress(mesh: &Mesh, path: &Path, progress: &mut dyn FnM
     // A device or pipe cannot be renamed over; a folder is left to the rename to refuse.
     let direct = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
     let target = if direct { path.to_path_buf() } else { partial_path(path) };
+    if !direct {
+        remove_stale_partials(path);
+    }
     let written = (|| {
         let file = std::fs::OpenOptions::new().write(true).create(true).truncate(!direct).open(&target)?;
         let mut counted = Counted { inner: &file, bytes: 0, progress };
@@ -299,6 +303,30 @@ pub fn write_mesh_with_progress(mesh: &Mesh, path: &Path, progress: &mut dyn FnM
 fn partial_path(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     path.with_file_name(format!(".{name}.tessera-partial-{}", std::process::id()))
+}
+
+/// Removes the temporary files that killed runs writing `path` left beside it (see
+/// [`write_mesh`]): those whose process no longer exists. A large output killed part-way
+/// would otherwise keep its gigabytes on disk until someone looks for hidden files; the next
+/// write of the same output cleans up after it. Only where a process's existence can be
+/// told (`/proc` on Linux); elsewhere nothing is removed. Errors are ignored: this is
+/// tidying, not the write. Cost: one read of the folder.
+fn remove_stale_partials(path: &Path) {
+    let (Some(name), Some(folder)) = (path.file_name(), path.parent()) else { return };
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{}.tessera-partial-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(folder) else { return };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(pid) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else { continue };
+        let alive = pid.parse::<u32>().map_or(true, |pid| Path::new(&format!("/proc/{pid}")).exists());
+        if !alive {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// About how many bytes [`write_mesh`] writes for a mesh of `vertices` and `triangles` (with
@@ -387,6 +415,42 @@ fn emit<W: Write>(mesh: &Mesh, prepared: &Prepared, w: W) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A write replaces the file through a temporary one, which it removes, and removes the
+    /// temporary files of dead writers of the same output, not those of live ones.
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn writes_are_whole_and_clean_up_after_killed_runs() {
+        let dir = std::env::temp_dir().join(format!("tessera-io-partials-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("m.ply");
+        // A process that has exited: its pid names no process now (pids are not reused at once).
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let stale = dir.join(format!(".m.ply.tessera-partial-{dead}"));
+        let live = dir.join(".m.ply.tessera-partial-1");
+        let other = dir.join(format!(".n.ply.tessera-partial-{dead}"));
+        for f in [&stale, &live, &other] {
+            std::fs::write(f, b"partial").unwrap();
+        }
+        let mesh = Mesh {
+            positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            normals: vec![[0.0, 0.0, 1.0]; 3],
+            uvs: vec![[0.0; 2]; 3],
+            vertex_patch: vec![0; 3],
+            indices: vec![0, 1, 2],
+            triangle_patch: vec![0],
+            ..Default::default()
+        };
+        write_mesh(&mesh, &out).unwrap();
+        assert!(!stale.exists(), "a dead writer's temporary file was kept");
+        assert!(live.exists() && other.exists(), "a live writer's or another output's file was removed");
+        assert!(!partial_path(&out).exists(), "the write left its own temporary file");
+        assert_eq!(read_mesh(&out).unwrap().triangle_count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
     use crate::io::binary::test_meshes::*;
     use glb::write_glb;
     use obj::write_obj;
