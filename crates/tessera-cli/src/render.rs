@@ -16,7 +16,7 @@ use tessera::mesh::Mesh;
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
-use tessera_render::{gpu, ColorMode, Drawing, Image, RenderError, RenderOptions, UncapturedErrors};
+use tessera_render::{gpu, ColorMode, Drawing, Image, RenderError, RenderOptions};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
@@ -118,18 +118,15 @@ pub struct Drawn {
     pub draw_seconds: f64,
 }
 
-/// A device for the wgpu renderer, with the errors wgpu reports outside the renderer's error
-/// scopes recorded instead of panicking (checked after each picture).
+/// A device for the wgpu renderer. Its context records the errors wgpu reports outside the
+/// renderer's error scopes instead of panicking; they are checked after each picture.
 pub struct Device {
     pub ctx: GpuContext,
-    errors: UncapturedErrors,
 }
 
 impl Device {
     fn new() -> Result<Device, GpuError> {
-        let ctx = GpuContext::new()?;
-        let errors = UncapturedErrors::install(&ctx.device);
-        Ok(Device { ctx, errors })
+        Ok(Device { ctx: GpuContext::new()? })
     }
 }
 
@@ -178,7 +175,7 @@ fn draw_uploaded(
     ctx.wait()?;
     let start = Instant::now();
     let image = gpu::render(ctx, &buffers.geometries(), camera, options, samples)?;
-    device.errors.check()?;
+    device.ctx.check_errors()?;
     let parts = match buffers.part_count() {
         1 => String::new(),
         n => format!(", the mesh in {n} parts within the adapter's binding limit"),
@@ -293,7 +290,7 @@ fn draw_gpu_engine(
     };
     let start = Instant::now();
     let image = gpu::render(ctx, &[geometry], camera, options, samples)?;
-    device.errors.check()?;
+    device.ctx.check_errors()?;
     let drawn = Drawn { image, renderer: wgpu_name(ctx), draw_seconds: start.elapsed().as_secs_f64() };
     Ok((drawn, triangles as usize))
 }

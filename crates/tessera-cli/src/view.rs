@@ -31,7 +31,7 @@ use tessera_gpu::tessellator::{PassTimer, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
 use tessera_render::instanced::InstancedDraw;
 use tessera_render::overlay::Overlay;
-use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, Renderer, UncapturedErrors};
+use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, Renderer};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -110,8 +110,6 @@ struct State {
     cpu: Option<Tessellator<'static>>,
     /// The scheme, the criterion's bits and culling the CPU tessellator was made for.
     cpu_key: (usize, u64, bool),
-    /// wgpu errors outside the renderer's scopes, recorded instead of panicking.
-    errors: UncapturedErrors,
     /// The instanced semi-uniform draw (paper 000), made on first use; Err once it cannot
     /// draw this set (mixed domains), then the CPU engine draws semi-uniform.
     instanced: Option<Result<InstancedDraw, String>>,
@@ -190,7 +188,6 @@ impl App {
         }))
         .map_err(|e| no_adapter(&e))?;
         let ctx = pollster::block_on(GpuContext::for_adapter(&adapter, "tessera view"))?;
-        let errors = UncapturedErrors::install(&ctx.device);
         let size = window.inner_size();
         check_size(&ctx.limits, size.width, size.height, self.args.screenshot.is_some())?;
         let mut config = surface
@@ -233,7 +230,6 @@ impl App {
             planned: Planned::default(),
             cpu: None,
             cpu_key: (usize::MAX, 0, false),
-            errors,
             instanced: None,
             ctx,
         })
@@ -444,7 +440,7 @@ impl App {
         state.ctx.queue.present(frame);
         // Statistics for the next frame's line (read back: see the module doc).
         state.ctx.wait()?;
-        state.errors.check()?;
+        state.ctx.check_errors()?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
         let triangles = match (triangles, &state.instanced) {
             (Some(t), _) => t as u64,

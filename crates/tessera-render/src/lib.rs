@@ -35,7 +35,6 @@ pub use shading::ColorMode;
 
 use std::future::Future;
 use std::path::Path;
-use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll, RawWaker, RawWakerVTable, Waker};
 
 /// What rendering can fail at.
@@ -55,8 +54,9 @@ pub enum RenderError {
         /// Which limit it exceeds, with the figures.
         reason: String,
     },
-    /// wgpu reported an error inside one of the renderer's error scopes ([`scoped`]) or, for a
-    /// device watched by [`UncapturedErrors`], outside any.
+    /// wgpu reported an error inside one of the renderer's error scopes ([`scoped`]). Errors
+    /// outside any scope are recorded by the [`tessera_gpu::GpuContext`] and come back as
+    /// [`RenderError::Gpu`] from its `wait` or `check_errors`.
     #[error("wgpu {kind} while {what}: {message}")]
     Wgpu {
         /// What the renderer was doing.
@@ -240,35 +240,6 @@ pub fn scoped<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Re
     match errors.iter().flatten().next() {
         Some(e) => Err(RenderError::from_wgpu(what, e)),
         None => Ok(out),
-    }
-}
-
-/// Errors wgpu reports outside any error scope on one device, recorded instead of wgpu's
-/// default handler, which panics. Install it once per device; [`UncapturedErrors::check`]
-/// after the work turns the first recorded error into [`RenderError::Wgpu`].
-#[derive(Debug, Clone, Default)]
-pub struct UncapturedErrors(Arc<Mutex<Vec<RenderError>>>);
-
-impl UncapturedErrors {
-    /// Replaces `device`'s uncaptured-error handler with one that records into the returned
-    /// log.
-    pub fn install(device: &wgpu::Device) -> UncapturedErrors {
-        let log = UncapturedErrors::default();
-        let sink = log.0.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            if let Ok(mut errors) = sink.lock() {
-                errors.push(RenderError::from_wgpu("using the GPU", &e));
-            }
-        }));
-        log
-    }
-
-    /// Err with the first error recorded since the last check (the rest dropped), Ok when
-    /// there was none.
-    pub fn check(&self) -> Result<(), RenderError> {
-        let mut errors = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        let first = errors.drain(..).next();
-        first.map_or(Ok(()), Err)
     }
 }
 

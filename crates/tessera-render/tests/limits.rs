@@ -13,7 +13,7 @@ use tessera::mesh::Mesh;
 use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::GpuContext;
-use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, UncapturedErrors, WgpuErrorKind};
+use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, WgpuErrorKind};
 
 /// The teapot at factor 8 (4032 triangles) and the camera framing it at 256 × 256.
 fn teapot() -> (Mesh, Camera) {
@@ -162,13 +162,11 @@ fn wgpu_errors_become_typed_errors_not_panics() {
         matches!(&e, RenderError::Wgpu { kind: WgpuErrorKind::Validation, what, .. } if what == "making a texture"),
         "{e}"
     );
-    // Outside any scope: recorded by the handler instead of wgpu's default, which panics.
-    let errors = UncapturedErrors::install(&ctx.device);
-    errors.check().unwrap();
+    // Outside any scope: recorded by the context instead of wgpu's default handler, which
+    // panics, and returned by its check.
     let _texture = ctx.device.create_texture(&too_wide);
-    let e = errors.check().unwrap_err();
-    assert!(matches!(e, RenderError::Wgpu { kind: WgpuErrorKind::Validation, .. }), "{e}");
-    errors.check().unwrap();
+    assert!(ctx.check_errors().is_err());
+    ctx.check_errors().unwrap();
     // And a good call in a scope is Ok.
     tessera_render::scoped(&ctx.device, "nothing", || ()).unwrap();
 }
