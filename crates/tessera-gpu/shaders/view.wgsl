@@ -74,14 +74,14 @@ struct CheckRow {
 @group(1) @binding(4) var<storage, read_write> checks: array<CheckRow>;
 
 const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
-const INTERIOR_GLOBAL: u32 = 0u;
-const INTERIOR_CORE: u32 = 1u;
-const INTERIOR_MAX_EDGE: u32 = 2u;
-const CRITERION_PIXEL_ERROR: u32 = 0u;
-const CRITERION_SILHOUETTENESS: u32 = 1u;
-const CRITERION_FIXED: u32 = 2u;
-const EDGE_RULE_INTEGER: u32 = 0u;
-const EDGE_RULE_HARDWARE: u32 = 1u;
+const INTERIOR_GLOBAL: u32 = {{INTERIOR_GLOBAL}}u;
+const INTERIOR_CORE: u32 = {{INTERIOR_CORE}}u;
+const INTERIOR_MAX_EDGE: u32 = {{INTERIOR_MAX_EDGE}}u;
+const CRITERION_PIXEL_ERROR: u32 = {{CRITERION_PIXEL_ERROR}}u;
+const CRITERION_SILHOUETTENESS: u32 = {{CRITERION_SILHOUETTENESS}}u;
+const CRITERION_FIXED: u32 = {{CRITERION_FIXED}}u;
+const EDGE_RULE_INTEGER: u32 = {{EDGE_RULE_INTEGER}}u;
+const EDGE_RULE_HARDWARE: u32 = {{EDGE_RULE_HARDWARE}}u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
 
 // `Prepared::minimum_segments` of edge e, kept in the w of its first edge row (a whole

@@ -69,6 +69,11 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
 /// [`GpuTessellator::prepare_screen`]).
 pub const PASSES: [&str; 7] = ["cull", "factors", "count", "scan", "args", "vertices", "triangles"];
 
+/// The CPU↔GPU contract test (the uniform structs against their WGSL).
+#[cfg(test)]
+#[path = "contract.rs"]
+mod contract;
+
 const COMMON: &str = include_str!("../shaders/common.wgsl");
 const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
 const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
@@ -155,7 +160,7 @@ fn partitioning_code(p: Partitioning) -> u32 {
 
 /// Constants the tessellation shaders share with this crate (and with the CPU library: the
 /// partitionings' ranges and the settling gap are `tessera::sampling::hardware`'s own).
-fn constants() -> Vec<(&'static str, u32)> {
+pub(crate) fn constants() -> Vec<(&'static str, u32)> {
     let range = |p: Partitioning, hi: bool| {
         let (lo, top) = p.range();
         let x = if hi { top } else { lo };
@@ -173,6 +178,14 @@ fn constants() -> Vec<(&'static str, u32)> {
         ("VERTEX_FLOATS", VERTEX_FLOATS),
         ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
         ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
+        ("INTERIOR_GLOBAL", INTERIOR_GLOBAL),
+        ("INTERIOR_CORE", INTERIOR_CORE),
+        ("INTERIOR_MAX_EDGE", INTERIOR_MAX_EDGE),
+        ("CRITERION_PIXEL_ERROR", CRITERION_PIXEL_ERROR),
+        ("CRITERION_SILHOUETTENESS", CRITERION_SILHOUETTENESS),
+        ("CRITERION_FIXED", CRITERION_FIXED),
+        ("EDGE_RULE_INTEGER", EDGE_RULE_INTEGER),
+        ("EDGE_RULE_HARDWARE", EDGE_RULE_HARDWARE),
         ("PARTITIONING_INTEGER", partitioning_code(Partitioning::Integer)),
         ("PARTITIONING_POW2", partitioning_code(Partitioning::Pow2)),
         ("PARTITIONING_FRACTIONAL_ODD", partitioning_code(Partitioning::FractionalOdd)),
@@ -447,10 +460,10 @@ struct CheckPipelines {
     recheck: wgpu::ComputePipeline,
 }
 
-/// `common.wgsl`'s `Params`.
+/// `common.wgsl`'s `Params` (member for member: `contract::tests` checks the offsets).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Params {
+pub(crate) struct Params {
     edges: u32,
     patches: u32,
     corners: u32,
@@ -1301,15 +1314,7 @@ impl GpuTessellator {
         };
         self.camera = Some(*camera);
         let view = camera.view();
-        let f = |x: f64| (x as f32).to_bits();
-        let v4 = |v: glam::DVec3| [f(v.x), f(v.y), f(v.z), 0];
-        let mut words = [0u32; 28];
-        words[0..4].copy_from_slice(&v4(view.eye));
-        words[4..8].copy_from_slice(&v4(view.right));
-        words[8..12].copy_from_slice(&v4(view.up));
-        words[12..16].copy_from_slice(&v4(view.forward));
-        let t = view.half_tangents;
-        words[16..20].copy_from_slice(&[f(view.near), f(view.far), f(t.x), f(t.y)]);
+        let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         let s = self.screen.unwrap_or(Screen {
             criterion: CRITERION_PIXEL_ERROR,
             pixels: 1.0,
@@ -1319,9 +1324,26 @@ impl GpuTessellator {
             interior: INTERIOR_GLOBAL,
             edge_rule: EDGE_RULE_INTEGER,
         });
-        words[20..24].copy_from_slice(&[f(view.focal_pixels), f(s.pixels), f(s.cap), s.interior]);
-        words[24..28].copy_from_slice(&[s.criterion, f(s.lo), f(s.hi), s.edge_rule]);
-        ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::cast_slice(&words));
+        let t = view.half_tangents;
+        let uniform = ViewUniform {
+            eye: v4(view.eye),
+            right: v4(view.right),
+            up: v4(view.up),
+            forward: v4(view.forward),
+            near: view.near as f32,
+            far: view.far as f32,
+            tan_x: t.x as f32,
+            tan_y: t.y as f32,
+            focal: view.focal_pixels as f32,
+            pixels: s.pixels as f32,
+            cap: s.cap as f32,
+            interior_rule: s.interior,
+            criterion: s.criterion,
+            lo: s.lo as f32,
+            hi: s.hi as f32,
+            edge_rule: s.edge_rule,
+        };
+        ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
     /// Reads the plan the last frame drew back from the device: the uploaded one, or the
@@ -1459,7 +1481,31 @@ pub struct ScreenCriterion {
     pub capacity: Option<Capacity>,
 }
 
-/// `view.wgsl`'s interior rules, criteria and edge rules.
+/// `view.wgsl`'s `View` uniform (member for member: `contract::tests` checks the offsets):
+/// the camera's basis and frustum, and the screen criterion of the frame.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ViewUniform {
+    eye: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    forward: [f32; 4],
+    near: f32,
+    far: f32,
+    tan_x: f32,
+    tan_y: f32,
+    focal: f32,
+    pixels: f32,
+    cap: f32,
+    interior_rule: u32,
+    criterion: u32,
+    lo: f32,
+    hi: f32,
+    edge_rule: u32,
+}
+
+/// `view.wgsl`'s interior rules, criteria and edge rules (substituted into it by
+/// [`constants`], so they are typed here only).
 const INTERIOR_GLOBAL: u32 = 0;
 const INTERIOR_CORE: u32 = 1;
 const INTERIOR_MAX_EDGE: u32 = 2;
@@ -1543,7 +1589,7 @@ impl ViewBuffers {
     ) -> ViewBuffers {
         use wgpu::BufferUsages as U;
         let patches = set.patches.len() as u64;
-        let uniform = buffer(device, "view", 112, U::UNIFORM | U::COPY_DST);
+        let uniform = buffer(device, "view", std::mem::size_of::<ViewUniform>() as u64, U::UNIFORM | U::COPY_DST);
         let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
         let proposals = buffer(device, "proposals", 16 * patches, U::STORAGE);
         let state = buffer(device, "frame state", 32, U::STORAGE | U::COPY_DST | U::COPY_SRC);
