@@ -123,8 +123,8 @@ struct MeshArgs {
     /// --cull and a pixel error (uniform, transition; --max-factor up to 64), silhouetteness,
     /// or a hardware scheme's --factor, the GPU plans the frame from the camera itself, else
     /// it draws the CPU's plan; --stats adds per-pass GPU times).
-    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
-    engine: String,
+    #[arg(long, value_enum, default_value = "cpu")]
+    engine: plan::EngineArg,
     /// Let -o name the input file itself (it is replaced once the new mesh is complete).
     #[arg(long)]
     force: bool,
@@ -268,7 +268,10 @@ fn ratio(x: f64) -> String {
 fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
     let r = &set.repairs;
     let lines = [
-        (r.split_polygons, "input polygons split into triangles (fans from their first corner) for PN triangles"),
+        (
+            r.split_polygons,
+            "input polygons split into triangles (fans from their first corner) for PN triangles",
+        ),
         (r.skipped_primitives, "glTF primitives left out: POINTS or LINES, not surfaces"),
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
@@ -353,7 +356,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     // median then measures tessellation, not page faults.
     let mut frames = Vec::new();
     // The GPU engine takes the first frame's plan; only it repeats.
-    let cpu_frames = if a.engine == "gpu" { 1 } else { a.repeat.max(1) };
+    let cpu_frames = if a.engine == plan::EngineArg::Gpu { 1 } else { a.repeat.max(1) };
     for frame in 0..cpu_frames {
         let layout = tess.plan_frame(chosen.options.camera.as_ref()).map_err(explain)?;
         if frame == 0 {
@@ -400,7 +403,7 @@ fn run_mesh(a: MeshArgs) -> CliResult {
     let mut gpu_mesh = Mesh::default();
     let mut gpu_times = Vec::new();
     let mut gpu_run = None;
-    if a.engine == "gpu" {
+    if a.engine == plan::EngineArg::Gpu {
         if a.measure_error || a.strips {
             return Err(
                 "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips"
@@ -570,7 +573,11 @@ const ANNOUNCED_TRIANGLES: u64 = 20_000_000;
 /// Says on stderr, before the frame is written, how large a large output will be: its counts,
 /// its memory and (with `-o`) about its file size, so a run that will take a while and a lot
 /// of disk never starts without a word.
-fn announce_large_output(layout: &tessera::engine::layout::Layout, opts: &TessellateOptions, out: Option<&Path>) {
+fn announce_large_output(
+    layout: &tessera::engine::layout::Layout,
+    opts: &TessellateOptions,
+    out: Option<&Path>,
+) {
     let (vertices, triangles) = (layout.vertex_count() as u64, layout.triangle_count() as u64);
     if triangles < ANNOUNCED_TRIANGLES {
         return;
@@ -778,7 +785,11 @@ fn run_demo(a: DemoArgs) -> CliResult {
     let picture = a.picture.clone().unwrap_or_else(|| a.output.with_extension("png"));
     // The picture is PNG bytes: a name that promises another format is refused, as render does.
     if picture.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
-        return Err(format!("--picture {}: the picture is written as PNG: give a .png name", picture.display()).into());
+        return Err(format!(
+            "--picture {}: the picture is written as PNG: give a .png name",
+            picture.display()
+        )
+        .into());
     }
     let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());

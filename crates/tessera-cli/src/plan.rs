@@ -124,9 +124,25 @@ pub struct CriterionArgs {
     /// closed mesh.
     #[arg(long)]
     pub cull: bool,
-    /// Keep every patch: the default (kept so that older command lines still run).
-    #[arg(long, hide = true, conflicts_with = "cull")]
-    pub no_cull: bool,
+}
+
+/// Which engine tessellates (`--engine`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EngineArg {
+    /// The CPU engine (rayon).
+    Cpu,
+    /// The GPU engine (tessera-gpu on wgpu).
+    Gpu,
+}
+
+impl std::fmt::Display for EngineArg {
+    /// The command-line name, as messages and `--stats` print it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            EngineArg::Cpu => "cpu",
+            EngineArg::Gpu => "gpu",
+        })
+    }
 }
 
 /// A plan, its scheme and pattern, a one-line description, and the guarantee report where

@@ -64,8 +64,8 @@ pub struct RenderArgs {
     color: ColorArg,
     /// Engine: `cpu` (the CPU mesh, uploaded) or `gpu` (tessellated by tessera-gpu and drawn
     /// from its buffers, no read-back between the two).
-    #[arg(long, default_value = "cpu", value_parser = ["cpu", "gpu"])]
-    engine: String,
+    #[arg(long, value_enum, default_value = "cpu")]
+    engine: plan::EngineArg,
     /// Renderer.
     #[arg(long, value_enum, default_value = "auto")]
     renderer: RendererArg,
@@ -311,10 +311,10 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
     let mut chosen = plan::choose(&a.criterion, &set, engine_options.max_triangles.unwrap_or(u64::MAX))?;
     let camera = camera(&a, &set)?;
     chosen.options.camera = Some(camera);
-    if a.engine == "gpu" && a.renderer == RendererArg::Cpu {
+    if a.engine == plan::EngineArg::Gpu && a.renderer == RendererArg::Cpu {
         return Err("--engine gpu draws the GPU engine's buffers: it needs --renderer wgpu or auto".into());
     }
-    let device = if a.engine == "gpu" { Ok(Device::new()?) } else { context(a.renderer)? };
+    let device = if a.engine == plan::EngineArg::Gpu { Ok(Device::new()?) } else { context(a.renderer)? };
     check_size(&camera, &device, a.msaa)?;
     let start = Instant::now();
     let mut tess = Tessellator::new(
@@ -336,7 +336,7 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
         },
     };
     let (drawn, triangles) = match &device {
-        Ok(device) if a.engine == "gpu" => {
+        Ok(device) if a.engine == plan::EngineArg::Gpu => {
             let pattern = tess.pattern().expect("a frame was planned");
             draw_gpu_engine(device, &set, plan, pattern, &levels, &camera, &render_options, a.msaa)?
         }

@@ -151,7 +151,11 @@ fn bad_input_gives_one_clear_line() {
     std::fs::write(dir.join("quad.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
     let quad = tessera(&["mesh", "quad.obj"], &dir);
     assert!(quad.status.success(), "{}", text(&quad.stderr));
-    assert!(text(&quad.stderr).contains("repair: 1 input polygons split into triangles"), "{}", text(&quad.stderr));
+    assert!(
+        text(&quad.stderr).contains("repair: 1 input polygons split into triangles"),
+        "{}",
+        text(&quad.stderr)
+    );
     let missing = tessera(&["mesh", "does-not-exist.patches"], &dir);
     assert_eq!(missing.status.code(), Some(2));
     assert!(text(&missing.stderr).contains("does-not-exist.patches"));
@@ -215,19 +219,11 @@ fn pixel_error_keeps_closed_inputs_closed_unless_asked_to_cull() {
     let torus = data("bench/torus_64x32.patches");
     let cam = "eye=0,-3,1.5,target=0,0,0,fov=50,size=800x600";
     let t = torus.to_str().unwrap();
-    for extra in [&[][..], &["--no-cull"][..]] {
-        let mut args = vec!["mesh", t, "--pixel-error", "1", "--camera", cam, "--stats"];
-        args.extend_from_slice(extra);
-        let (v, err) = stats(&args, &dir);
-        assert_eq!(
-            (v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()),
-            (Some(0), Some(0)),
-            "{v}"
-        );
-        assert_eq!(v["culled_patches"], 0);
-        assert_eq!(v["euler_characteristic"], 0);
-        assert!(!err.contains("cull"), "{err}");
-    }
+    let (v, err) = stats(&["mesh", t, "--pixel-error", "1", "--camera", cam, "--stats"], &dir);
+    assert_eq!((v["boundary_edges"].as_u64(), v["nonmanifold_edges"].as_u64()), (Some(0), Some(0)), "{v}");
+    assert_eq!(v["culled_patches"], 0);
+    assert_eq!(v["euler_characteristic"], 0);
+    assert!(!err.contains("cull"), "{err}");
     let (v, err) = stats(&["mesh", t, "--pixel-error", "1", "--camera", cam, "--cull", "--stats"], &dir);
     let culled = v["culled_patches"].as_u64().unwrap();
     assert!(culled > 0, "back faces of the torus are culled: {v}");
@@ -310,7 +306,6 @@ fn sd2_with_strips_writes_a_closed_ply_whose_strips_decode_to_its_faces() {
             "sd2",
             "--silhouette",
             "1:7",
-            "--no-cull",
             "--strips",
             "-o",
             "cow.ply",

@@ -44,7 +44,11 @@ fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
         assert_eq!(v["repairs"]["split_polygons"], 6, "{input}");
         assert_eq!(v["patches"], 12, "{input}");
         assert_eq!(v["boundary_edges"], 0, "{input}: the split cube is not closed");
-        results.push((v["triangles"].clone(), v["vertices"].clone(), std::fs::read(dir.join("out.ply")).unwrap()));
+        results.push((
+            v["triangles"].clone(),
+            v["vertices"].clone(),
+            std::fs::read(dir.join("out.ply")).unwrap(),
+        ));
     }
     assert_eq!(results[0], results[1], "OBJ and PLY quads gave different meshes");
     // The checker reads OBJ polygons by the same rule.
@@ -81,11 +85,14 @@ fn small_inconsistencies_are_gone() {
     assert!(text(&out.stderr).contains("give a .png name"), "{}", text(&out.stderr));
     assert!(!dir.join("p.jpg").exists());
     // ESC level 0 (the 18 coarse triangles) is a pattern as it is a mesh level.
-    let out = tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "0", "-o", "e.json"], &dir);
+    let out =
+        tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "0", "-o", "e.json"], &dir);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("e.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("e.json")).unwrap()).unwrap();
     assert_eq!(json["triangles"].as_array().unwrap().len(), 18);
-    let out = tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "7", "-o", "e.json"], &dir);
+    let out =
+        tessera(&["pattern", "--scheme", "esc", "--domain", "quad", "--level", "7", "-o", "e.json"], &dir);
     assert!(text(&out.stderr).contains("use 0 to 6"), "{}", text(&out.stderr));
     // A folder is no file "without an extension".
     std::fs::create_dir_all(dir.join("models")).unwrap();
@@ -103,7 +110,8 @@ fn small_inconsistencies_are_gone() {
 fn gpu_ply_output_says_it_has_no_corner_parameters() {
     let dir = scratch("gpu-ply");
     let input = data("patches/teapot.patches");
-    let out = tessera(&["mesh", input.to_str().unwrap(), "--factor", "2", "--engine", "gpu", "-o", "g.ply"], &dir);
+    let out =
+        tessera(&["mesh", input.to_str().unwrap(), "--factor", "2", "--engine", "gpu", "-o", "g.ply"], &dir);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("g.ply has no patch_uv"), "{}", text(&out.stderr));
     let check = tessera(&["check", "g.ply", "--against", input.to_str().unwrap()], &dir);

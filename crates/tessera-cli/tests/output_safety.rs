@@ -52,7 +52,11 @@ fn culled_output_holds_only_used_vertices_and_stats_count_them() {
         assert!(v["culled_patches"].as_u64().unwrap() > 0, "{model}: nothing culled, the test tests nothing");
         let (vertices, used) = ply_vertex_use(&dir.join("c.ply"));
         assert_eq!(used, vertices, "{model} on {engine}: {} of {vertices} vertices unused", vertices - used);
-        assert_eq!(v["vertices"].as_u64().unwrap() as usize, vertices, "{model} on {engine}: --stats vertices");
+        assert_eq!(
+            v["vertices"].as_u64().unwrap() as usize,
+            vertices,
+            "{model} on {engine}: --stats vertices"
+        );
     }
 }
 
@@ -92,8 +96,10 @@ fn a_write_replaces_the_file_whole_and_leaves_nothing_else() {
     std::fs::write(dir.join("t.ply"), b"old contents").unwrap();
     let out = tessera(&["mesh", input.to_str().unwrap(), "-o", "t.ply", "--factor", "4"], &dir);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let names: Vec<String> =
-        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(names, vec!["t.ply".to_string()], "a temporary file was left behind: {names:?}");
     assert!(std::fs::read(dir.join("t.ply")).unwrap().starts_with(b"ply\n"));
     // A folder in the output's place: the finished file cannot replace it; the folder and
@@ -104,8 +110,10 @@ fn a_write_replaces_the_file_whole_and_leaves_nothing_else() {
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("d.ply"), "{}", text(&out.stderr));
     assert!(dir.join("d.ply/keep").exists());
-    let names: Vec<String> =
-        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(names.len(), 2, "a temporary file was left behind: {names:?}");
 }
 

@@ -29,10 +29,9 @@ fn wgsl_struct(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
         .find(|ty| ty.name.as_deref() == Some(name))
         .unwrap_or_else(|| panic!("no struct {name} in the WGSL"));
     match &ty.inner {
-        naga::TypeInner::Struct { members, span } => (
-            members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
-            *span,
-        ),
+        naga::TypeInner::Struct { members, span } => {
+            (members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(), *span)
+        }
         other => panic!("{name} is not a struct: {other:?}"),
     }
 }
@@ -105,13 +104,15 @@ fn the_codes_the_shaders_compare_against_come_from_rust() {
             ref other => panic!("{name} = {other:?}"),
         }
     };
-    for (name, rust) in constants().into_iter().filter(|(n, _)| {
-        ["INTERIOR_", "CRITERION_", "EDGE_RULE_"].iter().any(|p| n.starts_with(p))
-    }) {
+    for (name, rust) in constants()
+        .into_iter()
+        .filter(|(n, _)| ["INTERIOR_", "CRITERION_", "EDGE_RULE_"].iter().any(|p| n.starts_with(p)))
+    {
         assert_eq!(value(name), rust, "{name}");
     }
     // Distinct codes: two rules with one code would be one rule to the shader.
-    let mut codes: Vec<(&str, u32)> = constants().into_iter().filter(|(n, _)| n.starts_with("INTERIOR_")).collect();
+    let mut codes: Vec<(&str, u32)> =
+        constants().into_iter().filter(|(n, _)| n.starts_with("INTERIOR_")).collect();
     codes.sort_by_key(|&(_, v)| v);
     codes.dedup_by_key(|&mut (_, v)| v);
     assert_eq!(codes.len(), 3, "{codes:?}");

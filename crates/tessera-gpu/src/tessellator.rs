@@ -1589,7 +1589,8 @@ impl ViewBuffers {
     ) -> ViewBuffers {
         use wgpu::BufferUsages as U;
         let patches = set.patches.len() as u64;
-        let uniform = buffer(device, "view", std::mem::size_of::<ViewUniform>() as u64, U::UNIFORM | U::COPY_DST);
+        let uniform =
+            buffer(device, "view", std::mem::size_of::<ViewUniform>() as u64, U::UNIFORM | U::COPY_DST);
         let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
         let proposals = buffer(device, "proposals", 16 * patches, U::STORAGE);
         let state = buffer(device, "frame state", 32, U::STORAGE | U::COPY_DST | U::COPY_SRC);

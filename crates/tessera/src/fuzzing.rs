@@ -197,7 +197,8 @@ fn hostile_folder() -> &'static Path {
         let model = root.join("model");
         std::fs::create_dir_all(model.join("sub")).expect("a temporary folder");
         let ok = one_triangle_buffer();
-        let write = |name: &str, bytes: &[u8]| std::fs::write(model.join(name), bytes).expect("a temporary file");
+        let write =
+            |name: &str, bytes: &[u8]| std::fs::write(model.join(name), bytes).expect("a temporary file");
         write("ok.bin", &ok);
         write("short.bin", &ok[..4]);
         write("empty.bin", &[]);
@@ -209,7 +210,9 @@ fn hostile_folder() -> &'static Path {
             .expect("a sparse file");
         std::fs::write(root.join("outside.bin"), &ok).expect("a temporary file");
         #[cfg(unix)]
-        for (link, target) in [("zero.bin", "/dev/zero"), ("out.bin", "../outside.bin"), ("loop.bin", "loop.bin")] {
+        for (link, target) in
+            [("zero.bin", "/dev/zero"), ("out.bin", "../outside.bin"), ("loop.bin", "loop.bin")]
+        {
             let _ = std::os::unix::fs::symlink(target, model.join(link));
         }
         model
@@ -245,7 +248,8 @@ pub fn one_triangle_gltf(uri: &str) -> String {
 /// as [`check_gltf`]'s.
 pub fn check_gltf_folder(data: &[u8]) {
     // A file per thread, so parallel tests do not read each other's half-written inputs.
-    let path = hostile_folder().join(format!("input-{:?}.gltf", std::thread::current().id()).replace(['(', ')'], ""));
+    let path = hostile_folder()
+        .join(format!("input-{:?}.gltf", std::thread::current().id()).replace(['(', ')'], ""));
     std::fs::write(&path, data).expect("a temporary file");
     let read = glb::read_gltf_triangles(&path, glb::UriScope::ModelFolder);
     let _ = std::fs::remove_file(&path);

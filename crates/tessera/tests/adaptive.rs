@@ -123,8 +123,8 @@ fn projected_error(mesh: &Mesh, set: &SurfaceSet, camera: &Camera) -> f64 {
     worst
 }
 
-/// For seeded random cameras: the output is watertight (exactly the input's topology with
-/// `--no-cull`; with culling, open only along culled neighbours), and the measured projected
+/// For seeded random cameras: the output is watertight (exactly the input's topology
+/// without culling; with culling, open only along culled neighbours), and the measured projected
 /// error of visible patches stays under the requested pixels.
 #[test]
 fn screen_space_bounds_hold_for_random_cameras_on_the_fast_models() {

@@ -88,7 +88,13 @@ fn buffer_uris_are_bounded_confined_and_named() {
     // Refusals: (file, uri, scope, what the message must say besides both paths).
     let outside_uri = "..%2Foutside.bin";
     let mut cases: Vec<(&str, String, UriScope, &str, PathBuf)> = vec![
-        ("up.gltf", outside_uri.to_string(), UriScope::ModelFolder, "outside the model's folder", outside.clone()),
+        (
+            "up.gltf",
+            outside_uri.to_string(),
+            UriScope::ModelFolder,
+            "outside the model's folder",
+            outside.clone(),
+        ),
         (
             "abs.gltf",
             outside.display().to_string(),
@@ -96,17 +102,53 @@ fn buffer_uris_are_bounded_confined_and_named() {
             "outside the model's folder",
             outside.clone(),
         ),
-        ("passwd.gltf", "../../../../../../../../etc/passwd".into(), UriScope::ModelFolder, "outside", "/etc/passwd".into()),
+        (
+            "passwd.gltf",
+            "../../../../../../../../etc/passwd".into(),
+            UriScope::ModelFolder,
+            "outside",
+            "/etc/passwd".into(),
+        ),
         ("sub.gltf", "sub".into(), UriScope::Anywhere, "not a regular file", model.join("sub")),
-        ("short.gltf", "short.bin".into(), UriScope::ModelFolder, "declares 44 bytes", model.join("short.bin")),
-        ("missing.gltf", "missing.bin".into(), UriScope::ModelFolder, "cannot find it", model.join("missing.bin")),
-        ("dev.gltf", "/dev/zero".into(), UriScope::ModelFolder, "outside the model's folder", "/dev/zero".into()),
+        (
+            "short.gltf",
+            "short.bin".into(),
+            UriScope::ModelFolder,
+            "declares 44 bytes",
+            model.join("short.bin"),
+        ),
+        (
+            "missing.gltf",
+            "missing.bin".into(),
+            UriScope::ModelFolder,
+            "cannot find it",
+            model.join("missing.bin"),
+        ),
+        (
+            "dev.gltf",
+            "/dev/zero".into(),
+            UriScope::ModelFolder,
+            "outside the model's folder",
+            "/dev/zero".into(),
+        ),
         ("devany.gltf", "/dev/zero".into(), UriScope::Anywhere, "not a regular file", "/dev/zero".into()),
     ];
     #[cfg(unix)]
     {
-        cases.push(("link.gltf", "link.bin".into(), UriScope::ModelFolder, "outside the model's folder", outside.clone()));
-        cases.push(("zero.gltf", "zero.bin".into(), UriScope::Anywhere, "not a regular file", "/dev/zero".into()));
+        cases.push((
+            "link.gltf",
+            "link.bin".into(),
+            UriScope::ModelFolder,
+            "outside the model's folder",
+            outside.clone(),
+        ));
+        cases.push((
+            "zero.gltf",
+            "zero.bin".into(),
+            UriScope::Anywhere,
+            "not a regular file",
+            "/dev/zero".into(),
+        ));
     }
     for (name, uri, scope, needle, named) in cases {
         let path = write(name, &uri);
@@ -117,7 +159,11 @@ fn buffer_uris_are_bounded_confined_and_named() {
         let message = err.to_string();
         assert!(message.contains(&path.display().to_string()), "{name}: {message} does not name the .gltf");
         let named = named.canonicalize().unwrap_or(named);
-        assert!(message.contains(&named.display().to_string()), "{name}: {message} does not name {}", named.display());
+        assert!(
+            message.contains(&named.display().to_string()),
+            "{name}: {message} does not name {}",
+            named.display()
+        );
         assert!(message.contains(needle), "{name}: {message} lacks {needle:?}");
         assert!(
             matches!(err, Error::Unsupported { .. } | Error::Parse { .. } | Error::Referenced { .. }),
@@ -142,7 +188,9 @@ fn inputs_that_are_not_regular_files_are_refused_by_name() {
     assert!(err.to_string().contains("is a folder"), "{err}");
     let folder_obj = dir.join("folder.obj");
     std::fs::create_dir_all(&folder_obj).unwrap();
-    for err in [io::load(&folder_obj, BuildOptions::default()).unwrap_err(), io::read_mesh(&folder_obj).unwrap_err()] {
+    for err in
+        [io::load(&folder_obj, BuildOptions::default()).unwrap_err(), io::read_mesh(&folder_obj).unwrap_err()]
+    {
         assert!(err.to_string().contains("is a folder"), "{err}");
     }
     #[cfg(unix)]

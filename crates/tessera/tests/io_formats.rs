@@ -264,7 +264,8 @@ fn malformed_inputs_give_typed_errors_naming_the_file() {
         ),
         (
             "p.gltf",
-            json.replace("\"translation\":[10,0,0]", "\"matrix\":[1,0,0,1,0,1,0,0,0,0,1,0,0,0,0,1]").into_bytes(),
+            json.replace("\"translation\":[10,0,0]", "\"matrix\":[1,0,0,1,0,1,0,0,0,0,1,0,0,0,0,1]")
+                .into_bytes(),
             "projective matrix",
         ),
         ("i.bezt", b"1\n1,2,3\n".to_vec(), "expected 10 comma-separated indices"),

@@ -477,7 +477,12 @@ pub fn read_gltf_triangles(path: &Path, scope: UriScope) -> Result<ObjMesh> {
 /// and assumes the component type.
 ///
 /// Cost: O(`data.len()` + buffers + instanced triangles).
-pub fn parse_gltf_triangles(data: &[u8], file: &Path, dir: Option<&Path>, scope: UriScope) -> Result<ObjMesh> {
+pub fn parse_gltf_triangles(
+    data: &[u8],
+    file: &Path,
+    dir: Option<&Path>,
+    scope: UriScope,
+) -> Result<ObjMesh> {
     let err = |reason: String| Error::parse(file, 0, reason);
     // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
     // (an overflow panic with overflow checks on), so a shorter length is refused here.
@@ -824,8 +829,9 @@ fn resolve_uri(
         let Some((_, payload)) = rest.split_once(";base64,") else {
             return Err(refuse("a data: URI that is not base64".into()));
         };
-        return decode_base64(payload)
-            .ok_or_else(|| Error::parse(file, 0, format!("buffer {index}: a data: URI holds invalid base64")));
+        return decode_base64(payload).ok_or_else(|| {
+            Error::parse(file, 0, format!("buffer {index}: a data: URI holds invalid base64"))
+        });
     }
     if uri.contains("://") {
         return Err(refuse(format!("URI `{uri}` is not a local file")));
@@ -856,10 +862,7 @@ fn resolve_uri(
     }
     let metadata = std::fs::metadata(&resolved).map_err(|e| cannot("cannot read it", e))?;
     if !metadata.is_file() {
-        return Err(refuse(format!(
-            "URI `{uri}` names {}, which is not a regular file",
-            resolved.display()
-        )));
+        return Err(refuse(format!("URI `{uri}` names {}, which is not a regular file", resolved.display())));
     }
     if metadata.len() < byte_length as u64 {
         return Err(Error::parse(
@@ -1284,7 +1287,9 @@ mod tests {
     #[test]
     fn gltf_reader_reads_tessera_output_and_refuses_short_headers() {
         let mesh = grid(3, true);
-        let read = parse_gltf_triangles(&bytes(|w| write_glb(&mesh, w)), label(), None, UriScope::ModelFolder).unwrap();
+        let read =
+            parse_gltf_triangles(&bytes(|w| write_glb(&mesh, w)), label(), None, UriScope::ModelFolder)
+                .unwrap();
         let positions: Vec<[f32; 3]> = read.positions.iter().map(|p| p.as_vec3().to_array()).collect();
         assert_eq!(positions, mesh.positions);
         let indices: Vec<u32> = read.faces.iter().flat_map(|f| f.positions.clone()).collect();

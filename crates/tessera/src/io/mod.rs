@@ -195,7 +195,9 @@ pub(crate) fn read_input(path: &Path) -> Result<Vec<u8>> {
 /// here (its extension is judged first, then reading it fails).
 fn refuse_folder(path: &Path) -> Result<()> {
     match std::fs::metadata(path) {
-        Ok(metadata) if metadata.is_dir() => Err(Error::unsupported(path, 0, "is a folder, not an input file")),
+        Ok(metadata) if metadata.is_dir() => {
+            Err(Error::unsupported(path, 0, "is a folder, not an input file"))
+        }
         _ => Ok(()),
     }
 }
@@ -203,7 +205,8 @@ fn refuse_folder(path: &Path) -> Result<()> {
 /// Refuses an input `path` that is not a regular file (see [`read_input`]).
 fn check_input_file(path: &Path) -> Result<()> {
     refuse_folder(path)?;
-    let metadata = std::fs::metadata(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let metadata =
+        std::fs::metadata(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     if !metadata.is_file() {
         return Err(Error::unsupported(path, 0, "is not a regular file (a device, pipe or socket)"));
     }

@@ -355,7 +355,12 @@ impl At<'_> {
         let i = match token.parse::<i64>() {
             Ok(i) => i,
             // An integer too long for i64 is out of range, not malformed.
-            Err(e) if matches!(e.kind(), std::num::IntErrorKind::PosOverflow | std::num::IntErrorKind::NegOverflow) => {
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::num::IntErrorKind::PosOverflow | std::num::IntErrorKind::NegOverflow
+                ) =>
+            {
                 let (s, are) = if count == 1 { ("", "is") } else { ("s", "are") };
                 return Err(self.err(what(&format!(
                     "{name} index {token} is out of range: only {count} {name}{s} (`{kw}`) {are} \
@@ -851,7 +856,11 @@ mod tests {
         assert_parse_err(&e("f 1//1 2//-0 3//1\n"), 5, "normal index is 0");
         assert_parse_err(&e("f 1/1 2/1 3/1\n"), 5, "texture coordinate index 1");
         assert_parse_err(&e("f 1 2 -9223372036854775808\n"), 5, "out of range");
-        assert_parse_err(&e("f 1 2 99999999999999999999\n"), 5, "index 99999999999999999999 is out of range: only 3");
+        assert_parse_err(
+            &e("f 1 2 99999999999999999999\n"),
+            5,
+            "index 99999999999999999999 is out of range: only 3",
+        );
         assert_parse_err(&e("f 1 2 -99999999999999999999\n"), 5, "out of range");
         // Indices refer to what is defined so far, not to later lines.
         assert_parse_err("v 0 0 0\nv 0 0 0\nf 1 2 3\nv 0 0 0\n", 3, "only 2 positions");

@@ -423,7 +423,12 @@ enum FaceRole {
     Skip,
 }
 
-fn read_ply_body(header: &PlyHeader, src: &mut impl Source, file: &Path, polygons: &mut usize) -> Result<Mesh> {
+fn read_ply_body(
+    header: &PlyHeader,
+    src: &mut impl Source,
+    file: &Path,
+    polygons: &mut usize,
+) -> Result<Mesh> {
     let Some(vertex) = header.elements.iter().find(|e| e.name == "vertex") else {
         return Err(Error::parse(file, 0, "PLY header declares no vertex element"));
     };

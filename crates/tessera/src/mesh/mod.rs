@@ -1,6 +1,5 @@
 //! Output mesh buffers. The readers and writers of every format are in [`crate::io`] (one
-//! file per format); the old paths `mesh::read_mesh`, `mesh::write_mesh`, `mesh::read::*` and
-//! `mesh::write::*` are re-exports of them.
+//! file per format).
 //!
 //! The engine writes one indexed triangle mesh. Vertices shared by several patches carry the
 //! patch id and (u, v) of the patch that evaluated them (the edge's or corner's *owner*).
@@ -136,22 +135,3 @@ mod tests {
 }
 
 pub mod strips;
-
-pub use crate::io::{check_output_path, read_mesh, write_mesh};
-
-/// The mesh readers, now in [`crate::io`]; re-exported so the old paths keep working.
-pub mod read {
-    pub use crate::io::glb::parse_glb;
-    pub use crate::io::ply::parse_ply;
-    pub use crate::io::read_mesh;
-    pub use crate::io::stl::parse_stl;
-}
-
-/// The mesh writers, now in [`crate::io`]; re-exported so the old paths keep working.
-pub mod write {
-    pub use crate::io::glb::write_glb;
-    pub use crate::io::obj::write_obj;
-    pub use crate::io::ply::write_ply;
-    pub use crate::io::stl::write_stl;
-    pub use crate::io::{check_output_path, write_mesh};
-}
