@@ -435,25 +435,31 @@ fn run_mesh(a: MeshArgs) -> CliResult {
             );
         }
     }
-    let mut mesh = if gpu_run.is_some() { &gpu_mesh } else { tess.mesh() };
     let culled = plan.visible.iter().filter(|&&v| v == 0).count();
     // The numbering rule gives culled patches' corners (and their edges' normal variants)
-    // vertices no triangle uses; what is written and counted holds only the used ones.
+    // vertices no triangle uses; what is written and counted holds only the used ones. The
+    // GPU's mesh is ours to compact; the CPU's belongs to the tessellator.
     let compacted;
-    if culled > 0 {
-        let mut copy = mesh.clone();
+    let mesh = if gpu_run.is_some() {
+        if culled > 0 {
+            gpu_mesh.drop_unused_vertices();
+        }
+        &gpu_mesh
+    } else if culled > 0 {
+        let mut copy = tess.mesh().clone();
         copy.drop_unused_vertices();
         compacted = copy;
-        mesh = &compacted;
-    }
+        &compacted
+    } else {
+        tess.mesh()
+    };
+    pb.finish_and_clear();
     let mut output_file = None;
     if let Some(out) = &a.output {
-        pb.finish_and_clear();
         let start = Instant::now();
         write_with_bar(mesh, out, opts.corner_params)?;
         output_file = Some(start.elapsed().as_secs_f64());
     }
-    pb.finish_and_clear();
     let repairs = report_repairs(&set, mesh);
     if a.output.is_none() && !a.stats {
         eprintln!(
