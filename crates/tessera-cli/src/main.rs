@@ -16,6 +16,7 @@ use tessera::criterion::Plan;
 use tessera::engine::render_queues::{self, RenderQueues};
 use tessera::engine::{self, TessellateOptions};
 use tessera::io::glb::UriScope;
+use tessera::io::LoadOptions;
 use tessera::mesh::Mesh;
 use tessera::pattern::semi_uniform::StaticPattern;
 use tessera::pattern::uniform::Uniform;
@@ -189,23 +190,24 @@ fn spinner(message: &str) -> ProgressBar {
     pb
 }
 
-fn build_options(a: &InputArgs) -> Result<BuildOptions, Box<dyn std::error::Error>> {
+fn load_options(a: &InputArgs) -> Result<LoadOptions, Box<dyn std::error::Error>> {
     let weld = match a.weld {
         None => Weld::Exact,
         Some(eps) if eps.is_finite() && eps >= 0.0 => Weld::Within(eps),
         Some(eps) => return Err(format!("--weld {eps}: the distance must be finite and ≥ 0").into()),
     };
-    Ok(BuildOptions {
+    let build = BuildOptions {
         weld,
         orientation: if a.keep_orientation { Orientation::AsGiven } else { Orientation::Outward },
         flip: a.flip_normals,
-        uri_scope: if a.allow_outside_uris { UriScope::Anywhere } else { UriScope::ModelFolder },
-    })
+    };
+    let uri_scope = if a.allow_outside_uris { UriScope::Anywhere } else { UriScope::ModelFolder };
+    Ok(LoadOptions { build, uri_scope })
 }
 
 /// Loads a surface set by extension (`tessera::io::load`: .patches, .bezt, .obj, .ply, .stl,
 /// .glb, .gltf).
-fn load_surfaces(path: &Path, options: BuildOptions) -> Result<SurfaceSet, tessera::Error> {
+fn load_surfaces(path: &Path, options: LoadOptions) -> Result<SurfaceSet, tessera::Error> {
     tessera::io::load(path, options)
 }
 
@@ -223,7 +225,7 @@ fn memory_limit() -> u64 {
 /// else what the memory limit holds at a typical vertex-to-triangle ratio of 1:2).
 fn limits(max_triangles: Option<u64>, corner_params: bool) -> TessellateOptions {
     let memory = memory_limit();
-    let per_two_triangles = engine::output_bytes(1, 2, corner_params);
+    let per_two_triangles = tessera::mesh::output_bytes(1, 2, corner_params);
     TessellateOptions {
         corner_params,
         memory_limit: Some(memory),
@@ -310,7 +312,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn run_mesh(a: MeshArgs) -> CliResult {
-    let options = build_options(&a.input_args)?;
+    let options = load_options(&a.input_args)?;
     if a.repeat == 0 {
         return Err("--repeat 0: use 1 or more".into());
     }
@@ -589,7 +591,7 @@ fn announce_large_output(
         return;
     }
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-    let memory = engine::output_bytes(vertices, triangles, opts.corner_params);
+    let memory = tessera::mesh::output_bytes(vertices, triangles, opts.corner_params);
     let file = out
         .and_then(|o| {
             let bytes = tessera::io::estimated_file_bytes(o, vertices, triangles, opts.corner_params)?;
@@ -738,7 +740,7 @@ fn print_report(mesh: &Mesh, w: &verify::WatertightReport) {
 
 fn run_check(a: CheckArgs) -> CliResult {
     // Checked even without --against, so a bad option never passes unnoticed.
-    let build = build_options(&a.input_args)?;
+    let build = load_options(&a.input_args)?;
     let pb = spinner(&format!("reading {}", a.mesh.display()));
     let mesh = tessera::io::read_mesh(&a.mesh)?;
     let w = verify::watertight(&mesh);

@@ -296,7 +296,7 @@ fn draw_gpu_engine(
 }
 
 pub fn run(a: RenderArgs) -> crate::CliResult {
-    let options = crate::build_options(&a.input_args)?;
+    let options = crate::load_options(&a.input_args)?;
     if a.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("png")) {
         return Err(
             format!("-o {}: the picture is written as PNG: give a .png name", a.output.display()).into()

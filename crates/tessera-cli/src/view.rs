@@ -673,7 +673,7 @@ pub fn run(a: ViewArgs) -> crate::CliResult {
             parse(h).ok_or_else(|| format!("--size {}: expected WxH", a.size))?,
         )
     };
-    let options = crate::build_options(&a.input_args)?;
+    let options = crate::load_options(&a.input_args)?;
     // The tessellator borrows the set for the whole run (the event loop owns the app): leaked
     // once, freed at exit.
     let set: &'static SurfaceSet = Box::leak(Box::new(crate::load_surfaces(&a.input, options)?));

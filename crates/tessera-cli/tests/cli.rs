@@ -556,7 +556,7 @@ fn glb_and_bezt_inputs_of_a_closed_model_give_closed_meshes() {
     let obj = data("meshes/dragknob.obj");
     let input = tessera::io::read_mesh(&obj).unwrap();
     tessera::io::write_mesh(&input, &dir.join("knob.glb")).unwrap();
-    let set = tessera::io::load(&obj, Default::default()).unwrap();
+    let set = tessera::io::load(&obj, tessera::io::LoadOptions::default()).unwrap();
     let mut file = tessera::io::bezt::BezierTriangleFile { triangles: vec![], points: vec![], lines: vec![] };
     let mut ids = std::collections::HashMap::new();
     for p in &set.patches {

@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Once: the model, the GPU engine with the model uploaded, the view-independent bounds
     // and the criterion (the output sized for its worst case, every factor at the cap).
-    let set = tessera::io::load(&model, Default::default())?;
+    let set = tessera::io::load(&model, tessera::io::LoadOptions::default())?;
     let ctx = GpuContext::new()?; // a typed error naming the driver packages when there is no adapter
     let mut engine = GpuTessellator::new(&ctx, &set)?;
     let prepared = Prepared::new(&set, true);

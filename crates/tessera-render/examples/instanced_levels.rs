@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     });
     let frames: usize = args.get(2).map_or(Ok(20), |s| s.parse())?;
     let max_level = 5;
-    let set = tessera::io::load(&model, Default::default())?;
+    let set = tessera::io::load(&model, tessera::io::LoadOptions::default())?;
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, 1280, 720);
     let ctx = tessera_gpu::GpuContext::new()?;

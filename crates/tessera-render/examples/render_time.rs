@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map_or(Ok((1280, 720)), |(w, h)| Ok::<_, std::num::ParseIntError>((w.parse()?, h.parse()?)))?;
     let pixel_error: f64 = args.get(3).map_or(Ok(0.5), |s| s.parse())?;
     let frames: usize = args.get(4).map_or(Ok(20), |s| s.parse())?;
-    let set = tessera::io::load(&model, Default::default())?;
+    let set = tessera::io::load(&model, tessera::io::LoadOptions::default())?;
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, w, h);
     let criterion = Criterion::PixelError(pixel_error);

@@ -34,7 +34,7 @@ fn instanced_draw_equals_the_cpu_instanced_form_and_the_compacted_mesh() {
     let max_level = 5;
     let scheme = Scheme::SemiUniform { max_level };
     for model in ["patches/teapot.patches", "patches/teacup.patches", "meshes/blob.obj", "meshes/spool.obj"] {
-        let set = tessera::io::load(&data(model), Default::default()).unwrap();
+        let set = tessera::io::load(&data(model), tessera::io::LoadOptions::default()).unwrap();
         let (lo, hi) = set.bounds();
         let diagonal = lo.distance(hi) as f32;
         let draw = InstancedDraw::new(&ctx, &set, max_level, gpu::IMAGE_FORMAT, 1).unwrap();
@@ -117,7 +117,7 @@ fn instanced_triangles_equal_the_compacted_mesh_on_every_model_and_ten_cameras()
     let (colour, resolve, depth) = targets.views();
     let look = RenderOptions::default();
     for model in models {
-        let set = tessera::io::load(&data(model), Default::default()).unwrap();
+        let set = tessera::io::load(&data(model), tessera::io::LoadOptions::default()).unwrap();
         let (lo, hi) = set.bounds();
         let eps = 1e-6 * lo.distance(hi) as f32;
         let draw = InstancedDraw::new(&ctx, &set, max_level, gpu::IMAGE_FORMAT, 1).unwrap();

@@ -17,7 +17,8 @@ use tessera_render::{gpu, ColorMode, Drawing, RenderError, RenderOptions, WgpuEr
 
 /// The teapot at factor 8 (4032 triangles) and the camera framing it at 256 × 256.
 fn teapot() -> (Mesh, Camera) {
-    let set = tessera::io::load(&data("patches/teapot.patches"), Default::default()).unwrap();
+    let set =
+        tessera::io::load(&data("patches/teapot.patches"), tessera::io::LoadOptions::default()).unwrap();
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, 256, 256);
     let options = TessellatorOptions {

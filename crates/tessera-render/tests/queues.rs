@@ -26,7 +26,7 @@ fn gpu_render_queues_equal_the_cpu_queues() {
     let max_level = 5;
     let scheme = Scheme::SemiUniform { max_level };
     for model in models {
-        let set = tessera::io::load(&data(model), Default::default()).unwrap();
+        let set = tessera::io::load(&data(model), tessera::io::LoadOptions::default()).unwrap();
         let queues = GpuRenderQueues::new(&ctx, &set, max_level).unwrap();
         let (lo, hi) = set.bounds();
         let mut levels_seen = [false; 6];
@@ -55,7 +55,8 @@ fn gpu_render_queues_equal_the_cpu_queues() {
 #[test]
 fn a_plan_that_is_not_dyadic_is_refused() {
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
-    let set = tessera::io::load(&data("patches/teapot.patches"), Default::default()).unwrap();
+    let set =
+        tessera::io::load(&data("patches/teapot.patches"), tessera::io::LoadOptions::default()).unwrap();
     let queues = GpuRenderQueues::new(&ctx, &set, 5).unwrap();
     let plan = tessera::criterion::Plan::uniform(&set, 3).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());

@@ -22,8 +22,8 @@ use crate::engine::{self, TessellateOptions};
 use crate::error::Result;
 use crate::io::bezt;
 use crate::io::glb::{self, parse_glb, write_glb};
+use crate::io::obj;
 use crate::io::obj::write_obj;
-use crate::io::obj::{self, ObjMesh};
 use crate::io::patches;
 use crate::io::ply::{parse_ply, write_ply};
 use crate::io::stl::{parse_stl, write_stl};
@@ -33,6 +33,7 @@ use crate::pattern::hardware::Partitioning;
 use crate::pattern::transition::Transition;
 use crate::pattern::uniform::Uniform;
 use crate::pattern::Pattern;
+use crate::surface::PolygonMesh;
 use crate::surface::{BuildOptions, Orientation, SurfaceSet};
 use crate::topology::weld::Weld;
 use crate::verify;
@@ -74,7 +75,7 @@ pub fn check_obj(data: &[u8]) {
     assert_eq!(as_f32(&again.positions), list.positions, "write_obj → parse_obj changed the positions");
 }
 
-fn assert_obj_invariants(mesh: &ObjMesh) {
+fn assert_obj_invariants(mesh: &PolygonMesh) {
     assert!(!mesh.faces.is_empty(), "parse_obj returned a mesh without faces");
     assert!(mesh.positions.iter().all(|p| p.is_finite()), "parse_obj returned a non-finite position");
     assert!(mesh.normals.iter().all(|n| n.is_finite()), "parse_obj returned a non-finite normal");

@@ -7,9 +7,9 @@
 //! patch model with weights that are a function of position ([`position_weights`]), and
 //! the exact conics of revolution ([`sphere_octant`], [`cylinder`]).
 
-use crate::io::obj::{ObjFace, ObjMesh};
 use crate::io::patches::PatchFile;
 use crate::surface::RationalBicubic;
+use crate::surface::{PolygonFace, PolygonMesh};
 use glam::{DVec2, DVec3};
 
 /// Offsets of `copies` copies of a box `lo..hi` laid out in a near-square grid in the box's
@@ -53,12 +53,12 @@ pub fn patch_grid(file: &PatchFile, copies: usize) -> PatchFile {
 
 /// `copies` copies of a polygon mesh in a grid ([`grid_offsets`]). Cost: O(copies × mesh
 /// size).
-pub fn mesh_grid(mesh: &ObjMesh, copies: usize) -> ObjMesh {
+pub fn mesh_grid(mesh: &PolygonMesh, copies: usize) -> PolygonMesh {
     let (lo, hi) = point_bounds(&mesh.positions);
-    let mut out = ObjMesh::default();
+    let mut out = PolygonMesh::default();
     for offset in grid_offsets(lo, hi, copies) {
         let (p0, n0) = (out.positions.len() as u32, out.normals.len() as u32);
-        out.faces.extend(mesh.faces.iter().map(|f| ObjFace {
+        out.faces.extend(mesh.faces.iter().map(|f| PolygonFace {
             positions: f.positions.iter().map(|&i| i + p0).collect(),
             normals: f.normals.as_ref().map(|n| n.iter().map(|&i| i + n0).collect()),
             line: f.line,

@@ -48,7 +48,7 @@ fn scratch(name: &str) -> PathBuf {
 use tessera::fuzzing::{one_triangle_buffer as triangle_bin, one_triangle_gltf as gltf_with_uri};
 
 fn load(path: &Path, uri_scope: UriScope) -> tessera::Result<tessera::surface::SurfaceSet> {
-    io::load(path, BuildOptions { uri_scope, ..Default::default() })
+    io::load(path, io::LoadOptions { uri_scope, ..Default::default() })
 }
 
 #[test]

@@ -12,7 +12,7 @@ use tessera::surface::SurfaceSet;
 /// A model of the shared folder, by extension (`tessera::io::load`, default build options:
 /// exact welding, outward orientation — what `tessera mesh` does).
 pub fn load(ctx: &Ctx, rel: &str) -> BenchResult<SurfaceSet> {
-    Ok(tessera::io::load(&ctx.model(rel)?, Default::default())?)
+    Ok(tessera::io::load(&ctx.model(rel)?, tessera::io::LoadOptions::default())?)
 }
 
 /// `copies` copies of `bench/torus_64x32.patches` in a grid (45: the 92,160-patch scene of

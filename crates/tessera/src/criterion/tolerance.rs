@@ -119,12 +119,12 @@ fn built_pattern_bound(
     built: &LocalTessellation,
     params: &mut Vec<glam::DVec2>,
 ) -> f64 {
-    crate::engine::pattern_cache::local_params(input, built, params);
+    crate::pattern::cache::local_params(input, built, params);
     params_bound(m, built, params)
 }
 
 /// The bound of the pattern `built` over its local-vertex parameters `params`
-/// ([`crate::engine::pattern_cache::local_params`]): the largest triangle error.
+/// ([`crate::pattern::cache::local_params`]): the largest triangle error.
 fn params_bound(errors: &TriangleErrors, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
     triangles_bound(errors, &built.triangles, params, 0.0)
 }
@@ -257,7 +257,7 @@ pub(crate) struct Scratch {
     counts: Vec<u64>,
     per_patch: Vec<AtomicU64>,
     /// The first patterns of a round of checks, each distinct one built once.
-    patterns: crate::engine::pattern_cache::PatternCache,
+    patterns: crate::pattern::cache::PatternCache,
 }
 
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
@@ -523,7 +523,7 @@ impl<'a> Limit<'a> {
             triangles => Err(Error::OutputTooLarge {
                 vertices: triangles / 2,
                 triangles,
-                bytes: crate::engine::output_bytes(triangles / 2, triangles, false),
+                bytes: crate::mesh::output_bytes(triangles / 2, triangles, false),
             }),
         }
     }
@@ -553,7 +553,7 @@ fn check_patches(
     which: &[usize],
     firsts: &mut Vec<First>,
     counts: &mut Vec<u64>,
-    patterns: &mut crate::engine::pattern_cache::PatternCache,
+    patterns: &mut crate::pattern::cache::PatternCache,
     out: &mut Vec<Check>,
 ) {
     let CheckInputs { set, eps, layout, cap, minimum, errors } = *inputs;
@@ -561,7 +561,7 @@ fn check_patches(
     let global = segments.iter().copied().max().unwrap_or(1);
     // The engine's input, collapsed edges included, so the bound is that of the output.
     let input_of = |p: usize, domain, segments, interior| PatternInput {
-        collapsed: crate::engine::collapsed_edges(set, p),
+        collapsed: set.topology.collapsed_sides(p),
         ..PatternInput::new(domain, segments, interior)
     };
     // Each patch's first pattern: its edges and the smallest interior the layout gives it.
@@ -617,8 +617,7 @@ fn check_patches(
     // Tiny patterns (a cell or two, as in a distant view) cost about what a lookup costs, and
     // the lookups run on one thread: there each task reuses its last pattern instead.
     let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
-    let worth =
-        cells >= crate::engine::pattern_cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * firsts.len() as u64;
+    let worth = cells >= crate::pattern::cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * firsts.len() as u64;
     if admitted && worth && !limit.pattern.depends_on_patch() {
         let first_input = |i: usize| {
             let (p, (domain, seg, interior)) = (which[i], firsts[i]);
@@ -631,7 +630,7 @@ fn check_patches(
     let patterns = &*patterns;
     // Each thread's pattern buffers are kept from call to call (a per-frame loop then
     // allocates none here).
-    let generation = crate::engine::next_generation();
+    let generation = crate::pattern::cache::next_generation();
     out.resize(which.len(), ([1; 2], 0.0, false));
     let items = out.par_iter_mut().zip(which).zip(firsts.par_iter()).enumerate();
     items.for_each(|(i, ((o, &p), &(domain, seg, interior)))| {
@@ -659,8 +658,9 @@ fn check_patches(
                     }
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
-                    (None, None) => crate::engine::with_scratch(generation, |s| {
-                        let (built, params) = s.pattern_with_params(limit.pattern, &input);
+                    (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
+                        let slot = recent.get(generation, limit.pattern, &input, true);
+                        let (built, params) = (&slot.local, &slot.params[..]);
                         core_params_bound(&errors[p], limit.pattern.core_cells(&input), built, params)
                     }),
                 };

@@ -244,17 +244,6 @@ pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32, collapsed }
 }
 
-/// [`PatternInput::collapsed`] of patch `p`: which of its edges are boundary curves collapsed
-/// to a point. Whoever builds a patch's pattern to predict the engine's output (the error-
-/// bounded criteria) passes these too, or it predicts another triangulation. Cost: O(1).
-pub(crate) fn collapsed_edges(set: &SurfaceSet, p: usize) -> [bool; 4] {
-    let mut collapsed = [false; 4];
-    for (e, c) in collapsed.iter_mut().enumerate().take(set.topology.patch_domains[p].corner_count()) {
-        *c = set.topology.patch_edges[p][e].collapsed;
-    }
-    collapsed
-}
-
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that
 /// starts and ends at one point): only then can a pattern triangle degenerate. Public so that
 /// the GPU engine (tessera-gpu) flags the same patches for its collapsed-triangle path.

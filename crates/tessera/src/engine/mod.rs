@@ -14,7 +14,7 @@
 //! scheme's pattern, any sampling, triangle patches — in blocks of f32 lanes
 //! (`point_blocks`). Only rational patches whose weights span more than f32 keeps reliable
 //! (`uniform_quads::MIN_WEIGHT_RATIO`) keep the generic evaluation throughout. Patterns that
-//! repeat within a frame are built once (`pattern_cache`). One specialisation of writing: a
+//! repeat within a frame are built once (`pattern::cache`). One specialisation of writing: a
 //! frame of triangle patches at one uniform factor (a mesh's PN triangles) skips the
 //! per-patch bookkeeping and maps its triangles by addition (`uniform_triangles`).
 
@@ -22,19 +22,18 @@ use crate::criterion::Plan;
 use crate::error::{Error, Result};
 use crate::mesh::strips::RESTART;
 use crate::mesh::Mesh;
+use crate::pattern::cache::{next_generation, PatternCache, RecentPatterns, MIN_TRIANGLES_PER_PATCH};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, Patch, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
 pub mod layout;
-pub(crate) mod pattern_cache;
 pub(crate) mod point_blocks;
 pub mod render_queues;
 pub(crate) mod uniform_quads;
 pub(crate) mod uniform_triangles;
 
-pub(crate) use layout::collapsed_edges;
 pub use layout::Layout;
 
 /// Engine options.
@@ -53,18 +52,11 @@ pub struct TessellateOptions {
     pub strips: bool,
 }
 
-/// Bytes the engine allocates for an output of this size (buffers and parameters).
-pub fn output_bytes(vertices: u64, triangles: u64, corner_params: bool) -> u64 {
-    let per_vertex = 12 + 12 + 8 + 4; // position, normal, uv, patch
-    let per_triangle = 12 + 4 + if corner_params { 24 } else { 0 };
-    vertices.saturating_mul(per_vertex).saturating_add(triangles.saturating_mul(per_triangle))
-}
-
 /// Refuses an output of `vertices` and `triangles` that does not fit the u32 index range (the
 /// layout's offsets are u32, as a GPU reads them), the address space or the limits in
 /// `options`. Cost: O(1).
 pub(crate) fn check_size(vertices: u64, triangles: u64, options: &TessellateOptions) -> Result<()> {
-    let bytes = output_bytes(vertices, triangles, options.corner_params);
+    let bytes = crate::mesh::output_bytes(vertices, triangles, options.corner_params);
     if vertices > u32::MAX as u64
         || triangles > u32::MAX as u64
         || triangles.saturating_mul(3) > isize::MAX as u64 / 8
@@ -650,85 +642,6 @@ impl PatchScratch {
     pub(crate) fn pattern(&mut self, pattern: &dyn Pattern, input: &PatternInput) -> &LocalTessellation {
         &self.patterns.get(self.generation, pattern, input, false).local
     }
-
-    /// [`PatchScratch::pattern`] with the parameters of every local vertex
-    /// ([`pattern_cache::local_params`]), for the error checks.
-    pub(crate) fn pattern_with_params(
-        &mut self,
-        pattern: &dyn Pattern,
-        input: &PatternInput,
-    ) -> (&LocalTessellation, &[glam::DVec2]) {
-        let slot = self.patterns.get(self.generation, pattern, input, true);
-        (&slot.local, &slot.params)
-    }
-}
-
-/// Slots of [`RecentPatterns`]: a power of two.
-const RECENT_PATTERNS: usize = 64;
-
-/// The patterns a thread built recently, in a direct-mapped table by input hash: a build is
-/// replaced only by one of another input with the same slot. Written by hand: a cache of
-/// this shape (fixed size, no eviction policy, buffers kept per slot) is a few lines, and
-/// the crates of the field with caches allocate per entry.
-#[derive(Default)]
-struct RecentPatterns {
-    slots: Vec<RecentPattern>,
-    /// The slot of the last request: neighbouring patches often share an input, and a
-    /// comparison costs less than the hash.
-    last: usize,
-}
-
-#[derive(Default)]
-struct RecentPattern {
-    /// The call and input (its patch 0) `local` was built for; None when it holds nothing
-    /// reusable (never built, or built for a pattern that depends on the patch).
-    key: Option<(u64, PatternInput)>,
-    local: LocalTessellation,
-    /// `local`'s local-vertex parameters, valid when `with_params`.
-    params: Vec<glam::DVec2>,
-    with_params: bool,
-}
-
-impl RecentPatterns {
-    /// The slot holding `input`'s pattern for call `generation` (and its parameters, with
-    /// `params`), built into it unless it is there already.
-    fn get(
-        &mut self,
-        generation: u64,
-        pattern: &dyn Pattern,
-        input: &PatternInput,
-        params: bool,
-    ) -> &RecentPattern {
-        if self.slots.is_empty() {
-            self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
-        }
-        let reusable = !pattern.depends_on_patch();
-        let key = (generation, PatternInput { patch: 0, ..*input });
-        let index = match reusable {
-            true if self.slots[self.last].key == Some(key) => self.last,
-            true => pattern_cache::input_hash(input) as usize % RECENT_PATTERNS,
-            false => 0,
-        };
-        self.last = index;
-        let slot = &mut self.slots[index];
-        if !reusable || slot.key != Some(key) {
-            pattern.build(input, &mut slot.local);
-            slot.key = reusable.then_some(key);
-            slot.with_params = false;
-        }
-        if params && !slot.with_params {
-            pattern_cache::local_params(input, &slot.local, &mut slot.params);
-            slot.with_params = true;
-        }
-        slot
-    }
-}
-
-static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
-/// A number no earlier call got.
-pub(crate) fn next_generation() -> u64 {
-    GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1
 }
 
 thread_local! {
@@ -745,6 +658,27 @@ pub(crate) fn with_scratch<R>(generation: u64, f: impl FnOnce(&mut PatchScratch)
         }
         Err(_) => f(&mut PatchScratch { generation, ..PatchScratch::default() }),
     })
+}
+
+/// Fills `cache` for a frame: finds the distinct inputs of `plan`'s visible patches and builds each once, or turns
+/// the cache off for this frame where it would not pay (patterns that depend on the patch,
+/// or fewer than [`MIN_TRIANGLES_PER_PATCH`] triangles per visible patch: `triangles` is
+/// the layout's count). Cost: one hash lookup per visible patch (sequential), then the
+/// distinct builds (parallel); no allocation once the buffers have grown to the frame.
+pub(crate) fn fill_pattern_cache(
+    cache: &mut PatternCache,
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    triangles: u64,
+) {
+    let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
+    if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
+        cache.clear();
+        return;
+    }
+    let input_of = |p: usize| plan.is_visible(p).then(|| layout::pattern_input(set, plan, p));
+    cache.fill_inputs(pattern, set.patches.len(), input_of, false);
 }
 
 /// Per-patch mapping from local vertex indices to output vertices: the numbering rule of

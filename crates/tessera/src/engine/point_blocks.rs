@@ -1033,7 +1033,7 @@ mod tests {
         ];
         let (mut compared, mut refused) = (0, 0);
         for path in &models {
-            let set = match crate::io::load(path, Default::default()) {
+            let set = match crate::io::load(path, crate::io::LoadOptions::default()) {
                 Ok(set) => set,
                 Err(e) => panic!("{}: {e}", path.display()),
             };

@@ -38,7 +38,6 @@
 //! that have them, for AVX2 and FMA, chosen at run time. Calling the AVX2 build is the
 //! module's only `unsafe`.
 
-use super::pattern_cache::PatternCache;
 use super::point_blocks::{
     cross_normals, has_avx2_fma, local_frame, madd, rational_quotient, to_model, GridPatch, PointBlocks,
     LANES, MIN_DERIVATIVE2, MIN_SIN2,
@@ -46,6 +45,7 @@ use super::point_blocks::{
 use super::uniform_triangles::UniformTriangles;
 use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
+use crate::pattern::cache::PatternCache;
 use crate::pattern::{Pattern, PatternInput};
 use crate::sampling::{uniform_param, SamplingKind};
 use crate::surface::{Domain, RationalBicubic, SurfacePoint, SurfaceSet};
@@ -502,7 +502,7 @@ impl<'a> FastEvaluator<'a> {
         if self.triangles.retarget(self.set, plan, pattern) {
             self.patterns.clear();
         } else {
-            self.patterns.fill(self.set, plan, pattern, triangles);
+            super::fill_pattern_cache(&mut self.patterns, self.set, plan, pattern, triangles);
         }
     }
 

@@ -55,6 +55,7 @@ use glam::DVec3;
 
 use super::patches::{parse_indexed, read_text};
 use crate::error::Result;
+use crate::surface::{BezierTriangle, BuildOptions, Patch, SurfaceSet};
 
 /// Number of control points of a cubic Bézier triangle.
 const TRIANGLE_POINTS: usize = 10;
@@ -125,6 +126,25 @@ pub fn to_bezt_text(file: &BezierTriangleFile) -> String {
         let _ = writeln!(out, "{:?},{:?},{:?}", p.x, p.y, p.z);
     }
     out
+}
+
+impl SurfaceSet {
+    /// Builds cubic Bézier triangles from a parsed `.bezt` file
+    /// ([`crate::io::bezt`]). Triangles that use the same control points (by index, or by
+    /// position up to `options.weld`) share boundary curves in the topology, so their
+    /// tessellation is crack-free; all-collapsed triangles are dropped and counted in
+    /// [`Repairs`].
+    ///
+    /// Preconditions: indices in range and finite points, as the parser guarantees.
+    /// Cost: O(triangles) hashing, as [`SurfaceSet::from_patches`].
+    pub fn from_bezier_triangle_file(file: &BezierTriangleFile, options: BuildOptions) -> SurfaceSet {
+        let patches = file
+            .triangles
+            .iter()
+            .map(|idx| Patch::BezierTriangle(BezierTriangle { points: idx.map(|i| file.points[i as usize]) }))
+            .collect();
+        Self::from_patches(patches, options)
+    }
 }
 
 #[cfg(test)]

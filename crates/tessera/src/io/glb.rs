@@ -38,10 +38,10 @@ use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::validation::{Checked, USize64};
 
 use super::binary::{all_finite, fill_missing, put_u32, put_words, to_u32, write_chunks, BIN_CHUNK};
-use super::obj::{ObjFace, ObjMesh};
 use super::Format;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::surface::{PolygonFace, PolygonMesh};
 
 /// Largest integer an `f32` holds exactly (and with it every smaller one): the bound on vertex
 /// patch ids in the GLB `_PATCH` attribute, which glTF requires to be a float.
@@ -444,7 +444,7 @@ impl<'a> Glb<'a> {
 /// without scenes, every mesh untransformed) are instanced with their transforms; normals,
 /// where a primitive has `NORMAL`, go through the inverse transpose, and mirroring transforms
 /// reverse the winding so that the front side stays the front. Primitives in `POINTS` or
-/// `LINES` modes are skipped and counted in [`ObjMesh::skipped_primitives`]; every other attribute (texture coordinates, colours, tessera's
+/// `LINES` modes are skipped and counted in [`PolygonMesh::skipped_primitives`]; every other attribute (texture coordinates, colours, tessera's
 /// `_PATCH`) is ignored. Every face gets line 0 (binary data has no lines).
 ///
 /// # Errors
@@ -462,7 +462,7 @@ impl<'a> Glb<'a> {
 ///
 /// Cost: reads the file and at most each buffer's `byteLength` of its buffer files into
 /// memory, then O(file size + instanced triangles).
-pub fn read_gltf_triangles(path: &Path, scope: UriScope) -> Result<ObjMesh> {
+pub fn read_gltf_triangles(path: &Path, scope: UriScope) -> Result<PolygonMesh> {
     let data = super::read_input(path)?;
     parse_gltf_triangles(&data, path, path.parent(), scope)
 }
@@ -482,7 +482,7 @@ pub fn parse_gltf_triangles(
     file: &Path,
     dir: Option<&Path>,
     scope: UriScope,
-) -> Result<ObjMesh> {
+) -> Result<PolygonMesh> {
     let err = |reason: String| Error::parse(file, 0, reason);
     // The gltf crate subtracts the 12-byte header from the GLB's declared length unchecked
     // (an overflow panic with overflow checks on), so a shorter length is refused here.
@@ -569,7 +569,7 @@ pub fn parse_gltf_triangles(
     }
 
     let meshes: Vec<gltf::Mesh> = gltf.meshes().collect();
-    let mut out = ObjMesh::default();
+    let mut out = PolygonMesh::default();
     let mut skipped = std::collections::HashSet::new();
     for (mesh_index, world) in instances {
         let linear = glam::DMat3::from_mat4(world);
@@ -667,7 +667,7 @@ pub fn parse_gltf_triangles(
                 if det < 0.0 {
                     t.swap(1, 2);
                 }
-                out.faces.push(ObjFace {
+                out.faces.push(PolygonFace {
                     positions: t.iter().map(|&i| base as u32 + i).collect(),
                     normals: normal
                         .as_ref()

@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::surface::{BuildOptions, SurfaceSet};
+use crate::surface::{BuildOptions, PolygonMesh, SurfaceSet};
 use crate::topology::weld::Weld;
 use binary::{check_mesh, BUF_CAPACITY, WRITER_LABEL};
 
@@ -52,6 +52,21 @@ const SUPPORTED: &str = ".obj, .ply, .stl, .glb";
 /// The extensions [`load`] understands, for error messages.
 pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gltf";
 
+/// How [`load`] reads an input: how the set is built, and where a `.gltf` input's buffer
+/// files may be. A [`BuildOptions`] converts into it with the default (safe) URI scope.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LoadOptions {
+    pub build: BuildOptions,
+    /// Where a `.gltf` input's buffer files may be (`--allow-outside-uris`).
+    pub uri_scope: glb::UriScope,
+}
+
+impl From<BuildOptions> for LoadOptions {
+    fn from(build: BuildOptions) -> LoadOptions {
+        LoadOptions { build, uri_scope: glb::UriScope::default() }
+    }
+}
+
 /// Loads the surfaces of the input at `path`, choosing the format by the extension
 /// (case-insensitive):
 ///
@@ -62,12 +77,14 @@ pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gl
 /// - `.obj`, `.ply`, `.stl`, `.glb`, `.gltf`: a polygon mesh, made into PN triangles
 ///   ([`SurfaceSet::pn_from_mesh`]) with the file's normals where every corner of a face has a
 ///   non-zero one. Faces of more than three corners, in OBJ and PLY alike, are split into
-///   triangle fans from their first corner ([`obj::ObjMesh::split_polygons`]) and counted in
+///   triangle fans from their first corner ([`PolygonMesh::split_polygons`]) and counted in
 ///   [`Repairs::split_polygons`](crate::surface::Repairs::split_polygons). `.obj` is read by [`obj::read_obj`], `.ply` and `.stl` by [`read_mesh`], and
 ///   glTF by [`glb::read_gltf_triangles`] (every triangle primitive of the default scene, in
 ///   world coordinates), so a `.glb` from any tool works, tessera's own included.
 ///
-/// `options` say how control points or vertices are welded and how the set is oriented.
+/// `options` say how control points or vertices are welded and how the set is oriented
+/// ([`BuildOptions`], which converts into [`LoadOptions`]), and where a `.gltf` input's
+/// buffer files may be.
 ///
 /// Errors: an unknown or missing extension is [`Error::UnknownFormat`] naming the supported
 /// list; otherwise the reader's errors, which name `path`, the line where there is one, and
@@ -76,7 +93,8 @@ pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gl
 ///
 /// Cost: one read of the file, the parse (O(file size)), and building the set (O(patches)
 /// hashing).
-pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
+pub fn load(path: &Path, options: impl Into<LoadOptions>) -> Result<SurfaceSet> {
+    let LoadOptions { build: options, uri_scope } = options.into();
     refuse_folder(path)?;
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let set = match ext.as_deref() {
@@ -89,11 +107,11 @@ pub fn load(path: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         }
         Some("ply") => {
             let (mesh, split) = ply::parse_ply_counting_polygons(&read_input(path)?, path)?;
-            with_split(SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&mesh), path, options)?, split)
+            with_split(SurfaceSet::pn_from_mesh(&PolygonMesh::from_mesh(&mesh), path, options)?, split)
         }
-        Some("stl") => SurfaceSet::pn_from_mesh(&obj::ObjMesh::from_mesh(&read_mesh(path)?), path, options)?,
+        Some("stl") => SurfaceSet::pn_from_mesh(&PolygonMesh::from_mesh(&read_mesh(path)?), path, options)?,
         Some("glb" | "gltf") => {
-            let mesh = glb::read_gltf_triangles(path, options.uri_scope)?;
+            let mesh = glb::read_gltf_triangles(path, uri_scope)?;
             let mut set = SurfaceSet::pn_from_mesh(&mesh, path, options)?;
             set.repairs.skipped_primitives = mesh.skipped_primitives;
             set

@@ -24,6 +24,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use crate::error::{Error, Result};
+use crate::surface::{BuildOptions, Patch, RationalBicubic, SurfaceSet};
 
 /// Number of control points of a bicubic patch.
 const PATCH_POINTS: usize = 16;
@@ -414,6 +415,23 @@ pub(super) fn quote(s: &str) -> String {
 }
 
 /// Helpers shared by the tests of the parsers in this folder.
+impl SurfaceSet {
+    /// Builds bicubic rational patches from a parsed patch file.
+    pub fn from_patch_file(file: &PatchFile, options: BuildOptions) -> SurfaceSet {
+        let patches = file
+            .patches
+            .iter()
+            .map(|idx| {
+                Patch::Bicubic(RationalBicubic {
+                    points: idx.map(|i| file.points[i as usize]),
+                    weights: idx.map(|i| file.weights[i as usize]),
+                })
+            })
+            .collect();
+        Self::from_patches(patches, options)
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod test_support {
     use std::fmt::Debug;

@@ -28,10 +28,10 @@ use std::path::Path;
 use super::binary::{
     all_finite, fill_missing, le_floats, le_words, put_u32, to_u32, write_chunks, BIN_CHUNK,
 };
-use super::obj::fan;
 use super::Format;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::surface::polygon_mesh::fan;
 
 /// Parses PLY `data` (ASCII or binary, either byte order); `file` only labels errors.
 /// See the module documentation for what is read and what is filled in.

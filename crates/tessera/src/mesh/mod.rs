@@ -104,6 +104,14 @@ impl Mesh {
     }
 }
 
+/// Bytes a [`Mesh`] of `vertices` and `triangles` holds (its arrays, with `corner_params` its
+/// per-corner patch parameters): what an engine allocates for that output. Cost: O(1).
+pub fn output_bytes(vertices: u64, triangles: u64, corner_params: bool) -> u64 {
+    let per_vertex = 12 + 12 + 8 + 4; // position, normal, uv, patch
+    let per_triangle = 12 + 4 + if corner_params { 24 } else { 0 };
+    vertices.saturating_mul(per_vertex).saturating_add(triangles.saturating_mul(per_triangle))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

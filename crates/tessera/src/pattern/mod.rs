@@ -7,6 +7,7 @@
 //! `e+1`), then the pattern's interior vertices. Triangles are counter-clockwise in the
 //! `(u, v)` domain.
 
+pub(crate) mod cache;
 pub mod esc;
 pub mod hardware;
 pub mod sd2;

@@ -87,7 +87,7 @@ pub fn uniform_param(segments: u32, k: u32) -> f64 {
 pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
     match spacing {
         Spacing::Symmetric => symmetric_segments(factor),
-        Spacing::Hardware(p) => crate::pattern::hardware::edge_segments(factor, p),
+        Spacing::Hardware(p) => hardware::edge_segments(factor, p),
     }
 }
 
@@ -95,7 +95,7 @@ pub fn spacing_segments(factor: f64, spacing: Spacing) -> u32 {
 pub fn spacing_param(factor: f64, spacing: Spacing, k: u32) -> f64 {
     match spacing {
         Spacing::Symmetric => symmetric_param(factor, k),
-        Spacing::Hardware(p) => crate::pattern::hardware::edge_param(factor, p, k),
+        Spacing::Hardware(p) => hardware::edge_param(factor, p, k),
     }
 }
 

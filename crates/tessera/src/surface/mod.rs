@@ -12,6 +12,7 @@
 mod bezier_triangle;
 mod bicubic;
 mod pn_triangle;
+pub(crate) mod polygon_mesh;
 mod set;
 
 /// The parameter domains live in [`crate::domain`]; re-exported here for the surfaces' users.
@@ -19,6 +20,7 @@ pub use crate::domain::Domain;
 pub use bezier_triangle::BezierTriangle;
 pub use bicubic::RationalBicubic;
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
+pub use polygon_mesh::{PolygonFace, PolygonMesh};
 pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 

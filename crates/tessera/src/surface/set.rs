@@ -1,12 +1,9 @@
 //! A set of patches with the topology that ties them together, and the builders that make
 //! one from a patch file or a triangle mesh.
 
+use super::PolygonMesh;
 use super::{pn_triangle, BezierTriangle, Domain, Patch, PnTriangle};
 use crate::error::{Error, Result};
-use crate::io::bezt::BezierTriangleFile;
-use crate::io::obj::ObjMesh;
-use crate::io::patches::PatchFile;
-use crate::surface::RationalBicubic;
 use crate::topology::weld::{collapse_unresolved_curves, weld, Weld};
 use crate::topology::{PatchKeys, Topology, NONE};
 use glam::{DVec2, DVec3};
@@ -32,9 +29,6 @@ pub struct BuildOptions {
     pub orientation: Orientation,
     /// Reverse the orientation after `orientation` was applied (`--flip-normals`).
     pub flip: bool,
-    /// Where a `.gltf` input's buffer files may be ([`io::load`](crate::io::load) reads them;
-    /// `--allow-outside-uris`).
-    pub uri_scope: crate::io::glb::UriScope,
 }
 
 /// What the builder changed in the input, so the CLI can report it.
@@ -212,38 +206,6 @@ impl SurfaceSet {
         SurfaceSet { patches, keys, topology, repairs, up: Default::default() }
     }
 
-    /// Builds bicubic rational patches from a parsed patch file.
-    pub fn from_patch_file(file: &PatchFile, options: BuildOptions) -> SurfaceSet {
-        let patches = file
-            .patches
-            .iter()
-            .map(|idx| {
-                Patch::Bicubic(RationalBicubic {
-                    points: idx.map(|i| file.points[i as usize]),
-                    weights: idx.map(|i| file.weights[i as usize]),
-                })
-            })
-            .collect();
-        Self::from_patches(patches, options)
-    }
-
-    /// Builds cubic Bézier triangles from a parsed `.bezt` file
-    /// ([`crate::io::bezt`]). Triangles that use the same control points (by index, or by
-    /// position up to `options.weld`) share boundary curves in the topology, so their
-    /// tessellation is crack-free; all-collapsed triangles are dropped and counted in
-    /// [`Repairs`].
-    ///
-    /// Preconditions: indices in range and finite points, as the parser guarantees.
-    /// Cost: O(triangles) hashing, as [`SurfaceSet::from_patches`].
-    pub fn from_bezier_triangle_file(file: &BezierTriangleFile, options: BuildOptions) -> SurfaceSet {
-        let patches = file
-            .triangles
-            .iter()
-            .map(|idx| Patch::BezierTriangle(BezierTriangle { points: idx.map(|i| file.points[i as usize]) }))
-            .collect();
-        Self::from_patches(patches, options)
-    }
-
     /// Builds PN triangles from a triangle mesh.
     ///
     /// Vertices with identical positions at f32 precision are welded (or within `options.weld`); faces that
@@ -257,7 +219,7 @@ impl SurfaceSet {
     /// between its faces is a crease: its inner control points are placed along the crease
     /// tangent `nA × nB` (not in either face's tangent plane) so that both faces get the same
     /// boundary curve.
-    pub fn pn_from_mesh(mesh: &ObjMesh, file: &Path, options: BuildOptions) -> Result<SurfaceSet> {
+    pub fn pn_from_mesh(mesh: &PolygonMesh, file: &Path, options: BuildOptions) -> Result<SurfaceSet> {
         let tris = mesh.triangles(file)?;
         let mut repairs = Repairs::default();
         let welded = weld(&mesh.positions, &vec![1.0; mesh.positions.len()], options.weld);

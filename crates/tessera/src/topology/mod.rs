@@ -10,7 +10,7 @@
 
 pub mod weld;
 
-use crate::surface::Domain;
+use crate::domain::Domain;
 use std::collections::HashMap;
 
 /// Marks an unused key slot (the fourth corner of a triangle, inner ids of a mesh edge).
@@ -136,6 +136,18 @@ fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
 }
 
 impl Topology {
+    /// Which of patch `p`'s edges are boundary curves collapsed to a point (the pattern
+    /// input's `collapsed`, in the patch's edge order). Whoever builds a patch's pattern to
+    /// predict the engine's output (the error-bounded criteria) passes these too, or it
+    /// predicts another triangulation. Cost: O(1).
+    pub fn collapsed_sides(&self, p: usize) -> [bool; 4] {
+        let mut collapsed = [false; 4];
+        for (e, c) in collapsed.iter_mut().enumerate().take(self.patch_domains[p].corner_count()) {
+            *c = self.patch_edges[p][e].collapsed;
+        }
+        collapsed
+    }
+
     /// Builds the topology. Cost: O(P) hashing, P = number of patches.
     pub fn build(keys: &[PatchKeys]) -> Topology {
         let mut vertex_ids: HashMap<u32, u32> = HashMap::new();

@@ -1,4 +1,4 @@
-//! Patterns that repeat within a frame, built once: a table from each distinct pattern input
+//! Patterns that repeat, built once. [`PatternCache`]: a table from each distinct pattern input
 //! (the edge segments and factors, interior factors and collapsed edges of a patch) to its
 //! built pattern, as the semi-uniform render queues keep one pattern per level and the
 //! hardware tessellator one table per factor combination.
@@ -7,17 +7,16 @@
 //! patch of the same input on the same thread; in an adaptive frame neighbours differ, and
 //! building is a large part of writing (CudaTess's transition strips, the hardware patterns'
 //! rings). With it, the distinct inputs are found in one pass over the patches, built in
-//! parallel, and every patch reads its pattern by index.
+//! parallel, and every patch reads its pattern by index. [`RecentPatterns`]: the patterns one
+//! thread built lately, for the writers and the a-posteriori error check, which meet inputs in
+//! patch order and often the same input twice running.
 //!
 //! **No allocation in a steady frame loop.** The table, the index and each slot's buffers keep
 //! their capacity from frame to frame. Inputs get slots in patch order, so the same sequence of
 //! frames fills the same slots with the same patterns: a second walk along a camera path
 //! allocates nothing, whichever threads built what.
 
-use super::layout::pattern_input;
-use crate::criterion::Plan;
-use crate::pattern::{LocalTessellation, Pattern, PatternInput};
-use crate::surface::SurfaceSet;
+use super::{LocalTessellation, Pattern, PatternInput};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -34,7 +33,7 @@ struct Key {
 }
 
 /// A hash of the bits of `input` a pattern may read (not the patch), for tables keyed by
-/// pattern input ([`PatternCache`], the threads' recent builds in `engine::PatchScratch`).
+/// pattern input ([`PatternCache`], [`RecentPatterns`]).
 pub(crate) fn input_hash(input: &PatternInput) -> u64 {
     use std::hash::{BuildHasher, BuildHasherDefault};
     BuildHasherDefault::<WordHasher>::default().hash_one(Key::of(input))
@@ -145,21 +144,6 @@ pub(crate) fn boundary_positions(input: &PatternInput, built: &LocalTessellation
 }
 
 impl PatternCache {
-    /// Finds the distinct inputs of `plan`'s visible patches and builds each once, or turns
-    /// the cache off for this frame where it would not pay (patterns that depend on the patch,
-    /// or fewer than [`MIN_TRIANGLES_PER_PATCH`] triangles per visible patch: `triangles` is
-    /// the layout's count). Cost: one hash lookup per visible patch (sequential), then the
-    /// distinct builds (parallel); no allocation once the buffers have grown to the frame.
-    pub(crate) fn fill(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
-        let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
-        if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
-            self.clear();
-            return;
-        }
-        let input_of = |p: usize| plan.is_visible(p).then(|| pattern_input(set, plan, p));
-        self.fill_inputs(pattern, set.patches.len(), input_of, false);
-    }
-
     /// Empties the cache: every [`PatternCache::get`] answers None.
     pub(crate) fn clear(&mut self) {
         self.index.clear();
@@ -245,6 +229,88 @@ impl PatternCache {
     pub(crate) fn distinct(&self) -> usize {
         self.inputs.len()
     }
+}
+
+/// Slots of [`RecentPatterns`]: a power of two.
+const RECENT_PATTERNS: usize = 64;
+
+/// The patterns a thread built recently, in a direct-mapped table by input hash: a build is
+/// replaced only by one of another input with the same slot. Written by hand: a cache of
+/// this shape (fixed size, no eviction policy, buffers kept per slot) is a few lines, and
+/// the crates of the field with caches allocate per entry.
+#[derive(Default)]
+pub(crate) struct RecentPatterns {
+    slots: Vec<RecentPattern>,
+    /// The slot of the last request: neighbouring patches often share an input, and a
+    /// comparison costs less than the hash.
+    last: usize,
+}
+
+#[derive(Default)]
+pub(crate) struct RecentPattern {
+    /// The call and input (its patch 0) `local` was built for; None when it holds nothing
+    /// reusable (never built, or built for a pattern that depends on the patch).
+    key: Option<(u64, PatternInput)>,
+    pub(crate) local: LocalTessellation,
+    /// `local`'s local-vertex parameters, valid when `with_params`.
+    pub(crate) params: Vec<DVec2>,
+    with_params: bool,
+}
+
+impl RecentPatterns {
+    /// The slot holding `input`'s pattern for call `generation` (and its parameters, with
+    /// `params`), built into it unless it is there already.
+    pub(crate) fn get(
+        &mut self,
+        generation: u64,
+        pattern: &dyn Pattern,
+        input: &PatternInput,
+        params: bool,
+    ) -> &RecentPattern {
+        if self.slots.is_empty() {
+            self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
+        }
+        let reusable = !pattern.depends_on_patch();
+        let key = (generation, PatternInput { patch: 0, ..*input });
+        let index = match reusable {
+            true if self.slots[self.last].key == Some(key) => self.last,
+            true => input_hash(input) as usize % RECENT_PATTERNS,
+            false => 0,
+        };
+        self.last = index;
+        let slot = &mut self.slots[index];
+        if !reusable || slot.key != Some(key) {
+            pattern.build(input, &mut slot.local);
+            slot.key = reusable.then_some(key);
+            slot.with_params = false;
+        }
+        if params && !slot.with_params {
+            local_params(input, &slot.local, &mut slot.params);
+            slot.with_params = true;
+        }
+        slot
+    }
+}
+
+static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A number no earlier call got.
+pub(crate) fn next_generation() -> u64 {
+    GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1
+}
+
+thread_local! {
+    static RECENT: std::cell::RefCell<RecentPatterns> = std::cell::RefCell::new(RecentPatterns::default());
+}
+
+/// Runs `f` with this thread's recent patterns (a fresh table if the thread's is in use
+/// further up its stack, as when rayon runs another task inside a join). The a-posteriori
+/// error check builds through it; the engine keeps its own in its per-thread scratch.
+pub(crate) fn with_recent_patterns<R>(f: impl FnOnce(&mut RecentPatterns) -> R) -> R {
+    RECENT.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut recent) => f(&mut recent),
+        Err(_) => f(&mut RecentPatterns::default()),
+    })
 }
 
 impl std::fmt::Debug for PatternCache {
