@@ -161,6 +161,9 @@ struct DemoArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::View(_)) {
+        quiet_wayland_probe();
+    }
     let result = match cli.command {
         Command::Mesh(a) => run_mesh(a),
         Command::Check(a) => run_check(a),
@@ -176,6 +179,21 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// On a machine without a desktop session (no `XDG_RUNTIME_DIR`, no `WAYLAND_DISPLAY`), the
+/// Vulkan drivers' Wayland support probes for a compositor when wgpu creates its instance, and
+/// libwayland prints `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` —
+/// the first thing a newcomer running `tessera demo` on a server would read. There is no
+/// compositor to find, so the probe is pointed at an absolute socket path that does not exist
+/// (libwayland then skips `XDG_RUNTIME_DIR` and fails quietly). Only for the headless
+/// commands: the window of `tessera view` is X11 (winit is built without Wayland), and it
+/// sets nothing. Called first thing in `main`, before any thread exists.
+fn quiet_wayland_probe() {
+    #[cfg(target_os = "linux")]
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
+        std::env::set_var("WAYLAND_DISPLAY", "/nonexistent/tessera-headless-no-wayland");
     }
 }
 

@@ -17,7 +17,7 @@
 // The two decisions write the indirect arguments of the two passes after them: zero
 // workgroups once the rounds have ended. The CPU ends the loop when no patch fails or
 // when a round changes no edge (every failing patch at the cap), and so do they; a frame
-// records `MAX_ROUNDS` rounds, and a plan that needs more is reported (`state.done` stays
+// records `DEFAULT_CHECK_ROUNDS` rounds, and a plan that needs more is reported (`state.done` stays
 // 0), never cut silently: the plan of the last round is still crack-free (the maximum rule
 // holds every round), only some bounds are missed, as at the factor cap.
 //

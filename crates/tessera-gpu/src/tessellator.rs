@@ -125,7 +125,7 @@ const fn max_u32(a: u32, b: u32) -> u32 {
 /// 16, where patches at the cap miss their bound and each round moves the problem one patch
 /// along the mesh; 41 on another camera in `tests/check.rs`). A round that is not needed
 /// dispatches no work; a plan that needs more is reported ([`ScreenReport::converged`]).
-pub const MAX_ROUNDS: u32 = 64;
+pub const DEFAULT_CHECK_ROUNDS: u32 = 64;
 
 /// The largest factor cap of a frame whose a-posteriori check runs on the GPU (the CPU's
 /// default cap). Its shaders rely on it: a check walks strips of at most 2 · 64 steps, so the
@@ -137,7 +137,7 @@ pub const CHECK_MAX_FACTOR: u32 = 64;
 
 /// The most fix rounds a frame may record ([`GpuTessellator::set_check_rounds`]), as many as
 /// the CPU's loop runs.
-pub const MOST_ROUNDS: u32 = 256;
+pub const MAX_CHECK_ROUNDS: u32 = 256;
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
 const PATCH_VIEW_ROW: u32 = 8;
 
@@ -621,7 +621,7 @@ pub struct GpuTessellator {
     screen: Option<Screen>,
     /// The largest buffer the device binds or allocates.
     buffer_limit: u64,
-    /// Fix rounds of the a-posteriori check a frame records ([`MAX_ROUNDS`] unless set).
+    /// Fix rounds of the a-posteriori check a frame records ([`DEFAULT_CHECK_ROUNDS`] unless set).
     check_rounds: u32,
     /// Whether the adapter's shader compiler stops long loops ([`loop_limited`]).
     loop_limited: bool,
@@ -708,7 +708,7 @@ impl GpuTessellator {
             camera: None,
             screen: None,
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
-            check_rounds: MAX_ROUNDS,
+            check_rounds: DEFAULT_CHECK_ROUNDS,
             loop_limited: loop_limited(&ctx.info),
             set: gpu_set,
             pipelines,
@@ -1238,7 +1238,7 @@ impl GpuTessellator {
     }
 
     /// Records the a-posteriori check of a pixel-error transition plan into the factors pass
-    /// (`check.wgsl`): the first check of every patch, then [`MAX_ROUNDS`] rounds whose
+    /// (`check.wgsl`): the first check of every patch, then [`DEFAULT_CHECK_ROUNDS`] rounds whose
     /// passes the GPU sizes itself (no work once the rounds have ended). Groups 0 and 1 are
     /// bound by the caller.
     fn record_check(&self, c: &mut wgpu::ComputePass<'_>) {
@@ -1267,15 +1267,15 @@ impl GpuTessellator {
     }
 
     /// Sets how many fix rounds of the a-posteriori check every following frame records
-    /// (default [`MAX_ROUNDS`]). A round that is not needed dispatches no work, but still
+    /// (default [`DEFAULT_CHECK_ROUNDS`]). A round that is not needed dispatches no work, but still
     /// costs its four dispatches (about 70 µs on lavapipe, a few µs on a hardware GPU), so a
     /// real-time loop whose scenes converge in fewer rounds may record fewer and watch
     /// [`ScreenReport::converged`] now and then (a read-back, on request); at most
-    /// [`MOST_ROUNDS`] (more are clamped to it). A frame whose plan
+    /// [`MAX_CHECK_ROUNDS`] (more are clamped to it). A frame whose plan
     /// needs more rounds is still crack-free; its failing patches miss their bound and are
     /// counted. Cost: none until the next frame.
     pub fn set_check_rounds(&mut self, rounds: u32) {
-        self.check_rounds = rounds.min(MOST_ROUNDS);
+        self.check_rounds = rounds.min(MAX_CHECK_ROUNDS);
     }
 
     /// Reads the last frame's a-posteriori check back (after
@@ -1552,7 +1552,7 @@ pub struct ScreenReport {
     /// `tolerance::PlanReport::capped_patches` counts them on the CPU, or left failing when
     /// the rounds did not converge.
     pub failing_patches: u32,
-    /// Whether the rounds ended within the recorded ones ([`MAX_ROUNDS`], or as
+    /// Whether the rounds ended within the recorded ones ([`DEFAULT_CHECK_ROUNDS`], or as
     /// [`GpuTessellator::set_check_rounds`] set) as the CPU's would (no failing patch, or a
     /// round that changed no edge). When false the plan is still crack-free, but the failing
     /// patches' bounds are missed.

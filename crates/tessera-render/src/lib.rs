@@ -77,6 +77,14 @@ pub enum RenderError {
         /// The I/O or encoder message.
         reason: String,
     },
+    /// Reading a PNG file ([`Image::read_png`]).
+    #[error("{path}: {reason}")]
+    Read {
+        /// The file.
+        path: String,
+        /// The I/O or decoder message.
+        reason: String,
+    },
 }
 
 /// An 8-bit RGBA image, rows top to bottom.
@@ -130,7 +138,7 @@ impl Image {
 
     /// Reads an 8-bit RGB or RGBA PNG (as [`Image::write_png`] writes). For tests and tools.
     pub fn read_png(path: &Path) -> Result<Image, RenderError> {
-        let fail = |e: &dyn std::fmt::Display| RenderError::Write {
+        let fail = |e: &dyn std::fmt::Display| RenderError::Read {
             path: path.display().to_string(),
             reason: e.to_string(),
         };

@@ -1009,33 +1009,10 @@ pub fn run_engine_case(case: &EngineCase) -> EngineOutcome {
     }
     let watertight = verify::watertight(&mesh);
     if strict && !(watertight.boundary_edges == 0 && watertight.nonmanifold_edges == 0) {
-        let open = open_watertight_finding(case, &set, &plan);
-        if SKIP_OPEN_FINDINGS && open.is_some() {
-            return EngineOutcome::Refused;
-        }
-        let open =
-            open.map_or(String::new(), |name| format!(" (open finding fuzz/regressions/open/engine/{name})"));
-        panic!(
-            "closed input, output not watertight{open}: {watertight:?}\ninput topology {report:?}\n{case:#?}"
-        );
+        panic!("closed input, output not watertight: {watertight:?}\ninput topology {report:?}\n{case:#?}");
     }
     EngineOutcome::Tessellated { checked_watertight: strict }
 }
-
-/// The open finding a watertightness failure is an instance of, by the name of its saved
-/// input, or None for a new one. Each test is narrow (a scheme and the condition the finding
-/// needs, as the fixed `esc-fold-at-collapsed-edge` had `Scheme::Esc` with a collapsed curve),
-/// so that a different failure of the same scheme still stops the fuzzer. None is open now.
-fn open_watertight_finding(_case: &EngineCase, _set: &SurfaceSet, _plan: &Plan) -> Option<&'static str> {
-    None
-}
-
-/// True in the cargo-fuzz build (cargo-fuzz passes `--cfg fuzzing`): there the checks step
-/// over findings that are reported but not fixed yet, so that a run looks for new ones
-/// instead of stopping at a known one. `cargo test` is built without it and still fails on
-/// them (their inputs are in `fuzz/regressions/`).
-#[allow(unexpected_cfgs)]
-const SKIP_OPEN_FINDINGS: bool = cfg!(fuzzing);
 
 /// Why a plan breaks the [`Uniform`] pattern's precondition (every edge of a patch has
 /// `interior[0]` segments), or None. The engine trusts it: a plan that breaks it gives local

@@ -306,7 +306,7 @@ pub fn all_models() -> Vec<String> {
 /// recorded, against `Scheme::Transition`'s plan on the CPU with the same options:
 ///
 /// - the culled set equals the CPU's but for counted [`near_cull_tie`]s ([`check_culling`]);
-/// - the rounds converged within `MAX_ROUNDS`;
+/// - the rounds converged within `DEFAULT_CHECK_ROUNDS`;
 /// - every visible patch of the GPU's plan meets its tolerance, its bound computed in f64 by
 ///   the CPU library on that plan (`tolerance::patch_bound`), but for at most the patches
 ///   the GPU reports failing (at the cap, as the CPU reports them);
