@@ -660,9 +660,9 @@ pub(crate) fn with_scratch<R>(generation: u64, f: impl FnOnce(&mut PatchScratch)
     })
 }
 
-/// Fills `cache` for a frame: finds the distinct inputs of `plan`'s visible patches and builds each once, or turns
-/// the cache off for this frame where it would not pay (patterns that depend on the patch,
-/// or fewer than [`MIN_TRIANGLES_PER_PATCH`] triangles per visible patch: `triangles` is
+/// Fills `cache` for a frame: finds the distinct inputs of `plan`'s visible patches and
+/// builds each once, or turns the cache off for this frame where it would not pay (patterns
+/// that depend on the patch, or fewer than [`MIN_TRIANGLES_PER_PATCH`] triangles per visible patch: `triangles` is
 /// the layout's count). Cost: one hash lookup per visible patch (sequential), then the
 /// distinct builds (parallel); no allocation once the buffers have grown to the frame.
 pub(crate) fn fill_pattern_cache(
