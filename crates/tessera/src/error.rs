@@ -75,6 +75,10 @@ pub enum Error {
     /// The scheme cannot tessellate this kind of patch (`patch` is the first such patch).
     #[error("the {scheme} scheme does not tessellate {kind} patches (patch {patch} is one): {hint}")]
     PatchKindNotAccepted { scheme: &'static str, kind: &'static str, patch: usize, hint: &'static str },
+    /// The engine does not draw this request (a scheme, criterion or option of another
+    /// engine); [`crate::scheme::validate`] decides.
+    #[error("the {engine} engine does not support {what}")]
+    EngineNotSupported { engine: &'static str, what: String },
     /// The criterion (or culling) needs a camera and none was given.
     #[error("{what} needs a camera")]
     NeedsCamera { what: &'static str },

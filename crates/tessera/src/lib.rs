@@ -28,8 +28,10 @@
 //! ## Schemes
 //!
 //! Each published scheme is one [`scheme::Scheme`]: a pattern with its edge rule, interior
-//! rule, caps and the criteria it accepts. [`scheme::Scheme::plan`] is the way in; a scheme
-//! refuses a criterion it cannot honour with a typed error.
+//! rule, caps and the criteria it accepts. What a scheme × criterion × surface kind × engine
+//! accepts is decided in one function, [`scheme::validate`], which the
+//! [`tessellator::Tessellator`], [`scheme::Scheme::plan`], the GPU engine and the command-line
+//! tool all call: a request it cannot honour is refused up front with a typed [`Error`].
 //!
 //! | scheme | pattern | criteria | paper |
 //! | --- | --- | --- | --- |

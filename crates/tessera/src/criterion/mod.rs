@@ -7,7 +7,8 @@
 //! patch, that every engine reads as they are. Crack-freeness rests on one rule: the sampling
 //! of an edge is decided once, from data all its patches agree on, and every patch reads it.
 //!
-//! Which criteria go with which pattern is [`crate::scheme::Scheme`]'s business.
+//! [`Criterion`] names what decides the factors; which criteria go with which pattern is
+//! [`crate::scheme::Scheme`]'s business ([`crate::scheme::validate`]).
 
 pub mod bounds;
 pub mod esc;
@@ -18,10 +19,49 @@ pub mod tolerance;
 pub mod view;
 
 use crate::error::{Error, Result};
+use esc::Threshold;
+use view::ViewCriterion;
 use crate::sampling::{EdgeRow, SamplingKind};
 use crate::surface::SurfaceSet;
 
 pub use crate::sampling::MAX_FACTOR;
+
+/// What decides the factors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Criterion {
+    /// One factor everywhere (a real number for SD-2 and the fractional partitionings).
+    Factor(f64),
+    /// Guaranteed object-space error on every patch.
+    Tolerance(f64),
+    /// Guaranteed screen-space error in pixels, for [`crate::scheme::PlanOptions::camera`].
+    PixelError(f64),
+    /// A view heuristic without guarantee: factors in `[fmin, fmax]`.
+    View { criterion: ViewCriterion, fmin: f64, fmax: f64 },
+    /// ESC's own criterion: a level per object from the camera (or `level` for every patch)
+    /// and the distance test with `threshold`.
+    Esc { threshold: Threshold, level: Option<u32> },
+}
+
+impl Criterion {
+    /// Whether the criterion guarantees an error bound, so its plans need every patch's
+    /// second-derivative bounds ([`Prepared::new`] with bounds).
+    pub fn needs_bounds(&self) -> bool {
+        matches!(self, Criterion::Tolerance(_) | Criterion::PixelError(_))
+    }
+
+    /// A short name for messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Criterion::Factor(_) => "a fixed factor",
+            Criterion::Tolerance(_) => "an error tolerance",
+            Criterion::PixelError(_) => "a pixel error",
+            Criterion::View { criterion: ViewCriterion::Distance(_), .. } => "distance factors",
+            Criterion::View { criterion: ViewCriterion::SilhouetteVertices, .. } => "vertex silhouettes",
+            Criterion::View { criterion: ViewCriterion::Silhouetteness, .. } => "silhouetteness",
+            Criterion::Esc { .. } => "the ESC criterion",
+        }
+    }
+}
 
 /// What the criteria need that does not depend on the view or the tolerance, computed once
 /// per surface set: the topology's minimum samplings, for the error-bounded criteria every
@@ -63,6 +103,12 @@ impl Prepared {
             vertex_data: Default::default(),
             edge_midpoints: Default::default(),
         }
+    }
+
+    /// [`Prepared::new`] with the bounds where `criterion` needs them (the error-bounded
+    /// criteria). Cost: that of `new`.
+    pub fn for_criterion(set: &SurfaceSet, criterion: &Criterion) -> Prepared {
+        Prepared::new(set, criterion.needs_bounds())
     }
 
     /// Every patch's [`bounds::TriangleErrors`] (what the a-posteriori check's triangle bound

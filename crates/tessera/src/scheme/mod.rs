@@ -15,18 +15,22 @@
 //! | [`Scheme::Hardware`] (Direct3D 11) | its partitioning, in 16.16 fixed point | `max` reduction | factor, view |
 //! | [`Scheme::Esc`] (paper 002) | lattice points chosen by the distance test | level `3n` | its own ([`Criterion::Esc`]) |
 //!
-//! Asking a scheme for a criterion it does not accept is an
-//! [`Error::CriterionNotAccepted`]; a factor it cannot draw is an [`Error::FactorOutOfRange`].
+//! What a scheme accepts — criterion, factor ranges, surface kinds, engine — is decided in one
+//! place, [`validate`], which every planner, the GPU engine and the command-line tool call:
+//! a criterion it does not accept is an [`Error::CriterionNotAccepted`], a factor it cannot
+//! draw an [`Error::FactorOutOfRange`], a patch kind it is not defined for an
+//! [`Error::PatchKindNotAccepted`], an engine that does not draw it an
+//! [`Error::EngineNotSupported`]. Applications use the [`crate::tessellator::Tessellator`],
+//! which plans through [`Scheme::plan_into`] each frame.
 
 use crate::camera::Camera;
-use crate::criterion::esc::{self as esc_criterion, EscOptions, Threshold};
+use crate::criterion::esc::{self as esc_criterion, EscOptions};
 use crate::criterion::resolve::{EdgeRule, InteriorRule};
 use crate::criterion::sd2::{self as sd2_criterion, LevelFunction, Sd2Options};
 use crate::criterion::tolerance::{self, PlanReport};
 use crate::criterion::view::{self, EdgeFactors, Mapping, ViewCriterion};
 pub use crate::criterion::PlanScratch;
 use crate::criterion::{screen, Plan, MAX_FACTOR};
-use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::pattern::esc::Esc;
 use crate::pattern::hardware::{Hardware, Partitioning};
@@ -38,6 +42,9 @@ use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use crate::sampling::Spacing;
 use crate::surface::SurfaceSet;
 use rayon::prelude::*;
+
+mod validate;
+pub use validate::{validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR};
 
 /// A tessellation scheme: a pattern with the rules that feed it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,37 +63,6 @@ pub enum Scheme {
     Hardware(Partitioning),
     /// ESC (paper 002): bicubic patches only, level per object up to `max_level` (`≤ 6`).
     Esc { max_level: u32 },
-}
-
-/// What decides the factors.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Criterion {
-    /// One factor everywhere (a real number for SD-2 and the fractional partitionings).
-    Factor(f64),
-    /// Guaranteed object-space error on every patch.
-    Tolerance(f64),
-    /// Guaranteed screen-space error in pixels, for [`PlanOptions::camera`].
-    PixelError(f64),
-    /// A view heuristic without guarantee: factors in `[fmin, fmax]`.
-    View { criterion: ViewCriterion, fmin: f64, fmax: f64 },
-    /// ESC's own criterion: a level per object from the camera (or `level` for every patch)
-    /// and the distance test with `threshold`.
-    Esc { threshold: Threshold, level: Option<u32> },
-}
-
-impl Criterion {
-    /// A short name for messages.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Criterion::Factor(_) => "a fixed factor",
-            Criterion::Tolerance(_) => "an error tolerance",
-            Criterion::PixelError(_) => "a pixel error",
-            Criterion::View { criterion: ViewCriterion::Distance(_), .. } => "distance factors",
-            Criterion::View { criterion: ViewCriterion::SilhouetteVertices, .. } => "vertex silhouettes",
-            Criterion::View { criterion: ViewCriterion::Silhouetteness, .. } => "silhouetteness",
-            Criterion::Esc { .. } => "the ESC criterion",
-        }
-    }
 }
 
 /// Options of [`Scheme::plan`] that are not the criterion.
@@ -112,14 +88,7 @@ impl Default for PlanOptions {
     }
 }
 
-pub use crate::criterion::Prepared;
-
-impl Prepared {
-    /// [`Prepared::new`] with the bounds where `criterion` needs them.
-    pub fn for_criterion(set: &SurfaceSet, criterion: &Criterion) -> Prepared {
-        Prepared::new(set, matches!(criterion, Criterion::Tolerance(_) | Criterion::PixelError(_)))
-    }
-}
+pub use crate::criterion::{Criterion, Prepared};
 
 /// A plan, the pattern that draws it, and the guarantee report where the criterion has one.
 #[derive(Debug, Clone)]
@@ -259,41 +228,13 @@ impl Scheme {
         }
     }
 
-    /// Whether the scheme accepts `criterion`; the error names what it accepts instead.
-    /// Cost: O(1).
-    pub fn accepts(&self, criterion: &Criterion) -> Result<()> {
-        let refuse = |hint: &str| {
-            Err(Error::CriterionNotAccepted {
-                scheme: self.name(),
-                criterion: criterion.name(),
-                hint: hint.to_string(),
-            })
-        };
-        match (self, criterion) {
-            (Scheme::Esc { .. }, Criterion::Esc { .. }) => Ok(()),
-            (Scheme::Esc { .. }, _) => refuse("ESC has its own criterion: a quality threshold and levels"),
-            (_, Criterion::Esc { .. }) => refuse("the ESC criterion goes with the esc scheme only"),
-            (
-                Scheme::Sd2 { .. } | Scheme::Hardware(_),
-                Criterion::Tolerance(_) | Criterion::PixelError(_),
-            ) => refuse(
-                "it gives no error guarantee: use a factor or a view criterion, or the uniform, \
-                     transition or semi-uniform scheme for an error bound",
-            ),
-            (Scheme::Sd2 { .. }, Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }) => {
-                refuse("SD-2 needs a level function: use vertex silhouettes or distance factors")
-            }
-            _ => Ok(()),
-        }
-    }
-
     /// Plans `set` under `criterion`. Checks everything a caller can get wrong first: the
     /// criterion ([`Scheme::accepts`]), the factor ranges ([`Error::FactorOutOfRange`]), the
     /// patch kinds ([`Error::PatchKindNotAccepted`]), the camera ([`Error::NeedsCamera`]).
     /// Cost: that of the criterion — O(V + E + P) evaluations for the view criteria, bound
     /// computations and a-posteriori pattern checks for the error-bounded ones.
     pub fn plan(&self, set: &SurfaceSet, criterion: &Criterion, options: &PlanOptions) -> Result<Planned> {
-        self.check(criterion, options)?;
+        validate(*self, criterion, options, set, Engine::Cpu)?;
         self.plan_prepared(set, &Prepared::for_criterion(set, criterion), criterion, options)
     }
 
@@ -326,7 +267,7 @@ impl Scheme {
         scratch: &mut PlanScratch,
         out: &mut Planned,
     ) -> Result<()> {
-        self.check(criterion, options)?;
+        let accepted = validate(*self, criterion, options, set, Engine::Cpu)?;
         scratch.criterion_time = Default::default();
         scratch.resolve_time = Default::default();
         if let Scheme::Esc { max_level } = *self {
@@ -334,11 +275,11 @@ impl Scheme {
             return Ok(());
         }
         if let Scheme::Sd2 { warp } = *self {
-            *out = self.plan_sd2(set, criterion, options, warp)?;
+            *out = self.plan_sd2(set, criterion, options, warp, accepted.cap)?;
             return Ok(());
         }
-        let rule = self.edge_rule().expect("every scheme but ESC has an edge rule");
-        let interior = self.interior_rule();
+        let rule = accepted.edge_rule.expect("every scheme but ESC has an edge rule");
+        let interior = accepted.interior_rule;
         out.pattern = match self {
             Scheme::Uniform => SchemePattern::Uniform(Uniform),
             Scheme::Transition => SchemePattern::Transition(Transition),
@@ -347,7 +288,7 @@ impl Scheme {
             Scheme::Sd2 { .. } | Scheme::Esc { .. } => unreachable!("planned above"),
         };
         out.report = None;
-        let cap = self.cap(options);
+        let cap = accepted.cap;
         let caps = prepared.caps(cap);
         let camera = options.camera;
         let cull_camera = || camera.ok_or(Error::NeedsCamera { what: "culling" });
@@ -433,116 +374,14 @@ impl Scheme {
         Ok(())
     }
 
-    /// The largest factor this scheme may use under `options`: the scheme's own cap and
-    /// `max_factor`, a power of two for semi-uniform.
-    fn cap(&self, options: &PlanOptions) -> f64 {
-        let cap = self.factor_cap().min(options.max_factor.max(1) as f64);
-        match self {
-            Scheme::SemiUniform { .. } => (1u32 << (31 - (cap as u32).leading_zeros())) as f64,
-            _ => cap,
-        }
-    }
-
-    /// Validates `criterion` and `options` against the scheme before any work.
-    fn check(&self, criterion: &Criterion, options: &PlanOptions) -> Result<()> {
-        self.accepts(criterion)?;
-        if options.max_factor == 0 || options.max_factor > MAX_FACTOR {
-            return Err(Error::InvalidParameter {
-                name: "max factor",
-                reason: format!("{}: use 1 to {MAX_FACTOR}", options.max_factor),
-            });
-        }
-        let name = self.name();
-        let out_of_range =
-            |factor: f64, expected: String| Err(Error::FactorOutOfRange { scheme: name, factor, expected });
-        match (*self, *criterion) {
-            (Scheme::SemiUniform { max_level }, _) if max_level > SEMI_UNIFORM_MAX_LEVEL => {
-                Err(Error::InvalidParameter {
-                    name: "max level",
-                    reason: format!("{max_level}: semi-uniform levels go from 0 to {SEMI_UNIFORM_MAX_LEVEL}"),
-                })
-            }
-            (Scheme::Esc { max_level }, _) if max_level > crate::pattern::esc::MAX_LEVEL => {
-                Err(Error::InvalidParameter {
-                    name: "max level",
-                    reason: format!(
-                        "{max_level}: ESC levels go from 0 to {}",
-                        crate::pattern::esc::MAX_LEVEL
-                    ),
-                })
-            }
-            (Scheme::Esc { .. }, _) if options.cull => Err(Error::InvalidParameter {
-                name: "cull",
-                reason: "the esc scheme chooses one level per object and culls nothing".into(),
-            }),
-            (Scheme::Uniform | Scheme::Transition, Criterion::Factor(f)) => {
-                if f.fract() != 0.0 || !(1.0..=MAX_FACTOR as f64).contains(&f) {
-                    return out_of_range(
-                        f,
-                        format!(
-                            "an integer from 1 to {MAX_FACTOR} (real factors need the fractional-odd, \
-                             fractional-even or sd2 scheme)"
-                        ),
-                    );
-                }
-                Ok(())
-            }
-            (Scheme::SemiUniform { max_level }, Criterion::Factor(f)) => {
-                let top = 1u32 << max_level;
-                if f.fract() != 0.0 || !(1.0..=top as f64).contains(&f) || !(f as u32).is_power_of_two() {
-                    return out_of_range(f, format!("a power of two up to 2^{max_level} (the max level)"));
-                }
-                Ok(())
-            }
-            (Scheme::Sd2 { .. } | Scheme::Hardware(_), Criterion::Factor(f)) => {
-                let hi = self.factor_cap().min(options.max_factor as f64);
-                if !(f.is_finite() && f >= 1.0 && f <= hi) {
-                    let why = match self {
-                        Scheme::Hardware(p) if hi == p.range().1 as f64 => {
-                            format!("a number from 1 to {hi}, the hardware's {} range", p.name())
-                        }
-                        _ => format!("a number from 1 to the max factor {hi}"),
-                    };
-                    return out_of_range(f, why);
-                }
-                Ok(())
-            }
-            (_, Criterion::Tolerance(eps) | Criterion::PixelError(eps))
-                if !(eps.is_finite() && eps > 0.0) =>
-            {
-                Err(Error::InvalidParameter {
-                    name: if matches!(criterion, Criterion::Tolerance(_)) {
-                        "tolerance"
-                    } else {
-                        "pixel error"
-                    },
-                    reason: format!("{eps}: must be a positive number"),
-                })
-            }
-            (_, Criterion::View { fmin, fmax, .. }) => {
-                let integer = matches!(self.edge_rule(), Some(EdgeRule::Integer | EdgeRule::PowerOfTwo));
-                let valid = |f: f64| f.is_finite() && f >= 1.0 && (!integer || f.fract() == 0.0);
-                if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
-                    let what = if integer { "integers" } else { "numbers" };
-                    return out_of_range(
-                        if valid(fmin) { fmax } else { fmin },
-                        format!("a range FMIN:FMAX of {what} with 1 ≤ FMIN ≤ FMAX"),
-                    );
-                }
-                Ok(())
-            }
-            _ => Ok(()),
-        }
-    }
-
     fn plan_sd2(
         &self,
         set: &SurfaceSet,
         criterion: &Criterion,
         options: &PlanOptions,
         warp: bool,
+        cap: f64,
     ) -> Result<Planned> {
-        let cap = self.cap(options);
         let (level, fmin, fmax) = match *criterion {
             Criterion::Factor(f) => (LevelFunction::Distance(Mapping::Linear), f, f),
             Criterion::View { criterion: ViewCriterion::Distance(m), fmin, fmax } => {
@@ -573,15 +412,8 @@ impl Scheme {
         options: &PlanOptions,
         max_level: u32,
     ) -> Result<Planned> {
+        // Bicubic patches only: `validate` checked.
         let Criterion::Esc { threshold, level } = *criterion else { unreachable!("refused by accepts") };
-        if let Some(p) = set.patches.iter().position(|p| p.domain() != Domain::Quad) {
-            return Err(Error::PatchKindNotAccepted {
-                scheme: "esc",
-                kind: "triangle",
-                patch: p,
-                hint: "ESC tessellates bicubic Bézier patches only (a mesh gives PN triangles)",
-            });
-        }
         let camera = match (options.camera, level) {
             (Some(c), _) => c,
             (None, Some(_)) => framing(set),
@@ -604,9 +436,10 @@ fn framing(set: &SurfaceSet) -> Camera {
 mod tests {
     use super::*;
     use crate::surface::{Patch, RationalBicubic};
+    use crate::criterion::esc::Threshold;
     use glam::DVec3;
 
-    fn flat() -> SurfaceSet {
+    pub(super) fn flat() -> SurfaceSet {
         let points = std::array::from_fn(|k| DVec3::new((k / 4) as f64, (k % 4) as f64, 0.0));
         SurfaceSet::from_patches(
             vec![Patch::Bicubic(RationalBicubic { points, weights: [1.0; 16] })],
