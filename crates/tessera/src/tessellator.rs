@@ -32,11 +32,11 @@
 use crate::camera::Camera;
 use crate::criterion::tolerance::PlanReport;
 use crate::criterion::Plan;
-use crate::engine::uniform_quads::FastEvaluator;
+use crate::engine::fast_evaluator::FastEvaluator;
 use crate::engine::{self, Layout, TessellateOptions};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scheme::{Criterion, PlanOptions, PlanScratch, Planned, Prepared, Scheme};
+use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, Planned, Prepared, Scheme};
 use std::time::{Duration, Instant};
 
 /// Wall time of each stage of a frame ([`Tessellator::timings`]).
@@ -115,8 +115,8 @@ impl MeshBuilder for Mesh {
 /// Options of a [`Tessellator`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TessellatorOptions {
-    /// Everything about planning but the camera, which comes per frame
-    /// (`plan.camera` is ignored).
+    /// Everything about planning; `plan.camera` is the camera of the frames called without
+    /// one (a frame's own camera replaces it).
     pub plan: PlanOptions,
     /// The engine's options (size limits, corner parameters, strips).
     pub engine: TessellateOptions,
@@ -146,8 +146,9 @@ pub struct Tessellator<'a> {
 }
 
 impl<'a> Tessellator<'a> {
-    /// Prepares `set` for `scheme` under `criterion`: checks that the scheme accepts the
-    /// criterion (else [`crate::Error::CriterionNotAccepted`]) and computes what does not
+    /// Prepares `set` for `scheme` under `criterion`: checks the request
+    /// ([`crate::scheme::validate`]: the pairing, the ranges, the surface kinds; its typed
+    /// errors) and computes what does not
     /// depend on the view — the topology's minimum samplings and, for error-bounded
     /// criteria, every patch's second-derivative bound — and the vectorized evaluation's
     /// control-point tables. Cost: O(P) bound computations.
@@ -157,7 +158,7 @@ impl<'a> Tessellator<'a> {
         criterion: Criterion,
         options: TessellatorOptions,
     ) -> Result<Tessellator<'a>> {
-        scheme.accepts(&criterion)?;
+        validate(scheme, &criterion, &options.plan, set, Engine::Cpu)?;
         let prepared = Prepared::for_criterion(set, &criterion);
         let fast = FastEvaluator::for_set(set, true);
         Ok(Tessellator {
@@ -178,8 +179,24 @@ impl<'a> Tessellator<'a> {
         })
     }
 
-    /// Tessellates one frame seen from `camera` (None for criteria and options that need no
-    /// camera) into the tessellator's own buffers, reused from the last frame, and returns
+    /// Makes the next frames draw `scheme` under `criterion` and `plan`, keeping what was
+    /// prepared for the set (the error bounds are computed on the first criterion that needs
+    /// them): as an interactive viewer changes the scheme or the pixel error. Checks the
+    /// request as [`Tessellator::new`] does; on error the tessellator is unchanged. Cost:
+    /// O(1), or O(P) bound computations the first time they are needed.
+    pub fn reconfigure(&mut self, scheme: Scheme, criterion: Criterion, plan: PlanOptions) -> Result<()> {
+        validate(scheme, &criterion, &plan, self.set, Engine::Cpu)?;
+        if criterion.needs_bounds() && self.prepared.hessians.len() != self.set.patches.len() {
+            self.prepared = Prepared::for_criterion(self.set, &criterion);
+        }
+        (self.scheme, self.criterion, self.options.plan) = (scheme, criterion, plan);
+        self.planned_ok = false;
+        self.laid_out = false;
+        Ok(())
+    }
+
+    /// Tessellates one frame seen from `camera` (None: [`TessellatorOptions`]'s `plan.camera`,
+    /// or no camera for criteria and options that need none) into the tessellator's own buffers, reused from the last frame, and returns
     /// them: [`Tessellator::plan_frame`] then [`Tessellator::write_frame`]. Cost: the plan's
     /// (see [`Scheme::plan`]) plus O(output), parallel.
     pub fn frame(&mut self, camera: Option<&Camera>) -> Result<&Mesh> {
@@ -192,7 +209,7 @@ impl<'a> Tessellator<'a> {
     /// long the write will take, or refuse it) before anything of the output's size exists.
     /// Cost: the plan's plus the layout's (O(E + P)).
     pub fn plan_frame(&mut self, camera: Option<&Camera>) -> Result<&Layout> {
-        let options = PlanOptions { camera: camera.copied(), ..self.options.plan };
+        let options = PlanOptions { camera: camera.copied().or(self.options.plan.camera), ..self.options.plan };
         let start = Instant::now();
         self.planned_ok = false;
         self.laid_out = false;
@@ -218,6 +235,8 @@ impl<'a> Tessellator<'a> {
             layout: start.elapsed(),
             ..FrameTimings::default()
         };
+        // A frame planned for another engine to draw reports its planning stages.
+        self.timings = self.pending;
         Ok(&self.layout)
     }
 
@@ -266,9 +285,16 @@ impl<'a> Tessellator<'a> {
         &self.mesh
     }
 
-    /// How long each stage of the last successful frame took.
+    /// How long each stage of the last successful frame took (after
+    /// [`Tessellator::plan_frame`] alone, its planning stages, the write's zero).
     pub fn timings(&self) -> FrameTimings {
         self.timings
+    }
+
+    /// The last frame's mesh, handed over with the tessellator's other buffers dropped: for
+    /// a caller done with frames. Cost: O(1).
+    pub fn into_mesh(self) -> Mesh {
+        self.mesh
     }
 
     /// [`Tessellator::frame`], handed to `builder`. Cost: that of `frame` plus one pass over
