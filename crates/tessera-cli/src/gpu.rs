@@ -1,13 +1,12 @@
 //! `tessera mesh --engine gpu`: a frame tessellated by tessera-gpu and read back, with the
 //! GPU's per-pass times for `--stats`. Where the GPU plans the frame itself from the camera
-//! (culling on, a criterion and scheme `GpuTessellator::prepare_screen` takes), it does:
-//! the whole CudaTess frame on the GPU; otherwise it tessellates the plan the CPU chose.
+//! (what `tessera::scheme::validate` accepts for `Engine::GpuFromCamera`), it does: the whole
+//! CudaTess frame on the GPU; otherwise it tessellates the plan the CPU chose.
 
 use tessera::camera::Camera;
-use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
-use tessera::scheme::{Criterion, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera_gpu::tessellator::{PassTimer, ScreenCriterion, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator, ScreenReport};
@@ -20,36 +19,22 @@ pub struct GpuRun {
     pub adapter: String,
     /// Set when the GPU planned the frame from the camera: its a-posteriori check's report.
     pub screen: Option<ScreenReport>,
+    /// The patches the GPU culled, when it planned the frame (0 otherwise: the CPU's plan
+    /// says).
+    pub culled: usize,
 }
 
-/// The frame the GPU plans from `camera` alone for `scheme` under `criterion`, if it can:
-/// culling on (the GPU always culls what it plans) and a pairing `prepare_screen` takes (a
-/// pixel error with the uniform or transition scheme, silhouetteness with those or a hardware
-/// partitioning, a fixed real factor with a hardware partitioning).
+/// The frame the GPU plans from the camera alone for `scheme` under `criterion` and
+/// `options`, where it plans that request (`tessera::scheme::validate` for
+/// [`Engine::GpuFromCamera`]: culling on, and a pairing `prepare_screen` takes).
 pub fn screen_criterion(
+    set: &SurfaceSet,
     scheme: Scheme,
     criterion: &Criterion,
-    cull: bool,
-    max_factor: u32,
+    options: &PlanOptions,
 ) -> Option<ScreenCriterion> {
-    let on_gpu = matches!(
-        (scheme, criterion),
-        (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(_))
-            | (
-                Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
-                Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
-            )
-            | (Scheme::Hardware(_), Criterion::Factor(_))
-    );
-    // The GPU's a-posteriori check takes caps up to CHECK_MAX_FACTOR; the CPU plans the rest.
-    let checked = scheme == Scheme::Transition && matches!(criterion, Criterion::PixelError(_));
-    let within = !checked || max_factor <= tessera_gpu::tessellator::CHECK_MAX_FACTOR;
-    (cull && on_gpu && within).then_some(ScreenCriterion {
-        scheme,
-        criterion: *criterion,
-        max_factor,
-        capacity: None,
-    })
+    validate(scheme, criterion, options, set, Engine::GpuFromCamera).ok()?;
+    Some(ScreenCriterion { scheme, criterion: *criterion, max_factor: options.max_factor, capacity: None })
 }
 
 /// Plans and tessellates the frame of `camera` on the GPU `repeat` times (frames, from the
@@ -75,6 +60,7 @@ pub fn tessellate_from_camera(
     }
     *mesh = gpu.read_mesh(&ctx, set)?;
     run.screen = Some(gpu.read_screen_report(&ctx)?);
+    run.culled = gpu.read_visible(&ctx)?.iter().filter(|&&v| v == 0).count();
     Ok(run)
 }
 
@@ -113,7 +99,7 @@ fn frames(
     } else {
         Vec::new()
     };
-    Ok(GpuRun { passes_ms, adapter: ctx.info.name.clone(), screen: None })
+    Ok(GpuRun { passes_ms, adapter: ctx.info.name.clone(), screen: None, culled: 0 })
 }
 
 /// Tessellates `plan` on the GPU `repeat` times (frames), reads the last one back into

@@ -2,6 +2,7 @@
 
 mod bench;
 mod gpu;
+mod mesh_command;
 mod pattern_file;
 mod plan;
 mod render;
@@ -12,9 +13,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use tessera::criterion::Plan;
-use tessera::engine::render_queues::{self, RenderQueues};
-use tessera::engine::{self, TessellateOptions};
+use tessera::engine::render_queues::RenderQueues;
+use tessera::engine::TessellateOptions;
 use tessera::io::glb::UriScope;
 use tessera::io::LoadOptions;
 use tessera::mesh::Mesh;
@@ -23,7 +23,7 @@ use tessera::pattern::uniform::Uniform;
 use tessera::scheme::{Criterion, Scheme};
 use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
-use tessera::tessellator::{FrameTimings, Tessellator, TessellatorOptions};
+use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera::topology::weld::Weld;
 use tessera::verify;
 
@@ -44,7 +44,7 @@ enum Command {
     /// Tessellate a patch file (.patches, bicubic Bézier), a Bézier triangle file (.bezt) or a
     /// triangle mesh (.obj, .ply, .stl, .glb, .gltf, as PN triangles) into one watertight
     /// indexed mesh.
-    Mesh(MeshArgs),
+    Mesh(mesh_command::MeshArgs),
     /// Check a mesh: watertightness, triangle quality and, with --against, the input's
     /// topology and the approximation error.
     Check(CheckArgs),
@@ -70,7 +70,7 @@ enum Command {
 }
 
 #[derive(Args)]
-struct InputArgs {
+pub struct InputArgs {
     /// Merge control points / mesh vertices closer than EPS (default: only bit-identical
     /// positions are merged).
     #[arg(long, value_name = "EPS")]
@@ -85,52 +85,6 @@ struct InputArgs {
     /// links followed, to regular files inside it).
     #[arg(long)]
     allow_outside_uris: bool,
-}
-
-#[derive(Args)]
-struct MeshArgs {
-    /// Input: .patches (Newell bicubic patch format), .bezt (cubic Bézier triangles) or a
-    /// triangle mesh → PN triangles: .obj, .ply, .stl, .glb or .gltf.
-    input: PathBuf,
-    /// Output mesh; the format follows the extension: .obj, .ply, .stl or .glb.
-    #[arg(short, long, value_name = "OUT")]
-    output: Option<PathBuf>,
-    #[command(flatten)]
-    criterion: plan::CriterionArgs,
-    /// Print one JSON object with counts, topology and timing on one stdout line.
-    #[arg(long)]
-    stats: bool,
-    /// Tessellate R times (reusing the output buffers) and report the median time (--stats).
-    #[arg(long, value_name = "R", default_value_t = 1)]
-    repeat: u32,
-    /// Refuse, before allocating anything, an output of more triangles than this. Default:
-    /// what three quarters of the memory available now can hold.
-    #[arg(long, value_name = "N")]
-    max_triangles: Option<u64>,
-    /// Also measure the approximation error against the exact surface (with --stats).
-    #[arg(long)]
-    measure_error: bool,
-    /// Also produce triangle strips (schemes sd2 and esc): stored in .ply as a `tristrips`
-    /// element; the other formats keep the decoded triangle list.
-    #[arg(long)]
-    strips: bool,
-    /// Semi-uniform: also write the instanced form as JSON — the static patterns P^0..P^M
-    /// (vertices u, v, tag: edge + snap offset, or 4 for unsnapped) and the render queues
-    /// (per level: patch id and edge levels).
-    #[arg(long, value_name = "JSON")]
-    instanced: Option<PathBuf>,
-    /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform, transition,
-    /// integer, pow2, fractional-odd and fractional-even schemes on every surface kind; with
-    /// --cull and a pixel error (uniform, transition; --max-factor up to 64), silhouetteness,
-    /// or a hardware scheme's --factor, the GPU plans the frame from the camera itself, else
-    /// it draws the CPU's plan; --stats adds per-pass GPU times).
-    #[arg(long, value_enum, default_value = "cpu")]
-    engine: plan::EngineArg,
-    /// Let -o name the input file itself (it is replaced once the new mesh is complete).
-    #[arg(long)]
-    force: bool,
-    #[command(flatten)]
-    input_args: InputArgs,
 }
 
 #[derive(Args)]
@@ -165,7 +119,7 @@ fn main() -> ExitCode {
         quiet_wayland_probe();
     }
     let result = match cli.command {
-        Command::Mesh(a) => run_mesh(a),
+        Command::Mesh(a) => mesh_command::run(a),
         Command::Check(a) => run_check(a),
         Command::Demo(a) => run_demo(a),
         Command::Pattern(a) => pattern_file::run(a).map(|()| ExitCode::SUCCESS),
@@ -327,259 +281,6 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
-}
-
-fn run_mesh(a: MeshArgs) -> CliResult {
-    let options = load_options(&a.input_args)?;
-    if a.repeat == 0 {
-        return Err("--repeat 0: use 1 or more".into());
-    }
-    if a.max_triangles == Some(0) {
-        return Err("--max-triangles 0: use 1 or more".into());
-    }
-    if let Some(out) = &a.output {
-        tessera::io::check_output_path(out)?;
-        if !a.force && same_file(out, &a.input) {
-            return Err(format!(
-                "-o {}: that is the input; write elsewhere, or add --force to replace it",
-                out.display()
-            )
-            .into());
-        }
-    }
-    let pb = spinner(&format!("reading {}", a.input.display()));
-    let set = load_surfaces(&a.input, options)?;
-    pb.set_message("choosing factors");
-    let wants_params = a.measure_error
-        || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
-    let opts = TessellateOptions { strips: a.strips, ..limits(a.max_triangles, wants_params) };
-    let max_triangles = opts.max_triangles.unwrap_or(u64::MAX);
-    let chosen = plan::choose(&a.criterion, &set, max_triangles)?;
-    if chosen.options.cull || !matches!(chosen.criterion, Criterion::Factor(_) | Criterion::Tolerance(_)) {
-        plan::note_up_axis(a.criterion.camera.as_deref(), &a.input);
-    }
-    // Plan and engine errors alike: about a patch, they name the file; about size, they say
-    // which limit.
-    let explain = |e: tessera::Error| -> Box<dyn std::error::Error> {
-        match e {
-            tessera::Error::PatchKindNotAccepted { .. } => format!("{}: {e}", a.input.display()).into(),
-            e => explain_limit(e, &opts),
-        }
-    };
-    let start = Instant::now();
-    let tess_options = TessellatorOptions { plan: chosen.options, engine: opts };
-    let mut tess = Tessellator::new(&set, chosen.scheme, chosen.criterion, tess_options).map_err(explain)?;
-    let prepare = start.elapsed();
-    pb.set_message(format!("tessellating {} patches ({})", set.patches.len(), chosen.description));
-    // Every repeat is a whole frame from the camera, criterion to last index, into buffers
-    // reused from the last one, as an application re-tessellating every frame would: the
-    // median then measures tessellation, not page faults.
-    let mut frames = Vec::new();
-    // The GPU engine takes the first frame's plan; only it repeats.
-    let cpu_frames = if a.engine == plan::EngineArg::Gpu { 1 } else { a.repeat.max(1) };
-    for frame in 0..cpu_frames {
-        let layout = tess.plan_frame(chosen.options.camera.as_ref()).map_err(explain)?;
-        if frame == 0 {
-            announce_large_output(layout, &opts, a.output.as_deref());
-        }
-        tess.write_frame().map_err(explain)?;
-        frames.push(tess.timings());
-    }
-    let plan = tess.plan().expect("a frame was planned");
-    let report = tess.report().copied();
-    if let Some(r) = &report {
-        if r.capped_patches > 0 {
-            // Semi-uniform's cap is its highest level, 2^M, not --max-factor.
-            let (cap, flag) = if let Scheme::SemiUniform { max_level: m } = chosen.scheme {
-                (format!("--max-level {m} (factor {})", a.criterion.max_factor.min(1 << m)), "--max-level")
-            } else {
-                (format!("--max-factor {}", a.criterion.max_factor), "--max-factor")
-            };
-            eprintln!(
-                "warning: {cap} stopped the error bound on {} patches: the guaranteed bound there is up to {:.3e}, {}× the request; raise {flag}",
-                r.capped_patches,
-                r.worst_bound,
-                ratio(r.worst_ratio)
-            );
-        }
-    }
-    if a.strips
-        && a.output.as_ref().is_some_and(|o| !o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
-    {
-        eprintln!("note: only .ply stores triangle strips; the output gets the decoded triangle list");
-    }
-    let queues = match &a.instanced {
-        Some(path) => {
-            let Scheme::SemiUniform { max_level } = chosen.scheme else {
-                return Err("--instanced needs --scheme semi-uniform".into());
-            };
-            let queues = render_queues::build(&set, plan, max_level)?;
-            write_instanced(path, &set, &queues)?;
-            Some(queues)
-        }
-        None => None,
-    };
-    // --engine gpu: the tessellator's plan, tessellated again on the GPU and read back.
-    let mut gpu_mesh = Mesh::default();
-    let mut gpu_times = Vec::new();
-    let mut gpu_run = None;
-    if a.engine == plan::EngineArg::Gpu {
-        if a.measure_error || a.strips {
-            return Err(
-                "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips"
-                    .into(),
-            );
-        }
-        let pattern = tess.pattern().expect("a frame was planned");
-        let (cull, cap) = (chosen.options.cull, chosen.options.max_factor);
-        let camera = chosen.options.camera;
-        gpu_run = Some(match (camera, gpu::screen_criterion(chosen.scheme, &chosen.criterion, cull, cap)) {
-            // The whole frame from the camera on the GPU (it equals the CPU's plan; tests/gpu.rs).
-            (Some(camera), Some(screen)) => {
-                gpu::tessellate_from_camera(&set, &camera, screen, a.repeat, &mut gpu_mesh, &mut gpu_times)?
-            }
-            _ => gpu::tessellate(&set, plan, pattern, a.repeat, &mut gpu_mesh, &mut gpu_times)?,
-        });
-    }
-    if let Some(check) = gpu_run.as_ref().and_then(|r| r.screen).filter(|c| c.checked && !c.converged) {
-        eprintln!(
-            "warning: the GPU's a-posteriori check needed more than its {} fix rounds: {} patches miss the bound (the mesh is still crack-free)",
-            check.rounds, check.failing_patches
-        );
-    }
-    if let (Some(out), Some(_)) = (&a.output, &gpu_run) {
-        if out.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")) {
-            eprintln!(
-                "note: the GPU engine gives no per-corner patch parameters: {} has no patch_uv, so `tessera check --against` cannot measure its error (--engine cpu writes them)",
-                out.display()
-            );
-        }
-    }
-    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
-    // The numbering rule gives culled patches' corners (and their edges' normal variants)
-    // vertices no triangle uses; what is written and counted holds only the used ones. The
-    // GPU's mesh is ours to compact; the CPU's belongs to the tessellator.
-    let compacted;
-    let mesh = if gpu_run.is_some() {
-        if culled > 0 {
-            gpu_mesh.drop_unused_vertices();
-        }
-        &gpu_mesh
-    } else if culled > 0 {
-        let mut copy = tess.mesh().clone();
-        copy.drop_unused_vertices();
-        compacted = copy;
-        &compacted
-    } else {
-        tess.mesh()
-    };
-    pb.finish_and_clear();
-    let mut output_file = None;
-    if let Some(out) = &a.output {
-        let start = Instant::now();
-        write_with_bar(mesh, out, opts.corner_params)?;
-        output_file = Some(start.elapsed().as_secs_f64());
-    }
-    let repairs = report_repairs(&set, mesh);
-    if a.output.is_none() && !a.stats {
-        eprintln!(
-            "tessellated {} patches into {} triangles and {} vertices; nothing written: give -o OUT to write the mesh, or --stats for the figures",
-            set.patches.len(),
-            mesh.triangle_count(),
-            mesh.vertex_count()
-        );
-    }
-    if culled > 0 {
-        eprintln!(
-            "note: --cull left out {culled} of {} patches (outside the view or facing away): the mesh is open there",
-            set.patches.len()
-        );
-    }
-    // Checked on every run: a mesh that is open, non-manifold or degenerate where the input
-    // was not never leaves without a warning and exit status 1.
-    let w = verify::watertight(mesh);
-    let problems = output_problems(&set, &w, culled);
-    if a.stats {
-        let stage =
-            |f: fn(&FrameTimings) -> Duration| median(frames.iter().map(|t| f(t).as_secs_f64()).collect());
-        let seconds = if gpu_run.is_some() { median(gpu_times.clone()) } else { stage(FrameTimings::total) };
-        let mut stats = serde_json::json!({
-            "input": a.input.display().to_string(),
-            "scheme": chosen.description,
-            "culled_patches": culled,
-            "patches": set.patches.len(),
-            "triangles": mesh.triangle_count(),
-            "vertices": mesh.vertex_count(),
-            "boundary_edges": w.boundary_edges,
-            "nonmanifold_edges": w.nonmanifold_edges,
-            "degenerate_triangles": w.degenerate_triangles(),
-            "euler_characteristic": w.euler_characteristic,
-            "input_euler_characteristic": set.topology.report.euler_characteristic,
-            "input_boundary_edges": set.topology.report.boundary_edges,
-            "input_nonmanifold_edges": set.topology.report.nonmanifold_edges,
-            "seconds": seconds,
-            "repeat": a.repeat.max(1),
-            "mtri_per_s": mesh.triangle_count() as f64 / seconds / 1e6,
-            "threads": rayon::current_num_threads(),
-            // Medians over the repeats; `seconds` is their whole frame. `prepare` (once per
-            // set) and `output_file` (once) are not part of it.
-            "stages": {
-                "prepare": prepare.as_secs_f64(),
-                "criterion": stage(|t| t.criterion),
-                "resolve": stage(|t| t.resolve),
-                "layout": stage(|t| t.layout),
-                "write": stage(|t| t.write),
-                "write_vertices": stage(|t| t.write_vertices),
-                "write_indices": stage(|t| t.write_indices),
-                "output_file": output_file,
-            },
-            "repairs": repairs,
-        });
-        if let Some(r) = &report {
-            stats["guaranteed_bound"] = r.worst_bound.into();
-            stats["bound_met"] = (r.capped_patches == 0).into();
-            stats["capped_patches"] = r.capped_patches.into();
-        }
-        if let Some(t) = chosen.tolerance {
-            stats["tolerance"] = t.into();
-        }
-        if let Some(run) = &gpu_run {
-            stats["engine"] = "gpu".into();
-            stats["adapter"] = run.adapter.clone().into();
-            stats["planned_on"] = if run.screen.is_some() { "gpu" } else { "cpu" }.into();
-            if let Some(check) = run.screen.filter(|c| c.checked) {
-                stats["gpu_check_rounds"] = check.rounds.into();
-                stats["gpu_check_converged"] = check.converged.into();
-                stats["gpu_capped_patches"] = check.failing_patches.into();
-            }
-            stats["gpu_pass_ms"] = run
-                .passes_ms
-                .iter()
-                .map(|&(n, ms)| (n.to_string(), ms.into()))
-                .collect::<serde_json::Map<_, _>>()
-                .into();
-        }
-        if let Some(strips) = &mesh.strips {
-            stats["strip_indices"] = strips.len().into();
-            stats["strips"] =
-                (strips.iter().filter(|&&i| i == tessera::mesh::strips::RESTART).count() + 1).into();
-        }
-        if let Some(q) = &queues {
-            let sizes: Vec<usize> = (0..=q.max_level()).map(|m| q.level(m).len()).collect();
-            stats["render_queues"] = sizes.into();
-        }
-        if a.measure_error {
-            let e = verify::approximation_error(mesh, &set, 6)?;
-            stats["max_error"] = e.max.into();
-            stats["rms_error"] = e.rms.into();
-        }
-        stats["problems"] = problems.clone().into();
-        println!("{stats}");
-    }
-    for p in &problems {
-        eprintln!("warning: {p}");
-    }
-    Ok(if problems.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 /// Whether `a` and `b` name one file (links and `..` resolved); false when either does not
@@ -819,11 +520,16 @@ fn run_demo(a: DemoArgs) -> CliResult {
     }
     let file = tessera::io::patches::parse_patches(TEAPOT, Path::new("<embedded teapot>"))?;
     let set = SurfaceSet::from_patch_file(&file, BuildOptions::default());
-    let plan = Plan::uniform(&set, a.factor)?;
     let start = Instant::now();
     let opts = limits(None, true);
-    let mesh = engine::tessellate(&set, &plan, &Uniform, opts).map_err(|e| explain_limit(e, &opts))?;
+    let options = TessellatorOptions { engine: opts, ..Default::default() };
+    let criterion = Criterion::Factor(a.factor as f64);
+    let explain = |e| explain_limit(e, &opts);
+    let mut tess = Tessellator::new(&set, Scheme::Uniform, criterion, options).map_err(explain)?;
+    tess.frame(None).map_err(explain)?;
     let seconds = start.elapsed().as_secs_f64();
+    let plan = tess.plan().expect("a frame was planned").clone();
+    let mesh = tess.into_mesh();
     tessera::io::write_mesh(&mesh, &a.output)?;
     let w = verify::watertight(&mesh);
     let e = verify::approximation_error(&mesh, &set, 6)?;

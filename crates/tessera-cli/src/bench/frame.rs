@@ -231,8 +231,8 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
     let screens: Vec<_> = scenes
         .iter()
         .filter_map(|scene| {
-            let cap = scene.options().plan.max_factor;
-            crate::gpu::screen_criterion(scene.scheme, &scene.criterion, scene.cull, cap).map(|s| (scene, s))
+            let options = scene.options().plan;
+            crate::gpu::screen_criterion(&scene.set, scene.scheme, &scene.criterion, &options).map(|s| (scene, s))
         })
         .collect();
     ctx.plan_steps(screens.len() as u64);
