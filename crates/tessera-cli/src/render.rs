@@ -13,6 +13,7 @@ use tessera::camera::Camera;
 use tessera::criterion::Plan;
 use tessera::engine::layout::Layout;
 use tessera::mesh::Mesh;
+use tessera::scheme::{validate, Engine};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator};
@@ -317,13 +318,22 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
     let device = if a.engine == plan::EngineArg::Gpu { Ok(Device::new()?) } else { context(a.renderer)? };
     check_size(&camera, &device, a.msaa)?;
     let start = Instant::now();
+    let on_gpu = a.engine == plan::EngineArg::Gpu;
+    if on_gpu {
+        validate(chosen.scheme, &chosen.criterion, &chosen.options, &set, Engine::Gpu)?;
+    }
     let mut tess = Tessellator::new(
         &set,
         chosen.scheme,
         chosen.criterion,
         TessellatorOptions { plan: chosen.options, engine: engine_options },
     )?;
-    tess.frame(Some(&camera))?;
+    // The GPU engine draws the CPU's plan: no CPU write for it.
+    if on_gpu {
+        tess.plan_frame(Some(&camera))?;
+    } else {
+        tess.frame(Some(&camera))?;
+    }
     let tessellate = start.elapsed().as_secs_f64();
     let plan = tess.plan().expect("a frame was planned");
     let levels = tessera_render::patch_levels(plan, a.criterion.max_factor);
@@ -336,7 +346,7 @@ pub fn run(a: RenderArgs) -> crate::CliResult {
         },
     };
     let (drawn, triangles) = match &device {
-        Ok(device) if a.engine == plan::EngineArg::Gpu => {
+        Ok(device) if on_gpu => {
             let pattern = tess.pattern().expect("a frame was planned");
             draw_gpu_engine(device, &set, plan, pattern, &levels, &camera, &render_options, a.msaa)?
         }

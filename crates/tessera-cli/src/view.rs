@@ -24,7 +24,7 @@ use std::time::Instant;
 use tessera::camera::Camera;
 use tessera::criterion::PlanScratch;
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{Criterion, PlanOptions, Planned, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Planned, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::tessellator::{PassTimer, PASSES};
@@ -107,9 +107,11 @@ struct State {
     prepared: Prepared,
     scratch: PlanScratch,
     planned: Planned,
-    cpu: Option<Tessellator<'static>>,
-    /// The scheme, the criterion's bits and culling the CPU tessellator was made for.
-    cpu_key: (usize, u64, bool),
+    /// Every frame's plan, and the CPU engine's frames: made on the first frame,
+    /// reconfigured when the scheme, the criterion or culling change.
+    tess: Option<Tessellator<'static>>,
+    /// The scheme, the criterion's bits and culling `tess` was set for.
+    tess_key: (usize, u64, bool),
     /// The instanced semi-uniform draw (paper 000), made on first use; Err once it cannot
     /// draw this set (mixed domains), then the CPU engine draws semi-uniform.
     instanced: Option<Result<InstancedDraw, String>>,
@@ -228,8 +230,8 @@ impl App {
             prepared: Prepared::for_criterion(self.set, &criterion),
             scratch: PlanScratch::default(),
             planned: Planned::default(),
-            cpu: None,
-            cpu_key: (usize::MAX, 0, false),
+            tess: None,
+            tess_key: (usize::MAX, 0, false),
             instanced: None,
             ctx,
         })
@@ -263,8 +265,7 @@ impl App {
         };
         let camera = self.camera(w, h);
         let state = self.state.as_mut().expect("checked");
-        let set = self.set;
-        let settings = &self.settings;
+        let (set, settings) = (self.set, &self.settings);
         let scheme = SCHEMES[settings.scheme];
         let options = PlanOptions {
             camera: Some(camera),
@@ -274,90 +275,8 @@ impl App {
         };
         let start = Instant::now();
         let criterion = criterion_for(scheme, settings.pixel_error, set, state, &options)?;
-        // The GPU engine draws the uniform and transition schemes; anything it refuses is
-        // tessellated on the CPU this frame.
-        let mut on_gpu = false;
-        let mut plan_ms = 0.0;
-        // Semi-uniform on the GPU: render queues, level arguments and instanced draws.
-        let mut instanced = false;
-        if let (true, Scheme::SemiUniform { max_level }) = (settings.gpu_engine, scheme) {
-            if state.instanced.is_none() {
-                let made = InstancedDraw::new(&state.ctx, set, max_level, state.config.format, SAMPLES);
-                state.instanced = Some(made.map_err(|e| e.to_string()));
-            }
-            if let Some(Ok(_)) = &state.instanced {
-                scheme.plan_into(
-                    set,
-                    &state.prepared,
-                    &criterion,
-                    &options,
-                    &mut state.scratch,
-                    &mut state.planned,
-                )?;
-                plan_ms = start.elapsed().as_secs_f64() * 1e3;
-                instanced = true;
-            }
-        }
-        if settings.gpu_engine && matches!(scheme, Scheme::Uniform | Scheme::Transition) {
-            scheme.plan_into(
-                set,
-                &state.prepared,
-                &criterion,
-                &options,
-                &mut state.scratch,
-                &mut state.planned,
-            )?;
-            plan_ms = start.elapsed().as_secs_f64() * 1e3;
-            match state.engine.prepare(&state.ctx, set, &state.planned.plan, &state.planned.pattern) {
-                Ok(()) => on_gpu = true,
-                Err(GpuError::Unsupported { .. }) => {}
-                Err(e) => return Err(e.into()),
-            }
-        }
-        let levels;
-        let mut stages;
         let mut encoder = state.ctx.device.create_command_encoder(&Default::default());
-        let triangles;
-        let upload;
-        let level_buffer;
-        if instanced {
-            levels = Vec::new();
-            stages = format!("PLAN {plan_ms:.1} (INSTANCED)");
-            triangles = None;
-            upload = None;
-        } else if on_gpu {
-            state.engine.record_timed(&mut encoder, state.timer.as_ref());
-            levels = tessera_render::patch_levels(&state.planned.plan, self.args.max_factor);
-            stages = format!("PLAN {plan_ms:.1}");
-            triangles = None;
-            upload = None;
-        } else {
-            let bits = match criterion {
-                Criterion::Factor(f) => f.to_bits(),
-                _ => settings.pixel_error.to_bits(),
-            };
-            let key = (settings.scheme, bits, settings.cull);
-            if state.cpu.is_none() || state.cpu_key != key {
-                let options = TessellatorOptions { plan: options, engine: crate::limits(None, false) };
-                state.cpu = Some(Tessellator::new(set, scheme, criterion, options)?);
-                state.cpu_key = key;
-            }
-            let tess = state.cpu.as_mut().expect("made above");
-            let mesh = tess.frame(Some(&camera))?;
-            let count = mesh.triangle_count();
-            let t = tess.timings();
-            let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-            stages = format!(
-                "CRITERION {:.1} RESOLVE {:.1} LAYOUT {:.1} WRITE {:.1}",
-                ms(t.criterion),
-                ms(t.resolve),
-                ms(t.layout),
-                ms(t.write)
-            );
-            levels = tessera_render::patch_levels(tess.plan().expect("a frame"), self.args.max_factor);
-            upload = Some(gpu::MeshBuffers::upload(&state.ctx, tess.mesh(), &levels)?);
-            triangles = Some(count);
-        }
+        let mut drawn = tessellate(state, set, settings, scheme, criterion, &options, &mut encoder)?;
         let frame = match state.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
@@ -367,62 +286,9 @@ impl App {
             _ => return Ok(()),
         };
         let target = frame.texture.create_view(&Default::default());
-        let options = RenderOptions { wireframe: settings.wireframe, color: settings.color };
-        {
-            use wgpu::util::DeviceExt;
-            level_buffer = state.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("levels"),
-                contents: bytemuck::cast_slice(if levels.is_empty() { &[0f32] } else { &levels[..] }),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-        }
-        let parts = match &upload {
-            Some(buffers) => Some(buffers.geometries()),
-            None if instanced => None,
-            None => {
-                let (Some(vertices), Some(indices)) =
-                    (state.engine.vertex_buffer(), state.engine.index_buffer())
-                else {
-                    return Ok(());
-                };
-                Some(vec![gpu::Geometry {
-                    vertices,
-                    indices,
-                    indexed_args: state.engine.indirect_buffer(),
-                    // Patch colours of GPU output would need the engine's triangle offsets
-                    // every frame (a read-back): they are drawn from the CPU engine instead.
-                    triangle_patch: None,
-                    patch_level: Some(&level_buffer),
-                }])
-            }
-        };
-        let colour = state.msaa.0.create_view(&Default::default());
-        let depth = state.msaa.1.create_view(&Default::default());
-        match &state.instanced {
-            Some(Ok(draw)) if instanced => draw.record(
-                &state.ctx,
-                &mut encoder,
-                &state.planned.plan,
-                &camera,
-                &options,
-                &colour,
-                Some(&target),
-                &depth,
-            )?,
-            _ => {
-                if let Some(parts) = &parts {
-                    state.renderer.record(
-                        &state.ctx,
-                        &mut encoder,
-                        &colour,
-                        Some(&target),
-                        &depth,
-                        parts,
-                        &camera,
-                        &options,
-                    )?
-                }
-            }
+        let render = RenderOptions { wireframe: settings.wireframe, color: settings.color };
+        if !record_draw(state, &drawn, &camera, &render, &target, &mut encoder)? {
+            return Ok(());
         }
         let line1 = self.status.clone();
         // Twice the font size when the longer line fits the window.
@@ -442,31 +308,11 @@ impl App {
         state.ctx.wait()?;
         state.ctx.check_errors()?;
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
-        let triangles = match (triangles, &state.instanced) {
-            (Some(t), _) => t as u64,
-            // Drawn by the instanced path: the queues' patches times their patterns'
-            // triangles, degenerate ones included (the rasteriser drops those).
-            (None, Some(Ok(draw))) if instanced => {
-                let queues = draw.queues().read(&state.ctx)?;
-                let max = queues.max_level();
-                (0..=max)
-                    .map(|m| (queues.level(m).len() * draw.patterns()[m as usize].triangles.len()) as u64)
-                    .sum()
-            }
-            (None, _) => {
-                if let Some(timer) = &state.timer {
-                    for (name, ms) in timer.read(&state.ctx)? {
-                        if name != PASSES[0] || settings.cull {
-                            stages += &format!(" {} {ms:.2}", name.to_uppercase());
-                        }
-                    }
-                }
-                state.engine.read_status(&state.ctx)?.2 as u64
-            }
-        };
-        let culled = state_culled(on_gpu || instanced, state);
+        let triangles = triangles_drawn(state, &mut drawn, settings.cull)?;
+        let tess = state.tess.as_ref().expect("made by tessellate");
+        let culled = tess.plan().map_or(0, |p| p.visible.iter().filter(|&&v| v == 0).count());
         self.status = format!(
-            "{} {}PX{} / {} TRIS / {} PATCHES{} / {} ENGINE: {stages} / FRAME {frame_ms:.1} MS",
+            "{} {}PX{} / {} TRIS / {} PATCHES{} / {} ENGINE: {} / FRAME {frame_ms:.1} MS",
             scheme.name(),
             settings.pixel_error,
             match criterion {
@@ -476,10 +322,181 @@ impl App {
             triangles,
             set.patches.len(),
             if settings.cull { format!(" ({culled} CULLED)") } else { String::new() },
-            if on_gpu || instanced { "GPU" } else { "CPU" },
+            if drawn.path == Path::Cpu { "CPU" } else { "GPU" },
+            drawn.stages,
         );
         self.frames += 1;
         Ok(())
+    }
+}
+
+/// Which engine drew a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Path {
+    /// The CPU engine, the mesh uploaded.
+    Cpu,
+    /// The GPU engine, from the CPU's plan.
+    Gpu,
+    /// Semi-uniform's instanced draw (render queues on the GPU).
+    Instanced,
+}
+
+/// A frame tessellated, not drawn yet.
+struct Tessellated {
+    path: Path,
+    /// The statistics line's stages.
+    stages: String,
+    /// Per-patch levels for the level colours (empty for the instanced path).
+    levels: Vec<f32>,
+    /// The CPU engine's mesh, uploaded, and its triangle count.
+    upload: Option<(gpu::MeshBuffers, usize)>,
+}
+
+/// Plans the frame through the tessellator (made, or reconfigured, when the scheme, the
+/// criterion or culling changed) and tessellates it: on the GPU where the GPU draws the
+/// scheme (`validate` for [`Engine::Gpu`]; the instanced path for semi-uniform), else on
+/// the CPU. The GPU's passes go into `encoder`.
+fn tessellate(
+    state: &mut State,
+    set: &'static SurfaceSet,
+    settings: &Settings,
+    scheme: Scheme,
+    criterion: Criterion,
+    plan: &PlanOptions,
+    encoder: &mut wgpu::CommandEncoder,
+) -> Result<Tessellated, Box<dyn std::error::Error>> {
+    let start = Instant::now();
+    let camera = plan.camera.as_ref();
+    let options = TessellatorOptions { plan: *plan, engine: crate::limits(None, false) };
+    let key = (settings.scheme, criterion_bits(criterion, settings.pixel_error), settings.cull);
+    match &mut state.tess {
+        Some(tess) if state.tess_key == key => {}
+        Some(tess) => tess.reconfigure(scheme, criterion, options.plan)?,
+        None => state.tess = Some(Tessellator::new(set, scheme, criterion, options)?),
+    }
+    state.tess_key = key;
+    let tess = state.tess.as_mut().expect("made above");
+    let max_factor = options.plan.max_factor;
+    let mut path = Path::Cpu;
+    if settings.gpu_engine {
+        if let Scheme::SemiUniform { max_level } = scheme {
+            if state.instanced.is_none() {
+                let made = InstancedDraw::new(&state.ctx, set, max_level, state.config.format, SAMPLES);
+                state.instanced = Some(made.map_err(|e| e.to_string()));
+            }
+            if let Some(Ok(_)) = &state.instanced {
+                path = Path::Instanced;
+            }
+        } else if validate(scheme, &criterion, &options.plan, set, Engine::Gpu).is_ok() {
+            path = Path::Gpu;
+        }
+    }
+    if path != Path::Cpu {
+        tess.plan_frame(camera)?;
+        let plan_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (plan, pattern) = (tess.plan().expect("planned"), tess.pattern().expect("planned"));
+        if path == Path::Instanced {
+            return Ok(Tessellated { path, stages: format!("PLAN {plan_ms:.1} (INSTANCED)"), levels: Vec::new(), upload: None });
+        }
+        state.engine.prepare(&state.ctx, set, plan, pattern)?;
+        state.engine.record_timed(encoder, state.timer.as_ref());
+        let levels = tessera_render::patch_levels(plan, max_factor);
+        return Ok(Tessellated { path, stages: format!("PLAN {plan_ms:.1}"), levels, upload: None });
+    }
+    let mesh = tess.frame(camera)?;
+    let count = mesh.triangle_count();
+    let t = tess.timings();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let stages = format!(
+        "CRITERION {:.1} RESOLVE {:.1} LAYOUT {:.1} WRITE {:.1}",
+        ms(t.criterion),
+        ms(t.resolve),
+        ms(t.layout),
+        ms(t.write)
+    );
+    let levels = tessera_render::patch_levels(tess.plan().expect("a frame"), max_factor);
+    let upload = gpu::MeshBuffers::upload(&state.ctx, tess.mesh(), &levels)?;
+    Ok(Tessellated { path, stages, levels, upload: Some((upload, count)) })
+}
+
+/// The bits that tell criteria apart for [`tessellate`]'s key.
+fn criterion_bits(criterion: Criterion, pixel_error: f64) -> u64 {
+    match criterion {
+        Criterion::Factor(f) => f.to_bits(),
+        _ => pixel_error.to_bits(),
+    }
+}
+
+/// Records the draw of `drawn` into `encoder`; false when there is nothing to draw yet (the
+/// GPU engine has no buffers before its first plan).
+fn record_draw(
+    state: &State,
+    drawn: &Tessellated,
+    camera: &Camera,
+    options: &RenderOptions,
+    target: &wgpu::TextureView,
+    encoder: &mut wgpu::CommandEncoder,
+) -> Result<bool, Box<dyn std::error::Error>> {
+    let colour = state.msaa.0.create_view(&Default::default());
+    let depth = state.msaa.1.create_view(&Default::default());
+    if let (Path::Instanced, Some(Ok(draw))) = (drawn.path, &state.instanced) {
+        let plan = state.tess.as_ref().and_then(|t| t.plan()).expect("planned");
+        draw.record(&state.ctx, encoder, plan, camera, options, &colour, Some(target), &depth)?;
+        return Ok(true);
+    }
+    let level_buffer = {
+        use wgpu::util::DeviceExt;
+        state.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("levels"),
+            contents: bytemuck::cast_slice(if drawn.levels.is_empty() { &[0f32] } else { &drawn.levels[..] }),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    };
+    let parts = match &drawn.upload {
+        Some((buffers, _)) => buffers.geometries(),
+        None => {
+            let (Some(vertices), Some(indices)) = (state.engine.vertex_buffer(), state.engine.index_buffer())
+            else {
+                return Ok(false);
+            };
+            vec![gpu::Geometry {
+                vertices,
+                indices,
+                indexed_args: state.engine.indirect_buffer(),
+                // Patch colours of GPU output would need the engine's triangle offsets every
+                // frame (a read-back): they are drawn from the CPU engine instead.
+                triangle_patch: None,
+                patch_level: Some(&level_buffer),
+            }]
+        }
+    };
+    state.renderer.record(&state.ctx, encoder, &colour, Some(target), &depth, &parts, camera, options)?;
+    Ok(true)
+}
+
+/// The frame's triangle count for the statistics line; for the GPU engine also its pass
+/// times, appended to `drawn.stages` (a read-back).
+fn triangles_drawn(state: &State, drawn: &mut Tessellated, cull: bool) -> Result<u64, Box<dyn std::error::Error>> {
+    match (drawn.path, &drawn.upload, &state.instanced) {
+        (Path::Cpu, Some((_, count)), _) => Ok(*count as u64),
+        // Drawn by the instanced path: the queues' patches times their patterns' triangles,
+        // degenerate ones included (the rasteriser drops those).
+        (Path::Instanced, _, Some(Ok(draw))) => {
+            let queues = draw.queues().read(&state.ctx)?;
+            Ok((0..=queues.max_level())
+                .map(|m| (queues.level(m).len() * draw.patterns()[m as usize].triangles.len()) as u64)
+                .sum())
+        }
+        _ => {
+            if let Some(timer) = &state.timer {
+                for (name, ms) in timer.read(&state.ctx)? {
+                    if name != PASSES[0] || cull {
+                        drawn.stages += &format!(" {} {ms:.2}", name.to_uppercase());
+                    }
+                }
+            }
+            Ok(state.engine.read_status(&state.ctx)?.2 as u64)
+        }
     }
 }
 
@@ -507,16 +524,7 @@ fn criterion_for(
         &mut state.planned,
     )?;
     let factor = state.planned.plan.segments.iter().copied().max().unwrap_or(1) as f64;
-    Ok(Criterion::Factor(factor.clamp(1.0, scheme.factor_cap().min(options.max_factor as f64))))
-}
-
-fn state_culled(on_gpu: bool, state: &State) -> usize {
-    let visible = if on_gpu {
-        &state.planned.plan.visible
-    } else {
-        &state.cpu.as_ref().and_then(|t| t.plan()).map(|p| p.visible.clone()).unwrap_or_default()
-    };
-    visible.iter().filter(|&&v| v == 0).count()
+    Ok(Criterion::Factor(factor.clamp(1.0, scheme.cap(options))))
 }
 
 /// The keys, for `tessera view --help`.
