@@ -28,6 +28,7 @@ use crate::surface::{Domain, Patch, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
 
+pub(crate) mod fast_evaluator;
 pub mod layout;
 pub(crate) mod point_blocks;
 pub mod render_queues;
@@ -99,7 +100,7 @@ pub fn tessellate_into(
 }
 
 /// Writes the tessellation `layout` describes into `out`, reusing its buffers: the one writer
-/// every CPU path uses. Vertices are evaluated by `uniform_quads::FastEvaluator` where it
+/// every CPU path uses. Vertices are evaluated by `fast_evaluator::FastEvaluator` where it
 /// applies (f32 kernels: grids of bicubic patches, blocks of points elsewhere) and by the
 /// generic f64 evaluation where it does not; the numbering, the triangles and every other
 /// array do not depend on which.
@@ -114,7 +115,7 @@ pub fn write(
     options: TessellateOptions,
     out: &mut Mesh,
 ) -> Result<()> {
-    let mut fast = uniform_quads::FastEvaluator::new(set, plan);
+    let mut fast = fast_evaluator::FastEvaluator::new(set, plan);
     fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
     write_with(set, plan, pattern, layout, options, out, Some(&fast)).map(|_| ())
 }
@@ -143,7 +144,7 @@ pub(crate) fn write_with(
     layout: &Layout,
     options: TessellateOptions,
     out: &mut Mesh,
-    fast: Option<&uniform_quads::FastEvaluator<'_>>,
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
 ) -> Result<WriteTimes> {
     let start = std::time::Instant::now();
     let topo = &set.topology;
@@ -292,7 +293,7 @@ pub(crate) fn take_front<'a, T>(s: &mut &'a mut [T], k: usize) -> &'a mut [T] {
 /// Every corner entry, evaluated at its owner's corner. Corners do not depend on the view or
 /// the plan: with an evaluator they are evaluated once per set (and kernel) and copied in
 /// every later frame.
-fn write_corners(set: &SurfaceSet, fast: Option<&uniform_quads::FastEvaluator<'_>>, out: VertexSlices<'_>) {
+fn write_corners(set: &SurfaceSet, fast: Option<&fast_evaluator::FastEvaluator<'_>>, out: VertexSlices<'_>) {
     match fast {
         Some(f) => f.corner_records().copy_to(out),
         None => evaluate_corners(set, None, out),
@@ -310,7 +311,7 @@ pub(crate) struct CornerRecords {
 
 impl CornerRecords {
     /// Every corner entry of `set`, evaluated as `fast` evaluates them. Cost: O(corners).
-    pub(crate) fn evaluate(set: &SurfaceSet, fast: &uniform_quads::FastEvaluator<'_>) -> CornerRecords {
+    pub(crate) fn evaluate(set: &SurfaceSet, fast: &fast_evaluator::FastEvaluator<'_>) -> CornerRecords {
         let n = set.topology.corner_entries.len();
         let mut records = CornerRecords {
             pos: vec![[0.0; 3]; n],
@@ -340,7 +341,7 @@ impl CornerRecords {
 /// a PN corner or the generic evaluation elsewhere.
 fn evaluate_corners(
     set: &SurfaceSet,
-    fast: Option<&uniform_quads::FastEvaluator<'_>>,
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
     mut out: VertexSlices<'_>,
 ) {
     if let Some(f) = fast.filter(|f| f.grid()) {
@@ -418,7 +419,7 @@ struct Writer<'a> {
     plan: &'a Plan,
     pattern: &'a dyn Pattern,
     layout: &'a Layout,
-    fast: Option<&'a uniform_quads::FastEvaluator<'a>>,
+    fast: Option<&'a fast_evaluator::FastEvaluator<'a>>,
     /// This call's number, so that a thread's scratch built in an earlier call (for another
     /// pattern) is never taken for this one's.
     generation: u64,
@@ -857,7 +858,7 @@ mod tests {
                     let options = TessellateOptions { corner_params, ..Default::default() };
                     let mut layout = Layout::default();
                     layout.build(&set, &plan, &Transition, &options).unwrap();
-                    let mut fast = uniform_quads::FastEvaluator::new(&set, &plan);
+                    let mut fast = fast_evaluator::FastEvaluator::new(&set, &plan);
                     fast.fill_patterns(&plan, &Transition, layout.triangle_count() as u64);
                     assert_eq!(
                         fast.patterns().distinct() > 0,

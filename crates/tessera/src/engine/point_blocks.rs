@@ -921,7 +921,7 @@ mod tests {
                 layout.build(set, plan, pattern, &opts).unwrap();
                 for avx2_fma in [false, true] {
                     let mut evaluator =
-                        super::super::uniform_quads::FastEvaluator::with_kernels(set, plan, avx2_fma);
+                        super::super::fast_evaluator::FastEvaluator::with_kernels(set, plan, avx2_fma);
                     // The frame's distinct patterns, built once (where they pay), read by the
                     // writer instead of its per-patch builds, which the reference makes.
                     evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
@@ -954,7 +954,7 @@ mod tests {
         plan: &crate::criterion::Plan,
         pattern: &dyn crate::pattern::Pattern,
         layout: &crate::engine::Layout,
-        evaluator: &super::super::uniform_quads::FastEvaluator<'_>,
+        evaluator: &super::super::fast_evaluator::FastEvaluator<'_>,
         size: f64,
         kernels_ran: bool,
     ) {
@@ -1050,7 +1050,7 @@ mod tests {
                 let (plan, pattern) = (&planned.plan, &planned.pattern);
                 let mut layout = Layout::default();
                 layout.build(&set, plan, pattern, &TessellateOptions::default()).unwrap();
-                let mut evaluator = super::super::uniform_quads::FastEvaluator::new(&set, plan);
+                let mut evaluator = super::super::fast_evaluator::FastEvaluator::new(&set, plan);
                 evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                 // A few hundred evaluated points can fall mostly on the f64 fallback.
                 let kernels = layout.interior_offsets[set.patches.len()] - layout.corners > 2_000;

@@ -39,20 +39,10 @@
 //! module's only `unsafe`.
 
 use super::point_blocks::{
-    cross_normals, has_avx2_fma, local_frame, madd, rational_quotient, to_model, GridPatch, PointBlocks,
-    LANES, MIN_DERIVATIVE2, MIN_SIN2,
+    cross_normals, local_frame, madd, rational_quotient, to_model, LANES, MIN_DERIVATIVE2, MIN_SIN2,
 };
-use super::uniform_triangles::UniformTriangles;
-use super::{CornerRecords, VertexSlices};
-use crate::criterion::Plan;
-use crate::pattern::cache::PatternCache;
-use crate::pattern::{Pattern, PatternInput};
-use crate::sampling::{uniform_param, SamplingKind};
-use crate::surface::{Domain, RationalBicubic, SurfacePoint, SurfaceSet};
-use crate::topology::EdgeUse;
-use glam::DVec2;
-use rayon::prelude::*;
-use std::sync::OnceLock;
+use crate::sampling::uniform_param;
+use crate::surface::{RationalBicubic, SurfacePoint};
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -67,7 +57,7 @@ fn bernstein3(t: f64) -> ([f64; 4], [f64; 4]) {
 /// `n`, so that a block of lanes may start at any `i ≤ n` and its spare lanes hold a real point
 /// (whose result is ignored, but which does not spoil [`Block::all_ok`]).
 #[derive(Default)]
-struct Basis {
+pub(super) struct Basis {
     b: [Vec<f32>; 4],
     d: [Vec<f32>; 4],
     /// `at[i] = ([B_k(i / n)], [B_k'(i / n)])`, for setting up lines.
@@ -76,7 +66,7 @@ struct Basis {
 
 impl Basis {
     /// Refills the tables for factor `n`, reusing their allocations.
-    fn refill(&mut self, n: usize) {
+    pub(super) fn refill(&mut self, n: usize) {
         let len = n + 1 + LANES;
         for v in self.b.iter_mut().chain(self.d.iter_mut()) {
             v.clear();
@@ -163,13 +153,13 @@ impl<const C: usize> LocalPatch<C> {
     /// The curve `v = j / n`: its control points `c_i = Σ_j p_ij B_j(v)` and the cross
     /// derivative's `d_i = Σ_j p_ij B_j'(v)`.
     #[inline(always)]
-    fn row(&self, basis: &Basis, j: usize) -> Line<C> {
+    pub(super) fn row(&self, basis: &Basis, j: usize) -> Line<C> {
         Line::new(&self.by_v, basis, j, false)
     }
 
     /// The curve `u = i / n`, likewise (along `v`, cross derivative `∂/∂u`).
     #[inline(always)]
-    fn column(&self, basis: &Basis, i: usize) -> Line<C> {
+    pub(super) fn column(&self, basis: &Basis, i: usize) -> Line<C> {
         // Columns are rare (two edges a patch): transpose here rather than store both forms.
         let by_u = self.by_v.map(|q| std::array::from_fn(|a| std::array::from_fn(|b| q[b][a])));
         Line::new(&by_u, basis, i, true)
@@ -178,7 +168,7 @@ impl<const C: usize> LocalPatch<C> {
 
 /// A grid line of a patch as a cubic Bézier curve in the local frame (homogeneous where
 /// `C = 4`), with the control points of its cross derivative.
-struct Line<const C: usize> {
+pub(super) struct Line<const C: usize> {
     /// `c[component][k]`.
     c: [[f32; 4]; C],
     d: [[f32; 4]; C],
@@ -187,7 +177,7 @@ struct Line<const C: usize> {
 }
 
 /// [`LANES`] consecutive points of a line, in structure-of-arrays form.
-struct Block {
+pub(super) struct Block {
     pos: [[f32; LANES]; 3],
     nrm: [[f32; LANES]; 3],
     /// Positive where the f32 normal is reliable; elsewhere (zero, negative or NaN) the point
@@ -209,7 +199,7 @@ impl Block {
 
     /// Writes lanes `0..pos.len()`, taking `exact(l)` where a lane is unreliable.
     #[inline(always)]
-    fn write(&self, pos: &mut [[f32; 3]], nrm: &mut [[f32; 3]], exact: impl Fn(usize) -> SurfacePoint) {
+    pub(super) fn write(&self, pos: &mut [[f32; 3]], nrm: &mut [[f32; 3]], exact: impl Fn(usize) -> SurfacePoint) {
         if self.all_ok() {
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 *pos = [self.pos[0][l], self.pos[1][l], self.pos[2][l]];
@@ -267,7 +257,7 @@ impl<const C: usize> Line<C> {
 }
 
 /// The grid kernel of one form of patch: polynomial (`Line<3>`) or rational (`Line<4>`).
-trait GridLine {
+pub(super) trait GridLine {
     /// Points `t0 .. t0 + LANES` of the grid along the line (past `n`, copies of point `n`),
     /// in the model's frame.
     fn block<const FMA: bool>(&self, basis: &Basis, t0: usize, origin: &[f32; 3], scale: f32) -> Block;
@@ -324,7 +314,7 @@ impl GridLine for Line<4> {
 
 /// Writes lane `l` of `block`, or the f64 evaluation `exact()` where the lane is unreliable.
 #[inline(always)]
-fn store(
+pub(super) fn store(
     block: &Block,
     l: usize,
     pos: &mut [f32; 3],
@@ -342,7 +332,7 @@ fn store(
 }
 
 /// The grid line that local edge `e` of a patch runs along, as (row or column, index).
-fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n: usize, e: usize) -> Line<C> {
+pub(super) fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n: usize, e: usize) -> Line<C> {
     match e {
         0 => patch.row(basis, 0),
         1 => patch.column(basis, n),
@@ -351,392 +341,9 @@ fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n: usize, e: 
     }
 }
 
-/// The tables of one factor `n`: bases, grid parameters, edge parameters.
-#[derive(Default)]
-struct FactorTables {
-    n: usize,
-    basis: Basis,
-    /// `(i / n)` as the uniform pattern computes interior parameters (`i · (1/n)`), in f64.
-    grid: Vec<f64>,
-    /// `grid` rounded to f32, the interior vertices' parameters.
-    grid32: Vec<f32>,
-    /// Per local edge and reversed flag, the f64 parameters of canonical sample `k` in the
-    /// owner's domain, as the generic engine evaluates edge vertices.
-    edge_uv: [[Vec<DVec2>; 2]; 4],
-}
-
-impl FactorTables {
-    /// Fills the tables for factor `n` (≥ 1).
-    fn fill(&mut self, n: u32) {
-        let step = 1.0 / n as f64;
-        let nu = n as usize;
-        self.n = nu;
-        self.basis.refill(nu);
-        self.grid.clear();
-        self.grid.extend((0..=nu).map(|i| i as f64 * step));
-        self.grid32.clear();
-        self.grid32.extend((0..=nu).map(|i| (i as f64 * step) as f32));
-        let d = Domain::Quad;
-        for (e, by_direction) in self.edge_uv.iter_mut().enumerate() {
-            for (rev, uvs) in by_direction.iter_mut().enumerate() {
-                uvs.clear();
-                uvs.extend((0..=n).map(|k| {
-                    let t = uniform_param(n, k);
-                    d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
-                }));
-            }
-        }
-    }
-}
-
-/// The evaluator: everything its tasks share. It evaluates every point the engine asks for,
-/// on the grid kernels of this module where the plan and pattern allow, on
-/// [`PointBlocks`] elsewhere.
-pub(crate) struct FastEvaluator<'a> {
-    set: &'a SurfaceSet,
-    /// `tables[n]` for every factor `n` a plan so far needed (`n == 0`: not filled yet);
-    /// kept from plan to plan, so a frame loop refills nothing once its factors were seen.
-    tables: Vec<FactorTables>,
-    /// Every patch in its local frame; each is needed by several tasks (its corners, edges
-    /// and rows), so it is made once.
-    points: PointBlocks,
-    /// The current plan's distinct patterns ([`FastEvaluator::fill_patterns`]).
-    patterns: PatternCache,
-    /// The writer of triangle meshes at one uniform factor, where the current plan is one
-    /// ([`FastEvaluator::fill_patterns`]).
-    triangles: UniformTriangles,
-    /// The grid kernels apply to the current plan: every patch a bicubic with a local form
-    /// (polynomial, or rational within [`MIN_WEIGHT_RATIO`]), integer samplings
-    /// ([`FastEvaluator::retarget`]).
-    grid: bool,
-    /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
-    /// the `unsafe` calls below rely on it.
-    avx2_fma: bool,
-    /// Every corner entry's vertex record, evaluated on first use, without and with the grid
-    /// kernels (which evaluate corners in their own way): 36 bytes a corner.
-    corners: [OnceLock<CornerRecords>; 2],
-}
-
-impl<'a> FastEvaluator<'a> {
-    /// The evaluator for `set` and `plan`. On bicubic patches (polynomial or rational) and
-    /// integer plans it evaluates every corner, every edge of one normal variant and every
-    /// patch interior its pattern promises to be a grid ([`Pattern::interior_grid`]) on grids;
-    /// every other point (any surface kind) in [`PointBlocks`]. Cost: O(P) (each patch moved
-    /// to its local frame).
-    pub(crate) fn new(set: &'a SurfaceSet, plan: &Plan) -> FastEvaluator<'a> {
-        Self::with_kernels(set, plan, has_avx2_fma())
-    }
-
-    /// [`FastEvaluator::new`] with the kernels chosen by the caller (`avx2_fma` is ignored
-    /// where the CPU lacks either).
-    pub(crate) fn with_kernels(set: &'a SurfaceSet, plan: &Plan, avx2_fma: bool) -> FastEvaluator<'a> {
-        let mut f = Self::for_set(set, avx2_fma);
-        f.retarget(plan);
-        f
-    }
-
-    /// The evaluator's per-set part, prepared once: every patch in its local frame. Cost: O(P).
-    pub(crate) fn for_set(set: &'a SurfaceSet, avx2_fma: bool) -> FastEvaluator<'a> {
-        FastEvaluator {
-            set,
-            tables: Vec::new(),
-            points: PointBlocks::for_set(set, avx2_fma),
-            patterns: PatternCache::default(),
-            triangles: UniformTriangles::for_set(set),
-            grid: false,
-            avx2_fma: avx2_fma && has_avx2_fma(),
-            corners: Default::default(),
-        }
-    }
-
-    /// Every corner entry's vertex record as the current plan's kernels evaluate it, evaluated
-    /// once per set and kernel. Cost: O(corners) the first time, then O(1).
-    pub(crate) fn corner_records(&self) -> &CornerRecords {
-        self.corners[usize::from(self.grid)].get_or_init(|| CornerRecords::evaluate(self.set, self))
-    }
-
-    /// Makes the tables of every factor `plan` uses (edge segments, interior factors, and
-    /// 1 to 3, which the transition pattern may raise a core to), and says whether the grid
-    /// kernels apply to the plan (bicubic patches with a local form, integer samplings). Cost:
-    /// O(E + P), plus O(n) for each factor not seen before.
-    pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
-        // Until `fill_patterns` sees the plan's pattern.
-        self.triangles.deactivate();
-        self.grid = plan.kind == SamplingKind::Uniform && self.points.all_bicubic();
-        if !self.grid {
-            return false;
-        }
-        // Every factor up to the plan's largest (at most DENSE) gets its tables: a max is one
-        // vectorized pass over the plan, where asking for each factor in turn cost a lookup
-        // per edge and patch every frame; the tables of factors up to 64 take a few hundred
-        // kilobytes. Larger factors (rare, and up to MAX_FACTOR) get tables only where used.
-        const DENSE: usize = 64;
-        // Folds rather than `Iterator::max`, which does not vectorize.
-        let max_edge = plan.segments.iter().fold(1, |m, &s| m.max(s));
-        let max_interior = plan.interior.iter().fold(1, |m, f| m.max(f[0]).max(f[1]));
-        let max = max_edge.max(max_interior).max(3) as usize;
-        if max >= self.tables.len() {
-            self.tables.resize_with(max + 1, FactorTables::default);
-        }
-        for (n, tables) in self.tables.iter_mut().enumerate().take(max.min(DENSE) + 1).skip(1) {
-            if tables.n != n {
-                tables.fill(n as u32);
-            }
-        }
-        if max > DENSE {
-            for n in plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()) {
-                let n = n as usize;
-                if n > DENSE && self.tables[n].n != n {
-                    self.tables[n].fill(n as u32);
-                }
-            }
-        }
-        true
-    }
-
-    /// Prepares the writer's per-frame patterns for `plan` and `pattern` (`triangles`: the
-    /// layout's count): the one pattern of a uniform triangle plan ([`UniformTriangles`]), or
-    /// else the distinct patterns ([`PatternCache::fill`]), for the writer to read instead of
-    /// building one per patch. Precondition: [`FastEvaluator::retarget`] saw `plan`.
-    pub(crate) fn fill_patterns(&mut self, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
-        if self.triangles.retarget(self.set, plan, pattern) {
-            self.patterns.clear();
-        } else {
-            super::fill_pattern_cache(&mut self.patterns, self.set, plan, pattern, triangles);
-        }
-    }
-
-    /// The writer of uniform triangle plans.
-    pub(crate) fn triangles(&self) -> &UniformTriangles {
-        &self.triangles
-    }
-
-    /// The current plan's distinct patterns.
-    pub(crate) fn patterns(&self) -> &PatternCache {
-        &self.patterns
-    }
-
-    /// Whether the grid kernels apply to the current plan (corners among them).
-    pub(crate) fn grid(&self) -> bool {
-        self.grid
-    }
-
-    /// The evaluator of arbitrary parameter lists.
-    pub(crate) fn points(&self) -> &PointBlocks {
-        &self.points
-    }
-
-    /// The tables of factor `n`, when made.
-    fn factor(&self, n: usize) -> Option<&FactorTables> {
-        self.tables.get(n).filter(|t| self.grid && t.n == n && n > 0)
-    }
-
-    /// Whether edge `e`'s samples are this evaluator's: a factor with tables, one normal
-    /// variant, not collapsed.
-    pub(crate) fn covers_edge(&self, plan: &Plan, e: usize) -> bool {
-        let edge = &self.set.topology.edges[e];
-        self.factor(plan.segments(e) as usize).is_some() && edge.variants == 1 && !edge.collapsed
-    }
-
-    /// The interior grid `[nu, nv]` of the patch with `input` when it is this evaluator's: a
-    /// quad whose pattern promises a grid of factors with tables.
-    pub(crate) fn covers_patch(&self, pattern: &dyn Pattern, input: &PatternInput) -> Option<[u32; 2]> {
-        if input.domain != Domain::Quad {
-            return None;
-        }
-        let grid = pattern.interior_grid(input)?;
-        (self.factor(grid[0] as usize).is_some() && self.factor(grid[1] as usize).is_some()).then_some(grid)
-    }
-
-    fn local(&self, p: usize) -> GridPatch<'_> {
-        self.points.grid_patch(p).expect("the grid kernels run on bicubic patches with a local form only")
-    }
-
-    /// The generic f64 evaluation, for the rare points f32 cannot resolve.
-    #[cold]
-    #[inline(never)]
-    fn exact(&self, p: usize, uv: DVec2) -> SurfacePoint {
-        self.set.patches[p].eval(uv)
-    }
-
-    /// Evaluates every corner entry at its owner's corner.
-    pub(crate) fn corners(&self, out: VertexSlices<'_>) {
-        let topo = &self.set.topology;
-        // Any factor's tables give the corners' bases (B(0) and B(1) exactly).
-        let tables = self.factor(1).expect("retarget makes factor 1");
-        let (basis, n) = (&tables.basis, 1);
-        out.pos
-            .par_iter_mut()
-            .zip(out.nrm.par_iter_mut())
-            .zip(out.uv.par_iter_mut())
-            .zip(out.patch.par_iter_mut())
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(i, (((pos, nrm), uv), vp))| {
-                let entry = &topo.corner_entries[i];
-                let (p, c) = (entry.owner_patch as usize, entry.owner_corner as usize);
-                let (gi, gj) = [(0, 0), (n, 0), (n, n), (0, n)][c];
-                let block = match self.local(p) {
-                    GridPatch::Polynomial(l) => {
-                        l.row(basis, gj).block::<false>(basis, gi, &l.origin, l.scale)
-                    }
-                    GridPatch::Rational(l) => l.row(basis, gj).block::<false>(basis, gi, &l.origin, l.scale),
-                };
-                let corner = Domain::Quad.corner(c);
-                store(&block, 0, pos, nrm, || self.exact(p, corner));
-                *uv = corner.as_vec2().to_array();
-                *vp = p as u32;
-            });
-    }
-
-    /// Evaluates the inner samples of edge `e` (precondition: [`FastEvaluator::covers_edge`])
-    /// with its owner patch, in canonical order.
-    pub(crate) fn edge(&self, plan: &Plan, e: usize, out: VertexSlices<'_>) {
-        let tables = self.factor(plan.segments(e) as usize).expect("covers_edge checked the factor");
-        if self.avx2_fma {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
-            return unsafe { self.edge_avx2_fma(tables, e, out) };
-        }
-        self.edge_with::<false>(tables, e, out)
-    }
-
-    /// [`FastEvaluator::edge_with`] compiled for AVX2 and FMA (everything it calls is inlined).
-    ///
-    /// # Safety
-    /// The CPU must support AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn edge_avx2_fma(&self, tables: &FactorTables, e: usize, out: VertexSlices<'_>) {
-        self.edge_with::<true>(tables, e, out)
-    }
-
-    /// The inner samples of edge `e`, evaluated by its owner.
-    #[inline(always)]
-    fn edge_with<const FMA: bool>(&self, tables: &FactorTables, e: usize, out: VertexSlices<'_>) {
-        let owner = self.set.topology.edge_uses(e)[0];
-        match self.local(owner.patch as usize) {
-            GridPatch::Polynomial(local) => self.edge_line::<FMA, 3>(tables, owner, local, out),
-            GridPatch::Rational(local) => self.edge_line::<FMA, 4>(tables, owner, local, out),
-        }
-    }
-
-    /// The inner samples of the edge of `owner`, evaluated on `local`, its patch.
-    #[inline(always)]
-    fn edge_line<const FMA: bool, const C: usize>(
-        &self,
-        tables: &FactorTables,
-        owner: EdgeUse,
-        local: &LocalPatch<C>,
-        out: VertexSlices<'_>,
-    ) where
-        Line<C>: GridLine,
-    {
-        let (p, local_edge, rev) = (owner.patch as usize, owner.local as usize, owner.reversed);
-        let (basis, n) = (&tables.basis, tables.n);
-        let line = edge_line(local, basis, n, local_edge);
-        // The line runs with the patch's grid index; canonical sample k sits at line index k
-        // or n − k (edges 2 and 3 run against the grid, reversed edges against the patch).
-        let flip = rev ^ (local_edge >= 2);
-        let uvs = &tables.edge_uv[local_edge][rev as usize];
-        for t0 in (1..n).step_by(LANES) {
-            let block = line.block::<FMA>(basis, t0, &local.origin, local.scale);
-            for l in 0..LANES.min(n - t0) {
-                let t = t0 + l;
-                let k = if flip { n - t } else { t };
-                store(&block, l, &mut out.pos[k - 1], &mut out.nrm[k - 1], || self.exact(p, uvs[k]));
-                out.uv[k - 1] = uvs[k].as_vec2().to_array();
-            }
-        }
-        out.patch.fill(p as u32);
-    }
-
-    /// Evaluates the interior of patch `p` on the grid `[nu, nv]` (precondition: the grid
-    /// [`FastEvaluator::covers_patch`] gave): the `(nu − 1)(nv − 1)` grid points, row after
-    /// row.
-    pub(crate) fn interior(&self, p: usize, grid: [u32; 2], out: VertexSlices<'_>) {
-        let [tu, tv] = grid.map(|n| self.factor(n as usize).expect("covers_patch checked the factors"));
-        if self.avx2_fma {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
-            return unsafe { self.interior_avx2_fma(p, tu, tv, out) };
-        }
-        self.interior_with::<false>(p, tu, tv, out)
-    }
-
-    /// [`FastEvaluator::interior_with`] compiled for AVX2 and FMA (everything it calls is
-    /// inlined).
-    ///
-    /// # Safety
-    /// The CPU must support AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn interior_avx2_fma(
-        &self,
-        p: usize,
-        tu: &FactorTables,
-        tv: &FactorTables,
-        out: VertexSlices<'_>,
-    ) {
-        self.interior_with::<true>(p, tu, tv, out)
-    }
-
-    /// The body of [`FastEvaluator::interior`]. Inlined into both builds; so are the kernels
-    /// it calls, which is what compiles them for AVX2 in the fast build (a kernel left out of
-    /// line would be baseline code, and its `mul_add` a library call).
-    #[inline(always)]
-    fn interior_with<const FMA: bool>(
-        &self,
-        p: usize,
-        tu: &FactorTables,
-        tv: &FactorTables,
-        mut out: VertexSlices<'_>,
-    ) {
-        let m = tu.n - 1;
-        match self.local(p) {
-            GridPatch::Polynomial(local) => {
-                for j in 1..tv.n {
-                    self.interior_row::<FMA, 3>(p, local, tu, tv, j, out.take_front(m));
-                }
-            }
-            GridPatch::Rational(local) => {
-                for j in 1..tv.n {
-                    self.interior_row::<FMA, 4>(p, local, tu, tv, j, out.take_front(m));
-                }
-            }
-        }
-    }
-
-    /// Interior vertices `i = 1..nu` of grid row `j` (`1 ≤ j < nv`) of patch `p`: the row's
-    /// curve from the `v` tables, its points from the `u` tables.
-    #[inline(always)]
-    fn interior_row<const FMA: bool, const C: usize>(
-        &self,
-        p: usize,
-        local: &LocalPatch<C>,
-        tu: &FactorTables,
-        tv: &FactorTables,
-        j: usize,
-        out: VertexSlices<'_>,
-    ) where
-        Line<C>: GridLine,
-    {
-        let line = local.row(&tv.basis, j);
-        let v = tv.grid[j];
-        let chunks = out.pos.chunks_mut(LANES).zip(out.nrm.chunks_mut(LANES));
-        for (b, (pos, nrm)) in chunks.enumerate() {
-            let t0 = 1 + b * LANES;
-            let block = line.block::<FMA>(&tu.basis, t0, &local.origin, local.scale);
-            block.write(pos, nrm, |l| self.exact(p, DVec2::new(tu.grid[t0 + l], v)));
-        }
-        let v = tv.grid32[j];
-        out.uv.iter_mut().zip(&tu.grid32[1..tu.n]).for_each(|(x, &u)| *x = [u, v]);
-        out.patch.fill(p as u32);
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::fast_evaluator::FastEvaluator;
     use super::*;
     use crate::engine::{write_with, Layout, TessellateOptions};
     use crate::mesh::Mesh;

@@ -213,7 +213,7 @@ impl<'a> PatchOut<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::uniform_quads::FastEvaluator;
+    use crate::engine::fast_evaluator::FastEvaluator;
     use crate::engine::{write_with, TessellateOptions};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
