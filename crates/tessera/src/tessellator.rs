@@ -26,8 +26,9 @@
 //! ```
 //!
 //! Output goes through [`MeshBuilder`]: [`Tessellator::frame`] hands out the tessellator's own
-//! [`Mesh`] (a struct of arrays, zero copies); [`Tessellator::frame_into`] feeds any builder,
-//! such as an application's interleaved vertex buffer with its own index type.
+//! [`Mesh`] (a struct of arrays, zero copies); [`Tessellator::frame_into`] writes into the
+//! caller's `Mesh` directly, or streams the frame to any other builder, such as an
+//! application's interleaved vertex buffer with its own index type.
 
 use crate::camera::Camera;
 use crate::criterion::tolerance::PlanReport;
@@ -80,6 +81,12 @@ pub trait MeshBuilder {
     fn triangle(&mut self, indices: [u32; 3], patch: u32);
     /// Called once per frame, last.
     fn end(&mut self) {}
+    /// The builder as a [`Mesh`] the engine may write the frame into directly, in parallel
+    /// and with no copy, instead of streaming it through [`MeshBuilder::vertex`] and
+    /// [`MeshBuilder::triangle`]; None (the default) streams.
+    fn as_mesh(&mut self) -> Option<&mut Mesh> {
+        None
+    }
 }
 
 impl MeshBuilder for Mesh {
@@ -109,6 +116,9 @@ impl MeshBuilder for Mesh {
     fn triangle(&mut self, indices: [u32; 3], patch: u32) {
         self.indices.extend_from_slice(&indices);
         self.triangle_patch.push(patch);
+    }
+    fn as_mesh(&mut self) -> Option<&mut Mesh> {
+        Some(self)
     }
 }
 
@@ -246,6 +256,14 @@ impl<'a> Tessellator<'a> {
     /// Errors: [`crate::Error::PlanMismatch`] when no frame was planned and laid out since the
     /// last write; the engine's otherwise. Cost: O(output), parallel.
     pub fn write_frame(&mut self) -> Result<&Mesh> {
+        let mut mesh = std::mem::take(&mut self.mesh);
+        let written = self.write_frame_to(&mut mesh);
+        self.mesh = mesh;
+        written.map(|()| &self.mesh)
+    }
+
+    /// [`Tessellator::write_frame`] into `out` (its buffers reused). Cost: O(output), parallel.
+    fn write_frame_to(&mut self, out: &mut Mesh) -> Result<()> {
         if !std::mem::take(&mut self.laid_out) {
             return Err(crate::Error::PlanMismatch { what: "write_frame without a planned frame".into() });
         }
@@ -262,7 +280,7 @@ impl<'a> Tessellator<'a> {
             pattern,
             layout_ref,
             self.options.engine,
-            &mut self.mesh,
+            out,
             fast,
         )?;
         self.timings = FrameTimings {
@@ -272,7 +290,7 @@ impl<'a> Tessellator<'a> {
             write: start.elapsed(),
             ..self.pending
         };
-        Ok(&self.mesh)
+        Ok(())
     }
 
     /// The last frame's pattern (None before the first frame).
@@ -297,9 +315,16 @@ impl<'a> Tessellator<'a> {
         self.mesh
     }
 
-    /// [`Tessellator::frame`], handed to `builder`. Cost: that of `frame` plus one pass over
-    /// the output.
+    /// [`Tessellator::frame`], handed to `builder`: a builder that is a [`Mesh`]
+    /// ([`MeshBuilder::as_mesh`]) receives the engine's parallel writes directly (its buffers
+    /// reused, the tessellator's own mesh left as it was); any other receives the frame
+    /// streamed, vertex after vertex, then triangle after triangle. Cost: that of `frame`,
+    /// plus one pass over the output when streamed.
     pub fn frame_into(&mut self, camera: Option<&Camera>, builder: &mut impl MeshBuilder) -> Result<()> {
+        if let Some(mesh) = builder.as_mesh() {
+            self.plan_frame(camera)?;
+            return self.write_frame_to(mesh);
+        }
         let mesh = self.frame(camera)?;
         builder.begin(mesh.vertex_count(), mesh.triangle_count());
         for i in 0..mesh.vertex_count() {
@@ -390,4 +415,59 @@ mod tests {
         .unwrap();
         assert!(matches!(tess.frame(None), Err(crate::Error::NeedsCamera { .. })));
     }
+    /// A builder that is not a `Mesh`: it receives the frame streamed, in the numbering of
+    /// the tessellator's own mesh.
+    #[derive(Default)]
+    struct Interleaved {
+        vertices: Vec<[f32; 8]>,
+        triangles: Vec<[u32; 4]>,
+        begun: Option<(usize, usize)>,
+    }
+
+    impl MeshBuilder for Interleaved {
+        fn begin(&mut self, vertices: usize, triangles: usize) {
+            self.vertices.clear();
+            self.triangles.clear();
+            self.begun = Some((vertices, triangles));
+        }
+        fn vertex(&mut self, p: [f32; 3], n: [f32; 3], uv: [f32; 2], _patch: u32) {
+            self.vertices.push([p[0], p[1], p[2], n[0], n[1], n[2], uv[0], uv[1]]);
+        }
+        fn triangle(&mut self, t: [u32; 3], patch: u32) {
+            self.triangles.push([t[0], t[1], t[2], patch]);
+        }
+    }
+
+    #[test]
+    fn a_streaming_builder_and_a_reconfigured_tessellator_get_the_same_frames() {
+        let set = teapot();
+        let (lo, hi) = set.bounds();
+        let camera = Camera::framing(lo, hi, 640, 480);
+        // The options' camera is the camera of frames given none.
+        let plan = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+        let options = TessellatorOptions { plan, ..TessellatorOptions::default() };
+        let mut tess = Tessellator::new(&set, Scheme::Uniform, Criterion::Factor(3.0), options).unwrap();
+        let mut streamed = Interleaved::default();
+        tess.frame_into(None, &mut streamed).unwrap();
+        let mesh = tess.frame(None).unwrap().clone();
+        assert_eq!(streamed.begun, Some((mesh.vertex_count(), mesh.triangle_count())));
+        for (i, v) in streamed.vertices.iter().enumerate() {
+            assert_eq!(v[..3], mesh.positions[i], "vertex {i}");
+            assert_eq!(v[6..], mesh.uvs[i], "vertex {i}");
+        }
+        let t = mesh.triangle_count() - 1;
+        assert_eq!(streamed.triangles[t][..3], mesh.triangle(t));
+        // Reconfigured for a pixel error: the frames of a fresh tessellator, from the options'
+        // camera.
+        let criterion = Criterion::PixelError(1.0);
+        tess.reconfigure(Scheme::Transition, criterion, plan).unwrap();
+        let fresh = Tessellator::new(&set, Scheme::Transition, criterion, options).unwrap().frame(None).unwrap().clone();
+        assert_eq!(*tess.frame(None).unwrap(), fresh);
+        assert!(tess.report().unwrap().worst_ratio <= 1.0);
+        // A request the scheme refuses leaves the tessellator as it was.
+        let odd = Scheme::Hardware(crate::sampling::Partitioning::FractionalOdd);
+        assert!(matches!(tess.reconfigure(odd, criterion, plan), Err(crate::Error::CriterionNotAccepted { .. })));
+        assert_eq!(tess.scheme(), Scheme::Transition);
+    }
+
 }

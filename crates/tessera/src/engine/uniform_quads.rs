@@ -348,7 +348,10 @@ mod tests {
     use crate::engine::{write_with, Layout, TessellateOptions};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
-    use crate::surface::{BuildOptions, Orientation, Patch};
+    use crate::criterion::Plan;
+    use crate::pattern::PatternInput;
+    use crate::sampling::SamplingKind;
+    use crate::surface::{BuildOptions, Domain, Orientation, Patch, SurfaceSet};
     use crate::verify;
     use glam::DVec3;
 
