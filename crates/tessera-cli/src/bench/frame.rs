@@ -1,6 +1,6 @@
 //! `frame`: per-frame re-tessellation along camera walks of scenes at the papers' scale —
 //! the 92,160-patch torus grid and the killeroo herd (≈ 91k PN patches) at a guaranteed half
-//! pixel with culling (the real-time issue's frames), and paper 002's 100 teacups with ESC.
+//! pixel with culling, and paper 002's 100 teacups with ESC.
 
 use super::plot::{self, Axes, Series};
 use super::table::{num, Table};
@@ -212,7 +212,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
          triangles; their walks start at the framing camera (whole scene in view) and dolly in to a third of the \
          distance while orbiting 40°. Teacups: paper 002's scene and walk (1280×1024), ESC with Lmax = 3.",
     );
-    first.note(format!("Medians of {repeats} frames at the walk's first camera after a warm-up frame: the real-time issue's single-frame rows."));
+    first.note(format!("Medians of {repeats} frames at the walk's first camera after a warm-up frame: the scenes' single-frame figures."));
     let mut tables = vec![walk, first];
     if ctx.gpu {
         if let Some(table) = gpu_first_frames(ctx, &all, repeats)? {

@@ -15,8 +15,8 @@ pub fn load(ctx: &Ctx, rel: &str) -> BenchResult<SurfaceSet> {
     Ok(tessera::io::load(&ctx.model(rel)?, tessera::io::LoadOptions::default())?)
 }
 
-/// `copies` copies of `bench/torus_64x32.patches` in a grid (45: the 92,160-patch scene of
-/// the real-time issue).
+/// `copies` copies of `bench/torus_64x32.patches` in a grid (45: the 92,160-patch real-time
+/// scene).
 pub fn torus_grid(ctx: &Ctx, copies: usize) -> BenchResult<SurfaceSet> {
     let file = tessera::io::patches::read_patches(&ctx.model("bench/torus_64x32.patches")?)?;
     Ok(SurfaceSet::from_patch_file(&tessera::scene::patch_grid(&file, copies), Default::default()))
@@ -37,7 +37,7 @@ pub fn teacups(ctx: &Ctx) -> BenchResult<(SurfaceSet, Vec<Camera>)> {
 }
 
 /// A walk of `frames` cameras through a scene bounded by `lo..hi`: it starts at the framing
-/// camera (the whole scene in view, as the real-time issue's single frame) and dollies in to
+/// camera (the whole scene in view) and dollies in to
 /// a third of the distance while orbiting 40° about the up axis, so that later frames see
 /// fewer patches, nearer and larger.
 pub fn walk(lo: DVec3, hi: DVec3, frames: usize, width: u32, height: u32) -> Vec<Camera> {

@@ -215,7 +215,7 @@ const STAGE_COLUMNS: [&str; 11] = [
     "ns/vertex",
 ];
 
-/// The adaptive and hardware schemes' engines, the real-time issue's rows: the cow with
+/// The adaptive and hardware schemes' engines: the cow with
 /// silhouette factors 4:7 (transition, semi-uniform, SD-2), fractional-odd at factor 6.4,
 /// the torus at a tolerance of 0.001 % of its diagonal, ESC on the teapot; the framing
 /// camera at 1280×720 (`tessera mesh`'s default).
