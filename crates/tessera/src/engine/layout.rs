@@ -234,13 +234,13 @@ impl Layout {
 #[inline]
 pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
     let domain = set.topology.patch_domains[p];
-    let (mut segments, mut factors, mut collapsed) = ([1; 4], [1.0; 4], [false; 4]);
+    let (mut segments, mut factors) = ([1; 4], [1.0; 4]);
     for (e, pe) in set.topology.patch_edges[p][..domain.corner_count()].iter().enumerate() {
         let edge = pe.edge as usize;
         segments[e] = plan.segments(edge);
         factors[e] = plan.factor(edge);
-        collapsed[e] = pe.collapsed;
     }
+    let collapsed = set.topology.collapsed_sides(p);
     PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32, collapsed }
 }
 
