@@ -83,13 +83,39 @@ pub fn module(
     parts: &[&str],
     extra: &[(&str, u32)],
 ) -> wgpu::ShaderModule {
-    let mut constants = common_constants();
-    constants.extend_from_slice(extra);
-    let text = expand(&parts.concat(), &constants);
+    module_with_functions(device, label, parts, extra, &[])
+}
+
+/// [`module`] with every `{{NAME}}` of `functions` replaced by the WGSL function it names: a
+/// file shared by several patterns calls the pattern's own function through a placeholder,
+/// so which one it calls is chosen by the caller, and a module missing that function fails
+/// to compile instead of calling whichever one its parts happen to define. Cost: one WGSL
+/// compilation.
+pub fn module_with_functions(
+    device: &wgpu::Device,
+    label: &str,
+    parts: &[&str],
+    extra: &[(&str, u32)],
+    functions: &[(&str, &str)],
+) -> wgpu::ShaderModule {
+    let text = source(parts, extra, functions);
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(text.into()),
     })
+}
+
+/// The text of [`module_with_functions`]'s module: `parts` concatenated, each `{{NAME}}` of
+/// `functions` replaced by its function, then expanded with [`common_constants`] and `extra`.
+/// Panics as [`expand`]. Cost: O(source length).
+pub fn source(parts: &[&str], extra: &[(&str, u32)], functions: &[(&str, &str)]) -> String {
+    let mut constants = common_constants();
+    constants.extend_from_slice(extra);
+    let mut text = parts.concat();
+    for (name, function) in functions {
+        text = text.replace(&format!("{{{{{name}}}}}"), function);
+    }
+    expand(&text, &constants)
 }
 
 /// How a shader reads one binding of group 0.

@@ -150,6 +150,107 @@ impl GpuPattern {
     }
 }
 
+/// How one pattern's pipelines are built: the WGSL files of its modules, the functions of
+/// those files that the shared passes call (substituted for `count.wgsl`'s,
+/// `write_vertices.wgsl`'s and `grid_vertices.wgsl`'s `{{NAME}}`), and its triangle passes'
+/// entry points. A module whose parts lack a function named here fails to compile; none
+/// calls another pattern's function by concatenation order.
+struct PatternShaders {
+    /// The count pass's module, and the triangle passes' where `triangles` is None.
+    count: (&'static str, &'static [&'static str]),
+    /// The vertex passes' module.
+    vertices: (&'static str, &'static [&'static str]),
+    /// The triangle passes' own module, if they have one.
+    triangles: Option<(&'static str, &'static [&'static str])>,
+    /// `{{PATCH_COUNTS}}` (`count.wgsl`): a visible patch's interior vertices and kept
+    /// triangles; `{{EDGE_PARAM}}` and `{{INTERIOR_POINT}}` (`write_vertices.wgsl`): where the
+    /// pattern puts edge samples and interior vertices; `{{INTERIOR_GRID}}`
+    /// (`grid_vertices.wgsl`, for the patterns on a grid): the interior grid's factors.
+    functions: &'static [(&'static str, &'static str)],
+    /// The entry point of the triangle pass.
+    write_triangles: &'static str,
+    /// The entry point of the uniform pattern's second triangle pass, for the patches at a
+    /// collapsed corner.
+    write_collapsed_triangles: Option<&'static str>,
+}
+
+/// The uniform pattern: one module per pass kind.
+const UNIFORM_SHADERS: PatternShaders = PatternShaders {
+    count: ("count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]),
+    vertices: (
+        "vertices uniform",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
+    ),
+    triangles: Some(("triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM])),
+    functions: &[
+        ("PATCH_COUNTS", "uniform_patch_counts"),
+        ("INTERIOR_GRID", "uniform_interior_grid"),
+        ("EDGE_PARAM", "grid_edge_param"),
+        ("INTERIOR_POINT", "grid_interior_point"),
+    ],
+    write_triangles: "write_uniform_triangles",
+    write_collapsed_triangles: Some("write_uniform_collapsed_triangles"),
+};
+
+/// The transition pattern: counts and triangles in one module.
+const TRANSITION_SHADERS: PatternShaders = PatternShaders {
+    count: ("transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]),
+    vertices: (
+        "vertices transition",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, LOCAL, BOUNDS, TRANSITION, GRID_VERTICES, WRITE_VERTICES],
+    ),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "transition_patch_counts"),
+        ("INTERIOR_GRID", "transition_interior_grid"),
+        ("EDGE_PARAM", "grid_edge_param"),
+        ("INTERIOR_POINT", "grid_interior_point"),
+    ],
+    write_triangles: "write_transition_triangles",
+    write_collapsed_triangles: None,
+};
+
+/// The Direct3D 11 patterns (every partitioning: `Params::partitioning` tells them apart):
+/// counts and triangles in one module.
+const HARDWARE_SHADERS: PatternShaders = PatternShaders {
+    count: ("hardware", &[COMMON, HARDWARE_PARTITION, LOCAL, HARDWARE, COUNT]),
+    vertices: (
+        "vertices hardware",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
+    ),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "hardware_patch_counts"),
+        ("EDGE_PARAM", "hardware_plan_edge_param"),
+        ("INTERIOR_POINT", "hardware_interior_point"),
+    ],
+    write_triangles: "write_hardware_triangles",
+    write_collapsed_triangles: None,
+};
+
+impl PatternShaders {
+    /// Compiles the pattern's modules and makes its pipelines with group 0 laid out by
+    /// `layout`. Cost: two or three WGSL compilations.
+    fn pipelines(&self, device: &wgpu::Device, layout: &wgpu::PipelineLayout) -> PatternPipelines {
+        let module = |(label, parts): (&str, &[&str])| {
+            shader::module_with_functions(device, label, parts, &constants(), self.functions)
+        };
+        let count = module(self.count);
+        let vertices = module(self.vertices);
+        let triangles = self.triangles.map(module);
+        let triangles = triangles.as_ref().unwrap_or(&count);
+        let make = |module: &wgpu::ShaderModule, entry: &str| compute_pipeline(device, layout, module, entry);
+        PatternPipelines {
+            count: make(&count, "count"),
+            corners: make(&vertices, "write_corners"),
+            edge_vertices: make(&vertices, "write_edge_vertices"),
+            interior_vertices: make(&vertices, "write_interior_vertices"),
+            triangles: make(triangles, self.write_triangles),
+            collapsed_triangles: self.write_collapsed_triangles.map(|entry| make(triangles, entry)),
+        }
+    }
+}
+
 /// The pattern-specific pipelines: counts, vertex writes (the interior grid is the
 /// pattern's), triangle writes.
 #[derive(Debug)]
@@ -250,40 +351,8 @@ impl Pipelines {
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
         let factors = module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS]);
-        let uniform = {
-            let count = module(device, "count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]);
-            let vertices = module(
-                device,
-                "vertices uniform",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
-            );
-            let triangles =
-                module(device, "triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM]);
-            PatternPipelines {
-                count: make(&one, &count, "count"),
-                corners: make(&one, &vertices, "write_corners"),
-                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
-                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
-                triangles: make(&one, &triangles, "write_triangles"),
-                collapsed_triangles: Some(make(&one, &triangles, "write_collapsed_patch_triangles")),
-            }
-        };
-        let transition = {
-            let pattern = module(device, "transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]);
-            let vertices = module(
-                device,
-                "vertices transition",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, LOCAL, BOUNDS, TRANSITION, GRID_VERTICES, WRITE_VERTICES],
-            );
-            PatternPipelines {
-                count: make(&one, &pattern, "count"),
-                corners: make(&one, &vertices, "write_corners"),
-                edge_vertices: make(&one, &vertices, "write_edge_vertices"),
-                interior_vertices: make(&one, &vertices, "write_interior_vertices"),
-                triangles: make(&one, &pattern, "write_patch_triangles"),
-                collapsed_triangles: None,
-            }
-        };
+        let uniform = UNIFORM_SHADERS.pipelines(device, &one);
+        let transition = TRANSITION_SHADERS.pipelines(device, &one);
         let check = {
             let parts = [COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS, LOCAL, BOUNDS, TRANSITION, CHECK];
             let m = module(device, "check", &parts);
@@ -319,23 +388,8 @@ impl Pipelines {
     /// dispatch: about 5 s, once per device); later calls nothing.
     pub(super) fn hardware(&self, device: &wgpu::Device) -> &PatternPipelines {
         self.hardware.get_or_init(|| {
-            let make = |module: &wgpu::ShaderModule, entry: &str| {
-                compute_pipeline(device, &self.main_pipeline_layout, module, entry)
-            };
-            let pattern = module(device, "hardware", &[COMMON, HARDWARE_PARTITION, LOCAL, HARDWARE, COUNT]);
-            let vertices = module(
-                device,
-                "vertices hardware",
-                &[COMMON, BICUBIC, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
-            );
-            PatternPipelines {
-                count: make(&pattern, "count"),
-                corners: make(&vertices, "write_corners"),
-                edge_vertices: make(&vertices, "write_edge_vertices"),
-                interior_vertices: make(&vertices, "write_interior_vertices"),
-                triangles: make(&pattern, "write_patch_triangles"),
-                collapsed_triangles: None,
-            }
+            // One set for every partitioning: the shaders read `Params::partitioning`.
+            HARDWARE_SHADERS.pipelines(device, &self.main_pipeline_layout)
         })
     }
 
@@ -372,4 +426,74 @@ pub(crate) struct Params {
     pub(crate) triangle_capacity: u32,
     pub(crate) partitioning: u32,
     pub(crate) _pad: [u32; 2],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ROWS: [(&str, &PatternShaders); 3] =
+        [("uniform", &UNIFORM_SHADERS), ("transition", &TRANSITION_SHADERS), ("hardware", &HARDWARE_SHADERS)];
+
+    /// The modules of `row` (count, vertices, triangles), expanded with `functions` as
+    /// [`PatternShaders::pipelines`] expands them, parsed by naga.
+    fn parse(
+        row: &PatternShaders,
+        functions: &[(&str, &str)],
+    ) -> Vec<std::result::Result<naga::Module, String>> {
+        let modules = [Some(row.count), Some(row.vertices), row.triangles];
+        modules
+            .into_iter()
+            .flatten()
+            .map(|(_, parts)| {
+                let text = shader::source(parts, &constants(), functions);
+                naga::front::wgsl::parse_str(&text).map_err(|e| format!("{e}"))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_pattern_row_compiles_with_its_entry_points() {
+        for (name, row) in ROWS {
+            let modules: Vec<naga::Module> = parse(row, row.functions)
+                .into_iter()
+                .map(|m| m.unwrap_or_else(|e| panic!("{name}: {e}")))
+                .collect();
+            let has = |m: &naga::Module, entry: &str| m.entry_points.iter().any(|e| e.name == entry);
+            let triangles = modules.last().expect("a row has modules");
+            assert!(has(&modules[0], "count"), "{name}");
+            for entry in ["write_corners", "write_edge_vertices", "write_interior_vertices"] {
+                assert!(has(&modules[1], entry), "{name}: {entry}");
+            }
+            let triangles = if row.triangles.is_some() { triangles } else { &modules[0] };
+            for entry in std::iter::once(row.write_triangles).chain(row.write_collapsed_triangles) {
+                assert!(has(triangles, entry), "{name}: {entry}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_pattern_row_with_another_patterns_function_fails_to_compile() {
+        for (name, row) in ROWS {
+            for (other, other_row) in ROWS {
+                for &(placeholder, theirs) in other_row.functions {
+                    let Some(&(_, ours)) = row.functions.iter().find(|(n, _)| *n == placeholder) else {
+                        continue;
+                    };
+                    if ours == theirs {
+                        continue; // shared by both patterns (the grid patterns' vertex places)
+                    }
+                    let functions: Vec<(&str, &str)> = row
+                        .functions
+                        .iter()
+                        .map(|&(n, f)| if n == placeholder { (n, theirs) } else { (n, f) })
+                        .collect();
+                    assert!(
+                        parse(row, &functions).iter().any(|m| m.is_err()),
+                        "{name}'s modules compiled with {other}'s {placeholder} ({theirs})"
+                    );
+                }
+            }
+        }
+    }
 }
