@@ -55,7 +55,7 @@ fn enclosing_radius(a: vec2<f32>, b: vec2<f32>, c: vec2<f32>) -> f32 {
 // (about 1e-5 of a side of 1/64). A side that does not follow an axis is skewed by at
 // least 1/(64·64) of its length in a pattern whose factors are at most 64 (a strip triangle
 // joins a sample k/s of an edge to a grid point i/n one row inside), which the check's
-// frames keep to (`CHECK_MAX_FACTOR` in `tessellator.rs`): 1e-4 classifies as exact
+// frames keep to (`CHECK_MAX_FACTOR` in `tessellator/screen.rs`): 1e-4 classifies as exact
 // arithmetic does.
 const AXIS_SKEW: f32 = 1e-4;
 

@@ -2,8 +2,10 @@
 // place into the offset arrays (the scan turns them into offsets).
 // Invocation x < E: edge x's inner vertices, `(segments − 1) · variants`, none for a collapsed
 // edge or one no visible patch uses. E ≤ x < E + P: patch x − E's interior vertices
-// and triangles, `patch_counts(p)` of the pattern's own file (its `Pattern::counts` minus the
+// and triangles, `{{PATCH_COUNTS}}(p)` of the pattern's own file (its `Pattern::counts` minus the
 // triangles that degenerate at a collapsed curve), 0 for culled patches. x = E + P: the trailing entry, 0.
+// The pattern's function is named by the pipeline's table (`src/tessellator/pipelines.rs`,
+// `PatternShaders`), so a module built without that pattern's file fails to compile.
 
 @compute @workgroup_size(WORKGROUP)
 fn count(
@@ -20,7 +22,7 @@ fn count(
         let p = x - edges;
         var counts = vec2<u32>(0u, 0u);
         if (visible[p] != 0u) {
-            counts = patch_counts(p);
+            counts = {{PATCH_COUNTS}}(p);
         }
         vertex_offsets[x] = counts.x;
         triangle_offsets[p] = counts.y;

@@ -2,7 +2,7 @@
 // vertices and triangles (`pattern::uniform::Uniform::counts`) minus those that degenerate at
 // a collapsed curve (only patches with a repeated corner have any; on quads only in the outer
 // ring of cells).
-fn patch_counts(p: u32) -> vec2<u32> {
+fn uniform_patch_counts(p: u32) -> vec2<u32> {
     let n = interior[p].x;
     let tri = patch_is_tri(p);
     var counts = uniform_counts(tri, n);

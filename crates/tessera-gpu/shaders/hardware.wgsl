@@ -14,7 +14,7 @@
 //
 // Parallelism: the count and vertex passes are parallel over patches and vertices (a point's
 // place is O(rings) to find); the triangle pass runs one invocation per patch, walking its
-// bands and stitches serially in the CPU's order (`write_patch_triangles`).
+// bands and stitches serially in the CPU's order (`write_hardware_triangles`).
 
 // Direct3D edge and inside factors of one patch, in Direct3D's order (quad `U==0, V==0,
 // U==1, V==1`; tri `U==0, V==0, W==0`; inside quad `[U, V]`, tri `[inside, inside]`).
@@ -684,7 +684,7 @@ fn build_hardware(p: u32, write: bool, first: u32) -> u32 {
 // Counts of the hardware pattern for the count pass (`count.wgsl`): `Hardware::counts`
 // (interior points, pattern triangles), the triangles rebuilt and counted where a corner
 // repeats (the engine leaves out those that degenerate).
-fn patch_counts(p: u32) -> vec2<u32> {
+fn hardware_patch_counts(p: u32) -> vec2<u32> {
     let pre = patch_processed(p);
     var counts = processed_counts(pre);
     counts.x = counts.x - outer_points(pre);
@@ -697,7 +697,7 @@ fn patch_counts(p: u32) -> vec2<u32> {
 // Parameter k of edge e in canonical orientation: `Plan::param` of a
 // `SamplingKind::Fractional(Spacing::Hardware(_))` plan, `sampling::hardware::edge_param` of
 // the plan's f32 factor.
-fn edge_param(e: u32, k: u32) -> f32 {
+fn hardware_plan_edge_param(e: u32, k: u32) -> f32 {
     return hardware_edge_param(edge_factor(e), params.partitioning, k);
 }
 
@@ -770,7 +770,7 @@ fn tri_interior_point(pre: Processed, j: u32) -> vec2<f32> {
 
 // Interior vertex j of patch p: the hardware's interior point j (its points after the outer
 // ring), as `Hardware::build` hands them to the engine.
-fn interior_point(p: u32, j: u32) -> vec2<f32> {
+fn hardware_interior_point(p: u32, j: u32) -> vec2<f32> {
     let pre = patch_processed(p);
     if (pre.nc == 4u) { return quad_interior_point(pre, j); }
     return tri_interior_point(pre, j);
@@ -779,7 +779,7 @@ fn interior_point(p: u32, j: u32) -> vec2<f32> {
 // Triangle pass: one invocation per visible patch writes its pattern (the engine's
 // `Writer::patch` with `Hardware::build`).
 @compute @workgroup_size(WORKGROUP)
-fn write_patch_triangles(
+fn write_hardware_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,

@@ -8,7 +8,7 @@
 // or infinity): `GpuTessellator::prepare` refuses other plans, and the factor pass makes
 // finite ones.
 
-// `Partitioning` as `Params::partitioning` holds it (values from `tessellator.rs`).
+// `Partitioning` as `Params::partitioning` holds it (values from `tessellator/pipelines.rs`).
 const PARTITIONING_INTEGER: u32 = {{PARTITIONING_INTEGER}}u;
 const PARTITIONING_POW2: u32 = {{PARTITIONING_POW2}}u;
 const PARTITIONING_FRACTIONAL_ODD: u32 = {{PARTITIONING_FRACTIONAL_ODD}}u;

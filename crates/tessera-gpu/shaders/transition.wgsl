@@ -99,7 +99,7 @@ fn pattern_input(p: u32, interior_factors: vec2<u32>) -> PatchInput {
 // The pattern's core factors, read by the interior vertex pass: on a quad the interior grid
 // is (nu − 1) × (nv − 1) points at (i / nu, j / nv), rows of j (`QuadLayout::build`); on a
 // triangle the n-grid's interior points (`TriLayout::build`), nu = nv = n.
-fn interior_grid(p: u32) -> vec2<u32> {
+fn transition_interior_grid(p: u32) -> vec2<u32> {
     let input = patch_input(p);
     return vec2<u32>(input.core.nu, input.core.nv);
 }
@@ -349,7 +349,7 @@ fn build_transition(input: PatchInput, out: ptr<function, Sink>) {
 
 // Counts of the transition pattern for the count pass (`count.wgsl`): a visible patch's
 // `transition_counts`, its triangles rebuilt and counted where a corner repeats.
-fn patch_counts(p: u32) -> vec2<u32> {
+fn transition_patch_counts(p: u32) -> vec2<u32> {
     let input = patch_input(p);
     var counts = transition_counts(input);
     if (patch_repeated_corner(p)) {
@@ -362,7 +362,7 @@ fn patch_counts(p: u32) -> vec2<u32> {
 
 // Triangle pass: one invocation per visible patch writes its pattern.
 @compute @workgroup_size(WORKGROUP)
-fn write_patch_triangles(
+fn write_transition_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,

@@ -4,7 +4,7 @@
 // (`engine::layout::degenerate_after_collapse`).
 
 // The uniform pattern's interior grid: n × n cells (read by the interior vertex pass).
-fn interior_grid(p: u32) -> vec2<u32> {
+fn uniform_interior_grid(p: u32) -> vec2<u32> {
     let n = interior[p].x;
     return vec2<u32>(n, n);
 }

@@ -1,6 +1,6 @@
 // The camera and the view-independent per-patch data of the view passes (group 1): culling
 // (`cull.wgsl`) and the screen-space factors (`factors.wgsl`). Row formats:
-// `src/tessellator.rs` (`patch_view_rows`).
+// `src/tessellator/screen.rs` (`patch_view_rows`).
 
 struct View {
     eye: vec4<f32>,
@@ -43,7 +43,8 @@ struct View {
 @group(1) @binding(1) var<storage, read_write> patch_views: array<vec4<f32>>;
 // Per patch, the factor it proposes for each local edge (0 for culled patches).
 @group(1) @binding(2) var<storage, read_write> proposals: array<vec4<f32>>;
-// The frame's planning state, zeroed before the factor passes.
+// The frame's planning state, zeroed before the factor passes; read back by name through
+// Rust's `FrameState` (`src/tessellator/report.rs`, the same layout: the contract test).
 struct FrameState {
     // The largest segment count and minimum interior of the frame (the global factor of
     // `InteriorRule::Global`).

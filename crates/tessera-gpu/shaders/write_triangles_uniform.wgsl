@@ -4,7 +4,7 @@
 // One invocation per output triangle, for patches without a repeated corner (every pattern
 // triangle kept, so output triangle t is pattern triangle t).
 @compute @workgroup_size(WORKGROUP)
-fn write_triangles(
+fn write_uniform_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
@@ -26,7 +26,7 @@ fn write_triangles(
 // are numbered as on the CPU. Serial within the patch: O(n²) for one invocation, for the few
 // patches that touch a collapsed curve.
 @compute @workgroup_size(WORKGROUP)
-fn write_collapsed_patch_triangles(
+fn write_uniform_collapsed_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,

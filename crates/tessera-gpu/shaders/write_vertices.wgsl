@@ -1,6 +1,9 @@
 // Vertex write passes: every output vertex evaluated once, at the place the layout gives it
 // (`tessera::engine::write`'s corners, edges and patches). Shared edge vertices are written
 // once, by the edge's owner use, and every patch indexes them: watertight bit for bit.
+// Where the pattern puts its vertices, `{{EDGE_PARAM}}` and `{{INTERIOR_POINT}}`, are the
+// functions of the pattern's files that the pipeline's table names
+// (`src/tessellator/pipelines.rs`, `PatternShaders`).
 
 // Corner entry x: position from its vertex's first entry's owner (`position_entry`), normal
 // and uv from its own owner, as `engine::write_corners` and the split-normal copy do.
@@ -32,7 +35,7 @@ fn use_of_variant(e: u32, variant: u32) -> u32 {
 
 // Edge vertex corners + x: `engine::write_edge`. Sample k of variant v of edge e, evaluated by
 // the first use of variant v (its normal and uv) at the canonical parameter the pattern's file
-// gives (`edge_param(e, k)`, `Plan::param`) mirrored for a reversed use; its position is
+// gives (`{{EDGE_PARAM}}(e, k)`, `Plan::param`) mirrored for a reversed use; its position is
 // variant 0's.
 @compute @workgroup_size(WORKGROUP)
 fn write_edge_vertices(
@@ -47,7 +50,7 @@ fn write_edge_vertices(
     let local = v - vertex_offsets[e];
     let variant = local / (s - 1u);
     let k = local % (s - 1u) + 1u;
-    let t = edge_param(e, k);
+    let t = {{EDGE_PARAM}}(e, k);
     let owner = edge_first_use(e);
     let u = use_of_variant(e, variant);
     let uv = edge_use_point(u, t);
@@ -64,7 +67,7 @@ fn edge_use_point(u: u32, t: f32) -> vec2<f32> {
 }
 
 // Interior vertex j of patch p (`vertex_offsets[E + p] + j`), at the pattern's
-// `interior_point(p, j)`: the engine's `Writer::patch`.
+// `{{INTERIOR_POINT}}(p, j)`: the engine's `Writer::patch`.
 @compute @workgroup_size(WORKGROUP)
 fn write_interior_vertices(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -75,7 +78,7 @@ fn write_interior_vertices(
     let v = vertex_offsets[edges] + thread_index(wid, nwg, lid);
     if (v >= vertex_offsets[edges + params.patches]) { return; }
     let p = find_vertex_range(edges, edges + params.patches, v) - edges;
-    let uv = interior_point(p, v - vertex_offsets[edges + p]);
+    let uv = {{INTERIOR_POINT}}(p, v - vertex_offsets[edges + p]);
     let point = eval_patch(p, uv);
     store_vertex(v, point.position, point.normal, uv);
 }

@@ -1,5 +1,5 @@
-//! The CPU↔GPU contract, checked: every uniform struct the engine writes is laid out in Rust
-//! exactly as the WGSL that reads it declares it, member for member (names, offsets, size),
+//! The CPU↔GPU contract, checked: every uniform struct the engine writes, and every storage
+//! struct it reads back by name, is laid out in Rust exactly as the WGSL declares it, member for member (names, offsets, size),
 //! as naga (wgpu's shader compiler) lays the WGSL out. The codes the shaders compare against
 //! (`INTERIOR_*`, `CRITERION_*`, `EDGE_RULE_*`, `PARTITIONING_*`) are not typed twice at all:
 //! they are substituted into the WGSL from their Rust constants (`constants`), and a
@@ -8,8 +8,9 @@
 
 use std::mem::{offset_of, size_of};
 
-use super::{constants, Params, ViewUniform, COMMON, CULL, VIEW};
+use crate::shader::sources::{COMMON, CULL, VIEW};
 use crate::shader::{common_constants, expand};
+use crate::tessellator::{constants, CheckRow, FrameState, Params, ViewUniform};
 
 /// The module the cull pass compiles (`common.wgsl`, `view.wgsl`, `cull.wgsl`), expanded as
 /// the engine expands it, parsed by naga.
@@ -50,7 +51,7 @@ fn assert_same_layout(module: &naga::Module, name: &str, rust: &[(&str, usize)],
 }
 
 #[test]
-fn uniform_structs_match_their_wgsl_member_for_member() {
+fn shared_structs_match_their_wgsl_member_for_member() {
     let module = cull_module();
     assert_same_layout(
         &module,
@@ -87,6 +88,29 @@ fn uniform_structs_match_their_wgsl_member_for_member() {
             ("edge_rule", offset_of!(ViewUniform, edge_rule)),
         ],
         size_of::<ViewUniform>(),
+    );
+    assert_same_layout(
+        &module,
+        "FrameState",
+        &[
+            ("global_factor", offset_of!(FrameState, global_factor)),
+            ("failing", offset_of!(FrameState, failing)),
+            ("changed", offset_of!(FrameState, changed)),
+            ("done", offset_of!(FrameState, done)),
+            ("rounds", offset_of!(FrameState, rounds)),
+        ],
+        size_of::<FrameState>(),
+    );
+    assert_same_layout(
+        &module,
+        "CheckRow",
+        &[
+            ("eps", offset_of!(CheckRow, eps)),
+            ("bound", offset_of!(CheckRow, bound)),
+            ("flags", offset_of!(CheckRow, flags)),
+            ("marked", offset_of!(CheckRow, marked)),
+        ],
+        size_of::<CheckRow>(),
     );
 }
 

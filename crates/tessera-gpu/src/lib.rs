@@ -38,6 +38,9 @@
 #![warn(missing_docs)]
 
 pub mod context;
+/// The CPU↔GPU contract test (the uniform and state structs against their WGSL).
+#[cfg(test)]
+mod contract;
 pub mod error;
 pub mod readback;
 pub mod scan;

@@ -8,6 +8,47 @@ pub const WORKGROUP: u32 = 64;
 /// dispatches are laid out in two dimensions ([`grid`]).
 pub const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
 
+/// The WGSL sources of the crate, as written (placeholders unexpanded). Most are the engine's
+/// own; the patch evaluations are public so that other crates' shaders evaluate patches by
+/// the same rule instead of a copy ([`evaluation_wgsl`]).
+pub mod sources {
+    pub(crate) const COMMON: &str = include_str!("../shaders/common.wgsl");
+    /// `bicubic.wgsl`: `bicubic_eval(p, uv)`, patch `p`'s position and normal as
+    /// `tessera::surface::RationalBicubic::eval` computes them, from the `control_points`
+    /// rows ([`crate::upload`]).
+    pub const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
+    /// `bezier_triangle.wgsl`: `triangle_eval` and `pn_eval` (cubic Bézier triangles, PN
+    /// triangles) and `eval_patch(p, uv)`, which picks the evaluation by the patch row's kind
+    /// bits. Needs [`BICUBIC`] before it.
+    pub const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
+    pub(crate) const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
+    pub(crate) const COUNT: &str = include_str!("../shaders/count.wgsl");
+    pub(crate) const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
+    pub(crate) const WRITE_VERTICES: &str = include_str!("../shaders/write_vertices.wgsl");
+    pub(crate) const WRITE_TRIANGLES_UNIFORM: &str = include_str!("../shaders/write_triangles_uniform.wgsl");
+    pub(crate) const INDIRECT_ARGS: &str = include_str!("../shaders/indirect_args.wgsl");
+    pub(crate) const CULL: &str = include_str!("../shaders/cull.wgsl");
+    pub(crate) const VIEW: &str = include_str!("../shaders/view.wgsl");
+    pub(crate) const FACTORS: &str = include_str!("../shaders/factors.wgsl");
+    pub(crate) const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
+    pub(crate) const BOUNDS: &str = include_str!("../shaders/bounds.wgsl");
+    pub(crate) const CHECK: &str = include_str!("../shaders/check.wgsl");
+    pub(crate) const LOCAL: &str = include_str!("../shaders/local.wgsl");
+    pub(crate) const GRID_VERTICES: &str = include_str!("../shaders/grid_vertices.wgsl");
+    pub(crate) const HARDWARE_PARTITION: &str = include_str!("../shaders/hardware_partition.wgsl");
+    pub(crate) const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
+}
+
+/// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`] then
+/// [`sources::BEZIER_TRIANGLE`]), for a shader that draws the engine's patches by the
+/// engine's own evaluation rather than a copy. The shader that includes it declares what
+/// `common.wgsl` declares for it: the `control_points` array, the constant `CONTROL_POINTS`
+/// ([`crate::upload::CONTROL_POINTS`]) and the patch-row accessors `patch_is_tri` and
+/// `patch_has_pn_normals`.
+pub fn evaluation_wgsl() -> String {
+    [sources::BICUBIC, sources::BEZIER_TRIANGLE].concat()
+}
+
 /// `source` with every `{{NAME}}` replaced by its value from `constants`.
 ///
 /// Panics when a placeholder is left unreplaced: a shader and its Rust constants out of step
@@ -42,13 +83,39 @@ pub fn module(
     parts: &[&str],
     extra: &[(&str, u32)],
 ) -> wgpu::ShaderModule {
-    let mut constants = common_constants();
-    constants.extend_from_slice(extra);
-    let text = expand(&parts.concat(), &constants);
+    module_with_functions(device, label, parts, extra, &[])
+}
+
+/// [`module`] with every `{{NAME}}` of `functions` replaced by the WGSL function it names: a
+/// file shared by several patterns calls the pattern's own function through a placeholder,
+/// so which one it calls is chosen by the caller, and a module missing that function fails
+/// to compile instead of calling whichever one its parts happen to define. Cost: one WGSL
+/// compilation.
+pub fn module_with_functions(
+    device: &wgpu::Device,
+    label: &str,
+    parts: &[&str],
+    extra: &[(&str, u32)],
+    functions: &[(&str, &str)],
+) -> wgpu::ShaderModule {
+    let text = source(parts, extra, functions);
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(text.into()),
     })
+}
+
+/// The text of [`module_with_functions`]'s module: `parts` concatenated, each `{{NAME}}` of
+/// `functions` replaced by its function, then expanded with [`common_constants`] and `extra`.
+/// Panics as [`expand`]. Cost: O(source length).
+pub fn source(parts: &[&str], extra: &[(&str, u32)], functions: &[(&str, &str)]) -> String {
+    let mut constants = common_constants();
+    constants.extend_from_slice(extra);
+    let mut text = parts.concat();
+    for (name, function) in functions {
+        text = text.replace(&format!("{{{{{name}}}}}"), function);
+    }
+    expand(&text, &constants)
 }
 
 /// How a shader reads one binding of group 0.

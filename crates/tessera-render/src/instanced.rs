@@ -205,9 +205,6 @@ impl GpuRenderQueues {
 
 const INSTANCED: &str = include_str!("../shaders/instanced.wgsl");
 const DRAW: &str = include_str!("../shaders/draw.wgsl");
-// The GPU engine's patch evaluation, shared rather than copied (one rule).
-const BICUBIC: &str = include_str!("../../tessera-gpu/shaders/bicubic.wgsl");
-const BEZIER_TRIANGLE: &str = include_str!("../../tessera-gpu/shaders/bezier_triangle.wgsl");
 
 /// Bytes per static-pattern vertex: u, v, t, snap offset (f32), edge (u32; 4 for none).
 const PATTERN_STRIDE: u64 = 20;
@@ -318,7 +315,8 @@ impl InstancedDraw {
             mapped_at_creation: false,
         });
         let source = tessera_gpu::shader::expand(
-            &[BICUBIC, BEZIER_TRIANGLE, DRAW, INSTANCED].concat(),
+            // The GPU engine's patch evaluation, shared rather than copied (one rule).
+            &[tessera_gpu::shader::evaluation_wgsl().as_str(), DRAW, INSTANCED].concat(),
             &[
                 ("CONTROL_POINTS", tessera_gpu::upload::CONTROL_POINTS),
                 ("PATCH_ROW", tessera_gpu::upload::PATCH_ROW),

@@ -1,0 +1,499 @@
+//! The frame's compiled pipelines: which WGSL files make which shader module ([`Pipelines::new`],
+//! the table of each [`GpuPattern`]'s parts), the constants substituted into them
+//! ([`constants`]), the bind group layouts, and `common.wgsl`'s uniform [`Params`].
+
+use super::screen::{
+    CRITERION_FIXED, CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER,
+    EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING,
+    STATE_BINDING,
+};
+use super::VERTEX_FLOATS;
+use crate::context::GpuContext;
+use crate::error::{GpuError, Result};
+use crate::scan::ScanPipelines;
+use crate::shader::sources::*;
+use crate::shader::{self, Binding};
+use crate::upload;
+use tessera::pattern::hardware::{Hardware, Partitioning};
+use tessera::pattern::transition::Transition;
+use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
+
+/// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
+const MAIN_STORAGE: u32 = 12;
+/// Storage buffers in group 1 of the args pass (its outputs).
+const ARGS_STORAGE: u32 = 3;
+/// Storage buffers in group 1 of the view passes (`view.wgsl`).
+const VIEW_STORAGE: u32 = 4;
+/// Storage buffers in group 1 of the check rounds' decisions (the frame state and the rounds'
+/// dispatch arguments, at the frame state's binding and one of their own).
+const ROUND_STORAGE: u32 = 2;
+
+/// Storage buffers per shader stage a frame needs: group 0's and the largest group 1. Within
+/// 16, what most adapters give (not the WebGPU default of 8, which no GPU engine of this
+/// shape fits: the prepared set, the plan, the layout and the outputs are 12 on their own).
+pub const STORAGE_BUFFERS: u32 = MAIN_STORAGE + max_u32(ARGS_STORAGE, max_u32(VIEW_STORAGE, ROUND_STORAGE));
+
+const fn max_u32(a: u32, b: u32) -> u32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The Direct3D 11 partitionings, in the order of their codes ([`partitioning_code`]).
+const PARTITIONINGS: [Partitioning; 4] =
+    [Partitioning::Integer, Partitioning::Pow2, Partitioning::FractionalOdd, Partitioning::FractionalEven];
+
+/// The CPU pattern of each partitioning, in the same order.
+static HARDWARE_PATTERNS: [Hardware; 4] = [
+    Hardware { partitioning: PARTITIONINGS[0] },
+    Hardware { partitioning: PARTITIONINGS[1] },
+    Hardware { partitioning: PARTITIONINGS[2] },
+    Hardware { partitioning: PARTITIONINGS[3] },
+];
+
+/// `Params::partitioning`'s code of `p` (`hardware_partition.wgsl`'s PARTITIONING_*).
+fn partitioning_code(p: Partitioning) -> u32 {
+    PARTITIONINGS.iter().position(|&q| q == p).expect("every partitioning is listed") as u32
+}
+
+/// Constants the tessellation shaders share with this crate (and with the CPU library: the
+/// partitionings' ranges and the settling gap are `tessera::sampling::hardware`'s own).
+pub(crate) fn constants() -> Vec<(&'static str, u32)> {
+    let range = |p: Partitioning, hi: bool| {
+        let (lo, top) = p.range();
+        let x = if hi { top } else { lo };
+        debug_assert_eq!(x.fract(), 0.0, "the hardware's factor ranges end on integers");
+        x as u32
+    };
+    let gap_inverse = 1.0 / tessera::sampling::hardware::OUTPUT_GAP;
+    debug_assert_eq!(gap_inverse.fract(), 0.0, "the settling gap is 1/n");
+    vec![
+        ("PATCH_ROW", upload::PATCH_ROW),
+        ("EDGE_ROW", upload::EDGE_ROW),
+        ("USE_ROW", upload::USE_ROW),
+        ("CORNER_ROW", upload::CORNER_ROW),
+        ("CONTROL_POINTS", upload::CONTROL_POINTS),
+        ("VERTEX_FLOATS", VERTEX_FLOATS),
+        ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
+        ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
+        ("INTERIOR_GLOBAL", INTERIOR_GLOBAL),
+        ("INTERIOR_CORE", INTERIOR_CORE),
+        ("INTERIOR_MAX_EDGE", INTERIOR_MAX_EDGE),
+        ("CRITERION_PIXEL_ERROR", CRITERION_PIXEL_ERROR),
+        ("CRITERION_SILHOUETTENESS", CRITERION_SILHOUETTENESS),
+        ("CRITERION_FIXED", CRITERION_FIXED),
+        ("EDGE_RULE_INTEGER", EDGE_RULE_INTEGER),
+        ("EDGE_RULE_HARDWARE", EDGE_RULE_HARDWARE),
+        ("PARTITIONING_INTEGER", partitioning_code(Partitioning::Integer)),
+        ("PARTITIONING_POW2", partitioning_code(Partitioning::Pow2)),
+        ("PARTITIONING_FRACTIONAL_ODD", partitioning_code(Partitioning::FractionalOdd)),
+        ("PARTITIONING_FRACTIONAL_EVEN", partitioning_code(Partitioning::FractionalEven)),
+        ("INTEGER_LO", range(Partitioning::Integer, false)),
+        ("INTEGER_HI", range(Partitioning::Integer, true)),
+        ("FRACTIONAL_ODD_LO", range(Partitioning::FractionalOdd, false)),
+        ("FRACTIONAL_ODD_HI", range(Partitioning::FractionalOdd, true)),
+        ("FRACTIONAL_EVEN_LO", range(Partitioning::FractionalEven, false)),
+        ("FRACTIONAL_EVEN_HI", range(Partitioning::FractionalEven, true)),
+        ("OUTPUT_GAP_INVERSE", gap_inverse as u32),
+    ]
+}
+
+fn module(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
+    shader::module(device, label, parts, &constants())
+}
+
+/// The patterns the GPU draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpuPattern {
+    /// [`tessera::pattern::uniform::Uniform`]: one invocation per output triangle.
+    Uniform,
+    /// [`tessera::pattern::transition::Transition`] on quads and triangles (CudaTess): one
+    /// invocation per patch builds its core and strips serially.
+    Transition,
+    /// [`tessera::pattern::hardware::Hardware`], the Direct3D 11 tessellator with one of its
+    /// partitionings (`integer`, `pow2`, `fractional_odd`, `fractional_even`) on quads and
+    /// triangles: one invocation per patch walks its rings and stitches serially.
+    Hardware(Partitioning),
+}
+
+impl GpuPattern {
+    /// The GPU form of `pattern`, by its name; None for patterns not on the GPU.
+    pub fn of(pattern: &dyn Pattern) -> Option<GpuPattern> {
+        match pattern.name() {
+            n if n == Uniform.name() => Some(GpuPattern::Uniform),
+            n if n == Transition.name() => Some(GpuPattern::Transition),
+            n => PARTITIONINGS
+                .into_iter()
+                .find(|&p| Hardware { partitioning: p }.name() == n)
+                .map(GpuPattern::Hardware),
+        }
+    }
+
+    /// The CPU pattern this draws (for counts read back, [`GpuTessellator::read_mesh`]).
+    pub(super) fn cpu_pattern(self) -> &'static dyn Pattern {
+        match self {
+            GpuPattern::Uniform => &Uniform,
+            GpuPattern::Transition => &Transition,
+            GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
+        }
+    }
+
+    /// `Params::partitioning`: the partitioning's code, 0 for the integer patterns.
+    pub(super) fn partitioning_code(self) -> u32 {
+        match self {
+            GpuPattern::Hardware(p) => partitioning_code(p),
+            _ => 0,
+        }
+    }
+}
+
+/// How one pattern's pipelines are built: the WGSL files of its modules, the functions of
+/// those files that the shared passes call (substituted for `count.wgsl`'s,
+/// `write_vertices.wgsl`'s and `grid_vertices.wgsl`'s `{{NAME}}`), and its triangle passes'
+/// entry points. A module whose parts lack a function named here fails to compile; none
+/// calls another pattern's function by concatenation order.
+struct PatternShaders {
+    /// The count pass's module, and the triangle passes' where `triangles` is None.
+    count: (&'static str, &'static [&'static str]),
+    /// The vertex passes' module.
+    vertices: (&'static str, &'static [&'static str]),
+    /// The triangle passes' own module, if they have one.
+    triangles: Option<(&'static str, &'static [&'static str])>,
+    /// `{{PATCH_COUNTS}}` (`count.wgsl`): a visible patch's interior vertices and kept
+    /// triangles; `{{EDGE_PARAM}}` and `{{INTERIOR_POINT}}` (`write_vertices.wgsl`): where the
+    /// pattern puts edge samples and interior vertices; `{{INTERIOR_GRID}}`
+    /// (`grid_vertices.wgsl`, for the patterns on a grid): the interior grid's factors.
+    functions: &'static [(&'static str, &'static str)],
+    /// The entry point of the triangle pass.
+    write_triangles: &'static str,
+    /// The entry point of the uniform pattern's second triangle pass, for the patches at a
+    /// collapsed corner.
+    write_collapsed_triangles: Option<&'static str>,
+}
+
+/// The uniform pattern: one module per pass kind.
+const UNIFORM_SHADERS: PatternShaders = PatternShaders {
+    count: ("count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]),
+    vertices: (
+        "vertices uniform",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
+    ),
+    triangles: Some(("triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM])),
+    functions: &[
+        ("PATCH_COUNTS", "uniform_patch_counts"),
+        ("INTERIOR_GRID", "uniform_interior_grid"),
+        ("EDGE_PARAM", "grid_edge_param"),
+        ("INTERIOR_POINT", "grid_interior_point"),
+    ],
+    write_triangles: "write_uniform_triangles",
+    write_collapsed_triangles: Some("write_uniform_collapsed_triangles"),
+};
+
+/// The transition pattern: counts and triangles in one module.
+const TRANSITION_SHADERS: PatternShaders = PatternShaders {
+    count: ("transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]),
+    vertices: (
+        "vertices transition",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, LOCAL, BOUNDS, TRANSITION, GRID_VERTICES, WRITE_VERTICES],
+    ),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "transition_patch_counts"),
+        ("INTERIOR_GRID", "transition_interior_grid"),
+        ("EDGE_PARAM", "grid_edge_param"),
+        ("INTERIOR_POINT", "grid_interior_point"),
+    ],
+    write_triangles: "write_transition_triangles",
+    write_collapsed_triangles: None,
+};
+
+/// The Direct3D 11 patterns (every partitioning: `Params::partitioning` tells them apart):
+/// counts and triangles in one module.
+const HARDWARE_SHADERS: PatternShaders = PatternShaders {
+    count: ("hardware", &[COMMON, HARDWARE_PARTITION, LOCAL, HARDWARE, COUNT]),
+    vertices: (
+        "vertices hardware",
+        &[COMMON, BICUBIC, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
+    ),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "hardware_patch_counts"),
+        ("EDGE_PARAM", "hardware_plan_edge_param"),
+        ("INTERIOR_POINT", "hardware_interior_point"),
+    ],
+    write_triangles: "write_hardware_triangles",
+    write_collapsed_triangles: None,
+};
+
+impl PatternShaders {
+    /// Compiles the pattern's modules and makes its pipelines with group 0 laid out by
+    /// `layout`. Cost: two or three WGSL compilations.
+    fn pipelines(&self, device: &wgpu::Device, layout: &wgpu::PipelineLayout) -> PatternPipelines {
+        let module = |(label, parts): (&str, &[&str])| {
+            shader::module_with_functions(device, label, parts, &constants(), self.functions)
+        };
+        let count = module(self.count);
+        let vertices = module(self.vertices);
+        let triangles = self.triangles.map(module);
+        let triangles = triangles.as_ref().unwrap_or(&count);
+        let make = |module: &wgpu::ShaderModule, entry: &str| compute_pipeline(device, layout, module, entry);
+        PatternPipelines {
+            count: make(&count, "count"),
+            corners: make(&vertices, "write_corners"),
+            edge_vertices: make(&vertices, "write_edge_vertices"),
+            interior_vertices: make(&vertices, "write_interior_vertices"),
+            triangles: make(triangles, self.write_triangles),
+            collapsed_triangles: self.write_collapsed_triangles.map(|entry| make(triangles, entry)),
+        }
+    }
+}
+
+/// The pattern-specific pipelines: counts, vertex writes (the interior grid is the
+/// pattern's), triangle writes.
+#[derive(Debug)]
+pub(super) struct PatternPipelines {
+    pub(super) count: wgpu::ComputePipeline,
+    pub(super) corners: wgpu::ComputePipeline,
+    pub(super) edge_vertices: wgpu::ComputePipeline,
+    pub(super) interior_vertices: wgpu::ComputePipeline,
+    /// Uniform: one invocation per triangle (indirect), then the collapsed-corner patches.
+    /// Transition and hardware: one invocation per patch.
+    pub(super) triangles: wgpu::ComputePipeline,
+    pub(super) collapsed_triangles: Option<wgpu::ComputePipeline>,
+}
+
+/// Every compiled pipeline of a frame, independent of the set: made once per device
+/// ([`Pipelines::new`]) and shared by any number of tessellators
+/// ([`GpuTessellator::with_pipelines`](super::GpuTessellator::with_pipelines)).
+#[derive(Debug)]
+pub struct Pipelines {
+    pub(super) main_layout: wgpu::BindGroupLayout,
+    pub(super) args_layout: wgpu::BindGroupLayout,
+    pub(super) view_layout: wgpu::BindGroupLayout,
+    pub(super) cull: wgpu::ComputePipeline,
+    pub(super) patch_proposals: wgpu::ComputePipeline,
+    pub(super) edge_segments: wgpu::ComputePipeline,
+    pub(super) interiors: wgpu::ComputePipeline,
+    pub(super) check: CheckPipelines,
+    pub(super) rounds_layout: wgpu::BindGroupLayout,
+    pub(super) scan: ScanPipelines,
+    pub(super) args: wgpu::ComputePipeline,
+    uniform: PatternPipelines,
+    transition: PatternPipelines,
+    /// The hardware pattern's, compiled on first use ([`Pipelines::hardware`]): a frame of
+    /// the integer patterns does not wait for them.
+    hardware: std::sync::OnceLock<PatternPipelines>,
+    main_pipeline_layout: wgpu::PipelineLayout,
+}
+
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+impl Pipelines {
+    /// Whether `ctx`'s device can make the pipelines: [`GpuError::Unsupported`] for fewer
+    /// than [`STORAGE_BUFFERS`] storage buffers per shader stage. [`Pipelines::new`] on such
+    /// a device would fail wgpu's validation (a panic under wgpu's default error handler), so
+    /// call this first. Cost: O(1).
+    pub fn check_limits(ctx: &GpuContext) -> Result<()> {
+        let have = ctx.limits.max_storage_buffers_per_shader_stage;
+        if have < STORAGE_BUFFERS {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "an adapter with {have} storage buffers per shader stage ({STORAGE_BUFFERS} needed)"
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Compiles every shader of the frame on `device`. Cost: about a dozen WGSL compilations
+    /// (a second or more on lavapipe).
+    pub fn new(device: &wgpu::Device) -> Pipelines {
+        use Binding::*;
+        let mut main = vec![Uniform];
+        main.extend(std::iter::repeat_n(Write, MAIN_STORAGE as usize));
+        let main_layout = shader::layout(device, &main);
+        let args_layout = shader::layout(device, &[Write; ARGS_STORAGE as usize]);
+        let mut view = vec![Uniform];
+        view.extend(std::iter::repeat_n(Write, VIEW_STORAGE as usize));
+        let view_layout = shader::layout(device, &view);
+        let rounds_layout = shader::layout_at(device, &[(STATE_BINDING, Write), (ROUND_ARGS_BINDING, Write)]);
+        let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            })
+        };
+        let one = pipeline_layout(&[Some(&main_layout)]);
+        let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
+        let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
+        let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&rounds_layout)]);
+        let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
+            compute_pipeline(device, layout, module, entry)
+        };
+        let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
+        let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
+        let factors = module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS]);
+        let uniform = UNIFORM_SHADERS.pipelines(device, &one);
+        let transition = TRANSITION_SHADERS.pipelines(device, &one);
+        let check = {
+            let parts = [COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS, LOCAL, BOUNDS, TRANSITION, CHECK];
+            let m = module(device, "check", &parts);
+            CheckPipelines {
+                check_all: make(&with_view, &m, "check_all"),
+                open: make(&with_rounds, &m, "round_open"),
+                resolve: make(&with_view, &m, "round_resolve"),
+                close: make(&with_rounds, &m, "round_close"),
+                recheck: make(&with_view, &m, "round_check"),
+            }
+        };
+        Pipelines {
+            check,
+            rounds_layout,
+            cull: make(&with_view, &cull, "cull"),
+            patch_proposals: make(&with_view, &factors, "patch_proposals"),
+            edge_segments: make(&with_view, &factors, "edge_segments"),
+            interiors: make(&with_view, &factors, "interiors"),
+            scan: ScanPipelines::new(device),
+            args: make(&two, &args, "write_args"),
+            uniform,
+            transition,
+            hardware: std::sync::OnceLock::new(),
+            main_pipeline_layout: one,
+            main_layout,
+            args_layout,
+            view_layout,
+        }
+    }
+
+    /// The hardware pattern's pipelines (`hardware.wgsl`), compiled on the first call.
+    /// Cost: the first call two WGSL compilations (lavapipe finishes them at their first
+    /// dispatch: about 5 s, once per device); later calls nothing.
+    pub(super) fn hardware(&self, device: &wgpu::Device) -> &PatternPipelines {
+        self.hardware.get_or_init(|| {
+            // One set for every partitioning: the shaders read `Params::partitioning`.
+            HARDWARE_SHADERS.pipelines(device, &self.main_pipeline_layout)
+        })
+    }
+
+    /// The pipelines of `pattern`; None for the hardware pattern before
+    /// [`Pipelines::hardware`] compiled them.
+    pub(super) fn of(&self, pattern: GpuPattern) -> Option<&PatternPipelines> {
+        match pattern {
+            GpuPattern::Uniform => Some(&self.uniform),
+            GpuPattern::Transition => Some(&self.transition),
+            GpuPattern::Hardware(_) => self.hardware.get(),
+        }
+    }
+}
+
+/// The a-posteriori check's pipelines (`check.wgsl`): the first check, then per round the
+/// opening decision, the resolve, the closing decision and the re-check.
+#[derive(Debug)]
+pub(super) struct CheckPipelines {
+    pub(super) check_all: wgpu::ComputePipeline,
+    pub(super) open: wgpu::ComputePipeline,
+    pub(super) resolve: wgpu::ComputePipeline,
+    pub(super) close: wgpu::ComputePipeline,
+    pub(super) recheck: wgpu::ComputePipeline,
+}
+
+/// `common.wgsl`'s `Params` (member for member: the contract test, `contract.rs`, checks the offsets).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct Params {
+    pub(crate) edges: u32,
+    pub(crate) patches: u32,
+    pub(crate) corners: u32,
+    pub(crate) vertex_capacity: u32,
+    pub(crate) triangle_capacity: u32,
+    pub(crate) partitioning: u32,
+    pub(crate) _pad: [u32; 2],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ROWS: [(&str, &PatternShaders); 3] =
+        [("uniform", &UNIFORM_SHADERS), ("transition", &TRANSITION_SHADERS), ("hardware", &HARDWARE_SHADERS)];
+
+    /// The modules of `row` (count, vertices, triangles), expanded with `functions` as
+    /// [`PatternShaders::pipelines`] expands them, parsed by naga.
+    fn parse(
+        row: &PatternShaders,
+        functions: &[(&str, &str)],
+    ) -> Vec<std::result::Result<naga::Module, String>> {
+        let modules = [Some(row.count), Some(row.vertices), row.triangles];
+        modules
+            .into_iter()
+            .flatten()
+            .map(|(_, parts)| {
+                let text = shader::source(parts, &constants(), functions);
+                naga::front::wgsl::parse_str(&text).map_err(|e| format!("{e}"))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_pattern_row_compiles_with_its_entry_points() {
+        for (name, row) in ROWS {
+            let modules: Vec<naga::Module> = parse(row, row.functions)
+                .into_iter()
+                .map(|m| m.unwrap_or_else(|e| panic!("{name}: {e}")))
+                .collect();
+            let has = |m: &naga::Module, entry: &str| m.entry_points.iter().any(|e| e.name == entry);
+            let triangles = modules.last().expect("a row has modules");
+            assert!(has(&modules[0], "count"), "{name}");
+            for entry in ["write_corners", "write_edge_vertices", "write_interior_vertices"] {
+                assert!(has(&modules[1], entry), "{name}: {entry}");
+            }
+            let triangles = if row.triangles.is_some() { triangles } else { &modules[0] };
+            for entry in std::iter::once(row.write_triangles).chain(row.write_collapsed_triangles) {
+                assert!(has(triangles, entry), "{name}: {entry}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_pattern_row_with_another_patterns_function_fails_to_compile() {
+        for (name, row) in ROWS {
+            for (other, other_row) in ROWS {
+                for &(placeholder, theirs) in other_row.functions {
+                    let Some(&(_, ours)) = row.functions.iter().find(|(n, _)| *n == placeholder) else {
+                        continue;
+                    };
+                    if ours == theirs {
+                        continue; // shared by both patterns (the grid patterns' vertex places)
+                    }
+                    let functions: Vec<(&str, &str)> = row
+                        .functions
+                        .iter()
+                        .map(|&(n, f)| if n == placeholder { (n, theirs) } else { (n, f) })
+                        .collect();
+                    assert!(
+                        parse(row, &functions).iter().any(|m| m.is_err()),
+                        "{name}'s modules compiled with {other}'s {placeholder} ({theirs})"
+                    );
+                }
+            }
+        }
+    }
+}

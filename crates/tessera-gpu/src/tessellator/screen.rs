@@ -1,0 +1,447 @@
+//! Planning on the GPU from the camera alone ([`GpuTessellator::prepare_screen`]): the
+//! request ([`ScreenCriterion`]) checked and turned into `view.wgsl`'s uniform
+//! ([`ViewUniform`]), the view passes' buffers ([`ViewBuffers`]) and their view-independent
+//! rows ([`patch_view_rows`]), and the culling camera ([`GpuTessellator::set_cull_camera`]).
+
+use std::mem::size_of;
+
+use super::capacity::screen_worst_case;
+use super::report::{CheckRow, FrameState};
+use super::{buffer, Capacity, GpuPattern, GpuTessellator};
+use crate::context::GpuContext;
+use crate::error::{GpuError, Result};
+use crate::shader;
+use crate::upload;
+use tessera::camera::Camera;
+use tessera::criterion::view::ViewCriterion;
+use tessera::scheme::{Criterion, Prepared, Scheme};
+use tessera::surface::SurfaceSet;
+
+/// `view.wgsl`'s binding of the frame state, and `check.wgsl`'s of the rounds' arguments.
+pub(super) const STATE_BINDING: u32 = 3;
+pub(super) const ROUND_ARGS_BINDING: u32 = 5;
+
+/// The largest factor cap of a frame whose a-posteriori check runs on the GPU (the CPU's
+/// default cap). Its shaders rely on it: a check walks strips of at most 2 · 64 steps, so the
+/// loops of one invocation stay well within the 65,535 iterations lavapipe allows an
+/// invocation in all (about 21,000 at the worst: 39 interior steps of four strips), and
+/// `bounds.wgsl`'s test for sides along an axis tells exact arithmetic's answer in f32 only
+/// while factors are at most 64.
+pub const CHECK_MAX_FACTOR: u32 = 64;
+
+/// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
+pub(super) const PATCH_VIEW_ROW: u32 = 8;
+
+/// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under `criterion`
+/// with `PlanOptions::max_factor = max_factor`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenCriterion {
+    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`] or [`Scheme::Hardware`].
+    pub scheme: Scheme,
+    /// [`Criterion::PixelError`] (uniform and transition schemes), [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`], or [`Criterion::Factor`] (hardware schemes).
+    pub criterion: Criterion,
+    /// The factor cap, `1..=MAX_FACTOR`.
+    pub max_factor: u32,
+    /// The output room to start with: None for the worst case (every patch at the cap),
+    /// clamped to the device's buffer limits; a smaller one saves memory, and a frame that
+    /// needs more overflows (drawing nothing) until [`GpuTessellator::grow_if_overflowed`]
+    /// grows it.
+    pub capacity: Option<Capacity>,
+}
+
+/// `view.wgsl`'s `View` uniform (member for member: the contract test, `contract.rs`, checks
+/// the offsets): the camera's basis and frustum, and the screen criterion of the frame.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ViewUniform {
+    pub(crate) eye: [f32; 4],
+    pub(crate) right: [f32; 4],
+    pub(crate) up: [f32; 4],
+    pub(crate) forward: [f32; 4],
+    pub(crate) near: f32,
+    pub(crate) far: f32,
+    pub(crate) tan_x: f32,
+    pub(crate) tan_y: f32,
+    pub(crate) focal: f32,
+    pub(crate) pixels: f32,
+    pub(crate) cap: f32,
+    pub(crate) interior_rule: u32,
+    pub(crate) criterion: u32,
+    pub(crate) lo: f32,
+    pub(crate) hi: f32,
+    pub(crate) edge_rule: u32,
+}
+
+/// `view.wgsl`'s interior rules, criteria and edge rules (substituted into it by
+/// [`constants`], so they are typed here only).
+pub(super) const INTERIOR_GLOBAL: u32 = 0;
+pub(super) const INTERIOR_CORE: u32 = 1;
+pub(super) const INTERIOR_MAX_EDGE: u32 = 2;
+pub(super) const CRITERION_PIXEL_ERROR: u32 = 0;
+pub(super) const CRITERION_SILHOUETTENESS: u32 = 1;
+pub(super) const CRITERION_FIXED: u32 = 2;
+pub(super) const EDGE_RULE_INTEGER: u32 = 0;
+pub(super) const EDGE_RULE_HARDWARE: u32 = 1;
+/// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
+pub(super) const EDGE_VIEW_ROW: usize = 3;
+
+/// The criterion of [`GpuTessellator::prepare_screen`], as `view.wgsl` reads it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Screen {
+    pub(super) criterion: u32,
+    pub(super) pixels: f64,
+    pub(super) lo: f64,
+    pub(super) hi: f64,
+    /// The factor cap (`Scheme`'s own and `max_factor`).
+    pub(super) cap: f64,
+    pub(super) interior: u32,
+    pub(super) edge_rule: u32,
+}
+
+impl Screen {
+    /// Whether the frame's interiors come from the a-posteriori check (a pixel error with
+    /// the transition scheme's core rule).
+    pub(super) fn checked(&self) -> bool {
+        self.criterion == CRITERION_PIXEL_ERROR && self.interior == INTERIOR_CORE
+    }
+}
+
+/// The view passes' buffers (`view.wgsl`'s group 1) and their bind group.
+#[derive(Debug)]
+pub(super) struct ViewBuffers {
+    pub(super) uniform: wgpu::Buffer,
+    pub(super) patch_views: wgpu::Buffer,
+    /// `view.wgsl`'s `FrameState`.
+    pub(super) state: wgpu::Buffer,
+    /// The check rows (`view.wgsl`'s `CheckRow`, per patch).
+    pub(super) checks: wgpu::Buffer,
+    pub(super) bind: wgpu::BindGroup,
+    /// The check rounds' dispatch arguments (`check.wgsl`'s `round_args`) and their bind
+    /// group (group 2 of the rounds' decisions).
+    pub(super) round_args: wgpu::Buffer,
+    pub(super) rounds: wgpu::BindGroup,
+    /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
+    /// device.
+    pub(super) bounds_uploaded: bool,
+}
+
+impl ViewBuffers {
+    /// The buffers for `set`, the culling rows filled (the bounds come with
+    /// [`GpuTessellator::prepare_screen`]). Cost: O(P) cone computations, one upload.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        rounds_layout: &wgpu::BindGroupLayout,
+        set: &SurfaceSet,
+    ) -> ViewBuffers {
+        use wgpu::BufferUsages as U;
+        let patches = set.patches.len() as u64;
+        let uniform =
+            buffer(device, "view", std::mem::size_of::<ViewUniform>() as u64, U::UNIFORM | U::COPY_DST);
+        let patch_views = upload::storage_buffer(device, "patch views", &patch_view_rows(set, None));
+        let proposals = buffer(device, "proposals", 16 * patches, U::STORAGE);
+        let state = buffer(
+            device,
+            "frame state",
+            size_of::<FrameState>() as u64,
+            U::STORAGE | U::COPY_DST | U::COPY_SRC,
+        );
+        let checks =
+            buffer(device, "check rows", size_of::<CheckRow>() as u64 * patches, U::STORAGE | U::COPY_SRC);
+        let bind = shader::bind(device, layout, &[&uniform, &patch_views, &proposals, &state, &checks]);
+        let round_args = buffer(device, "check round dispatches", 24, U::STORAGE | U::INDIRECT);
+        let rounds = shader::bind_at(
+            device,
+            rounds_layout,
+            &[(STATE_BINDING, &state), (ROUND_ARGS_BINDING, &round_args)],
+        );
+        ViewBuffers { uniform, patch_views, state, checks, bind, round_args, rounds, bounds_uploaded: false }
+    }
+}
+
+/// Per patch, [`PATCH_VIEW_ROW`] `vec4<f32>` (`view.wgsl`): from
+/// [`tessera::criterion::screen::PatchView`] the normal cone (axis, half-angle α), the
+/// bounding sphere of the control points about their mean (`screen::back_facing`'s),
+/// `(sin α, cos α, has cone, 0)`, the control-point box's lo and hi; then from `prepared`
+/// (zero without it) the second-derivative bound `(uu, uv, vv, 0)`, the four boundary
+/// curves' bounds and the minimum interior factors; after the patches, [`EDGE_VIEW_ROW`]
+/// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, with
+/// the edge's `Prepared::minimum_segments` in w; the normals of its first and last patch).
+/// View-independent: computed once. Cost: O(P) cone
+/// computations, the midpoints' evaluations when `prepared` has none yet.
+fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
+    let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+    let mut out = Vec::with_capacity(PATCH_VIEW_ROW as usize * set.patches.len());
+    for (p, patch) in set.patches.iter().enumerate() {
+        let view = tessera::criterion::screen::PatchView::new(patch);
+        let (axis, alpha) = view.cone.unwrap_or((glam::DVec3::Z, 0.0));
+        out.push(v4(axis, alpha));
+        out.push(v4(view.centre, view.radius));
+        out.push([alpha.sin() as f32, alpha.cos() as f32, view.cone.is_some() as u32 as f32, 0.0]);
+        out.push(v4(view.lo, 0.0));
+        out.push(v4(view.hi, 0.0));
+        match prepared {
+            Some(prepared) => {
+                let m = &prepared.hessians[p];
+                out.push([m.uu as f32, m.uv as f32, m.vv as f32, 0.0]);
+                out.push(prepared.curves[p].map(|c| c as f32));
+                let [u, v] = prepared.minimum_interior[p];
+                out.push([u as f32, v as f32, 0.0, 0.0]);
+            }
+            None => out.extend([[0.0; 4]; 3]),
+        }
+    }
+    let edges = set.topology.edges.len();
+    match prepared {
+        Some(prepared) => {
+            let minimum = &prepared.minimum_segments;
+            for (e, [(mid, nl), (_, nr)]) in prepared.edge_midpoints(set).iter().enumerate() {
+                out.extend([v4(*mid, minimum[e] as f64), v4(*nl, 0.0), v4(*nr, 0.0)]);
+            }
+        }
+        None => out.resize(out.len() + EDGE_VIEW_ROW * edges, [0.0; 4]),
+    }
+    out
+}
+
+impl GpuTessellator {
+    /// Makes every following frame plan itself on the GPU from the camera alone: culling
+    /// for `camera` (`cull.wgsl`), then the factors of `criterion` (`factors.wgsl`: per
+    /// patch its proposals — for a pixel error the object-space tolerance of
+    /// `screen::PatchView::tolerance` and the proposals from `prepared`'s bounds, for
+    /// silhouetteness its edges' factors from `prepared`'s edge midpoints — per edge the
+    /// maximum over its patches through the topology's edge uses, the cap and the minimum
+    /// segments, then the scheme's interior rule), as `scheme.plan_prepared(set, prepared,
+    /// &criterion, &PlanOptions { camera, cull: true, max_factor, .. })` plans on the CPU.
+    /// Later cameras go to [`GpuTessellator::set_cull_camera`] (a 112-byte upload a frame);
+    /// the plan never comes back to the CPU ([`GpuTessellator::read_plan`] reads it for
+    /// tests).
+    ///
+    /// On the GPU: [`Criterion::PixelError`] with [`Scheme::Uniform`] (the global factor:
+    /// the largest over the visible patches) or [`Scheme::Transition`] (CudaTess: per-edge
+    /// factors and the a-posteriori check of `check.wgsl`, which raises interiors and, round
+    /// by round, edges until every visible patch's bound holds; see
+    /// [`GpuTessellator::read_screen_report`]); [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
+    /// (per-edge factors, CudaTess's core rule) or a [`Scheme::Hardware`] partitioning (real
+    /// per-edge factors by `EdgeRule::Fractional`: the cap, the minimum segments, the hull
+    /// shader's pow2 rounding and `settled_factor`; Direct3D's `max` inside reduction in the
+    /// pattern); and [`Criterion::Factor`] with a [`Scheme::Hardware`] partitioning (one real
+    /// factor, resolved the same way, with the GPU's culling). A silhouetteness strictly
+    /// between 0 and 1 is computed in f32 from f32 copies of the CPU's data, so such an edge's
+    /// real factor may differ from the CPU's in its last bits (`factors.wgsl`). The distance
+    /// and vertex-silhouette criteria are planned on the CPU (their plans draw on the GPU
+    /// through [`GpuTessellator::prepare`]). The output is sized for the worst case, every
+    /// patch at the cap (or at the largest minimum when that is higher), within the device's
+    /// buffer limits, or as `criterion.capacity` says; a frame that needs more draws nothing
+    /// and is reported ([`GpuTessellator::grow_if_overflowed`]).
+    ///
+    /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
+    /// Errors: [`GpuError::Unsupported`] for another scheme or criterion or a `prepared`
+    /// without bounds; [`tessera::Error::InvalidParameter`] for a pixel error that is not a
+    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` (in integers for the
+    /// integer schemes), or a `max_factor` outside `1..=MAX_FACTOR`, and
+    /// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks
+    /// of [`Scheme::plan`]);
+    /// [`GpuError::Unsupported`] too for the transition scheme's pixel error with a
+    /// `max_factor` above [`CHECK_MAX_FACTOR`];
+    /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
+    /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
+    /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
+    /// bytes a patch and 52 an edge; later calls (another camera, criterion or cap) O(P)
+    /// pattern counts for the capacity and a 112-byte upload.
+    pub fn prepare_screen(
+        &mut self,
+        ctx: &GpuContext,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+        camera: &Camera,
+        criterion: ScreenCriterion,
+    ) -> Result<()> {
+        let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
+        let screen = check_screen_request(scheme, criterion, max_factor)?;
+        self.check_screen_support(set, prepared, scheme, &screen, max_factor)?;
+        let hardware = match scheme {
+            Scheme::Hardware(p) => Some(p),
+            _ => None,
+        };
+        let worst = screen_worst_case(set, prepared, &screen, hardware, max_factor)?;
+        self.reserve_screen(ctx, worst, capacity)?;
+        if !self.view.bounds_uploaded {
+            // View-independent and the same for every `Prepared` of the set: uploaded once.
+            let rows = patch_view_rows(set, Some(prepared));
+            ctx.queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
+            self.view.bounds_uploaded = true;
+        }
+        self.screen = Some(screen);
+        self.pattern = match scheme {
+            Scheme::Uniform => GpuPattern::Uniform,
+            Scheme::Hardware(p) => {
+                self.pipelines.hardware(&ctx.device);
+                GpuPattern::Hardware(p)
+            }
+            _ => GpuPattern::Transition,
+        };
+        self.write_params(ctx);
+        self.set_cull_camera(ctx, Some(camera));
+        Ok(())
+    }
+
+    /// What [`GpuTessellator::prepare_screen`] refuses beyond the request itself: on this
+    /// adapter and this tessellator, with `prepared` (the checks after
+    /// [`check_screen_request`]'s, in `prepare_screen`'s order of errors). Cost: O(1).
+    fn check_screen_support(
+        &self,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+        scheme: Scheme,
+        screen: &Screen,
+        max_factor: u32,
+    ) -> Result<()> {
+        if scheme == Scheme::Transition {
+            self.check_loop_budget(max_factor)?;
+        }
+        if screen.checked() && max_factor > CHECK_MAX_FACTOR {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "the a-posteriori check on the GPU with a factor cap of {max_factor} (it takes caps up \
+                     to {CHECK_MAX_FACTOR}; plan this frame on the CPU)"
+                ),
+            });
+        }
+        let patches = set.patches.len();
+        if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
+            return Err(
+                tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
+            );
+        }
+        if prepared.hessians.len() != patches
+            || prepared.curves.len() != patches
+            || prepared.minimum_segments.len() != set.topology.edges.len()
+            || prepared.minimum_interior.len() != patches
+        {
+            return Err(GpuError::Unsupported {
+                what: "a Prepared without the error bounds (make it with Prepared::new(set, true))".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
+    /// following frame, writing the plan's visibility row on the device (the plan's own row
+    /// is then ignored), and, after [`GpuTessellator::prepare_screen`], plan the factors for
+    /// it; None goes back to the plan's row (and ends the GPU's own planning). The output
+    /// capacity then covers every patch. Cost: a 112-byte upload.
+    pub fn set_cull_camera(&mut self, ctx: &GpuContext, camera: Option<&Camera>) {
+        let Some(camera) = camera else {
+            self.camera = None;
+            self.screen = None;
+            return;
+        };
+        self.camera = Some(*camera);
+        let view = camera.view();
+        let v4 = |v: glam::DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        let s = self.screen.unwrap_or(Screen {
+            criterion: CRITERION_PIXEL_ERROR,
+            pixels: 1.0,
+            lo: 1.0,
+            hi: 1.0,
+            cap: 1.0,
+            interior: INTERIOR_GLOBAL,
+            edge_rule: EDGE_RULE_INTEGER,
+        });
+        let t = view.half_tangents;
+        let uniform = ViewUniform {
+            eye: v4(view.eye),
+            right: v4(view.right),
+            up: v4(view.up),
+            forward: v4(view.forward),
+            near: view.near as f32,
+            far: view.far as f32,
+            tan_x: t.x as f32,
+            tan_y: t.y as f32,
+            focal: view.focal_pixels as f32,
+            pixels: s.pixels as f32,
+            cap: s.cap as f32,
+            interior_rule: s.interior,
+            criterion: s.criterion,
+            lo: s.lo as f32,
+            hi: s.hi as f32,
+            edge_rule: s.edge_rule,
+        };
+        ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+}
+
+/// The screen criterion `criterion` asks of `scheme` with the factor cap `max_factor`, as
+/// `view.wgsl` reads it, or the error [`GpuTessellator::prepare_screen`] returns for the
+/// request: [`tessera::Error::InvalidParameter`] for a `max_factor` outside `1..=MAX_FACTOR`,
+/// a pixel error that is not a positive number or a factor range that is not
+/// `1 ≤ FMIN ≤ FMAX` (in integers for the integer schemes),
+/// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks of
+/// [`Scheme::plan`]), [`GpuError::Unsupported`] for a scheme and criterion not planned on the
+/// GPU. Cost: O(1).
+fn check_screen_request(scheme: Scheme, criterion: Criterion, max_factor: u32) -> Result<Screen> {
+    let unsupported = || {
+        Err(GpuError::Unsupported {
+            what: format!("{} with the {} scheme planned on the GPU", criterion.name(), scheme.name()),
+        })
+    };
+    let invalid = |name: &'static str, reason: String| {
+        Err(GpuError::from(tessera::Error::InvalidParameter { name, reason }))
+    };
+    if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
+        return invalid("max factor", format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR));
+    }
+    // The scheme's own cap and `max_factor`, as `Scheme::plan_into` caps (the hardware's
+    // range for its partitionings).
+    let cap = scheme.factor_cap().min(max_factor as f64);
+    let hardware = match scheme {
+        Scheme::Hardware(p) => Some(p),
+        _ => None,
+    };
+    let (kind, pixels, lo, hi) = match (scheme, criterion) {
+        (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(px)) => {
+            if !(px.is_finite() && px > 0.0) {
+                return invalid("pixel error", format!("{px}: must be a positive number"));
+            }
+            (CRITERION_PIXEL_ERROR, px, 1.0, 1.0)
+        }
+        (
+            Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
+            Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax },
+        ) => {
+            // Real factors for the hardware schemes, integers for the others.
+            let integer = hardware.is_none();
+            let valid = |f: f64| f.is_finite() && f >= 1.0 && (!integer || f.fract() == 0.0);
+            if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
+                let what = if integer { "integers" } else { "numbers" };
+                return invalid("factor range", format!("{fmin}:{fmax}: use {what} 1 ≤ FMIN ≤ FMAX"));
+            }
+            // As `Scheme::plan_into` and `view::edge_factors_into` bound the range.
+            let fmax = fmax.min(cap);
+            let lo = fmin.min(fmax).max(1.0);
+            (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
+        }
+        (Scheme::Hardware(p), Criterion::Factor(f)) => {
+            if !(f.is_finite() && f >= 1.0 && f <= cap) {
+                return Err(tessera::Error::FactorOutOfRange {
+                    scheme: scheme.name(),
+                    factor: f,
+                    expected: format!("a number from 1 to {cap} (the {} range and the max factor)", p.name()),
+                }
+                .into());
+            }
+            (CRITERION_FIXED, 1.0, f, f)
+        }
+        _ => return unsupported(),
+    };
+    let interior = match scheme {
+        Scheme::Uniform => INTERIOR_GLOBAL,
+        Scheme::Hardware(_) => INTERIOR_MAX_EDGE,
+        _ => INTERIOR_CORE,
+    };
+    let edge_rule = if hardware.is_some() { EDGE_RULE_HARDWARE } else { EDGE_RULE_INTEGER };
+    Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule })
+}
