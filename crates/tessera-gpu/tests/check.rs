@@ -145,7 +145,10 @@ fn checked_frames_past_the_check_cap_are_refused_not_truncated() {
         capacity: None,
     };
     let err = gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap_err();
-    assert!(matches!(err, tessera_gpu::GpuError::Unsupported { .. }), "{err}");
+    assert!(
+        matches!(err, tessera_gpu::GpuError::Tessera(tessera::Error::EngineNotSupported { .. })),
+        "{err}"
+    );
     // The uniform scheme's pixel error has no check and takes the cap.
     let screen = tessera_gpu::tessellator::ScreenCriterion { scheme: Scheme::Uniform, ..screen };
     gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap();

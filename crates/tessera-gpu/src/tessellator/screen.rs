@@ -13,21 +13,21 @@ use crate::error::{GpuError, Result};
 use crate::shader;
 use crate::upload;
 use tessera::camera::Camera;
+use tessera::criterion::resolve::{EdgeRule, InteriorRule};
+#[cfg(doc)]
 use tessera::criterion::view::ViewCriterion;
-use tessera::scheme::{Criterion, Prepared, Scheme};
+use tessera::sampling::Spacing;
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 
 /// `view.wgsl`'s binding of the frame state, and `check.wgsl`'s of the rounds' arguments.
 pub(super) const STATE_BINDING: u32 = 3;
 pub(super) const ROUND_ARGS_BINDING: u32 = 5;
 
-/// The largest factor cap of a frame whose a-posteriori check runs on the GPU (the CPU's
-/// default cap). Its shaders rely on it: a check walks strips of at most 2 · 64 steps, so the
-/// loops of one invocation stay well within the 65,535 iterations lavapipe allows an
-/// invocation in all (about 21,000 at the worst: 39 interior steps of four strips), and
-/// `bounds.wgsl`'s test for sides along an axis tells exact arithmetic's answer in f32 only
-/// while factors are at most 64.
-pub const CHECK_MAX_FACTOR: u32 = 64;
+/// The largest factor cap of a frame whose a-posteriori check runs on the GPU: the library's
+/// [`tessera::scheme::GPU_CHECK_MAX_FACTOR`] (whose documentation says why the shaders rely
+/// on it), which `validate` enforces.
+pub const CHECK_MAX_FACTOR: u32 = tessera::scheme::GPU_CHECK_MAX_FACTOR;
 
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
 pub(super) const PATCH_VIEW_ROW: u32 = 8;
@@ -238,14 +238,12 @@ impl GpuTessellator {
     /// and is reported ([`GpuTessellator::grow_if_overflowed`]).
     ///
     /// Preconditions: `prepared` was made for `set` with bounds (`Prepared::new(set, true)`).
-    /// Errors: [`GpuError::Unsupported`] for another scheme or criterion or a `prepared`
-    /// without bounds; [`tessera::Error::InvalidParameter`] for a pixel error that is not a
-    /// positive number, a factor range that is not `1 ≤ FMIN ≤ FMAX` (in integers for the
-    /// integer schemes), or a `max_factor` outside `1..=MAX_FACTOR`, and
-    /// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks
-    /// of [`Scheme::plan`]);
-    /// [`GpuError::Unsupported`] too for the transition scheme's pixel error with a
-    /// `max_factor` above [`CHECK_MAX_FACTOR`];
+    /// Errors: whatever `tessera::scheme::validate` refuses for [`Engine::GpuFromCamera`]
+    /// ([`tessera::Error::EngineNotSupported`] for another scheme or criterion, or the
+    /// transition scheme's pixel error with a `max_factor` above [`CHECK_MAX_FACTOR`];
+    /// [`tessera::Error::InvalidParameter`] and [`tessera::Error::FactorOutOfRange`] for the
+    /// ranges, as [`Scheme::plan`] refuses them); [`GpuError::Unsupported`] for a `prepared`
+    /// without bounds or transition factors past this adapter's loop budget;
     /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
     /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
     /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
@@ -260,8 +258,8 @@ impl GpuTessellator {
         criterion: ScreenCriterion,
     ) -> Result<()> {
         let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
-        let screen = check_screen_request(scheme, criterion, max_factor)?;
-        self.check_screen_support(set, prepared, scheme, &screen, max_factor)?;
+        let screen = screen_of(set, camera, scheme, criterion, max_factor)?;
+        self.check_screen_support(set, prepared, scheme, max_factor)?;
         let hardware = match scheme {
             Scheme::Hardware(p) => Some(p),
             _ => None,
@@ -288,27 +286,17 @@ impl GpuTessellator {
         Ok(())
     }
 
-    /// What [`GpuTessellator::prepare_screen`] refuses beyond the request itself: on this
-    /// adapter and this tessellator, with `prepared` (the checks after
-    /// [`check_screen_request`]'s, in `prepare_screen`'s order of errors). Cost: O(1).
+    /// What [`GpuTessellator::prepare_screen`] refuses beyond the request itself ([`screen_of`]):
+    /// on this adapter and this tessellator, with `prepared`. Cost: O(1).
     fn check_screen_support(
         &self,
         set: &SurfaceSet,
         prepared: &Prepared,
         scheme: Scheme,
-        screen: &Screen,
         max_factor: u32,
     ) -> Result<()> {
         if scheme == Scheme::Transition {
             self.check_loop_budget(max_factor)?;
-        }
-        if screen.checked() && max_factor > CHECK_MAX_FACTOR {
-            return Err(GpuError::Unsupported {
-                what: format!(
-                    "the a-posteriori check on the GPU with a factor cap of {max_factor} (it takes caps up \
-                     to {CHECK_MAX_FACTOR}; plan this frame on the CPU)"
-                ),
-            });
         }
         let patches = set.patches.len();
         if patches as u32 != self.set.patches || set.topology.edges.len() as u32 != self.set.edges {
@@ -375,73 +363,40 @@ impl GpuTessellator {
 }
 
 /// The screen criterion `criterion` asks of `scheme` with the factor cap `max_factor`, as
-/// `view.wgsl` reads it, or the error [`GpuTessellator::prepare_screen`] returns for the
-/// request: [`tessera::Error::InvalidParameter`] for a `max_factor` outside `1..=MAX_FACTOR`,
-/// a pixel error that is not a positive number or a factor range that is not
-/// `1 ≤ FMIN ≤ FMAX` (in integers for the integer schemes),
-/// [`tessera::Error::FactorOutOfRange`] for a fixed factor outside `1..=cap` (the checks of
-/// [`Scheme::plan`]), [`GpuError::Unsupported`] for a scheme and criterion not planned on the
-/// GPU. Cost: O(1).
-fn check_screen_request(scheme: Scheme, criterion: Criterion, max_factor: u32) -> Result<Screen> {
-    let unsupported = || {
-        Err(GpuError::Unsupported {
-            what: format!("{} with the {} scheme planned on the GPU", criterion.name(), scheme.name()),
-        })
-    };
-    let invalid = |name: &'static str, reason: String| {
-        Err(GpuError::from(tessera::Error::InvalidParameter { name, reason }))
-    };
-    if max_factor == 0 || max_factor > tessera::criterion::MAX_FACTOR {
-        return invalid("max factor", format!("{max_factor}: use 1 to {}", tessera::criterion::MAX_FACTOR));
-    }
-    // The scheme's own cap and `max_factor`, as `Scheme::plan_into` caps (the hardware's
-    // range for its partitionings).
-    let cap = scheme.factor_cap().min(max_factor as f64);
-    let hardware = match scheme {
-        Scheme::Hardware(p) => Some(p),
-        _ => None,
-    };
-    let (kind, pixels, lo, hi) = match (scheme, criterion) {
-        (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(px)) => {
-            if !(px.is_finite() && px > 0.0) {
-                return invalid("pixel error", format!("{px}: must be a positive number"));
-            }
-            (CRITERION_PIXEL_ERROR, px, 1.0, 1.0)
-        }
-        (
-            Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
-            Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin, fmax },
-        ) => {
-            // Real factors for the hardware schemes, integers for the others.
-            let integer = hardware.is_none();
-            let valid = |f: f64| f.is_finite() && f >= 1.0 && (!integer || f.fract() == 0.0);
-            if !(valid(fmin) && valid(fmax) && fmin <= fmax) {
-                let what = if integer { "integers" } else { "numbers" };
-                return invalid("factor range", format!("{fmin}:{fmax}: use {what} 1 ≤ FMIN ≤ FMAX"));
-            }
-            // As `Scheme::plan_into` and `view::edge_factors_into` bound the range.
+/// `view.wgsl` reads it: the request is the library's to accept (`tessera::scheme::validate`
+/// for [`Engine::GpuFromCamera`], so the GPU refuses exactly what the CPU's planner and the
+/// command line refuse, with the same typed [`tessera::Error`]), then written in the
+/// shader's codes, the factor range bounded as `Scheme::plan_into` and
+/// `view::edge_factors_into` bound it. Cost: O(1).
+fn screen_of(
+    set: &SurfaceSet,
+    camera: &Camera,
+    scheme: Scheme,
+    criterion: Criterion,
+    max_factor: u32,
+) -> Result<Screen> {
+    let options = PlanOptions { camera: Some(*camera), cull: true, max_factor, ..PlanOptions::default() };
+    let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
+    let cap = accepted.cap;
+    let (kind, pixels, lo, hi) = match criterion {
+        Criterion::PixelError(px) => (CRITERION_PIXEL_ERROR, px, 1.0, 1.0),
+        Criterion::View { fmin, fmax, .. } => {
             let fmax = fmax.min(cap);
             let lo = fmin.min(fmax).max(1.0);
             (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
         }
-        (Scheme::Hardware(p), Criterion::Factor(f)) => {
-            if !(f.is_finite() && f >= 1.0 && f <= cap) {
-                return Err(tessera::Error::FactorOutOfRange {
-                    scheme: scheme.name(),
-                    factor: f,
-                    expected: format!("a number from 1 to {cap} (the {} range and the max factor)", p.name()),
-                }
-                .into());
-            }
-            (CRITERION_FIXED, 1.0, f, f)
-        }
-        _ => return unsupported(),
+        Criterion::Factor(f) => (CRITERION_FIXED, 1.0, f, f),
+        Criterion::Tolerance(_) | Criterion::Esc { .. } => unreachable!("validate refuses them on the GPU"),
     };
-    let interior = match scheme {
-        Scheme::Uniform => INTERIOR_GLOBAL,
-        Scheme::Hardware(_) => INTERIOR_MAX_EDGE,
-        _ => INTERIOR_CORE,
+    let interior = match accepted.interior_rule {
+        InteriorRule::Global => INTERIOR_GLOBAL,
+        InteriorRule::Core => INTERIOR_CORE,
+        InteriorRule::MaxEdge => INTERIOR_MAX_EDGE,
+        InteriorRule::Level => unreachable!("validate refuses the level schemes on the GPU"),
     };
-    let edge_rule = if hardware.is_some() { EDGE_RULE_HARDWARE } else { EDGE_RULE_INTEGER };
+    let edge_rule = match accepted.edge_rule {
+        Some(EdgeRule::Fractional(Spacing::Hardware(_))) => EDGE_RULE_HARDWARE,
+        _ => EDGE_RULE_INTEGER,
+    };
     Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule })
 }
