@@ -74,6 +74,7 @@ pub mod criterion;
 pub mod domain;
 pub mod engine;
 pub mod error;
+#[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod io;
