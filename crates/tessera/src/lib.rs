@@ -85,6 +85,9 @@ pub mod scene;
 pub mod scheme;
 pub mod surface;
 pub mod tessellator;
+#[cfg(any(test, feature = "fuzzing"))]
+#[doc(hidden)]
+pub mod test_support;
 pub mod topology;
 pub mod verify;
 

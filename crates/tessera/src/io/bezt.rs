@@ -151,7 +151,7 @@ impl SurfaceSet {
 mod tests {
     use super::*;
     use crate::error::Error;
-    use crate::io::patches::test_support::assert_parse_error;
+    use crate::test_support::assert_parse_error;
 
     fn parse(text: &str) -> Result<BezierTriangleFile> {
         parse_bezt(text, Path::new("<test>"))
