@@ -50,6 +50,9 @@ impl Lcg {
     }
 
     /// The next 31 pseudo-random bits (the state's top 31).
+    // Not an `Iterator`: the stream never ends, and the tests (tessera-gpu's too) call it by
+    // this name.
+    #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> u32 {
         (self.step() >> 33) as u32
     }

@@ -105,7 +105,7 @@ pub fn decode_engine_case(data: &[u8]) -> EngineCase {
         _ => Weld::Exact,
     };
     let orientation = if d.one_in(2) { Orientation::Outward } else { Orientation::AsGiven };
-    let build = BuildOptions { weld, orientation, flip: d.one_in(4), ..Default::default() };
+    let build = BuildOptions { weld, orientation, flip: d.one_in(4) };
     let camera = (!d.one_in(3)).then(|| {
         let mut spec = format!(
             "eye={},{},{},target={},{},{},fov={},size={}x{}",

@@ -28,7 +28,6 @@
 //! which a fuzzed or lying file breaks. Outside glTF files (`.gltf` or `.glb`, any number of
 //! meshes and nodes) are read as PN-triangle input by [`read_gltf_triangles`], which does use
 //! the `gltf` crate, after the same checks.
-
 //!
 //! The code is in four files by responsibility: `read` (tessera's own GLB), `outside` (any
 //! glTF as PN-triangle input), `uri` (which buffer files an outside `.gltf` may name, and

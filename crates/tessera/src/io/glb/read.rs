@@ -14,7 +14,7 @@ use crate::mesh::Mesh;
 use super::*;
 
 /// Parses glTF binary `data`; `file` only labels errors. Reads the layout `write_glb`
-/// produces, and the one it wrote before (see the module documentation); whatever the file
+/// produces, and the one it wrote before (see [`io::glb`](super)); whatever the file
 /// lacks is filled in as [`read_mesh`](crate::io::read_mesh) says.
 ///
 /// Preconditions: none; any bytes give a mesh or an error. Errors carry line 0 and, for the

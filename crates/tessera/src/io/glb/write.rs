@@ -17,7 +17,7 @@ use super::*;
 /// triangle primitive (`POSITION` with min/max, `NORMAL`, the vertex's patch parameters
 /// `_PATCH_UV`, the float vertex patch id `_PATCH`, `u32` indices), one node and one scene.
 /// Triangle patches and corner params go to byte ranges of the buffer named in the
-/// primitive's extras (see the module documentation). A mesh
+/// primitive's extras (see [`io::glb`](super)). A mesh
 /// without triangles is written as a file holding only the asset, since glTF forbids empty
 /// accessors; any vertices are dropped.
 ///
@@ -131,7 +131,7 @@ pub(in crate::io) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         let a_indices = accessor(v_indices, 3 * t, C::U32, T::Scalar, None);
 
         // Byte ranges of the buffer, not buffer views: a view no accessor uses is an unused
-        // object to the glTF validator (see the module documentation).
+        // object to the glTF validator (see `io::glb`'s documentation).
         let range = |s: &Span| serde_json::json!({ "byteOffset": s.offset, "byteLength": s.len });
         let mut extras = serde_json::Map::new();
         extras.insert("trianglePatch".into(), range(&triangle_patch));
@@ -149,7 +149,7 @@ pub(in crate::io) fn plan_glb(mesh: &Mesh) -> Result<GlbPlan> {
         let attributes = [
             (Semantic::Positions, a_positions),
             (Semantic::Normals, a_normals),
-            // "_PATCH_UV": patch parameters, not texture coordinates (module documentation).
+            // "_PATCH_UV": patch parameters, not texture coordinates (`io::glb`'s documentation).
             (Semantic::Extras("PATCH_UV".to_string()), a_uvs),
             // Serialised as "_PATCH": glTF requires application attributes to start with '_'.
             (Semantic::Extras("PATCH".to_string()), a_patches),
