@@ -12,7 +12,8 @@
 //! accessors outside `primitive.indices`, a float accessor would round patch ids above 2^24,
 //! and glTF has no per-triangle attributes). They are byte ranges of buffer 0 named in the
 //! primitive's `extras`: `{"tessera": {"trianglePatch": {"byteOffset": o, "byteLength": l},
-//! "cornerParams": {...}}}` (the second key only when [`Mesh::corner_params`] is set). The
+//! "cornerParams": {...}}}` (the second key only when
+//! [`Mesh::corner_params`](crate::mesh::Mesh::corner_params) is set). The
 //! first holds one little-endian `u32` per triangle, the second two little-endian `f32` (u, v)
 //! per triangle corner, in index order. They are not buffer views because a buffer view no
 //! accessor uses is an unused object to the validator.
