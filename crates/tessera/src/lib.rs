@@ -76,6 +76,7 @@ pub mod criterion;
 pub mod domain;
 pub mod engine;
 pub mod error;
+#[cfg(feature = "fuzzing")]
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod io;
@@ -86,6 +87,9 @@ pub mod scene;
 pub mod scheme;
 pub mod surface;
 pub mod tessellator;
+#[cfg(any(test, feature = "fuzzing"))]
+#[doc(hidden)]
+pub mod test_support;
 pub mod topology;
 pub mod verify;
 

@@ -363,7 +363,7 @@ mod tests {
     use super::*;
 
     fn teapot() -> SurfaceSet {
-        let path = crate::io::patches::test_support::data("patches/teapot.patches");
+        let path = crate::test_support::data("patches/teapot.patches");
         SurfaceSet::from_patch_file(
             &crate::io::patches::read_patches(&path).expect("test model"),
             Default::default(),

@@ -94,14 +94,8 @@ pub fn patch_models() -> Vec<String> {
     models
 }
 
-/// Tiny LCG: the tests' pseudo-random inputs, seeded.
-pub struct Lcg(pub u64);
-impl Lcg {
-    pub fn next(&mut self) -> u32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 33) as u32
-    }
-}
+/// The tests' pseudo-random inputs, seeded: the library tests' generator.
+pub use tessera::test_support::Lcg;
 
 /// The CPU engine's layout and mesh for `plan`.
 pub fn cpu(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> (Layout, Mesh) {

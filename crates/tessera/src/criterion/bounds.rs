@@ -332,7 +332,7 @@ mod tests {
     /// orientations of the cell's diagonal), to rounding, on bounds and cells of every shape.
     #[test]
     fn cell_error_is_the_triangle_error_of_a_half_cell() {
-        let mut rng = crate::io::patches::test_support::Lcg(11);
+        let mut rng = crate::test_support::Lcg(11);
         let mut next = || rng.unit();
         for _ in 0..5000 {
             let scale = 10f64.powf(6.0 * next() - 3.0);

@@ -276,7 +276,8 @@ pub fn visibility_into(set: &SurfaceSet, views: &[PatchView], camera: &View, cul
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::patches::{read_patches, test_support::data};
+    use crate::io::patches::read_patches;
+    use crate::test_support::data;
 
     /// The control-point test, transforming every point and taking the angles with inverse
     /// trigonometry, as culling was first written: the oracle of the prepared form.

@@ -738,7 +738,7 @@ mod tests {
             best
         };
         let mut anisotropic = 0;
-        let mut rng = crate::io::patches::test_support::Lcg(7);
+        let mut rng = crate::test_support::Lcg(7);
         let mut next = || rng.unit();
         for _ in 0..2000 {
             let scale = 10f64.powf(4.0 * next() - 2.0);

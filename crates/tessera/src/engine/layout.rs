@@ -356,7 +356,7 @@ mod tests {
     /// give, on a set of each domain, for the uniform and the transition pattern.
     #[test]
     fn one_input_layouts_equal_the_general_build() {
-        let path = crate::io::patches::test_support::data("meshes/cow.obj");
+        let path = crate::test_support::data("meshes/cow.obj");
         let mesh = crate::io::obj::read_obj(&path).unwrap();
         let cow = SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap();
         let options = TessellateOptions::default();

@@ -802,12 +802,12 @@ mod tests {
     use crate::pattern::uniform::Uniform;
 
     fn teapot() -> SurfaceSet {
-        let path = crate::io::patches::test_support::data("patches/teapot.patches");
+        let path = crate::test_support::data("patches/teapot.patches");
         SurfaceSet::from_patch_file(&crate::io::patches::read_patches(&path).unwrap(), Default::default())
     }
 
     fn cow() -> SurfaceSet {
-        let path = crate::io::patches::test_support::data("meshes/cow.obj");
+        let path = crate::test_support::data("meshes/cow.obj");
         let mesh = crate::io::obj::read_obj(&path).unwrap();
         SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap()
     }

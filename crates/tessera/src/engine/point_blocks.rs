@@ -751,11 +751,8 @@ mod tests {
     fn rational_kernels_hold_the_normal_bound_on_random_nets() {
         use crate::engine::uniform_quads::MIN_WEIGHT_RATIO;
         use crate::surface::RationalBicubic;
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut random = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::test_support::Lcg(0x2545_f491_4f6c_dd1d);
+        let mut random = move || rng.unit53();
         let (mut kept, mut total) = (0, 0);
         for span in [1.0, 2.0, 4.0, 8.0, 1.0 / MIN_WEIGHT_RATIO] {
             for _ in 0..1000 {
@@ -828,7 +825,7 @@ mod tests {
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
-        let data = crate::io::patches::test_support::data;
+        let data = crate::test_support::data;
         let patches = |name: &str, rational: bool| {
             let file = crate::io::patches::read_patches(&data(name)).unwrap();
             let file = if rational { crate::scene::position_weights(&file) } else { file };
@@ -1001,7 +998,7 @@ mod tests {
         use crate::engine::{Layout, TessellateOptions};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
-        let data = crate::io::patches::test_support::data;
+        let data = crate::test_support::data;
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
         let mut models = Vec::new();
         // Every patch model and every triangle mesh (bench/ also holds the torus as a quad

@@ -356,8 +356,7 @@ mod tests {
     use glam::DVec3;
 
     fn load(name: &str) -> SurfaceSet {
-        let file = crate::io::patches::read_patches(&crate::io::patches::test_support::data(name))
-            .expect("test model");
+        let file = crate::io::patches::read_patches(&crate::test_support::data(name)).expect("test model");
         SurfaceSet::from_patch_file(&file, Default::default())
     }
 
@@ -365,8 +364,7 @@ mod tests {
     /// within [0.5, 2] ([`crate::scene::position_weights`]), so that shared curves stay
     /// shared.
     fn load_rational(name: &str) -> SurfaceSet {
-        let file = crate::io::patches::read_patches(&crate::io::patches::test_support::data(name))
-            .expect("test model");
+        let file = crate::io::patches::read_patches(&crate::test_support::data(name)).expect("test model");
         let set = SurfaceSet::from_patch_file(&crate::scene::position_weights(&file), Default::default());
         assert!(set.patches.iter().all(|p| matches!(p, Patch::Bicubic(b) if !b.is_polynomial())));
         set

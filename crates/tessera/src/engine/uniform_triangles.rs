@@ -219,7 +219,7 @@ mod tests {
     use crate::pattern::uniform::Uniform;
 
     fn cow() -> SurfaceSet {
-        let path = crate::io::patches::test_support::data("meshes/cow.obj");
+        let path = crate::test_support::data("meshes/cow.obj");
         let mesh = crate::io::obj::read_obj(&path).unwrap();
         SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap()
     }
@@ -239,10 +239,8 @@ mod tests {
         let mut culled = plan.clone();
         culled.visible[2] = 0;
         assert!(!writer.retarget(&set, &culled, &Uniform));
-        let teapot = crate::io::patches::read_patches(&crate::io::patches::test_support::data(
-            "patches/teapot.patches",
-        ))
-        .unwrap();
+        let teapot =
+            crate::io::patches::read_patches(&crate::test_support::data("patches/teapot.patches")).unwrap();
         let quads = SurfaceSet::from_patch_file(&teapot, Default::default());
         let quad_plan = Plan::uniform(&quads, 4).unwrap();
         assert!(!UniformTriangles::for_set(&quads).retarget(&quads, &quad_plan, &Uniform));

@@ -133,7 +133,7 @@ impl SurfaceSet {
     /// ([`crate::io::bezt`]). Triangles that use the same control points (by index, or by
     /// position up to `options.weld`) share boundary curves in the topology, so their
     /// tessellation is crack-free; all-collapsed triangles are dropped and counted in
-    /// [`Repairs`].
+    /// [`Repairs`](crate::surface::Repairs).
     ///
     /// Preconditions: indices in range and finite points, as the parser guarantees.
     /// Cost: O(triangles) hashing, as [`SurfaceSet::from_patches`].
@@ -151,7 +151,7 @@ impl SurfaceSet {
 mod tests {
     use super::*;
     use crate::error::Error;
-    use crate::io::patches::test_support::assert_parse_error;
+    use crate::test_support::assert_parse_error;
 
     fn parse(text: &str) -> Result<BezierTriangleFile> {
         parse_bezt(text, Path::new("<test>"))

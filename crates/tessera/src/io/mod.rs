@@ -617,7 +617,7 @@ mod tests {
         use crate::criterion::Plan;
         use crate::engine::{tessellate, TessellateOptions};
         use crate::pattern::uniform::Uniform;
-        let file = patches::read_patches(&patches::test_support::data("bench/torus_64x32.patches")).unwrap();
+        let file = patches::read_patches(&crate::test_support::data("bench/torus_64x32.patches")).unwrap();
         let set = SurfaceSet::from_patch_file(&file, Default::default());
         let plan = Plan::uniform(&set, 7).unwrap();
         let options = TessellateOptions { corner_params: true, ..Default::default() };

@@ -433,7 +433,7 @@ fn is_tie(x: f32, printed: &[u8]) -> bool {
 mod tests {
     use super::*;
     use crate::io::binary::test_meshes::{bytes, grid};
-    use crate::io::patches::test_support::{assert_parse_error, data, Lcg};
+    use crate::test_support::{assert_parse_error, data, Lcg};
 
     #[test]
     fn obj_lines_match_the_mesh() {

@@ -433,67 +433,9 @@ impl SurfaceSet {
 }
 
 #[cfg(test)]
-pub(crate) mod test_support {
-    use std::fmt::Debug;
-    use std::path::{Path, PathBuf};
-
-    use crate::error::{Error, Location, Result};
-
-    /// Path of a test model, relative to the shared data folder: `$TESSERA_DATA`, else
-    /// `../shared/data` beside the checkout (as the integration tests find it).
-    pub fn data(rel: &str) -> PathBuf {
-        let dir = std::env::var_os("TESSERA_DATA")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-        dir.join(rel)
-    }
-
-    /// Asserts that `result` is a parse error at `file:line` whose message names the file
-    /// and contains `needle`.
-    #[track_caller]
-    pub fn assert_parse_error<T: Debug>(result: Result<T>, file: &str, line: usize, needle: &str) {
-        let err = match result {
-            Ok(v) => panic!("expected an error containing {needle:?}, got {v:?}"),
-            Err(e) => e,
-        };
-        let msg = err.to_string();
-        match &err {
-            Error::Parse { at: Location { file: f, line: l }, .. } => {
-                assert_eq!(f, Path::new(file), "{msg}");
-                assert_eq!(*l, line, "{msg}");
-            }
-            other => panic!("expected a parse error, got {other:?}"),
-        }
-        assert!(msg.contains(file), "{msg}");
-        assert!(msg.contains(needle), "{msg:?} lacks {needle:?}");
-    }
-
-    /// Tiny LCG so the property loops need no extra dependency.
-    pub struct Lcg(pub u64);
-
-    impl Lcg {
-        /// The next 31 pseudo-random bits.
-        pub fn next(&mut self) -> u32 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (self.0 >> 33) as u32
-        }
-
-        /// A pseudo-random number in `0..n` (`n > 0`).
-        pub fn below(&mut self, n: usize) -> usize {
-            self.next() as usize % n
-        }
-
-        /// A pseudo-random number in `[0, 1)`.
-        pub fn unit(&mut self) -> f64 {
-            self.next() as f64 / (1u64 << 31) as f64
-        }
-    }
-}
-
-#[cfg(test)]
 mod tests {
-    use super::test_support::{assert_parse_error, data, Lcg};
     use super::*;
+    use crate::test_support::{assert_parse_error, data, Lcg};
 
     fn parse(text: &str) -> Result<PatchFile> {
         parse_patches(text, Path::new("test.patches"))

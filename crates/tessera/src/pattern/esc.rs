@@ -801,11 +801,8 @@ mod tests {
     /// Levels 5 and 6 (n = 6, 7): a deterministic pseudo-random sample of patterns.
     #[test]
     fn sampled_insertion_patterns_tile_at_high_levels() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 33) as u32
-        };
+        let mut rng = crate::test_support::Lcg(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.next();
         for n in 6..=7u32 {
             for _ in 0..3000 {
                 let mut c = CoarseTriangle::full(n);

@@ -931,7 +931,7 @@ mod tests {
     /// holes, read as meshes to check.
     #[test]
     fn implementations_agree_on_the_shared_meshes() {
-        use crate::io::patches::test_support::data;
+        use crate::test_support::data;
         let cases = [
             ("meshes/bunny.obj", false),
             ("meshes/spot.obj", true),
@@ -961,8 +961,9 @@ mod tests {
     fn implementations_agree_on_broken_tessellations() {
         use crate::criterion::Plan;
         use crate::engine::{tessellate, TessellateOptions};
-        use crate::io::patches::{read_patches, test_support::data};
+        use crate::io::patches::read_patches;
         use crate::pattern::uniform::Uniform;
+        use crate::test_support::data;
         let tessellation = |rel: &str, factor: u32| {
             let set = SurfaceSet::from_patch_file(&read_patches(&data(rel)).unwrap(), Default::default());
             let plan = Plan::uniform(&set, factor).unwrap();
