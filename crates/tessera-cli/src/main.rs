@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tessera::engine::render_queues::RenderQueues;
-use tessera::engine::TessellateOptions;
+use tessera::engine::EngineOptions;
 use tessera::io::glb::UriScope;
 use tessera::io::LoadOptions;
 use tessera::mesh::Mesh;
@@ -195,10 +195,10 @@ fn memory_limit() -> u64 {
 
 /// The engine limits for a run: the memory limit and the triangle limit (`--max-triangles`,
 /// else what the memory limit holds at a typical vertex-to-triangle ratio of 1:2).
-fn limits(max_triangles: Option<u64>, corner_params: bool) -> TessellateOptions {
+fn limits(max_triangles: Option<u64>, corner_params: bool) -> EngineOptions {
     let memory = memory_limit();
     let per_two_triangles = tessera::mesh::output_bytes(1, 2, corner_params);
-    TessellateOptions {
+    EngineOptions {
         corner_params,
         memory_limit: Some(memory),
         max_triangles: Some(max_triangles.unwrap_or(memory / per_two_triangles * 2)),
@@ -208,7 +208,7 @@ fn limits(max_triangles: Option<u64>, corner_params: bool) -> TessellateOptions 
 
 /// The CLI's line for an output the engine refused: the estimate, the memory, and which limit
 /// (and flag) stopped it.
-fn explain_limit(e: tessera::Error, options: &TessellateOptions) -> Box<dyn std::error::Error> {
+fn explain_limit(e: tessera::Error, options: &EngineOptions) -> Box<dyn std::error::Error> {
     let tessera::Error::OutputTooLarge { vertices, triangles, bytes } = e else { return e.into() };
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     let max_triangles = options.max_triangles.unwrap_or(u64::MAX);
@@ -302,7 +302,7 @@ const ANNOUNCED_TRIANGLES: u64 = 20_000_000;
 /// of disk never starts without a word.
 fn announce_large_output(
     layout: &tessera::engine::layout::Layout,
-    opts: &TessellateOptions,
+    opts: &EngineOptions,
     out: Option<&Path>,
 ) {
     let (vertices, triangles) = (layout.vertex_count() as u64, layout.triangle_count() as u64);

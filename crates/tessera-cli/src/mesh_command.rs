@@ -8,9 +8,9 @@ use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use tessera::criterion::tolerance::PlanReport;
+use tessera::criterion::tolerance::BoundReport;
 use tessera::engine::render_queues::{self, RenderQueues};
-use tessera::engine::TessellateOptions;
+use tessera::engine::EngineOptions;
 use tessera::mesh::Mesh;
 use tessera::scheme::{validate, Criterion, Engine, Scheme};
 use tessera::surface::SurfaceSet;
@@ -70,7 +70,7 @@ struct Drawn {
     /// Patches the plan left out (`--cull`).
     culled: usize,
     /// The CPU plan's guarantee report, for the error-bounded criteria planned on the CPU.
-    report: Option<PlanReport>,
+    report: Option<BoundReport>,
     /// The CPU's stage times per frame (planning only, when the GPU drew the frame; none
     /// when the GPU also planned it).
     frames: Vec<FrameTimings>,
@@ -94,7 +94,7 @@ pub fn run(a: MeshArgs) -> CliResult {
     pb.set_message("choosing factors");
     let wants_params = a.measure_error
         || a.output.as_ref().is_some_and(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")));
-    let opts = TessellateOptions { strips: a.strips, ..crate::limits(a.max_triangles, wants_params) };
+    let opts = EngineOptions { strips: a.strips, ..crate::limits(a.max_triangles, wants_params) };
     let chosen = plan::choose(&a.criterion, &set, opts.max_triangles.unwrap_or(u64::MAX))?;
     if chosen.options.cull || !matches!(chosen.criterion, Criterion::Factor(_) | Criterion::Tolerance(_)) {
         plan::note_up_axis(a.criterion.camera.as_deref(), &a.input);
@@ -211,7 +211,7 @@ fn draw_on_cpu(
     a: &MeshArgs,
     set: &SurfaceSet,
     chosen: &Chosen,
-    opts: TessellateOptions,
+    opts: EngineOptions,
     explain: Explain<'_>,
 ) -> Result<Drawn, Box<dyn std::error::Error>> {
     let start = Instant::now();
@@ -248,7 +248,7 @@ fn draw_on_gpu(
     a: &MeshArgs,
     set: &SurfaceSet,
     chosen: &Chosen,
-    opts: TessellateOptions,
+    opts: EngineOptions,
     explain: Explain<'_>,
 ) -> Result<Drawn, Box<dyn std::error::Error>> {
     let (scheme, criterion, options) = (chosen.scheme, chosen.criterion, chosen.options);
@@ -276,7 +276,7 @@ fn draw_on_gpu(
 }
 
 /// Says where `--max-factor` (or semi-uniform's highest level) stopped an error bound.
-fn warn_capped(a: &MeshArgs, set: &SurfaceSet, chosen: &Chosen, report: Option<&PlanReport>) {
+fn warn_capped(a: &MeshArgs, set: &SurfaceSet, chosen: &Chosen, report: Option<&BoundReport>) {
     let Some(r) = report.filter(|r| r.capped_patches > 0) else { return };
     let Ok(accepted) = validate(chosen.scheme, &chosen.criterion, &chosen.options, set, Engine::Cpu) else { return };
     let flag = if matches!(chosen.scheme, Scheme::SemiUniform { .. }) { "--max-level" } else { "--max-factor" };

@@ -24,7 +24,7 @@ use std::time::Instant;
 use tessera::camera::Camera;
 use tessera::criterion::PlanScratch;
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Planned, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, SchemePlan, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::tessellator::{PassTimer, PASSES};
@@ -106,7 +106,7 @@ struct State {
     timer: Option<PassTimer>,
     prepared: Prepared,
     scratch: PlanScratch,
-    planned: Planned,
+    planned: SchemePlan,
     /// Every frame's plan, and the CPU engine's frames: made on the first frame,
     /// reconfigured when the scheme, the criterion or culling change.
     tess: Option<Tessellator<'static>>,
@@ -229,7 +229,7 @@ impl App {
             timer,
             prepared: Prepared::for_criterion(self.set, &criterion),
             scratch: PlanScratch::default(),
-            planned: Planned::default(),
+            planned: SchemePlan::default(),
             tess: None,
             tess_key: (usize::MAX, 0, false),
             instanced: None,

@@ -7,7 +7,7 @@ mod common;
 
 use common::*;
 use tessera::criterion::Plan;
-use tessera::engine::{Layout, TessellateOptions};
+use tessera::engine::{Layout, EngineOptions};
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::SurfaceSet;
@@ -579,7 +579,7 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
         .plan;
     assert_eq!(cpu.segments.iter().max(), Some(&cap), "{model}: the camera does not reach the cap");
     let mut layout = Layout::default();
-    layout.build(&set, &cpu, &Uniform, &TessellateOptions::default()).unwrap();
+    layout.build(&set, &cpu, &Uniform, &EngineOptions::default()).unwrap();
     let total = *layout.triangle_offsets.last().unwrap();
     let tiny = Capacity { vertices: 16, triangles: 16 };
     for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {

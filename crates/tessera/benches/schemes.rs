@@ -9,10 +9,10 @@ use tessera::camera::Camera;
 use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::Pattern;
-use tessera::scheme::{self, PlanOptions, Planned, Scheme};
+use tessera::scheme::{self, PlanOptions, SchemePlan, Scheme};
 use tessera::surface::SurfaceSet;
 
 fn data_dir() -> PathBuf {
@@ -40,12 +40,12 @@ fn bench_engine(
     plan: &Plan,
     pattern: &dyn Pattern,
 ) {
-    let triangles = tessellate(set, plan, pattern, TessellateOptions::default()).unwrap().triangle_count();
+    let triangles = tessellate(set, plan, pattern, EngineOptions::default()).unwrap().triangle_count();
     let mut g = c.benchmark_group(group);
     g.sample_size(20);
     g.throughput(Throughput::Elements(triangles as u64));
     g.bench_function(format!("{name}/engine"), |b| {
-        b.iter(|| tessellate(set, plan, pattern, TessellateOptions::default()).unwrap())
+        b.iter(|| tessellate(set, plan, pattern, EngineOptions::default()).unwrap())
     });
     g.finish();
 }
@@ -55,7 +55,7 @@ fn schemes(c: &mut Criterion) {
     let (lo, hi) = cow.bounds();
     let camera = Camera::framing(lo, hi, 1280, 720);
     let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
-    let plan = |set: &SurfaceSet, scheme: Scheme, criterion: scheme::Criterion| -> Planned {
+    let plan = |set: &SurfaceSet, scheme: Scheme, criterion: scheme::Criterion| -> SchemePlan {
         scheme.plan(set, &criterion, &options).unwrap()
     };
     let silhouette = |criterion, fmin, fmax| scheme::Criterion::View { criterion, fmin, fmax };

@@ -8,7 +8,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::path::PathBuf;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, tessellate_into, TessellateOptions};
+use tessera::engine::{tessellate, tessellate_into, EngineOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::SurfaceSet;
@@ -32,11 +32,11 @@ fn uniform_torus(c: &mut Criterion) {
         let mut mesh = Mesh::default();
         group.bench_function(format!("torus_64x32/factor_{n}/reuse"), |b| {
             b.iter(|| {
-                tessellate_into(&set, &plan, &Uniform, TessellateOptions::default(), &mut mesh).unwrap()
+                tessellate_into(&set, &plan, &Uniform, EngineOptions::default(), &mut mesh).unwrap()
             })
         });
         group.bench_function(format!("torus_64x32/factor_{n}/fresh"), |b| {
-            b.iter(|| tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap())
+            b.iter(|| tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap())
         });
     }
     group.finish();

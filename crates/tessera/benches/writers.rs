@@ -14,7 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::SurfaceSet;
@@ -31,7 +31,7 @@ fn torus(factor: u32) -> Mesh {
     let file = tessera::io::patches::read_patches(&path).expect("benchmark model");
     let set = SurfaceSet::from_patch_file(&file, Default::default());
     let plan = Plan::uniform(&set, factor).unwrap();
-    tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap()
+    tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap()
 }
 
 type Writer = fn(&Mesh, &mut Vec<u8>) -> tessera::Result<()>;

@@ -43,7 +43,7 @@
 //! | `Esc` | [`pattern::esc`] (strips) | its own ([`criterion::esc`]) | Concheiro et al. (002) |
 //!
 //! Patterns with a strip form fill [`mesh::Mesh::strips`] when
-//! [`engine::TessellateOptions::strips`] is set; [`mesh::strips::decode`] turns strips back
+//! [`engine::EngineOptions::strips`] is set; [`mesh::strips::decode`] turns strips back
 //! into the triangle list.
 //!
 //! ## Example

@@ -31,13 +31,13 @@
 //! application's interleaved vertex buffer with its own index type.
 
 use crate::camera::Camera;
-use crate::criterion::tolerance::PlanReport;
+use crate::criterion::tolerance::BoundReport;
 use crate::criterion::Plan;
 use crate::engine::fast_evaluator::FastEvaluator;
-use crate::engine::{self, Layout, TessellateOptions};
+use crate::engine::{self, Layout, EngineOptions};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, Planned, Prepared, Scheme};
+use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, SchemePlan, Prepared, Scheme};
 use std::time::{Duration, Instant};
 
 /// Wall time of each stage of a frame ([`Tessellator::timings`]).
@@ -129,7 +129,7 @@ pub struct TessellatorOptions {
     /// one (a frame's own camera replaces it).
     pub plan: PlanOptions,
     /// The engine's options (size limits, corner parameters, strips).
-    pub engine: TessellateOptions,
+    pub engine: EngineOptions,
 }
 
 /// A surface set prepared for one scheme and criterion, re-tessellated per frame into reused
@@ -142,7 +142,7 @@ pub struct Tessellator<'a> {
     prepared: Prepared,
     layout: Layout,
     /// The last frame's plan, valid when `planned_ok`; its buffers are reused.
-    planned: Planned,
+    planned: SchemePlan,
     planned_ok: bool,
     /// A frame was planned and laid out and not written yet.
     laid_out: bool,
@@ -178,7 +178,7 @@ impl<'a> Tessellator<'a> {
             options,
             prepared,
             layout: Layout::default(),
-            planned: Planned::default(),
+            planned: SchemePlan::default(),
             planned_ok: false,
             laid_out: false,
             scratch: PlanScratch::default(),
@@ -343,7 +343,7 @@ impl<'a> Tessellator<'a> {
     }
 
     /// The last frame's guarantee report, for error-bounded criteria.
-    pub fn report(&self) -> Option<&PlanReport> {
+    pub fn report(&self) -> Option<&BoundReport> {
         self.planned.report.as_ref().filter(|_| self.planned_ok)
     }
 

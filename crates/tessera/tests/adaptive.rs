@@ -7,9 +7,9 @@ use glam::{DVec2, DVec3, Vec3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use tessera::camera::Camera;
-use tessera::criterion::tolerance::PlanReport;
+use tessera::criterion::tolerance::BoundReport;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
@@ -27,14 +27,14 @@ fn plan(
     criterion: Criterion,
     camera: Option<Camera>,
     cull: bool,
-) -> (Plan, SchemePattern, PlanReport) {
+) -> (Plan, SchemePattern, BoundReport) {
     let options = PlanOptions { camera, cull, max_factor: 4096, ..PlanOptions::default() };
     let planned = scheme.plan(set, &criterion, &options).unwrap();
     (planned.plan, planned.pattern, planned.report.expect("an error-bounded criterion reports"))
 }
 
 fn run(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Mesh {
-    tessellate(set, plan, pattern, TessellateOptions { corner_params: true, ..Default::default() }).unwrap()
+    tessellate(set, plan, pattern, EngineOptions { corner_params: true, ..Default::default() }).unwrap()
 }
 
 fn diagonal(set: &SurfaceSet) -> f64 {

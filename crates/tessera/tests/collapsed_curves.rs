@@ -8,9 +8,9 @@
 mod common;
 
 use glam::DVec3;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{Criterion, PlanOptions, Planned, Scheme};
+use tessera::scheme::{Criterion, PlanOptions, SchemePlan, Scheme};
 use tessera::surface::{BuildOptions, Orientation, Patch, RationalBicubic, SurfaceSet};
 use tessera::verify;
 
@@ -90,8 +90,8 @@ fn schemes() -> Vec<(Scheme, Criterion)> {
 fn keeps_topology(set: &SurfaceSet, name: &str) {
     for (scheme, criterion) in schemes() {
         let label = format!("{name}, {scheme:?}, {criterion:?}");
-        let Planned { plan, pattern, .. } = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
-        let mesh = tessellate(set, &plan, &pattern, TessellateOptions::default()).unwrap();
+        let SchemePlan { plan, pattern, .. } = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
+        let mesh = tessellate(set, &plan, &pattern, EngineOptions::default()).unwrap();
         common::expect_topology(set, &plan, &mesh, &label);
         let w = verify::watertight(&mesh);
         assert_eq!(w.degenerate_triangles(), 0, "{label}: {w:?}");

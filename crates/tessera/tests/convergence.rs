@@ -3,14 +3,14 @@
 mod common;
 
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::uniform::Uniform;
 use tessera::verify;
 
 fn max_error(set: &tessera::surface::SurfaceSet, n: u32) -> f64 {
     let plan = Plan::uniform(set, n).unwrap();
     let mesh =
-        tessellate(set, &plan, &Uniform, TessellateOptions { corner_params: true, ..Default::default() })
+        tessellate(set, &plan, &Uniform, EngineOptions { corner_params: true, ..Default::default() })
             .unwrap();
     verify::approximation_error(&mesh, set, 6).unwrap().max
 }

@@ -24,7 +24,7 @@ use std::collections::HashMap;
 use tessera::camera::Camera;
 use tessera::criterion::esc::{self, EscOptions, Threshold};
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::mesh::strips;
 use tessera::pattern::esc::Esc;
 use tessera::pattern::uniform::Uniform;
@@ -66,7 +66,7 @@ fn cameras(set: &SurfaceSet, count: usize) -> Vec<Camera> {
 /// Tessellates with the ESC plan and checks watertightness against the input's own topology
 /// and the strip form against the list. Returns the triangle count.
 fn check(set: &SurfaceSet, plan: &Plan, pattern: &Esc, open: (usize, usize), what: &str) -> usize {
-    let options = TessellateOptions { strips: true, corner_params: true, ..Default::default() };
+    let options = EngineOptions { strips: true, corner_params: true, ..Default::default() };
     let mesh = tessellate(set, plan, pattern, options).unwrap_or_else(|e| panic!("{what}: {e}"));
     // Every triangle is counter-clockwise in its patch's domain: the pattern placed each
     // boundary vertex where the plan's edge sampling put it (no folds).

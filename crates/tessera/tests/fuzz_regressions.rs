@@ -14,7 +14,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
-use tessera::engine::TessellateOptions;
+use tessera::engine::EngineOptions;
 use tessera::fuzzing::{self, Criterion, EngineCase, EngineOutcome, Scheme, Shape};
 use tessera::io::glb::write_glb;
 use tessera::io::ply::write_ply;
@@ -388,7 +388,7 @@ fn uniform_scheme_with_a_view_criterion_on_a_pillow() {
         max_level: 0,
         variant: false,
         esc_threshold: Threshold::Medium,
-        options: TessellateOptions { corner_params: true, ..Default::default() },
+        options: EngineOptions { corner_params: true, ..Default::default() },
     };
     fuzzing::run_engine_case(&case);
 }

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use tessera::criterion::Plan;
-use tessera::engine::{self, TessellateOptions};
+use tessera::engine::{self, EngineOptions};
 use tessera::io::bezt::{self, BezierTriangleFile};
 use tessera::io::{self, glb, patches};
 use tessera::mesh::Mesh;
@@ -28,14 +28,14 @@ fn scratch(name: &str) -> PathBuf {
 fn tessellated(rel: &str, factor: u32) -> (SurfaceSet, Mesh) {
     let set = io::load(&common::model(rel), BuildOptions::default()).unwrap();
     let plan = Plan::uniform(&set, factor).unwrap();
-    let opts = TessellateOptions { corner_params: true, ..Default::default() };
+    let opts = EngineOptions { corner_params: true, ..Default::default() };
     let mesh = engine::tessellate(&set, &plan, &Uniform, opts).unwrap();
     (set, mesh)
 }
 
 fn tessellate(set: &SurfaceSet, factor: u32) -> Mesh {
     let plan = Plan::uniform(set, factor).unwrap();
-    engine::tessellate(set, &plan, &Uniform, TessellateOptions::default()).unwrap()
+    engine::tessellate(set, &plan, &Uniform, EngineOptions::default()).unwrap()
 }
 
 /// The triangles as position triples, for formats that renumber vertices.

@@ -5,7 +5,7 @@ mod common;
 use glam::{DVec3, Vec3};
 use std::path::Path;
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
@@ -13,7 +13,7 @@ use tessera::topology::weld::Weld;
 use tessera::verify;
 
 fn mesh_of(set: &SurfaceSet, n: u32) -> Mesh {
-    tessellate(set, &Plan::uniform(set, n).unwrap(), &Uniform, TessellateOptions::default()).unwrap()
+    tessellate(set, &Plan::uniform(set, n).unwrap(), &Uniform, EngineOptions::default()).unwrap()
 }
 
 fn signed_volume(m: &Mesh) -> f64 {

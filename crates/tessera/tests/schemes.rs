@@ -12,12 +12,12 @@ use tessera::camera::Camera;
 use tessera::criterion::sd2;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::render_queues;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::mesh::strips;
 use tessera::mesh::Mesh;
 use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::semi_uniform::StaticPattern;
-use tessera::scheme::{Criterion, PlanOptions, Planned, Scheme};
+use tessera::scheme::{Criterion, PlanOptions, SchemePlan, Scheme};
 use tessera::surface::{Domain, SurfaceSet};
 use tessera::Error;
 
@@ -25,7 +25,7 @@ use tessera::Error;
 const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 5 };
 
 /// Plans through the library's front door, factors up to 64.
-fn planned(set: &SurfaceSet, scheme: Scheme, criterion: Criterion, camera: Camera, cull: bool) -> Planned {
+fn planned(set: &SurfaceSet, scheme: Scheme, criterion: Criterion, camera: Camera, cull: bool) -> SchemePlan {
     let options = PlanOptions { camera: Some(camera), cull, ..PlanOptions::default() };
     scheme.plan(set, &criterion, &options).unwrap()
 }
@@ -110,8 +110,8 @@ fn view_criterion(kind: u8) -> ViewCriterion {
     }
 }
 
-fn options(strips: bool) -> TessellateOptions {
-    TessellateOptions { strips, ..Default::default() }
+fn options(strips: bool) -> EngineOptions {
+    EngineOptions { strips, ..Default::default() }
 }
 
 #[test]
@@ -134,7 +134,7 @@ fn semi_uniform_is_watertight_and_its_render_queues_match_in(tier: Tier) {
         |set, name, camera, (kind, lo, cull)| {
             let top = top_factor(set) as u32;
             let fmin = 1 + (lo * (top - 1) as f64) as u32;
-            let Planned { plan, pattern, .. } =
+            let SchemePlan { plan, pattern, .. } =
                 planned(set, SEMI_UNIFORM, view(kind, fmin as f64, top as f64), camera, cull);
             let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
             common::expect_topology(set, &plan, &mesh, name);
@@ -180,13 +180,13 @@ fn instanced_draw_equals_the_compacted_mesh() {
         let (lo, hi) = set.bounds();
         let camera = Camera::framing(lo, hi, 1280, 720);
         for kind in 0..4 {
-            let Planned { plan, pattern, .. } =
+            let SchemePlan { plan, pattern, .. } =
                 planned(&set, SEMI_UNIFORM, view(kind, 1.0, 32.0), camera, kind % 2 == 0);
             let compact = tessellate(
                 &set,
                 &plan,
                 &pattern,
-                TessellateOptions { corner_params: true, ..Default::default() },
+                EngineOptions { corner_params: true, ..Default::default() },
             )
             .unwrap();
             let queues = render_queues::build(&set, &plan, 5).unwrap();
@@ -260,7 +260,7 @@ fn sd2_is_two_different_watertight_and_strips_decode_in(tier: Tier) {
         let (fmin, fmax) = (1.0 + a * (top - 1.0), 1.0 + b * (top - 1.0));
         let (fmin, fmax) = (fmin.min(fmax), fmin.max(fmax));
         let kind = if silhouette { 3 } else { 0 };
-        let Planned { plan, pattern, .. } =
+        let SchemePlan { plan, pattern, .. } =
             planned(set, Scheme::Sd2 { warp }, view(kind, fmin, fmax), camera, cull);
         prop_assert_eq!(sd2::three_different(set, &plan), 0, "{}: three different factors", name);
         let mesh = tessellate(set, &plan, &pattern, options(true)).unwrap();
@@ -304,7 +304,7 @@ fn hardware_partitionings_are_watertight_in(tier: Tier) {
             Partitioning::FractionalOdd,
             Partitioning::FractionalEven,
         ][mode];
-        let Planned { plan, pattern, .. } =
+        let SchemePlan { plan, pattern, .. } =
             planned(set, Scheme::Hardware(partitioning), criterion, camera, cull);
         let mesh = tessellate(set, &plan, &pattern, options(false)).unwrap();
         common::expect_topology(set, &plan, &mesh, name);
@@ -318,7 +318,7 @@ fn strips_round_trip_through_ply() {
     let set = common::load(&common::model("meshes/spool.obj")).unwrap();
     let (lo, hi) = set.bounds();
     let camera = Camera::framing(lo, hi, 800, 600);
-    let Planned { plan, pattern, .. } =
+    let SchemePlan { plan, pattern, .. } =
         planned(&set, Scheme::Sd2 { warp: false }, view(3, 1.0, 4.5), camera, false);
     let mesh: Mesh = tessellate(&set, &plan, &pattern, options(true)).unwrap();
     let dir = std::env::temp_dir().join(format!("tessera-strips-{}", std::process::id()));

@@ -204,7 +204,7 @@ fn flipping_reverses_the_normal_and_keeps_the_surface() {
 /// two rims, without welding.
 #[test]
 fn tessellated_rational_conics_stay_exact() {
-    use tessera::engine::{tessellate, TessellateOptions};
+    use tessera::engine::{tessellate, EngineOptions};
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     use tessera::surface::SurfaceSet;
     let sphere = SurfaceSet::from_patches(vec![Patch::Bicubic(sphere_octant())], Default::default());
@@ -214,7 +214,7 @@ fn tessellated_rational_conics_stay_exact() {
         for (name, set) in [("sphere", &sphere), ("cylinder", &cylinder)] {
             let planned = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
             let mesh =
-                tessellate(set, &planned.plan, &planned.pattern, TessellateOptions::default()).unwrap();
+                tessellate(set, &planned.plan, &planned.pattern, EngineOptions::default()).unwrap();
             let what = format!("{name} {scheme:?} {criterion:?}");
             for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
                 let (p, n) = (glam::Vec3::from(*p).as_dvec3(), glam::Vec3::from(*n).as_dvec3());

@@ -5,7 +5,7 @@ mod common;
 use std::collections::HashMap;
 
 use tessera::criterion::Plan;
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::uniform::Uniform;
 use tessera::verify;
 
@@ -38,7 +38,7 @@ fn uniform_output_refines_the_input_topology_exactly() {
         let name = path.file_name().unwrap().to_string_lossy();
         {
             let plan = Plan::uniform(&set, 1).unwrap();
-            let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+            let mesh = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
             let w = verify::watertight(&mesh);
             assert_eq!((w.boundary_edges, w.nonmanifold_edges, w.euler_characteristic), chords, "{name} n=1");
         }
@@ -55,7 +55,7 @@ fn uniform_output_refines_the_input_topology_exactly() {
             .count();
         for n in [2u32, 3, 5, 8] {
             let plan = Plan::uniform(&set, n).unwrap();
-            let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+            let mesh = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
             let w = verify::watertight(&mesh);
             let (loop_boundary, loop_euler) =
                 if n == 2 { (2 * free_loops, free_loops as i64) } else { (0, 0) };
@@ -84,7 +84,7 @@ fn torus_counts_are_exact() {
     assert!(set.topology.report.is_closed());
     for n in [1u32, 2, 3, 4] {
         let plan = Plan::uniform(&set, n).unwrap();
-        let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+        let mesh = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
         assert_eq!(mesh.triangle_count(), 2 * (n * n) as usize * 2048);
         assert_eq!(mesh.vertex_count(), (n * n) as usize * 2048);
         let w = verify::watertight(&mesh);
@@ -114,7 +114,7 @@ fn shared_vertices_are_evaluated_once() {
     for rel in ["patches/teapot.patches", "patches/teacup.patches", "meshes/blob.obj", "meshes/spot.obj"] {
         let set = common::load(&common::model(rel)).unwrap();
         let plan = Plan::uniform(&set, 4).unwrap();
-        let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+        let mesh = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
         let w = verify::watertight(&mesh);
         assert_eq!(w.vertices, mesh.vertex_count(), "{rel}: duplicated vertex positions");
     }

@@ -18,7 +18,7 @@ use super::{scenes, BenchResult, Ctx};
 use tessera::camera::Camera;
 use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
-use tessera::engine::{tessellate, TessellateOptions};
+use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
 use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::surface::{Domain, SurfaceSet};
@@ -138,7 +138,7 @@ impl Model {
             Err(e) if too_large(&e) => return Ok(None),
             Err(e) => return Err(format!("{} {}: {e}", self.name, scheme.name()).into()),
         };
-        let engine = TessellateOptions {
+        let engine = EngineOptions {
             corner_params: true,
             max_triangles: Some(max_triangles),
             ..Default::default()

@@ -16,7 +16,7 @@ use tessera::camera::Camera;
 use tessera::criterion::esc::{EscOptions, Threshold};
 use tessera::criterion::view::ViewCriterion;
 use tessera::criterion::Plan;
-use tessera::engine::{render_queues, tessellate, TessellateOptions};
+use tessera::engine::{render_queues, tessellate, EngineOptions};
 use tessera::pattern::semi_uniform::StaticPattern;
 use tessera::pattern::uniform::Uniform;
 use tessera::scheme::{Criterion, Scheme};
@@ -330,7 +330,7 @@ fn paper002(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         &["tessellation", "triangles", "max error", "rms error", "max error / diagonal"],
     );
     let camera = &cameras[cameras.len() / 2];
-    let params = TessellateOptions { corner_params: true, ..Default::default() };
+    let params = EngineOptions { corner_params: true, ..Default::default() };
     let cup_diagonal = {
         let cup = scenes::load(ctx, "patches/teacup.patches")?;
         let (a, b) = cup.bounds();

@@ -18,7 +18,7 @@ pub struct ScreenReport {
     /// Fix rounds run after the first check (the CPU's loop iterations that changed edges).
     pub rounds: u32,
     /// Visible patches whose bound the plan misses: at the factor cap, as
-    /// `tolerance::PlanReport::capped_patches` counts them on the CPU, or left failing when
+    /// `tolerance::BoundReport::capped_patches` counts them on the CPU, or left failing when
     /// the rounds did not converge.
     pub failing_patches: u32,
     /// Whether the rounds ended within the recorded ones

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use tessera::criterion::Plan;
-use tessera::engine::{self, Layout, TessellateOptions};
+use tessera::engine::{self, Layout, EngineOptions};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
@@ -100,8 +100,8 @@ pub use tessera::test_support::Lcg;
 /// The CPU engine's layout and mesh for `plan`.
 pub fn cpu(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> (Layout, Mesh) {
     let mut layout = Layout::default();
-    layout.build(set, plan, pattern, &TessellateOptions::default()).unwrap();
-    let mesh = engine::tessellate(set, plan, pattern, TessellateOptions::default()).unwrap();
+    layout.build(set, plan, pattern, &EngineOptions::default()).unwrap();
+    let mesh = engine::tessellate(set, plan, pattern, EngineOptions::default()).unwrap();
     (layout, mesh)
 }
 

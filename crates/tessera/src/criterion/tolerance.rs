@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// What an error-bounded plan achieved.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PlanReport {
+pub struct BoundReport {
     /// Patches culled (not tessellated).
     pub culled: usize,
     /// Visible patches whose guarantee the factor cap prevented.
@@ -285,7 +285,7 @@ pub(crate) fn plan_limited(
     max_triangles: u64,
     scratch: &mut Scratch,
     plan: &mut Plan,
-) -> Result<PlanReport> {
+) -> Result<BoundReport> {
     let cap = max_factor.max(1);
     let topo = &set.topology;
     let patches = set.patches.len();
@@ -309,7 +309,7 @@ pub(crate) fn plan_limited(
         computed_curves = curve_bounds(set);
         &computed_curves
     };
-    let mut report = PlanReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
+    let mut report = BoundReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
     let Scratch {
         proposals,
         next_segments,

@@ -22,7 +22,7 @@
 //! uploaded as they are, beside the plan's arrays; a write shader finds its ranges there and
 //! numbers vertices with [`Layout::edge_vertex`]'s and [`Layout::interior_vertex`]'s formulas.
 
-use super::{check_size, TessellateOptions};
+use super::{check_size, EngineOptions};
 use crate::criterion::Plan;
 use crate::error::Result;
 use crate::pattern::{Pattern, PatternInput, Slot};
@@ -84,7 +84,7 @@ impl Layout {
         set: &SurfaceSet,
         plan: &Plan,
         pattern: &dyn Pattern,
-        options: &TessellateOptions,
+        options: &EngineOptions,
     ) -> Result<()> {
         plan.check(set)?;
         let topo = &set.topology;
@@ -101,7 +101,7 @@ impl Layout {
         set: &SurfaceSet,
         plan: &Plan,
         pattern: &dyn Pattern,
-        options: &TessellateOptions,
+        options: &EngineOptions,
     ) -> Result<()> {
         let topo = &set.topology;
         // Edges: inner samples per variant; none for collapsed edges or edges seen by no
@@ -200,7 +200,7 @@ impl Layout {
         set: &SurfaceSet,
         plan: &Plan,
         pattern: &dyn Pattern,
-        options: &TessellateOptions,
+        options: &EngineOptions,
     ) -> Result<()> {
         let topo = &set.topology;
         let patches = set.patches.len();
@@ -306,7 +306,7 @@ mod tests {
         let set = strip(3, false);
         let plan = Plan::uniform(&set, 4).unwrap();
         let mut layout = Layout::default();
-        layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap();
+        layout.build(&set, &plan, &Uniform, &EngineOptions::default()).unwrap();
         let (c, e, p) = (layout.corners as usize, set.topology.edges.len(), set.patches.len());
         assert_eq!(c, 8);
         assert_eq!(layout.edge_offsets.len(), e + 1);
@@ -327,7 +327,7 @@ mod tests {
         assert_eq!(set.topology.report.collapsed_edges, 1);
         let mut plan = Plan::uniform(&set, 4).unwrap();
         let mut layout = Layout::default();
-        layout.build(&set, &plan, &Transition, &TessellateOptions::default()).unwrap();
+        layout.build(&set, &plan, &Transition, &EngineOptions::default()).unwrap();
         let collapsed = set.topology.edges.iter().position(|e| e.collapsed).unwrap();
         assert_eq!(
             layout.edge_offsets[collapsed + 1],
@@ -342,7 +342,7 @@ mod tests {
         );
         // Culling the second patch leaves its own curves without vertices.
         plan.visible[1] = 0;
-        layout.build(&set, &plan, &Transition, &TessellateOptions::default()).unwrap();
+        layout.build(&set, &plan, &Transition, &EngineOptions::default()).unwrap();
         assert_eq!(layout.triangle_offsets[2], layout.triangle_offsets[1], "a culled patch has no triangles");
         for e in 0..set.topology.edges.len() {
             let only_culled = set.topology.edge_uses(e).iter().all(|u| u.patch == 1);
@@ -359,7 +359,7 @@ mod tests {
         let path = crate::test_support::data("meshes/cow.obj");
         let mesh = crate::io::obj::read_obj(&path).unwrap();
         let cow = SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap();
-        let options = TessellateOptions::default();
+        let options = EngineOptions::default();
         for set in [strip(5, false), cow] {
             assert!(set.topology.one_shape.is_some());
             for n in [1, 2, 7] {
@@ -380,7 +380,7 @@ mod tests {
         }
         // A collapsed curve makes the set two-shaped: the general build alone applies.
         assert!(strip(2, true).topology.one_shape.is_none());
-        let small = TessellateOptions { max_triangles: Some(100), ..Default::default() };
+        let small = EngineOptions { max_triangles: Some(100), ..Default::default() };
         let err = Layout::default().build(
             &strip(5, false),
             &Plan::uniform(&strip(5, false), 4).unwrap(),
@@ -396,10 +396,10 @@ mod tests {
         let other = strip(3, false);
         let plan = Plan::uniform(&other, 4).unwrap();
         let mut layout = Layout::default();
-        let err = layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap_err();
+        let err = layout.build(&set, &plan, &Uniform, &EngineOptions::default()).unwrap_err();
         assert!(matches!(err, crate::Error::PlanMismatch { .. }), "{err}");
         let plan = Plan::uniform(&set, 64).unwrap();
-        let small = TessellateOptions { max_triangles: Some(1000), ..Default::default() };
+        let small = EngineOptions { max_triangles: Some(1000), ..Default::default() };
         let err = layout.build(&set, &plan, &Uniform, &small).unwrap_err();
         assert!(matches!(err, crate::Error::OutputTooLarge { triangles: 16384, .. }), "{err}");
     }

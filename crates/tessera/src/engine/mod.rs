@@ -39,7 +39,7 @@ pub use layout::Layout;
 
 /// Engine options.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct TessellateOptions {
+pub struct EngineOptions {
     /// Fill [`Mesh::corner_params`] (needed to measure the approximation error).
     pub corner_params: bool,
     /// Refuse (with [`Error::OutputTooLarge`]) an output whose buffers would take more bytes
@@ -56,7 +56,7 @@ pub struct TessellateOptions {
 /// Refuses an output of `vertices` and `triangles` that does not fit the u32 index range (the
 /// layout's offsets are u32, as a GPU reads them), the address space or the limits in
 /// `options`. Cost: O(1).
-pub(crate) fn check_size(vertices: u64, triangles: u64, options: &TessellateOptions) -> Result<()> {
+pub(crate) fn check_size(vertices: u64, triangles: u64, options: &EngineOptions) -> Result<()> {
     let bytes = crate::mesh::output_bytes(vertices, triangles, options.corner_params);
     if vertices > u32::MAX as u64
         || triangles > u32::MAX as u64
@@ -78,7 +78,7 @@ pub fn tessellate(
     set: &SurfaceSet,
     plan: &Plan,
     pattern: &dyn Pattern,
-    options: TessellateOptions,
+    options: EngineOptions,
 ) -> Result<Mesh> {
     let mut mesh = Mesh::default();
     tessellate_into(set, plan, pattern, options, &mut mesh)?;
@@ -91,7 +91,7 @@ pub fn tessellate_into(
     set: &SurfaceSet,
     plan: &Plan,
     pattern: &dyn Pattern,
-    options: TessellateOptions,
+    options: EngineOptions,
     out: &mut Mesh,
 ) -> Result<()> {
     let mut layout = Layout::default();
@@ -112,7 +112,7 @@ pub fn write(
     plan: &Plan,
     pattern: &dyn Pattern,
     layout: &Layout,
-    options: TessellateOptions,
+    options: EngineOptions,
     out: &mut Mesh,
 ) -> Result<()> {
     let mut fast = fast_evaluator::FastEvaluator::new(set, plan);
@@ -142,7 +142,7 @@ pub(crate) fn write_with(
     plan: &Plan,
     pattern: &dyn Pattern,
     layout: &Layout,
-    options: TessellateOptions,
+    options: EngineOptions,
     out: &mut Mesh,
     fast: Option<&fast_evaluator::FastEvaluator<'_>>,
 ) -> Result<WriteTimes> {
@@ -855,7 +855,7 @@ mod tests {
                     *visible = u32::from(p % 7 != 3);
                 }
                 for corner_params in [false, true] {
-                    let options = TessellateOptions { corner_params, ..Default::default() };
+                    let options = EngineOptions { corner_params, ..Default::default() };
                     let mut layout = Layout::default();
                     layout.build(&set, &plan, &Transition, &options).unwrap();
                     let mut fast = fast_evaluator::FastEvaluator::new(&set, &plan);
@@ -881,9 +881,9 @@ mod tests {
     fn uniform_frames_follow_the_numbering_rule() {
         for set in [cow(), teapot()] {
             let plan = Plan::uniform(&set, 5).unwrap();
-            let mesh = tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap();
+            let mesh = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
             let mut layout = Layout::default();
-            layout.build(&set, &plan, &Uniform, &TessellateOptions::default()).unwrap();
+            layout.build(&set, &plan, &Uniform, &EngineOptions::default()).unwrap();
             let (indices, patches) = numbered(&set, &plan, &Uniform, &layout);
             assert_eq!(mesh.indices, indices);
             assert_eq!(mesh.triangle_patch, patches);

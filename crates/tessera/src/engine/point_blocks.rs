@@ -821,7 +821,7 @@ mod tests {
     #[test]
     fn every_scheme_and_surface_kind_matches_the_generic_engine() {
         use crate::criterion::view::{Mapping, ViewCriterion};
-        use crate::engine::{Layout, TessellateOptions};
+        use crate::engine::{Layout, EngineOptions};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
@@ -913,7 +913,7 @@ mod tests {
                     }
                 };
                 let (plan, pattern) = (&planned.plan, &planned.pattern);
-                let opts = TessellateOptions::default();
+                let opts = EngineOptions::default();
                 let mut layout = Layout::default();
                 layout.build(set, plan, pattern, &opts).unwrap();
                 for avx2_fma in [false, true] {
@@ -955,9 +955,9 @@ mod tests {
         size: f64,
         kernels_ran: bool,
     ) {
-        use crate::engine::{write_with, TessellateOptions};
+        use crate::engine::{write_with, EngineOptions};
         use crate::mesh::Mesh;
-        let opts = TessellateOptions::default();
+        let opts = EngineOptions::default();
         let mut mesh = Mesh::default();
         write_with(set, plan, pattern, layout, opts, &mut mesh, Some(evaluator)).unwrap();
         let mut reference = Mesh::default();
@@ -995,7 +995,7 @@ mod tests {
     #[ignore = "slow tier: every model of the shared data × every scheme, fast paths against the generic engine"]
     fn fast_paths_equal_the_generic_engine_on_every_model_and_scheme() {
         use crate::criterion::view::{Mapping, ViewCriterion};
-        use crate::engine::{Layout, TessellateOptions};
+        use crate::engine::{Layout, EngineOptions};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let data = crate::test_support::data;
@@ -1046,7 +1046,7 @@ mod tests {
                 };
                 let (plan, pattern) = (&planned.plan, &planned.pattern);
                 let mut layout = Layout::default();
-                layout.build(&set, plan, pattern, &TessellateOptions::default()).unwrap();
+                layout.build(&set, plan, pattern, &EngineOptions::default()).unwrap();
                 let mut evaluator = super::super::fast_evaluator::FastEvaluator::new(&set, plan);
                 evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                 // A few hundred evaluated points can fall mostly on the f64 fallback.

@@ -345,7 +345,7 @@ pub(super) fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n:
 mod tests {
     use super::super::fast_evaluator::FastEvaluator;
     use super::*;
-    use crate::engine::{write_with, Layout, TessellateOptions};
+    use crate::engine::{write_with, Layout, EngineOptions};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
     use crate::criterion::Plan;
@@ -383,7 +383,7 @@ mod tests {
     const KERNELS: [bool; 2] = [false, true];
 
     /// The engine's writer with the evaluator, with the chosen kernels.
-    fn fast(set: &SurfaceSet, plan: &Plan, options: TessellateOptions, out: &mut Mesh, avx2_fma: bool) {
+    fn fast(set: &SurfaceSet, plan: &Plan, options: EngineOptions, out: &mut Mesh, avx2_fma: bool) {
         let mut layout = Layout::default();
         layout.build(set, plan, &Uniform, &options).expect("layout");
         let evaluator = FastEvaluator::with_kernels(set, plan, avx2_fma);
@@ -392,7 +392,7 @@ mod tests {
     }
 
     /// The engine's writer with the generic f64 evaluation everywhere.
-    fn generic(set: &SurfaceSet, plan: &Plan, options: TessellateOptions) -> Mesh {
+    fn generic(set: &SurfaceSet, plan: &Plan, options: EngineOptions) -> Mesh {
         let mut layout = Layout::default();
         layout.build(set, plan, &Uniform, &options).expect("layout");
         let mut mesh = Mesh::default();
@@ -470,7 +470,7 @@ mod tests {
                 let distinct: std::collections::BTreeSet<u32> = plan.segments.iter().copied().collect();
                 adaptive += usize::from(distinct.len() > 2);
                 for avx2_fma in KERNELS {
-                    let opts = TessellateOptions::default();
+                    let opts = EngineOptions::default();
                     let mut layout = Layout::default();
                     layout.build(&set, plan, pattern, &opts).expect("layout");
                     let evaluator = FastEvaluator::with_kernels(&set, plan, avx2_fma);
@@ -509,7 +509,7 @@ mod tests {
                 for n in [1, 2, 3, 7, 16, 2] {
                     let plan = Plan::uniform(&set, n).unwrap();
                     for corner_params in [false, true] {
-                        let options = TessellateOptions { corner_params, ..Default::default() };
+                        let options = EngineOptions { corner_params, ..Default::default() };
                         fast(&set, &plan, options, &mut mesh, avx2_fma);
                         let what = format!("{model} n={n} corner_params={corner_params} avx2_fma={avx2_fma}");
                         assert_same_mesh(&mesh, &generic(&set, &plan, options), &what);
@@ -539,8 +539,8 @@ mod tests {
             for n in [1, 4, 9] {
                 let plan = Plan::uniform(&set, n).unwrap();
                 let mut mesh = Mesh::default();
-                fast(&set, &plan, TessellateOptions::default(), &mut mesh, avx2_fma);
-                let reference = generic(&set, &plan, TessellateOptions::default());
+                fast(&set, &plan, EngineOptions::default(), &mut mesh, avx2_fma);
+                let reference = generic(&set, &plan, EngineOptions::default());
                 assert_same_mesh(&mesh, &reference, &format!("pinched corner n={n} avx2_fma={avx2_fma}"));
                 let corner = set.topology.patch_corner_entries[0][0] as usize;
                 assert_eq!(mesh.normals[corner], reference.normals[corner], "n={n}: the limit normal");
@@ -558,7 +558,7 @@ mod tests {
             for n in [1, 2, 5, 16] {
                 let plan = Plan::uniform(set, n).unwrap();
                 let mut mesh = Mesh::default();
-                fast(set, &plan, TessellateOptions::default(), &mut mesh, avx2_fma);
+                fast(set, &plan, EngineOptions::default(), &mut mesh, avx2_fma);
                 let w = verify::watertight(&mesh);
                 assert!(w.is_closed(), "n={n}: {w:?}");
                 assert_eq!(w.degenerate_triangles(), 0, "n={n}");
@@ -579,7 +579,7 @@ mod tests {
         culled.visible[3] = 0;
         for avx2_fma in KERNELS {
             for corner_params in [false, true] {
-                let options = TessellateOptions { corner_params, ..Default::default() };
+                let options = EngineOptions { corner_params, ..Default::default() };
                 let mut mesh = Mesh::default();
                 let plan = Plan::uniform(&teapot, 5).unwrap();
                 fast(&teapot, &plan, options, &mut mesh, avx2_fma);

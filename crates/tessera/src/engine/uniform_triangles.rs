@@ -214,7 +214,7 @@ impl<'a> PatchOut<'a> {
 mod tests {
     use super::*;
     use crate::engine::fast_evaluator::FastEvaluator;
-    use crate::engine::{write_with, TessellateOptions};
+    use crate::engine::{write_with, EngineOptions};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
 
@@ -245,7 +245,7 @@ mod tests {
         let quad_plan = Plan::uniform(&quads, 4).unwrap();
         assert!(!UniformTriangles::for_set(&quads).retarget(&quads, &quad_plan, &Uniform));
 
-        let options = TessellateOptions { corner_params: true, ..Default::default() };
+        let options = EngineOptions { corner_params: true, ..Default::default() };
         let mut layout = Layout::default();
         layout.build(&set, &plan, &Uniform, &options).unwrap();
         let mut fast = FastEvaluator::new(&set, &plan);

@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::criterion::esc::Threshold;
 use crate::criterion::view::{Mapping, ViewCriterion};
 use crate::criterion::Plan;
-use crate::engine::{self, TessellateOptions};
+use crate::engine::{self, EngineOptions};
 use crate::io::obj;
 use crate::io::patches;
 use crate::mesh::strips;
@@ -66,7 +66,7 @@ pub struct EngineCase {
     /// ESC's distance-test threshold (`--quality`, `--threshold`).
     pub esc_threshold: Threshold,
     /// Corner parameters, strips and the memory limit asked of the engine.
-    pub options: TessellateOptions,
+    pub options: EngineOptions,
 }
 
 /// What [`check_engine`] did with its input, so that tests can see they are not vacuous.
@@ -161,11 +161,11 @@ pub fn decode_engine_case(data: &[u8]) -> EngineCase {
     // Asking a pattern without a strip form for strips is an error, so ask mostly the two
     // patterns that have one.
     let strips = if matches!(scheme, Scheme::Sd2 | Scheme::Esc) { d.one_in(2) } else { d.one_in(8) };
-    let options = TessellateOptions {
+    let options = EngineOptions {
         corner_params: d.one_in(2),
         memory_limit: Some(1 << 26),
         strips,
-        ..TessellateOptions::default()
+        ..EngineOptions::default()
     };
     // The geometry comes last: it takes most of the bytes, and an input that runs out while
     // jittering points has still chosen its scheme.

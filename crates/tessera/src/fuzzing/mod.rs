@@ -18,7 +18,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use crate::criterion::Plan;
-use crate::engine::{self, TessellateOptions};
+use crate::engine::{self, EngineOptions};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::pattern::transition::Transition;
@@ -75,7 +75,7 @@ fn tessellate_small(set: &SurfaceSet) {
     let patterns: [(u32, &dyn Pattern); 2] = [(2, &Uniform), (3, &Transition)];
     for (factor, pattern) in patterns {
         let Ok(plan) = Plan::uniform(set, factor) else { continue };
-        if let Ok(mesh) = engine::tessellate(set, &plan, pattern, TessellateOptions::default()) {
+        if let Ok(mesh) = engine::tessellate(set, &plan, pattern, EngineOptions::default()) {
             assert_mesh_consistent(&mesh, "engine");
             let _ = verify::watertight(&mesh);
         }

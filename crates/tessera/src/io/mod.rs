@@ -615,12 +615,12 @@ mod tests {
     /// 98 a patch so that chunk boundaries fall inside runs of one patch), with corner params.
     fn torus_factor_7() -> Mesh {
         use crate::criterion::Plan;
-        use crate::engine::{tessellate, TessellateOptions};
+        use crate::engine::{tessellate, EngineOptions};
         use crate::pattern::uniform::Uniform;
         let file = patches::read_patches(&crate::test_support::data("bench/torus_64x32.patches")).unwrap();
         let set = SurfaceSet::from_patch_file(&file, Default::default());
         let plan = Plan::uniform(&set, 7).unwrap();
-        let options = TessellateOptions { corner_params: true, ..Default::default() };
+        let options = EngineOptions { corner_params: true, ..Default::default() };
         let mut mesh = tessellate(&set, &plan, &Uniform, options).unwrap();
         // Strips as the PLY writer stores them: a restart every 50 indices.
         mesh.strips = Some(

@@ -2,7 +2,7 @@
 //! edge rule, its interior rule, its caps and the criteria it accepts.
 //!
 //! ```text
-//! Scheme::plan(set, criterion, options) ─► Planned { plan (plain arrays), pattern, report }
+//! Scheme::plan(set, criterion, options) ─► SchemePlan { plan (plain arrays), pattern, report }
 //!                                             └─► engine::tessellate(set, &plan, &pattern, ..)
 //! ```
 //!
@@ -27,7 +27,7 @@ use crate::camera::Camera;
 use crate::criterion::esc::{self as esc_criterion, EscOptions};
 use crate::criterion::resolve::{EdgeRule, InteriorRule};
 use crate::criterion::sd2::{self as sd2_criterion, LevelFunction, Sd2Options};
-use crate::criterion::tolerance::{self, PlanReport};
+use crate::criterion::tolerance::{self, BoundReport};
 use crate::criterion::view::{self, EdgeFactors, Mapping, ViewCriterion};
 pub use crate::criterion::PlanScratch;
 use crate::criterion::{screen, Plan, MAX_FACTOR};
@@ -92,16 +92,16 @@ pub use crate::criterion::{Criterion, Prepared};
 
 /// A plan, the pattern that draws it, and the guarantee report where the criterion has one.
 #[derive(Debug, Clone)]
-pub struct Planned {
+pub struct SchemePlan {
     pub plan: Plan,
     pub pattern: SchemePattern,
-    pub report: Option<PlanReport>,
+    pub report: Option<BoundReport>,
 }
 
-impl Default for Planned {
+impl Default for SchemePlan {
     /// An empty uniform plan, for [`Scheme::plan_into`] to fill.
     fn default() -> Self {
-        Planned { plan: Plan::default(), pattern: SchemePattern::Uniform(Uniform), report: None }
+        SchemePlan { plan: Plan::default(), pattern: SchemePattern::Uniform(Uniform), report: None }
     }
 }
 
@@ -233,7 +233,7 @@ impl Scheme {
     /// patch kinds ([`Error::PatchKindNotAccepted`]), the camera ([`Error::NeedsCamera`]).
     /// Cost: that of the criterion — O(V + E + P) evaluations for the view criteria, bound
     /// computations and a-posteriori pattern checks for the error-bounded ones.
-    pub fn plan(&self, set: &SurfaceSet, criterion: &Criterion, options: &PlanOptions) -> Result<Planned> {
+    pub fn plan(&self, set: &SurfaceSet, criterion: &Criterion, options: &PlanOptions) -> Result<SchemePlan> {
         validate(*self, criterion, options, set, Engine::Cpu)?;
         self.plan_prepared(set, &Prepared::for_criterion(set, criterion), criterion, options)
     }
@@ -247,8 +247,8 @@ impl Scheme {
         prepared: &Prepared,
         criterion: &Criterion,
         options: &PlanOptions,
-    ) -> Result<Planned> {
-        let mut planned = Planned::default();
+    ) -> Result<SchemePlan> {
+        let mut planned = SchemePlan::default();
         self.plan_into(set, prepared, criterion, options, &mut PlanScratch::default(), &mut planned)?;
         Ok(planned)
     }
@@ -265,7 +265,7 @@ impl Scheme {
         criterion: &Criterion,
         options: &PlanOptions,
         scratch: &mut PlanScratch,
-        out: &mut Planned,
+        out: &mut SchemePlan,
     ) -> Result<()> {
         let accepted = validate(*self, criterion, options, set, Engine::Cpu)?;
         scratch.criterion_time = Default::default();
@@ -381,7 +381,7 @@ impl Scheme {
         options: &PlanOptions,
         warp: bool,
         cap: f64,
-    ) -> Result<Planned> {
+    ) -> Result<SchemePlan> {
         let (level, fmin, fmax) = match *criterion {
             Criterion::Factor(f) => (LevelFunction::Distance(Mapping::Linear), f, f),
             Criterion::View { criterion: ViewCriterion::Distance(m), fmin, fmax } => {
@@ -402,7 +402,7 @@ impl Scheme {
         };
         let sd2_options = Sd2Options { level, fmin, fmax, warp, cull: options.cull };
         let (plan, pattern) = sd2_criterion::plan(set, &camera, &sd2_options)?;
-        Ok(Planned { plan, pattern: SchemePattern::Sd2(pattern), report: None })
+        Ok(SchemePlan { plan, pattern: SchemePattern::Sd2(pattern), report: None })
     }
 
     fn plan_esc(
@@ -411,7 +411,7 @@ impl Scheme {
         criterion: &Criterion,
         options: &PlanOptions,
         max_level: u32,
-    ) -> Result<Planned> {
+    ) -> Result<SchemePlan> {
         // Bicubic patches only: `validate` checked.
         let Criterion::Esc { threshold, level } = *criterion else { unreachable!("refused by accepts") };
         let camera = match (options.camera, level) {
@@ -421,7 +421,7 @@ impl Scheme {
         };
         let esc_options = EscOptions { max_level, level, threshold, ..EscOptions::default() };
         let (plan, pattern) = esc_criterion::plan(set, &camera, &esc_options)?;
-        Ok(Planned { plan, pattern: SchemePattern::Esc(pattern), report: None })
+        Ok(SchemePlan { plan, pattern: SchemePattern::Esc(pattern), report: None })
     }
 }
 

@@ -960,14 +960,14 @@ mod tests {
     #[test]
     fn implementations_agree_on_broken_tessellations() {
         use crate::criterion::Plan;
-        use crate::engine::{tessellate, TessellateOptions};
+        use crate::engine::{tessellate, EngineOptions};
         use crate::io::patches::read_patches;
         use crate::pattern::uniform::Uniform;
         use crate::test_support::data;
         let tessellation = |rel: &str, factor: u32| {
             let set = SurfaceSet::from_patch_file(&read_patches(&data(rel)).unwrap(), Default::default());
             let plan = Plan::uniform(&set, factor).unwrap();
-            tessellate(&set, &plan, &Uniform, TessellateOptions::default()).unwrap()
+            tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap()
         };
         let teapot = tessellation("patches/teapot.patches", 6);
         assert_all_agree(&teapot, "teapot");
