@@ -228,7 +228,7 @@ fn draw_on_cpu(
         frames.push(tess.timings());
     }
     let plan = tess.plan().expect("a frame was planned");
-    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
+    let culled = plan.culled_count();
     let queues = match (&a.instanced, chosen.scheme) {
         (Some(path), Scheme::SemiUniform { max_level }) => {
             let queues = render_queues::build(set, plan, max_level)?;
@@ -270,7 +270,7 @@ fn draw_on_gpu(
     crate::announce_large_output(layout, &opts, a.output.as_deref());
     let (plan, pattern) = (tess.plan().expect("a frame was planned"), tess.pattern().expect("a frame was planned"));
     let run = gpu::tessellate(set, plan, pattern, a.repeat, &mut mesh, &mut times)?;
-    let culled = plan.visible.iter().filter(|&&v| v == 0).count();
+    let culled = plan.culled_count();
     let frames = vec![tess.timings()];
     Ok(Drawn { mesh, culled, report: tess.report().copied(), frames, prepare, queues: None, gpu: Some((run, times)) })
 }

@@ -22,7 +22,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 use tessera::camera::Camera;
-use tessera::criterion::PlanScratch;
+use tessera::criterion::{Plan, PlanScratch};
 use tessera::pattern::hardware::Partitioning;
 use tessera::scheme::{validate, Criterion, Engine, PlanOptions, SchemePlan, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
@@ -310,7 +310,7 @@ impl App {
         let frame_ms = start.elapsed().as_secs_f64() * 1e3;
         let triangles = triangles_drawn(state, &mut drawn, settings.cull)?;
         let tess = state.tess.as_ref().expect("made by tessellate");
-        let culled = tess.plan().map_or(0, |p| p.visible.iter().filter(|&&v| v == 0).count());
+        let culled = tess.plan().map_or(0, Plan::culled_count);
         self.status = format!(
             "{} {}PX{} / {} TRIS / {} PATCHES{} / {} ENGINE: {} / FRAME {frame_ms:.1} MS",
             scheme.name(),

@@ -26,9 +26,10 @@
 //! ```
 //!
 //! Output goes through [`MeshBuilder`]: [`Tessellator::frame`] hands out the tessellator's own
-//! [`Mesh`] (a struct of arrays, zero copies); [`Tessellator::frame_into`] writes into the
-//! caller's `Mesh` directly, or streams the frame to any other builder, such as an
-//! application's interleaved vertex buffer with its own index type.
+//! [`Mesh`] (a struct of arrays, zero copies); [`Tessellator::frame_into`] writes straight into
+//! a builder's arrays when it lends them ([`MeshBuilder::buffers`]: a `Mesh`, separate vertex
+//! streams), or streams the frame to any other builder, such as an application's interleaved
+//! vertex buffer with its own index type.
 
 use crate::camera::Camera;
 use crate::criterion::tolerance::BoundReport;
@@ -36,7 +37,7 @@ use crate::criterion::Plan;
 use crate::engine::fast_evaluator::FastEvaluator;
 use crate::engine::{self, Layout, EngineOptions};
 use crate::error::Result;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshBuffers};
 use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, SchemePlan, Prepared, Scheme};
 use std::time::{Duration, Instant};
 
@@ -81,10 +82,15 @@ pub trait MeshBuilder {
     fn triangle(&mut self, indices: [u32; 3], patch: u32);
     /// Called once per frame, last.
     fn end(&mut self) {}
-    /// The builder as a [`Mesh`] the engine may write the frame into directly, in parallel
-    /// and with no copy, instead of streaming it through [`MeshBuilder::vertex`] and
-    /// [`MeshBuilder::triangle`]; None (the default) streams.
-    fn as_mesh(&mut self) -> Option<&mut Mesh> {
+    /// Arrays of exactly `vertices` and `triangles` entries ([`MeshBuffers`], `Mesh`'s
+    /// struct-of-arrays layout) that the engine may write the frame into directly, in
+    /// parallel and with no copy, instead of streaming it through [`MeshBuilder::vertex`] and
+    /// [`MeshBuilder::triangle`]: a builder whose vertex attributes live in arrays of their
+    /// own (a `Mesh`, separate GPU vertex streams) lends them here, after
+    /// [`MeshBuilder::begin`]. None (the default) streams. Frames with corner parameters or
+    /// strips ([`EngineOptions`]) always stream.
+    fn buffers(&mut self, vertices: usize, triangles: usize) -> Option<MeshBuffers<'_>> {
+        let _ = (vertices, triangles);
         None
     }
 }
@@ -117,8 +123,21 @@ impl MeshBuilder for Mesh {
         self.indices.extend_from_slice(&indices);
         self.triangle_patch.push(patch);
     }
-    fn as_mesh(&mut self) -> Option<&mut Mesh> {
-        Some(self)
+    fn buffers(&mut self, vertices: usize, triangles: usize) -> Option<MeshBuffers<'_>> {
+        self.positions.resize(vertices, [0.0; 3]);
+        self.normals.resize(vertices, [0.0; 3]);
+        self.uvs.resize(vertices, [0.0; 2]);
+        self.vertex_patch.resize(vertices, 0);
+        self.indices.resize(3 * triangles, 0);
+        self.triangle_patch.resize(triangles, 0);
+        Some(MeshBuffers {
+            positions: &mut self.positions,
+            normals: &mut self.normals,
+            uvs: &mut self.uvs,
+            vertex_patch: &mut self.vertex_patch,
+            indices: &mut self.indices,
+            triangle_patch: &mut self.triangle_patch,
+        })
     }
 }
 
@@ -257,13 +276,14 @@ impl<'a> Tessellator<'a> {
     /// last write; the engine's otherwise. Cost: O(output), parallel.
     pub fn write_frame(&mut self) -> Result<&Mesh> {
         let mut mesh = std::mem::take(&mut self.mesh);
-        let written = self.write_frame_to(&mut mesh);
+        let written = self.write_planned(Output::Mesh(&mut mesh));
         self.mesh = mesh;
         written.map(|()| &self.mesh)
     }
 
-    /// [`Tessellator::write_frame`] into `out` (its buffers reused). Cost: O(output), parallel.
-    fn write_frame_to(&mut self, out: &mut Mesh) -> Result<()> {
+    /// Writes the frame [`Tessellator::plan_frame`] laid out into `out`. Cost: O(output),
+    /// parallel.
+    fn write_planned(&mut self, out: Output<'_>) -> Result<()> {
         if !std::mem::take(&mut self.laid_out) {
             return Err(crate::Error::PlanMismatch { what: "write_frame without a planned frame".into() });
         }
@@ -274,15 +294,12 @@ impl<'a> Tessellator<'a> {
         let filled = start.elapsed();
         let fast = Some(&self.fast);
         let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
-        let written = engine::write_with(
-            self.set,
-            plan,
-            pattern,
-            layout_ref,
-            self.options.engine,
-            out,
-            fast,
-        )?;
+        let written = match out {
+            Output::Mesh(mesh) => {
+                engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, mesh, fast)?
+            }
+            Output::Buffers(buffers) => engine::write_into(self.set, plan, pattern, layout_ref, buffers, fast)?,
+        };
         self.timings = FrameTimings {
             // The pattern cache's fill counts with the vertices, whose pass uses it first.
             write_vertices: filled + written.vertices,
@@ -315,26 +332,27 @@ impl<'a> Tessellator<'a> {
         self.mesh
     }
 
-    /// [`Tessellator::frame`], handed to `builder`: a builder that is a [`Mesh`]
-    /// ([`MeshBuilder::as_mesh`]) receives the engine's parallel writes directly (its buffers
-    /// reused, the tessellator's own mesh left as it was); any other receives the frame
-    /// streamed, vertex after vertex, then triangle after triangle. Cost: that of `frame`,
-    /// plus one pass over the output when streamed.
+    /// [`Tessellator::frame`], handed to `builder`: a builder that lends its arrays
+    /// ([`MeshBuilder::buffers`]) receives the engine's parallel writes directly (the
+    /// tessellator's own mesh left as it was); any other receives the frame streamed, vertex
+    /// after vertex, then triangle after triangle, from the tessellator's mesh. Cost: that of
+    /// `frame`, plus one pass over the output when streamed.
     pub fn frame_into(&mut self, camera: Option<&Camera>, builder: &mut impl MeshBuilder) -> Result<()> {
-        if let Some(mesh) = builder.as_mesh() {
-            self.plan_frame(camera)?;
-            return self.write_frame_to(mesh);
+        let layout = self.plan_frame(camera)?;
+        let (vertices, triangles) = (layout.vertex_count(), layout.triangle_count());
+        let engine = self.options.engine;
+        if !engine.corner_params && !engine.strips {
+            builder.begin(vertices, triangles);
+            if let Some(buffers) = builder.buffers(vertices, triangles) {
+                self.write_planned(Output::Buffers(buffers))?;
+                builder.end();
+                return Ok(());
+            }
+            let mesh = self.write_frame()?;
+            return stream(mesh, builder, false);
         }
-        let mesh = self.frame(camera)?;
-        builder.begin(mesh.vertex_count(), mesh.triangle_count());
-        for i in 0..mesh.vertex_count() {
-            builder.vertex(mesh.positions[i], mesh.normals[i], mesh.uvs[i], mesh.vertex_patch[i]);
-        }
-        for t in 0..mesh.triangle_count() {
-            builder.triangle(mesh.triangle(t), mesh.triangle_patch[t]);
-        }
-        builder.end();
-        Ok(())
+        let mesh = self.write_frame()?;
+        stream(mesh, builder, true)
     }
 
     /// The last frame's plan (None before the first frame).
@@ -356,6 +374,29 @@ impl<'a> Tessellator<'a> {
     pub fn scheme(&self) -> Scheme {
         self.scheme
     }
+}
+
+/// Where [`Tessellator::write_planned`] writes.
+enum Output<'m> {
+    /// A `Mesh`, sized, with corner parameters and strips where the options ask for them.
+    Mesh(&'m mut Mesh),
+    /// A builder's lent arrays.
+    Buffers(MeshBuffers<'m>),
+}
+
+/// Streams `mesh` to `builder` (`begin` first when `begin`; the caller called it otherwise).
+fn stream(mesh: &Mesh, builder: &mut impl MeshBuilder, begin: bool) -> Result<()> {
+    if begin {
+        builder.begin(mesh.vertex_count(), mesh.triangle_count());
+    }
+    for i in 0..mesh.vertex_count() {
+        builder.vertex(mesh.positions[i], mesh.normals[i], mesh.uvs[i], mesh.vertex_patch[i]);
+    }
+    for t in 0..mesh.triangle_count() {
+        builder.triangle(mesh.triangle(t), mesh.triangle_patch[t]);
+    }
+    builder.end();
+    Ok(())
 }
 
 #[cfg(test)]

@@ -309,7 +309,7 @@ pub fn frames(
         let mesh = tess.frame(c.as_ref())?;
         let (t, v) = (mesh.triangle_count(), mesh.vertex_count());
         series.push(tess.timings(), t, v);
-        series.culled.push(tess.plan().map_or(0, |p| p.visible.iter().filter(|&&v| v == 0).count()));
+        series.culled.push(tess.plan().map_or(0, tessera::criterion::Plan::culled_count));
     }
     Ok(series)
 }

@@ -288,6 +288,11 @@ impl Plan {
         self.visible[p] != 0
     }
 
+    /// How many patches the plan leaves out (culled). Cost: O(P).
+    pub fn culled_count(&self) -> usize {
+        self.visible.iter().filter(|&&v| v == 0).count()
+    }
+
     /// Segments of edge `e`.
     #[inline]
     pub fn segments(&self, e: usize) -> u32 {

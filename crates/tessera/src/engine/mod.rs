@@ -21,7 +21,7 @@
 use crate::criterion::Plan;
 use crate::error::{Error, Result};
 use crate::mesh::strips::RESTART;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshBuffers};
 use crate::pattern::cache::{next_generation, PatternCache, RecentPatterns, MIN_TRIANGLES_PER_PATCH};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, Patch, SurfaceSet};
@@ -147,7 +147,6 @@ pub(crate) fn write_with(
     fast: Option<&fast_evaluator::FastEvaluator<'_>>,
 ) -> Result<WriteTimes> {
     let start = std::time::Instant::now();
-    let topo = &set.topology;
     let (vertices, triangles) = (layout.vertex_count(), layout.triangle_count());
     reuse(&mut out.positions, vertices, [0.0; 3]);
     reuse(&mut out.normals, vertices, [0.0; 3]);
@@ -165,18 +164,69 @@ pub(crate) fn write_with(
         &mut no_params
     };
     out.collapsed_triangles = layout.collapsed_triangles as usize;
-    let uniform = fast.filter(|f| f.triangles().active() && !options.corner_params);
+    let buffers = MeshBuffers {
+        positions: &mut out.positions,
+        normals: &mut out.normals,
+        uvs: &mut out.uvs,
+        vertex_patch: &mut out.vertex_patch,
+        indices: &mut out.indices,
+        triangle_patch: &mut out.triangle_patch,
+    };
+    let vertices_done = write_buffers(set, plan, pattern, layout, options.corner_params, buffers, params, fast);
+    out.strips = if options.strips { Some(strips_of(set, plan, pattern, layout)?) } else { None };
+    Ok(WriteTimes { vertices: vertices_done - start, indices: vertices_done.elapsed() })
+}
+
+/// [`write_with`] into a builder's own arrays (no corner parameters, no strips).
+/// Errors: [`crate::Error::InvalidParameter`] when `out` does not hold exactly the layout's
+/// counts. Cost: O(output), parallel.
+pub(crate) fn write_into(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    layout: &Layout,
+    out: MeshBuffers<'_>,
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
+) -> Result<WriteTimes> {
+    let (vertices, triangles) = (layout.vertex_count(), layout.triangle_count());
+    if !out.fit(vertices, triangles) {
+        return Err(crate::Error::InvalidParameter {
+            name: "mesh builder buffers",
+            reason: format!(
+                "{} positions and {} indices lent for a frame of {vertices} vertices and {triangles} triangles",
+                out.positions.len(),
+                out.indices.len()
+            ),
+        });
+    }
+    let start = std::time::Instant::now();
+    let vertices_done = write_buffers(set, plan, pattern, layout, false, out, &mut [], fast);
+    Ok(WriteTimes { vertices: vertices_done - start, indices: vertices_done.elapsed() })
+}
+
+/// The two passes of [`write_with`] into arrays sized for `layout` (`out`, and `params`: three
+/// corner parameters a triangle, or empty without them); returns when the vertex pass ended.
+/// Preconditions: `out.fit(layout's counts)`. Cost: O(output), parallel.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write_buffers(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn Pattern,
+    layout: &Layout,
+    corner_params: bool,
+    out: MeshBuffers<'_>,
+    params: &mut [[f32; 2]],
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
+) -> std::time::Instant {
+    let topo = &set.topology;
+    let MeshBuffers { positions, normals, uvs, vertex_patch, indices, triangle_patch } = out;
+    let uniform = fast.filter(|f| f.triangles().active() && !corner_params);
     let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
-    let mut all = VertexSlices {
-        pos: &mut out.positions,
-        nrm: &mut out.normals,
-        uv: &mut out.uvs,
-        patch: &mut out.vertex_patch,
-    };
+    let mut all = VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     let corner_part = all.take_front(layout.corners as usize);
     let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
-    let patch_part = PatchOut { verts: all, idx: &mut out.indices, tp: &mut out.triangle_patch, params };
+    let patch_part = PatchOut { verts: all, idx: &mut *indices, tp: &mut *triangle_patch, params: &mut *params };
     rayon::join(
         || {
             write_corners(set, fast, corner_part);
@@ -197,28 +247,21 @@ pub(crate) fn write_with(
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
         if entry.position_entry as usize != i {
-            out.positions[i] = out.positions[entry.position_entry as usize];
+            positions[i] = positions[entry.position_entry as usize];
         }
     }
     let vertices_done = std::time::Instant::now();
 
-    let mut all = VertexSlices {
-        pos: &mut out.positions,
-        nrm: &mut out.normals,
-        uv: &mut out.uvs,
-        patch: &mut out.vertex_patch,
-    };
+    let mut all = VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     all.take_front(layout.interior_offsets[0] as usize);
-    let params = out.corner_params.as_deref_mut().unwrap_or(&mut []);
-    let patch_part = PatchOut { verts: all, idx: &mut out.indices, tp: &mut out.triangle_patch, params };
+    let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
     match uniform {
         Some(f) => {
             f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part, Pass::Indices)
         }
         None => writer.patches(0..set.patches.len(), patch_part, Pass::Indices),
     }
-    out.strips = if options.strips { Some(strips_of(set, plan, pattern, layout)?) } else { None };
-    Ok(WriteTimes { vertices: vertices_done - start, indices: vertices_done.elapsed() })
+    vertices_done
 }
 
 /// Which of [`write_with`]'s passes a patch writer runs.

@@ -35,6 +35,37 @@ pub struct Mesh {
     pub collapsed_triangles: usize,
 }
 
+/// The arrays of one frame's output, lent to the engine to write in parallel: exactly the
+/// frame's vertex count for the vertex arrays, three indices and one patch a triangle
+/// (`Mesh`'s layout, struct of arrays). A [`crate::tessellator::MeshBuilder`] with its own
+/// arrays lends them through [`crate::tessellator::MeshBuilder::buffers`].
+#[derive(Debug)]
+pub struct MeshBuffers<'a> {
+    /// Vertex positions.
+    pub positions: &'a mut [[f32; 3]],
+    /// Unit vertex normals.
+    pub normals: &'a mut [[f32; 3]],
+    /// Each vertex's parameters in its patch.
+    pub uvs: &'a mut [[f32; 2]],
+    /// The patch that evaluated each vertex.
+    pub vertex_patch: &'a mut [u32],
+    /// Three vertex indices a triangle.
+    pub indices: &'a mut [u32],
+    /// The patch of each triangle.
+    pub triangle_patch: &'a mut [u32],
+}
+
+impl MeshBuffers<'_> {
+    /// Whether the arrays hold exactly `vertices` vertices and `triangles` triangles.
+    pub fn fit(&self, vertices: usize, triangles: usize) -> bool {
+        [self.positions.len(), self.normals.len(), self.uvs.len(), self.vertex_patch.len()]
+            .iter()
+            .all(|&n| n == vertices)
+            && self.indices.len() == 3 * triangles
+            && self.triangle_patch.len() == triangles
+    }
+}
+
 impl Mesh {
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
