@@ -247,6 +247,10 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
             "input polygons split into triangles (fans from their first corner) for PN triangles",
         ),
         (r.skipped_primitives, "glTF primitives left out: POINTS or LINES, not surfaces"),
+        (
+            r.ignored_tag_lines,
+            "OpenSubdiv tag lines (creases, corners, holes) not used: PN triangles interpolate the cage, they do not subdivide it",
+        ),
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
         (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
@@ -273,6 +277,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         "dropped_collapsed_patches": r.dropped_collapsed_patches,
         "split_polygons": r.split_polygons,
         "skipped_primitives": r.skipped_primitives,
+        "ignored_tag_lines": r.ignored_tag_lines,
         "collapsed_triangles": mesh.collapsed_triangles,
         "flipped": r.flipped,
     })
@@ -300,11 +305,7 @@ const ANNOUNCED_TRIANGLES: u64 = 20_000_000;
 /// Says on stderr, before the frame is written, how large a large output will be: its counts,
 /// its memory and (with `-o`) about its file size, so a run that will take a while and a lot
 /// of disk never starts without a word.
-fn announce_large_output(
-    layout: &tessera::engine::layout::Layout,
-    opts: &EngineOptions,
-    out: Option<&Path>,
-) {
+fn announce_large_output(layout: &tessera::engine::layout::Layout, opts: &EngineOptions, out: Option<&Path>) {
     let (vertices, triangles) = (layout.vertex_count() as u64, layout.triangle_count() as u64);
     if triangles < ANNOUNCED_TRIANGLES {
         return;

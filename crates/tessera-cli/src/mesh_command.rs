@@ -63,7 +63,6 @@ pub struct MeshArgs {
     pub input_args: InputArgs,
 }
 
-
 /// One frame, whichever engine drew it.
 struct Drawn {
     mesh: Mesh,
@@ -126,7 +125,9 @@ pub fn run(a: MeshArgs) -> CliResult {
                 check.rounds, check.failing_patches
             );
         }
-        if let Some(out) = a.output.as_ref().filter(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply"))) {
+        if let Some(out) =
+            a.output.as_ref().filter(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
+        {
             eprintln!(
                 "note: the GPU engine gives no per-corner patch parameters: {} has no patch_uv, so `tessera check --against` cannot measure its error (--engine cpu writes them)",
                 out.display()
@@ -188,7 +189,8 @@ fn check_flags(a: &MeshArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if a.engine == EngineArg::Gpu && (a.measure_error || a.strips) {
         return Err(
-            "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips".into()
+            "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips"
+                .into(),
         );
     }
     if let Some(out) = &a.output {
@@ -260,7 +262,15 @@ fn draw_on_gpu(
         let run = gpu::tessellate_from_camera(set, &camera, screen, a.repeat, &mut mesh, &mut times)?;
         let culled = run.culled;
         let gpu = Some((run, times));
-        return Ok(Drawn { mesh, culled, report: None, frames: Vec::new(), prepare: Duration::ZERO, queues: None, gpu });
+        return Ok(Drawn {
+            mesh,
+            culled,
+            report: None,
+            frames: Vec::new(),
+            prepare: Duration::ZERO,
+            queues: None,
+            gpu,
+        });
     }
     let start = Instant::now();
     let tess_options = TessellatorOptions { plan: options, engine: opts };
@@ -268,18 +278,30 @@ fn draw_on_gpu(
     let prepare = start.elapsed();
     let layout = tess.plan_frame(None).map_err(explain)?;
     crate::announce_large_output(layout, &opts, a.output.as_deref());
-    let (plan, pattern) = (tess.plan().expect("a frame was planned"), tess.pattern().expect("a frame was planned"));
+    let (plan, pattern) =
+        (tess.plan().expect("a frame was planned"), tess.pattern().expect("a frame was planned"));
     let run = gpu::tessellate(set, plan, pattern, a.repeat, &mut mesh, &mut times)?;
     let culled = plan.culled_count();
     let frames = vec![tess.timings()];
-    Ok(Drawn { mesh, culled, report: tess.report().copied(), frames, prepare, queues: None, gpu: Some((run, times)) })
+    Ok(Drawn {
+        mesh,
+        culled,
+        report: tess.report().copied(),
+        frames,
+        prepare,
+        queues: None,
+        gpu: Some((run, times)),
+    })
 }
 
 /// Says where `--max-factor` (or semi-uniform's highest level) stopped an error bound.
 fn warn_capped(a: &MeshArgs, set: &SurfaceSet, chosen: &Chosen, report: Option<&BoundReport>) {
     let Some(r) = report.filter(|r| r.capped_patches > 0) else { return };
-    let Ok(accepted) = validate(chosen.scheme, &chosen.criterion, &chosen.options, set, Engine::Cpu) else { return };
-    let flag = if matches!(chosen.scheme, Scheme::SemiUniform { .. }) { "--max-level" } else { "--max-factor" };
+    let Ok(accepted) = validate(chosen.scheme, &chosen.criterion, &chosen.options, set, Engine::Cpu) else {
+        return;
+    };
+    let flag =
+        if matches!(chosen.scheme, Scheme::SemiUniform { .. }) { "--max-level" } else { "--max-factor" };
     let cap = match chosen.scheme {
         Scheme::SemiUniform { max_level } => format!("--max-level {max_level} (factor {})", accepted.cap),
         _ => format!("--max-factor {}", a.criterion.max_factor),
@@ -370,7 +392,8 @@ fn stats_json(
     }
     if let Some(strips) = &mesh.strips {
         stats["strip_indices"] = strips.len().into();
-        stats["strips"] = (strips.iter().filter(|&&i| i == tessera::mesh::strips::RESTART).count() + 1).into();
+        stats["strips"] =
+            (strips.iter().filter(|&&i| i == tessera::mesh::strips::RESTART).count() + 1).into();
     }
     if let Some(q) = &drawn.queues {
         let sizes: Vec<usize> = (0..=q.max_level()).map(|m| q.level(m).len()).collect();

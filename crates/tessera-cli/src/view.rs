@@ -24,7 +24,7 @@ use std::time::Instant;
 use tessera::camera::Camera;
 use tessera::criterion::{Plan, PlanScratch};
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{validate, Criterion, Engine, PlanOptions, SchemePlan, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme, SchemePlan};
 use tessera::surface::SurfaceSet;
 use tessera::tessellator::{Tessellator, TessellatorOptions};
 use tessera_gpu::tessellator::{PassTimer, PASSES};
@@ -396,7 +396,12 @@ fn tessellate(
         let plan_ms = start.elapsed().as_secs_f64() * 1e3;
         let (plan, pattern) = (tess.plan().expect("planned"), tess.pattern().expect("planned"));
         if path == Path::Instanced {
-            return Ok(Tessellated { path, stages: format!("PLAN {plan_ms:.1} (INSTANCED)"), levels: Vec::new(), upload: None });
+            return Ok(Tessellated {
+                path,
+                stages: format!("PLAN {plan_ms:.1} (INSTANCED)"),
+                levels: Vec::new(),
+                upload: None,
+            });
         }
         state.engine.prepare(&state.ctx, set, plan, pattern)?;
         state.engine.record_timed(encoder, state.timer.as_ref());
@@ -476,7 +481,11 @@ fn record_draw(
 
 /// The frame's triangle count for the statistics line; for the GPU engine also its pass
 /// times, appended to `drawn.stages` (a read-back).
-fn triangles_drawn(state: &State, drawn: &mut Tessellated, cull: bool) -> Result<u64, Box<dyn std::error::Error>> {
+fn triangles_drawn(
+    state: &State,
+    drawn: &mut Tessellated,
+    cull: bool,
+) -> Result<u64, Box<dyn std::error::Error>> {
     match (drawn.path, &drawn.upload, &state.instanced) {
         (Path::Cpu, Some((_, count)), _) => Ok(*count as u64),
         // Drawn by the instanced path: the queues' patches times their patterns' triangles,

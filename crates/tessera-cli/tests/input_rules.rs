@@ -57,6 +57,32 @@ fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
     assert!(text(&check.stdout).contains("boundary edges       0"), "{}", text(&check.stdout));
 }
 
+/// A subdivision cage's tag lines are read (a bad one is an error naming its line) and, as PN
+/// triangles do not use them, reported as not used.
+#[test]
+fn opensubdiv_tags_are_read_and_reported_unused_by_pn_triangles() {
+    let dir = scratch("cage-tags");
+    // catmark_cube_creases1: 12 crease lines and an interpolateboundary line.
+    let cage = data("subdivision/catmark_cube_creases1.obj");
+    let out = tessera(&["mesh", cage.to_str().unwrap(), "--factor", "2", "--stats"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("repair: 13 OpenSubdiv tag lines"), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+    assert_eq!(v["repairs"]["ignored_tag_lines"], 13);
+    // A crease between two vertices that share no edge: refused, naming the line.
+    let mut bad = std::fs::read_to_string(&cage).unwrap();
+    if !bad.ends_with('\n') {
+        bad.push('\n');
+    }
+    bad.push_str("t crease 2/1/0 0 7 2.0\n");
+    std::fs::write(dir.join("bad.obj"), &bad).unwrap();
+    let refused = tessera(&["mesh", "bad.obj", "--factor", "2"], &dir);
+    assert_eq!(refused.status.code(), Some(2));
+    let line = bad.lines().count();
+    let expected = format!("bad.obj:{line}: tag `crease` names vertices 0 and 7, which share no face edge");
+    assert!(text(&refused.stderr).contains(&expected), "{}", text(&refused.stderr));
+}
+
 #[test]
 fn the_default_camera_takes_the_formats_up_axis_and_says_so() {
     let dir = scratch("up-axis");

@@ -7,7 +7,7 @@ mod common;
 
 use common::*;
 use tessera::criterion::Plan;
-use tessera::engine::{Layout, EngineOptions};
+use tessera::engine::{EngineOptions, Layout};
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::surface::SurfaceSet;

@@ -12,7 +12,7 @@ use tessera::criterion::Plan;
 use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::Pattern;
-use tessera::scheme::{self, PlanOptions, SchemePlan, Scheme};
+use tessera::scheme::{self, PlanOptions, Scheme, SchemePlan};
 use tessera::surface::SurfaceSet;
 
 fn data_dir() -> PathBuf {

@@ -31,9 +31,7 @@ fn uniform_torus(c: &mut Criterion) {
         group.throughput(Throughput::Elements(triangles));
         let mut mesh = Mesh::default();
         group.bench_function(format!("torus_64x32/factor_{n}/reuse"), |b| {
-            b.iter(|| {
-                tessellate_into(&set, &plan, &Uniform, EngineOptions::default(), &mut mesh).unwrap()
-            })
+            b.iter(|| tessellate_into(&set, &plan, &Uniform, EngineOptions::default(), &mut mesh).unwrap())
         });
         group.bench_function(format!("torus_64x32/factor_{n}/fresh"), |b| {
             b.iter(|| tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap())

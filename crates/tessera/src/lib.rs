@@ -85,6 +85,7 @@ pub mod pattern;
 pub mod sampling;
 pub mod scene;
 pub mod scheme;
+pub mod subdivision;
 pub mod surface;
 pub mod tessellator;
 #[cfg(any(test, feature = "fuzzing"))]

@@ -35,10 +35,10 @@ use crate::camera::Camera;
 use crate::criterion::tolerance::BoundReport;
 use crate::criterion::Plan;
 use crate::engine::fast_evaluator::FastEvaluator;
-use crate::engine::{self, Layout, EngineOptions};
+use crate::engine::{self, EngineOptions, Layout};
 use crate::error::Result;
 use crate::mesh::{Mesh, MeshBuffers};
-use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, SchemePlan, Prepared, Scheme};
+use crate::scheme::{validate, Criterion, Engine, PlanOptions, PlanScratch, Prepared, Scheme, SchemePlan};
 use std::time::{Duration, Instant};
 
 /// Wall time of each stage of a frame ([`Tessellator::timings`]).
@@ -238,7 +238,8 @@ impl<'a> Tessellator<'a> {
     /// long the write will take, or refuse it) before anything of the output's size exists.
     /// Cost: the plan's plus the layout's (O(E + P)).
     pub fn plan_frame(&mut self, camera: Option<&Camera>) -> Result<&Layout> {
-        let options = PlanOptions { camera: camera.copied().or(self.options.plan.camera), ..self.options.plan };
+        let options =
+            PlanOptions { camera: camera.copied().or(self.options.plan.camera), ..self.options.plan };
         let start = Instant::now();
         self.planned_ok = false;
         self.laid_out = false;
@@ -298,7 +299,9 @@ impl<'a> Tessellator<'a> {
             Output::Mesh(mesh) => {
                 engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, mesh, fast)?
             }
-            Output::Buffers(buffers) => engine::write_into(self.set, plan, pattern, layout_ref, buffers, fast)?,
+            Output::Buffers(buffers) => {
+                engine::write_into(self.set, plan, pattern, layout_ref, buffers, fast)?
+            }
         };
         self.timings = FrameTimings {
             // The pattern cache's fill counts with the vertices, whose pass uses it first.
@@ -502,13 +505,19 @@ mod tests {
         // camera.
         let criterion = Criterion::PixelError(1.0);
         tess.reconfigure(Scheme::Transition, criterion, plan).unwrap();
-        let fresh = Tessellator::new(&set, Scheme::Transition, criterion, options).unwrap().frame(None).unwrap().clone();
+        let fresh = Tessellator::new(&set, Scheme::Transition, criterion, options)
+            .unwrap()
+            .frame(None)
+            .unwrap()
+            .clone();
         assert_eq!(*tess.frame(None).unwrap(), fresh);
         assert!(tess.report().unwrap().worst_ratio <= 1.0);
         // A request the scheme refuses leaves the tessellator as it was.
         let odd = Scheme::Hardware(crate::sampling::Partitioning::FractionalOdd);
-        assert!(matches!(tess.reconfigure(odd, criterion, plan), Err(crate::Error::CriterionNotAccepted { .. })));
+        assert!(matches!(
+            tess.reconfigure(odd, criterion, plan),
+            Err(crate::Error::CriterionNotAccepted { .. })
+        ));
         assert_eq!(tess.scheme(), Scheme::Transition);
     }
-
 }

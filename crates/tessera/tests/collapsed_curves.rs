@@ -10,7 +10,7 @@ mod common;
 use glam::DVec3;
 use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{Criterion, PlanOptions, SchemePlan, Scheme};
+use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePlan};
 use tessera::surface::{BuildOptions, Orientation, Patch, RationalBicubic, SurfaceSet};
 use tessera::verify;
 

@@ -9,9 +9,8 @@ use tessera::verify;
 
 fn max_error(set: &tessera::surface::SurfaceSet, n: u32) -> f64 {
     let plan = Plan::uniform(set, n).unwrap();
-    let mesh =
-        tessellate(set, &plan, &Uniform, EngineOptions { corner_params: true, ..Default::default() })
-            .unwrap();
+    let mesh = tessellate(set, &plan, &Uniform, EngineOptions { corner_params: true, ..Default::default() })
+        .unwrap();
     verify::approximation_error(&mesh, set, 6).unwrap().max
 }
 

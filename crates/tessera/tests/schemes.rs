@@ -17,7 +17,7 @@ use tessera::mesh::strips;
 use tessera::mesh::Mesh;
 use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::semi_uniform::StaticPattern;
-use tessera::scheme::{Criterion, PlanOptions, SchemePlan, Scheme};
+use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePlan};
 use tessera::surface::{Domain, SurfaceSet};
 use tessera::Error;
 

@@ -213,8 +213,7 @@ fn tessellated_rational_conics_stay_exact() {
     for (scheme, criterion) in cases {
         for (name, set) in [("sphere", &sphere), ("cylinder", &cylinder)] {
             let planned = scheme.plan(set, &criterion, &PlanOptions::default()).unwrap();
-            let mesh =
-                tessellate(set, &planned.plan, &planned.pattern, EngineOptions::default()).unwrap();
+            let mesh = tessellate(set, &planned.plan, &planned.pattern, EngineOptions::default()).unwrap();
             let what = format!("{name} {scheme:?} {criterion:?}");
             for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
                 let (p, n) = (glam::Vec3::from(*p).as_dvec3(), glam::Vec3::from(*n).as_dvec3());

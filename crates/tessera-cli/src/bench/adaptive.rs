@@ -138,11 +138,8 @@ impl Model {
             Err(e) if too_large(&e) => return Ok(None),
             Err(e) => return Err(format!("{} {}: {e}", self.name, scheme.name()).into()),
         };
-        let engine = EngineOptions {
-            corner_params: true,
-            max_triangles: Some(max_triangles),
-            ..Default::default()
-        };
+        let engine =
+            EngineOptions { corner_params: true, max_triangles: Some(max_triangles), ..Default::default() };
         let mesh = match tessellate(&self.set, &planned.plan, &planned.pattern, engine) {
             Ok(m) => m,
             Err(e) if too_large(&e) => return Ok(None),

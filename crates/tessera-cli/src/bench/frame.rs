@@ -232,7 +232,8 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
         .iter()
         .filter_map(|scene| {
             let options = scene.options().plan;
-            crate::gpu::screen_criterion(&scene.set, scene.scheme, &scene.criterion, &options).map(|s| (scene, s))
+            crate::gpu::screen_criterion(&scene.set, scene.scheme, &scene.criterion, &options)
+                .map(|s| (scene, s))
         })
         .collect();
     ctx.plan_steps(screens.len() as u64);

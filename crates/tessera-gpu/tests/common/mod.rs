@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use tessera::criterion::Plan;
-use tessera::engine::{self, Layout, EngineOptions};
+use tessera::engine::{self, EngineOptions, Layout};
 use tessera::mesh::Mesh;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;

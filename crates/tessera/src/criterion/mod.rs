@@ -19,10 +19,10 @@ pub mod tolerance;
 pub mod view;
 
 use crate::error::{Error, Result};
-use esc::Threshold;
-use view::ViewCriterion;
 use crate::sampling::{EdgeRow, SamplingKind};
 use crate::surface::SurfaceSet;
+use esc::Threshold;
+use view::ViewCriterion;
 
 pub use crate::sampling::MAX_FACTOR;
 

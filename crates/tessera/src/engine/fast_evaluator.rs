@@ -402,4 +402,3 @@ impl<'a> FastEvaluator<'a> {
         out.patch.fill(p as u32);
     }
 }
-

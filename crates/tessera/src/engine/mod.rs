@@ -172,7 +172,8 @@ pub(crate) fn write_with(
         indices: &mut out.indices,
         triangle_patch: &mut out.triangle_patch,
     };
-    let vertices_done = write_buffers(set, plan, pattern, layout, options.corner_params, buffers, params, fast);
+    let vertices_done =
+        write_buffers(set, plan, pattern, layout, options.corner_params, buffers, params, fast);
     out.strips = if options.strips { Some(strips_of(set, plan, pattern, layout)?) } else { None };
     Ok(WriteTimes { vertices: vertices_done - start, indices: vertices_done.elapsed() })
 }
@@ -223,10 +224,12 @@ pub(crate) fn write_buffers(
     let uniform = fast.filter(|f| f.triangles().active() && !corner_params);
     let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
-    let mut all = VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
+    let mut all =
+        VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     let corner_part = all.take_front(layout.corners as usize);
     let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
-    let patch_part = PatchOut { verts: all, idx: &mut *indices, tp: &mut *triangle_patch, params: &mut *params };
+    let patch_part =
+        PatchOut { verts: all, idx: &mut *indices, tp: &mut *triangle_patch, params: &mut *params };
     rayon::join(
         || {
             write_corners(set, fast, corner_part);
@@ -252,7 +255,8 @@ pub(crate) fn write_buffers(
     }
     let vertices_done = std::time::Instant::now();
 
-    let mut all = VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
+    let mut all =
+        VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     all.take_front(layout.interior_offsets[0] as usize);
     let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
     match uniform {

@@ -821,7 +821,7 @@ mod tests {
     #[test]
     fn every_scheme_and_surface_kind_matches_the_generic_engine() {
         use crate::criterion::view::{Mapping, ViewCriterion};
-        use crate::engine::{Layout, EngineOptions};
+        use crate::engine::{EngineOptions, Layout};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let view = |criterion, fmin, fmax| Criterion::View { criterion, fmin, fmax };
@@ -995,7 +995,7 @@ mod tests {
     #[ignore = "slow tier: every model of the shared data × every scheme, fast paths against the generic engine"]
     fn fast_paths_equal_the_generic_engine_on_every_model_and_scheme() {
         use crate::criterion::view::{Mapping, ViewCriterion};
-        use crate::engine::{Layout, EngineOptions};
+        use crate::engine::{EngineOptions, Layout};
         use crate::sampling::Partitioning;
         use crate::scheme::{Criterion, PlanOptions, Scheme};
         let data = crate::test_support::data;

@@ -199,7 +199,12 @@ impl Block {
 
     /// Writes lanes `0..pos.len()`, taking `exact(l)` where a lane is unreliable.
     #[inline(always)]
-    pub(super) fn write(&self, pos: &mut [[f32; 3]], nrm: &mut [[f32; 3]], exact: impl Fn(usize) -> SurfacePoint) {
+    pub(super) fn write(
+        &self,
+        pos: &mut [[f32; 3]],
+        nrm: &mut [[f32; 3]],
+        exact: impl Fn(usize) -> SurfacePoint,
+    ) {
         if self.all_ok() {
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 *pos = [self.pos[0][l], self.pos[1][l], self.pos[2][l]];
@@ -345,10 +350,10 @@ pub(super) fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n:
 mod tests {
     use super::super::fast_evaluator::FastEvaluator;
     use super::*;
-    use crate::engine::{write_with, Layout, EngineOptions};
+    use crate::criterion::Plan;
+    use crate::engine::{write_with, EngineOptions, Layout};
     use crate::mesh::Mesh;
     use crate::pattern::uniform::Uniform;
-    use crate::criterion::Plan;
     use crate::pattern::PatternInput;
     use crate::sampling::SamplingKind;
     use crate::surface::{BuildOptions, Domain, Orientation, Patch, SurfaceSet};

@@ -66,6 +66,32 @@ fn assert_obj_invariants(mesh: &PolygonMesh) {
             );
         }
     }
+    // Tags are checked against the cage: every index in range, every sharpness ≥ 0.
+    let tags = &mesh.tags;
+    let vertices = mesh.positions.len();
+    for c in &tags.creases {
+        assert!(
+            c.vertices.iter().all(|&v| (v as usize) < vertices),
+            "line {}: crease vertex out of range",
+            c.line
+        );
+        assert!(
+            c.sharpness.is_finite() && c.sharpness >= 0.0,
+            "line {}: crease sharpness {}",
+            c.line,
+            c.sharpness
+        );
+    }
+    for c in &tags.corners {
+        assert!((c.vertex as usize) < vertices, "line {}: corner vertex out of range", c.line);
+        assert!(
+            c.sharpness.is_finite() && c.sharpness >= 0.0,
+            "line {}: corner sharpness {}",
+            c.line,
+            c.sharpness
+        );
+    }
+    assert!(tags.holes.iter().all(|&f| (f as usize) < mesh.faces.len()), "hole face out of range");
 }
 
 /// Checks the Newell patch reader: [`patches::parse_patches`] on the bytes. A parsed file

@@ -103,7 +103,9 @@ pub fn load(path: &Path, options: impl Into<LoadOptions>) -> Result<SurfaceSet> 
         Some("obj") => {
             let mut mesh = obj::read_obj(path)?;
             let split = mesh.split_polygons();
-            with_split(SurfaceSet::pn_from_mesh(&mesh, path, options)?, split)
+            let mut set = with_split(SurfaceSet::pn_from_mesh(&mesh, path, options)?, split);
+            set.repairs.ignored_tag_lines = mesh.tags.lines.iter().map(|&(_, n)| n).sum();
+            set
         }
         Some("ply") => {
             let (mesh, split) = ply::parse_ply_counting_polygons(&read_input(path)?, path)?;

@@ -7,8 +7,10 @@
 //! Supported: `v x y z [w]` (a 4th value `w` or vertex colours after `x y z` are ignored),
 //! `vn x y z`, `vt` (ignored, but counted so texture indices can be checked), and `f` with
 //! corners `a`, `a/b`, `a//c` or `a/b/c`, including negative (relative) indices. Lines ending
-//! in a backslash continue on the next line; `#` starts a comment. `o`, `g`, `s`, `usemtl`,
-//! `mtllib`, `l`, `p` and unknown statements are ignored.
+//! in a backslash continue on the next line; `#` starts a comment. OpenSubdiv's tag lines
+//! (`t crease …`, `t corner …`, `t hole …`, …) of subdivision cages are read into
+//! [`PolygonMesh::tags`] ([`crate::subdivision::tags`]). `o`, `g`, `s`, `usemtl`, `mtllib`, `l`,
+//! `p` and unknown statements are ignored.
 //!
 //! Indices follow the standard rule: a positive index `i` refers to the `i`-th element of
 //! its kind defined *so far* (1-based), a negative index `-k` to the `k`-th most recent one.
@@ -93,6 +95,7 @@ pub fn parse_obj(text: &str, file: &Path) -> Result<PolygonMesh> {
             "v" => mesh.positions.push(at.vector(&mut tokens, "v")?),
             "vn" => mesh.normals.push(at.vector(&mut tokens, "vn")?),
             "vt" => texcoord_count += 1,
+            "t" => mesh.tags.read_line(tokens, file, line)?,
             "f" => {
                 let face = at.face(tokens, mesh.positions.len(), texcoord_count, mesh.normals.len())?;
                 mesh.faces.push(face);
@@ -104,6 +107,10 @@ pub fn parse_obj(text: &str, file: &Path) -> Result<PolygonMesh> {
 
     if mesh.faces.is_empty() {
         return Err(Error::unsupported(file, 0, "no faces"));
+    }
+    if !mesh.tags.is_empty() {
+        let faces: Vec<&[u32]> = mesh.faces.iter().map(|f| f.positions.as_slice()).collect();
+        mesh.tags.check(mesh.positions.len(), &faces, file)?;
     }
     Ok(mesh)
 }

@@ -435,8 +435,8 @@ fn framing(set: &SurfaceSet) -> Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::surface::{Patch, RationalBicubic};
     use crate::criterion::esc::Threshold;
+    use crate::surface::{Patch, RationalBicubic};
     use glam::DVec3;
 
     pub(super) fn flat() -> SurfaceSet {

@@ -84,7 +84,11 @@ pub fn validate(
     check_request(scheme, criterion, options)?;
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
-    Ok(Accepted { cap: scheme.cap(options), edge_rule: scheme.edge_rule(), interior_rule: scheme.interior_rule() })
+    Ok(Accepted {
+        cap: scheme.cap(options),
+        edge_rule: scheme.edge_rule(),
+        interior_rule: scheme.interior_rule(),
+    })
 }
 
 impl Scheme {
@@ -128,7 +132,6 @@ impl Scheme {
     }
 }
 
-
 /// The scheme × criterion × options part of [`validate`]: the pairing and every range.
 fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -> Result<()> {
     scheme.accepts(criterion)?;
@@ -142,14 +145,18 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
     let out_of_range =
         |factor: f64, expected: String| Err(Error::FactorOutOfRange { scheme: name, factor, expected });
     match (scheme, *criterion) {
-        (Scheme::SemiUniform { max_level }, _) if max_level > SEMI_UNIFORM_MAX_LEVEL => Err(Error::InvalidParameter {
-            name: "max level",
-            reason: format!("{max_level}: semi-uniform levels go from 0 to {SEMI_UNIFORM_MAX_LEVEL}"),
-        }),
-        (Scheme::Esc { max_level }, _) if max_level > crate::pattern::esc::MAX_LEVEL => Err(Error::InvalidParameter {
-            name: "max level",
-            reason: format!("{max_level}: ESC levels go from 0 to {}", crate::pattern::esc::MAX_LEVEL),
-        }),
+        (Scheme::SemiUniform { max_level }, _) if max_level > SEMI_UNIFORM_MAX_LEVEL => {
+            Err(Error::InvalidParameter {
+                name: "max level",
+                reason: format!("{max_level}: semi-uniform levels go from 0 to {SEMI_UNIFORM_MAX_LEVEL}"),
+            })
+        }
+        (Scheme::Esc { max_level }, _) if max_level > crate::pattern::esc::MAX_LEVEL => {
+            Err(Error::InvalidParameter {
+                name: "max level",
+                reason: format!("{max_level}: ESC levels go from 0 to {}", crate::pattern::esc::MAX_LEVEL),
+            })
+        }
         (Scheme::Esc { .. }, _) if options.cull => Err(Error::InvalidParameter {
             name: "cull",
             reason: "the esc scheme chooses one level per object and culls nothing".into(),
@@ -217,9 +224,11 @@ fn check_surface_kinds(scheme: Scheme, set: &SurfaceSet) -> Result<()> {
             "quad",
             "SD-2 is defined for triangles (paper 001); use the semi-uniform, hardware or transition scheme",
         ),
-        Scheme::Esc { .. } => {
-            (Domain::Quad, "triangle", "ESC tessellates bicubic Bézier patches only (a mesh gives PN triangles)")
-        }
+        Scheme::Esc { .. } => (
+            Domain::Quad,
+            "triangle",
+            "ESC tessellates bicubic Bézier patches only (a mesh gives PN triangles)",
+        ),
         _ => return Ok(()),
     };
     match set.patches.iter().position(|p| p.domain() != needs) {
@@ -251,7 +260,11 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     | (Scheme::Hardware(_), Criterion::Factor(_))
             );
             if !planned_on_gpu {
-                return refuse(format!("{} with the {} scheme planned on the GPU", criterion.name(), scheme.name()));
+                return refuse(format!(
+                    "{} with the {} scheme planned on the GPU",
+                    criterion.name(),
+                    scheme.name()
+                ));
             }
             if !options.cull {
                 return refuse("a frame without culling (it culls every frame it plans)".into());
@@ -293,15 +306,30 @@ mod tests {
         v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Cpu).unwrap();
         // The GPU: three scheme families; from the camera, four pairings, culled.
         let engine_refused = |r: Result<Accepted>| matches!(r, Err(Error::EngineNotSupported { .. }));
-        assert!(engine_refused(v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Gpu)));
+        assert!(engine_refused(v(
+            Scheme::SemiUniform { max_level: 5 },
+            Criterion::Factor(8.0),
+            &o,
+            Engine::Gpu
+        )));
         v(odd, Criterion::Factor(5.5), &o, Engine::Gpu).unwrap();
         v(odd, Criterion::Factor(5.5), &culled, Engine::GpuFromCamera).unwrap();
         assert!(engine_refused(v(odd, Criterion::Factor(5.5), &o, Engine::GpuFromCamera)), "no culling");
         v(Scheme::Transition, silhouette, &culled, Engine::GpuFromCamera).unwrap();
-        assert!(engine_refused(v(Scheme::Transition, Criterion::Tolerance(0.1), &culled, Engine::GpuFromCamera)));
+        assert!(engine_refused(v(
+            Scheme::Transition,
+            Criterion::Tolerance(0.1),
+            &culled,
+            Engine::GpuFromCamera
+        )));
         v(Scheme::Transition, Criterion::PixelError(0.5), &culled, Engine::GpuFromCamera).unwrap();
         let high_cap = PlanOptions { max_factor: GPU_CHECK_MAX_FACTOR + 1, ..culled };
-        assert!(engine_refused(v(Scheme::Transition, Criterion::PixelError(0.5), &high_cap, Engine::GpuFromCamera)));
+        assert!(engine_refused(v(
+            Scheme::Transition,
+            Criterion::PixelError(0.5),
+            &high_cap,
+            Engine::GpuFromCamera
+        )));
         v(Scheme::Uniform, Criterion::PixelError(0.5), &high_cap, Engine::GpuFromCamera).unwrap();
         // The request's own errors come first, the same for every engine.
         for engine in [Engine::Cpu, Engine::Gpu, Engine::GpuFromCamera] {

@@ -7,6 +7,7 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::subdivision::SubdivisionTags;
 
 /// One polygon of an input mesh.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -34,6 +35,9 @@ pub struct PolygonMesh {
     /// Primitives of a glTF input that are no surface (`POINTS`, `LINES`) and were left out;
     /// 0 for every other format.
     pub skipped_primitives: usize,
+    /// OpenSubdiv's tag lines of an OBJ subdivision cage (creases, corners, holes, boundary
+    /// rule), checked against the faces; empty for every other input.
+    pub tags: SubdivisionTags,
 }
 
 impl PolygonMesh {
@@ -153,6 +157,7 @@ impl PolygonMesh {
             },
             faces,
             skipped_primitives: 0,
+            tags: SubdivisionTags::default(),
         }
     }
 }

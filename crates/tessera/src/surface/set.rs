@@ -52,6 +52,9 @@ pub struct Repairs {
     pub split_polygons: usize,
     /// glTF primitives left out because they are no surface (`POINTS`, `LINES`).
     pub skipped_primitives: usize,
+    /// OpenSubdiv tag lines of an OBJ cage (creases, corners, holes, rules) that PN
+    /// triangles, which interpolate the mesh rather than subdivide it, do not use.
+    pub ignored_tag_lines: usize,
     /// The orientation was reversed (by `Outward` or by `flip`).
     pub flipped: bool,
 }

@@ -1,0 +1,64 @@
+//! Subdivision cages: the control meshes of Catmull-Clark and Loop surfaces, with the
+//! sharpness and boundary tags that shape their limit surfaces, in OpenSubdiv's terms (Sdc).
+//!
+//! This module holds what a cage *says* — [`SubdivisionTags`]: semi-sharp and infinitely
+//! sharp creases, corners, holes, the boundary interpolation, the crease method and
+//! Catmull-Clark's triangle rule — as [`crate::io::obj`] reads it from OpenSubdiv's OBJ dialect
+//! (`t NAME nint/nfloat/nstring ints floats strings`, vertex and face indices 0-based). Limit
+//! surface evaluation builds on it.
+//!
+//! Defaults are those OpenSubdiv's own regression tools apply to a cage whose file does not
+//! say ([`SubdivisionOptions::default`]); the shared `subdivision/` cages are those tools'
+//! shapes, so their limit surfaces are defined by them.
+
+pub mod tags;
+
+pub use tags::{Corner, Crease, SubdivisionTags, UnknownTag};
+
+/// How the limit surface meets the cage's boundary (OpenSubdiv's `VtxBoundaryInterpolation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BoundaryInterpolation {
+    /// No limit surface on faces at the boundary (tag value 0).
+    None,
+    /// Boundary edges are infinitely sharp; boundary vertices of one face stay smooth
+    /// (tag value 2, and the default when a cage says nothing).
+    #[default]
+    EdgeOnly,
+    /// Boundary edges are infinitely sharp and boundary vertices of one face are corners
+    /// (tag value 1).
+    EdgeAndCorner,
+}
+
+/// How semi-sharp creases lose sharpness from level to level (`Sdc::Options::CreasingMethod`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CreaseMethod {
+    /// Sharpness drops by one a level (`normal`, the default).
+    #[default]
+    Uniform,
+    /// Chaikin's rule: a crease's sharpness averages with its neighbours' (`chaikin`).
+    Chaikin,
+}
+
+/// Catmull-Clark's rule for the face points of triangles (`Sdc::Options::TriangleSubdivision`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TriangleRule {
+    /// Catmull-Clark's own rule (`catmark`, the default).
+    #[default]
+    Catmark,
+    /// The smoother weights for triangles (`smooth`).
+    Smooth,
+}
+
+/// The rules of a cage's limit surface that are not per edge or vertex.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SubdivisionOptions {
+    /// The boundary rule (`t interpolateboundary`).
+    pub boundary: BoundaryInterpolation,
+    /// The crease method (`t creasemethod`).
+    pub crease_method: CreaseMethod,
+    /// Catmull-Clark's triangle rule (`t smoothtriangles`).
+    pub triangles: TriangleRule,
+}
+
+/// Sharpness at or above this is infinitely sharp (OpenSubdiv's `SHARPNESS_INFINITE`).
+pub const INFINITELY_SHARP: f32 = 10.0;
