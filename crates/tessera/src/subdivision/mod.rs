@@ -11,9 +11,25 @@
 //! say ([`SubdivisionOptions::default`]); the shared `subdivision/` cages are those tools'
 //! shapes, so their limit surfaces are defined by them.
 
+pub mod bspline;
+pub mod cage;
+mod catmull_clark;
 pub mod tags;
 
+pub use cage::Cage;
+pub use catmull_clark::CageOptions;
 pub use tags::{Corner, Crease, SubdivisionTags, UnknownTag};
+
+/// Where a patch of a set built from a cage comes from
+/// ([`crate::surface::SurfaceSet::origins`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PatchOrigin {
+    /// The cage face (0-based, file order).
+    pub face: u32,
+    /// The corner sub-face of a face that is not a quad (OpenSubdiv's `QUAD_SUBFACES`
+    /// parameterisation: sub-face `i` is the quad at corner `i`); 0 for a quad.
+    pub subface: u16,
+}
 
 /// How the limit surface meets the cage's boundary (OpenSubdiv's `VtxBoundaryInterpolation`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

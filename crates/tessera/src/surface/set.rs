@@ -69,6 +69,10 @@ pub struct SurfaceSet {
     /// The model's up axis, for default cameras: +Z unless the loader knows the format's
     /// convention ([`crate::io::load`] sets it by [`crate::io::up_axis_of`]).
     pub up: crate::camera::UpAxis,
+    /// For a set built from a subdivision cage
+    /// ([`SurfaceSet::from_subdivision_cage`](crate::surface::SurfaceSet::from_subdivision_cage)):
+    /// patch `p`'s base face and sub-face; empty for every other input.
+    pub origins: Vec<crate::subdivision::PatchOrigin>,
 }
 
 /// Control-point indices of each corner and each edge (corner `e` → `e+1`) of a patch kind.
@@ -206,7 +210,7 @@ impl SurfaceSet {
         }
         let patches = kept;
         let topology = Topology::build(&keys);
-        SurfaceSet { patches, keys, topology, repairs, up: Default::default() }
+        SurfaceSet { patches, keys, topology, repairs, up: Default::default(), origins: Vec::new() }
     }
 
     /// Builds PN triangles from a triangle mesh.
@@ -389,7 +393,7 @@ impl SurfaceSet {
                 Patch::Pn(PnTriangle::from_edge_points(p, n, e))
             })
             .collect();
-        Ok(SurfaceSet { patches, keys, topology, repairs, up: Default::default() })
+        Ok(SurfaceSet { patches, keys, topology, repairs, up: Default::default(), origins: Vec::new() })
     }
 
     /// Axis-aligned bounds of all control points (the surface lies inside them).

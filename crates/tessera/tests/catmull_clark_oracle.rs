@@ -1,0 +1,128 @@
+//! tessera's Catmull-Clark limit surface against OpenSubdiv's own: every `catmark_*` cage of
+//! the shared data, uniform rates 1–8, face by face, compared with the points OpenSubdiv's Bfr
+//! prints through `tools/osd-oracle` (a C++ program linked against OpenSubdiv, which CI builds
+//! from Debian's `libosd-dev`; `scripts/test` builds it).
+//!
+//! What tessera calls a regular face must be exactly what Bfr calls one, and on those faces
+//! the points must agree within 1e-6 of the cage's bounding-box diagonal (in f64 they agree to
+//! rounding).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::{DVec2, DVec3};
+use tessera::io::obj::read_obj;
+use tessera::subdivision::bspline::{regular_face_grid, to_bezier};
+use tessera::subdivision::Cage;
+use tessera::surface::RationalBicubic;
+use tessera::test_support::data;
+
+/// The oracle binary: `$TESSERA_OSD_ORACLE`, else `tools/osd-oracle/osd_oracle`.
+fn oracle() -> PathBuf {
+    let path = std::env::var_os("TESSERA_OSD_ORACLE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/osd-oracle/osd_oracle"));
+    assert!(
+        path.exists(),
+        "the OpenSubdiv oracle {} is not built: install a C++ compiler and OpenSubdiv \
+         (apt-get install -y g++ libosd-dev) and run tools/osd-oracle/build.sh (scripts/test does both checks)",
+        path.display()
+    );
+    path
+}
+
+/// One face of the oracle's output.
+struct OracleFace {
+    regular: bool,
+    limit: bool,
+    /// `(u, v)` and the limit point there.
+    points: Vec<(DVec2, DVec3)>,
+}
+
+fn run_oracle(cage: &Path, rate: u32) -> Vec<OracleFace> {
+    let out = Command::new(oracle()).arg(cage).arg(rate.to_string()).output().expect("run the oracle");
+    assert!(
+        out.status.success(),
+        "oracle failed on {}: {}",
+        cage.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut faces: Vec<OracleFace> = Vec::new();
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let w: Vec<&str> = line.split_ascii_whitespace().collect();
+        if w[0] == "face" {
+            faces.push(OracleFace {
+                regular: w[6] == "regular",
+                limit: w[6] != "nolimit",
+                points: Vec::new(),
+            });
+        } else {
+            let n: Vec<f64> = w.iter().map(|x| x.parse().unwrap()).collect();
+            faces.last_mut().unwrap().points.push((DVec2::new(n[0], n[1]), DVec3::new(n[2], n[3], n[4])));
+        }
+    }
+    faces
+}
+
+fn catmark_cages() -> Vec<PathBuf> {
+    let mut cages: Vec<PathBuf> = std::fs::read_dir(data("subdivision"))
+        .expect("the shared data's subdivision folder")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("catmark_"))
+        .collect();
+    cages.sort();
+    cages
+}
+
+/// The cages whose non-manifold edges or vertices tessera refuses so far.
+const NON_MANIFOLD: &[&str] = &["catmark_fan.obj", "catmark_gregory_test4.obj", "catmark_nonman_edges.obj"];
+
+#[test]
+fn regular_faces_are_bfrs_regular_faces_and_their_points_agree() {
+    let mut compared_faces = 0;
+    let mut worst = (0.0f64, String::new());
+    for path in catmark_cages() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let mesh = read_obj(&path).unwrap();
+        let cage = match Cage::new(&mesh, &path) {
+            Ok(c) => c,
+            // Non-manifold cages are refused for now (with an error naming the face).
+            Err(e) => {
+                eprintln!("refused: {e}");
+                assert!(NON_MANIFOLD.contains(&name.as_str()), "{name}: {e}");
+                continue;
+            }
+        };
+        let (lo, hi) = mesh
+            .positions
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let diagonal = (hi - lo).length();
+        for rate in 1..=8 {
+            let faces = run_oracle(&path, rate);
+            assert_eq!(faces.len(), cage.face_count(), "{name}");
+            for (f, face) in faces.iter().enumerate() {
+                assert_eq!(!cage.holes[f], face.limit, "{name} face {f}: has a limit surface");
+                assert_eq!(cage.is_regular_face(f), face.regular, "{name} face {f}: regular");
+                if !face.regular {
+                    continue;
+                }
+                let patch = RationalBicubic::polynomial(to_bezier(&regular_face_grid(&cage, f)));
+                for &(uv, expected) in &face.points {
+                    let d = (patch.position(uv) - expected).length() / diagonal;
+                    if d > worst.0 {
+                        worst = (d, format!("{name} face {f} rate {rate} at {uv}"));
+                    }
+                }
+                compared_faces += 1;
+            }
+        }
+    }
+    eprintln!(
+        "compared {compared_faces} regular face × rate cases; worst {:.3e} of the diagonal ({})",
+        worst.0, worst.1
+    );
+    assert!(worst.0 < 1e-6, "worst {:.3e} at {}", worst.0, worst.1);
+    assert!(compared_faces > 8 * 1000, "only {compared_faces} faces compared");
+}
