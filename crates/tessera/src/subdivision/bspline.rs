@@ -26,6 +26,20 @@ pub type BSplineGrid = [[DVec3; 4]; 4];
 ///
 /// Precondition: [`Cage::is_regular_face`]`(f)`. Cost: O(16).
 pub fn regular_face_grid(cage: &Cage, f: usize) -> BSplineGrid {
+    let mut mask = 0;
+    for (k, &e) in cage.face_edges(f).iter().enumerate() {
+        mask |= u8::from(cage.is_boundary_edge(e)) << k;
+    }
+    grid(cage, f, mask)
+}
+
+/// The B-spline grid of a quad `f` whose corners are regular within the part of their ring
+/// on `f`'s side of the edges in `mask` (bit `k`: edge `k` is a boundary or infinitely
+/// sharp): the points around it, and phantom points beyond the edges in `mask`.
+///
+/// Precondition: `f` is a regular patch in Far's sense with that boundary mask (its corners'
+/// rings, where not masked, are those of a regular grid). Cost: O(16).
+pub(crate) fn grid(cage: &Cage, f: usize, mask: u8) -> BSplineGrid {
     // Each corner's position in the grid and the grid directions of its leading edge (to the
     // next corner) and trailing edge (to the previous corner), as (col, row).
     const AT: [(i32, i32); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
@@ -48,11 +62,13 @@ pub fn regular_face_grid(cage: &Cage, f: usize) -> BSplineGrid {
         // The faces after this one counter-clockwise (across its trailing edge, then the
         // opposite one, then across its leading edge), where the cage has them; each is
         // read from the corner as [corner, leading, diagonal, trailing].
+        // (Around a corner of another valence the patch is regular only within a span of one
+        // or two faces between sharp edges, and the opposite quadrant is masked.)
         let step = |s: usize| -> Option<FaceCorner> { (interior || k + s < n).then(|| fan[(k + s) % n]) };
         let before = (k > 0 || interior).then(|| fan[(k + n - 1) % n]);
         let quads = [
             (step(1), [(t.0, t.1), (t.0 - l.0, t.1 - l.1), (-l.0, -l.1)]),
-            (step(2).filter(|_| interior), [(-l.0, -l.1), (-l.0 - t.0, -l.1 - t.1), (-t.0, -t.1)]),
+            (step(2).filter(|_| interior && n == 4), [(-l.0, -l.1), (-l.0 - t.0, -l.1 - t.1), (-t.0, -t.1)]),
             (before, [(-t.0, -t.1), (l.0 - t.0, l.1 - t.1), (l.0, l.1)]),
         ];
         for (face, offsets) in quads {
@@ -62,11 +78,6 @@ pub fn regular_face_grid(cage: &Cage, f: usize) -> BSplineGrid {
                 put(*d, q[(fc.corner as usize + 1 + s) % 4]);
             }
         }
-    }
-    let boundary = cage.face_edges(f).iter().map(|&e| cage.is_boundary_edge(e));
-    let mut mask = 0;
-    for (k, b) in boundary.enumerate() {
-        mask |= u8::from(b) << k;
     }
     fill_phantoms(&mut grid, mask);
     grid.map(|row| row.map(|p| p.expect("a regular face's grid is complete after the phantoms")))

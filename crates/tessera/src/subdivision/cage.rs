@@ -85,10 +85,7 @@ impl Cage {
                     return Err(Error::unsupported(
                         file,
                         face.line,
-                        format!(
-                            "face uses vertex {} twice; a subdivision cage's faces need distinct corners",
-                            v + 1
-                        ),
+                        format!("face uses vertex {} twice; a subdivision cage's faces need distinct corners", v + 1),
                     ));
                 }
             }
@@ -96,8 +93,49 @@ impl Cage {
             face_start.push(face_vertices.len() as u32);
         }
         let face_lines: Vec<usize> = mesh.faces.iter().map(|f| f.line).collect();
-        let faces = mesh.faces.len();
+        let mut cage =
+            Cage::with_topology(mesh.positions.clone(), face_start, face_vertices, face_lines, None, file)?;
+        cage.options = mesh.tags.options;
+        cage.apply_tags(mesh);
+        Ok(cage)
+    }
 
+    /// A piece of a refined cage (the neighbourhood of a face at some level): the same
+    /// adjacency, with sharpness given and only the vertices marked `complete` having all
+    /// their faces (the others' order around them is not needed and not checked).
+    ///
+    /// Preconditions: faces with distinct corners, consistently oriented, manifold at the
+    /// complete vertices; `edge_sharpness(a, b)` gives the sharpness of the edge between
+    /// vertices `a` and `b`. Cost: O(corners).
+    pub(crate) fn local(
+        points: Vec<DVec3>,
+        face_start: Vec<u32>,
+        face_vertices: Vec<u32>,
+        complete: &[bool],
+        edge_sharpness: impl Fn(u32, u32) -> f32,
+        vertex_sharpness: Vec<f32>,
+        options: SubdivisionOptions,
+    ) -> Cage {
+        let lines = vec![0; face_start.len() - 1];
+        let mut cage = Cage::with_topology(points, face_start, face_vertices, lines, Some(complete), Path::new(""))
+            .expect("a refined neighbourhood is manifold where it is complete");
+        cage.edge_sharpness = cage.edges.iter().map(|&[a, b]| edge_sharpness(a, b)).collect();
+        cage.vertex_sharpness = vertex_sharpness;
+        cage.options = options;
+        cage
+    }
+
+    /// The adjacency of faces given by their corners; `complete` (for a local piece) says
+    /// which vertices have all their faces, and only those are checked and ordered.
+    fn with_topology(
+        points: Vec<DVec3>,
+        face_start: Vec<u32>,
+        face_vertices: Vec<u32>,
+        face_lines: Vec<usize>,
+        complete: Option<&[bool]>,
+        file: &Path,
+    ) -> Result<Cage> {
+        let faces = face_start.len() - 1;
         // Edges, each with the face along it and the face against it.
         let mut edge_of: std::collections::HashMap<(u32, u32), u32> = Default::default();
         let mut edges: Vec<[u32; 2]> = Vec::new();
@@ -133,9 +171,9 @@ impl Cage {
                 face_edges[s + k] = id;
             }
         }
-
+        let vertices = points.len();
         let mut cage = Cage {
-            points: mesh.positions.clone(),
+            points,
             face_start,
             face_vertices,
             face_edges,
@@ -143,18 +181,17 @@ impl Cage {
             edge_faces,
             vertex_faces: Vec::new(),
             edge_sharpness: Vec::new(),
-            vertex_sharpness: vec![0.0; mesh.positions.len()],
+            vertex_sharpness: vec![0.0; vertices],
             holes: vec![false; faces],
-            options: mesh.tags.options,
+            options: SubdivisionOptions::default(),
             face_lines,
         };
-        cage.vertex_faces = cage.order_vertex_faces(file)?;
-        cage.apply_tags(mesh);
+        cage.vertex_faces = cage.order_vertex_faces(complete, file)?;
         Ok(cage)
     }
 
     /// The faces around every vertex in Vtr's order (see the module doc).
-    fn order_vertex_faces(&self, file: &Path) -> Result<Vec<Vec<FaceCorner>>> {
+    fn order_vertex_faces(&self, complete: Option<&[bool]>, file: &Path) -> Result<Vec<Vec<FaceCorner>>> {
         let mut incident: Vec<Vec<FaceCorner>> = vec![Vec::new(); self.points.len()];
         for f in 0..self.face_count() {
             for (c, &v) in self.face(f).iter().enumerate() {
@@ -163,7 +200,7 @@ impl Cage {
         }
         let mut ordered = Vec::with_capacity(incident.len());
         for (v, around) in incident.into_iter().enumerate() {
-            if around.is_empty() {
+            if around.is_empty() || complete.is_some_and(|c| !c[v]) {
                 ordered.push(around);
                 continue;
             }
@@ -279,6 +316,24 @@ impl Cage {
     /// Face `f`'s line in its file.
     pub fn face_line(&self, f: usize) -> usize {
         self.face_lines[f]
+    }
+
+    /// The faces of edge `e` (one at a boundary, else two).
+    pub fn edge_faces(&self, e: u32) -> Vec<u32> {
+        self.edge_faces[e as usize].iter().copied().filter(|&f| f != NO_FACE).collect()
+    }
+
+    /// The edge between vertices `a` and `b`, if any. Cost: O(faces around `a`).
+    pub fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
+        self.vertex_faces[a as usize].iter().flat_map(|fc| [self.leading_edge(*fc), self.trailing_edge(*fc)]).find(|&e| {
+            let [x, y] = self.edges[e as usize];
+            (x, y) == (a, b) || (x, y) == (b, a)
+        })
+    }
+
+    /// The sharpness of the edge between `a` and `b` (0 where there is none).
+    pub fn edge_sharpness_between(&self, a: u32, b: u32) -> f32 {
+        self.edge_between(a, b).map_or(0.0, |e| self.edge_sharpness[e as usize])
     }
 
     /// Whether edge `e` has a face on one side only.
