@@ -153,13 +153,18 @@ pub struct BaseVertexTopology {
 ///   non-manifold edges already make a crease.
 ///
 /// Cost: O(1).
-pub fn base_vertex_sharpness(tagged: f32, topology: BaseVertexTopology, boundary: BoundaryInterpolation) -> f32 {
+pub fn base_vertex_sharpness(
+    tagged: f32,
+    topology: BaseVertexTopology,
+    boundary: BoundaryInterpolation,
+) -> f32 {
     let t = topology;
     let corner = t.faces == 1 && t.edges == 2;
     if corner && boundary == BoundaryInterpolation::EdgeAndCorner {
         return INFINITELY_SHARP;
     }
-    let interior_non_manifold_crease = t.non_manifold_edges == 2 && t.boundary_edges == 0 && t.faces > t.edges;
+    let interior_non_manifold_crease =
+        t.non_manifold_edges == 2 && t.boundary_edges == 0 && t.faces > t.edges;
     if t.non_manifold && !interior_non_manifold_crease {
         return INFINITELY_SHARP;
     }
@@ -441,7 +446,12 @@ pub fn edge_child_rule(sharpness: f32, child_sharpness: [f32; 2]) -> VertexRule 
 ///   as in OpenSubdiv.
 ///
 /// Cost: O(faces).
-pub fn edge_mask(sharpness: f32, child_rule: VertexRule, face_sizes: &[usize], triangles: TriangleRule) -> EdgeMask {
+pub fn edge_mask(
+    sharpness: f32,
+    child_rule: VertexRule,
+    face_sizes: &[usize],
+    triangles: TriangleRule,
+) -> EdgeMask {
     let smooth = smooth_edge_mask(face_sizes, triangles);
     if !is_sharp(sharpness) {
         return smooth;
@@ -551,12 +561,15 @@ impl VertexMask {
     }
 }
 
+/// Two crease edges (indices into a vertex's incident edges) and the weight of each.
+type CreasePair = ([usize; 2], f64);
+
 /// One rule's mask before blending; `None` edges or faces mean the mask has no such weights
 /// (Sdc's sparse masks, which blend differently from weights of 0).
 #[derive(Clone, Copy)]
 struct RuleMask {
     vertex: f64,
-    edges: Option<(f64, Option<([usize; 2], f64)>)>,
+    edges: Option<(f64, Option<CreasePair>)>,
     face: Option<f64>,
 }
 
@@ -617,16 +630,32 @@ impl RuleMask {
 /// In debug builds, if a smooth rule meets `faces != edge_sharpness.len()`.
 ///
 /// Cost: O(edges), no allocation.
-pub fn vertex_mask(vertex_sharpness: f32, edge_sharpness: &[f32], faces: usize, crease: CreaseMethod) -> VertexMask {
+pub fn vertex_mask(
+    vertex_sharpness: f32,
+    edge_sharpness: &[f32],
+    faces: usize,
+    crease: CreaseMethod,
+) -> VertexMask {
     let n = edge_sharpness.len();
     let rule = vertex_rule(vertex_sharpness, edge_sharpness);
     let smooth_ok = |r: VertexRule| {
-        debug_assert!(!r.is_smooth() || faces == n, "the smooth Catmark rule needs as many faces as edges ({n} edges, {faces} faces)");
+        debug_assert!(
+            !r.is_smooth() || faces == n,
+            "the smooth Catmark rule needs as many faces as edges ({n} edges, {faces} faces)"
+        );
     };
     let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]));
     let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
         let (edge, crease) = m.edges.unwrap_or((0.0, None));
-        VertexMask { vertex: m.vertex, edge, crease, face: m.face.unwrap_or(0.0), rule, child_rule, parent_weight }
+        VertexMask {
+            vertex: m.vertex,
+            edge,
+            crease,
+            face: m.face.unwrap_or(0.0),
+            rule,
+            child_rule,
+            parent_weight,
+        }
     };
     let at = EdgesAtVertex::new(edge_sharpness, crease);
     let child_edge = |i: usize| at.child(edge_sharpness[i]);
@@ -718,7 +747,13 @@ mod tests {
 
     fn point(v: DVec3, ends: &[DVec3], faces: &[DVec3], vs: f32, es: &[f32], method: CreaseMethod) -> DVec3 {
         vertex_point(
-            &VertexNeighborhood { position: v, sharpness: vs, edge_ends: ends, edge_sharpness: es, face_points: faces },
+            &VertexNeighborhood {
+                position: v,
+                sharpness: vs,
+                edge_ends: ends,
+                edge_sharpness: es,
+                face_points: faces,
+            },
             method,
         )
     }
@@ -759,7 +794,10 @@ mod tests {
         let (ends, faces) = ring(2, 1);
         assert_eq!(point(v, &ends, &faces, INF, &[INF, INF], CreaseMethod::Uniform), v);
         // A boundary corner left smooth by EdgeOnly is still a crease of its two edges.
-        assert!(close(point(v, &ends, &faces, 0.0, &[INF, INF], CreaseMethod::Uniform), (v * 6.0 + ends[0] + ends[1]) / 8.0));
+        assert!(close(
+            point(v, &ends, &faces, 0.0, &[INF, INF], CreaseMethod::Uniform),
+            (v * 6.0 + ends[0] + ends[1]) / 8.0
+        ));
     }
 
     #[test]
@@ -789,7 +827,10 @@ mod tests {
             let got = point(v, &ends, &faces, 0.0, &es, method);
             assert!(close(got, (crease + smooth) * 0.5), "{method:?}");
             let m = vertex_mask(0.0, &es, n, method);
-            assert_eq!((m.rule, m.child_rule, m.parent_weight), (VertexRule::Crease, VertexRule::Smooth, 0.5));
+            assert_eq!(
+                (m.rule, m.child_rule, m.parent_weight),
+                (VertexRule::Crease, VertexRule::Smooth, 0.5)
+            );
         }
         // An edge of sharpness 0.5: half midpoint, half smooth edge point.
         let (a, b) = (DVec3::ZERO, DVec3::new(1.0, 0.0, 0.2));
@@ -797,7 +838,13 @@ mod tests {
         let edge = |s: f32| {
             let c = subdivide_sharpness(s);
             edge_point(
-                &EdgeNeighborhood { ends: [a, b], sharpness: s, child_sharpness: [c, c], face_points: &fps, face_sizes: &[4, 4] },
+                &EdgeNeighborhood {
+                    ends: [a, b],
+                    sharpness: s,
+                    child_sharpness: [c, c],
+                    face_points: &fps,
+                    face_sizes: &[4, 4],
+                },
                 TriangleRule::Catmark,
             )
         };
@@ -845,10 +892,41 @@ mod tests {
         // A single semi-sharp edge (infinite ones do not count) just decrements.
         assert_eq!(child_edge_sharpness(2.5, &[2.5, INF, 0.0], CreaseMethod::Chaikin), 1.5);
         // The two ends of one edge can disagree.
-        let ends = [child_edge_sharpness(1.2, &[1.2, 0.2], CreaseMethod::Chaikin), child_edge_sharpness(1.2, &[1.2, 2.8], CreaseMethod::Chaikin)];
+        let ends = [
+            child_edge_sharpness(1.2, &[1.2, 0.2], CreaseMethod::Chaikin),
+            child_edge_sharpness(1.2, &[1.2, 2.8], CreaseMethod::Chaikin),
+        ];
         assert_eq!(ends[0], 0.0);
         assert!(ends[1] > 0.0);
         assert_eq!(edge_child_rule(1.2, ends), VertexRule::Dart);
+    }
+
+    /// Chaikin decaying an edge of sharpness 1.2 to 0 at one end only: OpenSubdiv's own
+    /// refinement (Far::TopologyRefiner + PrimvarRefinerReal<double>, 4×3 grid of quads, the
+    /// edge between grid vertices (1,1) and (2,1), sharpness 0.2 on the edge before it and 2.8
+    /// on the edge after it) puts its edge point at z = 0.23499999642372127, the
+    /// unclamped blend 1.2·crease − 0.2·smooth, not on the crease (0.25).
+    #[test]
+    fn chaikin_edge_blend_matches_far_refinement() {
+        let p = |i: f64, j: f64| DVec3::new(i, j, 0.1 * i * i + 0.3 * j * j - 0.2 * i * j);
+        let method = CreaseMethod::Chaikin;
+        let child_sharpness = [
+            child_edge_sharpness(1.2, &[1.2, 0.2, 0.0, 0.0], method),
+            child_edge_sharpness(1.2, &[1.2, 2.8, 0.0, 0.0], method),
+        ];
+        let faces = [
+            face_point(&[p(1.0, 0.0), p(2.0, 0.0), p(2.0, 1.0), p(1.0, 1.0)]),
+            face_point(&[p(1.0, 1.0), p(2.0, 1.0), p(2.0, 2.0), p(1.0, 2.0)]),
+        ];
+        let hood = EdgeNeighborhood {
+            ends: [p(1.0, 1.0), p(2.0, 1.0)],
+            sharpness: 1.2,
+            child_sharpness,
+            face_points: &faces,
+            face_sizes: &[4, 4],
+        };
+        let got = edge_point(&hood, TriangleRule::Catmark);
+        assert!((got - DVec3::new(1.5, 1.0, 0.23499999642372127)).length() < 1e-15, "{got}");
     }
 
     #[test]
@@ -875,9 +953,21 @@ mod tests {
         let corner = BaseVertexTopology { faces: 1, edges: 2, boundary_edges: 2, ..Default::default() };
         assert_eq!(base_vertex_sharpness(0.0, corner, BoundaryInterpolation::EdgeOnly), 0.0);
         assert_eq!(base_vertex_sharpness(0.0, corner, BoundaryInterpolation::EdgeAndCorner), INF);
-        let fin = BaseVertexTopology { faces: 5, edges: 4, non_manifold: true, non_manifold_edges: 2, boundary_edges: 0 };
+        let fin = BaseVertexTopology {
+            faces: 5,
+            edges: 4,
+            non_manifold: true,
+            non_manifold_edges: 2,
+            boundary_edges: 0,
+        };
         assert_eq!(base_vertex_sharpness(0.2, fin, BoundaryInterpolation::EdgeOnly), 0.2);
-        let bowtie = BaseVertexTopology { faces: 2, edges: 4, non_manifold: true, non_manifold_edges: 0, boundary_edges: 4 };
+        let bowtie = BaseVertexTopology {
+            faces: 2,
+            edges: 4,
+            non_manifold: true,
+            non_manifold_edges: 0,
+            boundary_edges: 4,
+        };
         assert_eq!(base_vertex_sharpness(0.0, bowtie, BoundaryInterpolation::EdgeOnly), INF);
     }
 
