@@ -14,6 +14,7 @@
 pub mod bspline;
 pub mod cage;
 mod catmull_clark;
+pub mod sdc;
 pub mod tags;
 
 pub use cage::Cage;
