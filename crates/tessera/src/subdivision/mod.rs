@@ -11,6 +11,7 @@
 //! say ([`SubdivisionOptions::default`]); the shared `subdivision/` cages are those tools'
 //! shapes, so their limit surfaces are defined by them.
 
+pub mod gregory;
 pub mod tags;
 
 pub use tags::{Corner, Crease, SubdivisionTags, UnknownTag};
