@@ -14,6 +14,8 @@
 pub mod bspline;
 pub mod cage;
 mod catmull_clark;
+pub mod gregory;
+pub mod isolation;
 pub mod sdc;
 pub mod tags;
 
