@@ -126,3 +126,52 @@ fn regular_faces_are_bfrs_regular_faces_and_their_points_agree() {
     assert!(worst.0 < 1e-6, "worst {:.3e} at {}", worst.0, worst.1);
     assert!(compared_faces > 8 * 1000, "only {compared_faces} faces compared");
 }
+
+#[test]
+fn isolated_faces_agree_with_bfr() {
+    use tessera::subdivision::isolation::{isolate, IsolationLevels};
+    use tessera::subdivision::PatchOrigin;
+    let mut worst_overall = 0.0f64;
+    let mut report = Vec::new();
+    for path in catmark_cages() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let mesh = read_obj(&path).unwrap();
+        let Ok(cage) = Cage::new(&mesh, &path) else { continue };
+        let (lo, hi) = mesh
+            .positions
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let diagonal = (hi - lo).length();
+        let trees: Vec<Vec<_>> = (0..cage.face_count())
+            .map(|f| {
+                if cage.holes[f] || cage.is_regular_face(f) {
+                    Vec::new()
+                } else {
+                    isolate(&cage, f, IsolationLevels::default())
+                }
+            })
+            .collect();
+        let mut worst = (0.0f64, String::new());
+        for rate in [1, 2, 5, 8] {
+            let faces = run_oracle(&path, rate);
+            for (f, face) in faces.iter().enumerate() {
+                if face.regular || !face.limit {
+                    continue;
+                }
+                let n = cage.face(f).len();
+                for &(uv, expected) in &face.points {
+                    let (origin, st) = PatchOrigin::from_face_uv(f as u32, n, uv);
+                    let got = trees[f][origin.subface as usize].position(st);
+                    let d = (got - expected).length() / diagonal;
+                    if d > worst.0 {
+                        worst = (d, format!("face {f} ({n} corners) rate {rate} at {uv}"));
+                    }
+                }
+            }
+        }
+        worst_overall = worst_overall.max(worst.0);
+        report.push(format!("{name}: {:.2e} {}", worst.0, worst.1));
+    }
+    eprintln!("{}", report.join("\n"));
+    assert!(worst_overall < 1e-6, "worst {worst_overall:.3e}");
+}

@@ -85,7 +85,10 @@ impl Cage {
                     return Err(Error::unsupported(
                         file,
                         face.line,
-                        format!("face uses vertex {} twice; a subdivision cage's faces need distinct corners", v + 1),
+                        format!(
+                            "face uses vertex {} twice; a subdivision cage's faces need distinct corners",
+                            v + 1
+                        ),
                     ));
                 }
             }
@@ -117,8 +120,9 @@ impl Cage {
         options: SubdivisionOptions,
     ) -> Cage {
         let lines = vec![0; face_start.len() - 1];
-        let mut cage = Cage::with_topology(points, face_start, face_vertices, lines, Some(complete), Path::new(""))
-            .expect("a refined neighbourhood is manifold where it is complete");
+        let mut cage =
+            Cage::with_topology(points, face_start, face_vertices, lines, Some(complete), Path::new(""))
+                .expect("a refined neighbourhood is manifold where it is complete");
         cage.edge_sharpness = cage.edges.iter().map(|&[a, b]| edge_sharpness(a, b)).collect();
         cage.vertex_sharpness = vertex_sharpness;
         cage.options = options;
@@ -325,10 +329,13 @@ impl Cage {
 
     /// The edge between vertices `a` and `b`, if any. Cost: O(faces around `a`).
     pub fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
-        self.vertex_faces[a as usize].iter().flat_map(|fc| [self.leading_edge(*fc), self.trailing_edge(*fc)]).find(|&e| {
-            let [x, y] = self.edges[e as usize];
-            (x, y) == (a, b) || (x, y) == (b, a)
-        })
+        self.vertex_faces[a as usize]
+            .iter()
+            .flat_map(|fc| [self.leading_edge(*fc), self.trailing_edge(*fc)])
+            .find(|&e| {
+                let [x, y] = self.edges[e as usize];
+                (x, y) == (a, b) || (x, y) == (b, a)
+            })
     }
 
     /// The sharpness of the edge between `a` and `b` (0 where there is none).

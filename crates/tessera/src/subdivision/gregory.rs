@@ -803,12 +803,7 @@ impl GregoryPatch {
         let f1 = blend(v * inv(uc + v), 8);
         let f2 = blend(uc * inv(uc + vc), 13);
         let f3 = blend(vc * inv(u + vc), 18);
-        [
-            [g[0], g[1], g[7], g[5]],
-            [g[2], f0, f1, g[6]],
-            [g[16], f3, f2, g[12]],
-            [g[15], g[17], g[11], g[10]],
-        ]
+        [[g[0], g[1], g[7], g[5]], [g[2], f0, f1, g[6]], [g[16], f3, f2, g[12]], [g[15], g[17], g[11], g[10]]]
     }
 
     /// The surface point at `(u, v)` ∈ [0,1]², `u` along corner 0 → 1 and `v` along
@@ -973,7 +968,12 @@ mod tests {
     /// valence `n`) or open (a boundary centre with `n` faces). Returns the mesh and
     /// `g(sector, a, b)`, the vertex `a` steps along the sector's first spoke and `b` along
     /// its second.
-    fn fan_mesh(n: usize, k: usize, closed: bool, seed: u64) -> (Mesh, impl Fn(usize, usize, usize) -> usize) {
+    fn fan_mesh(
+        n: usize,
+        k: usize,
+        closed: bool,
+        seed: u64,
+    ) -> (Mesh, impl Fn(usize, usize, usize) -> usize) {
         let spokes = if closed { n } else { n + 1 };
         let spoke = move |j: usize, a: usize| 1 + j * k + (a - 1);
         let inner = move |j: usize, a: usize, b: usize| 1 + spokes * k + j * k * k + (a - 1) * k + (b - 1);
@@ -1010,7 +1010,12 @@ mod tests {
     /// The uniform cubic B-spline curve of four points at `t`.
     fn bspline(p: [DVec3; 4], t: f64) -> DVec3 {
         let tc = 1.0 - t;
-        let w = [tc * tc * tc, 3.0 * t * t * t - 6.0 * t * t + 4.0, -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0, t * t * t];
+        let w = [
+            tc * tc * tc,
+            3.0 * t * t * t - 6.0 * t * t + 4.0,
+            -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
+            t * t * t,
+        ];
         (p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3]) / 6.0
     }
 
@@ -1074,7 +1079,12 @@ mod tests {
     }
 
     /// Max distance between two patches along a shared edge, given how each parametrises it.
-    fn edge_gap(a: &GregoryPatch, ea: impl Fn(f64) -> (f64, f64), b: &GregoryPatch, eb: impl Fn(f64) -> (f64, f64)) -> f64 {
+    fn edge_gap(
+        a: &GregoryPatch,
+        ea: impl Fn(f64) -> (f64, f64),
+        b: &GregoryPatch,
+        eb: impl Fn(f64) -> (f64, f64),
+    ) -> f64 {
         (0..=32)
             .map(|i| {
                 let t = i as f64 / 32.0;
@@ -1118,7 +1128,10 @@ mod tests {
             let curve = [before, centre, p(g(0, 1, 0)), p(g(0, 2, 0))];
             for i in 0..=16 {
                 let t = i as f64 / 16.0;
-                assert!(close(patch.position(t, 0.0), bspline(curve, t), 1e-12), "n = {n}, sharp {sharp}, t = {t}");
+                assert!(
+                    close(patch.position(t, 0.0), bspline(curve, t), 1e-12),
+                    "n = {n}, sharp {sharp}, t = {t}"
+                );
             }
             // The same along the last spoke, on the last sector's v edge.
             let f = mesh.face_with([g(n - 1, 0, 0), g(n - 1, 1, 0), g(n - 1, 1, 1), g(n - 1, 0, 1)]);
@@ -1127,7 +1140,10 @@ mod tests {
             let curve = [after, centre, p(g(n - 1, 0, 1)), p(g(n - 1, 0, 2))];
             for i in 0..=16 {
                 let t = i as f64 / 16.0;
-                assert!(close(patch.position(0.0, t), bspline(curve, t), 1e-12), "n = {n}, sharp {sharp}, v = {t}");
+                assert!(
+                    close(patch.position(0.0, t), bspline(curve, t), 1e-12),
+                    "n = {n}, sharp {sharp}, v = {t}"
+                );
             }
         }
     }

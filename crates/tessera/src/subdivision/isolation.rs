@@ -116,6 +116,29 @@ impl PatchTree {
         }
     }
 
+    /// The surface point at `uv` ∈ `[0,1]²`. Cost: O(depth) and one patch evaluation.
+    pub fn position(&self, uv: DVec2) -> DVec3 {
+        let (leaf, st) = self.locate(uv);
+        match &leaf.patch {
+            LeafPatch::Bezier(p) => bezier_position(p, st),
+            LeafPatch::Gregory(g) => g.position(st.x, st.y),
+        }
+    }
+
+    /// Position and first derivatives with respect to the tree's `uv` at `uv` (Gregory
+    /// leaves: OpenSubdiv's approximate derivatives, see [`GregoryPatch::derivatives`]).
+    pub fn derivatives(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
+        let (leaf, st) = self.locate(uv);
+        let (p, du, dv) = match &leaf.patch {
+            LeafPatch::Bezier(b) => {
+                let d = crate::surface::RationalBicubic::polynomial(*b).derivatives(st);
+                (d.position, d.du, d.dv)
+            }
+            LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
+        };
+        (p, du / leaf.size, dv / leaf.size)
+    }
+
     /// The control points of all leaves (the surface lies in their convex hull: Bézier and
     /// Gregory patches are convex combinations of their points).
     pub fn control_points(&self) -> &[DVec3] {
@@ -157,6 +180,22 @@ pub fn isolate(cage: &Cage, face: usize, levels: IsolationLevels) -> Vec<PatchTr
         .collect()
 }
 
+/// A polynomial bicubic Bézier net at `st`.
+fn bezier_position(points: &[DVec3; 16], st: DVec2) -> DVec3 {
+    let b = |t: f64| {
+        let s = 1.0 - t;
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
+    };
+    let (bu, bv) = (b(st.x), b(st.y));
+    let mut p = DVec3::ZERO;
+    for i in 0..4 {
+        for j in 0..4 {
+            p += points[4 * i + j] * (bu[i] * bv[j]);
+        }
+    }
+    p
+}
+
 struct Context {
     levels: IsolationLevels,
     /// Whether the neighbourhood of the root has a face that is not a quad (Far's
@@ -185,7 +224,15 @@ impl TreeBuilder {
 
 impl Context {
     /// The subtree of face `f` of `mesh` at `level`, covering `origin + [0, size]²`.
-    fn node(&self, mesh: &Cage, f: usize, level: u8, origin: DVec2, size: f64, out: &mut TreeBuilder) -> Slot {
+    fn node(
+        &self,
+        mesh: &Cage,
+        f: usize,
+        level: u8,
+        origin: DVec2,
+        size: f64,
+        out: &mut TreeBuilder,
+    ) -> Slot {
         // Far's level `i` is made with the full feature set while `i` ≤ the smooth depth, with
         // the reduced one after; refining `f` makes level `level + 1`.
         let more = level < self.levels.sharp && {
@@ -340,11 +387,8 @@ fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
             VertexRule::Crease => {
                 t.inf_sharp_crease = true;
                 if !t.xordinary {
-                    t.inf_irregular = if boundary {
-                        false
-                    } else {
-                        is_infinite(sharpness[0]) != is_infinite(sharpness[2])
-                    };
+                    t.inf_irregular =
+                        if boundary { false } else { is_infinite(sharpness[0]) != is_infinite(sharpness[2]) };
                 }
             }
             VertexRule::Corner => {
@@ -455,7 +499,10 @@ fn corner_span(mesh: &Cage, f: usize, corner: usize) -> Span {
     let edges = mesh.vertex_edges(v);
     let n = edges.len();
     let singular = |e: u32| mesh.is_boundary_edge(e) || is_infinite(mesh.edge_sharpness[e as usize]);
-    let lead_start = edges.iter().position(|&e| e == mesh.face_edges(f)[corner]).expect("the face's edge is at its corner");
+    let lead_start = edges
+        .iter()
+        .position(|&e| e == mesh.face_edges(f)[corner])
+        .expect("the face's edge is at its corner");
     let trail_start = (lead_start + 1) % n;
     let mut span = Span { start: 0, faces: 1, corner_in_span: 0, periodic: false };
     let mut lead = lead_start;
@@ -501,7 +548,8 @@ fn gregory_source(mesh: &Cage, f: usize) -> GregorySource {
             if span.periodic {
                 (fan.to_vec(), 0, k, t.boundary)
             } else {
-                let picked: Vec<FaceCorner> = (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
+                let picked: Vec<FaceCorner> =
+                    (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
                 (picked, span.start, span.corner_in_span, true)
             }
         } else {
@@ -601,7 +649,9 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
     }
 
     // Points, sharpness and completeness of the children.
-    let face_point = |g: usize| sdc::face_point(&mesh.face(g).iter().map(|&v| mesh.points[v as usize]).collect::<Vec<_>>());
+    let face_point = |g: usize| {
+        sdc::face_point(&mesh.face(g).iter().map(|&v| mesh.points[v as usize]).collect::<Vec<_>>())
+    };
     let mut points = Vec::with_capacity(parents.len());
     let mut vertex_sharpness = Vec::with_capacity(parents.len());
     let mut complete = Vec::with_capacity(parents.len());
@@ -646,7 +696,8 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
             mesh.vertex_edges(v as usize).iter().map(|&x| mesh.edge_sharpness[x as usize]).collect();
         sdc::child_edge_sharpness(s, &around, options.crease_method)
     };
-    let child = Cage::local(points, face_start, face_vertices, &complete, sharpness_of, vertex_sharpness, options);
+    let child =
+        Cage::local(points, face_start, face_vertices, &complete, sharpness_of, vertex_sharpness, options);
     (child, children)
 }
 
@@ -688,7 +739,8 @@ fn vertex_point(mesh: &Cage, v: usize, face_point: &dyn Fn(usize) -> DVec3) -> D
         })
         .collect();
     let sharpness: Vec<f32> = edges.iter().map(|&e| mesh.edge_sharpness[e as usize]).collect();
-    let face_points: Vec<DVec3> = mesh.vertex_faces(v).iter().map(|fc| face_point(fc.face as usize)).collect();
+    let face_points: Vec<DVec3> =
+        mesh.vertex_faces(v).iter().map(|fc| face_point(fc.face as usize)).collect();
     sdc::vertex_point(
         &VertexNeighborhood {
             position: mesh.points[v],
@@ -731,6 +783,7 @@ fn neighbourhood(cage: &Cage, face: usize) -> (Cage, usize) {
     let complete: Vec<bool> = global.iter().map(|v| corners.contains(v)).collect();
     let vertex_sharpness = global.iter().map(|&v| cage.vertex_sharpness[v as usize]).collect();
     let sharpness = |a: u32, b: u32| cage.edge_sharpness_between(global[a as usize], global[b as usize]);
-    let local = Cage::local(points, face_start, face_vertices, &complete, sharpness, vertex_sharpness, cage.options);
+    let local =
+        Cage::local(points, face_start, face_vertices, &complete, sharpness, vertex_sharpness, cage.options);
     (local, 0)
 }

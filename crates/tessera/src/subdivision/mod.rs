@@ -79,5 +79,43 @@ pub struct SubdivisionOptions {
     pub triangles: TriangleRule,
 }
 
+impl PatchOrigin {
+    /// How many sub-face tiles a row of a `corners`-sided face's parameter domain holds in
+    /// Bfr's `QUAD_SUBFACES` parameterisation (`bfr/parameterization.cpp`): sub-face `i`'s
+    /// tile has its origin at `(i mod D, i div D)`.
+    pub fn tiles_per_row(corners: usize) -> usize {
+        match corners {
+            0..=4 => 2,
+            5..=9 => 3,
+            k => 1 + ((k - 1) as f64).sqrt().floor() as usize,
+        }
+    }
+
+    /// Bfr's face parameters of the point `st` ∈ `[0,1]²` of this patch, for a face of
+    /// `corners` corners (a quad's patch is its face; another face's sub-face `i` covers the
+    /// half-size square at its tile's origin, `s` along edge `i`, `t` back along edge `i−1`).
+    pub fn face_uv(&self, corners: usize, st: glam::DVec2) -> glam::DVec2 {
+        if corners == 4 {
+            return st;
+        }
+        let d = Self::tiles_per_row(corners);
+        let i = self.subface as usize;
+        glam::DVec2::new((i % d) as f64, (i / d) as f64) + st * 0.5
+    }
+
+    /// Which sub-face of a `corners`-sided face holds Bfr's face parameters `uv`, and where
+    /// in its `[0,1]²` (the inverse of [`PatchOrigin::face_uv`]).
+    pub fn from_face_uv(face: u32, corners: usize, uv: glam::DVec2) -> (PatchOrigin, glam::DVec2) {
+        if corners == 4 {
+            return (PatchOrigin { face, subface: 0 }, uv);
+        }
+        let d = Self::tiles_per_row(corners);
+        let (tx, ty) = (uv.x.floor().max(0.0) as usize, uv.y.floor().max(0.0) as usize);
+        let subface = (tx + d * ty).min(corners - 1);
+        let origin = glam::DVec2::new((subface % d) as f64, (subface / d) as f64);
+        (PatchOrigin { face, subface: subface as u16 }, (uv - origin) * 2.0)
+    }
+}
+
 /// Sharpness at or above this is infinitely sharp (OpenSubdiv's `SHARPNESS_INFINITE`).
 pub const INFINITELY_SHARP: f32 = 10.0;
