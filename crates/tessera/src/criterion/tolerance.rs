@@ -90,13 +90,15 @@ fn curve_factor(m_edge: f64, eps: f64) -> f64 {
 }
 
 /// The four control points (and weights) of a patch's boundary curve `local`, from corner
-/// `local` to corner `local + 1`.
-pub fn edge_control_points(patch: &Patch, local: usize) -> ([glam::DVec3; 4], [f64; 4]) {
+/// `local` to corner `local + 1`; `None` for a subdivision patch, whose boundary is
+/// piecewise.
+pub fn edge_control_points(patch: &Patch, local: usize) -> Option<([glam::DVec3; 4], [f64; 4])> {
     let idx = crate::surface::corner_and_edge_points(patch.domain()).1[local];
     let points = patch.control_points();
     match patch {
-        Patch::Bicubic(b) => (idx.map(|i| points[i]), idx.map(|i| b.weights[i])),
-        Patch::BezierTriangle(_) | Patch::Pn(_) => (idx.map(|i| points[i]), [1.0; 4]),
+        Patch::Bicubic(b) => Some((idx.map(|i| points[i]), idx.map(|i| b.weights[i]))),
+        Patch::BezierTriangle(_) | Patch::Pn(_) => Some((idx.map(|i| points[i]), [1.0; 4])),
+        Patch::Subdivision(_) => None,
     }
 }
 
@@ -431,8 +433,19 @@ pub fn curve_bounds(set: &SurfaceSet) -> Vec<[f64; 4]> {
         .map(|patch| {
             let mut out = [0.0; 4];
             for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
-                let (points, weights) = edge_control_points(patch, l);
-                *o = bounds::curve_second_derivative(points, weights);
+                *o = match edge_control_points(patch, l) {
+                    Some((points, weights)) => bounds::curve_second_derivative(points, weights),
+                    // A piecewise boundary: the patch's own bound along the edge's direction
+                    // bounds the curve's second derivative (edges 0 and 2 run along u).
+                    None => {
+                        let h = bounds::hessian(patch);
+                        if l % 2 == 0 {
+                            h.uu
+                        } else {
+                            h.vv
+                        }
+                    }
+                };
             }
             out
         })

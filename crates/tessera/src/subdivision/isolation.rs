@@ -85,6 +85,9 @@ pub struct PatchTree {
     root: Slot,
     /// Every leaf's points, for hulls and bounds.
     points: Vec<DVec3>,
+    /// `u` and `v` are exchanged on the way in and out (the surface with the opposite
+    /// orientation, [`PatchTree::transposed`]).
+    transposed: bool,
 }
 
 impl PatchTree {
@@ -92,6 +95,7 @@ impl PatchTree {
     /// between leaves go to the upper (right) one, as `searchQuadtree` does; the surface is
     /// continuous there. Cost: O(depth).
     pub fn locate(&self, uv: DVec2) -> (&Leaf, DVec2) {
+        let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
         let mut slot = self.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
         loop {
@@ -136,7 +140,23 @@ impl PatchTree {
             }
             LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
         };
-        (p, du / leaf.size, dv / leaf.size)
+        let (du, dv) = (du / leaf.size, dv / leaf.size);
+        if self.transposed {
+            (p, dv, du)
+        } else {
+            (p, du, dv)
+        }
+    }
+
+    /// The same surface with `u` and `v` exchanged (the opposite orientation).
+    pub fn transposed(&self) -> PatchTree {
+        PatchTree { transposed: !self.transposed, ..self.clone() }
+    }
+
+    /// Whether [`PatchTree::transposed`] was applied an odd number of times: leaf
+    /// parameters are then the tree's with `u` and `v` exchanged.
+    pub fn is_transposed(&self) -> bool {
+        self.transposed
     }
 
     /// The control points of all leaves (the surface lies in their convex hull: Bézier and
@@ -218,7 +238,7 @@ impl TreeBuilder {
                 LeafPatch::Gregory(g) => points.extend_from_slice(&g.points),
             }
         }
-        PatchTree { leaves: self.leaves, nodes: self.nodes, root, points }
+        PatchTree { leaves: self.leaves, nodes: self.nodes, root, points, transposed: false }
     }
 }
 

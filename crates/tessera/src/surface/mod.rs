@@ -24,6 +24,7 @@ pub use polygon_mesh::{PolygonFace, PolygonMesh};
 pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 
+use crate::subdivision::isolation::PatchTree;
 use glam::{DVec2, DVec3};
 
 /// A point on a surface with its unit normal.
@@ -52,13 +53,18 @@ pub enum Patch {
     BezierTriangle(BezierTriangle),
     /// A PN triangle: cubic Bézier triangle geometry and a quadratic normal field.
     Pn(PnTriangle),
+    /// The Catmull-Clark limit surface over a cage face (or a corner sub-face of a face that
+    /// is not a quad) whose neighbourhood is not regular: the pieces of its feature-adaptive
+    /// isolation, B-spline patches and Gregory end caps, over the unit square
+    /// ([`crate::subdivision::isolation`]).
+    Subdivision(Box<PatchTree>),
 }
 
 impl Patch {
     /// The patch's domain.
     pub fn domain(&self) -> Domain {
         match self {
-            Patch::Bicubic(_) => Domain::Quad,
+            Patch::Bicubic(_) | Patch::Subdivision(_) => Domain::Quad,
             Patch::BezierTriangle(_) | Patch::Pn(_) => Domain::Tri,
         }
     }
@@ -69,6 +75,15 @@ impl Patch {
             Patch::Bicubic(p) => p.eval(uv),
             Patch::BezierTriangle(p) => p.eval(uv),
             Patch::Pn(p) => p.eval(uv),
+            Patch::Subdivision(t) => {
+                let (position, du, dv) = t.derivatives(uv);
+                let inside = DVec2::new(0.5 - uv.x, 0.5 - uv.y);
+                let normal = robust_normal(du, dv, uv, inside, || DVec3::ZERO, |q| {
+                    let (_, du, dv) = t.derivatives(q);
+                    du.cross(dv)
+                });
+                SurfacePoint { position, normal }
+            }
         }
     }
 
@@ -78,6 +93,7 @@ impl Patch {
             Patch::Bicubic(p) => p.position(uv),
             Patch::BezierTriangle(p) => p.position(uv),
             Patch::Pn(p) => p.geometry.position(uv),
+            Patch::Subdivision(t) => t.position(uv),
         }
     }
 
@@ -87,6 +103,10 @@ impl Patch {
             Patch::Bicubic(p) => p.derivatives(uv),
             Patch::BezierTriangle(p) => p.derivatives(uv),
             Patch::Pn(p) => p.geometry.derivatives(uv),
+            Patch::Subdivision(t) => {
+                let (position, du, dv) = t.derivatives(uv);
+                SurfaceDerivatives { position, du, dv }
+            }
         }
     }
 
@@ -97,6 +117,7 @@ impl Patch {
             Patch::Bicubic(p) => Patch::Bicubic(p.transposed()),
             Patch::BezierTriangle(p) => Patch::BezierTriangle(p.swapped_uv()),
             Patch::Pn(p) => Patch::Pn(p.flipped()),
+            Patch::Subdivision(t) => Patch::Subdivision(Box::new(t.transposed())),
         }
     }
 
@@ -106,6 +127,7 @@ impl Patch {
             Patch::Bicubic(p) => &p.points,
             Patch::BezierTriangle(p) => &p.points,
             Patch::Pn(p) => &p.geometry.points,
+            Patch::Subdivision(t) => t.control_points(),
         }
     }
 }

@@ -194,6 +194,9 @@ impl SurfaceSet {
                     Patch::Bicubic(b) => b.points.copy_from_slice(&snapped),
                     Patch::BezierTriangle(b) => b.points.copy_from_slice(&snapped),
                     Patch::Pn(b) => b.geometry.points.copy_from_slice(&snapped),
+                    // A subdivision patch's points are its pieces', not one net to snap;
+                    // cages are tied by their own topology, not by welding.
+                    Patch::Subdivision(_) => {}
                 }
             }
             let (corners, edges) = corner_and_edge_points(p.domain());
