@@ -314,12 +314,12 @@ pub fn hessian(p: &Patch) -> HessianBound {
 pub fn tree_hessian(t: &crate::subdivision::isolation::PatchTree) -> HessianBound {
     use crate::subdivision::isolation::LeafPatch;
     let mut m = HessianBound::default();
-    for leaf in &t.leaves {
+    for (leaf, _, size) in t.visible_leaves() {
         let h = match &leaf.patch {
             LeafPatch::Bezier(points) => bicubic_hessian(&RationalBicubic::polynomial(*points)),
             LeafPatch::Gregory(g) => gregory_hessian(g),
         };
-        let s = 1.0 / (leaf.size * leaf.size);
+        let s = 1.0 / (size * size);
         m.uu = m.uu.max(h.uu * s);
         m.uv = m.uv.max(h.uv * s);
         m.vv = m.vv.max(h.vv * s);

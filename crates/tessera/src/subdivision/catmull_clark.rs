@@ -13,6 +13,7 @@ use glam::DVec3;
 
 use super::bspline::{regular_face_grid, to_bezier};
 use super::cage::Cage;
+use super::isolation::{isolate, IsolationLevels};
 use super::PatchOrigin;
 use crate::error::{Error, Result};
 use crate::surface::{Domain, Orientation, Patch, PolygonMesh, RationalBicubic, Repairs, SurfaceSet};
@@ -27,6 +28,8 @@ pub struct CageOptions {
     pub orientation: Orientation,
     /// Reverse the faces after `orientation` was applied (`--flip-normals`).
     pub flip: bool,
+    /// How deep irregular faces are isolated (Bfr's defaults unless changed).
+    pub isolation: IsolationLevels,
 }
 
 /// Keys for the topology: cage vertices keep their index; every curve between two keyed
@@ -74,23 +77,59 @@ fn signed_volume(mesh: &PolygonMesh) -> f64 {
     volume / 6.0
 }
 
+/// The quarter `q` ([`super::QUADRANTS`]) of a polynomial bicubic Bézier net, exactly
+/// (de Casteljau at ½ in `u`, then in `v`).
+fn bezier_quadrant(points: &[DVec3; 16], q: usize) -> [DVec3; 16] {
+    let half = |c: [DVec3; 4], upper: bool| {
+        let (a, b, d) = ((c[0] + c[1]) * 0.5, (c[1] + c[2]) * 0.5, (c[2] + c[3]) * 0.5);
+        let (e, f) = ((a + b) * 0.5, (b + d) * 0.5);
+        let m = (e + f) * 0.5;
+        if upper {
+            [m, f, d, c[3]]
+        } else {
+            [c[0], a, e, m]
+        }
+    };
+    let (upper_u, upper_v) = (q == 1 || q == 2, q >= 2);
+    let mut out = *points;
+    for j in 0..4 {
+        let row = half([out[j], out[4 + j], out[8 + j], out[12 + j]], upper_u);
+        for i in 0..4 {
+            out[4 * i + j] = row[i];
+        }
+    }
+    for i in 0..4 {
+        let col = half([out[4 * i], out[4 * i + 1], out[4 * i + 2], out[4 * i + 3]], upper_v);
+        out[4 * i..4 * i + 4].copy_from_slice(&col);
+    }
+    out
+}
+
 impl SurfaceSet {
     /// The Catmull-Clark limit surface of the cage `mesh` (with its OpenSubdiv tags), as
-    /// OpenSubdiv's Bfr evaluates it with its default options.
+    /// OpenSubdiv's Bfr evaluates it with its default options (or the isolation depths of
+    /// `options`).
     ///
-    /// Each face with a limit surface becomes one patch (faces that are not quads: one patch
-    /// per corner sub-face, in corner order); [`SurfaceSet::origins`] gives each patch's base
-    /// face and sub-face. A face that is regular in Bfr's sense becomes the bicubic Bézier
-    /// form of its B-spline patch, exactly. Patch parameters are Bfr's face parameters when
-    /// the faces keep their orientation.
+    /// Patches: a cage of quads gets one per face with a limit surface, over the face's own
+    /// parameters; a cage with any other face gets one per corner sub-face of every such
+    /// face ([`PatchOrigin`]). [`SurfaceSet::origins`] gives each patch's face and sub-face,
+    /// [`PatchOrigin::face_uv`] Bfr's face parameters of its points. A face that is regular in
+    /// Bfr's sense becomes the bicubic Bézier form of its B-spline patch, exactly (its quarters
+    /// exactly too); any other face the pieces of its feature-adaptive isolation
+    /// ([`Patch::Subdivision`]). The faces keep their orientation unless `options` reverse
+    /// them (the patches' parameters are then those of the reversed faces).
+    ///
+    /// The patches meet along the cage's own edges (or their halves), which the topology
+    /// takes from the cage: no welding, and the engines' shared edge points make the output
+    /// watertight bit for bit.
     ///
     /// # Errors
     ///
     /// [`Error::Unsupported`] naming `file` and a face's line: a cage [`Cage::new`] refuses,
-    /// a face that is not regular (feature-adaptive isolation comes next), or a cage with no
-    /// face that has a limit surface.
+    /// or a cage with no face that has a limit surface.
     ///
-    /// Cost: O(corners) to build the adjacency, O(1) per regular face.
+    /// Cost: O(corners) for the adjacency, O(1) per regular face, a local refinement of a few
+    /// dozen faces per level of isolation for every other face.
     pub fn from_subdivision_cage(
         mesh: &PolygonMesh,
         file: &Path,
@@ -112,33 +151,72 @@ impl SurfaceSet {
             mesh
         };
         let cage = Cage::new(mesh, file)?;
-        let mut keys = Keys::new(cage.points.len());
+        let split = (0..cage.face_count()).any(|f| cage.face(f).len() != 4);
+        let (vertices, edges) = (cage.points.len() as u32, cage.edge_count() as u32);
+        let mid = |e: u32| vertices + e;
+        let centre = |f: usize| vertices + edges + f as u32;
+        let mut keys = Keys::new(vertices as usize + edges as usize + cage.face_count());
         let mut patches = Vec::new();
         let mut patch_keys = Vec::new();
         let mut origins = Vec::new();
+        let mut push = |patch: Patch, corners: [u32; 4], origin: PatchOrigin| {
+            let mut k = PatchKeys { domain: Domain::Quad, corners, edges: [[0; 4]; 4], normals: [0; 4] };
+            for i in 0..4 {
+                k.edges[i] = keys.curve(corners[i], corners[(i + 1) % 4]);
+            }
+            patches.push(patch);
+            patch_keys.push(k);
+            origins.push(origin);
+        };
         for f in 0..cage.face_count() {
             if cage.holes[f] {
                 continue;
             }
-            if !cage.is_regular_face(f) {
-                return Err(Error::unsupported(
-                    file,
-                    cage.face_line(f),
-                    "face is not a regular Catmull-Clark patch (an extraordinary vertex, a crease, a \
-                     non-quad or a smooth boundary corner touches it); tessera evaluates regular faces only so far",
-                ));
+            let c = cage.face(f);
+            let n = c.len();
+            let e = cage.face_edges(f);
+            let origin = |subface: usize| PatchOrigin {
+                face: f as u32,
+                subface: subface as u16,
+                corners: n as u16,
+                is_subface: split,
+            };
+            // A quad's quarters, corners listed from the one at the quarter's (0,0).
+            let quarter = |q: usize| match q {
+                0 => [c[0], mid(e[0]), centre(f), mid(e[3])],
+                1 => [mid(e[0]), c[1], mid(e[1]), centre(f)],
+                2 => [centre(f), mid(e[1]), c[2], mid(e[2])],
+                _ => [mid(e[3]), centre(f), mid(e[2]), c[3]],
+            };
+            if n == 4 && cage.is_regular_face(f) {
+                let bezier = to_bezier(&regular_face_grid(&cage, f));
+                if split {
+                    for q in 0..4 {
+                        let piece = RationalBicubic::polynomial(bezier_quadrant(&bezier, q));
+                        push(Patch::Bicubic(piece), quarter(q), origin(q));
+                    }
+                } else {
+                    push(
+                        Patch::Bicubic(RationalBicubic::polynomial(bezier)),
+                        [c[0], c[1], c[2], c[3]],
+                        origin(0),
+                    );
+                }
+                continue;
             }
-            let corners = cage.face(f);
-            let bezier = to_bezier(&regular_face_grid(&cage, f));
-            patches.push(Patch::Bicubic(RationalBicubic::polynomial(bezier)));
-            let mut k =
-                PatchKeys { domain: Domain::Quad, corners: [0; 4], edges: [[0; 4]; 4], normals: [0; 4] };
-            for i in 0..4 {
-                k.corners[i] = corners[i];
-                k.edges[i] = keys.curve(corners[i], corners[(i + 1) % 4]);
+            let trees = isolate(&cage, f, options.isolation);
+            if n == 4 && split {
+                for q in 0..4 {
+                    push(Patch::Subdivision(Box::new(trees[0].quadrant(q))), quarter(q), origin(q));
+                }
+            } else if n == 4 {
+                push(Patch::Subdivision(Box::new(trees[0].clone())), [c[0], c[1], c[2], c[3]], origin(0));
+            } else {
+                for (i, tree) in trees.into_iter().enumerate() {
+                    let corners = [c[i], mid(e[i]), centre(f), mid(e[(i + n - 1) % n])];
+                    push(Patch::Subdivision(Box::new(tree)), corners, origin(i));
+                }
             }
-            patch_keys.push(k);
-            origins.push(PatchOrigin { face: f as u32, subface: 0 });
         }
         if patches.is_empty() {
             return Err(Error::unsupported(
@@ -149,5 +227,26 @@ impl SurfaceSet {
         }
         let topology = Topology::build(&patch_keys);
         Ok(SurfaceSet { patches, keys: patch_keys, topology, repairs, up: Default::default(), origins })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    #[test]
+    fn quarters_of_a_bezier_net_are_the_same_surface() {
+        let mut rng = crate::test_support::Lcg(3);
+        let net: [DVec3; 16] = std::array::from_fn(|_| DVec3::new(rng.unit53(), rng.unit53(), rng.unit53()));
+        let whole = RationalBicubic::polynomial(net);
+        for q in 0..4 {
+            let part = RationalBicubic::polynomial(bezier_quadrant(&net, q));
+            for k in 0..20 {
+                let st = DVec2::new(rng.unit53(), rng.unit53());
+                let d = part.position(st) - whole.position(super::super::QUADRANTS[q] + st * 0.5);
+                assert!(d.length() < 1e-14, "quarter {q} sample {k}: {d}");
+            }
+        }
     }
 }

@@ -88,6 +88,10 @@ pub struct PatchTree {
     /// `u` and `v` are exchanged on the way in and out (the surface with the opposite
     /// orientation, [`PatchTree::transposed`]).
     transposed: bool,
+    /// The square of the tree's domain this patch covers, `view_origin + [0, view_size]²`
+    /// ([`PatchTree::quadrant`]).
+    view_origin: DVec2,
+    view_size: f64,
 }
 
 impl PatchTree {
@@ -96,6 +100,7 @@ impl PatchTree {
     /// continuous there. Cost: O(depth).
     pub fn locate(&self, uv: DVec2) -> (&Leaf, DVec2) {
         let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
+        let uv = self.view_origin + uv * self.view_size;
         let mut slot = self.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
         loop {
@@ -140,7 +145,7 @@ impl PatchTree {
             }
             LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
         };
-        let (du, dv) = (du / leaf.size, dv / leaf.size);
+        let (du, dv) = (du * (self.view_size / leaf.size), dv * (self.view_size / leaf.size));
         if self.transposed {
             (p, dv, du)
         } else {
@@ -151,6 +156,33 @@ impl PatchTree {
     /// The same surface with `u` and `v` exchanged (the opposite orientation).
     pub fn transposed(&self) -> PatchTree {
         PatchTree { transposed: !self.transposed, ..self.clone() }
+    }
+
+    /// The quarter `q` of the patch (quadrants as [`crate::subdivision::QUADRANTS`]) as a
+    /// patch of its own over `[0,1]²`, `u` and `v` running as the whole's.
+    /// Precondition: not transposed.
+    pub fn quadrant(&self, q: usize) -> PatchTree {
+        let size = self.view_size * 0.5;
+        PatchTree {
+            view_origin: self.view_origin + super::QUADRANTS[q] * self.view_size,
+            view_size: size,
+            ..self.clone()
+        }
+    }
+
+    /// The leaves this patch covers, each with its square in the patch's own parameters
+    /// (origin, size) — before any transposition.
+    pub fn visible_leaves(&self) -> impl Iterator<Item = (&Leaf, DVec2, f64)> + '_ {
+        let (o, s) = (self.view_origin, self.view_size);
+        self.leaves
+            .iter()
+            .filter(move |l| {
+                l.origin.x < o.x + s
+                    && l.origin.x + l.size > o.x
+                    && l.origin.y < o.y + s
+                    && l.origin.y + l.size > o.y
+            })
+            .map(move |l| (l, (l.origin - o) / s, l.size / s))
     }
 
     /// Whether [`PatchTree::transposed`] was applied an odd number of times: leaf
@@ -238,7 +270,15 @@ impl TreeBuilder {
                 LeafPatch::Gregory(g) => points.extend_from_slice(&g.points),
             }
         }
-        PatchTree { leaves: self.leaves, nodes: self.nodes, root, points, transposed: false }
+        PatchTree {
+            leaves: self.leaves,
+            nodes: self.nodes,
+            root,
+            points,
+            transposed: false,
+            view_origin: DVec2::ZERO,
+            view_size: 1.0,
+        }
     }
 }
 

@@ -23,15 +23,33 @@ pub use cage::Cage;
 pub use catmull_clark::CageOptions;
 pub use tags::{Corner, Crease, SubdivisionTags, UnknownTag};
 
+/// The quarters of a quad's parameter square, by their lower-left corner: the children at
+/// corners 0, 1, 2, 3.
+pub const QUADRANTS: [glam::DVec2; 4] = [
+    glam::DVec2::new(0.0, 0.0),
+    glam::DVec2::new(0.5, 0.0),
+    glam::DVec2::new(0.5, 0.5),
+    glam::DVec2::new(0.0, 0.5),
+];
+
 /// Where a patch of a set built from a cage comes from
 /// ([`crate::surface::SurfaceSet::origins`]).
+///
+/// A cage of quads gets one patch per face, over the face's own parameters. A cage with any
+/// other face gets one patch per corner *sub-face* of every face (the faces of one level of
+/// subdivision), because a face that is not a quad is parameterised by its sub-faces
+/// (OpenSubdiv's `QUAD_SUBFACES`) and its neighbours must then meet it edge for edge; a
+/// quad's sub-faces are the quarters of its square.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PatchOrigin {
     /// The cage face (0-based, file order).
     pub face: u32,
-    /// The corner sub-face of a face that is not a quad (OpenSubdiv's `QUAD_SUBFACES`
-    /// parameterisation: sub-face `i` is the quad at corner `i`); 0 for a quad.
+    /// The corner sub-face (0 for a whole quad).
     pub subface: u16,
+    /// The face's corner count.
+    pub corners: u16,
+    /// Whether the patch is a sub-face (else the whole quad).
+    pub is_subface: bool,
 }
 
 /// How the limit surface meets the cage's boundary (OpenSubdiv's `VtxBoundaryInterpolation`).
@@ -91,29 +109,55 @@ impl PatchOrigin {
         }
     }
 
-    /// Bfr's face parameters of the point `st` ∈ `[0,1]²` of this patch, for a face of
-    /// `corners` corners (a quad's patch is its face; another face's sub-face `i` covers the
-    /// half-size square at its tile's origin, `s` along edge `i`, `t` back along edge `i−1`).
-    pub fn face_uv(&self, corners: usize, st: glam::DVec2) -> glam::DVec2 {
-        if corners == 4 {
-            return st;
-        }
-        let d = Self::tiles_per_row(corners);
+    /// Bfr's face parameters of the point `st` ∈ `[0,1]²` of this patch: a whole quad's
+    /// are its own; a quad's quarter `q` covers [`QUADRANTS`]`[q]` + `[0,½]²`, `u` and `v`
+    /// as the face's; another face's sub-face `i` covers the half-size square at its tile's
+    /// origin, `s` along edge `i`, `t` back along edge `i−1`.
+    pub fn face_uv(&self, st: glam::DVec2) -> glam::DVec2 {
         let i = self.subface as usize;
-        glam::DVec2::new((i % d) as f64, (i / d) as f64) + st * 0.5
+        if !self.is_subface {
+            st
+        } else if self.corners == 4 {
+            QUADRANTS[i] + st * 0.5
+        } else {
+            let d = Self::tiles_per_row(self.corners as usize);
+            glam::DVec2::new((i % d) as f64, (i / d) as f64) + st * 0.5
+        }
     }
 
-    /// Which sub-face of a `corners`-sided face holds Bfr's face parameters `uv`, and where
-    /// in its `[0,1]²` (the inverse of [`PatchOrigin::face_uv`]).
-    pub fn from_face_uv(face: u32, corners: usize, uv: glam::DVec2) -> (PatchOrigin, glam::DVec2) {
+    /// Which patch of face `face` (`corners` corners, split into sub-faces or not) holds
+    /// Bfr's face parameters `uv`, and where in its `[0,1]²` (the inverse of
+    /// [`PatchOrigin::face_uv`]; a point on a border between sub-faces goes to the upper or
+    /// right one).
+    pub fn from_face_uv(
+        face: u32,
+        corners: usize,
+        is_subface: bool,
+        uv: glam::DVec2,
+    ) -> (PatchOrigin, glam::DVec2) {
+        let at = |subface: usize| PatchOrigin {
+            face,
+            subface: subface as u16,
+            corners: corners as u16,
+            is_subface,
+        };
+        if !is_subface {
+            return (at(0), uv);
+        }
         if corners == 4 {
-            return (PatchOrigin { face, subface: 0 }, uv);
+            let q = match (uv.x >= 0.5, uv.y >= 0.5) {
+                (false, false) => 0,
+                (true, false) => 1,
+                (true, true) => 2,
+                (false, true) => 3,
+            };
+            return (at(q), (uv - QUADRANTS[q]) * 2.0);
         }
         let d = Self::tiles_per_row(corners);
         let (tx, ty) = (uv.x.floor().max(0.0) as usize, uv.y.floor().max(0.0) as usize);
         let subface = (tx + d * ty).min(corners - 1);
         let origin = glam::DVec2::new((subface % d) as f64, (subface / d) as f64);
-        (PatchOrigin { face, subface: subface as u16 }, (uv - origin) * 2.0)
+        (at(subface), (uv - origin) * 2.0)
     }
 }
 

@@ -78,10 +78,17 @@ impl Patch {
             Patch::Subdivision(t) => {
                 let (position, du, dv) = t.derivatives(uv);
                 let inside = DVec2::new(0.5 - uv.x, 0.5 - uv.y);
-                let normal = robust_normal(du, dv, uv, inside, || DVec3::ZERO, |q| {
-                    let (_, du, dv) = t.derivatives(q);
-                    du.cross(dv)
-                });
+                let normal = robust_normal(
+                    du,
+                    dv,
+                    uv,
+                    inside,
+                    || DVec3::ZERO,
+                    |q| {
+                        let (_, du, dv) = t.derivatives(q);
+                        du.cross(dv)
+                    },
+                );
                 SurfacePoint { position, normal }
             }
         }
