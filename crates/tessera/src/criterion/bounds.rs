@@ -311,8 +311,8 @@ pub fn hessian(p: &Patch) -> HessianBound {
 /// to meet with continuous tangents, which B-spline leaves do (they are pieces of one
 /// B-spline surface) and Gregory end caps do only approximately, as in OpenSubdiv; the
 /// property tests measure the error against the bound on every cage.
-pub fn tree_hessian(t: &crate::subdivision::isolation::PatchTree) -> HessianBound {
-    use crate::subdivision::isolation::LeafPatch;
+pub fn tree_hessian(t: &crate::surface::PatchTree) -> HessianBound {
+    use crate::surface::patch_tree::LeafPatch;
     let mut m = HessianBound::default();
     for (leaf, _, size) in t.visible_leaves() {
         let h = match &leaf.patch {
@@ -342,7 +342,7 @@ pub fn tree_hessian(t: &crate::subdivision::isolation::PatchTree) -> HessianBoun
 /// 1500² sample of the closed forms over the square stays below them (17.6, 8.7, 16.5).
 /// The other corners' functions are reflections of it (corner 2's also exchanges `u` and
 /// `v`), and the `uu` and `vv` constants are equal, so one set serves all four.
-pub fn gregory_hessian(g: &crate::subdivision::gregory::GregoryPatch) -> HessianBound {
+pub fn gregory_hessian(g: &crate::surface::GregoryPatch) -> HessianBound {
     let p = &g.points;
     // The Bézier net with Fm inside (rows along v, columns along u; see the Gregory module).
     let net = [

@@ -52,18 +52,90 @@ const SUPPORTED: &str = ".obj, .ply, .stl, .glb";
 /// The extensions [`load`] understands, for error messages.
 pub const INPUT_EXTENSIONS: &str = ".patches, .bezt, .obj, .ply, .stl, .glb, .gltf";
 
-/// How [`load`] reads an input: how the set is built, and where a `.gltf` input's buffer
-/// files may be. A [`BuildOptions`] converts into it with the default (safe) URI scope.
+/// Which surface a polygon mesh input (`.obj`, `.ply`, `.stl`, `.glb`, `.gltf`) stands for
+/// (`--surface`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SurfaceKind {
+    /// Catmull-Clark for an OBJ with any face that is not a triangle (a subdivision cage),
+    /// PN triangles for everything else.
+    #[default]
+    Auto,
+    /// PN triangles: an interpolating surface through the mesh's vertices (polygons are
+    /// split into triangle fans).
+    Pn,
+    /// The Catmull-Clark limit surface of the mesh as a cage, as OpenSubdiv's Bfr evaluates
+    /// it ([`SurfaceSet::from_subdivision_cage`]); triangles too (OpenSubdiv's rule).
+    CatmullClark,
+    /// The Loop limit surface of a triangle cage (not implemented yet: refused).
+    Loop,
+}
+
+/// How [`load`] reads an input: how the set is built, which surface a mesh stands for, and
+/// where a `.gltf` input's buffer files may be. A [`BuildOptions`] converts into it with the
+/// defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LoadOptions {
     pub build: BuildOptions,
     /// Where a `.gltf` input's buffer files may be (`--allow-outside-uris`).
     pub uri_scope: glb::UriScope,
+    /// The surface of a polygon mesh input (`--surface`).
+    pub surface: SurfaceKind,
+    /// How deep a subdivision cage's irregular faces are isolated (`--isolation-smooth`,
+    /// `--isolation-sharp`).
+    pub isolation: crate::subdivision::isolation::IsolationLevels,
 }
 
 impl From<BuildOptions> for LoadOptions {
     fn from(build: BuildOptions) -> LoadOptions {
-        LoadOptions { build, uri_scope: glb::UriScope::default() }
+        LoadOptions { build, ..Default::default() }
+    }
+}
+
+/// The surface set of a polygon mesh `mesh` read from `path`, of the kind `options` say
+/// (`split` polygons were already fanned by the reader; `keeps_polygons` says whether it
+/// keeps them, as the OBJ reader does).
+fn mesh_surfaces(
+    mesh: PolygonMesh,
+    path: &Path,
+    options: &LoadOptions,
+    split: usize,
+    keeps_polygons: bool,
+) -> Result<SurfaceSet> {
+    let polygons = mesh.faces.iter().any(|f| f.positions.len() != 3);
+    let kind = match options.surface {
+        SurfaceKind::Auto if keeps_polygons && polygons => SurfaceKind::CatmullClark,
+        SurfaceKind::Auto => SurfaceKind::Pn,
+        k => k,
+    };
+    match kind {
+        SurfaceKind::CatmullClark => {
+            if split > 0 {
+                return Err(Error::unsupported(
+                    path,
+                    0,
+                    format!("{split} polygons of this format are read as triangle fans; give the cage as .obj for its Catmull-Clark surface"),
+                ));
+            }
+            let cage = crate::subdivision::CageOptions {
+                orientation: options.build.orientation,
+                flip: options.build.flip,
+                isolation: options.isolation,
+            };
+            SurfaceSet::from_subdivision_cage(&mesh, path, cage)
+        }
+        SurfaceKind::Loop => Err(Error::unsupported(
+            path,
+            0,
+            "Loop subdivision surfaces are not implemented yet (--surface catmull-clark or pn)",
+        )),
+        SurfaceKind::Pn | SurfaceKind::Auto => {
+            let mut mesh = mesh;
+            let split = split + mesh.split_polygons();
+            let mut set = with_split(SurfaceSet::pn_from_mesh(&mesh, path, options.build)?, split);
+            set.repairs.ignored_tag_lines = mesh.tags.lines.iter().map(|&(_, n)| n).sum();
+            set.repairs.skipped_primitives = mesh.skipped_primitives;
+            Ok(set)
+        }
     }
 }
 
@@ -94,29 +166,21 @@ impl From<BuildOptions> for LoadOptions {
 /// Cost: one read of the file, the parse (O(file size)), and building the set (O(patches)
 /// hashing).
 pub fn load(path: &Path, options: impl Into<LoadOptions>) -> Result<SurfaceSet> {
-    let LoadOptions { build: options, uri_scope } = options.into();
+    let load = options.into();
+    let options = load.build;
     refuse_folder(path)?;
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     let set = match ext.as_deref() {
         Some("patches") => SurfaceSet::from_patch_file(&patches::read_patches(path)?, options),
         Some("bezt") => SurfaceSet::from_bezier_triangle_file(&bezt::read_bezt(path)?, options),
-        Some("obj") => {
-            let mut mesh = obj::read_obj(path)?;
-            let split = mesh.split_polygons();
-            let mut set = with_split(SurfaceSet::pn_from_mesh(&mesh, path, options)?, split);
-            set.repairs.ignored_tag_lines = mesh.tags.lines.iter().map(|&(_, n)| n).sum();
-            set
-        }
+        Some("obj") => mesh_surfaces(obj::read_obj(path)?, path, &load, 0, true)?,
         Some("ply") => {
             let (mesh, split) = ply::parse_ply_counting_polygons(&read_input(path)?, path)?;
-            with_split(SurfaceSet::pn_from_mesh(&PolygonMesh::from_mesh(&mesh), path, options)?, split)
+            mesh_surfaces(PolygonMesh::from_mesh(&mesh), path, &load, split, false)?
         }
-        Some("stl") => SurfaceSet::pn_from_mesh(&PolygonMesh::from_mesh(&read_mesh(path)?), path, options)?,
+        Some("stl") => mesh_surfaces(PolygonMesh::from_mesh(&read_mesh(path)?), path, &load, 0, false)?,
         Some("glb" | "gltf") => {
-            let mesh = glb::read_gltf_triangles(path, uri_scope)?;
-            let mut set = SurfaceSet::pn_from_mesh(&mesh, path, options)?;
-            set.repairs.skipped_primitives = mesh.skipped_primitives;
-            set
+            mesh_surfaces(glb::read_gltf_triangles(path, load.uri_scope)?, path, &load, 0, false)?
         }
         other => return Err(unknown(path, "input", other, INPUT_EXTENSIONS)),
     };

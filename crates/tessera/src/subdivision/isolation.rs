@@ -23,6 +23,8 @@ use super::cage::{Cage, FaceCorner};
 use super::gregory::{GregoryCorner, GregoryPatch, GregorySource};
 use super::sdc::{self, EdgeNeighborhood, VertexNeighborhood, VertexRule};
 use super::INFINITELY_SHARP;
+use crate::surface::patch_tree::Slot;
+pub use crate::surface::patch_tree::{Leaf, LeafPatch, PatchTree};
 
 /// How deep feature-adaptive isolation refines (Bfr's `SurfaceFactory::Options`
 /// `ApproxLevelSmooth` and `ApproxLevelSharp`).
@@ -45,163 +47,6 @@ impl Default for IsolationLevels {
 /// The most either level may be: each level quarters the leaves' size, and Bfr's own limit
 /// is 10.
 pub const MAX_ISOLATION_LEVEL: u8 = 10;
-
-/// One leaf of a face's patch tree: a square `origin + [0, size]²` of the face's (or
-/// sub-face's) domain and the patch over it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Leaf {
-    pub origin: DVec2,
-    /// `2^-level`.
-    pub size: f64,
-    /// The refinement level the leaf was made at (0: the face itself).
-    pub level: u8,
-    pub patch: LeafPatch,
-}
-
-/// The surface over a leaf.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LeafPatch {
-    /// A regular piece: its B-spline patch as a Bézier net (`points[4*i + j]`, `i` along `u`).
-    Bezier([DVec3; 16]),
-    /// An end cap.
-    Gregory(GregoryPatch),
-}
-
-/// Child slots of a quadtree node, by quadrant: `[u low v low, u high v low, u high v high,
-/// u low v high]`; a child is a node (`Node(i)`) or a leaf (`Leaf(i)`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Slot {
-    Node(u32),
-    Leaf(u32),
-}
-
-/// The piecewise surface over one face (a quad) or one corner sub-face (of any other face),
-/// with parameters in `[0,1]²`: the leaves of its isolation and the quadtree that finds the
-/// leaf of a parameter point, as Bfr's `PatchTree` does.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PatchTree {
-    pub leaves: Vec<Leaf>,
-    nodes: Vec<[Slot; 4]>,
-    root: Slot,
-    /// Every leaf's points, for hulls and bounds.
-    points: Vec<DVec3>,
-    /// `u` and `v` are exchanged on the way in and out (the surface with the opposite
-    /// orientation, [`PatchTree::transposed`]).
-    transposed: bool,
-    /// The square of the tree's domain this patch covers, `view_origin + [0, view_size]²`
-    /// ([`PatchTree::quadrant`]).
-    view_origin: DVec2,
-    view_size: f64,
-}
-
-impl PatchTree {
-    /// The leaf holding `uv`, with `uv` in the leaf's own `[0,1]²`. Points on a border
-    /// between leaves go to the upper (right) one, as `searchQuadtree` does; the surface is
-    /// continuous there. Cost: O(depth).
-    pub fn locate(&self, uv: DVec2) -> (&Leaf, DVec2) {
-        let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
-        let uv = self.view_origin + uv * self.view_size;
-        let mut slot = self.root;
-        let (mut origin, mut size) = (DVec2::ZERO, 1.0);
-        loop {
-            match slot {
-                Slot::Leaf(i) => {
-                    let leaf = &self.leaves[i as usize];
-                    return (leaf, (uv - leaf.origin) / leaf.size);
-                }
-                Slot::Node(n) => {
-                    size *= 0.5;
-                    let (right, up) = (uv.x >= origin.x + size, uv.y >= origin.y + size);
-                    let q = match (right, up) {
-                        (false, false) => 0,
-                        (true, false) => 1,
-                        (true, true) => 2,
-                        (false, true) => 3,
-                    };
-                    origin += DVec2::new(f64::from(u8::from(right)), f64::from(u8::from(up))) * size;
-                    slot = self.nodes[n as usize][q];
-                }
-            }
-        }
-    }
-
-    /// The surface point at `uv` ∈ `[0,1]²`. Cost: O(depth) and one patch evaluation.
-    pub fn position(&self, uv: DVec2) -> DVec3 {
-        let (leaf, st) = self.locate(uv);
-        match &leaf.patch {
-            LeafPatch::Bezier(p) => bezier_position(p, st),
-            LeafPatch::Gregory(g) => g.position(st.x, st.y),
-        }
-    }
-
-    /// Position and first derivatives with respect to the tree's `uv` at `uv` (Gregory
-    /// leaves: OpenSubdiv's approximate derivatives, see [`GregoryPatch::derivatives`]).
-    pub fn derivatives(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
-        let (leaf, st) = self.locate(uv);
-        let (p, du, dv) = match &leaf.patch {
-            LeafPatch::Bezier(b) => {
-                let d = crate::surface::RationalBicubic::polynomial(*b).derivatives(st);
-                (d.position, d.du, d.dv)
-            }
-            LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
-        };
-        let (du, dv) = (du * (self.view_size / leaf.size), dv * (self.view_size / leaf.size));
-        if self.transposed {
-            (p, dv, du)
-        } else {
-            (p, du, dv)
-        }
-    }
-
-    /// The same surface with `u` and `v` exchanged (the opposite orientation).
-    pub fn transposed(&self) -> PatchTree {
-        PatchTree { transposed: !self.transposed, ..self.clone() }
-    }
-
-    /// The quarter `q` of the patch (quadrants as [`crate::subdivision::QUADRANTS`]) as a
-    /// patch of its own over `[0,1]²`, `u` and `v` running as the whole's.
-    /// Precondition: not transposed.
-    pub fn quadrant(&self, q: usize) -> PatchTree {
-        let size = self.view_size * 0.5;
-        PatchTree {
-            view_origin: self.view_origin + super::QUADRANTS[q] * self.view_size,
-            view_size: size,
-            ..self.clone()
-        }
-    }
-
-    /// The leaves this patch covers, each with its square in the patch's own parameters
-    /// (origin, size) — before any transposition.
-    pub fn visible_leaves(&self) -> impl Iterator<Item = (&Leaf, DVec2, f64)> + '_ {
-        let (o, s) = (self.view_origin, self.view_size);
-        self.leaves
-            .iter()
-            .filter(move |l| {
-                l.origin.x < o.x + s
-                    && l.origin.x + l.size > o.x
-                    && l.origin.y < o.y + s
-                    && l.origin.y + l.size > o.y
-            })
-            .map(move |l| (l, (l.origin - o) / s, l.size / s))
-    }
-
-    /// Whether [`PatchTree::transposed`] was applied an odd number of times: leaf
-    /// parameters are then the tree's with `u` and `v` exchanged.
-    pub fn is_transposed(&self) -> bool {
-        self.transposed
-    }
-
-    /// The control points of all leaves (the surface lies in their convex hull: Bézier and
-    /// Gregory patches are convex combinations of their points).
-    pub fn control_points(&self) -> &[DVec3] {
-        &self.points
-    }
-
-    /// The tree's deepest leaf level.
-    pub fn depth(&self) -> u8 {
-        self.leaves.iter().map(|l| l.level).max().unwrap_or(0)
-    }
-}
 
 /// Builds the patch trees of face `face` of `cage`: one for a quad, one per corner sub-face
 /// (in corner order) for any other face.
@@ -232,22 +77,6 @@ pub fn isolate(cage: &Cage, face: usize, levels: IsolationLevels) -> Vec<PatchTr
         .collect()
 }
 
-/// A polynomial bicubic Bézier net at `st`.
-fn bezier_position(points: &[DVec3; 16], st: DVec2) -> DVec3 {
-    let b = |t: f64| {
-        let s = 1.0 - t;
-        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
-    };
-    let (bu, bv) = (b(st.x), b(st.y));
-    let mut p = DVec3::ZERO;
-    for i in 0..4 {
-        for j in 0..4 {
-            p += points[4 * i + j] * (bu[i] * bv[j]);
-        }
-    }
-    p
-}
-
 struct Context {
     levels: IsolationLevels,
     /// Whether the neighbourhood of the root has a face that is not a quad (Far's
@@ -263,22 +92,7 @@ struct TreeBuilder {
 
 impl TreeBuilder {
     fn finish(self, root: Slot) -> PatchTree {
-        let mut points = Vec::new();
-        for l in &self.leaves {
-            match &l.patch {
-                LeafPatch::Bezier(p) => points.extend_from_slice(p),
-                LeafPatch::Gregory(g) => points.extend_from_slice(&g.points),
-            }
-        }
-        PatchTree {
-            leaves: self.leaves,
-            nodes: self.nodes,
-            root,
-            points,
-            transposed: false,
-            view_origin: DVec2::ZERO,
-            view_size: 1.0,
-        }
+        PatchTree::from_parts(self.leaves, self.nodes, root)
     }
 }
 

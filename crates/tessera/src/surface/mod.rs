@@ -11,20 +11,24 @@
 
 mod bezier_triangle;
 mod bicubic;
+mod gregory_patch;
+pub mod patch_tree;
 mod pn_triangle;
 pub(crate) mod polygon_mesh;
 mod set;
+pub mod subdivision_tags;
 
 /// The parameter domains live in [`crate::domain`]; re-exported here for the surfaces' users.
 pub use crate::domain::Domain;
 pub use bezier_triangle::BezierTriangle;
 pub use bicubic::RationalBicubic;
+pub use gregory_patch::GregoryPatch;
+pub use patch_tree::{PatchOrigin, PatchTree};
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
 pub use polygon_mesh::{PolygonFace, PolygonMesh};
 pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 
-use crate::subdivision::isolation::PatchTree;
 use glam::{DVec2, DVec3};
 
 /// A point on a surface with its unit normal.
@@ -56,7 +60,7 @@ pub enum Patch {
     /// The Catmull-Clark limit surface over a cage face (or a corner sub-face of a face that
     /// is not a quad) whose neighbourhood is not regular: the pieces of its feature-adaptive
     /// isolation, B-spline patches and Gregory end caps, over the unit square
-    /// ([`crate::subdivision::isolation`]).
+    /// ([`crate::subdivision::isolation`], [`patch_tree`]).
     Subdivision(Box<PatchTree>),
 }
 

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::subdivision_tags::SubdivisionTags;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::subdivision::SubdivisionTags;
 
 /// One polygon of an input mesh.
 #[derive(Debug, Clone, PartialEq, Eq)]

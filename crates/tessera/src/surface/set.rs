@@ -72,7 +72,7 @@ pub struct SurfaceSet {
     /// For a set built from a subdivision cage
     /// ([`SurfaceSet::from_subdivision_cage`](crate::surface::SurfaceSet::from_subdivision_cage)):
     /// patch `p`'s base face and sub-face; empty for every other input.
-    pub origins: Vec<crate::subdivision::PatchOrigin>,
+    pub origins: Vec<crate::surface::PatchOrigin>,
 }
 
 /// Control-point indices of each corner and each edge (corner `e` → `e+1`) of a patch kind.

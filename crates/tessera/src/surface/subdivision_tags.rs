@@ -11,7 +11,7 @@
 //! | `creasemethod` | `normal` or `chaikin` |
 //! | `smoothtriangles` | `catmark` or `smooth` |
 //!
-//! Sharpness is a finite number ≥ 0 ([`super::INFINITELY_SHARP`] and above is infinitely
+//! Sharpness is a finite number ≥ 0 ([`INFINITELY_SHARP`] and above is infinitely
 //! sharp); a NaN, infinite or negative one is an error naming its line, as is an index out of
 //! range or a crease between vertices that share no face edge. Unknown tags are kept in
 //! [`SubdivisionTags::unknown`] for the caller to report; they are not fatal.
@@ -19,8 +19,55 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::{BoundaryInterpolation, CreaseMethod, SubdivisionOptions, TriangleRule};
 use crate::error::{Error, Result};
+
+/// How the limit surface meets the cage's boundary (OpenSubdiv's `VtxBoundaryInterpolation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BoundaryInterpolation {
+    /// No limit surface on faces at the boundary (tag value 0).
+    None,
+    /// Boundary edges are infinitely sharp; boundary vertices of one face stay smooth
+    /// (tag value 2, and the default when a cage says nothing).
+    #[default]
+    EdgeOnly,
+    /// Boundary edges are infinitely sharp and boundary vertices of one face are corners
+    /// (tag value 1).
+    EdgeAndCorner,
+}
+
+/// How semi-sharp creases lose sharpness from level to level (`Sdc::Options::CreasingMethod`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CreaseMethod {
+    /// Sharpness drops by one a level (`normal`, the default).
+    #[default]
+    Uniform,
+    /// Chaikin's rule: a crease's sharpness averages with its neighbours' (`chaikin`).
+    Chaikin,
+}
+
+/// Catmull-Clark's rule for the face points of triangles (`Sdc::Options::TriangleSubdivision`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TriangleRule {
+    /// Catmull-Clark's own rule (`catmark`, the default).
+    #[default]
+    Catmark,
+    /// The smoother weights for triangles (`smooth`).
+    Smooth,
+}
+
+/// The rules of a cage's limit surface that are not per edge or vertex.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SubdivisionOptions {
+    /// The boundary rule (`t interpolateboundary`).
+    pub boundary: BoundaryInterpolation,
+    /// The crease method (`t creasemethod`).
+    pub crease_method: CreaseMethod,
+    /// Catmull-Clark's triangle rule (`t smoothtriangles`).
+    pub triangles: TriangleRule,
+}
+
+/// Sharpness at or above this is infinitely sharp (OpenSubdiv's `SHARPNESS_INFINITE`).
+pub const INFINITELY_SHARP: f32 = 10.0;
 
 /// A sharp edge: the cage edge between two vertices (0-based) and its sharpness.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -159,7 +206,7 @@ impl SubdivisionTags {
             if !(s.is_finite() && s >= 0.0) {
                 return Err(format!(
                     "tag `{name}`: sharpness {s} must be a finite number ≥ 0 ({} and above is infinitely sharp)",
-                    super::INFINITELY_SHARP
+                    INFINITELY_SHARP
                 ));
             }
             Ok(s as f32)
