@@ -16,11 +16,12 @@ use std::time::{Duration, Instant};
 use tessera::engine::render_queues::RenderQueues;
 use tessera::engine::EngineOptions;
 use tessera::io::glb::UriScope;
-use tessera::io::LoadOptions;
+use tessera::io::{LoadOptions, SurfaceKind};
 use tessera::mesh::Mesh;
 use tessera::pattern::semi_uniform::StaticPattern;
 use tessera::pattern::uniform::Uniform;
 use tessera::scheme::{Criterion, Scheme};
+use tessera::subdivision::isolation::IsolationLevels;
 use tessera::surface::Domain;
 use tessera::surface::{BuildOptions, Orientation, SurfaceSet};
 use tessera::tessellator::{Tessellator, TessellatorOptions};
@@ -85,6 +86,29 @@ pub struct InputArgs {
     /// links followed, to regular files inside it).
     #[arg(long)]
     allow_outside_uris: bool,
+    /// The surface a mesh input stands for. `auto`: the Catmull-Clark limit surface of an
+    /// OBJ with any face that is not a triangle (a subdivision cage, with OpenSubdiv's tags),
+    /// PN triangles for everything else.
+    #[arg(long, value_enum, default_value_t = SurfaceArg::Auto)]
+    surface: SurfaceArg,
+    /// How many levels Catmull-Clark cages isolate smooth features (extraordinary vertices,
+    /// smooth boundary corners) before Gregory end caps; 2 is OpenSubdiv Bfr's default, more
+    /// comes closer to the exact limit surface.
+    #[arg(long, value_name = "LEVELS", default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=10))]
+    isolation_smooth: u8,
+    /// How many levels Catmull-Clark cages isolate sharp features (semi-sharp creases and
+    /// corners); 6 is OpenSubdiv Bfr's default.
+    #[arg(long, value_name = "LEVELS", default_value_t = 6, value_parser = clap::value_parser!(u8).range(1..=10))]
+    isolation_sharp: u8,
+}
+
+/// `--surface`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum SurfaceArg {
+    Auto,
+    Pn,
+    CatmullClark,
+    Loop,
 }
 
 #[derive(Args)]
@@ -174,13 +198,29 @@ fn load_options(a: &InputArgs) -> Result<LoadOptions, Box<dyn std::error::Error>
         flip: a.flip_normals,
     };
     let uri_scope = if a.allow_outside_uris { UriScope::Anywhere } else { UriScope::ModelFolder };
-    Ok(LoadOptions { build, uri_scope })
+    let surface = match a.surface {
+        SurfaceArg::Auto => SurfaceKind::Auto,
+        SurfaceArg::Pn => SurfaceKind::Pn,
+        SurfaceArg::CatmullClark => SurfaceKind::CatmullClark,
+        SurfaceArg::Loop => SurfaceKind::Loop,
+    };
+    let isolation = IsolationLevels { smooth: a.isolation_smooth, sharp: a.isolation_sharp };
+    Ok(LoadOptions { build, uri_scope, surface, isolation })
 }
 
 /// Loads a surface set by extension (`tessera::io::load`: .patches, .bezt, .obj, .ply, .stl,
-/// .glb, .gltf).
+/// .glb, .gltf), saying on stderr when `--surface auto` took a cage's Catmull-Clark surface.
 fn load_surfaces(path: &Path, options: LoadOptions) -> Result<SurfaceSet, tessera::Error> {
-    tessera::io::load(path, options)
+    let set = tessera::io::load(path, options)?;
+    if options.surface == SurfaceKind::Auto && !set.origins.is_empty() {
+        eprintln!(
+            "note: {}: faces that are not triangles, so this is a subdivision cage: tessellating its \
+             Catmull-Clark limit surface ({} patches; --surface pn for PN triangles)",
+            path.display(),
+            set.patches.len()
+        );
+    }
+    Ok(set)
 }
 
 /// Output buffers may use up to 3/4 of the memory available now (Linux `MemAvailable`), or
@@ -251,6 +291,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
             r.ignored_tag_lines,
             "OpenSubdiv tag lines (creases, corners, holes) not used: PN triangles interpolate the cage, they do not subdivide it",
         ),
+        (r.unknown_tag_lines, "OpenSubdiv tag lines of unknown names ignored"),
         (r.welded_points, "input points merged into coincident ones by welding"),
         (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
         (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
@@ -278,6 +319,7 @@ fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
         "split_polygons": r.split_polygons,
         "skipped_primitives": r.skipped_primitives,
         "ignored_tag_lines": r.ignored_tag_lines,
+        "unknown_tag_lines": r.unknown_tag_lines,
         "collapsed_triangles": mesh.collapsed_triangles,
         "flipped": r.flipped,
     })

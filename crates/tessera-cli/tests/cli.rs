@@ -155,9 +155,13 @@ fn bad_input_gives_one_clear_line() {
         let expect = if *name == "range.patches" { "range.patches:2" } else { expect };
         assert!(err.contains(expect), "{name}: expected `{expect}` in `{err}`");
     }
-    // A quad is no bad input: it is split into triangles, and says so (tests/input_rules.rs).
+    // A quad is no bad input: under `--surface auto` it is a subdivision cage and says so;
+    // as PN triangles it is split into triangles, and says so (tests/input_rules.rs).
     std::fs::write(dir.join("quad.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
     let quad = tessera(&["mesh", "quad.obj"], &dir);
+    assert!(quad.status.success(), "{}", text(&quad.stderr));
+    assert!(text(&quad.stderr).contains("its Catmull-Clark limit surface"), "{}", text(&quad.stderr));
+    let quad = tessera(&["mesh", "quad.obj", "--surface", "pn"], &dir);
     assert!(quad.status.success(), "{}", text(&quad.stderr));
     assert!(
         text(&quad.stderr).contains("repair: 1 input polygons split into triangles"),

@@ -1,5 +1,6 @@
 //! One rule for every input format, and inputs refused with the reason rather than misread:
-//! polygons are split into triangles the same way for OBJ and PLY and reported as a repair.
+//! as PN triangles, polygons are split into triangles the same way for OBJ and PLY and
+//! reported as a repair; an OBJ with polygons is a subdivision cage by default.
 
 mod common;
 
@@ -33,7 +34,8 @@ fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
     let (obj, ply) = cube(&dir);
     let mut results = Vec::new();
     for input in [&obj, &ply] {
-        let out = tessera(&["mesh", input, "--factor", "3", "--stats", "-o", "out.ply"], &dir);
+        let out =
+            tessera(&["mesh", input, "--surface", "pn", "--factor", "3", "--stats", "-o", "out.ply"], &dir);
         assert!(out.status.success(), "{input}: {}", text(&out.stderr));
         let stderr = text(&out.stderr);
         assert!(
@@ -55,6 +57,26 @@ fn polygons_are_split_alike_in_obj_and_ply_and_reported() {
     let check = tessera(&["check", &obj], &dir);
     assert!(check.status.success(), "{}", text(&check.stderr));
     assert!(text(&check.stdout).contains("boundary edges       0"), "{}", text(&check.stdout));
+    // `--surface auto` (the default): the OBJ's quads are a Catmull-Clark cage, said on stderr;
+    // the PLY's polygons, which its reader fans, stay PN triangles; asking for Catmull-Clark on
+    // them is refused with the reason rather than subdividing the fans.
+    let out = tessera(&["mesh", &obj, "--factor", "3", "--stats"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("Catmull-Clark limit surface (6 patches"), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+    assert_eq!((v["patches"].as_u64(), v["boundary_edges"].as_u64()), (Some(6), Some(0)));
+    let out = tessera(&["mesh", &ply, "--factor", "3", "--stats"], &dir);
+    assert!(text(&out.stderr).contains("repair: 6 input polygons split"), "{}", text(&out.stderr));
+    let out = tessera(&["mesh", &ply, "--surface", "catmull-clark"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("give the cage as .obj"), "{}", text(&out.stderr));
+    let out = tessera(&["mesh", &obj, "--surface", "loop"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("Loop subdivision surfaces are not implemented yet"),
+        "{}",
+        text(&out.stderr)
+    );
 }
 
 /// A subdivision cage's tag lines are read (a bad one is an error naming its line) and, as PN
@@ -64,11 +86,17 @@ fn opensubdiv_tags_are_read_and_reported_unused_by_pn_triangles() {
     let dir = scratch("cage-tags");
     // catmark_cube_creases1: 12 crease lines and an interpolateboundary line.
     let cage = data("subdivision/catmark_cube_creases1.obj");
-    let out = tessera(&["mesh", cage.to_str().unwrap(), "--factor", "2", "--stats"], &dir);
+    let out = tessera(&["mesh", cage.to_str().unwrap(), "--surface", "pn", "--factor", "2", "--stats"], &dir);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("repair: 13 OpenSubdiv tag lines"), "{}", text(&out.stderr));
     let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
     assert_eq!(v["repairs"]["ignored_tag_lines"], 13);
+    // As the Catmull-Clark cage it is, the tags shape the surface: nothing is reported unused.
+    let out = tessera(&["mesh", cage.to_str().unwrap(), "--factor", "2", "--stats"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(!text(&out.stderr).contains("tag lines"), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+    assert_eq!(v["repairs"]["ignored_tag_lines"], 0);
     // A crease between two vertices that share no edge: refused, naming the line.
     let mut bad = std::fs::read_to_string(&cage).unwrap();
     if !bad.ends_with('\n') {

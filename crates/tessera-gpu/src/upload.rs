@@ -71,6 +71,13 @@ impl PackedSet {
             packed.any_repeated_corner |= repeated;
             let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
             let (tri, pn) = match patch {
+                Patch::Subdivision(_) => {
+                    return Err(tessera::Error::EngineNotSupported {
+                        engine: tessera::scheme::Engine::Gpu.name(),
+                        what: tessera::scheme::SUBDIVISION_ON_GPU.into(),
+                    }
+                    .into())
+                }
                 Patch::Bicubic(b) => {
                     packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
                     (false, false)

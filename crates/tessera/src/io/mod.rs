@@ -121,7 +121,9 @@ fn mesh_surfaces(
                 flip: options.build.flip,
                 isolation: options.isolation,
             };
-            SurfaceSet::from_subdivision_cage(&mesh, path, cage)
+            let mut set = SurfaceSet::from_subdivision_cage(&mesh, path, cage)?;
+            set.repairs.unknown_tag_lines = mesh.tags.unknown.len();
+            Ok(set)
         }
         SurfaceKind::Loop => Err(Error::unsupported(
             path,

@@ -44,7 +44,7 @@ use crate::surface::SurfaceSet;
 use rayon::prelude::*;
 
 mod validate;
-pub use validate::{validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR};
+pub use validate::{validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR, SUBDIVISION_ON_GPU};
 
 /// A tessellation scheme: a pattern with the rules that feed it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -15,7 +15,7 @@ use crate::criterion::MAX_FACTOR;
 use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::pattern::semi_uniform::MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL;
-use crate::surface::SurfaceSet;
+use crate::surface::{Patch, SurfaceSet};
 
 /// The engine that is to draw a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -84,6 +84,9 @@ pub fn validate(
     check_request(scheme, criterion, options)?;
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
+    if engine != Engine::Cpu && set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_))) {
+        return Err(Error::EngineNotSupported { engine: engine.name(), what: SUBDIVISION_ON_GPU.into() });
+    }
     Ok(Accepted {
         cap: scheme.cap(options),
         edge_rule: scheme.edge_rule(),
@@ -215,6 +218,11 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
     }
 }
 
+/// What the GPU engine does not draw yet: the feature-adaptive pieces of a Catmull-Clark
+/// cage's irregular faces (its regular faces are bicubic patches, which it draws).
+pub const SUBDIVISION_ON_GPU: &str = "the isolated faces of a Catmull-Clark cage (next to extraordinary \
+     vertices, creases or faces that are not quads); a cage whose faces are all regular draws on the GPU";
+
 /// The surface-kind part of [`validate`]: SD-2 is defined for triangles (paper 001), ESC for
 /// bicubic patches (paper 002); every other scheme and both engines take every kind.
 fn check_surface_kinds(scheme: Scheme, set: &SurfaceSet) -> Result<()> {
@@ -231,10 +239,22 @@ fn check_surface_kinds(scheme: Scheme, set: &SurfaceSet) -> Result<()> {
         ),
         _ => return Ok(()),
     };
-    match set.patches.iter().position(|p| p.domain() != needs) {
-        Some(patch) => Err(Error::PatchKindNotAccepted { scheme: scheme.name(), kind, patch, hint }),
-        None => Ok(()),
+    if let Some(patch) = set.patches.iter().position(|p| p.domain() != needs) {
+        return Err(Error::PatchKindNotAccepted { scheme: scheme.name(), kind, patch, hint });
     }
+    if matches!(scheme, Scheme::Esc { .. }) {
+        if let Some(patch) = set.patches.iter().position(|p| matches!(p, Patch::Subdivision(_))) {
+            return Err(Error::PatchKindNotAccepted {
+                scheme: scheme.name(),
+                kind: "piecewise subdivision",
+                patch,
+                hint: "ESC needs one bicubic control net per patch; the isolated faces of a cage (next to \
+                       extraordinary vertices or creases) are piecewise: use the transition, semi-uniform or \
+                       uniform scheme",
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The engine part of [`validate`].

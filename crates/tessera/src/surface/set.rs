@@ -55,6 +55,9 @@ pub struct Repairs {
     /// OpenSubdiv tag lines of an OBJ cage (creases, corners, holes, rules) that PN
     /// triangles, which interpolate the mesh rather than subdivide it, do not use.
     pub ignored_tag_lines: usize,
+    /// Tag lines of a subdivision cage whose names tessera does not know (OpenSubdiv's
+    /// face-varying options, for instance), ignored.
+    pub unknown_tag_lines: usize,
     /// The orientation was reversed (by `Outward` or by `flip`).
     pub flipped: bool,
 }
