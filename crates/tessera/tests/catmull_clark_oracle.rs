@@ -39,6 +39,46 @@ struct OracleFace {
     points: Vec<(DVec2, DVec3)>,
 }
 
+/// The OpenSubdiv release the oracle was built against, from its header line.
+fn oracle_version() -> [u32; 3] {
+    static VERSION: std::sync::OnceLock<[u32; 3]> = std::sync::OnceLock::new();
+    *VERSION.get_or_init(|| {
+        let out = Command::new(oracle())
+            .arg(data("subdivision/catmark_cube.obj"))
+            .output()
+            .expect("run the oracle");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let header = text.lines().next().unwrap_or_default();
+        let version = header.split_whitespace().skip_while(|w| *w != "opensubdiv").nth(1).unwrap_or("0.0.0");
+        let v: Vec<u32> = version.split('.').map(|x| x.parse().unwrap_or(0)).collect();
+        [v[0], v.get(1).copied().unwrap_or(0), v.get(2).copied().unwrap_or(0)]
+    })
+}
+
+/// OpenSubdiv before 3.5.1 (Debian's `libosd-dev` is 3.5.0) reads uninitialised memory on
+/// valence-2 interior vertices (fixed by commit 51eb6a04): on this cage it crashes or prints
+/// wrong points. With such a build the cage's points come from fixtures the 3.6.0 build
+/// printed (`tools/osd-oracle/osd_oracle CAGE RATE`), at rates 1–3.
+const VAL2: &str = "catmark_val2_interior.obj";
+
+/// The oracle's faces for `cage` at `rate`, or None where they cannot be had (said on stderr).
+fn oracle_faces(cage: &Path, rate: u32) -> Option<Vec<OracleFace>> {
+    let name = cage.file_name().unwrap().to_string_lossy();
+    if name == VAL2 && oracle_version() < [3, 5, 1] {
+        let fixture = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("tests/fixtures/osd/catmark_val2_interior_rate{rate}.txt"));
+        let Ok(text) = std::fs::read_to_string(&fixture) else {
+            eprintln!(
+                "{name} rate {rate}: not compared (OpenSubdiv {:?} is wrong on it; the fixtures hold rates 1-3)",
+                oracle_version()
+            );
+            return None;
+        };
+        return Some(parse_oracle(&text));
+    }
+    Some(run_oracle(cage, rate))
+}
+
 fn run_oracle(cage: &Path, rate: u32) -> Vec<OracleFace> {
     let out = Command::new(oracle()).arg(cage).arg(rate.to_string()).output().expect("run the oracle");
     assert!(
@@ -47,7 +87,10 @@ fn run_oracle(cage: &Path, rate: u32) -> Vec<OracleFace> {
         cage.display(),
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8(out.stdout).unwrap();
+    parse_oracle(&String::from_utf8(out.stdout).unwrap())
+}
+
+fn parse_oracle(text: &str) -> Vec<OracleFace> {
     let mut faces: Vec<OracleFace> = Vec::new();
     for line in text.lines().filter(|l| !l.starts_with('#')) {
         let w: Vec<&str> = line.split_ascii_whitespace().collect();
@@ -100,7 +143,7 @@ fn regular_faces_are_bfrs_regular_faces_and_their_points_agree() {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let diagonal = (hi - lo).length();
         for rate in 1..=8 {
-            let faces = run_oracle(&path, rate);
+            let Some(faces) = oracle_faces(&path, rate) else { continue };
             assert_eq!(faces.len(), cage.face_count(), "{name}");
             for (f, face) in faces.iter().enumerate() {
                 assert_eq!(!cage.holes[f], face.limit, "{name} face {f}: has a limit surface");
@@ -155,7 +198,8 @@ fn every_face_of_the_set_agrees_with_bfr() {
         let mut worst = (0.0f64, String::new());
         let mut points = 0;
         for rate in 1..=8 {
-            for (f, face) in run_oracle(&path, rate).iter().enumerate() {
+            let Some(faces) = oracle_faces(&path, rate) else { continue };
+            for (f, face) in faces.iter().enumerate() {
                 assert_eq!(
                     patch_of.contains_key(&(f as u32, 0)),
                     face.limit,

@@ -95,6 +95,8 @@ fn fill_phantoms(grid: &mut [[Option<DVec3>; 4]; 4], mask: u8) {
         if mask & (1 << edge) == 0 {
             continue;
         }
+        // (Rows and columns by turns: an index loop reads plainest.)
+        #[allow(clippy::needless_range_loop)]
         for i in 0..4 {
             match edge {
                 0 => grid[0][i] = extrapolate(grid[1][i], grid[2][i]),

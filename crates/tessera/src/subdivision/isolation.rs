@@ -265,10 +265,9 @@ fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
                         if boundary { false } else { is_infinite(sharpness[0]) != is_infinite(sharpness[2]) };
                 }
             }
-            VertexRule::Corner => {
-                if inf_edges == edges.len() && (edges.len() > 2 || t.inf_sharp) {
-                    t.inf_irregular = false;
-                }
+            // A regular set of infinitely sharp corners: every edge sharp, not a smooth corner.
+            VertexRule::Corner if inf_edges == edges.len() && (edges.len() > 2 || t.inf_sharp) => {
+                t.inf_irregular = false;
             }
             _ => {}
         }
@@ -289,12 +288,13 @@ fn face_has_features(mesh: &Cage, f: usize, level: u8, full: bool) -> bool {
     if comp.incident_irregular_face && level == 0 {
         return true;
     }
-    if comp.xordinary && full {
-        if comp.rules == SMOOTH {
-            return true;
-        } else if level < 2 && tags.iter().any(|t| t.xordinary && t.rules == SMOOTH) {
-            return true;
-        }
+    // Smooth extraordinary vertices: all corners smooth, or (the first two levels) one of
+    // the extraordinary corners smooth.
+    if comp.xordinary
+        && full
+        && (comp.rules == SMOOTH || (level < 2 && tags.iter().any(|t| t.xordinary && t.rules == SMOOTH)))
+    {
+        return true;
     }
     if comp.rules == SMOOTH {
         return false;

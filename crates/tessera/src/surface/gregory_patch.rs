@@ -36,7 +36,7 @@ impl GregoryPatch {
         [[g[0], g[1], g[7], g[5]], [g[2], f0, f1, g[6]], [g[16], f3, f2, g[12]], [g[15], g[17], g[11], g[10]]]
     }
 
-    /// The surface point at `(u, v)` ∈ [0,1]², `u` along corner 0 → 1 and `v` along
+    /// The surface point at `(u, v)` ∈ `[0,1]²`, `u` along corner 0 → 1 and `v` along
     /// corner 0 → 3. Cost: a 4×4 Bézier evaluation.
     pub fn position(&self, u: f64, v: f64) -> DVec3 {
         let net = self.bezier_net(u, v);
