@@ -207,10 +207,14 @@ fn every_face_of_the_set_agrees_with_bfr() {
                 );
                 let n = mesh.faces[f].positions.len();
                 for &(uv, expected) in &face.points {
-                    let (origin, st) = PatchOrigin::from_face_uv(f as u32, n, split, uv);
+                    let (origin, sub_st) = PatchOrigin::from_face_uv(f as u32, n, split, uv);
                     let p = patch_of[&(origin.face, origin.subface)];
-                    assert_eq!(set.origins[p], origin);
-                    assert!((origin.face_uv(st) - uv).length() < 1e-15);
+                    let st = set.origins[p].patch_st(sub_st);
+                    assert_eq!(
+                        (set.origins[p].corners, set.origins[p].is_subface),
+                        (origin.corners, origin.is_subface)
+                    );
+                    assert!((set.origins[p].face_uv(st) - uv).length() < 1e-15);
                     let d = (set.patches[p].position(st) - expected).length() / diagonal;
                     if d > worst.0 {
                         worst = (d, format!("face {f} ({n} corners) rate {rate} at {uv}"));
@@ -227,4 +231,108 @@ fn every_face_of_the_set_agrees_with_bfr() {
     eprintln!("{}", report.join("\n"));
     eprintln!("worst of all: {:.3e} of the diagonal, {}", worst_overall.0, worst_overall.1);
     assert!(worst_overall.0 < 1e-6, "worst {:.3e} at {}", worst_overall.0, worst_overall.1);
+}
+
+/// tessera's output itself, in f32: the uniform tessellation at factor N of every manifold
+/// cage has, vertex for vertex, Bfr's points (rate N, or 2N for a cage split into sub-faces,
+/// whose patches are half a face wide) within 1e-5 of the diagonal, and every Bfr point is an
+/// output vertex.
+#[test]
+fn the_f32_output_is_bfrs_tessellation() {
+    use tessera::criterion::Plan;
+    use tessera::engine::{tessellate, EngineOptions};
+    use tessera::pattern::uniform::Uniform;
+    use tessera::subdivision::CageOptions;
+    use tessera::surface::{Orientation, SurfaceSet};
+    let mut worst = (0.0f64, String::new());
+    for path in catmark_cages() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if NON_MANIFOLD.contains(&name.as_str()) {
+            continue;
+        }
+        let mesh = read_obj(&path).unwrap();
+        let options = CageOptions { orientation: Orientation::AsGiven, ..Default::default() };
+        let set = SurfaceSet::from_subdivision_cage(&mesh, &path, options).unwrap();
+        let split = set.origins[0].is_subface;
+        let (lo, hi) = mesh
+            .positions
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let diagonal = (hi - lo).length();
+        for n in [1u32, 2, 4] {
+            let rate = if split { 2 * n } else { n };
+            let Some(faces) = oracle_faces(&path, rate) else { continue };
+            let plan = Plan::uniform(&set, n).unwrap();
+            let out = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
+            // Bfr's points by face and grid index: a quad's by its face parameters (on the
+            // grid of 1/rate), another face's by sub-face and sub-face parameters (on the grid
+            // of 1/n), where a point on the border of two sub-faces (or the centre) is entered
+            // under each, as Bfr writes it under one.
+            let mut bfr: std::collections::HashMap<(u32, u16, i64, i64), DVec3> = Default::default();
+            let grid = |x: f64, k: u32| (x * k as f64).round() as i64;
+            for (f, face) in faces.iter().enumerate() {
+                let corners = mesh.faces[f].positions.len();
+                for &(uv, p) in &face.points {
+                    if corners == 4 {
+                        bfr.insert((f as u32, 0, grid(uv.x, rate), grid(uv.y, rate)), p);
+                        continue;
+                    }
+                    let (origin, st) =
+                        tessera::subdivision::PatchOrigin::from_face_uv(f as u32, corners, split, uv);
+                    let (i, k) = (origin.subface as usize, corners);
+                    let (s, t) = (grid(st.x, n), grid(st.y, n));
+                    let m = n as i64;
+                    bfr.insert((f as u32, i as u16, s, t), p);
+                    if s == m {
+                        bfr.insert((f as u32, ((i + 1) % k) as u16, t, m), p);
+                    }
+                    if t == m {
+                        bfr.insert((f as u32, ((i + k - 1) % k) as u16, m, s), p);
+                    }
+                    if s == m && t == m {
+                        for j in 0..k {
+                            bfr.insert((f as u32, j as u16, m, m), p);
+                        }
+                    }
+                }
+            }
+            for (v, q) in out.positions.iter().enumerate() {
+                let o = set.origins[out.vertex_patch[v] as usize];
+                let st = glam::DVec2::new(out.uvs[v][0] as f64, out.uvs[v][1] as f64);
+                let key = if o.corners == 4 {
+                    let uv = o.face_uv(st);
+                    (o.face, 0, grid(uv.x, rate), grid(uv.y, rate))
+                } else {
+                    let st = o.subface_st(st);
+                    (o.face, o.subface, grid(st.x, n), grid(st.y, n))
+                };
+                let expected = *bfr
+                    .get(&key)
+                    .unwrap_or_else(|| panic!("{name} n={n}: output vertex {v} at {key:?} is no Bfr point"));
+                let d = (DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64) - expected).length() / diagonal;
+                if d > worst.0 {
+                    worst = (d, format!("{name} n={n} face {} sub-face {}", o.face, o.subface));
+                }
+            }
+            // Every Bfr point is an output vertex (shared points are evaluated by one patch of
+            // either face, so this compares by position).
+            let cell = 1e-4 * diagonal;
+            let at = |p: DVec3| ((p / cell).floor()).as_i64vec3();
+            let mut grid: std::collections::HashSet<glam::I64Vec3> = Default::default();
+            for q in &out.positions {
+                grid.insert(at(DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64)));
+            }
+            for (f, face) in faces.iter().enumerate() {
+                for &(uv, p) in &face.points {
+                    let c = at(p);
+                    let near = (-1..=1).any(|x| {
+                        (-1..=1).any(|y| (-1..=1).any(|z| grid.contains(&(c + glam::I64Vec3::new(x, y, z)))))
+                    });
+                    assert!(near, "{name} n={n}: Bfr's point of face {f} at {uv} is no output vertex");
+                }
+            }
+        }
+    }
+    eprintln!("worst f32 output vertex: {:.3e} of the diagonal ({})", worst.0, worst.1);
+    assert!(worst.0 < 1e-5, "worst {:.3e} at {}", worst.0, worst.1);
 }

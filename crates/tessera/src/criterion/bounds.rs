@@ -324,7 +324,8 @@ pub fn tree_hessian(t: &crate::surface::PatchTree) -> HessianBound {
         m.uv = m.uv.max(h.uv * s);
         m.vv = m.vv.max(h.vv * s);
     }
-    if t.is_transposed() {
+    // A quarter turn or a transposition exchanges the parameters' roles.
+    if t.is_transposed() != (t.rotation() % 2 == 1) {
         std::mem::swap(&mut m.uu, &mut m.vv);
     }
     m

@@ -21,13 +21,20 @@ use crate::surface::{BuildOptions, SurfaceSet};
 use super::*;
 
 /// Checks the OBJ reader: [`obj::parse_obj`] on the bytes (decoded as `read_obj` does, with
-/// invalid UTF-8 replaced). A parsed mesh must keep its documented invariants, must build PN
-/// triangles or refuse them with an error, and, as a triangle list, must survive
-/// [`write_obj`] → [`obj::parse_obj`] with the same positions and triangles.
+/// invalid UTF-8 replaced). A parsed mesh must keep its documented invariants, must build its
+/// Catmull-Clark surface (a cage with tags) and PN triangles or refuse them with an error, and,
+/// as a triangle list, must survive [`write_obj`] → [`obj::parse_obj`] with the same positions
+/// and triangles.
 pub fn check_obj(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let Ok(mesh) = obj::parse_obj(&text, label()) else { return };
     assert_obj_invariants(&mesh);
+    if mesh.faces.len() <= ENGINE_PATCH_LIMIT {
+        let options = crate::subdivision::CageOptions::default();
+        if let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, label(), options) {
+            tessellate_small(&set);
+        }
+    }
     let Ok(triangles) = mesh.triangles(label()) else { return };
     if triangles.len() <= 4 * ENGINE_PATCH_LIMIT {
         if let Ok(set) = SurfaceSet::pn_from_mesh(&mesh, label(), BuildOptions::default()) {

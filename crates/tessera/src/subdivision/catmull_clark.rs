@@ -180,6 +180,7 @@ impl SurfaceSet {
                 subface: subface as u16,
                 corners: n as u16,
                 is_subface: split,
+                rotation: 0,
             };
             // A quad's quarters, corners listed from the one at the quarter's (0,0).
             let quarter = |q: usize| match q {
@@ -225,8 +226,43 @@ impl SurfaceSet {
                 "no face of the cage has a limit surface (all are holes)",
             ));
         }
+        turn_corners_off_valence_two(&cage, &mut patches, &mut patch_keys, &mut origins);
         let topology = Topology::build(&patch_keys);
         Ok(SurfaceSet { patches, keys: patch_keys, topology, repairs, up: Default::default(), origins })
+    }
+}
+
+/// At an interior vertex of valence 2 its two faces share both edges there, and a pattern
+/// that cuts the corner's cell along the chord between the first samples of those edges (the
+/// uniform grid does at corners 1 and 3) gives both faces the same triangle — covered twice.
+/// Such a patch is turned a quarter (its parameters, not its surface) so that the vertex is at
+/// corner 0 or 2, where the cells are cut through the corner.
+fn turn_corners_off_valence_two(
+    cage: &Cage,
+    patches: &mut [Patch],
+    keys: &mut [PatchKeys],
+    origins: &mut [PatchOrigin],
+) {
+    let valence_two: std::collections::HashSet<u32> = (0..cage.points.len())
+        .filter(|&v| cage.vertex_faces(v).len() == 2 && !cage.is_boundary_vertex(v))
+        .map(|v| v as u32)
+        .collect();
+    if valence_two.is_empty() {
+        return;
+    }
+    for p in 0..patches.len() {
+        let c = keys[p].corners;
+        let at = |i: usize| valence_two.contains(&c[i]);
+        if !(at(1) || at(3)) || at(0) || at(2) {
+            continue;
+        }
+        // Faces at such a vertex are never regular: they are isolated patch trees.
+        let Patch::Subdivision(tree) = &patches[p] else { continue };
+        patches[p] = Patch::Subdivision(Box::new(tree.rotated(1)));
+        let k = &mut keys[p];
+        k.corners = [c[1], c[2], c[3], c[0]];
+        k.edges = [k.edges[1], k.edges[2], k.edges[3], k.edges[0]];
+        origins[p].rotation = 1;
     }
 }
 

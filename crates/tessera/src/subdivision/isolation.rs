@@ -35,6 +35,8 @@ pub struct IsolationLevels {
     pub smooth: u8,
     /// Depth for sharp features: semi-sharp creases and corners, irregular infinitely sharp
     /// corners. Bfr's default 6; never below `smooth` in effect.
+    ///
+    /// Both take effect between 1 and [`MAX_ISOLATION_LEVEL`].
     pub sharp: u8,
 }
 
@@ -55,7 +57,10 @@ pub const MAX_ISOLATION_LEVEL: u8 = 10;
 /// few dozen faces per level, for as many levels as its features need.
 pub fn isolate(cage: &Cage, face: usize, levels: IsolationLevels) -> Vec<PatchTree> {
     let (local, root) = neighbourhood(cage, face);
-    let levels = IsolationLevels { smooth: levels.smooth.min(levels.sharp), sharp: levels.sharp };
+    // Depths from 1 (a face that is not regular is refined at least once, as Bfr forces a
+    // level where a patch at the face itself is impossible) to the most Bfr allows.
+    let sharp = levels.sharp.clamp(1, MAX_ISOLATION_LEVEL);
+    let levels = IsolationLevels { smooth: levels.smooth.clamp(1, sharp), sharp };
     let has_irregular_faces = (0..local.face_count()).any(|f| local.face(f).len() != 4);
     let ctx = Context { levels, has_irregular_faces };
     let n = local.face(root).len();
@@ -562,17 +567,23 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
             (Parent::Vertex(v), Parent::Edge(e)) | (Parent::Edge(e), Parent::Vertex(v)) => (v, e),
             _ => return 0.0,
         };
-        let s = mesh.edge_sharpness[e as usize];
-        if s <= 0.0 || is_infinite(s) {
-            return s;
-        }
-        let around: Vec<f32> =
-            mesh.vertex_edges(v as usize).iter().map(|&x| mesh.edge_sharpness[x as usize]).collect();
-        sdc::child_edge_sharpness(s, &around, options.crease_method)
+        child_sharpness(mesh, e, v)
     };
     let child =
         Cage::local(points, face_start, face_vertices, &complete, sharpness_of, vertex_sharpness, options);
     (child, children)
+}
+
+/// The sharpness of edge `e`'s child at its end `v` (a complete vertex): Sdc's rule for
+/// semi-sharp edges (uniform or Chaikin), smooth and infinitely sharp edges unchanged.
+fn child_sharpness(mesh: &Cage, e: u32, v: u32) -> f32 {
+    let s = mesh.edge_sharpness[e as usize];
+    if s <= 0.0 || is_infinite(s) {
+        return s;
+    }
+    let around: Vec<f32> =
+        mesh.vertex_edges(v as usize).iter().map(|&x| mesh.edge_sharpness[x as usize]).collect();
+    sdc::child_edge_sharpness(s, &around, mesh.options.crease_method)
 }
 
 /// Sdc's edge point of edge `e` (both its faces are in `mesh`).
@@ -582,14 +593,7 @@ fn edge_point(mesh: &Cage, e: u32, face_point: &dyn Fn(usize) -> DVec3) -> DVec3
     let faces = mesh.edge_faces(e);
     let face_points: Vec<DVec3> = faces.iter().map(|&g| face_point(g as usize)).collect();
     let face_sizes: Vec<usize> = faces.iter().map(|&g| mesh.face(g as usize).len()).collect();
-    let child_at = |v: u32| {
-        if s <= 0.0 || is_infinite(s) {
-            return s;
-        }
-        let around: Vec<f32> =
-            mesh.vertex_edges(v as usize).iter().map(|&x| mesh.edge_sharpness[x as usize]).collect();
-        sdc::child_edge_sharpness(s, &around, mesh.options.crease_method)
-    };
+    let child_at = |v: u32| child_sharpness(mesh, e, v);
     sdc::edge_point(
         &EdgeNeighborhood {
             ends: [mesh.points[a as usize], mesh.points[b as usize]],

@@ -34,6 +34,9 @@ pub struct PatchOrigin {
     pub corners: u16,
     /// Whether the patch is a sub-face (else the whole quad).
     pub is_subface: bool,
+    /// Quarter turns from the patch's parameters to the sub-face's (or face's): the patch's
+    /// corner 0 is the sub-face's corner `rotation` ([`PatchOrigin::subface_st`]).
+    pub rotation: u8,
 }
 
 impl PatchOrigin {
@@ -53,6 +56,7 @@ impl PatchOrigin {
     /// as the face's; another face's sub-face `i` covers the half-size square at its tile's
     /// origin, `s` along edge `i`, `t` back along edge `i−1`.
     pub fn face_uv(&self, st: glam::DVec2) -> glam::DVec2 {
+        let st = self.subface_st(st);
         let i = self.subface as usize;
         if !self.is_subface {
             st
@@ -64,10 +68,23 @@ impl PatchOrigin {
         }
     }
 
+    /// The sub-face's (or whole face's) own parameters of the patch point `st`: `st` turned by
+    /// [`PatchOrigin::rotation`].
+    pub fn subface_st(&self, st: glam::DVec2) -> glam::DVec2 {
+        rotate(st, self.rotation)
+    }
+
+    /// The patch point of the sub-face's parameters `sub_st` (the inverse of
+    /// [`PatchOrigin::subface_st`]).
+    pub fn patch_st(&self, sub_st: glam::DVec2) -> glam::DVec2 {
+        rotate(sub_st, (4 - self.rotation) % 4)
+    }
+
     /// Which patch of face `face` (`corners` corners, split into sub-faces or not) holds
     /// Bfr's face parameters `uv`, and where in its `[0,1]²` (the inverse of
-    /// [`PatchOrigin::face_uv`]; a point on a border between sub-faces goes to the upper or
-    /// right one).
+    /// [`PatchOrigin::face_uv`] for an unturned patch — its `rotation` is 0, and the patch
+    /// point of a turned patch is [`PatchOrigin::patch_st`] of the returned parameters; a point
+    /// on a border between sub-faces goes to the upper or right one).
     pub fn from_face_uv(
         face: u32,
         corners: usize,
@@ -79,6 +96,7 @@ impl PatchOrigin {
             subface: subface as u16,
             corners: corners as u16,
             is_subface,
+            rotation: 0,
         };
         if !is_subface {
             return (at(0), uv);
@@ -142,6 +160,9 @@ pub struct PatchTree {
     /// `u` and `v` are exchanged on the way in and out (the surface with the opposite
     /// orientation, [`PatchTree::transposed`]).
     transposed: bool,
+    /// Quarter turns between the patch's parameters and the tree's: the patch's corner 0 is
+    /// the tree's corner `rotation` ([`PatchTree::rotated`]).
+    rotation: u8,
     /// The square of the tree's domain this patch covers, `view_origin + [0, view_size]²`
     /// ([`PatchTree::quadrant`]).
     view_origin: DVec2,
@@ -159,7 +180,16 @@ impl PatchTree {
                 LeafPatch::Gregory(g) => points.extend_from_slice(&g.points),
             }
         }
-        PatchTree { leaves, nodes, root, points, transposed: false, view_origin: DVec2::ZERO, view_size: 1.0 }
+        PatchTree {
+            leaves,
+            nodes,
+            root,
+            points,
+            transposed: false,
+            rotation: 0,
+            view_origin: DVec2::ZERO,
+            view_size: 1.0,
+        }
     }
 
     /// The leaf holding `uv`, with `uv` in the leaf's own `[0,1]²`. Points on a border
@@ -167,6 +197,7 @@ impl PatchTree {
     /// continuous there. Cost: O(depth).
     pub fn locate(&self, uv: DVec2) -> (&Leaf, DVec2) {
         let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
+        let uv = rotate(uv, self.rotation);
         let uv = self.view_origin + uv * self.view_size;
         let mut slot = self.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
@@ -212,7 +243,11 @@ impl PatchTree {
             }
             LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
         };
-        let (du, dv) = (du * (self.view_size / leaf.size), dv * (self.view_size / leaf.size));
+        let (mut du, mut dv) = (du * (self.view_size / leaf.size), dv * (self.view_size / leaf.size));
+        // Back through the rotation: with (u, v) = (1 − v', u'), ∂/∂u' = ∂/∂v, ∂/∂v' = −∂/∂u.
+        for _ in 0..self.rotation {
+            (du, dv) = (dv, -du);
+        }
         if self.transposed {
             (p, dv, du)
         } else {
@@ -223,6 +258,13 @@ impl PatchTree {
     /// The same surface with `u` and `v` exchanged (the opposite orientation).
     pub fn transposed(&self) -> PatchTree {
         PatchTree { transposed: !self.transposed, ..self.clone() }
+    }
+
+    /// The same surface with its parameters turned by `quarters` quarter turns: the new
+    /// patch's corner 0 is this one's corner `quarters` (mod 4), the orientation unchanged.
+    /// Precondition: not transposed.
+    pub fn rotated(&self, quarters: u8) -> PatchTree {
+        PatchTree { rotation: (self.rotation + quarters) % 4, ..self.clone() }
     }
 
     /// The quarter `q` of the patch (quadrants as [`QUADRANTS`]) as a
@@ -258,6 +300,11 @@ impl PatchTree {
         self.transposed
     }
 
+    /// The quarter turns of [`PatchTree::rotated`] (0 to 3).
+    pub fn rotation(&self) -> u8 {
+        self.rotation
+    }
+
     /// The control points of all leaves (the surface lies in their convex hull: Bézier and
     /// Gregory patches are convex combinations of their points).
     pub fn control_points(&self) -> &[DVec3] {
@@ -268,6 +315,16 @@ impl PatchTree {
     pub fn depth(&self) -> u8 {
         self.leaves.iter().map(|l| l.level).max().unwrap_or(0)
     }
+}
+
+/// `uv` turned by `quarters` quarter turns about the square's centre, `(u, v) → (1 − v, u)`
+/// each: the point of the unturned square that the turned one's `uv` is.
+pub fn rotate(uv: DVec2, quarters: u8) -> DVec2 {
+    let mut p = uv;
+    for _ in 0..quarters % 4 {
+        p = DVec2::new(1.0 - p.y, p.x);
+    }
+    p
 }
 
 /// A polynomial bicubic Bézier net at `st`.
