@@ -171,3 +171,27 @@ fn gpu_ply_output_says_it_has_no_corner_parameters() {
     let check = tessera(&["check", "g.ply", "--against", input.to_str().unwrap()], &dir);
     assert!(text(&check.stdout).contains("--engine cpu"), "{}", text(&check.stdout));
 }
+
+/// `tessera check --against CAGE` measures a tessellation of a subdivision cage against the
+/// cage's limit surface, and the error is within the bound `--stats` guaranteed.
+#[test]
+fn check_measures_a_cage_tessellation_against_its_limit_surface() {
+    let dir = scratch("cage-check");
+    let cage = data("subdivision/catmark_cube.obj");
+    let cage = cage.to_str().unwrap();
+    let out = tessera(&["mesh", cage, "--tolerance", "0.1%", "--stats", "-o", "cube.ply"], &dir);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+    let bound = v["guaranteed_bound"].as_f64().expect("a tolerance run reports its bound");
+    assert_eq!(v["problems"].as_array().map(|p| p.len()), Some(0), "{v}");
+    let check = tessera(&["check", "cube.ply", "--against", cage], &dir);
+    assert!(check.status.success(), "{}", text(&check.stdout));
+    let report = text(&check.stdout);
+    let max = report
+        .lines()
+        .find(|l| l.starts_with("max error"))
+        .and_then(|l| l.split_whitespace().last())
+        .and_then(|x| x.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("no max error line in {report}"));
+    assert!(max > 0.0 && max <= bound, "measured {max} against the bound {bound}");
+}
