@@ -819,3 +819,29 @@ fn transition_from_the_camera_on_the_gpu_on_10_cameras() {
         5,
     );
 }
+
+/// Catmull-Clark cages whose faces are all regular (their patches are exact bicubic Bézier
+/// patches) tessellate on the GPU index for index as on the CPU, uniform and transition; a
+/// cage with isolated faces is refused by name before any upload.
+#[test]
+fn regular_subdivision_cages_equal_the_cpu_engine() {
+    use tessera::io::{LoadOptions, SurfaceKind};
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let options = LoadOptions { surface: SurfaceKind::CatmullClark, ..Default::default() };
+    for cage in ["subdivision/catmark_torus.obj", "subdivision/catmark_edgecorner.obj"] {
+        let path = tessera::test_support::data(cage);
+        let set = tessera::io::load(&path, options).unwrap();
+        assert!(set.patches.iter().all(|p| matches!(p, tessera::surface::Patch::Bicubic(_))), "{cage}");
+        let mut gpu = tessellator(&set);
+        for n in [1, 4] {
+            let plan = Plan::uniform(&set, n).unwrap();
+            assert_gpu_equals_cpu(&format!("{cage} n={n}"), &set, &mut gpu, &plan);
+        }
+        let planned =
+            Scheme::Transition.plan(&set, &Criterion::Tolerance(1e-3 * diagonal(&set)), &PlanOptions::default()).unwrap();
+        assert_pattern_equals_cpu(&format!("{cage} tolerance"), &set, &mut gpu, &planned.plan, &planned.pattern);
+    }
+    let cube = tessera::io::load(&tessera::test_support::data("subdivision/catmark_cube.obj"), options).unwrap();
+    let refused = tessera_gpu::upload::PackedSet::new(&cube).map(|_| ()).unwrap_err().to_string();
+    assert!(refused.contains("isolated faces of a Catmull-Clark cage"), "{refused}");
+}
