@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::bspline::{regular_face_grid, to_bezier};
 use super::cage::Cage;
@@ -30,6 +31,17 @@ pub struct CageOptions {
     pub flip: bool,
     /// How deep irregular faces are isolated (Bfr's defaults unless changed).
     pub isolation: IsolationLevels,
+}
+
+/// One face's surface before it becomes patches.
+#[derive(Default)]
+enum Built {
+    #[default]
+    Hole,
+    /// A regular face's Bézier net.
+    Regular([DVec3; 16]),
+    /// The trees of a face's isolation (one per sub-face of a face that is not a quad).
+    Isolated(Vec<super::isolation::PatchTree>),
 }
 
 /// Keys for the topology: cage vertices keep their index; every curve between two keyed
@@ -168,10 +180,21 @@ impl SurfaceSet {
             patch_keys.push(k);
             origins.push(origin);
         };
+        // Each face's surface on its own (in parallel: isolation is most of the work), then the
+        // patches and their keys in face order.
+        let mut built: Vec<Built> = (0..cage.face_count())
+            .into_par_iter()
+            .map(|f| {
+                if cage.holes[f] {
+                    Built::Hole
+                } else if cage.face(f).len() == 4 && cage.is_regular_face(f) {
+                    Built::Regular(to_bezier(&regular_face_grid(&cage, f)))
+                } else {
+                    Built::Isolated(isolate(&cage, f, options.isolation))
+                }
+            })
+            .collect();
         for f in 0..cage.face_count() {
-            if cage.holes[f] {
-                continue;
-            }
             let c = cage.face(f);
             let n = c.len();
             let e = cage.face_edges(f);
@@ -189,23 +212,25 @@ impl SurfaceSet {
                 2 => [centre(f), mid(e[1]), c[2], mid(e[2])],
                 _ => [mid(e[3]), centre(f), mid(e[2]), c[3]],
             };
-            if n == 4 && cage.is_regular_face(f) {
-                let bezier = to_bezier(&regular_face_grid(&cage, f));
-                if split {
-                    for q in 0..4 {
-                        let piece = RationalBicubic::polynomial(bezier_quadrant(&bezier, q));
-                        push(Patch::Bicubic(piece), quarter(q), origin(q));
+            let trees = match std::mem::take(&mut built[f]) {
+                Built::Regular(bezier) => {
+                    if split {
+                        for q in 0..4 {
+                            let piece = RationalBicubic::polynomial(bezier_quadrant(&bezier, q));
+                            push(Patch::Bicubic(piece), quarter(q), origin(q));
+                        }
+                    } else {
+                        push(
+                            Patch::Bicubic(RationalBicubic::polynomial(bezier)),
+                            [c[0], c[1], c[2], c[3]],
+                            origin(0),
+                        );
                     }
-                } else {
-                    push(
-                        Patch::Bicubic(RationalBicubic::polynomial(bezier)),
-                        [c[0], c[1], c[2], c[3]],
-                        origin(0),
-                    );
+                    continue;
                 }
-                continue;
-            }
-            let trees = isolate(&cage, f, options.isolation);
+                Built::Isolated(trees) => trees,
+                Built::Hole => continue,
+            };
             if n == 4 && split {
                 for q in 0..4 {
                     push(Patch::Subdivision(Box::new(trees[0].quadrant(q))), quarter(q), origin(q));

@@ -139,6 +139,14 @@ pub enum LeafPatch {
     Gregory(GregoryPatch),
 }
 
+/// The leaves and the quadtree of a face's isolation, shared by its views.
+#[derive(Debug, PartialEq)]
+struct TreeData {
+    leaves: Vec<Leaf>,
+    nodes: Vec<[Slot; 4]>,
+    root: Slot,
+}
+
 /// Child slots of a quadtree node, by quadrant: `[u low v low, u high v low, u high v high,
 /// u low v high]`; a child is a node (`Node(i)`) or a leaf (`Leaf(i)`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -150,13 +158,15 @@ pub(crate) enum Slot {
 /// The piecewise surface over one face (a quad) or one corner sub-face (of any other face),
 /// with parameters in `[0,1]²`: the leaves of its isolation and the quadtree that finds the
 /// leaf of a parameter point, as Bfr's `PatchTree` does.
+///
+/// Cloning is cheap: the leaves are shared (the quarters of one face, [`PatchTree::quadrant`],
+/// are views of one tree).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchTree {
-    pub leaves: Vec<Leaf>,
-    nodes: Vec<[Slot; 4]>,
-    root: Slot,
-    /// Every leaf's points, for hulls and bounds.
-    points: Vec<DVec3>,
+    data: std::sync::Arc<TreeData>,
+    /// The corners of the bounding box of the visible leaves' points: the surface lies in
+    /// their convex hull ([`PatchTree::control_points`]).
+    hull: [DVec3; 8],
     /// `u` and `v` are exchanged on the way in and out (the surface with the opposite
     /// orientation, [`PatchTree::transposed`]).
     transposed: bool,
@@ -173,23 +183,43 @@ impl PatchTree {
     /// A tree of `leaves` with quadtree `nodes` under `root` (children by quadrant, see
     /// [`PatchTree::locate`]). Precondition: the leaves tile `[0,1]²` as the nodes say.
     pub(crate) fn from_parts(leaves: Vec<Leaf>, nodes: Vec<[Slot; 4]>, root: Slot) -> PatchTree {
-        let mut points = Vec::new();
-        for l in &leaves {
-            match &l.patch {
-                LeafPatch::Bezier(p) => points.extend_from_slice(p),
-                LeafPatch::Gregory(g) => points.extend_from_slice(&g.points),
-            }
-        }
-        PatchTree {
-            leaves,
-            nodes,
-            root,
-            points,
+        let mut tree = PatchTree {
+            data: std::sync::Arc::new(TreeData { leaves, nodes, root }),
+            hull: [DVec3::ZERO; 8],
             transposed: false,
             rotation: 0,
             view_origin: DVec2::ZERO,
             view_size: 1.0,
+        };
+        tree.hull = tree.visible_hull();
+        tree
+    }
+
+    /// The leaves of the whole tree (of every view of it).
+    pub fn leaves(&self) -> &[Leaf] {
+        &self.data.leaves
+    }
+
+    /// The bounding box corners of the visible leaves' points.
+    fn visible_hull(&self) -> [DVec3; 8] {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for (leaf, _, _) in self.visible_leaves() {
+            let points: &[DVec3] = match &leaf.patch {
+                LeafPatch::Bezier(p) => p,
+                LeafPatch::Gregory(g) => &g.points,
+            };
+            for p in points {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
         }
+        std::array::from_fn(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
     }
 
     /// The leaf holding `uv`, with `uv` in the leaf's own `[0,1]²`. Points on a border
@@ -199,12 +229,12 @@ impl PatchTree {
         let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
         let uv = rotate(uv, self.rotation);
         let uv = self.view_origin + uv * self.view_size;
-        let mut slot = self.root;
+        let mut slot = self.data.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
         loop {
             match slot {
                 Slot::Leaf(i) => {
-                    let leaf = &self.leaves[i as usize];
+                    let leaf = &self.data.leaves[i as usize];
                     return (leaf, (uv - leaf.origin) / leaf.size);
                 }
                 Slot::Node(n) => {
@@ -217,7 +247,7 @@ impl PatchTree {
                         (false, true) => 3,
                     };
                     origin += DVec2::new(f64::from(u8::from(right)), f64::from(u8::from(up))) * size;
-                    slot = self.nodes[n as usize][q];
+                    slot = self.data.nodes[n as usize][q];
                 }
             }
         }
@@ -272,18 +302,21 @@ impl PatchTree {
     /// Precondition: not transposed.
     pub fn quadrant(&self, q: usize) -> PatchTree {
         let size = self.view_size * 0.5;
-        PatchTree {
+        let mut view = PatchTree {
             view_origin: self.view_origin + QUADRANTS[q] * self.view_size,
             view_size: size,
             ..self.clone()
-        }
+        };
+        view.hull = view.visible_hull();
+        view
     }
 
     /// The leaves this patch covers, each with its square in the patch's own parameters
     /// (origin, size) — before any transposition.
     pub fn visible_leaves(&self) -> impl Iterator<Item = (&Leaf, DVec2, f64)> + '_ {
         let (o, s) = (self.view_origin, self.view_size);
-        self.leaves
+        self.data
+            .leaves
             .iter()
             .filter(move |l| {
                 l.origin.x < o.x + s
@@ -305,15 +338,16 @@ impl PatchTree {
         self.rotation
     }
 
-    /// The control points of all leaves (the surface lies in their convex hull: Bézier and
-    /// Gregory patches are convex combinations of their points).
+    /// The eight corners of the box around the visible leaves' control points: the surface
+    /// lies in their convex hull (Bézier and Gregory patches are convex combinations of their
+    /// points), which is what hulls and boxes need; not a control net.
     pub fn control_points(&self) -> &[DVec3] {
-        &self.points
+        &self.hull
     }
 
     /// The tree's deepest leaf level.
     pub fn depth(&self) -> u8 {
-        self.leaves.iter().map(|l| l.level).max().unwrap_or(0)
+        self.data.leaves.iter().map(|l| l.level).max().unwrap_or(0)
     }
 }
 
