@@ -267,10 +267,7 @@ impl PatchTree {
     pub fn derivatives(&self, uv: DVec2) -> (DVec3, DVec3, DVec3) {
         let (leaf, st) = self.locate(uv);
         let (p, du, dv) = match &leaf.patch {
-            LeafPatch::Bezier(b) => {
-                let d = crate::surface::RationalBicubic::polynomial(*b).derivatives(st);
-                (d.position, d.du, d.dv)
-            }
+            LeafPatch::Bezier(b) => bezier_derivatives(b, st),
             LeafPatch::Gregory(g) => g.derivatives(st.x, st.y),
         };
         let (mut du, mut dv) = (du * (self.view_size / leaf.size), dv * (self.view_size / leaf.size));
@@ -359,6 +356,27 @@ pub fn rotate(uv: DVec2, quarters: u8) -> DVec2 {
         p = DVec2::new(1.0 - p.y, p.x);
     }
     p
+}
+
+/// A polynomial bicubic Bézier net's position and first derivatives at `st` (the leaves'
+/// nets are polynomial: no weights to divide by, and nothing copied).
+fn bezier_derivatives(points: &[DVec3; 16], st: DVec2) -> (DVec3, DVec3, DVec3) {
+    let (bu, du, _) = super::bicubic::bernstein3(st.x);
+    let (bv, dv, _) = super::bicubic::bernstein3(st.y);
+    let (mut p, mut pu, mut pv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    for i in 0..4 {
+        // The column of the net along v for this u index, reduced in v first.
+        let (mut c, mut cv) = (DVec3::ZERO, DVec3::ZERO);
+        for j in 0..4 {
+            let q = points[4 * i + j];
+            c += q * bv[j];
+            cv += q * dv[j];
+        }
+        p += c * bu[i];
+        pu += c * du[i];
+        pv += cv * bu[i];
+    }
+    (p, pu, pv)
 }
 
 /// A polynomial bicubic Bézier net at `st`.
