@@ -837,11 +837,19 @@ fn regular_subdivision_cages_equal_the_cpu_engine() {
             let plan = Plan::uniform(&set, n).unwrap();
             assert_gpu_equals_cpu(&format!("{cage} n={n}"), &set, &mut gpu, &plan);
         }
-        let planned =
-            Scheme::Transition.plan(&set, &Criterion::Tolerance(1e-3 * diagonal(&set)), &PlanOptions::default()).unwrap();
-        assert_pattern_equals_cpu(&format!("{cage} tolerance"), &set, &mut gpu, &planned.plan, &planned.pattern);
+        let planned = Scheme::Transition
+            .plan(&set, &Criterion::Tolerance(1e-3 * diagonal(&set)), &PlanOptions::default())
+            .unwrap();
+        assert_pattern_equals_cpu(
+            &format!("{cage} tolerance"),
+            &set,
+            &mut gpu,
+            &planned.plan,
+            &planned.pattern,
+        );
     }
-    let cube = tessera::io::load(&tessera::test_support::data("subdivision/catmark_cube.obj"), options).unwrap();
+    let cube =
+        tessera::io::load(&tessera::test_support::data("subdivision/catmark_cube.obj"), options).unwrap();
     let refused = tessera_gpu::upload::PackedSet::new(&cube).map(|_| ()).unwrap_err().to_string();
     assert!(refused.contains("isolated faces of a Catmull-Clark cage"), "{refused}");
 }

@@ -281,7 +281,13 @@ fn bad_cages_are_refused_naming_the_line() {
     for text in [
         format!("{quad}f 1 2 3 4\nt crease 2/1/0 0 1 1e30\nt corner 1/1/0 2 1e30\n"),
         (0..40)
-            .map(|k| format!("v {} {} 0\n", (k as f64 / 40.0 * 6.283).cos(), (k as f64 / 40.0 * 6.283).sin()))
+            .map(|k| {
+                format!(
+                    "v {} {} 0\n",
+                    (k as f64 / 40.0 * std::f64::consts::TAU).cos(),
+                    (k as f64 / 40.0 * std::f64::consts::TAU).sin()
+                )
+            })
             .collect::<String>()
             + &format!("f {}\n", (1..=40).map(|k| k.to_string()).collect::<Vec<_>>().join(" ")),
         format!("{quad}f 1 2 3 4\nt interpolateboundary 1/0/0 1\n"),

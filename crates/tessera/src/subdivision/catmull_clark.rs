@@ -39,7 +39,7 @@ enum Built {
     #[default]
     Hole,
     /// A regular face's Bézier net.
-    Regular([DVec3; 16]),
+    Regular(Box<[DVec3; 16]>),
     /// The trees of a face's isolation (one per sub-face of a face that is not a quad).
     Isolated(Vec<super::isolation::PatchTree>),
 }
@@ -188,13 +188,13 @@ impl SurfaceSet {
                 if cage.holes[f] {
                     Built::Hole
                 } else if cage.face(f).len() == 4 && cage.is_regular_face(f) {
-                    Built::Regular(to_bezier(&regular_face_grid(&cage, f)))
+                    Built::Regular(Box::new(to_bezier(&regular_face_grid(&cage, f))))
                 } else {
                     Built::Isolated(isolate(&cage, f, options.isolation))
                 }
             })
             .collect();
-        for f in 0..cage.face_count() {
+        for (f, face) in built.iter_mut().enumerate() {
             let c = cage.face(f);
             let n = c.len();
             let e = cage.face_edges(f);
@@ -212,7 +212,7 @@ impl SurfaceSet {
                 2 => [centre(f), mid(e[1]), c[2], mid(e[2])],
                 _ => [mid(e[3]), centre(f), mid(e[2]), c[3]],
             };
-            let trees = match std::mem::take(&mut built[f]) {
+            let trees = match std::mem::take(face) {
                 Built::Regular(bezier) => {
                     if split {
                         for q in 0..4 {
@@ -221,7 +221,7 @@ impl SurfaceSet {
                         }
                     } else {
                         push(
-                            Patch::Bicubic(RationalBicubic::polynomial(bezier)),
+                            Patch::Bicubic(RationalBicubic::polynomial(*bezier)),
                             [c[0], c[1], c[2], c[3]],
                             origin(0),
                         );
