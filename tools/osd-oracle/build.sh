@@ -22,7 +22,8 @@
 #                                                  -> tools/osd-oracle/osd_oracle
 #
 # An explicit output path may be given as $1. JOBS (default 2) sets the
-# parallel compile count for way 2.
+# parallel compile count for way 2. SOURCE (default osd_oracle.cpp) names the
+# program to build: bfr_bench.sh builds bfr_bench.cpp through this script.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 out=${1:-"$here/osd_oracle"}
@@ -46,5 +47,6 @@ if [ -n "${OSD_SRC:-}" ]; then
 elif [ -n "${OSD_PREFIX:-}" ]; then
     flags=(-I"$OSD_PREFIX/include" -L"$OSD_PREFIX/lib" -Wl,-rpath,"$OSD_PREFIX/lib")
 fi
-$CXX -std=c++17 -O2 -Wall -Wextra -o "$out" "$here/osd_oracle.cpp" "${flags[@]}" "${libs[@]}"
-echo "built $out"
+SOURCE=${SOURCE:-osd_oracle.cpp}
+$CXX -std=c++17 -O2 -Wall -Wextra -pthread -o "$out" "$here/$SOURCE" "${flags[@]}" "${libs[@]}"
+echo "built $out (${libs[*]})"

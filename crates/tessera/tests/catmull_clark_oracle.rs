@@ -108,6 +108,15 @@ fn parse_oracle(text: &str) -> Vec<OracleFace> {
     faces
 }
 
+/// The length of the cage's bounding-box diagonal (the unit the agreements are measured in).
+fn cage_diagonal(mesh: &tessera::surface::PolygonMesh) -> f64 {
+    let (lo, hi) = mesh
+        .positions
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    (hi - lo).length()
+}
+
 fn catmark_cages() -> Vec<PathBuf> {
     let mut cages: Vec<PathBuf> = std::fs::read_dir(data("subdivision"))
         .expect("the shared data's subdivision folder")
@@ -137,11 +146,7 @@ fn regular_faces_are_bfrs_regular_faces_and_their_points_agree() {
                 continue;
             }
         };
-        let (lo, hi) = mesh
-            .positions
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let diagonal = (hi - lo).length();
+        let diagonal = cage_diagonal(&mesh);
         for rate in 1..=8 {
             let Some(faces) = oracle_faces(&path, rate) else { continue };
             assert_eq!(faces.len(), cage.face_count(), "{name}");
@@ -190,11 +195,7 @@ fn every_face_of_the_set_agrees_with_bfr() {
         let patch_of: std::collections::HashMap<(u32, u16), usize> =
             set.origins.iter().enumerate().map(|(p, o)| ((o.face, o.subface), p)).collect();
         let split = set.origins[0].is_subface;
-        let (lo, hi) = mesh
-            .positions
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let diagonal = (hi - lo).length();
+        let diagonal = cage_diagonal(&mesh);
         let mut worst = (0.0f64, String::new());
         let mut points = 0;
         for rate in 1..=8 {
@@ -254,11 +255,7 @@ fn the_f32_output_is_bfrs_tessellation() {
         let options = CageOptions { orientation: Orientation::AsGiven, ..Default::default() };
         let set = SurfaceSet::from_subdivision_cage(&mesh, &path, options).unwrap();
         let split = set.origins[0].is_subface;
-        let (lo, hi) = mesh
-            .positions
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        let diagonal = (hi - lo).length();
+        let diagonal = cage_diagonal(&mesh);
         for n in [1u32, 2, 4] {
             let rate = if split { 2 * n } else { n };
             let Some(faces) = oracle_faces(&path, rate) else { continue };
