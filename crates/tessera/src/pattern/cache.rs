@@ -56,7 +56,11 @@ impl Key {
 /// hashed once per patch per frame, so it matters. (The field's hashers — FxHash and kin — are
 /// not among this project's dependencies; this is their few lines.)
 #[derive(Default)]
-struct WordHasher(u64);
+pub(crate) struct WordHasher(u64);
+
+/// A hash map keyed by small integer keys through [`WordHasher`] (the library's other
+/// hot lookups: a cage's edges, a refinement's child vertices).
+pub(crate) type WordMap<K, V> = HashMap<K, V, BuildHasherDefault<WordHasher>>;
 
 impl Hasher for WordHasher {
     fn finish(&self) -> u64 {

@@ -21,6 +21,7 @@ use glam::DVec3;
 
 use super::{BoundaryInterpolation, SubdivisionOptions, INFINITELY_SHARP};
 use crate::error::{Error, Result};
+use crate::pattern::cache::WordMap;
 use crate::surface::PolygonMesh;
 
 /// No face on this side of an edge.
@@ -141,7 +142,7 @@ impl Cage {
     ) -> Result<Cage> {
         let faces = face_start.len() - 1;
         // Edges, each with the face along it and the face against it.
-        let mut edge_of: std::collections::HashMap<(u32, u32), u32> = Default::default();
+        let mut edge_of: WordMap<(u32, u32), u32> = Default::default();
         let mut edges: Vec<[u32; 2]> = Vec::new();
         let mut edge_faces: Vec<[u32; 2]> = Vec::new();
         let mut face_edges = vec![0u32; face_vertices.len()];
@@ -245,7 +246,7 @@ impl Cage {
     /// Sharpness, holes and the boundary rule, as Far prepares them.
     fn apply_tags(&mut self, mesh: &PolygonMesh) {
         let mut sharpness = vec![0.0f32; self.edges.len()];
-        let mut edge_of = std::collections::HashMap::new();
+        let mut edge_of: WordMap<(u32, u32), usize> = Default::default();
         for (e, &[a, b]) in self.edges.iter().enumerate() {
             edge_of.insert((a.min(b), a.max(b)), e);
         }

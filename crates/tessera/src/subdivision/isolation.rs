@@ -23,6 +23,7 @@ use super::cage::{Cage, FaceCorner};
 use super::gregory::{GregoryCorner, GregoryPatch, GregorySource};
 use super::sdc::{self, EdgeNeighborhood, VertexNeighborhood, VertexRule};
 use super::INFINITELY_SHARP;
+use crate::pattern::cache::WordMap;
 use crate::surface::patch_tree::Slot;
 pub use crate::surface::patch_tree::{Leaf, LeafPatch, PatchTree};
 
@@ -483,7 +484,7 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
         Edge(u32),
         Face(u32),
     }
-    let mut index: std::collections::HashMap<Parent, u32> = Default::default();
+    let mut index: WordMap<Parent, u32> = Default::default();
     let mut parents: Vec<Parent> = Vec::new();
     let mut id = |p: Parent| -> u32 {
         *index.entry(p).or_insert_with(|| {
@@ -494,7 +495,7 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
     let mut face_start = vec![0u32];
     let mut face_vertices = Vec::new();
     let mut children = Vec::new();
-    let mut seen = std::collections::HashSet::new();
+    let mut seen: WordMap<(u32, u32), ()> = Default::default();
     let corners = mesh.face(f).to_vec();
     // f's own children first, in corner order.
     let mut work: Vec<FaceCorner> =
@@ -503,7 +504,7 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
         work.extend(mesh.vertex_faces(v as usize).iter().copied());
     }
     for fc in work {
-        if !seen.insert((fc.face, fc.corner)) {
+        if seen.insert((fc.face, fc.corner), ()).is_some() {
             continue;
         }
         let g = fc.face as usize;
@@ -643,7 +644,7 @@ fn neighbourhood(cage: &Cage, face: usize) -> (Cage, usize) {
             }
         }
     }
-    let mut local_of: std::collections::HashMap<u32, u32> = Default::default();
+    let mut local_of: WordMap<u32, u32> = Default::default();
     let mut global = Vec::new();
     let mut face_start = vec![0u32];
     let mut face_vertices = Vec::new();
