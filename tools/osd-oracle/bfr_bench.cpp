@@ -287,24 +287,7 @@ template <typename REAL>
 int run(const Cage &cage, const Topology &topo, const Args &args) {
     // ---- setup: refiner + surface factory
     auto s0 = Clock::now();
-    Far::TopologyDescriptor desc;
-    desc.numVertices = cage.numVertices();
-    desc.numFaces = cage.numFaces();
-    desc.numVertsPerFace = cage.faceSizes.data();
-    desc.vertIndicesPerFace = cage.faceVerts.data();
-    desc.numCreases = (int)topo.creaseWeights.size();
-    desc.creaseVertexIndexPairs = topo.creasePairs.data();
-    desc.creaseWeights = topo.creaseWeights.data();
-    desc.numCorners = (int)topo.cornerWeights.size();
-    desc.cornerVertexIndices = topo.corners.data();
-    desc.cornerWeights = topo.cornerWeights.data();
-    desc.numHoles = (int)topo.holes.size();
-    desc.holeIndices = topo.holes.data();
-
-    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-    Far::TopologyRefiner *refiner =
-        Factory::Create(desc, Factory::Options(topo.scheme, topo.options));
-    if (!refiner) die("OpenSubdiv's TopologyRefinerFactory refused the topology");
+    Far::TopologyRefiner *refiner = createRefiner(cage, topo);
     Bfr::RefinerSurfaceFactory<> factory(*refiner);  // default SurfaceFactory::Options
     std::vector<REAL> meshPos(cage.pos.begin(), cage.pos.end());
     const double setupMs = msSince(s0);

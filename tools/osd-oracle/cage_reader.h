@@ -226,3 +226,26 @@ Topology applyTags(const Cage &cage, Sdc::SchemeType scheme) {
     }
     return topo;
 }
+
+// The Far::TopologyRefiner of a cage and its tags (dies when OpenSubdiv refuses it).
+Far::TopologyRefiner *createRefiner(const Cage &cage, const Topology &topo) {
+    Far::TopologyDescriptor desc;
+    desc.numVertices = cage.numVertices();
+    desc.numFaces = cage.numFaces();
+    desc.numVertsPerFace = cage.faceSizes.data();
+    desc.vertIndicesPerFace = cage.faceVerts.data();
+    desc.numCreases = (int)topo.creaseWeights.size();
+    desc.creaseVertexIndexPairs = topo.creasePairs.data();
+    desc.creaseWeights = topo.creaseWeights.data();
+    desc.numCorners = (int)topo.cornerWeights.size();
+    desc.cornerVertexIndices = topo.corners.data();
+    desc.cornerWeights = topo.cornerWeights.data();
+    desc.numHoles = (int)topo.holes.size();
+    desc.holeIndices = topo.holes.data();
+
+    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+    Far::TopologyRefiner *refiner =
+        Factory::Create(desc, Factory::Options(topo.scheme, topo.options));
+    if (!refiner) die("OpenSubdiv's TopologyRefinerFactory refused the topology");
+    return refiner;
+}

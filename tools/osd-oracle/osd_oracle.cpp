@@ -88,24 +88,7 @@ void usage() {
 template <typename REAL>
 int run(const Cage &cage, const Topology &topo, int rate, bool normals, bool facets,
         bool noCache, int smoothLevel, int sharpLevel) {
-    Far::TopologyDescriptor desc;
-    desc.numVertices = cage.numVertices();
-    desc.numFaces = cage.numFaces();
-    desc.numVertsPerFace = cage.faceSizes.data();
-    desc.vertIndicesPerFace = cage.faceVerts.data();
-    desc.numCreases = (int)topo.creaseWeights.size();
-    desc.creaseVertexIndexPairs = topo.creasePairs.data();
-    desc.creaseWeights = topo.creaseWeights.data();
-    desc.numCorners = (int)topo.cornerWeights.size();
-    desc.cornerVertexIndices = topo.corners.data();
-    desc.cornerWeights = topo.cornerWeights.data();
-    desc.numHoles = (int)topo.holes.size();
-    desc.holeIndices = topo.holes.data();
-
-    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-    Far::TopologyRefiner *refiner =
-        Factory::Create(desc, Factory::Options(topo.scheme, topo.options));
-    if (!refiner) die("OpenSubdiv's TopologyRefinerFactory refused the topology");
+    Far::TopologyRefiner *refiner = createRefiner(cage, topo);
 
     // The descriptor factory silently skips creases whose edge does not exist;
     // say so.

@@ -83,9 +83,8 @@ fn cage_topology(path: &Path) -> Option<(i64, usize)> {
 }
 
 /// The schemes a camera case picks from, with a criterion each.
-fn scheme_case(k: usize, camera: &Camera, diagonal: f64) -> (Scheme, Criterion) {
+fn scheme_case(k: usize, diagonal: f64) -> (Scheme, Criterion) {
     let view = |c| Criterion::View { criterion: c, fmin: 1.0, fmax: 6.0 };
-    let _ = camera;
     match k % 8 {
         0 => (Scheme::Uniform, Criterion::Factor(3.0)),
         1 => (Scheme::Transition, Criterion::Tolerance(2e-3 * diagonal)),
@@ -127,7 +126,7 @@ fn watertight_through_every_scheme(fast: bool) {
             .run(&(common::random_camera(&set), any::<bool>()), |((camera, _), cull)| {
                 let k = case.get();
                 case.set(k + 1);
-                let (scheme, criterion) = scheme_case(k, &camera, diagonal);
+                let (scheme, criterion) = scheme_case(k, diagonal);
                 let options = PlanOptions { camera: Some(camera), cull, ..PlanOptions::default() };
                 let SchemePlan { plan, pattern, .. } = scheme.plan(&set, &criterion, &options).unwrap();
                 let mesh = tessellate(&set, &plan, &pattern, EngineOptions::default()).unwrap();

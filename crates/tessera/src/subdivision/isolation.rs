@@ -423,19 +423,18 @@ fn gregory_source(mesh: &Cage, f: usize) -> GregorySource {
         let dart = t.rules & DART != 0 && t.inf_sharp_edges;
         let test_edges = t.inf_sharp_edges && t.rules != DART;
         let k = fan.iter().position(|fc| fc.face as usize == f).expect("the face is at its corner");
-        let (faces, start, patch_face, boundary): (Vec<FaceCorner>, usize, usize, bool) = if test_edges {
+        let (faces, patch_face, boundary): (Vec<FaceCorner>, usize, bool) = if test_edges {
             let span = corner_span(mesh, f, i);
             if span.periodic {
-                (fan.to_vec(), 0, k, t.boundary)
+                (fan.to_vec(), k, t.boundary)
             } else {
                 let picked: Vec<FaceCorner> =
                     (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
-                (picked, span.start, span.corner_in_span, true)
+                (picked, span.corner_in_span, true)
             }
         } else {
-            (fan.to_vec(), 0, k, t.boundary)
+            (fan.to_vec(), k, t.boundary)
         };
-        let _ = start;
         let sharp = if t.corner {
             true
         } else if test_edges {
@@ -529,9 +528,12 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
     }
 
     // Points, sharpness and completeness of the children.
-    let face_point = |g: usize| {
-        sdc::face_point(&mesh.face(g).iter().map(|&v| mesh.points[v as usize]).collect::<Vec<_>>())
-    };
+    // Each face point of the neighbourhood once: most are needed, several times over (as a
+    // child vertex and by the edge and vertex points around it).
+    let face_points: Vec<DVec3> = (0..mesh.face_count())
+        .map(|g| sdc::face_point(&mesh.face(g).iter().map(|&v| mesh.points[v as usize]).collect::<Vec<_>>()))
+        .collect();
+    let face_point = |g: usize| face_points[g];
     let mut points = Vec::with_capacity(parents.len());
     let mut vertex_sharpness = Vec::with_capacity(parents.len());
     let mut complete = Vec::with_capacity(parents.len());
