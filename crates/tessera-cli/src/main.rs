@@ -223,27 +223,10 @@ fn load_surfaces(path: &Path, options: LoadOptions) -> Result<SurfaceSet, tesser
     Ok(set)
 }
 
-/// Output buffers may use up to 3/4 of the memory available now (Linux `MemAvailable`), or
-/// 8 GiB where that cannot be read, so an absurd factor is refused instead of thrashing.
-fn memory_limit() -> u64 {
-    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
-        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
-        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
-    });
-    available.map_or(8 << 30, |b| b / 4 * 3)
-}
-
-/// The engine limits for a run: the memory limit and the triangle limit (`--max-triangles`,
-/// else what the memory limit holds at a typical vertex-to-triangle ratio of 1:2).
+/// The engine limits for a run (the library's rule,
+/// [`EngineOptions::within_available_memory`]).
 fn limits(max_triangles: Option<u64>, corner_params: bool) -> EngineOptions {
-    let memory = memory_limit();
-    let per_two_triangles = tessera::mesh::output_bytes(1, 2, corner_params);
-    EngineOptions {
-        corner_params,
-        memory_limit: Some(memory),
-        max_triangles: Some(max_triangles.unwrap_or(memory / per_two_triangles * 2)),
-        strips: false,
-    }
+    EngineOptions::within_available_memory(max_triangles, corner_params)
 }
 
 /// The CLI's line for an output the engine refused: the estimate, the memory, and which limit
@@ -278,51 +261,22 @@ fn ratio(x: f64) -> String {
     }
 }
 
-/// One line per kind of repair the input needed, on stderr, and the same as JSON for --stats.
+/// One line per kind of repair the input needed, on stderr, and the same as JSON for --stats
+/// (the library's list, [`tessera::surface::Repairs::counted`]).
 fn report_repairs(set: &SurfaceSet, mesh: &Mesh) -> serde_json::Value {
     let r = &set.repairs;
-    let lines = [
-        (
-            r.split_polygons,
-            "input polygons split into triangles (fans from their first corner) for PN triangles",
-        ),
-        (r.skipped_primitives, "glTF primitives left out: POINTS or LINES, not surfaces"),
-        (
-            r.ignored_tag_lines,
-            "OpenSubdiv tag lines (creases, corners, holes) not used: PN triangles interpolate the cage, they do not subdivide it",
-        ),
-        (r.unknown_tag_lines, "OpenSubdiv tag lines of unknown names ignored"),
-        (r.welded_points, "input points merged into coincident ones by welding"),
-        (r.dropped_degenerate_faces, "input faces dropped: two of their corners are one vertex"),
-        (r.dropped_duplicate_faces, "input faces dropped: exact duplicates of earlier faces"),
-        (r.dropped_zero_area_faces, "input faces dropped: zero area (three collinear vertices)"),
-        (r.dropped_collapsed_patches, "input patches dropped: all their control points are one point"),
-        (
-            mesh.collapsed_triangles,
-            "triangles not emitted: they collapse where a boundary curve is a single point",
-        ),
-    ];
-    for (n, what) in lines {
+    let mut json = serde_json::Map::new();
+    for (key, n, what) in r.counted(mesh.collapsed_triangles) {
         if n > 0 {
             eprintln!("repair: {n} {what}");
         }
+        json.insert(key.to_string(), n.into());
     }
     if r.flipped {
         eprintln!("repair: the orientation was reversed so that normals point outward");
     }
-    serde_json::json!({
-        "welded_points": r.welded_points,
-        "dropped_degenerate_faces": r.dropped_degenerate_faces,
-        "dropped_duplicate_faces": r.dropped_duplicate_faces,
-        "dropped_zero_area_faces": r.dropped_zero_area_faces,
-        "dropped_collapsed_patches": r.dropped_collapsed_patches,
-        "split_polygons": r.split_polygons,
-        "skipped_primitives": r.skipped_primitives,
-        "ignored_tag_lines": r.ignored_tag_lines,
-        "unknown_tag_lines": r.unknown_tag_lines,
-        "collapsed_triangles": mesh.collapsed_triangles,
-        "flipped": r.flipped,
-    })
+    json.insert("flipped".to_string(), r.flipped.into());
+    json.into()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -390,43 +344,10 @@ fn write_with_bar(mesh: &Mesh, out: &Path, corner_params: bool) -> Result<(), te
     written
 }
 
-/// What is wrong with the output that was not wrong with the input. Culled patches leave
-/// holes by request, so with culling only the degeneracies count.
+/// What is wrong with the output that was not wrong with the input
+/// ([`verify::output_problems`]).
 fn output_problems(set: &SurfaceSet, w: &verify::WatertightReport, culled: usize) -> Vec<String> {
-    let t = set.topology.report;
-    let mut problems = Vec::new();
-    if w.degenerate_triangles() > 0 {
-        problems.push(format!(
-            "the mesh has {} degenerate triangles ({} with two corners at one position, {} of zero area)",
-            w.degenerate_triangles(),
-            w.collapsed_triangles,
-            w.zero_area_triangles
-        ));
-    }
-    // A non-manifold input curve legitimately gives non-manifold output edges, one per segment.
-    if w.nonmanifold_edges > 0 && t.nonmanifold_edges == 0 {
-        problems.push(format!(
-            "the input is manifold but the mesh has {} non-manifold edges",
-            w.nonmanifold_edges
-        ));
-    }
-    if w.misoriented_edges > 0 && t.inconsistently_oriented_edges == 0 {
-        problems.push(format!("the mesh has {} edges used twice in the same direction", w.misoriented_edges));
-    }
-    if culled == 0 {
-        if t.boundary_edges == 0 && w.boundary_edges > 0 {
-            problems
-                .push(format!("the input is closed but the mesh has {} boundary edges", w.boundary_edges));
-        }
-        // Non-manifold inputs too: coincident copies of a patch weld into one surface.
-        if w.euler_characteristic != t.euler_characteristic {
-            problems.push(format!(
-                "the mesh's Euler characteristic is {}, the input's {}: its topology changed (a pinch or a hole)",
-                w.euler_characteristic, t.euler_characteristic
-            ));
-        }
-    }
-    problems
+    verify::output_problems(&set.topology.report, w, culled)
 }
 
 /// Writes the instanced form of a semi-uniform plan (see `--instanced`).

@@ -164,19 +164,6 @@ fn range(text: &str, flag: &str) -> Result<(f64, f64), String> {
     }
 }
 
-/// Parses `0.1%` (of `diagonal`) or an absolute distance.
-pub fn parse_tolerance(text: &str, diagonal: f64) -> Result<f64, String> {
-    let (number, relative) = match text.strip_suffix('%') {
-        Some(n) => (n, true),
-        None => (text, false),
-    };
-    let v: f64 = number.trim().parse().map_err(|_| format!("--tolerance {text}: not a number"))?;
-    if !(v.is_finite() && v > 0.0) {
-        return Err(format!("--tolerance {text}: must be a positive number"));
-    }
-    Ok(if relative { v / 100.0 * diagonal } else { v })
-}
-
 /// The criterion's camera: `--camera` on the default framing camera, whose up axis is the
 /// model's (its format's convention, [`tessera::io::up_axis_of`]).
 pub fn camera(args: &CriterionArgs, set: &SurfaceSet) -> Result<Camera, tessera::Error> {
@@ -238,7 +225,11 @@ fn criterion(
     }
     if let Some(t) = &args.tolerance {
         let (lo, hi) = set.bounds();
-        let eps = parse_tolerance(t, lo.distance(hi))?;
+        let eps =
+            tessera::criterion::tolerance::parse_tolerance(t, lo.distance(hi)).map_err(|e| match e {
+                tessera::Error::InvalidParameter { reason, .. } => format!("--tolerance {reason}"),
+                e => e.to_string(),
+            })?;
         return Ok((Criterion::Tolerance(eps), format!("tolerance {eps:.4e}")));
     }
     if let Some(px) = args.pixel_error {

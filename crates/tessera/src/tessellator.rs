@@ -335,6 +335,13 @@ impl<'a> Tessellator<'a> {
         self.mesh
     }
 
+    /// The last frame's mesh, handed over and replaced by an empty one: for a caller that
+    /// keeps each frame (the Python package's arrays own their buffers), at the price of the
+    /// next frame allocating its buffers anew. Cost: O(1).
+    pub fn take_mesh(&mut self) -> Mesh {
+        std::mem::take(&mut self.mesh)
+    }
+
     /// [`Tessellator::frame`], handed to `builder`: a builder that lends its arrays
     /// ([`MeshBuilder::buffers`]) receives the engine's parallel writes directly (the
     /// tessellator's own mesh left as it was); any other receives the frame streamed, vertex

@@ -33,6 +33,25 @@ pub struct BoundReport {
     pub rounds: usize,
 }
 
+/// Parses a tolerance as a front end takes it: a distance in model units (`"0.002"`), or a
+/// share of `diagonal` (the bounding-box diagonal) written with `%` (`"0.1%"`). The one rule
+/// for both the command line's `--tolerance` and the Python package's `tolerance=`.
+///
+/// Errors: [`Error::InvalidParameter`] (name `tolerance`) for text that is not a finite
+/// positive number. Cost: O(length of `text`).
+pub fn parse_tolerance(text: &str, diagonal: f64) -> Result<f64> {
+    let (number, relative) = match text.trim().strip_suffix('%') {
+        Some(n) => (n, true),
+        None => (text.trim(), false),
+    };
+    let invalid = |why: &str| Error::InvalidParameter { name: "tolerance", reason: format!("{text}: {why}") };
+    let v: f64 = number.trim().parse().map_err(|_| invalid("not a number"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(invalid("must be a positive number"));
+    }
+    Ok(if relative { v / 100.0 * diagonal } else { v })
+}
+
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
 /// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
 fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
@@ -699,6 +718,20 @@ fn check_patches(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tolerances_parse_as_distances_or_shares_of_the_diagonal() {
+        assert_eq!(parse_tolerance("0.5", 10.0).unwrap(), 0.5);
+        assert!((parse_tolerance("0.1%", 200.0).unwrap() - 0.2).abs() < 1e-15);
+        assert!((parse_tolerance(" 2 % ", 50.0).unwrap() - 1.0).abs() < 1e-15);
+        for bad in ["", "%", "x", "-1", "0", "nan", "inf", "1e400%"] {
+            let e = parse_tolerance(bad, 1.0).unwrap_err();
+            assert!(
+                matches!(&e, Error::InvalidParameter { name: "tolerance", reason } if reason.starts_with(bad)),
+                "{bad:?}: {e}"
+            );
+        }
+    }
 
     #[test]
     fn quad_grid_meets_filip_with_few_cells() {

@@ -53,6 +53,29 @@ pub struct EngineOptions {
     pub strips: bool,
 }
 
+impl EngineOptions {
+    /// Limits for a run on this machine, the rule every front end (the command line, the
+    /// Python package) applies: output buffers may take up to three quarters of the memory
+    /// available now (Linux `MemAvailable`; 8 GiB where it cannot be read), and at most
+    /// `max_triangles` triangles (None: what that memory holds at a typical vertex-to-triangle
+    /// ratio of 1:2). So an absurd factor is refused before allocating instead of thrashing.
+    /// Cost: one read of `/proc/meminfo`.
+    pub fn within_available_memory(max_triangles: Option<u64>, corner_params: bool) -> EngineOptions {
+        let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+            let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
+            line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
+        });
+        let memory = available.map_or(8 << 30, |b| b / 4 * 3);
+        let per_two_triangles = crate::mesh::output_bytes(1, 2, corner_params);
+        EngineOptions {
+            corner_params,
+            memory_limit: Some(memory),
+            max_triangles: Some(max_triangles.unwrap_or(memory / per_two_triangles * 2)),
+            strips: false,
+        }
+    }
+}
+
 /// Refuses an output of `vertices` and `triangles` that does not fit the u32 index range (the
 /// layout's offsets are u32, as a GPU reads them), the address space or the limits in
 /// `options`. Cost: O(1).

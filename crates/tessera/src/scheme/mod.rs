@@ -43,6 +43,7 @@ use crate::sampling::Spacing;
 use crate::surface::SurfaceSet;
 use rayon::prelude::*;
 
+pub mod domain_pattern;
 mod validate;
 pub use validate::{validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR, SUBDIVISION_ON_GPU};
 
@@ -171,6 +172,25 @@ impl Scheme {
             Criterion::Esc { .. } => Scheme::Esc { max_level: Self::DEFAULT_ESC_LEVEL },
             _ => Scheme::Transition,
         }
+    }
+
+    /// Every scheme, in the command line's order, with the default levels and no warp.
+    pub const ALL: [Scheme; 9] = [
+        Scheme::Uniform,
+        Scheme::Transition,
+        Scheme::SemiUniform { max_level: Self::DEFAULT_SEMI_UNIFORM_LEVEL },
+        Scheme::Sd2 { warp: false },
+        Scheme::Hardware(Partitioning::Integer),
+        Scheme::Hardware(Partitioning::Pow2),
+        Scheme::Hardware(Partitioning::FractionalOdd),
+        Scheme::Hardware(Partitioning::FractionalEven),
+        Scheme::Esc { max_level: Self::DEFAULT_ESC_LEVEL },
+    ];
+
+    /// The scheme of a [`Scheme::name`] (default levels, no warp), for front ends that take
+    /// the scheme as text. Cost: O(1).
+    pub fn from_name(name: &str) -> Option<Scheme> {
+        Self::ALL.into_iter().find(|s| s.name() == name)
     }
 
     /// The name the command line and reports use.

@@ -62,6 +62,57 @@ pub struct Repairs {
     pub flipped: bool,
 }
 
+impl Repairs {
+    /// Every counted kind of repair as `(key, count, what it means)`, zeros included, in a
+    /// fixed order; `collapsed_triangles` is the engine's count of triangles not emitted where
+    /// a boundary curve is one point ([`crate::mesh::Mesh::collapsed_triangles`]), the one
+    /// repair made while tessellating. The keys are `--stats`' `repairs` object's and the
+    /// Python package's `report["repairs"]`'s; the sentences are `tessera mesh`'s `repair:`
+    /// lines. [`Repairs::flipped`] is the one repair that is not a count. Cost: O(1).
+    pub fn counted(&self, collapsed_triangles: usize) -> [(&'static str, usize, &'static str); 10] {
+        [
+            (
+                "split_polygons",
+                self.split_polygons,
+                "input polygons split into triangles (fans from their first corner) for PN triangles",
+            ),
+            ("skipped_primitives", self.skipped_primitives, "glTF primitives left out: POINTS or LINES, not surfaces"),
+            (
+                "ignored_tag_lines",
+                self.ignored_tag_lines,
+                "OpenSubdiv tag lines (creases, corners, holes) not used: PN triangles interpolate the cage, they do not subdivide it",
+            ),
+            ("unknown_tag_lines", self.unknown_tag_lines, "OpenSubdiv tag lines of unknown names ignored"),
+            ("welded_points", self.welded_points, "input points merged into coincident ones by welding"),
+            (
+                "dropped_degenerate_faces",
+                self.dropped_degenerate_faces,
+                "input faces dropped: two of their corners are one vertex",
+            ),
+            (
+                "dropped_duplicate_faces",
+                self.dropped_duplicate_faces,
+                "input faces dropped: exact duplicates of earlier faces",
+            ),
+            (
+                "dropped_zero_area_faces",
+                self.dropped_zero_area_faces,
+                "input faces dropped: zero area (three collinear vertices)",
+            ),
+            (
+                "dropped_collapsed_patches",
+                self.dropped_collapsed_patches,
+                "input patches dropped: all their control points are one point",
+            ),
+            (
+                "collapsed_triangles",
+                collapsed_triangles,
+                "triangles not emitted: they collapse where a boundary curve is a single point",
+            ),
+        ]
+    }
+}
+
 /// Patches plus their shared-edge topology: the input of every criterion, pattern and engine.
 #[derive(Debug, Clone)]
 pub struct SurfaceSet {

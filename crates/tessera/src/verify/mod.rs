@@ -9,6 +9,53 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};
 
+/// What is wrong with an output mesh that was not wrong with its input (`input`, the set's
+/// [`crate::topology::TopologyReport`]): degenerate triangles; non-manifold or misoriented
+/// edges where the input had none; and, unless `culled` patches were left out on purpose,
+/// boundary edges on a closed input or another Euler characteristic. One sentence per
+/// problem, empty when the output is sound — the rule behind `tessera mesh`'s warnings and
+/// exit status 1, and the Python package's `report["problems"]`. Cost: O(1).
+pub fn output_problems(
+    input: &crate::topology::TopologyReport,
+    w: &WatertightReport,
+    culled: usize,
+) -> Vec<String> {
+    let t = input;
+    let mut problems = Vec::new();
+    if w.degenerate_triangles() > 0 {
+        problems.push(format!(
+            "the mesh has {} degenerate triangles ({} with two corners at one position, {} of zero area)",
+            w.degenerate_triangles(),
+            w.collapsed_triangles,
+            w.zero_area_triangles
+        ));
+    }
+    // A non-manifold input curve legitimately gives non-manifold output edges, one per segment.
+    if w.nonmanifold_edges > 0 && t.nonmanifold_edges == 0 {
+        problems.push(format!(
+            "the input is manifold but the mesh has {} non-manifold edges",
+            w.nonmanifold_edges
+        ));
+    }
+    if w.misoriented_edges > 0 && t.inconsistently_oriented_edges == 0 {
+        problems.push(format!("the mesh has {} edges used twice in the same direction", w.misoriented_edges));
+    }
+    if culled == 0 {
+        if t.boundary_edges == 0 && w.boundary_edges > 0 {
+            problems
+                .push(format!("the input is closed but the mesh has {} boundary edges", w.boundary_edges));
+        }
+        // Non-manifold inputs too: coincident copies of a patch weld into one surface.
+        if w.euler_characteristic != t.euler_characteristic {
+            problems.push(format!(
+                "the mesh's Euler characteristic is {}, the input's {}: its topology changed (a pinch or a hole)",
+                w.euler_characteristic, t.euler_characteristic
+            ));
+        }
+    }
+    problems
+}
+
 /// Topological soundness of a mesh after welding bit-identical positions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct WatertightReport {
