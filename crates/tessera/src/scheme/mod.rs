@@ -459,6 +459,17 @@ mod tests {
     use crate::surface::{Patch, RationalBicubic};
     use glam::DVec3;
 
+    #[test]
+    fn every_scheme_is_found_by_its_name_once() {
+        let names: Vec<&str> = Scheme::ALL.iter().map(Scheme::name).collect();
+        for (k, name) in names.iter().enumerate() {
+            assert_eq!(Scheme::from_name(name), Some(Scheme::ALL[k]));
+            assert!(!names[..k].contains(name), "{name} twice");
+        }
+        assert_eq!(Scheme::from_name("fractional_odd"), None);
+        assert_eq!(Scheme::from_name(""), None);
+    }
+
     pub(super) fn flat() -> SurfaceSet {
         let points = std::array::from_fn(|k| DVec3::new((k / 4) as f64, (k % 4) as f64, 0.0));
         SurfaceSet::from_patches(
