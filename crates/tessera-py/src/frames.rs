@@ -34,31 +34,42 @@ struct Chosen {
     tolerance: Option<f64>,
 }
 
-/// Maps the keyword arguments to the library's request; every rule it applies is the
-/// library's (`Scheme::default_for`, `default_silhouette`, `parse_tolerance`).
-#[allow(clippy::too_many_arguments)]
-fn choose(
-    py: Python<'_>,
-    set: &tessera::surface::SurfaceSet,
-    scheme: Option<&str>,
+/// The criterion and plan keyword arguments of `Tessellator`, as given (None where left
+/// out): `tessera mesh`'s flags.
+struct Request<'a, 'py> {
+    /// A name of `Scheme::ALL`; None: the criterion's default scheme.
+    scheme: Option<&'a str>,
+    /// The criteria, at most one given.
     factor: Option<f64>,
-    tolerance: Option<&Bound<'_, PyAny>>,
+    tolerance: Option<&'a Bound<'py, PyAny>>,
     pixel_error: Option<f64>,
     distance: Option<(f64, f64)>,
     silhouette: Option<(f64, f64)>,
-    silhouette_mode: Option<&str>,
-    mapping: &str,
-    camera: Option<tessera::camera::Camera>,
+    /// How `silhouette` finds silhouettes, and how `distance` maps to factors.
+    silhouette_mode: Option<&'a str>,
+    mapping: &'a str,
+    /// Culling and the adaptive criteria's cap.
     cull: bool,
     max_factor: u32,
+    /// Semi-uniform's or ESC's highest level; ESC's fixed level and distance test.
     max_level: Option<u32>,
     level: Option<u32>,
-    quality: Option<&str>,
+    quality: Option<&'a str>,
     threshold: Option<f64>,
+    /// SD-2's reverse projection.
     warp: bool,
+}
+
+/// Maps the keyword arguments to the library's request; every rule it applies is the
+/// library's (`Scheme::default_for`, `default_silhouette`, `parse_tolerance`).
+fn choose(
+    py: Python<'_>,
+    set: &tessera::surface::SurfaceSet,
+    r: &Request<'_, '_>,
+    camera: Option<tessera::camera::Camera>,
     max_triangles: u64,
 ) -> PyResult<Chosen> {
-    let named = match scheme {
+    let named = match r.scheme {
         None => None,
         Some(name) => Some(
             Scheme::from_name(name)
@@ -67,25 +78,25 @@ fn choose(
                 })
                 .map(|s| match s {
                     Scheme::SemiUniform { .. } => Scheme::SemiUniform {
-                        max_level: max_level.unwrap_or(Scheme::DEFAULT_SEMI_UNIFORM_LEVEL),
+                        max_level: r.max_level.unwrap_or(Scheme::DEFAULT_SEMI_UNIFORM_LEVEL),
                     },
                     Scheme::Esc { .. } => {
-                        Scheme::Esc { max_level: max_level.unwrap_or(Scheme::DEFAULT_ESC_LEVEL) }
+                        Scheme::Esc { max_level: r.max_level.unwrap_or(Scheme::DEFAULT_ESC_LEVEL) }
                     }
-                    Scheme::Sd2 { .. } => Scheme::Sd2 { warp },
+                    Scheme::Sd2 { .. } => Scheme::Sd2 { warp: r.warp },
                     other => other,
                 })?,
         ),
     };
-    if warp && !matches!(named, Some(Scheme::Sd2 { .. })) {
+    if r.warp && !matches!(named, Some(Scheme::Sd2 { .. })) {
         return Err(parameter_error(py, "warp=True applies to scheme=\"sd2\" only"));
     }
     let given = [
-        factor.is_some(),
-        tolerance.is_some(),
-        pixel_error.is_some(),
-        distance.is_some(),
-        silhouette.is_some(),
+        r.factor.is_some(),
+        r.tolerance.is_some(),
+        r.pixel_error.is_some(),
+        r.distance.is_some(),
+        r.silhouette.is_some(),
     ];
     if given.iter().filter(|&&g| g).count() > 1 {
         return Err(parameter_error(
@@ -94,9 +105,9 @@ fn choose(
         ));
     }
     let mut tolerance_value = None;
-    let criterion = if let Some(f) = factor {
+    let criterion = if let Some(f) = r.factor {
         Criterion::Factor(f)
-    } else if let Some(t) = tolerance {
+    } else if let Some(t) = r.tolerance {
         // A number or text such as "0.1%": the one parser of the command line's --tolerance.
         let text = match t.extract::<f64>() {
             Ok(v) => v.to_string(),
@@ -109,10 +120,10 @@ fn choose(
             .map_err(|e| to_py_err(py, e, None))?;
         tolerance_value = Some(eps);
         Criterion::Tolerance(eps)
-    } else if let Some(px) = pixel_error {
+    } else if let Some(px) = r.pixel_error {
         Criterion::PixelError(px)
-    } else if let Some((fmin, fmax)) = distance {
-        let mapping = match mapping {
+    } else if let Some((fmin, fmax)) = r.distance {
+        let mapping = match r.mapping {
             "linear" => Mapping::Linear,
             "quadratic" => Mapping::Quadratic,
             other => {
@@ -123,8 +134,8 @@ fn choose(
             }
         };
         Criterion::View { criterion: ViewCriterion::Distance(mapping), fmin, fmax }
-    } else if let Some((fmin, fmax)) = silhouette {
-        let criterion = match silhouette_mode {
+    } else if let Some((fmin, fmax)) = r.silhouette {
+        let criterion = match r.silhouette_mode {
             Some("silhouetteness") => ViewCriterion::Silhouetteness,
             Some("vertices") => ViewCriterion::SilhouetteVertices,
             None => named.unwrap_or(Scheme::Transition).default_silhouette(),
@@ -136,12 +147,12 @@ fn choose(
             }
         };
         Criterion::View { criterion, fmin, fmax }
-    } else if level.is_some()
-        || quality.is_some()
-        || threshold.is_some()
+    } else if r.level.is_some()
+        || r.quality.is_some()
+        || r.threshold.is_some()
         || matches!(named, Some(Scheme::Esc { .. }))
     {
-        let threshold = match (threshold, quality) {
+        let threshold = match (r.threshold, r.quality) {
             (Some(d), None) => Threshold::Absolute(d),
             (None, Some("high")) => Threshold::High,
             (None, Some("medium") | None) => Threshold::Medium,
@@ -150,13 +161,13 @@ fn choose(
                 return Err(parameter_error(py, format!("quality={other:?}: use \"high\" or \"medium\"")))
             }
         };
-        Criterion::Esc { threshold, level }
+        Criterion::Esc { threshold, level: r.level }
     } else {
         Criterion::Factor(8.0)
     };
     let scheme = named.unwrap_or_else(|| Scheme::default_for(&criterion));
     let camera = camera.unwrap_or_else(|| default_camera(set, (1280, 720)));
-    let plan = PlanOptions { camera: Some(camera), cull, max_factor, max_triangles };
+    let plan = PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles };
     Ok(Chosen { scheme, criterion, plan, tolerance: tolerance_value })
 }
 
@@ -219,9 +230,7 @@ impl Tessellator {
         }
         let engine =
             EngineOptions { strips, ..EngineOptions::within_available_memory(max_triangles, corner_params) };
-        let chosen = choose(
-            py,
-            &set,
+        let request = Request {
             scheme,
             factor,
             tolerance,
@@ -230,7 +239,6 @@ impl Tessellator {
             silhouette,
             silhouette_mode,
             mapping,
-            camera.map(|c| c.camera),
             cull,
             max_factor,
             max_level,
@@ -238,8 +246,9 @@ impl Tessellator {
             quality,
             threshold,
             warp,
-            engine.max_triangles.unwrap_or(u64::MAX),
-        )?;
+        };
+        let camera = camera.map(|c| c.camera);
+        let chosen = choose(py, &set, &request, camera, engine.max_triangles.unwrap_or(u64::MAX))?;
         // SAFETY: the allocation behind `set` lives as long as this object's `set` field, and
         // `inner`, the only holder of this reference, is dropped before it (see `Drop`).
         let borrowed: &'static tessera::surface::SurfaceSet = unsafe { &*Arc::as_ptr(&set) };

@@ -14,7 +14,7 @@
 //! use tessera::surface::Domain;
 //!
 //! let p = build(&PatternRequest::new(Scheme::Transition, Domain::Quad, &[5.0, 4.0, 7.0, 3.0]))?;
-//! assert_eq!(p.points.len(), 24);
+//! assert_eq!(p.points.len(), 37);
 //! assert!(p.triangles.len() > 0);
 //! # Ok::<(), tessera::Error>(())
 //! ```
