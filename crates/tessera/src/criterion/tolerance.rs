@@ -594,6 +594,7 @@ fn check_patches(
     // The engine's input, collapsed edges included, so the bound is that of the output.
     let input_of = |p: usize, domain, segments, interior| PatternInput {
         collapsed: set.topology.collapsed_sides(p),
+        pinched: set.topology.pinched_corners(p),
         ..PatternInput::new(domain, segments, interior)
     };
     // Each patch's first pattern: its edges and the smallest interior the layout gives it.

@@ -241,7 +241,16 @@ pub fn pattern_input(set: &SurfaceSet, plan: &Plan, p: usize) -> PatternInput {
         factors[e] = plan.factor(edge);
     }
     let collapsed = set.topology.collapsed_sides(p);
-    PatternInput { domain, segments, interior: plan.interior[p], factors, patch: p as u32, collapsed }
+    let pinched = set.topology.pinched_corners(p);
+    PatternInput {
+        domain,
+        segments,
+        interior: plan.interior[p],
+        factors,
+        patch: p as u32,
+        collapsed,
+        pinched,
+    }
 }
 
 /// True when two corners of the patch are the same vertex (a collapsed curve, or a curve that

@@ -462,7 +462,7 @@ impl Pattern for Esc {
         (l.interior.len() as u32, l.triangles)
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         let l = self.patch(input);
         debug_assert!((0..4).all(|e| {
             input.segments[e] as usize == self.grids[input.patch as usize].edge_points(e).len() + 1

@@ -37,6 +37,12 @@ pub struct PatternInput {
     /// still form a fan at the point once its samples are one vertex; [`transition`] reads
     /// this to keep its strips from fanning over a neighbouring edge.
     pub collapsed: [bool; 4],
+    /// Corners whose two edges are both shared with one other patch (an interior vertex of
+    /// valence 2: a subdivision cage can have them). There both patches would cut the corner
+    /// along the same chord, between the first samples of the two edges, and give the same
+    /// triangle twice; [`Pattern::build`] cuts such a corner's cell through the corner instead
+    /// ([`cut_pinched_corners`]). Entries past the corner count are ignored.
+    pub pinched: [bool; 4],
 }
 
 impl PatternInput {
@@ -49,6 +55,7 @@ impl PatternInput {
             factors: segments.map(f64::from),
             patch: 0,
             collapsed: [false; 4],
+            pinched: [false; 4],
         }
     }
 
@@ -132,8 +139,21 @@ pub trait Pattern: Sync {
     /// Number of interior vertices and of triangles. Must agree with [`Pattern::build`].
     fn counts(&self, input: &PatternInput) -> (u32, u32);
 
-    /// Writes interior parameters and triangles into `out` (cleared first).
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation);
+    /// Writes the pattern's interior parameters and triangles into `out` (cleared first):
+    /// what each pattern implements. Callers call [`Pattern::build`].
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation);
+
+    /// Writes interior parameters and triangles into `out` (cleared first): the pattern's
+    /// [`Pattern::triangulate`], with the cells of [`PatternInput::pinched`] corners cut
+    /// through the corner ([`cut_pinched_corners`]; counts unchanged). The one call every
+    /// engine and check makes, so that all of them see one triangulation; patterns implement
+    /// `triangulate` and keep this method as it is.
+    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        self.triangulate(input, out);
+        if input.pinched.iter().any(|&p| p) {
+            cut_pinched_corners(input, out);
+        }
+    }
 
     /// A short name for messages (`uniform`, `transition`, ...).
     fn name(&self) -> &'static str {
@@ -182,6 +202,131 @@ pub trait Pattern: Sync {
     fn strips(&self, _input: &PatternInput, _out: &mut Vec<u32>) -> bool {
         false
     }
+}
+
+/// At a pinched corner `c` ([`PatternInput::pinched`]) the two edges there are the other
+/// patch's two edges too, so a triangle whose three vertices all lie on them — typically the
+/// chord triangle `(c, a, b)` between the corner and the first samples of its edges — would be
+/// the other patch's triangle as well (the same three vertices): the mesh would cover it
+/// twice. Where a pattern made such a triangle, edges are put in along the domain's diagonal
+/// from `c` to the opposite corner (through the vertices on it, by Sloan's edge insertion:
+/// flipping the edges that cross each piece) until none is left. Every triangle with a vertex
+/// on each of the two edges would cross that diagonal, and one with all three on one edge
+/// is flat, so once the diagonal is in, each triangle at the corner has a vertex inside the
+/// patch and the two patches share only the edges' segments, as neighbours do. A flip turns
+/// the quad of two triangles on its other diagonal and is made only where both new triangles
+/// are positively oriented in the domain. Counts, the boundary and the triangles off the
+/// diagonal stay the pattern's; on a grid the diagonal runs through cell corners and each
+/// flip keeps both halves halves of their cell ([`Pattern::grid_cells`] holds). Quads only:
+/// two triangles sharing two edges share all three corners (a duplicate face, removed on
+/// input), so a triangle domain has no pinched corner to cut. Cost: O(triangles) per flip, a
+/// few flips per pinched corner.
+pub fn cut_pinched_corners(input: &PatternInput, out: &mut LocalTessellation) {
+    if input.domain != Domain::Quad {
+        return;
+    }
+    let mut positions = Vec::new();
+    for c in 0..4 {
+        if !input.pinched[c] {
+            continue;
+        }
+        let prev = (c + 3) % 4;
+        let on_edges: Vec<u32> = (0..=input.segments[c])
+            .map(|k| input.boundary_vertex(c, k))
+            .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
+            .collect();
+        let shared = |t: &[u32; 3]| t.iter().all(|v| on_edges.contains(v));
+        if !out.triangles.iter().any(shared) {
+            continue;
+        }
+        if positions.is_empty() {
+            cache::local_params(input, out, &mut positions);
+        }
+        // The diagonal's vertices from the corner on: those strictly inside it, then the
+        // opposite corner.
+        let (from, to) = (positions[c], positions[(c + 2) % 4]);
+        let along = |q: DVec2| (q - from).dot(to - from) / (to - from).length_squared();
+        let mut waypoints: Vec<u32> = (0..positions.len() as u32)
+            .filter(|&k| {
+                let q = positions[k as usize];
+                (to - from).perp_dot(q - from).abs() <= 1e-12 && along(q) > 1e-12 && along(q) < 1.0 - 1e-12
+            })
+            .collect();
+        waypoints.sort_by(|&i, &j| along(positions[i as usize]).total_cmp(&along(positions[j as usize])));
+        waypoints.push(((c + 2) % 4) as u32);
+        let mut at = c as u32;
+        for w in waypoints {
+            insert_edge(out, &positions, at, w);
+            at = w;
+            if !out.triangles.iter().any(shared) {
+                break;
+            }
+        }
+    }
+}
+
+/// Flips edges crossing the segment `c v` until the triangulation has the edge `c v`:
+/// Sloan's edge insertion — the crossing edges in a queue; one whose quad is convex is
+/// flipped, and its new diagonal, if it still crosses, goes to the back of the queue, as does
+/// an edge whose quad is not convex yet. It stops early (the triangulation valid as it is)
+/// after a bounded number of tries. Cost: O(triangles) per try, O(k²) tries for k crossing
+/// edges.
+fn insert_edge(out: &mut LocalTessellation, positions: &[DVec2], c: u32, v: u32) {
+    let (pc, pv) = (positions[c as usize], positions[v as usize]);
+    let crosses = |p: u32, q: u32| {
+        let (pp, pq) = (positions[p as usize], positions[q as usize]);
+        let (sp, sq) = ((pv - pc).perp_dot(pp - pc), (pv - pc).perp_dot(pq - pc));
+        let (sc, sv) = ((pq - pp).perp_dot(pc - pp), (pq - pp).perp_dot(pv - pp));
+        sp * sq < 0.0 && sc * sv < 0.0
+    };
+    let mut queue: std::collections::VecDeque<(u32, u32)> = out
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |r| (t[r], t[(r + 1) % 3])))
+        .filter(|&(p, q)| p < q && crosses(p, q))
+        .collect();
+    let limit = 4 * (queue.len() + 1) * (queue.len() + 1);
+    for _ in 0..limit {
+        let Some((p, q)) = queue.pop_front() else { return };
+        if find_edge(&out.triangles, p, q).is_none() {
+            continue; // flipped away already
+        }
+        match flip(out, positions, p, q) {
+            Some((r, s)) if crosses(r, s) => queue.push_back((r, s)),
+            Some(_) => {}
+            None => queue.push_back((p, q)),
+        }
+    }
+}
+
+/// The triangle that runs the edge from `p` to `q`.
+fn find_edge(triangles: &[[u32; 3]], p: u32, q: u32) -> Option<usize> {
+    triangles.iter().position(|t| (0..3).any(|r| t[r] == p && t[(r + 1) % 3] == q))
+}
+
+/// The vertex of `t` that is neither `p` nor `q`.
+fn third(t: [u32; 3], p: u32, q: u32) -> u32 {
+    t.into_iter().find(|&v| v != p && v != q).expect("a triangle has three corners")
+}
+
+/// Flips the inner edge `p q` (the triangles running `p → q` and `q → p`) to the quad's other
+/// diagonal when both new triangles are positively oriented at `positions`, and returns that
+/// diagonal; None (and nothing changed) otherwise.
+fn flip(out: &mut LocalTessellation, positions: &[DVec2], p: u32, q: u32) -> Option<(u32, u32)> {
+    let (i, j) = (find_edge(&out.triangles, p, q)?, find_edge(&out.triangles, q, p)?);
+    let (r, s) = (third(out.triangles[i], p, q), third(out.triangles[j], q, p));
+    let area = |t: [u32; 3]| {
+        let [u, v, w] = t.map(|k| positions[k as usize]);
+        (v - u).perp_dot(w - u)
+    };
+    // The quad runs p, s, q, r counter-clockwise; its other diagonal is r s.
+    let (first, second) = ([r, p, s], [s, q, r]);
+    if area(first) > 0.0 && area(second) > 0.0 {
+        out.triangles[i] = first;
+        out.triangles[j] = second;
+        return Some((r, s));
+    }
+    None
 }
 
 /// The check every pattern's tests share: `out` is a valid conforming triangulation of the
@@ -257,5 +402,74 @@ mod tests {
         for (l, s) in expected.iter().enumerate() {
             assert_eq!(input.slot(l as u32), *s, "local {l}");
         }
+    }
+
+    /// At a pinched corner no pattern leaves the chord triangle between the first samples of
+    /// the corner's two edges, and the cut keeps a tiling of the domain with the pattern's own
+    /// counts: every pattern an isolated subdivision face can be drawn with, over the factors
+    /// and corners that matter (each edge 1–4 segments, interiors 1–5 each way, every corner).
+    #[test]
+    fn pinched_corners_are_cut_through_the_corner() {
+        use crate::pattern::hardware::{Hardware, Partitioning};
+        // The fractional partitionings run through tests/catmull_clark.rs on a cage with a
+        // valence-2 vertex (their segments follow from real factors).
+        let patterns: [&dyn Pattern; 4] = [
+            &uniform::Uniform,
+            &transition::Transition,
+            &semi_uniform::SemiUniform,
+            &Hardware { partitioning: Partitioning::Integer },
+        ];
+        let mut cut = 0;
+        for pattern in patterns {
+            // Quads: the patches of a subdivision cage, the only surfaces with pinched corners
+            // (two triangles sharing two edges share all three corners: a duplicate face).
+            {
+                let domain = Domain::Quad;
+                let nc = domain.corner_count();
+                for code in 0..4u32.pow(nc as u32) {
+                    let segments: [u32; 4] =
+                        std::array::from_fn(|e| if e < nc { 1 + (code >> (2 * e)) % 4 } else { 1 });
+                    let top = *segments.iter().max().unwrap();
+                    let interiors: Vec<[u32; 2]> = match pattern.name() {
+                        "uniform" if segments[..nc].iter().any(|&s| s != top) => continue,
+                        "uniform" => vec![[top, top]],
+                        "semi-uniform" if segments[..nc].iter().any(|s| !s.is_power_of_two()) => continue,
+                        "semi-uniform" => vec![[top, top]],
+                        _ => (1..=5).flat_map(|n| (1..=5).map(move |m| [n, m])).collect(),
+                    };
+                    for interior in interiors {
+                        for c in 0..nc {
+                            let mut input = PatternInput::new(domain, segments, interior);
+                            input.pinched[c] = true;
+                            let mut plain = LocalTessellation::default();
+                            pattern.triangulate(&input, &mut plain);
+                            let mut out = LocalTessellation::default();
+                            pattern.build(&input, &mut out);
+                            assert_eq!(
+                                pattern.counts(&input),
+                                (out.interior.len() as u32, out.triangles.len() as u32),
+                                "{} {input:?}",
+                                pattern.name()
+                            );
+                            let prev = (c + nc - 1) % nc;
+                            let a = input.boundary_vertex(c, 1);
+                            let b = input.boundary_vertex(prev, input.segments[prev] - 1);
+                            let chord =
+                                |t: &[u32; 3]| t.contains(&(c as u32)) && t.contains(&a) && t.contains(&b);
+                            assert!(
+                                !out.triangles.iter().any(chord),
+                                "{} {input:?}: a triangle on the corner's two edges stayed",
+                                pattern.name()
+                            );
+                            cut += usize::from(plain.triangles.iter().any(chord));
+                            let mut p = Vec::new();
+                            cache::local_params(&input, &out, &mut p);
+                            assert_tiles(&input, &out, &p, 0.0);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(cut > 100, "only {cut} inputs had a chord to cut: the test sees too little");
     }
 }

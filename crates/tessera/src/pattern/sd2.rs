@@ -170,11 +170,11 @@ impl Pattern for Sd2 {
         }
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         out.interior.clear();
         out.triangles.clear();
         let Some(l) = Layout::new(input) else {
-            Transition.build(&fallback(input), out);
+            Transition.triangulate(&fallback(input), out);
             return;
         };
         let d = l.d;
@@ -232,6 +232,7 @@ mod tests {
             factors: [f[0], f[1], f[2], 1.0],
             patch: 0,
             collapsed: [false; 4],
+            pinched: [false; 4],
         }
     }
 

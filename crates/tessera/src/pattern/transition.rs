@@ -443,7 +443,7 @@ impl Pattern for Transition {
     }
 
     /// Builds the pattern; O(vertices + triangles), no allocation beyond `out`'s growth.
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         out.interior.clear();
         out.triangles.clear();
         match input.domain {
@@ -470,6 +470,10 @@ impl Pattern for Transition {
     /// The core's cells come first in [`Pattern::build`]: two triangles per cell of the core
     /// rectangle (quads), the `m²` triangles of the core triangle (triangles).
     fn core_cells(&self, input: &PatternInput) -> Option<([u32; 2], u32)> {
+        // A pinched corner's cut may reach into the core: no promise then.
+        if input.pinched.iter().any(|&p| p) {
+            return None;
+        }
         match input.domain {
             Domain::Quad => {
                 let l = QuadLayout::new(input);

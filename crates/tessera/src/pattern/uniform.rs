@@ -74,7 +74,7 @@ impl Pattern for Uniform {
         }
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         let n = input.interior[0];
         let local = |i, j| match input.domain {
             Domain::Quad => quad_local(n, i, j),

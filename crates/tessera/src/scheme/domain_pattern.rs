@@ -243,6 +243,7 @@ pub fn build(r: &PatternRequest<'_>) -> Result<DomainPattern> {
                 factors,
                 patch: 0,
                 collapsed: [false; 4],
+                pinched: [false; 4],
             };
             let params = (0..nc)
                 .map(|e| {

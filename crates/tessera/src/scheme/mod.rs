@@ -135,8 +135,8 @@ impl Pattern for SchemePattern {
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         self.inner().counts(input)
     }
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
-        self.inner().build(input, out)
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        self.inner().triangulate(input, out)
     }
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
         self.inner().interior_grid(input)

@@ -124,6 +124,9 @@ pub struct Topology {
     /// segments and interior factors have the same output counts, and a one-factor plan's
     /// layout is arithmetic (`engine::layout`). Decided once, here.
     pub one_shape: Option<Domain>,
+    /// Per patch, its pinched corners ([`Topology::pinched_corners`]); empty when no patch
+    /// has one.
+    pub patch_pinched: Vec<[bool; 4]>,
 }
 
 fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
@@ -146,6 +149,24 @@ impl Topology {
             *c = self.patch_edges[p][e].collapsed;
         }
         collapsed
+    }
+
+    /// Which of patch `p`'s corners are pinched: both edges there are shared with one same
+    /// other patch, and with no third — the two faces at an interior vertex of valence 2 (a
+    /// subdivision cage can have one). The pattern input's `pinched`
+    /// ([`crate::pattern::PatternInput::pinched`]), in the patch's corner order. Cost: O(1).
+    pub fn pinched_corners(&self, p: usize) -> [bool; 4] {
+        self.patch_pinched.get(p).copied().unwrap_or_default()
+    }
+
+    /// The other patch on patch `p`'s local edge `e` when exactly two patches share it and it
+    /// is not collapsed.
+    fn only_neighbour(&self, p: usize, e: usize) -> Option<u32> {
+        let pe = self.patch_edges[p][e];
+        match self.edge_uses(pe.edge as usize) {
+            [x, y] if !pe.collapsed => Some(if x.patch == p as u32 { y.patch } else { x.patch }),
+            _ => None,
+        }
     }
 
     /// Builds the topology. Cost: O(P) hashing, P = number of patches.
@@ -270,7 +291,7 @@ impl Topology {
                 k.domain == d && (0..c.len()).all(|i| !c[i + 1..].contains(&c[i]))
             }) && edges.iter().all(|e| !e.collapsed)
         });
-        Topology {
+        let mut topology = Topology {
             one_shape,
             vertex_count: vertex_ids.len() as u32,
             edges,
@@ -281,7 +302,25 @@ impl Topology {
             patch_domains: keys.iter().map(|k| k.domain).collect(),
             corner_entries,
             report,
+            patch_pinched: Vec::new(),
+        };
+        let pinched: Vec<[bool; 4]> = (0..keys.len())
+            .map(|p| {
+                let nc = topology.patch_domains[p].corner_count();
+                std::array::from_fn(|c| {
+                    c < nc && {
+                        let here = topology.only_neighbour(p, c);
+                        here.is_some()
+                            && here != Some(p as u32)
+                            && here == topology.only_neighbour(p, (c + nc - 1) % nc)
+                    }
+                })
+            })
+            .collect();
+        if pinched.iter().any(|c| c.contains(&true)) {
+            topology.patch_pinched = pinched;
         }
+        topology
     }
 
     /// The uses of edge `e`; the first is the owner.

@@ -606,7 +606,7 @@ impl Pattern for Hardware {
         (points - pre.outer_points() as u32, triangles)
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         out.interior.clear();
         out.triangles.clear();
         let d = input.domain;

@@ -73,6 +73,7 @@ fn input(domain: Domain, partitioning: Partitioning, factors: [f64; 4]) -> Patte
         factors,
         patch: 0,
         collapsed: [false; 4],
+        pinched: [false; 4],
     }
 }
 

@@ -223,7 +223,7 @@ impl Pattern for SemiUniform {
         (interior, 2 * interior + boundary - 2)
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
+    fn triangulate(&self, input: &PatternInput, out: &mut LocalTessellation) {
         let layout = Layout::new(input);
         // The same grid and triangle order as the uniform pattern, with every vertex mapped
         // through φ; only the boundary vertices can move.
