@@ -260,8 +260,10 @@ impl SurfaceSet {
 /// At an interior vertex of valence 2 its two faces share both edges there, and a pattern
 /// that cuts the corner's cell along the chord between the first samples of those edges (the
 /// uniform grid does at corners 1 and 3) gives both faces the same triangle — covered twice.
-/// Such a patch is turned a quarter (its parameters, not its surface) so that the vertex is at
-/// corner 0 or 2, where the cells are cut through the corner.
+/// Every pattern is corrected for that where it happens (`pattern::cut_pinched_corners`, by
+/// flips); such a patch is also turned a quarter (its parameters, not its surface) so that the
+/// vertex is at corner 0 or 2, where the uniform grid already cuts the cells through the
+/// corner and needs no flip.
 fn turn_corners_off_valence_two(
     cage: &Cage,
     patches: &mut [Patch],
