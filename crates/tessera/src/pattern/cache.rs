@@ -28,8 +28,8 @@ struct Key {
     segments: [u32; 4],
     interior: [u32; 2],
     factors: [u64; 4],
-    /// Domain (bit 4) and collapsed edges (bits 0–3).
-    flags: u8,
+    /// Collapsed edges (bits 0–3), domain (bit 4) and pinched corners (bits 8–11).
+    flags: u16,
 }
 
 /// A hash of the bits of `input` a pattern may read (not the patch), for tables keyed by
@@ -41,12 +41,14 @@ pub(crate) fn input_hash(input: &PatternInput) -> u64 {
 
 impl Key {
     fn of(input: &PatternInput) -> Key {
-        let collapsed = input.collapsed.iter().enumerate().fold(0u8, |m, (e, &c)| m | (u8::from(c) << e));
+        let bits = |set: &[bool; 4]| set.iter().enumerate().fold(0u16, |m, (e, &c)| m | (u16::from(c) << e));
         Key {
             segments: input.segments,
             interior: input.interior,
             factors: input.factors.map(f64::to_bits),
-            flags: collapsed | (u8::from(input.domain == crate::domain::Domain::Quad) << 4),
+            flags: bits(&input.collapsed)
+                | (u16::from(input.domain == crate::domain::Domain::Quad) << 4)
+                | (bits(&input.pinched) << 8),
         }
     }
 }
@@ -320,5 +322,29 @@ pub(crate) fn with_recent_patterns<R>(f: impl FnOnce(&mut RecentPatterns) -> R) 
 impl std::fmt::Debug for PatternCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PatternCache").field("distinct", &self.inputs.len()).finish_non_exhaustive()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Domain;
+    use crate::pattern::uniform::Uniform;
+
+    /// A pinched corner changes the triangulation ([`crate::pattern::cut_pinched_corners`]),
+    /// so an input that differs from another only there is built apart, not shared.
+    #[test]
+    fn inputs_that_differ_only_in_pinched_corners_are_built_apart() {
+        let plain = PatternInput::new(Domain::Quad, [2; 4], [2, 2]);
+        let pinched = PatternInput { pinched: [false, true, false, false], ..plain };
+        let mut cache = PatternCache::default();
+        cache.fill_inputs(&Uniform, 2, |i| Some(if i == 0 { plain } else { pinched }), false);
+        let (a, b) = (cache.get(0).unwrap(), cache.get(1).unwrap());
+        assert_eq!(*a.0, plain);
+        assert_eq!(*b.0, pinched);
+        assert_ne!(a.1.triangles, b.1.triangles, "the pinched corner was not cut");
+        let mut recent = RecentPatterns::default();
+        let plain_triangles = recent.get(7, &Uniform, &plain, false).local.triangles.clone();
+        assert_ne!(recent.get(7, &Uniform, &pinched, false).local.triangles, plain_triangles);
     }
 }
