@@ -697,30 +697,35 @@ pub fn approximation_error(mesh: &Mesh, set: &SurfaceSet, order: u32) -> Result<
             bary.push(DVec3::new(i as f64, j as f64, k as f64) / order as f64);
         }
     }
-    let (max, max_triangle, sum2) = (0..mesh.triangle_count())
+    // Fixed blocks summed in order: rayon's own reduction splits by work stealing, so the
+    // floating-point sum (and the RMS) would change in its last bits from run to run.
+    const BLOCK: usize = 1024;
+    let blocks: Vec<(f64, usize, f64)> = (0..mesh.triangle_count().div_ceil(BLOCK))
         .into_par_iter()
-        .map(|t| {
-            let patch = &set.patches[mesh.triangle_patch[t] as usize];
-            let x = mesh.triangle(t).map(|i| Vec3::from(mesh.positions[i as usize]).as_dvec3());
-            let uv = [0, 1, 2].map(|c| DVec2::from(params[3 * t + c].map(f64::from)));
-            let mut worst = 0.0f64;
+        .map(|block| {
+            let mut worst = (0.0f64, block * BLOCK);
             let mut sum2 = 0.0;
-            for b in &bary {
-                let linear = x[0] * b.x + x[1] * b.y + x[2] * b.z;
-                let q = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
-                let d = linear.distance(patch.position(q));
-                worst = worst.max(d);
-                sum2 += d * d;
+            for t in block * BLOCK..((block + 1) * BLOCK).min(mesh.triangle_count()) {
+                let patch = &set.patches[mesh.triangle_patch[t] as usize];
+                let x = mesh.triangle(t).map(|i| Vec3::from(mesh.positions[i as usize]).as_dvec3());
+                let uv = [0, 1, 2].map(|c| DVec2::from(params[3 * t + c].map(f64::from)));
+                for b in &bary {
+                    let linear = x[0] * b.x + x[1] * b.y + x[2] * b.z;
+                    let q = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+                    let d = linear.distance(patch.position(q));
+                    if d > worst.0 {
+                        worst = (d, t);
+                    }
+                    sum2 += d * d;
+                }
             }
-            (worst, t, sum2)
+            (worst.0, worst.1, sum2)
         })
-        .reduce(
-            || (0.0, 0, 0.0),
-            |a, b| {
-                let (m, t) = if b.0 > a.0 { (b.0, b.1) } else { (a.0, a.1) };
-                (m, t, a.2 + b.2)
-            },
-        );
+        .collect();
+    let (max, max_triangle, sum2) = blocks.into_iter().fold((0.0, 0, 0.0), |a, b| {
+        let (m, t) = if b.0 > a.0 { (b.0, b.1) } else { (a.0, a.1) };
+        (m, t, a.2 + b.2)
+    });
     let samples = bary.len() * mesh.triangle_count();
     Ok(ErrorReport {
         max,
@@ -1000,6 +1005,36 @@ mod tests {
         assert!(w.collapsed_triangles == 32 && w.boundary_edges == 64, "the README's counts: {w:?}");
         let w = watertight(&crate::io::read_mesh(&data("awkward/elephant_with_holes.obj")).unwrap());
         assert!(w.boundary_edges > 0, "{w:?}");
+    }
+
+    /// The measured error is the same number, to the last bit, whatever the thread count and
+    /// however rayon splits the work (the CLI and the Python package compare it exactly).
+    #[test]
+    fn approximation_error_does_not_depend_on_the_threads() {
+        use crate::criterion::Plan;
+        use crate::engine::{tessellate, EngineOptions};
+        use crate::io::patches::read_patches;
+        use crate::pattern::uniform::Uniform;
+        use crate::test_support::data;
+        let patches = read_patches(&data("patches/teacup.patches")).unwrap();
+        let set = SurfaceSet::from_patch_file(&patches, Default::default());
+        let plan = Plan::uniform(&set, 24).unwrap();
+        let options = EngineOptions { corner_params: true, ..Default::default() };
+        let mesh = tessellate(&set, &plan, &Uniform, options).unwrap();
+        assert!(mesh.triangle_count() > 4 * 1024, "several blocks: {}", mesh.triangle_count());
+        let measure = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| approximation_error(&mesh, &set, 5).unwrap())
+        };
+        let one = measure(1);
+        for threads in [2, 3, 7] {
+            let other = measure(threads);
+            assert_eq!(
+                (one.max.to_bits(), one.rms.to_bits(), one.max_triangle),
+                (other.max.to_bits(), other.rms.to_bits(), other.max_triangle),
+                "{threads} threads"
+            );
+        }
     }
 
     /// A tessellation large enough for several chunks and parts (262,144 triangles), whole
