@@ -16,6 +16,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use tessera::camera::Camera;
 use tessera::criterion::view::{Mapping, ViewCriterion};
+use tessera::criterion::Prepared;
 use tessera::engine::{tessellate, EngineOptions};
 use tessera::io::{LoadOptions, SurfaceKind};
 use tessera::pattern::hardware::Partitioning;
@@ -118,13 +119,16 @@ fn watertight_through_every_scheme(fast: bool) {
             TestRng::deterministic_rng(RngAlgorithm::ChaCha),
         );
         let case = std::cell::Cell::new(0usize);
+        // Prepared once per cage, as a frame loop does: the bounds do not depend on the camera.
+        let prepared = Prepared::new(&set, true);
         runner
             .run(&(common::random_camera(&set), any::<bool>()), |((camera, _), cull)| {
                 let k = case.get();
                 case.set(k + 1);
                 let (scheme, criterion) = scheme_case(k, diagonal);
                 let options = PlanOptions { camera: Some(camera), cull, ..PlanOptions::default() };
-                let SchemePlan { plan, pattern, .. } = scheme.plan(&set, &criterion, &options).unwrap();
+                let SchemePlan { plan, pattern, .. } =
+                    scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
                 let mesh = tessellate(&set, &plan, &pattern, EngineOptions::default()).unwrap();
                 // Interior vertices of valence 2 (catmark_val2_interior) included: the two
                 // faces there share both edges at the vertex, and every pattern cuts the
@@ -174,6 +178,7 @@ fn tolerance_bounds_hold(fast: bool) {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         let set = load_cage(&path);
         let (lo, hi) = set.bounds();
+        let prepared = Prepared::new(&set, true);
         for share in [1e-2, 1e-3, 1e-4] {
             let eps = share * lo.distance(hi);
             let scheme = if share < 1e-3 {
@@ -185,7 +190,7 @@ fn tolerance_bounds_hold(fast: bool) {
             // isolated to level 6 are sharp: 0.01 % needs more than the default cap of 64.
             let options = PlanOptions { max_factor: 1024, ..PlanOptions::default() };
             let SchemePlan { plan, pattern, report } =
-                scheme.plan(&set, &Criterion::Tolerance(eps), &options).unwrap();
+                scheme.plan_prepared(&set, &prepared, &Criterion::Tolerance(eps), &options).unwrap();
             let report = report.expect("a tolerance plan reports its bounds");
             assert_eq!(report.capped_patches, 0, "{name}");
             assert!(report.worst_bound <= eps * (1.0 + 1e-9), "{name}");

@@ -89,15 +89,13 @@ impl Prepared {
     /// bound per patch with `with_bounds`.
     pub fn new(set: &SurfaceSet, with_bounds: bool) -> Prepared {
         use rayon::prelude::*;
+        let hessians: Vec<bounds::HessianBound> =
+            if with_bounds { set.patches.par_iter().map(bounds::hessian).collect() } else { Vec::new() };
         Prepared {
             minimum_segments: tolerance::minimum_segments(set),
             minimum_interior: tolerance::minimum_interior(set),
-            hessians: if with_bounds {
-                set.patches.par_iter().map(bounds::hessian).collect()
-            } else {
-                Vec::new()
-            },
-            curves: if with_bounds { tolerance::curve_bounds(set) } else { Vec::new() },
+            curves: if with_bounds { tolerance::curve_bounds(set, &hessians) } else { Vec::new() },
+            hessians,
             views: Default::default(),
             triangle_errors: Default::default(),
             vertex_data: Default::default(),

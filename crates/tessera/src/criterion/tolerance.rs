@@ -327,7 +327,7 @@ pub(crate) fn plan_limited(
     let curves: &[[f64; 4]] = if prepared.curves.len() == patches {
         &prepared.curves
     } else {
-        computed_curves = curve_bounds(set);
+        computed_curves = curve_bounds(set, hessians);
         &computed_curves
     };
     let mut report = BoundReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
@@ -445,25 +445,23 @@ pub(crate) fn plan_limited(
 
 /// The boundary curves' second-derivative bounds per patch and local edge
 /// ([`bounds::curve_second_derivative`]), view-independent: a curve needs `sqrt(M / 8ε)` segments on its own.
+/// `hessians` are the patches' own bounds ([`bounds::hessian`], one per patch): a piecewise
+/// boundary (a subdivision patch's) is bounded by them, computed once rather than per edge.
 /// Cost: O(P).
-pub fn curve_bounds(set: &SurfaceSet) -> Vec<[f64; 4]> {
+pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]> {
+    debug_assert_eq!(hessians.len(), set.patches.len());
     set.patches
         .par_iter()
-        .map(|patch| {
+        .zip(hessians)
+        .map(|(patch, h)| {
             let mut out = [0.0; 4];
             for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
                 *o = match edge_control_points(patch, l) {
                     Some((points, weights)) => bounds::curve_second_derivative(points, weights),
                     // A piecewise boundary: the patch's own bound along the edge's direction
                     // bounds the curve's second derivative (edges 0 and 2 run along u).
-                    None => {
-                        let h = bounds::hessian(patch);
-                        if l % 2 == 0 {
-                            h.uu
-                        } else {
-                            h.vv
-                        }
-                    }
+                    None if l % 2 == 0 => h.uu,
+                    None => h.vv,
                 };
             }
             out
