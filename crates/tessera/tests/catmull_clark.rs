@@ -365,3 +365,62 @@ fn random_cages_build_and_are_watertight() {
         assert!(mesh.positions.iter().all(|p| p.iter().all(|c| c.is_finite())), "case {case}");
     }
 }
+
+/// The cages' stencils (`CageStencils`): moved vertices give the surface of the moved cage
+/// built from scratch, patch by patch, to rounding, and the tessellation of the stencils'
+/// set is watertight as the rebuilt one is.
+#[test]
+fn stencils_give_moved_cages_their_surface() {
+    stencils_give_moved_cages(true);
+}
+
+#[test]
+#[ignore = "slow tier (every cage; probing the rook's creases takes seconds): scripts/test runs it"]
+fn stencils_give_every_moved_cage_its_surface() {
+    stencils_give_moved_cages(false);
+}
+
+fn stencils_give_moved_cages(fast: bool) {
+    use tessera::subdivision::{CageOptions, CageStencils};
+    use tessera::surface::Orientation;
+    for path in cages(fast) {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mesh = tessera::io::obj::read_obj(&path).unwrap();
+        let start = std::time::Instant::now();
+        let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+        println!("{name}: stencils in {:.3} s", start.elapsed().as_secs_f64());
+        let (lo, hi) = set.bounds();
+        let diagonal = lo.distance(hi);
+        // The orientation is decided once, for the cage as given; the rebuild is told it.
+        let same = CageOptions {
+            orientation: Orientation::AsGiven,
+            flip: set.repairs.flipped,
+            ..Default::default()
+        };
+        // A smooth twist about z plus a seeded jitter: every vertex moves.
+        let unit =
+            |k: u64| (k.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let mut moved = mesh.clone();
+        for (i, p) in moved.positions.iter_mut().enumerate() {
+            let (s, c) = (0.3 * p.z / diagonal).sin_cos();
+            let k = 3 * i as u64 + 1;
+            let jitter = glam::DVec3::new(unit(k), unit(k + 1), unit(k + 2));
+            *p = glam::DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z) + jitter * 0.02 * diagonal;
+        }
+        stencils.apply(&moved.positions, &mut set).unwrap();
+        let rebuilt = SurfaceSet::from_subdivision_cage(&moved, &path, same).unwrap();
+        assert_eq!(set.patches.len(), rebuilt.patches.len(), "{name}");
+        let mut worst = 0.0f64;
+        for (a, b) in set.patches.iter().zip(&rebuilt.patches) {
+            for k in 0..25 {
+                let uv = glam::DVec2::new((k % 5) as f64 / 4.0, (k / 5) as f64 / 4.0);
+                worst = worst.max(a.position(uv).distance(b.position(uv)));
+            }
+        }
+        assert!(worst <= 1e-12 * diagonal, "{name}: {worst:e}");
+        let plan = tessera::criterion::Plan::uniform(&set, 3).unwrap();
+        let mesh =
+            tessellate(&set, &plan, &tessera::pattern::uniform::Uniform, EngineOptions::default()).unwrap();
+        common::expect_topology(&set, &plan, &mesh, &name);
+    }
+}

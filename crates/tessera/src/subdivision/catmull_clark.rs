@@ -35,13 +35,42 @@ pub struct CageOptions {
 
 /// One face's surface before it becomes patches.
 #[derive(Default)]
-enum Built {
+pub(super) enum Built {
     #[default]
     Hole,
-    /// A regular face's Bézier net.
-    Regular(Box<[DVec3; 16]>),
+    /// A regular face's Bézier net: the whole face's, or its four quarters' (in
+    /// [`super::QUADRANTS`] order) in a cage whose faces are split into sub-faces.
+    Regular(Vec<[DVec3; 16]>),
     /// The trees of a face's isolation (one per sub-face of a face that is not a quad).
     Isolated(Vec<super::isolation::PatchTree>),
+}
+
+impl Built {
+    /// Face `f` of `cage` built: a hole, a regular face's net (its quarters when `split`),
+    /// or the isolation of any other face. The one rule for a face's surface, shared by
+    /// [`SurfaceSet::from_subdivision_cage`] and the stencils ([`super::stencils`]), which
+    /// rely on it being linear in `cage.points`. Cost: O(1) for a regular face, a local
+    /// refinement per level of isolation otherwise.
+    pub(super) fn face(cage: &Cage, f: usize, split: bool, isolation: IsolationLevels) -> Built {
+        if cage.holes[f] {
+            Built::Hole
+        } else if cage.face(f).len() == 4 && cage.is_regular_face(f) {
+            let net = to_bezier(&regular_face_grid(cage, f));
+            Built::Regular(if split { (0..4).map(|q| bezier_quadrant(&net, q)).collect() } else { vec![net] })
+        } else {
+            Built::Isolated(isolate(cage, f, isolation))
+        }
+    }
+
+    /// Appends the face's control points to `out`: the nets' in order, or every tree's
+    /// leaves' points (16 for a Bézier leaf, 20 for a Gregory one) in leaf order.
+    pub(super) fn points(&self, out: &mut Vec<DVec3>) {
+        match self {
+            Built::Hole => {}
+            Built::Regular(nets) => nets.iter().for_each(|n| out.extend_from_slice(n)),
+            Built::Isolated(trees) => trees.iter().for_each(|t| t.leaf_points(out)),
+        }
+    }
 }
 
 /// Keys for the topology: cage vertices keep their index; every curve between two keyed
@@ -147,114 +176,116 @@ impl SurfaceSet {
         file: &Path,
         options: CageOptions,
     ) -> Result<SurfaceSet> {
-        let mut repairs = Repairs::default();
-        let reverse =
-            (options.orientation == Orientation::Outward && signed_volume(mesh) < 0.0) != options.flip;
-        let reversed;
-        let mesh = if reverse {
-            repairs.flipped = true;
-            let mut m = mesh.clone();
-            for f in &mut m.faces {
-                f.positions[1..].reverse();
-            }
-            reversed = m;
-            &reversed
-        } else {
-            mesh
-        };
-        let cage = Cage::new(mesh, file)?;
-        let split = (0..cage.face_count()).any(|f| cage.face(f).len() != 4);
-        let (vertices, edges) = (cage.points.len() as u32, cage.edge_count() as u32);
-        let mid = |e: u32| vertices + e;
-        let centre = |f: usize| vertices + edges + f as u32;
-        let mut keys = Keys::new(vertices as usize + edges as usize + cage.face_count());
-        let mut patches = Vec::new();
-        let mut patch_keys = Vec::new();
-        let mut origins = Vec::new();
-        let mut push = |patch: Patch, corners: [u32; 4], origin: PatchOrigin| {
-            let mut k = PatchKeys { domain: Domain::Quad, corners, edges: [[0; 4]; 4], normals: [0; 4] };
-            for i in 0..4 {
-                k.edges[i] = keys.curve(corners[i], corners[(i + 1) % 4]);
-            }
-            patches.push(patch);
-            patch_keys.push(k);
-            origins.push(origin);
-        };
-        // Each face's surface on its own (in parallel: isolation is most of the work), then the
-        // patches and their keys in face order.
-        let mut built: Vec<Built> = (0..cage.face_count())
+        let (cage, repairs) = oriented_cage(mesh, file, options)?;
+        let split = is_split(&cage);
+        // Each face's surface on its own (in parallel: isolation is most of the work).
+        let built: Vec<Built> = (0..cage.face_count())
             .into_par_iter()
-            .map(|f| {
-                if cage.holes[f] {
-                    Built::Hole
-                } else if cage.face(f).len() == 4 && cage.is_regular_face(f) {
-                    Built::Regular(Box::new(to_bezier(&regular_face_grid(&cage, f))))
-                } else {
-                    Built::Isolated(isolate(&cage, f, options.isolation))
-                }
-            })
+            .map(|f| Built::face(&cage, f, split, options.isolation))
             .collect();
-        for (f, face) in built.iter_mut().enumerate() {
-            let c = cage.face(f);
-            let n = c.len();
-            let e = cage.face_edges(f);
-            let origin = |subface: usize| PatchOrigin {
-                face: f as u32,
-                subface: subface as u16,
-                corners: n as u16,
-                is_subface: split,
-                rotation: 0,
-            };
-            // A quad's quarters, corners listed from the one at the quarter's (0,0).
-            let quarter = |q: usize| match q {
-                0 => [c[0], mid(e[0]), centre(f), mid(e[3])],
-                1 => [mid(e[0]), c[1], mid(e[1]), centre(f)],
-                2 => [centre(f), mid(e[1]), c[2], mid(e[2])],
-                _ => [mid(e[3]), centre(f), mid(e[2]), c[3]],
-            };
-            let trees = match std::mem::take(face) {
-                Built::Regular(bezier) => {
-                    if split {
-                        for q in 0..4 {
-                            let piece = RationalBicubic::polynomial(bezier_quadrant(&bezier, q));
-                            push(Patch::Bicubic(piece), quarter(q), origin(q));
-                        }
-                    } else {
-                        push(
-                            Patch::Bicubic(RationalBicubic::polynomial(*bezier)),
-                            [c[0], c[1], c[2], c[3]],
-                            origin(0),
-                        );
-                    }
-                    continue;
+        assemble(&cage, built, repairs, file)
+    }
+}
+
+/// The cage of `mesh` with the faces oriented as `options` ask (reported in the repairs).
+/// Errors as [`Cage::new`]. Cost: O(corners).
+pub(super) fn oriented_cage(
+    mesh: &PolygonMesh,
+    file: &Path,
+    options: CageOptions,
+) -> Result<(Cage, Repairs)> {
+    let mut repairs = Repairs::default();
+    let reverse = (options.orientation == Orientation::Outward && signed_volume(mesh) < 0.0) != options.flip;
+    if !reverse {
+        return Ok((Cage::new(mesh, file)?, repairs));
+    }
+    repairs.flipped = true;
+    let mut m = mesh.clone();
+    for f in &mut m.faces {
+        f.positions[1..].reverse();
+    }
+    Ok((Cage::new(&m, file)?, repairs))
+}
+
+/// Whether the cage's faces become corner sub-faces (any face is not a quad): then every
+/// face, quads too, is split so that neighbours' edges halve alike.
+pub(super) fn is_split(cage: &Cage) -> bool {
+    (0..cage.face_count()).any(|f| cage.face(f).len() != 4)
+}
+
+/// The set of `cage`'s faces, `built` by [`Built::face`]: the patches and their keys in face
+/// order. Errors: [`Error::Unsupported`] when every face is a hole. Cost: O(P).
+pub(super) fn assemble(
+    cage: &Cage,
+    mut built: Vec<Built>,
+    repairs: Repairs,
+    file: &Path,
+) -> Result<SurfaceSet> {
+    let split = is_split(cage);
+    let (vertices, edges) = (cage.points.len() as u32, cage.edge_count() as u32);
+    let mid = |e: u32| vertices + e;
+    let centre = |f: usize| vertices + edges + f as u32;
+    let mut keys = Keys::new(vertices as usize + edges as usize + cage.face_count());
+    let mut patches = Vec::new();
+    let mut patch_keys = Vec::new();
+    let mut origins = Vec::new();
+    let mut push = |patch: Patch, corners: [u32; 4], origin: PatchOrigin| {
+        let mut k = PatchKeys { domain: Domain::Quad, corners, edges: [[0; 4]; 4], normals: [0; 4] };
+        for i in 0..4 {
+            k.edges[i] = keys.curve(corners[i], corners[(i + 1) % 4]);
+        }
+        patches.push(patch);
+        patch_keys.push(k);
+        origins.push(origin);
+    };
+    for (f, face) in built.iter_mut().enumerate() {
+        let c = cage.face(f);
+        let n = c.len();
+        let e = cage.face_edges(f);
+        let origin = |subface: usize| PatchOrigin {
+            face: f as u32,
+            subface: subface as u16,
+            corners: n as u16,
+            is_subface: split,
+            rotation: 0,
+        };
+        // A quad's quarters, corners listed from the one at the quarter's (0,0).
+        let quarter = |q: usize| match q {
+            0 => [c[0], mid(e[0]), centre(f), mid(e[3])],
+            1 => [mid(e[0]), c[1], mid(e[1]), centre(f)],
+            2 => [centre(f), mid(e[1]), c[2], mid(e[2])],
+            _ => [mid(e[3]), centre(f), mid(e[2]), c[3]],
+        };
+        let trees = match std::mem::take(face) {
+            Built::Regular(nets) => {
+                for (q, net) in nets.into_iter().enumerate() {
+                    let corners = if split { quarter(q) } else { [c[0], c[1], c[2], c[3]] };
+                    push(Patch::Bicubic(RationalBicubic::polynomial(net)), corners, origin(q));
                 }
-                Built::Isolated(trees) => trees,
-                Built::Hole => continue,
-            };
-            if n == 4 && split {
-                for q in 0..4 {
-                    push(Patch::Subdivision(Box::new(trees[0].quadrant(q))), quarter(q), origin(q));
-                }
-            } else if n == 4 {
-                push(Patch::Subdivision(Box::new(trees[0].clone())), [c[0], c[1], c[2], c[3]], origin(0));
-            } else {
-                for (i, tree) in trees.into_iter().enumerate() {
-                    let corners = [c[i], mid(e[i]), centre(f), mid(e[(i + n - 1) % n])];
-                    push(Patch::Subdivision(Box::new(tree)), corners, origin(i));
-                }
+                continue;
+            }
+            Built::Isolated(trees) => trees,
+            Built::Hole => continue,
+        };
+        if n == 4 && split {
+            for q in 0..4 {
+                push(Patch::Subdivision(Box::new(trees[0].quadrant(q))), quarter(q), origin(q));
+            }
+        } else if n == 4 {
+            push(Patch::Subdivision(Box::new(trees[0].clone())), [c[0], c[1], c[2], c[3]], origin(0));
+        } else {
+            for (i, tree) in trees.into_iter().enumerate() {
+                let corners = [c[i], mid(e[i]), centre(f), mid(e[(i + n - 1) % n])];
+                push(Patch::Subdivision(Box::new(tree)), corners, origin(i));
             }
         }
-        if patches.is_empty() {
-            return Err(Error::unsupported(
-                file,
-                0,
-                "no face of the cage has a limit surface (all are holes)",
-            ));
-        }
-        turn_corners_off_valence_two(&cage, &mut patches, &mut patch_keys, &mut origins);
-        let topology = Topology::build(&patch_keys);
-        Ok(SurfaceSet { patches, keys: patch_keys, topology, repairs, up: Default::default(), origins })
     }
+    if patches.is_empty() {
+        return Err(Error::unsupported(file, 0, "no face of the cage has a limit surface (all are holes)"));
+    }
+    turn_corners_off_valence_two(cage, &mut patches, &mut patch_keys, &mut origins);
+    let topology = Topology::build(&patch_keys);
+    Ok(SurfaceSet { patches, keys: patch_keys, topology, repairs, up: Default::default(), origins })
 }
 
 /// At an interior vertex of valence 2 its two faces share both edges there, and a pattern

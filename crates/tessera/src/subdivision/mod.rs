@@ -17,6 +17,7 @@ mod catmull_clark;
 pub mod gregory;
 pub mod isolation;
 pub mod sdc;
+pub mod stencils;
 
 pub use crate::surface::patch_tree::{PatchOrigin, QUADRANTS};
 /// A cage's tags and rules are input data, read with its faces into a
@@ -27,3 +28,4 @@ pub use crate::surface::subdivision_tags::{
 };
 pub use cage::Cage;
 pub use catmull_clark::CageOptions;
+pub use stencils::{CageStencils, SparseRows};

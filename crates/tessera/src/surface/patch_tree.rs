@@ -200,6 +200,61 @@ impl PatchTree {
         &self.data.leaves
     }
 
+    /// Appends the points of every leaf of the tree (of every view of it) to `out`, leaf by
+    /// leaf: a Bézier leaf's 16, a Gregory leaf's 20. Cost: O(leaves).
+    pub fn leaf_points(&self, out: &mut Vec<DVec3>) {
+        for leaf in &self.data.leaves {
+            match &leaf.patch {
+                LeafPatch::Bezier(p) => out.extend_from_slice(p),
+                LeafPatch::Gregory(g) => out.extend_from_slice(&g.points),
+            }
+        }
+    }
+
+    /// How many points [`PatchTree::leaf_points`] appends.
+    pub fn leaf_point_count(&self) -> usize {
+        self.data.leaves.iter().map(|l| if matches!(l.patch, LeafPatch::Bezier(_)) { 16 } else { 20 }).sum()
+    }
+
+    /// The same view (transposition, rotation, square) of a tree with the same nodes and
+    /// leaves whose points are `points`, in [`PatchTree::leaf_points`] order: the surface of
+    /// a moved cage. Precondition: `points.len()` is [`PatchTree::leaf_point_count`].
+    /// Cost: O(leaves).
+    pub fn with_leaf_points(&self, points: &[DVec3]) -> PatchTree {
+        assert_eq!(points.len(), self.leaf_point_count(), "one point per leaf point");
+        let mut next = points.iter().copied();
+        let mut take = || next.next().expect("counted above");
+        let leaves = self
+            .data
+            .leaves
+            .iter()
+            .map(|leaf| Leaf {
+                patch: match &leaf.patch {
+                    LeafPatch::Bezier(_) => LeafPatch::Bezier(std::array::from_fn(|_| take())),
+                    LeafPatch::Gregory(_) => {
+                        LeafPatch::Gregory(GregoryPatch { points: std::array::from_fn(|_| take()) })
+                    }
+                },
+                ..*leaf
+            })
+            .collect();
+        let data = TreeData { leaves, nodes: self.data.nodes.clone(), root: self.data.root };
+        self.with_data(std::sync::Arc::new(data))
+    }
+
+    /// This view of `other`'s tree (which has this one's structure, e.g. made by
+    /// [`PatchTree::with_leaf_points`] from another view of this tree): the quarters of a
+    /// moved face share one tree as the original quarters did. Cost: O(leaves).
+    pub fn with_tree_of(&self, other: &PatchTree) -> PatchTree {
+        self.with_data(other.data.clone())
+    }
+
+    fn with_data(&self, data: std::sync::Arc<TreeData>) -> PatchTree {
+        let mut tree = PatchTree { data, ..self.clone() };
+        tree.hull = tree.visible_hull();
+        tree
+    }
+
     /// The bounding box corners of the visible leaves' points.
     fn visible_hull(&self) -> [DVec3; 8] {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));

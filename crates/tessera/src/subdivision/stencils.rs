@@ -1,0 +1,447 @@
+//! Stencils of a Catmull-Clark cage: every control point of its patches as a fixed linear
+//! combination of the cage's vertices, so that an animated cage (same faces and tags, moving
+//! vertices) gets its patches back by a sparse matrix product instead of a rebuild.
+//!
+//! For fixed topology and tags, the surface a face builds ([`Built::face`]: a regular face's
+//! Bézier net, or the leaves of its isolation with their Gregory end caps) is linear in the
+//! cage's points: subdivision, the B-spline to Bézier change and the end caps are fixed
+//! weighted sums, and no choice depends on a position (the faces' orientation is decided once,
+//! when the stencils are made). So the weights are *probed*, not derived a second time: the
+//! face is built from a cage whose points are zero except a unit coordinate on up to three of
+//! its neighbourhood's vertices (x on one, y on the next, z on the third), and each output
+//! coordinate is then that vertex's weight. There is no second copy of any subdivision rule,
+//! and the weights are the rules' own.
+//!
+//! What a face reads is its neighbourhood: the vertices of the faces around its corners (the
+//! local mesh [`super::isolation`] refines). Probing costs about a third of the neighbourhood's
+//! size in face builds per face, once per topology.
+
+use std::path::Path;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::cage::Cage;
+use super::catmull_clark::{assemble, is_split, oriented_cage, Built};
+use super::isolation::PatchTree;
+use super::CageOptions;
+use crate::error::{Error, Result};
+use crate::surface::{Patch, PolygonMesh, RationalBicubic, SurfaceSet};
+
+/// Sparse rows: row `r`'s terms are `vertices[k]` with `weights[k]` for `k` in
+/// `starts[r]..starts[r + 1]`; `starts` has one more entry than there are rows.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SparseRows {
+    pub starts: Vec<u32>,
+    pub vertices: Vec<u32>,
+    pub weights: Vec<f64>,
+}
+
+impl SparseRows {
+    /// How many rows.
+    pub fn len(&self) -> usize {
+        self.starts.len().saturating_sub(1)
+    }
+
+    /// Whether there is no row.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Row `r` applied to `points`: `Σ weights[k] · points[vertices[k]]`. Precondition: every
+    /// vertex of the row indexes `points`. Cost: the row's length.
+    pub fn apply_row(&self, r: usize, points: &[DVec3]) -> DVec3 {
+        let range = self.starts[r] as usize..self.starts[r + 1] as usize;
+        self.vertices[range.clone()]
+            .iter()
+            .zip(&self.weights[range])
+            .fold(DVec3::ZERO, |sum, (&v, &w)| sum + points[v as usize] * w)
+    }
+
+    fn push_row(&mut self, terms: &[(u32, f64)]) {
+        if self.starts.is_empty() {
+            self.starts.push(0);
+        }
+        for &(v, w) in terms {
+            self.vertices.push(v);
+            self.weights.push(w);
+        }
+        self.starts.push(self.vertices.len() as u32);
+    }
+}
+
+/// What a face built, kept so that new points can be poured into the same structure.
+#[derive(Debug, Clone)]
+enum FaceShape {
+    Hole,
+    /// This many Bézier nets (1, or the 4 quarters of a split cage).
+    Regular(usize),
+    /// The isolation's trees (one per sub-face of a face that is not a quad).
+    Isolated(Vec<PatchTree>),
+}
+
+/// The stencils of a cage's [`SurfaceSet`] ([`CageStencils::build`]): one sparse row per
+/// control point of every face's surface, over the cage's vertices.
+#[derive(Debug, Clone)]
+pub struct CageStencils {
+    vertex_count: usize,
+    patch_count: usize,
+    shapes: Vec<FaceShape>,
+    /// Face `f`'s rows are `face_rows[f]..face_rows[f + 1]`, in [`Built::points`] order.
+    face_rows: Vec<u32>,
+    rows: SparseRows,
+}
+
+impl CageStencils {
+    /// The Catmull-Clark set of `mesh` ([`SurfaceSet::from_subdivision_cage`], the same set)
+    /// and its stencils.
+    ///
+    /// Errors as [`SurfaceSet::from_subdivision_cage`]. Cost: that of building the set, plus
+    /// about a third of each face's neighbourhood size in face builds; memory about 20
+    /// weights per control point of a regular face (16 × 16 for the whole net), more around
+    /// extraordinary vertices.
+    pub fn build(
+        mesh: &PolygonMesh,
+        file: &Path,
+        options: CageOptions,
+    ) -> Result<(SurfaceSet, CageStencils)> {
+        let (cage, repairs) = oriented_cage(mesh, file, options)?;
+        let split = is_split(&cage);
+        let faces = cage.face_count();
+        // Faces in chunks, each probing on its own zeroed copy of the cage.
+        let chunk = faces.div_ceil(4 * rayon::current_num_threads()).max(16);
+        let per_chunk: Vec<Vec<(Built, FaceRowsOut)>> = (0..faces)
+            .collect::<Vec<_>>()
+            .par_chunks(chunk)
+            .map(|fs| {
+                let mut probe = cage.clone();
+                probe.points.iter_mut().for_each(|p| *p = DVec3::ZERO);
+                fs.iter()
+                    .map(|&f| {
+                        let built = Built::face(&cage, f, split, options.isolation);
+                        let rows = probe_face(&cage, &mut probe, f, split, options);
+                        (built, rows)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut built = Vec::with_capacity(faces);
+        let mut shapes = Vec::with_capacity(faces);
+        let mut face_rows = vec![0u32];
+        let mut rows = SparseRows { starts: vec![0], ..Default::default() };
+        for (face, face_out) in per_chunk.into_iter().flatten() {
+            shapes.push(match &face {
+                Built::Hole => FaceShape::Hole,
+                Built::Regular(nets) => FaceShape::Regular(nets.len()),
+                Built::Isolated(trees) => FaceShape::Isolated(trees.clone()),
+            });
+            for terms in &face_out {
+                rows.push_row(terms);
+            }
+            face_rows.push(rows.len() as u32);
+            built.push(face);
+        }
+        let set = assemble(&cage, built, repairs, file)?;
+        let stencils = CageStencils {
+            vertex_count: cage.points.len(),
+            patch_count: set.patches.len(),
+            shapes,
+            face_rows,
+            rows,
+        };
+        Ok((set, stencils))
+    }
+
+    /// How many cage vertices the stencils read (the length of the positions
+    /// [`CageStencils::apply`] takes: the cage file's vertex count).
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// Every face's control points' rows, face after face in [`SurfaceSet::origins`]' face
+    /// order.
+    pub fn rows(&self) -> &SparseRows {
+        &self.rows
+    }
+
+    /// The set's patches for the cage vertices at `positions`: `set` (the set
+    /// [`CageStencils::build`] returned, or one this function updated) gets the surface of the
+    /// moved cage — the same patches, parameters, keys and topology, new control points.
+    /// Equal, to rounding, to building the moved cage from scratch.
+    ///
+    /// Errors: [`Error::InvalidParameter`] for positions of another count or not finite, or a
+    /// set that is not this cage's. Cost: O(stencil entries) multiply-adds, parallel, and a
+    /// new copy of every isolated face's leaves.
+    pub fn apply(&self, positions: &[DVec3], set: &mut SurfaceSet) -> Result<()> {
+        if positions.len() != self.vertex_count {
+            return Err(Error::InvalidParameter {
+                name: "positions",
+                reason: format!("{} positions for a cage of {} vertices", positions.len(), self.vertex_count),
+            });
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "positions",
+                reason: format!("vertex {} is at {} (not finite)", i + 1, positions[i]),
+            });
+        }
+        self.check_set(set)?;
+        let points: Vec<DVec3> =
+            (0..self.rows.len()).into_par_iter().map(|r| self.rows.apply_row(r, positions)).collect();
+        // The isolated faces' trees refilled once each; the patches are views of them.
+        let trees: Vec<Vec<PatchTree>> = self
+            .shapes
+            .par_iter()
+            .enumerate()
+            .map(|(f, shape)| match shape {
+                FaceShape::Isolated(trees) => {
+                    let mut at = self.face_rows[f] as usize;
+                    trees
+                        .iter()
+                        .map(|t| {
+                            let n = t.leaf_point_count();
+                            at += n;
+                            t.with_leaf_points(&points[at - n..at])
+                        })
+                        .collect()
+                }
+                _ => Vec::new(),
+            })
+            .collect();
+        set.patches.par_iter_mut().zip(&set.origins).for_each(|(patch, origin)| {
+            let f = origin.face as usize;
+            let piece = usize::from(origin.subface);
+            match patch {
+                Patch::Bicubic(b) => {
+                    let at = self.face_rows[f] as usize + 16 * piece;
+                    *b = RationalBicubic::polynomial(std::array::from_fn(|k| points[at + k]));
+                }
+                Patch::Subdivision(tree) => {
+                    let tree_index = if origin.corners == 4 { 0 } else { piece };
+                    **tree = tree.with_tree_of(&trees[f][tree_index]);
+                }
+                _ => unreachable!("checked by check_set"),
+            }
+        });
+        Ok(())
+    }
+
+    /// The rows of every patch's 16 control points in patch order (row `16 p + k` is point
+    /// `k` of patch `p`), for an engine that recomputes them itself, e.g. the GPU's.
+    ///
+    /// Errors: [`Error::InvalidParameter`] when `set` is not this cage's, or has a patch that
+    /// is not a bicubic (an isolated face's pieces are no single net). Cost: O(entries).
+    pub fn bicubic_rows(&self, set: &SurfaceSet) -> Result<SparseRows> {
+        self.check_set(set)?;
+        let mut out = SparseRows { starts: vec![0], ..Default::default() };
+        for (p, (patch, origin)) in set.patches.iter().zip(&set.origins).enumerate() {
+            if !matches!(patch, Patch::Bicubic(_)) {
+                return Err(Error::InvalidParameter {
+                    name: "set",
+                    reason: format!(
+                        "patch {p} (face {}) is an isolated face's pieces, not one bicubic net",
+                        origin.face + 1
+                    ),
+                });
+            }
+            let first = self.face_rows[origin.face as usize] as usize + 16 * usize::from(origin.subface);
+            for r in first..first + 16 {
+                let range = self.rows.starts[r] as usize..self.rows.starts[r + 1] as usize;
+                out.vertices.extend_from_slice(&self.rows.vertices[range.clone()]);
+                out.weights.extend_from_slice(&self.rows.weights[range]);
+                out.starts.push(out.vertices.len() as u32);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Whether `set` has the patches these stencils were made for: the count, and each
+    /// patch's kind and face as built.
+    fn check_set(&self, set: &SurfaceSet) -> Result<()> {
+        let mismatch = |reason: String| Err(Error::InvalidParameter { name: "set", reason });
+        if set.patches.len() != self.patch_count || set.origins.len() != self.patch_count {
+            return mismatch(format!(
+                "it has {} patches; the cage of these stencils has {}",
+                set.patches.len(),
+                self.patch_count
+            ));
+        }
+        for (p, (patch, origin)) in set.patches.iter().zip(&set.origins).enumerate() {
+            let fits = match (self.shapes.get(origin.face as usize), patch) {
+                (Some(FaceShape::Regular(nets)), Patch::Bicubic(_)) => usize::from(origin.subface) < *nets,
+                (Some(FaceShape::Isolated(trees)), Patch::Subdivision(_)) => {
+                    origin.corners == 4 || usize::from(origin.subface) < trees.len()
+                }
+                _ => false,
+            };
+            if !fits {
+                return mismatch(format!(
+                    "patch {p} is not what face {} of this cage built",
+                    origin.face + 1
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Rows of one face: per control point (in [`Built::points`] order), its `(vertex, weight)`
+/// terms.
+type FaceRowsOut = Vec<Vec<(u32, f64)>>;
+
+/// The vertices face `f`'s surface reads: those of the faces around its corners.
+fn neighbourhood_vertices(cage: &Cage, f: usize) -> Vec<u32> {
+    let mut vertices = Vec::new();
+    for &v in cage.face(f) {
+        for fc in cage.vertex_faces(v as usize) {
+            vertices.extend_from_slice(cage.face(fc.face as usize));
+        }
+    }
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}
+
+/// Probes face `f` on `probe` (a copy of `cage` whose points are all zero, left so).
+fn probe_face(cage: &Cage, probe: &mut Cage, f: usize, split: bool, options: CageOptions) -> FaceRowsOut {
+    if cage.holes[f] {
+        return Vec::new();
+    }
+    let mut rows: FaceRowsOut = Vec::new();
+    let mut points = Vec::new();
+    for chunk in neighbourhood_vertices(cage, f).chunks(3) {
+        for (c, &v) in chunk.iter().enumerate() {
+            probe.points[v as usize][c] = 1.0;
+        }
+        points.clear();
+        Built::face(probe, f, split, options.isolation).points(&mut points);
+        rows.resize_with(points.len(), Vec::new);
+        for (row, p) in rows.iter_mut().zip(&points) {
+            for (c, &v) in chunk.iter().enumerate() {
+                if p[c] != 0.0 {
+                    row.push((v, p[c]));
+                }
+            }
+        }
+        for &v in chunk {
+            probe.points[v as usize] = DVec3::ZERO;
+        }
+    }
+    rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::obj::read_obj;
+    use crate::test_support::{data, Lcg};
+
+    /// The largest distance between two sets' control points, patch by patch (evaluated
+    /// on a grid: trees have no single net).
+    fn largest_difference(a: &SurfaceSet, b: &SurfaceSet) -> f64 {
+        assert_eq!(a.patches.len(), b.patches.len());
+        let mut worst = 0.0f64;
+        for (p, q) in a.patches.iter().zip(&b.patches) {
+            for i in 0..=4 {
+                for j in 0..=4 {
+                    let uv = glam::DVec2::new(i as f64 / 4.0, j as f64 / 4.0);
+                    worst = worst.max(p.position(uv).distance(q.position(uv)));
+                }
+            }
+        }
+        worst
+    }
+
+    fn moved(points: &[DVec3], seed: u64, amount: f64) -> Vec<DVec3> {
+        let mut rng = Lcg(seed);
+        points
+            .iter()
+            .map(|p| *p + DVec3::new(rng.unit53() - 0.5, rng.unit53() - 0.5, rng.unit53() - 0.5) * amount)
+            .collect()
+    }
+
+    /// Applying the stencils to moved vertices gives the set built from the moved cage, on
+    /// cages with every feature the stencils must carry: extraordinary vertices, n-gons
+    /// (split faces), creases, corners, boundaries, holes.
+    #[test]
+    fn stencils_give_the_moved_cage_surface() {
+        for name in [
+            "catmark_cube.obj",
+            "catmark_torus_creases0.obj",
+            "catmark_pole8.obj",
+            "catmark_hole_test1.obj",
+            "catmark_edgecorner.obj",
+            "catmark_val2_interior.obj",
+            "catmark_nonquads.obj",
+        ] {
+            let path = data(&format!("subdivision/{name}"));
+            let mesh = read_obj(&path).unwrap();
+            let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+            let built = SurfaceSet::from_subdivision_cage(&mesh, &path, CageOptions::default()).unwrap();
+            let (lo, hi) = built.bounds();
+            let diagonal = lo.distance(hi);
+            assert_eq!(largest_difference(&set, &built), 0.0, "{name}: the same set");
+            // The original positions through the stencils: the same surface to rounding.
+            let mut again = set.clone();
+            stencils.apply(&mesh.positions, &mut again).unwrap();
+            assert!(largest_difference(&again, &built) < 1e-12 * diagonal, "{name}: identity");
+            // The orientation is decided once, for the cage as given; a rebuild of the moved
+            // cage is told the same.
+            let same = CageOptions {
+                orientation: crate::surface::Orientation::AsGiven,
+                flip: built.repairs.flipped,
+                ..CageOptions::default()
+            };
+            for seed in 1..=2 {
+                let mut moved_mesh = mesh.clone();
+                moved_mesh.positions = moved(&mesh.positions, seed, 0.2 * diagonal);
+                let rebuilt = SurfaceSet::from_subdivision_cage(&moved_mesh, &path, same).unwrap();
+                stencils.apply(&moved_mesh.positions, &mut set).unwrap();
+                let d = largest_difference(&set, &rebuilt);
+                assert!(d < 1e-12 * diagonal, "{name} seed {seed}: {d:e}");
+                assert_eq!(set.keys, rebuilt.keys, "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_positions_and_other_sets_are_refused() {
+        let path = data("subdivision/catmark_cube.obj");
+        let mesh = read_obj(&path).unwrap();
+        let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+        let short = stencils.apply(&mesh.positions[1..], &mut set).unwrap_err();
+        assert!(short.to_string().contains("7 positions for a cage of 8 vertices"), "{short}");
+        let mut nan = mesh.positions.clone();
+        nan[3].y = f64::NAN;
+        let e = stencils.apply(&nan, &mut set).unwrap_err();
+        assert!(e.to_string().contains("vertex 4") && e.to_string().contains("not finite"), "{e}");
+        let other = data("subdivision/catmark_torus.obj");
+        let mut torus =
+            SurfaceSet::from_subdivision_cage(&read_obj(&other).unwrap(), &other, CageOptions::default())
+                .unwrap();
+        let e = stencils.apply(&mesh.positions, &mut torus).unwrap_err();
+        assert!(e.to_string().contains("patches"), "{e}");
+        // The cube's faces are all isolated: no bicubic rows.
+        let e = stencils.bicubic_rows(&set).unwrap_err();
+        assert!(e.to_string().contains("not one bicubic net"), "{e}");
+    }
+
+    /// A regular cage's bicubic rows reproduce its control points.
+    #[test]
+    fn bicubic_rows_give_the_control_points() {
+        let path = data("subdivision/catmark_torus.obj");
+        let mesh = read_obj(&path).unwrap();
+        let (set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+        let rows = stencils.bicubic_rows(&set).unwrap();
+        assert_eq!(rows.len(), 16 * set.patches.len());
+        for (p, patch) in set.patches.iter().enumerate() {
+            let Patch::Bicubic(b) = patch else { panic!("the torus is regular") };
+            for k in 0..16 {
+                let d = rows.apply_row(16 * p + k, &mesh.positions).distance(b.points[k]);
+                assert!(d < 1e-12, "patch {p} point {k}: {d:e}");
+            }
+        }
+        // B-spline stencils: 16 terms at most per point of a regular net.
+        assert!((0..rows.len()).all(|r| rows.starts[r + 1] - rows.starts[r] <= 16));
+    }
+}
