@@ -38,7 +38,6 @@ struct Params {
 @group(0) @binding(11) var<storage, read_write> vertices: array<f32>;
 @group(0) @binding(12) var<storage, read_write> indices: array<u32>;
 
-const WORKGROUP: u32 = {{WORKGROUP}}u;
 const PATCH_ROW: u32 = {{PATCH_ROW}}u;
 const EDGE_ROW: u32 = {{EDGE_ROW}}u;
 const USE_ROW: u32 = {{USE_ROW}}u;
@@ -59,10 +58,7 @@ fn dispatch_grid(threads: u32) -> vec2<u32> {
     return vec2<u32>(groups, 1u);
 }
 
-// The invocation's index in a dispatch laid out by `shader::grid` (2D past 65,535 groups).
-fn thread_index(wid: vec3<u32>, nwg: vec3<u32>, lid: u32) -> u32 {
-    return (wid.y * nwg.x + wid.x) * WORKGROUP + lid;
-}
+// `thread_index` is in threads.wgsl, which `shader::sources::COMMON` puts before this file.
 
 // Patch rows.
 fn patch_edge(p: u32, e: u32) -> u32 { return patch_rows[p * PATCH_ROW + e]; }

@@ -45,9 +45,11 @@ pub mod error;
 pub mod readback;
 pub mod scan;
 pub mod shader;
+pub mod stencils;
 pub mod tessellator;
 pub mod upload;
 
 pub use context::{GpuContext, SOFTWARE_DRIVER_PACKAGES};
 pub use error::{GpuError, Result};
+pub use stencils::GpuStencils;
 pub use tessellator::{GpuTessellator, ScreenReport, VERTEX_LAYOUT};

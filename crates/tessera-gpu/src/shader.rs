@@ -12,7 +12,12 @@ pub const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
 /// own; the patch evaluations are public so that other crates' shaders evaluate patches by
 /// the same rule instead of a copy ([`evaluation_wgsl`]).
 pub mod sources {
-    pub(crate) const COMMON: &str = include_str!("../shaders/common.wgsl");
+    /// `threads.wgsl`: `thread_index`, the invocation numbering of [`super::grid`]'s dispatches.
+    pub(crate) const THREADS: &str = include_str!("../shaders/threads.wgsl");
+    /// `common.wgsl` after [`THREADS`]: the engine's bindings, constants and row accessors.
+    pub(crate) const COMMON: &str =
+        concat!(include_str!("../shaders/threads.wgsl"), include_str!("../shaders/common.wgsl"));
+    pub(crate) const STENCILS: &str = include_str!("../shaders/stencils.wgsl");
     /// `bicubic.wgsl`: `bicubic_eval(p, uv)`, patch `p`'s position and normal as
     /// `tessera::surface::RationalBicubic::eval` computes them, from the `control_points`
     /// rows ([`crate::upload`]).

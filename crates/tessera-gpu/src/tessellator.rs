@@ -360,6 +360,12 @@ impl GpuTessellator {
         Ok(())
     }
 
+    /// The control points the frame reads ([`crate::upload`]'s layout): what a pass that
+    /// moves the surface ([`crate::GpuStencils`]) writes.
+    pub(crate) fn control_points(&self) -> &wgpu::Buffer {
+        &self.set.control_points
+    }
+
     /// Reads the plan the last frame drew back from the device: the uploaded one, or the
     /// GPU's own after [`GpuTessellator::prepare_screen`] (segments, interior factors and
     /// visibility; for the hardware patterns the real factors and the

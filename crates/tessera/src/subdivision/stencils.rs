@@ -2,7 +2,7 @@
 //! combination of the cage's vertices, so that an animated cage (same faces and tags, moving
 //! vertices) gets its patches back by a sparse matrix product instead of a rebuild.
 //!
-//! For fixed topology and tags, the surface a face builds ([`Built::face`]: a regular face's
+//! For fixed topology and tags, the surface a face builds (`Built::face`: a regular face's
 //! Bézier net, or the leaves of its isolation with their Gregory end caps) is linear in the
 //! cage's points: subdivision, the B-spline to Bézier change and the end caps are fixed
 //! weighted sums, and no choice depends on a position (the faces' orientation is decided once,
@@ -32,8 +32,11 @@ use crate::surface::{Patch, PolygonMesh, RationalBicubic, SurfaceSet};
 /// `starts[r]..starts[r + 1]`; `starts` has one more entry than there are rows.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SparseRows {
+    /// Each row's first term, then the end of the last row.
     pub starts: Vec<u32>,
+    /// Each term's cage vertex (0-based, the cage file's order).
     pub vertices: Vec<u32>,
+    /// Each term's weight.
     pub weights: Vec<f64>,
 }
 
@@ -87,7 +90,7 @@ pub struct CageStencils {
     vertex_count: usize,
     patch_count: usize,
     shapes: Vec<FaceShape>,
-    /// Face `f`'s rows are `face_rows[f]..face_rows[f + 1]`, in [`Built::points`] order.
+    /// Face `f`'s rows are `face_rows[f]..face_rows[f + 1]`, in `Built::points` order.
     face_rows: Vec<u32>,
     rows: SparseRows,
 }
@@ -173,18 +176,7 @@ impl CageStencils {
     /// set that is not this cage's. Cost: O(stencil entries) multiply-adds, parallel, and a
     /// new copy of every isolated face's leaves.
     pub fn apply(&self, positions: &[DVec3], set: &mut SurfaceSet) -> Result<()> {
-        if positions.len() != self.vertex_count {
-            return Err(Error::InvalidParameter {
-                name: "positions",
-                reason: format!("{} positions for a cage of {} vertices", positions.len(), self.vertex_count),
-            });
-        }
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "positions",
-                reason: format!("vertex {} is at {} (not finite)", i + 1, positions[i]),
-            });
-        }
+        check_positions(positions, self.vertex_count)?;
         self.check_set(set)?;
         let points: Vec<DVec3> =
             (0..self.rows.len()).into_par_iter().map(|r| self.rows.apply_row(r, positions)).collect();
@@ -285,7 +277,27 @@ impl CageStencils {
     }
 }
 
-/// Rows of one face: per control point (in [`Built::points`] order), its `(vertex, weight)`
+/// Whether `positions` can be the vertices of a cage of `vertex_count` vertices: one each,
+/// all finite — what [`CageStencils::apply`] and any engine applying the stencils check.
+/// Errors: [`Error::InvalidParameter`] naming the count, or the first vertex (1-based, as in
+/// the file) that is not finite. Cost: O(V).
+pub fn check_positions(positions: &[DVec3], vertex_count: usize) -> Result<()> {
+    if positions.len() != vertex_count {
+        return Err(Error::InvalidParameter {
+            name: "positions",
+            reason: format!("{} positions for a cage of {vertex_count} vertices", positions.len()),
+        });
+    }
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "positions",
+            reason: format!("vertex {} is at {} (not finite)", i + 1, positions[i]),
+        });
+    }
+    Ok(())
+}
+
+/// Rows of one face: per control point (in `Built::points` order), its `(vertex, weight)`
 /// terms.
 type FaceRowsOut = Vec<Vec<(u32, f64)>>;
 
