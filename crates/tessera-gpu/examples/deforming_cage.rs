@@ -10,8 +10,9 @@
 //! draw them), and a line per frame gives the vertices uploaded and the GPU time of the
 //! stencil pass and the frame together (submit to idle, read-back excluded).
 //!
-//! The cage's faces must all be regular (every face a bicubic patch): the GPU does not draw
-//! the isolated pieces around extraordinary vertices and creases yet, and says so.
+//! The cage's faces must all be regular (every face a bicubic patch): the stencil pass does
+//! not move the isolated pieces around extraordinary vertices and creases yet, and says so
+//! (the GPU draws such cages when they stand still).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

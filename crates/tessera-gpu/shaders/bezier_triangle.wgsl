@@ -84,5 +84,6 @@ fn pn_eval(p: u32, uv: vec2<f32>) -> SurfacePoint {
 fn eval_patch(p: u32, uv: vec2<f32>) -> SurfacePoint {
     if (patch_has_pn_normals(p)) { return pn_eval(p, uv); }
     if (patch_is_tri(p)) { return triangle_eval(p, uv); }
+    if (patch_is_tree(p)) { return tree_eval(p, uv); }
     return bicubic_eval(p, uv);
 }

@@ -26,6 +26,14 @@ pub mod sources {
     /// triangles) and `eval_patch(p, uv)`, which picks the evaluation by the patch row's kind
     /// bits. Needs [`BICUBIC`] before it.
     pub const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
+    /// `tree.wgsl`: `tree_eval(p, uv)`, a Catmull-Clark subdivision patch's position and
+    /// normal as `tessera::surface::Patch::eval` computes them (the quadtree walked to the
+    /// piece, Bézier pieces and Gregory end caps), from `upload::pack_trees`' blocks. Needs
+    /// [`BICUBIC`] before it.
+    pub const TREE: &str = include_str!("../shaders/tree.wgsl");
+    /// `no_tree.wgsl`: [`TREE`]'s functions for a set without subdivision patches (never
+    /// taken), which keeps the tree walk out of its pipelines.
+    pub const NO_TREE: &str = include_str!("../shaders/no_tree.wgsl");
     pub(crate) const UNIFORM_GRID: &str = include_str!("../shaders/uniform_grid.wgsl");
     pub(crate) const COUNT: &str = include_str!("../shaders/count.wgsl");
     pub(crate) const COUNT_UNIFORM: &str = include_str!("../shaders/count_uniform.wgsl");
@@ -44,14 +52,16 @@ pub mod sources {
     pub(crate) const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
 }
 
-/// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`] then
-/// [`sources::BEZIER_TRIANGLE`]), for a shader that draws the engine's patches by the
-/// engine's own evaluation rather than a copy. The shader that includes it declares what
-/// `common.wgsl` declares for it: the `control_points` array, the constant `CONTROL_POINTS`
-/// ([`crate::upload::CONTROL_POINTS`]) and the patch-row accessors `patch_is_tri` and
-/// `patch_has_pn_normals`.
-pub fn evaluation_wgsl() -> String {
-    [sources::BICUBIC, sources::BEZIER_TRIANGLE].concat()
+/// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],
+/// [`sources::TREE`] or, for a set without subdivision patches, [`sources::NO_TREE`], then
+/// [`sources::BEZIER_TRIANGLE`]), for a shader that draws the engine's patches by the engine's
+/// own evaluation rather than a copy. The shader that includes it declares what `common.wgsl`
+/// declares for it: the `control_points` array, the constant `CONTROL_POINTS`
+/// ([`crate::upload::CONTROL_POINTS`]), the `patch_rows` array with the constant `PATCH_ROW`,
+/// and the patch-row accessors `patch_is_tri` and `patch_has_pn_normals`.
+pub fn evaluation_wgsl(with_trees: bool) -> String {
+    let trees = if with_trees { sources::TREE } else { sources::NO_TREE };
+    [sources::BICUBIC, trees, sources::BEZIER_TRIANGLE].concat()
 }
 
 /// `source` with every `{{NAME}}` replaced by its value from `constants`.

@@ -36,8 +36,8 @@ impl GpuStencils {
     /// `tessellator` (made for `set`). The cage's vertices start at the origin: write them
     /// ([`GpuStencils::write_positions`]) before the first [`GpuStencils::record`].
     ///
-    /// Errors: those of `bicubic_rows` (a set with isolated faces, whose pieces the GPU does
-    /// not draw yet, or another cage's set), as [`crate::GpuError::Tessera`]. Cost: O(terms)
+    /// Errors: those of `bicubic_rows` (a set with isolated faces, whose pieces this pass does
+    /// not move yet, or another cage's set), as [`crate::GpuError::Tessera`]. Cost: O(terms)
     /// packing, one upload of 8 bytes a term, one WGSL compilation.
     pub fn new(
         ctx: &GpuContext,

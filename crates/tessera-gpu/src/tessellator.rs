@@ -271,7 +271,9 @@ impl GpuTessellator {
     /// that is not uniform per patch (uniform pattern), a sampling kind that is not the
     /// pattern's ([`SamplingKind::Uniform`] for the integer patterns,
     /// `SamplingKind::Fractional(Spacing::Hardware(p))` of the pattern's own partitioning for
-    /// a hardware pattern) or a factor that is not a finite positive number;
+    /// a hardware pattern), a factor that is not a finite positive number, or a patch with a
+    /// corner pinched at a cage's valence-2 vertex that the pattern would not cut as the CPU
+    /// does (`tessera::scheme::pinched_beyond_the_gpu`);
     /// [`GpuError::OutputTooLarge`] when the worst case exceeds the u32 index range or the
     /// device's buffer limits (nothing is dropped). Cost: O(E + P) and an upload of the plan's
     /// arrays (16 bytes a patch, 8 an edge); a reallocation when the output grows; on the
@@ -297,6 +299,9 @@ impl GpuTessellator {
             return Err(
                 tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
             );
+        }
+        if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, kind == GpuPattern::Uniform) {
+            return Err(GpuError::Unsupported { what: tessera::scheme::pinched_on_gpu(p) });
         }
         let expected_kind = match kind {
             GpuPattern::Hardware(p) => SamplingKind::Fractional(Spacing::Hardware(p)),
@@ -331,6 +336,9 @@ impl GpuTessellator {
         self.reserve(ctx, capacity)?;
         if let GpuPattern::Hardware(_) = kind {
             self.pipelines.hardware(&ctx.device);
+        }
+        if self.set.has_trees {
+            self.pipelines.with_trees(&ctx.device, kind);
         }
         self.screen = None;
         self.pattern = kind;

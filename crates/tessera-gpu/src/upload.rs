@@ -8,8 +8,9 @@
 //!   (`patch_edges[p][e].edge`); `[4..8]` flags of each local edge: bit 0 reversed, bit 1 the
 //!   edge is collapsed, bits 8..16 the normal variant; `[8..12]` corner entry of each corner
 //!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`],
-//!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots); the
-//!   rest 0. Triangles fill three of the four edge and corner slots.
+//!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots), bit 3
+//!   a subdivision patch (a tree of pieces); `[13]` a subdivision patch's view record in the
+//!   control points (`pack_trees`); the rest 0. Triangles fill three of the four edge and corner slots.
 //! - **edge row** ([`EDGE_ROW`] u32): first use, end of uses (`edges[e].uses`), variants,
 //!   collapsed.
 //! - **edge use** ([`USE_ROW`] u32): patch; local edge | reversed << 8 | variant << 16.
@@ -18,7 +19,9 @@
 //!   position bits of their vertex's first entry, as on the CPU).
 //! - **control points**: 16 `vec4<f32>` per patch: a bicubic's `(x, y, z, w)` in
 //!   `points[4 i + j]` order (`i` along `u`); a Bézier triangle's 10 points
-//!   (`BezierTriangle::index` order, `w = 1`), then a PN triangle's six normals (`w = 0`).
+//!   (`BezierTriangle::index` order, `w = 1`), then a PN triangle's six normals (`w = 0`); a
+//!   subdivision patch's bounding-box corners, twice. After every patch's 16, the subdivision
+//!   patches' view records and trees (`pack_trees`).
 
 use crate::error::Result;
 use tessera::surface::{Patch, SurfaceSet};
@@ -50,6 +53,8 @@ pub struct PackedSet {
     pub control_points: Vec<[f32; 4]>,
     /// Whether any patch has a repeated corner (then the collapsed-triangle pass runs).
     pub any_repeated_corner: bool,
+    /// Whether any patch is a subdivision patch (then the vertex passes walk trees).
+    pub has_trees: bool,
 }
 
 impl PackedSet {
@@ -57,6 +62,7 @@ impl PackedSet {
     pub fn new(set: &SurfaceSet) -> Result<PackedSet> {
         let topo = &set.topology;
         let mut packed = PackedSet::default();
+        let mut trees = Vec::new();
         for (p, patch) in set.patches.iter().enumerate() {
             let mut row = [0u32; PATCH_ROW as usize];
             let corners = patch.domain().corner_count();
@@ -71,12 +77,13 @@ impl PackedSet {
             packed.any_repeated_corner |= repeated;
             let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
             let (tri, pn) = match patch {
-                Patch::Subdivision(_) => {
-                    return Err(tessera::Error::EngineNotSupported {
-                        engine: tessera::scheme::Engine::Gpu.name(),
-                        what: tessera::scheme::SUBDIVISION_ON_GPU.into(),
-                    }
-                    .into())
+                Patch::Subdivision(t) => {
+                    // The box around its pieces twice (what culling reads); the pieces
+                    // themselves follow all patches ([`pack_trees`]).
+                    let hull = t.control_points();
+                    packed.control_points.extend(hull.iter().chain(hull).map(|q| point(q, 1.0)));
+                    trees.push(p);
+                    (false, false)
                 }
                 Patch::Bicubic(b) => {
                     packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
@@ -93,9 +100,12 @@ impl PackedSet {
                     (true, true)
                 }
             };
-            row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2;
+            let tree = matches!(patch, Patch::Subdivision(_));
+            row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2 | (tree as u32) << 3;
             packed.patch_rows.extend_from_slice(&row);
         }
+        pack_trees(set, &trees, &mut packed);
+        packed.has_trees = !trees.is_empty();
         for edge in &topo.edges {
             packed.edge_rows.extend_from_slice(&[
                 edge.uses.start,
@@ -123,6 +133,56 @@ impl PackedSet {
     }
 }
 
+/// Appends the subdivision patches' pieces to the control points (after every patch's 16
+/// slots) and points their patch rows at them (`row[13]`), as `tree.wgsl` reads them:
+///
+/// - per patch in `trees`, a **view record** `(origin.x, origin.y, size, bits)`: the square
+///   of the tree it covers ([`tessera::surface::PatchTree::view_square`]), and `bits` (f32
+///   bits) = transposed | rotation << 1 | the tree block's index << 3;
+/// - per tree (views of one tree share it), a **block**: a header whose `x` bits are the root
+///   slot, then each node's four child slots (bits), then each leaf: `(origin.x, origin.y,
+///   size, kind bits: 0 Bézier, 1 Gregory)` and its 16 or 20 points (`w = 1`). A slot is a
+///   node index or `LEAF_SLOT |` the leaf's offset in the block.
+fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
+    use tessera::surface::patch_tree::{LeafPatch, LEAF_SLOT};
+    let bits = |u: u32| f32::from_bits(u);
+    let records = packed.control_points.len();
+    packed.control_points.resize(records + trees.len(), [0.0; 4]);
+    let mut blocks: std::collections::HashMap<usize, u32> = Default::default();
+    for (k, &p) in trees.iter().enumerate() {
+        let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("trees are subdivision patches") };
+        let block = *blocks.entry(tree.leaves_id()).or_insert_with(|| {
+            let block = packed.control_points.len() as u32;
+            let (root, nodes) = tree.quadtree();
+            // Leaf offsets in the block: after the header and the nodes.
+            let mut leaf_at = Vec::with_capacity(tree.leaves().len());
+            let mut at = 1 + nodes.len() as u32;
+            for leaf in tree.leaves() {
+                leaf_at.push(at);
+                at += 1 + if matches!(leaf.patch, LeafPatch::Bezier(_)) { 16 } else { 20 };
+            }
+            let slot =
+                |s: u32| if s & LEAF_SLOT != 0 { LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize] } else { s };
+            let out = &mut packed.control_points;
+            out.push([bits(slot(root)), 0.0, 0.0, 0.0]);
+            out.extend(nodes.iter().map(|n| n.map(|s| bits(slot(s)))));
+            for leaf in tree.leaves() {
+                let (kind, points): (u32, &[glam::DVec3]) = match &leaf.patch {
+                    LeafPatch::Bezier(points) => (0, points),
+                    LeafPatch::Gregory(g) => (1, &g.points),
+                };
+                out.push([leaf.origin.x as f32, leaf.origin.y as f32, leaf.size as f32, bits(kind)]);
+                out.extend(points.iter().map(|q| [q.x as f32, q.y as f32, q.z as f32, 1.0]));
+            }
+            block
+        });
+        let (origin, size) = tree.view_square();
+        let view = tree.is_transposed() as u32 | u32::from(tree.rotation()) << 1 | block << 3;
+        packed.control_points[records + k] = [origin.x as f32, origin.y as f32, size as f32, bits(view)];
+        packed.patch_rows[p * PATCH_ROW as usize + 13] = (records + k) as u32;
+    }
+}
+
 /// The set's buffers on the device (read-only storage), uploaded once.
 #[derive(Debug)]
 pub struct GpuSet {
@@ -134,6 +194,8 @@ pub struct GpuSet {
     pub corners: u32,
     /// Whether any patch has a repeated corner.
     pub any_repeated_corner: bool,
+    /// Whether any patch is a subdivision patch.
+    pub has_trees: bool,
     /// Control points.
     pub control_points: wgpu::Buffer,
     /// Patch rows.
@@ -174,6 +236,7 @@ impl GpuSet {
             edges: set.topology.edges.len() as u32,
             corners: set.topology.corner_entries.len() as u32,
             any_repeated_corner: packed.any_repeated_corner,
+            has_trees: packed.has_trees,
             control_points: storage_buffer(device, "control points", &packed.control_points),
             patch_rows: storage_buffer(device, "patch rows", &packed.patch_rows),
             edge_rows: storage_buffer(device, "edge rows", &packed.edge_rows),

@@ -316,7 +316,7 @@ impl InstancedDraw {
         });
         let source = tessera_gpu::shader::expand(
             // The GPU engine's patch evaluation, shared rather than copied (one rule).
-            &[tessera_gpu::shader::evaluation_wgsl().as_str(), DRAW, INSTANCED].concat(),
+            &[tessera_gpu::shader::evaluation_wgsl(gpu_set.has_trees).as_str(), DRAW, INSTANCED].concat(),
             &[
                 ("CONTROL_POINTS", tessera_gpu::upload::CONTROL_POINTS),
                 ("PATCH_ROW", tessera_gpu::upload::PATCH_ROW),

@@ -97,14 +97,20 @@ impl GpuTessellator {
         {
             let mut c = begin_pass(encoder, timer, 5);
             c.set_bind_group(0, &out.main, &[]);
+            // A set with subdivision patches evaluates them (compiled when it was prepared).
+            let v = if self.set.has_trees {
+                k.with_trees.get().expect("prepare compiles the tree passes of a set with trees")
+            } else {
+                &k.vertices
+            };
             if corners > 0 {
-                c.set_pipeline(&k.corners);
+                c.set_pipeline(&v.corners);
                 let (x, y) = shader::grid(corners.div_ceil(shader::WORKGROUP));
                 c.dispatch_workgroups(x, y, 1);
             }
-            c.set_pipeline(&k.edge_vertices);
+            c.set_pipeline(&v.edge_vertices);
             c.dispatch_workgroups_indirect(&self.dispatch_args, 0);
-            c.set_pipeline(&k.interior_vertices);
+            c.set_pipeline(&v.interior_vertices);
             c.dispatch_workgroups_indirect(&self.dispatch_args, 12);
         }
         {

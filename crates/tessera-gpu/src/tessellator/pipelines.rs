@@ -179,7 +179,7 @@ const UNIFORM_SHADERS: PatternShaders = PatternShaders {
     count: ("count uniform", &[COMMON, UNIFORM_GRID, COUNT_UNIFORM, COUNT]),
     vertices: (
         "vertices uniform",
-        &[COMMON, BICUBIC, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
+        &[COMMON, BICUBIC, NO_TREE, BEZIER_TRIANGLE, UNIFORM_GRID, GRID_VERTICES, WRITE_VERTICES],
     ),
     triangles: Some(("triangles uniform", &[COMMON, UNIFORM_GRID, WRITE_TRIANGLES_UNIFORM])),
     functions: &[
@@ -197,7 +197,17 @@ const TRANSITION_SHADERS: PatternShaders = PatternShaders {
     count: ("transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]),
     vertices: (
         "vertices transition",
-        &[COMMON, BICUBIC, BEZIER_TRIANGLE, LOCAL, BOUNDS, TRANSITION, GRID_VERTICES, WRITE_VERTICES],
+        &[
+            COMMON,
+            BICUBIC,
+            NO_TREE,
+            BEZIER_TRIANGLE,
+            LOCAL,
+            BOUNDS,
+            TRANSITION,
+            GRID_VERTICES,
+            WRITE_VERTICES,
+        ],
     ),
     triangles: None,
     functions: &[
@@ -216,7 +226,7 @@ const HARDWARE_SHADERS: PatternShaders = PatternShaders {
     count: ("hardware", &[COMMON, HARDWARE_PARTITION, LOCAL, HARDWARE, COUNT]),
     vertices: (
         "vertices hardware",
-        &[COMMON, BICUBIC, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
+        &[COMMON, BICUBIC, NO_TREE, BEZIER_TRIANGLE, HARDWARE_PARTITION, LOCAL, HARDWARE, WRITE_VERTICES],
     ),
     triangles: None,
     functions: &[
@@ -236,19 +246,45 @@ impl PatternShaders {
             shader::module_with_functions(device, label, parts, &constants(), self.functions)
         };
         let count = module(self.count);
-        let vertices = module(self.vertices);
         let triangles = self.triangles.map(module);
         let triangles = triangles.as_ref().unwrap_or(&count);
         let make = |module: &wgpu::ShaderModule, entry: &str| compute_pipeline(device, layout, module, entry);
         PatternPipelines {
             count: make(&count, "count"),
-            corners: make(&vertices, "write_corners"),
-            edge_vertices: make(&vertices, "write_edge_vertices"),
-            interior_vertices: make(&vertices, "write_interior_vertices"),
+            vertices: self.vertex_pipelines(device, layout, false),
+            with_trees: std::sync::OnceLock::new(),
             triangles: make(triangles, self.write_triangles),
             collapsed_triangles: self.write_collapsed_triangles.map(|entry| make(triangles, entry)),
         }
     }
+
+    /// The vertex passes' pipelines, evaluating subdivision patches (`tree.wgsl`) or not
+    /// (`no_tree.wgsl` in its place). Cost: one WGSL compilation.
+    fn vertex_pipelines(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::PipelineLayout,
+        trees: bool,
+    ) -> VertexPipelines {
+        let (label, parts) = self.vertices;
+        let parts: Vec<&str> = parts.iter().map(|&p| if trees && p == NO_TREE { TREE } else { p }).collect();
+        let label = if trees { format!("{label} with trees") } else { label.to_string() };
+        let module = shader::module_with_functions(device, &label, &parts, &constants(), self.functions);
+        let make = |entry: &str| compute_pipeline(device, layout, &module, entry);
+        VertexPipelines {
+            corners: make("write_corners"),
+            edge_vertices: make("write_edge_vertices"),
+            interior_vertices: make("write_interior_vertices"),
+        }
+    }
+}
+
+/// The vertex passes' pipelines: corners, edge samples, interior vertices.
+#[derive(Debug)]
+pub(super) struct VertexPipelines {
+    pub(super) corners: wgpu::ComputePipeline,
+    pub(super) edge_vertices: wgpu::ComputePipeline,
+    pub(super) interior_vertices: wgpu::ComputePipeline,
 }
 
 /// The pattern-specific pipelines: counts, vertex writes (the interior grid is the
@@ -256,9 +292,12 @@ impl PatternShaders {
 #[derive(Debug)]
 pub(super) struct PatternPipelines {
     pub(super) count: wgpu::ComputePipeline,
-    pub(super) corners: wgpu::ComputePipeline,
-    pub(super) edge_vertices: wgpu::ComputePipeline,
-    pub(super) interior_vertices: wgpu::ComputePipeline,
+    /// The vertex passes for sets without subdivision patches.
+    pub(super) vertices: VertexPipelines,
+    /// The vertex passes that also evaluate subdivision patches, compiled on first use
+    /// ([`Pipelines::with_trees`]): the tree walk makes lavapipe's compilation several times
+    /// slower, and most sets have no trees.
+    pub(super) with_trees: std::sync::OnceLock<VertexPipelines>,
     /// Uniform: one invocation per triangle (indirect), then the collapsed-corner patches.
     /// Transition and hardware: one invocation per patch.
     pub(super) triangles: wgpu::ComputePipeline,
@@ -393,6 +432,20 @@ impl Pipelines {
         })
     }
 
+    /// Compiles the vertex passes that evaluate subdivision patches for `pattern` (whose own
+    /// pipelines exist: [`Pipelines::hardware`] first for a hardware pattern). Cost: the
+    /// first call per pattern one WGSL compilation; later calls nothing.
+    pub(super) fn with_trees(&self, device: &wgpu::Device, pattern: GpuPattern) {
+        let shaders = match pattern {
+            GpuPattern::Uniform => &UNIFORM_SHADERS,
+            GpuPattern::Transition => &TRANSITION_SHADERS,
+            GpuPattern::Hardware(_) => &HARDWARE_SHADERS,
+        };
+        if let Some(p) = self.of(pattern) {
+            p.with_trees.get_or_init(|| shaders.vertex_pipelines(device, &self.main_pipeline_layout, true));
+        }
+    }
+
     /// The pipelines of `pattern`; None for the hardware pattern before
     /// [`Pipelines::hardware`] compiled them.
     pub(super) fn of(&self, pattern: GpuPattern) -> Option<&PatternPipelines> {
@@ -450,6 +503,23 @@ mod tests {
                 naga::front::wgsl::parse_str(&text).map_err(|e| format!("{e}"))
             })
             .collect()
+    }
+
+    /// The vertex modules with the tree walk in place of its stand-in, as
+    /// [`PatternShaders::vertex_pipelines`] makes them for a set with subdivision patches.
+    #[test]
+    fn every_vertex_module_compiles_with_trees() {
+        for (name, row) in ROWS {
+            let (_, parts) = row.vertices;
+            assert!(parts.contains(&NO_TREE), "{name}: the vertex module evaluates patches");
+            let parts: Vec<&str> = parts.iter().map(|&p| if p == NO_TREE { TREE } else { p }).collect();
+            let text = shader::source(&parts, &constants(), row.functions);
+            let module = naga::front::wgsl::parse_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(
+                module.functions.iter().any(|(_, f)| f.name.as_deref() == Some("tree_derivatives")),
+                "{name}"
+            );
+        }
     }
 
     #[test]

@@ -281,6 +281,9 @@ impl GpuTessellator {
             }
             _ => GpuPattern::Transition,
         };
+        if self.set.has_trees {
+            self.pipelines.with_trees(&ctx.device, self.pattern);
+        }
         self.write_params(ctx);
         self.set_cull_camera(ctx, Some(camera));
         Ok(())

@@ -45,7 +45,9 @@ use rayon::prelude::*;
 
 pub mod domain_pattern;
 mod validate;
-pub use validate::{validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR, SUBDIVISION_ON_GPU};
+pub use validate::{
+    pinched_beyond_the_gpu, pinched_on_gpu, validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR,
+};
 
 /// A tessellation scheme: a pattern with the rules that feed it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -84,8 +84,10 @@ pub fn validate(
     check_request(scheme, criterion, options)?;
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
-    if engine != Engine::Cpu && set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_))) {
-        return Err(Error::EngineNotSupported { engine: engine.name(), what: SUBDIVISION_ON_GPU.into() });
+    if engine != Engine::Cpu {
+        if let Some(p) = pinched_beyond_the_gpu(set, scheme == Scheme::Uniform) {
+            return Err(Error::EngineNotSupported { engine: engine.name(), what: pinched_on_gpu(p) });
+        }
     }
     Ok(Accepted {
         cap: scheme.cap(options),
@@ -218,10 +220,22 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
     }
 }
 
-/// What the GPU engine does not draw yet: the feature-adaptive pieces of a Catmull-Clark
-/// cage's irregular faces (its regular faces are bicubic patches, which it draws).
-pub const SUBDIVISION_ON_GPU: &str = "the isolated faces of a Catmull-Clark cage (next to extraordinary \
-     vertices, creases or faces that are not quads); a cage whose faces are all regular draws on the GPU";
+/// The first patch whose pinched corner (an interior vertex of valence 2 of a Catmull-Clark
+/// cage, [`crate::topology::Topology::pinched_corners`]) the GPU's patterns would not cut:
+/// they do not run `pattern::cut_pinched_corners`, so only the uniform grid, whose cells are
+/// already cut through corners 0 and 2 (where the cage's patches are turned to have them),
+/// draws such a patch as the CPU does. Cost: O(P) when the set has pinched corners, else O(1).
+pub fn pinched_beyond_the_gpu(set: &SurfaceSet, uniform: bool) -> Option<usize> {
+    set.topology.patch_pinched.iter().position(|c| if uniform { c[1] || c[3] } else { c.iter().any(|&x| x) })
+}
+
+/// What the GPU engine refuses for [`pinched_beyond_the_gpu`]'s patch `p`.
+pub fn pinched_on_gpu(p: usize) -> String {
+    format!(
+        "patch {p}'s corner at an interior vertex of valence 2 with this scheme (the GPU's patterns \
+         do not cut such corners yet: use the uniform scheme or the CPU engine)"
+    )
+}
 
 /// The surface-kind part of [`validate`]: SD-2 is defined for triangles (paper 001), ESC for
 /// bicubic patches (paper 002); every other scheme and both engines take every kind.

@@ -118,6 +118,9 @@ impl PatchOrigin {
     }
 }
 
+/// The flag of a leaf slot in [`PatchTree::quadtree`] (the rest of the slot is the leaf's index).
+pub const LEAF_SLOT: u32 = 1 << 31;
+
 /// One leaf of a face's patch tree: a square `origin + [0, size]²` of the face's (or
 /// sub-face's) domain and the patch over it.
 #[derive(Debug, Clone, PartialEq)]
@@ -395,6 +398,30 @@ impl PatchTree {
     /// points), which is what hulls and boxes need; not a control net.
     pub fn control_points(&self) -> &[DVec3] {
         &self.hull
+    }
+
+    /// The square of the tree's domain this patch covers, `origin + [0, size]²`
+    /// ([`PatchTree::quadrant`]), as `(origin, size)`.
+    pub fn view_square(&self) -> (DVec2, f64) {
+        (self.view_origin, self.view_size)
+    }
+
+    /// The quadtree as an engine that walks it itself reads it (the GPU's): the root slot and
+    /// the nodes' child slots by quadrant (as [`PatchTree::locate`] numbers them), each slot a
+    /// node index, or [`LEAF_SLOT`] `|` a leaf index into [`PatchTree::leaves`].
+    /// Cost: O(nodes).
+    pub fn quadtree(&self) -> (u32, Vec<[u32; 4]>) {
+        let code = |s: Slot| match s {
+            Slot::Node(n) => n,
+            Slot::Leaf(l) => LEAF_SLOT | l,
+        };
+        (code(self.data.root), self.data.nodes.iter().map(|n| n.map(code)).collect())
+    }
+
+    /// An identity of the tree's leaves: equal for the views of one tree ([`PatchTree::quadrant`],
+    /// [`PatchTree::rotated`], [`PatchTree::transposed`]), so that an engine stores them once.
+    pub fn leaves_id(&self) -> usize {
+        std::sync::Arc::as_ptr(&self.data) as usize
     }
 
     /// The tree's deepest leaf level.
