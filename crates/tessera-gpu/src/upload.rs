@@ -76,31 +76,30 @@ impl PackedSet {
             let repeated = tessera::engine::layout::has_repeated_corner(set, p);
             packed.any_repeated_corner |= repeated;
             let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
-            let (tri, pn) = match patch {
+            let (tri, pn, tree) = match patch {
                 Patch::Subdivision(t) => {
                     // The box around its pieces twice (what culling reads); the pieces
                     // themselves follow all patches ([`pack_trees`]).
                     let hull = t.control_points();
                     packed.control_points.extend(hull.iter().chain(hull).map(|q| point(q, 1.0)));
                     trees.push(p);
-                    (false, false)
+                    (false, false, true)
                 }
                 Patch::Bicubic(b) => {
                     packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
-                    (false, false)
+                    (false, false, false)
                 }
                 Patch::BezierTriangle(t) => {
                     packed.control_points.extend(t.points.iter().map(|q| point(q, 1.0)));
                     packed.control_points.extend([[0.0; 4]; 6]);
-                    (true, false)
+                    (true, false, false)
                 }
                 Patch::Pn(t) => {
                     packed.control_points.extend(t.geometry.points.iter().map(|q| point(q, 1.0)));
                     packed.control_points.extend(t.normals.iter().map(|n| point(n, 0.0)));
-                    (true, true)
+                    (true, true, false)
                 }
             };
-            let tree = matches!(patch, Patch::Subdivision(_));
             row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2 | (tree as u32) << 3;
             packed.patch_rows.extend_from_slice(&row);
         }
@@ -159,7 +158,7 @@ fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
             let mut at = 1 + nodes.len() as u32;
             for leaf in tree.leaves() {
                 leaf_at.push(at);
-                at += 1 + if matches!(leaf.patch, LeafPatch::Bezier(_)) { 16 } else { 20 };
+                at += 1 + leaf.patch.points().len() as u32;
             }
             let slot =
                 |s: u32| if s & LEAF_SLOT != 0 { LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize] } else { s };
@@ -167,12 +166,9 @@ fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
             out.push([bits(slot(root)), 0.0, 0.0, 0.0]);
             out.extend(nodes.iter().map(|n| n.map(|s| bits(slot(s)))));
             for leaf in tree.leaves() {
-                let (kind, points): (u32, &[glam::DVec3]) = match &leaf.patch {
-                    LeafPatch::Bezier(points) => (0, points),
-                    LeafPatch::Gregory(g) => (1, &g.points),
-                };
+                let kind = u32::from(matches!(leaf.patch, LeafPatch::Gregory(_)));
                 out.push([leaf.origin.x as f32, leaf.origin.y as f32, leaf.size as f32, bits(kind)]);
-                out.extend(points.iter().map(|q| [q.x as f32, q.y as f32, q.z as f32, 1.0]));
+                out.extend(leaf.patch.points().iter().map(|q| [q.x as f32, q.y as f32, q.z as f32, 1.0]));
             }
             block
         });

@@ -113,14 +113,13 @@ impl CageStencils {
         let faces = cage.face_count();
         // Faces in chunks, each probing on its own zeroed copy of the cage.
         let chunk = faces.div_ceil(4 * rayon::current_num_threads()).max(16);
-        let per_chunk: Vec<Vec<(Built, FaceRowsOut)>> = (0..faces)
-            .collect::<Vec<_>>()
-            .par_chunks(chunk)
-            .map(|fs| {
+        let per_chunk: Vec<Vec<(Built, FaceRowsOut)>> = (0..faces.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
                 let mut probe = cage.clone();
                 probe.points.iter_mut().for_each(|p| *p = DVec3::ZERO);
-                fs.iter()
-                    .map(|&f| {
+                (c * chunk..faces.min((c + 1) * chunk))
+                    .map(|f| {
                         let built = Built::face(&cage, f, split, options.isolation);
                         let rows = probe_face(&cage, &mut probe, f, split, options);
                         (built, rows)

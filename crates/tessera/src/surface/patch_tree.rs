@@ -142,6 +142,16 @@ pub enum LeafPatch {
     Gregory(GregoryPatch),
 }
 
+impl LeafPatch {
+    /// The piece's points: a Bézier net's 16 (`points[4*i + j]`), or a Gregory patch's 20.
+    pub fn points(&self) -> &[DVec3] {
+        match self {
+            LeafPatch::Bezier(p) => p,
+            LeafPatch::Gregory(g) => &g.points,
+        }
+    }
+}
+
 /// The leaves and the quadtree of a face's isolation, shared by its views.
 #[derive(Debug, PartialEq)]
 struct TreeData {
@@ -207,16 +217,13 @@ impl PatchTree {
     /// leaf: a Bézier leaf's 16, a Gregory leaf's 20. Cost: O(leaves).
     pub fn leaf_points(&self, out: &mut Vec<DVec3>) {
         for leaf in &self.data.leaves {
-            match &leaf.patch {
-                LeafPatch::Bezier(p) => out.extend_from_slice(p),
-                LeafPatch::Gregory(g) => out.extend_from_slice(&g.points),
-            }
+            out.extend_from_slice(leaf.patch.points());
         }
     }
 
     /// How many points [`PatchTree::leaf_points`] appends.
     pub fn leaf_point_count(&self) -> usize {
-        self.data.leaves.iter().map(|l| if matches!(l.patch, LeafPatch::Bezier(_)) { 16 } else { 20 }).sum()
+        self.data.leaves.iter().map(|l| l.patch.points().len()).sum()
     }
 
     /// The same view (transposition, rotation, square) of a tree with the same nodes and
@@ -262,11 +269,7 @@ impl PatchTree {
     fn visible_hull(&self) -> [DVec3; 8] {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for (leaf, _, _) in self.visible_leaves() {
-            let points: &[DVec3] = match &leaf.patch {
-                LeafPatch::Bezier(p) => p,
-                LeafPatch::Gregory(g) => &g.points,
-            };
-            for p in points {
+            for p in leaf.patch.points() {
                 lo = lo.min(*p);
                 hi = hi.max(*p);
             }
