@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Rows every quick run must have, per table: (table, column, values that must appear).
-const EXPECTED_ROWS: [(&str, &str, &[&str]); 12] = [
+const EXPECTED_ROWS: [(&str, &str, &[&str]); 13] = [
     ("speed_uniform", "model", &["torus_64x32", "teapot", "spot"]),
     ("speed_schemes", "scheme", &["transition"]),
     ("adaptive_ratio", "model", &["teapot", "teacup", "helmet"]),
@@ -34,12 +34,24 @@ const EXPECTED_ROWS: [(&str, &str, &[&str]); 12] = [
     ("paper002_table1", "row", &["input surfaces", "non-adaptive", "adaptive high", "adaptive medium"]),
     ("paper003_table1", "scene", &["teapot", "torus_64x32", "teacups", "torus grid"]),
     ("paper003_table2", "scene", &["elephant", "elephant_refined", "killeroo herd"]),
+    ("subdivision_bfr", "model", &["catmark_torus", "catmark_torus_creases0", "catmark_pyramid_creases0"]),
 ];
+
+/// OpenSubdiv's Bfr benchmark, which `scripts/test` builds (as the oracle tests' program).
+fn bfr_bench() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/osd-oracle/bfr_bench");
+    assert!(
+        path.is_file(),
+        "{} is not built: install g++ and libosd-dev and run tools/osd-oracle/bfr_bench.sh (scripts/test does)",
+        path.display()
+    );
+    path.to_str().unwrap().to_string()
+}
 
 /// Every table of every suite's JSON, by name.
 fn tables(out: &Path) -> BTreeMap<String, Value> {
     let mut all = BTreeMap::new();
-    for suite in ["speed", "adaptive", "frame", "paper"] {
+    for suite in ["speed", "adaptive", "frame", "paper", "subdivision"] {
         let path = out.join(format!("{suite}.json"));
         let json: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap())
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -71,7 +83,9 @@ fn triangle_counts(tables: &BTreeMap<String, Value>) -> Vec<(String, usize, Stri
 
 fn run(dir: &Path, out: &str) -> String {
     let data = data("");
-    let o = tessera(&["bench", "--quick", "--out", out, "--data", data.to_str().unwrap()], dir);
+    let bfr = bfr_bench();
+    let o =
+        tessera(&["bench", "--quick", "--out", out, "--data", data.to_str().unwrap(), "--bfr", &bfr], dir);
     assert!(o.status.success(), "bench failed: {}", text(&o.stderr));
     text(&o.stdout)
 }
@@ -108,6 +122,21 @@ fn quick_bench_writes_every_table_and_counts_repeat() {
     let speed = first["speed_uniform"]["rows"].as_array().unwrap();
     let torus4 = speed.iter().find(|r| r["model"] == "torus_64x32" && r["factor"] == 4).unwrap();
     assert_eq!(torus4["triangles"], 2048 * 2 * 16);
+    // OpenSubdiv's Bfr at rate 16 makes exactly tessera's uniform triangles (factor 16 on
+    // whole quads); at 0.5 px it tessellated the cages with the rates of tessera's plan.
+    for r in first["subdivision_bfr"]["rows"].as_array().unwrap() {
+        assert!(r["Bfr Mtri/s"].as_f64().unwrap() > 0.0, "{r}");
+        if r["tessellation"].as_str().unwrap().starts_with("uniform") {
+            assert_eq!(r["tessera triangles"], r["Bfr triangles"], "{r}");
+        }
+    }
+    let torus16 = first["subdivision_bfr"]["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["model"] == "catmark_torus")
+        .unwrap();
+    assert_eq!(torus16["tessera triangles"], 16 * 32 * 2 * 16 * 16);
     let teacups = &first["paper002_table1"]["rows"][0];
     assert_eq!(teacups["Teacups here"], 2600);
     // At 0.1 % of the diagonal the transition scheme needs clearly fewer triangles than

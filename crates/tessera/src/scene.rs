@@ -8,6 +8,7 @@
 //! the exact conics of revolution ([`sphere_octant`], [`cylinder`]).
 
 use crate::io::patches::PatchFile;
+use crate::surface::subdivision_tags::{Corner, Crease};
 use crate::surface::RationalBicubic;
 use crate::surface::{PolygonFace, PolygonMesh};
 use glam::{DVec2, DVec3};
@@ -51,11 +52,24 @@ pub fn patch_grid(file: &PatchFile, copies: usize) -> PatchFile {
     out
 }
 
-/// `copies` copies of a polygon mesh in a grid ([`grid_offsets`]). Cost: O(copies × mesh
-/// size).
+/// `copies` copies of a polygon mesh in a grid ([`grid_offsets`]), copy by copy (copy `c`'s
+/// faces are faces `c·F ..`); a subdivision cage's creases, corners and holes are copied with
+/// their copy, its cage-wide rules kept once. Cost: O(copies × mesh size).
 pub fn mesh_grid(mesh: &PolygonMesh, copies: usize) -> PolygonMesh {
     let (lo, hi) = point_bounds(&mesh.positions);
-    let mut out = PolygonMesh::default();
+    let mut out = PolygonMesh { tags: mesh.tags.clone(), ..PolygonMesh::default() };
+    out.tags.creases.clear();
+    out.tags.corners.clear();
+    out.tags.holes.clear();
+    let (vertices, faces) = (mesh.positions.len() as u32, mesh.faces.len() as u32);
+    for c in 0..copies as u32 {
+        let t = &mesh.tags;
+        out.tags.creases.extend(
+            t.creases.iter().map(|k| Crease { vertices: k.vertices.map(|v| v + c * vertices), ..*k }),
+        );
+        out.tags.corners.extend(t.corners.iter().map(|k| Corner { vertex: k.vertex + c * vertices, ..*k }));
+        out.tags.holes.extend(t.holes.iter().map(|&f| f + c * faces));
+    }
     for offset in grid_offsets(lo, hi, copies) {
         let (p0, n0) = (out.positions.len() as u32, out.normals.len() as u32);
         out.faces.extend(mesh.faces.iter().map(|f| PolygonFace {
@@ -149,6 +163,35 @@ pub fn cylinder(height: f64) -> PatchFile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn copies_of_a_cage_carry_its_tags() {
+        let path = crate::test_support::data("subdivision/catmark_rook.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        assert!(!mesh.tags.creases.is_empty(), "the rook has creases");
+        let grid = mesh_grid(&mesh, 3);
+        let (v, f) = (mesh.positions.len() as u32, mesh.faces.len());
+        assert_eq!(grid.faces.len(), 3 * f);
+        assert_eq!(grid.tags.creases.len(), 3 * mesh.tags.creases.len());
+        assert_eq!(grid.tags.options, mesh.tags.options);
+        for (c, copy) in grid.tags.creases.chunks(mesh.tags.creases.len()).enumerate() {
+            for (k, crease) in copy.iter().zip(&mesh.tags.creases) {
+                assert_eq!(k.vertices, crease.vertices.map(|i| i + c as u32 * v));
+                assert_eq!(k.sharpness, crease.sharpness);
+            }
+        }
+        // The copies are the same surface, moved: each copy's patches equal the first's.
+        let one =
+            crate::surface::SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default()).unwrap();
+        let three =
+            crate::surface::SurfaceSet::from_subdivision_cage(&grid, &path, Default::default()).unwrap();
+        assert_eq!(three.patches.len(), 3 * one.patches.len());
+        let offset = grid.positions[v as usize] - mesh.positions[0];
+        for (a, b) in one.patches.iter().zip(&three.patches[one.patches.len()..]) {
+            let (pa, pb) = (a.position(DVec2::splat(0.3)), b.position(DVec2::splat(0.3)));
+            assert!((pb - pa - offset).length() < 1e-9, "{pa} {pb}");
+        }
+    }
 
     #[test]
     fn copies_do_not_overlap_and_keep_the_model() {

@@ -12,6 +12,7 @@ mod paper;
 mod plot;
 mod scenes;
 mod speed;
+mod subdivision;
 mod table;
 
 use clap::{Args, ValueEnum};
@@ -39,6 +40,10 @@ pub enum Suite {
     /// Papers 000 (Table 1), 001 (Tables 1–2), 002 (Table 1) and 003 (Tables 1–2) beside the
     /// papers' own figures.
     Paper,
+    /// Catmull-Clark cages copied past 50,000 faces (the regular torus, the creased rook):
+    /// uniform at Bfr's rate 16 and adaptive at 0.5 px, beside OpenSubdiv's Bfr on the same
+    /// cage and rates when `tools/osd-oracle/bfr_bench` is built (--bfr).
+    Subdivision,
 }
 
 impl Suite {
@@ -48,13 +53,14 @@ impl Suite {
             Suite::Adaptive => "adaptive",
             Suite::Frame => "frame",
             Suite::Paper => "paper",
+            Suite::Subdivision => "subdivision",
         }
     }
 }
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Suite to run (repeat the flag for several; default: all four).
+    /// Suite to run (repeat the flag for several; default: all five).
     #[arg(long = "suite", value_enum, value_name = "S")]
     suites: Vec<Suite>,
     /// Folder for the CSV, JSON and SVG files (created if missing).
@@ -73,6 +79,10 @@ pub struct BenchArgs {
     /// Leave out the GPU rows even when a wgpu adapter exists.
     #[arg(long)]
     no_gpu: bool,
+    /// OpenSubdiv's Bfr benchmark for the subdivision suite's Bfr columns (built by
+    /// tools/osd-oracle/bfr_bench.sh; default: tools/osd-oracle/bfr_bench when it exists).
+    #[arg(long, value_name = "PATH")]
+    bfr: Option<PathBuf>,
 }
 
 /// What every suite gets: options, the model folder, the progress bar.
@@ -150,7 +160,7 @@ fn run_suites(a: BenchArgs) -> BenchResult<ExitCode> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     let mut suites = a.suites.clone();
     if suites.is_empty() {
-        suites = vec![Suite::Speed, Suite::Adaptive, Suite::Frame, Suite::Paper];
+        suites = vec![Suite::Speed, Suite::Adaptive, Suite::Frame, Suite::Paper, Suite::Subdivision];
     }
     suites.dedup();
     let pb = ProgressBar::new(0);
@@ -170,6 +180,7 @@ fn run_suites(a: BenchArgs) -> BenchResult<ExitCode> {
             Suite::Adaptive => adaptive::run(&ctx)?,
             Suite::Frame => frame::run(&ctx)?,
             Suite::Paper => paper::run(&ctx)?,
+            Suite::Subdivision => subdivision::run(&ctx, a.bfr.as_deref())?,
         };
         let seconds = start.elapsed().as_secs_f64();
         ctx.pb.suspend(|| {

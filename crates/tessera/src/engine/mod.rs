@@ -345,7 +345,11 @@ impl<'a> VertexSlices<'a> {
 
     /// Vertex `k`: patch `patch` evaluated at `uv` (f64, rounded once).
     fn set(&mut self, k: usize, set: &SurfaceSet, patch: u32, uv: DVec2) {
-        let p = set.patches[patch as usize].eval(uv);
+        self.put(k, patch, uv, set.patches[patch as usize].eval(uv));
+    }
+
+    /// Vertex `k`: `p`, the point of patch `patch` at `uv` (rounded once).
+    fn put(&mut self, k: usize, patch: u32, uv: DVec2, p: crate::surface::SurfacePoint) {
         self.pos[k] = p.position.as_vec3().to_array();
         self.nrm[k] = p.normal.as_vec3().to_array();
         self.uv[k] = uv.as_vec2().to_array();

@@ -557,13 +557,6 @@ impl PointBlocks {
     /// Preconditions: `out` holds `uvs.len()` vertices; `self` was made for `set`. Cost: about
     /// a tenth of the generic evaluation per point (less for PN triangles), no allocation.
     pub(crate) fn eval(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        if matches!(self.locals[p], Local::Generic) {
-            let mut out = out;
-            for (k, &uv) in uvs.iter().enumerate() {
-                out.set(k, set, p as u32, uv);
-            }
-            return;
-        }
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`PointBlocks::for_set`).
@@ -584,6 +577,13 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
+        if matches!(self.locals[p], Local::Generic) {
+            // In f64 as the generic evaluation, compiled here for the wider instructions
+            // (Rust never fuses a multiply and an add by itself, so the values are the same).
+            let mut out = out;
+            set.patches[p].eval_each(uvs, |k, point| out.put(k, p as u32, uvs[k], point));
+            return;
+        }
         // Short lists (the inner samples of a coarse edge, a small interior) in half-width
         // blocks, so that fewer lanes are spent on padding.
         if uvs.len() <= LANES / 2 {

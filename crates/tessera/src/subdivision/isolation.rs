@@ -66,9 +66,10 @@ pub fn isolate(cage: &Cage, face: usize, levels: IsolationLevels) -> Vec<PatchTr
     let ctx = Context { levels, has_irregular_faces };
     let n = local.face(root).len();
     if n == 4 {
-        let mut builder = TreeBuilder::default();
-        let root_slot = ctx.node(&local, root, 0, DVec2::ZERO, 1.0, &mut builder);
-        return vec![builder.finish(root_slot)];
+        return vec![TreeBuilder::with_scratch(|builder| {
+            let root_slot = ctx.node(&local, root, 0, DVec2::ZERO, 1.0, builder);
+            builder.finish(root_slot)
+        })];
     }
     // A face that is not a quad: its children are the sub-faces, each a tree of its own, in
     // the sub-face's own orientation (Bfr's QUAD_SUBFACES parameterisation).
@@ -76,9 +77,10 @@ pub fn isolate(cage: &Cage, face: usize, levels: IsolationLevels) -> Vec<PatchTr
     children
         .iter()
         .map(|&c| {
-            let mut builder = TreeBuilder::default();
-            let slot = ctx.node(&child, c, 1, DVec2::ZERO, 1.0, &mut builder);
-            builder.finish(slot)
+            TreeBuilder::with_scratch(|builder| {
+                let slot = ctx.node(&child, c, 1, DVec2::ZERO, 1.0, builder);
+                builder.finish(slot)
+            })
         })
         .collect()
 }
@@ -97,8 +99,32 @@ struct TreeBuilder {
 }
 
 impl TreeBuilder {
-    fn finish(self, root: Slot) -> PatchTree {
-        PatchTree::from_parts(self.leaves, self.nodes, root)
+    /// `build` with this thread's builder, emptied. Why: a tree's leaves (a few hundred
+    /// bytes each, hundreds per face near a crease) grown by pushing into fresh vectors made
+    /// every face reallocate through ever larger blocks, which glibc's per-thread arenas hand
+    /// back to the kernel and fault in again, zeroed: on a 50,000-face creased cage, most of
+    /// the load time was the kernel clearing pages. One growing scratch per thread and an
+    /// exact copy per tree ([`TreeBuilder::finish`]) allocate each tree once.
+    fn with_scratch<T>(build: impl FnOnce(&mut TreeBuilder) -> T) -> T {
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<TreeBuilder> = std::cell::RefCell::default();
+        }
+        SCRATCH.with(|scratch| {
+            // A tree is never built inside another's build; a fresh builder covers it anyway.
+            match scratch.try_borrow_mut() {
+                Ok(mut builder) => {
+                    builder.leaves.clear();
+                    builder.nodes.clear();
+                    build(&mut builder)
+                }
+                Err(_) => build(&mut TreeBuilder::default()),
+            }
+        })
+    }
+
+    /// The tree of the leaves and nodes built so far, copied to exact sizes.
+    fn finish(&mut self, root: Slot) -> PatchTree {
+        PatchTree::from_parts(self.leaves.drain(..).collect(), self.nodes.clone(), root)
     }
 }
 
@@ -124,7 +150,7 @@ impl Context {
                 let grid = super::bspline::grid(mesh, f, boundary_mask(mesh, f));
                 LeafPatch::Bezier(super::bspline::to_bezier(&grid))
             } else {
-                LeafPatch::Gregory(GregoryPatch::new(&gregory_source(mesh, f)))
+                LeafPatch::Gregory(Box::new(GregoryPatch::new(&gregory_source(mesh, f))))
             };
             out.leaves.push(Leaf { origin, size, level, patch });
             return Slot::Leaf((out.leaves.len() - 1) as u32);

@@ -79,22 +79,18 @@ impl Patch {
             Patch::Bicubic(p) => p.eval(uv),
             Patch::BezierTriangle(p) => p.eval(uv),
             Patch::Pn(p) => p.eval(uv),
-            Patch::Subdivision(t) => {
-                let (position, du, dv) = t.derivatives(uv);
-                let inside = DVec2::new(0.5 - uv.x, 0.5 - uv.y);
-                let normal = robust_normal(
-                    du,
-                    dv,
-                    uv,
-                    inside,
-                    || DVec3::ZERO,
-                    |q| {
-                        let (_, du, dv) = t.derivatives(q);
-                        du.cross(dv)
-                    },
-                );
-                SurfacePoint { position, normal }
-            }
+            Patch::Subdivision(t) => subdivision_point(t, uv, t.derivatives(uv)),
+        }
+    }
+
+    /// [`Patch::eval`] at each of `uvs`, handed to `each(k, point)` in order, with the same
+    /// values; a subdivision patch looks its leaves up a block ahead
+    /// ([`PatchTree::derivatives_each`]). Cost: as many [`Patch::eval`].
+    #[inline(always)]
+    pub fn eval_each(&self, uvs: &[DVec2], mut each: impl FnMut(usize, SurfacePoint)) {
+        match self {
+            Patch::Subdivision(t) => t.derivatives_each(uvs, |k, d| each(k, subdivision_point(t, uvs[k], d))),
+            _ => uvs.iter().enumerate().for_each(|(k, &uv)| each(k, self.eval(uv))),
         }
     }
 
@@ -151,6 +147,25 @@ impl Patch {
 /// points the same way as the normals just inside the domain (and likewise for `v`).
 /// `inside` gives the direction towards the domain's interior at `uv` (used for those signs
 /// and for the last-resort nudge).
+/// A subdivision patch's point at `uv` from its position and derivatives there.
+#[inline(always)]
+fn subdivision_point(t: &PatchTree, uv: DVec2, (position, du, dv): (DVec3, DVec3, DVec3)) -> SurfacePoint {
+    let inside = DVec2::new(0.5 - uv.x, 0.5 - uv.y);
+    let normal = robust_normal(
+        du,
+        dv,
+        uv,
+        inside,
+        || DVec3::ZERO,
+        |q| {
+            let (_, du, dv) = t.derivatives(q);
+            du.cross(dv)
+        },
+    );
+    SurfacePoint { position, normal }
+}
+
+#[inline(always)]
 pub(crate) fn robust_normal(
     du: DVec3,
     dv: DVec3,
