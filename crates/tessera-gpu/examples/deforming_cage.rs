@@ -10,9 +10,10 @@
 //! draw them), and a line per frame gives the vertices uploaded and the GPU time of the
 //! stencil pass and the frame together (submit to idle, read-back excluded).
 //!
-//! The cage's faces must all be regular (every face a bicubic patch): the stencil pass does
-//! not move the isolated pieces around extraordinary vertices and creases yet, and says so
-//! (the GPU draws such cages when they stand still).
+//! Any manifold cage moves, creases and extraordinary vertices included: the stencil pass
+//! recomputes regular faces' control points and isolated faces' pieces alike
+//! (`subdivision/catmark_rook.obj` takes a while to make its stencils: each isolated face is
+//! probed to isolation level 6).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

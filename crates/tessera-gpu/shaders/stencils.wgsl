@@ -1,6 +1,7 @@
-// Stencil pass: one invocation per control point recomputes it from the cage's vertices, the
-// GPU form of `tessera::subdivision::SparseRows::apply_row` (row `16 p + k` is point `k` of
-// patch `p`, a polynomial bicubic: w = 1).
+// Stencil pass: one invocation per point recomputes it from the cage's vertices, the GPU form
+// of `tessera::subdivision::SparseRows::apply_row`: row `r` is the point at `destinations[r]`
+// of the control points (a regular face's control point, or a leaf point of a tree block;
+// polynomial either way: w = 1).
 
 struct Stencils {
     rows: u32,
@@ -10,8 +11,9 @@ struct Stencils {
 @group(0) @binding(1) var<storage, read> starts: array<u32>;
 // (vertex, bitcast<u32>(weight)) per term.
 @group(0) @binding(2) var<storage, read> terms: array<vec2<u32>>;
-@group(0) @binding(3) var<storage, read> cage: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read_write> control_points: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> destinations: array<u32>;
+@group(0) @binding(4) var<storage, read> cage: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> control_points: array<vec4<f32>>;
 
 @compute @workgroup_size(WORKGROUP)
 fn apply_stencils(
@@ -26,5 +28,5 @@ fn apply_stencils(
         let term = terms[k];
         sum += bitcast<f32>(term.y) * cage[term.x].xyz;
     }
-    control_points[r] = vec4<f32>(sum, 1.0);
+    control_points[destinations[r]] = vec4<f32>(sum, 1.0);
 }

@@ -1,25 +1,39 @@
 //! Animated Catmull-Clark cages on the GPU: the cage's stencils
 //! ([`tessera::subdivision::CageStencils`]) uploaded once, and a pass that recomputes every
-//! patch's control points from the cage's vertices, so that a deforming cage re-tessellates
-//! each frame with only its vertices uploaded (16 bytes a vertex).
+//! patch's points from the cage's vertices, so that a deforming cage re-tessellates each frame
+//! with only its vertices uploaded (16 bytes a vertex).
 //!
-//! The rows are the library's ([`CageStencils::bicubic_rows`]), applied by `stencils.wgsl`
-//! in f32 as `SparseRows::apply_row` applies them in f64. What the pass does not refresh:
-//! the view passes' per-patch bounds (culling's boxes and normal cones, the screen criteria's
-//! second-derivative bounds), which [`GpuTessellator::new`] prepared from the set as it was.
-//! A deforming cage is therefore drawn from a plan that needs no bounds — a uniform factor
-//! or hardware factors planned on the CPU ([`GpuTessellator::prepare`]), without a culling
-//! camera — until those bounds are computed on the GPU too.
+//! The rows are the library's ([`CageStencils::rows`], placed by
+//! [`CageStencils::point_ranges`]): a regular face's 16 control points, and every leaf point
+//! of an isolated face's tree where [`crate::upload`] packed it (each tree once, however many
+//! patches view it). `stencils.wgsl` applies them in f32 as `SparseRows::apply_row` does in
+//! f64. What the pass does not refresh: an isolated patch's 16 slots (the bounding box of its
+//! pieces, which culling reads) and the view passes' per-patch bounds (culling's boxes and
+//! normal cones, the screen criteria's second-derivative bounds), which
+//! [`GpuTessellator::new`] prepared from the set as it was. A deforming cage is therefore
+//! drawn from a plan that needs no bounds — a uniform factor or hardware factors planned on
+//! the CPU ([`GpuTessellator::prepare`]), without a culling camera — until those bounds are
+//! computed on the GPU too.
 
 use glam::DVec3;
 
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::shader::{self, Binding};
-use crate::upload::storage_buffer;
+use crate::upload::{storage_buffer, CONTROL_POINTS};
 use crate::GpuTessellator;
 use tessera::subdivision::CageStencils;
-use tessera::surface::SurfaceSet;
+use tessera::surface::{Patch, SurfaceSet};
+
+/// The rows as the pass reads them.
+struct Rows {
+    /// Each row's first term, then the end of the last.
+    starts: Vec<u32>,
+    /// `(cage vertex, f32 weight bits)` per term.
+    terms: Vec<[u32; 2]>,
+    /// Each row's place in the control points.
+    destinations: Vec<u32>,
+}
 
 /// A cage's stencils on the device, bound to one tessellator's control points.
 #[derive(Debug)]
@@ -32,24 +46,62 @@ pub struct GpuStencils {
 }
 
 impl GpuStencils {
-    /// Uploads the rows of `set`'s control points ([`CageStencils::bicubic_rows`]) for
-    /// `tessellator` (made for `set`). The cage's vertices start at the origin: write them
-    /// ([`GpuStencils::write_positions`]) before the first [`GpuStencils::record`].
+    /// Uploads the rows of `set`'s points ([`CageStencils::point_ranges`]) for `tessellator`
+    /// (made for `set`), each with the place in the tessellator's control points it refreshes.
+    /// The cage's vertices start at the origin: write them ([`GpuStencils::write_positions`])
+    /// before the first [`GpuStencils::record`].
     ///
-    /// Errors: those of `bicubic_rows` (a set with isolated faces, whose pieces this pass does
-    /// not move yet, or another cage's set), as [`crate::GpuError::Tessera`]. Cost: O(terms)
-    /// packing, one upload of 8 bytes a term, one WGSL compilation.
+    /// Errors: [`tessera::Error::InvalidParameter`] (as [`crate::GpuError::Tessera`]) when
+    /// `set` is not the stencils' cage's, or `tessellator` was not made for `set`. Cost:
+    /// O(terms) packing, one upload of 8 bytes a term and 4 a point, one WGSL compilation.
     pub fn new(
         ctx: &GpuContext,
         stencils: &CageStencils,
         set: &SurfaceSet,
         tessellator: &GpuTessellator,
     ) -> Result<GpuStencils> {
-        let rows = stencils.bicubic_rows(set)?;
-        let terms: Vec<[u32; 2]> =
-            rows.vertices.iter().zip(&rows.weights).map(|(&v, &w)| [v, (w as f32).to_bits()]).collect();
+        let ranges = stencils.point_ranges(set)?;
+        let (patches, tree_blocks) = tessellator.layout();
+        let trees = set.patches.iter().filter(|p| matches!(p, Patch::Subdivision(_))).count();
+        if patches as usize != set.patches.len() || (trees > 0) != !tree_blocks.is_empty() {
+            return Err(tessera::Error::InvalidParameter {
+                name: "tessellator",
+                reason: format!(
+                    "it was made for a set of {patches} patches and {} trees, not this one of {}",
+                    tree_blocks.len(),
+                    set.patches.len()
+                ),
+            }
+            .into());
+        }
+        let all = stencils.rows();
+        let mut rows = Rows { starts: vec![0], terms: Vec::new(), destinations: Vec::new() };
+        let mut push = |r: usize, destination: usize| {
+            let range = all.starts[r] as usize..all.starts[r + 1] as usize;
+            let terms = all.vertices[range.clone()].iter().zip(&all.weights[range]);
+            rows.terms.extend(terms.map(|(&v, &w)| [v, (w as f32).to_bits()]));
+            rows.starts.push(rows.terms.len() as u32);
+            rows.destinations.push(destination as u32);
+        };
+        for (p, patch) in set.patches.iter().enumerate() {
+            if matches!(patch, Patch::Bicubic(_)) {
+                ranges[p].clone().enumerate().for_each(|(k, r)| push(r, CONTROL_POINTS as usize * p + k));
+            }
+        }
+        for &(p, block) in tree_blocks {
+            let Patch::Subdivision(tree) = &set.patches[p] else {
+                unreachable!("a tree block is a subdivision patch's")
+            };
+            let mut r = ranges[p].start;
+            for (leaf, at) in tree.leaves().iter().zip(crate::upload::leaf_offsets(tree)) {
+                for j in 0..leaf.patch.points().len() {
+                    push(r, (block + at + 1) as usize + j);
+                    r += 1;
+                }
+            }
+        }
         let device = &ctx.device;
-        let count = rows.len() as u32;
+        let count = rows.destinations.len() as u32;
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stencil rows"),
             size: 16,
@@ -58,11 +110,12 @@ impl GpuStencils {
         });
         ctx.queue.write_buffer(&uniform, 0, bytemuck::cast_slice(&[count, 0, 0, 0]));
         let starts = storage_buffer(device, "stencil starts", &rows.starts);
-        let terms = storage_buffer(device, "stencil terms", &terms);
+        let terms = storage_buffer(device, "stencil terms", &rows.terms);
+        let destinations = storage_buffer(device, "stencil destinations", &rows.destinations);
         let positions = storage_buffer(device, "cage vertices", &vec![[0f32; 4]; stencils.vertex_count()]);
         let layout = shader::layout(
             device,
-            &[Binding::Uniform, Binding::Read, Binding::Read, Binding::Read, Binding::Write],
+            &[Binding::Uniform, Binding::Read, Binding::Read, Binding::Read, Binding::Read, Binding::Write],
         );
         let module =
             shader::module(device, "stencils", &[shader::sources::THREADS, shader::sources::STENCILS], &[]);
@@ -70,7 +123,7 @@ impl GpuStencils {
         let bind_group = shader::bind(
             device,
             &layout,
-            &[&uniform, &starts, &terms, &positions, tessellator.control_points()],
+            &[&uniform, &starts, &terms, &destinations, &positions, tessellator.control_points()],
         );
         Ok(GpuStencils {
             rows: count,
@@ -94,10 +147,10 @@ impl GpuStencils {
         Ok(())
     }
 
-    /// Records the pass that recomputes the tessellator's control points from the positions
-    /// last written; record it before the frame ([`GpuTessellator::record`]) in the same or
-    /// an earlier submission. Cost: one invocation per control point, as many multiply-adds
-    /// as its row has terms (16 for a regular face).
+    /// Records the pass that recomputes the tessellator's points from the positions last
+    /// written; record it before the frame ([`GpuTessellator::record`]) in the same or an
+    /// earlier submission. Cost: one invocation per point, as many multiply-adds as its row
+    /// has terms (16 for a regular face's control point, more near features).
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("apply stencils"),

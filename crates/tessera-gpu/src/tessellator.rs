@@ -374,6 +374,12 @@ impl GpuTessellator {
         &self.set.control_points
     }
 
+    /// How many patches the tessellator was made for, and where their trees' blocks are in
+    /// [`GpuTessellator::control_points`] ([`crate::upload::PackedSet::tree_blocks`]).
+    pub(crate) fn layout(&self) -> (u32, &[(usize, u32)]) {
+        (self.set.patches, &self.set.tree_blocks)
+    }
+
     /// Reads the plan the last frame drew back from the device: the uploaded one, or the
     /// GPU's own after [`GpuTessellator::prepare_screen`] (segments, interior factors and
     /// visibility; for the hardware patterns the real factors and the

@@ -55,6 +55,9 @@ pub struct PackedSet {
     pub any_repeated_corner: bool,
     /// Whether any patch is a subdivision patch (then the vertex passes walk trees).
     pub has_trees: bool,
+    /// Each packed tree: the first patch that views it and its block's first row in the
+    /// control points ([`pack_trees`]).
+    pub tree_blocks: Vec<(usize, u32)>,
 }
 
 impl PackedSet {
@@ -152,14 +155,9 @@ fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
         let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("trees are subdivision patches") };
         let block = *blocks.entry(tree.leaves_id()).or_insert_with(|| {
             let block = packed.control_points.len() as u32;
+            packed.tree_blocks.push((p, block));
             let (root, nodes) = tree.quadtree();
-            // Leaf offsets in the block: after the header and the nodes.
-            let mut leaf_at = Vec::with_capacity(tree.leaves().len());
-            let mut at = 1 + nodes.len() as u32;
-            for leaf in tree.leaves() {
-                leaf_at.push(at);
-                at += 1 + leaf.patch.points().len() as u32;
-            }
+            let leaf_at = leaf_offsets(tree);
             let slot =
                 |s: u32| if s & LEAF_SLOT != 0 { LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize] } else { s };
             let out = &mut packed.control_points;
@@ -179,6 +177,20 @@ fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
     }
 }
 
+/// Where each leaf of `tree` starts in its block ([`pack_trees`]): after the header and the
+/// nodes, each leaf's record and then its points. Cost: O(leaves).
+pub(crate) fn leaf_offsets(tree: &tessera::surface::PatchTree) -> Vec<u32> {
+    let mut at = 1 + tree.quadtree().1.len() as u32;
+    tree.leaves()
+        .iter()
+        .map(|leaf| {
+            let start = at;
+            at += 1 + leaf.patch.points().len() as u32;
+            start
+        })
+        .collect()
+}
+
 /// The set's buffers on the device (read-only storage), uploaded once.
 #[derive(Debug)]
 pub struct GpuSet {
@@ -192,6 +204,8 @@ pub struct GpuSet {
     pub any_repeated_corner: bool,
     /// Whether any patch is a subdivision patch.
     pub has_trees: bool,
+    /// The packed trees ([`PackedSet::tree_blocks`]).
+    pub tree_blocks: Vec<(usize, u32)>,
     /// Control points.
     pub control_points: wgpu::Buffer,
     /// Patch rows.
@@ -233,6 +247,7 @@ impl GpuSet {
             corners: set.topology.corner_entries.len() as u32,
             any_repeated_corner: packed.any_repeated_corner,
             has_trees: packed.has_trees,
+            tree_blocks: packed.tree_blocks.clone(),
             control_points: storage_buffer(device, "control points", &packed.control_points),
             patch_rows: storage_buffer(device, "patch rows", &packed.patch_rows),
             edge_rows: storage_buffer(device, "edge rows", &packed.edge_rows),

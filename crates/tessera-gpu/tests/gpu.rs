@@ -909,53 +909,68 @@ fn subdivision_cages_equal_the_cpu_engine_on_every_cage() {
 }
 
 /// A deforming Catmull-Clark cage on the GPU (`GpuStencils`): each frame uploads the moved
-/// cage vertices only, the stencil pass recomputes the control points, and the frame equals
-/// the CPU engine's on the set the CPU's stencils give for the same vertices.
+/// cage vertices only, the stencil pass recomputes the control points and the isolated faces'
+/// pieces, and the frame equals the CPU engine's on the set the CPU's stencils give for the
+/// same vertices.
 #[test]
 fn stencils_deform_a_cage_on_the_gpu_as_on_the_cpu() {
     use glam::DVec3;
     use tessera::subdivision::{CageOptions, CageStencils};
     use tessera_gpu::GpuStencils;
     let ctx = ctx();
-    let path = data_dir().join("subdivision/catmark_torus.obj");
-    let mesh = tessera::io::obj::read_obj(&path).unwrap();
-    let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
-    let mut gpu = tessellator(&set);
-    let on_gpu = GpuStencils::new(ctx, &stencils, &set, &gpu).unwrap();
-    let plan = Plan::uniform(&set, 5).unwrap();
-    gpu.prepare(ctx, &set, &plan, &Uniform).unwrap();
-    let (_, before) = cpu(&set, &plan, &Uniform);
-    for frame in 1..=3 {
-        // A twist about z that grows frame by frame.
-        let moved: Vec<DVec3> = mesh
-            .positions
-            .iter()
-            .map(|p| {
-                let (s, c) = (0.4 * frame as f64 * p.z).sin_cos();
-                DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z * (1.0 + 0.1 * frame as f64))
-            })
-            .collect();
-        on_gpu.write_positions(ctx, &moved).unwrap();
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        on_gpu.record(&mut encoder);
-        gpu.record(&mut encoder);
-        ctx.queue.submit([encoder.finish()]);
-        stencils.apply(&moved, &mut set).unwrap();
-        assert_gpu_equals_cpu_after_record(&format!("torus frame {frame}"), &set, &gpu, &plan, &Uniform);
+    // A regular cage (control points only), one with creases (isolated quads: their trees'
+    // leaf points) and one split into sub-faces (an isolated quad's quarters view one tree).
+    for cage in ["catmark_torus", "catmark_torus_creases0", "catmark_pyramid_creases0"] {
+        let path = data_dir().join(format!("subdivision/{cage}.obj"));
+        let mesh = tessera::io::obj::read_obj(&path).unwrap();
+        let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+        let mut gpu = tessellator(&set);
+        let on_gpu = GpuStencils::new(ctx, &stencils, &set, &gpu).unwrap();
+        let plan = Plan::uniform(&set, 5).unwrap();
+        gpu.prepare(ctx, &set, &plan, &Uniform).unwrap();
+        let (_, before) = cpu(&set, &plan, &Uniform);
+        let (lo, hi) = set.bounds();
+        for frame in 1..=3 {
+            // A twist about z that grows frame by frame.
+            let moved: Vec<DVec3> = mesh
+                .positions
+                .iter()
+                .map(|p| {
+                    let (s, c) = (0.4 * frame as f64 * p.z / (hi.z - lo.z)).sin_cos();
+                    DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z * (1.0 + 0.1 * frame as f64))
+                })
+                .collect();
+            on_gpu.write_positions(ctx, &moved).unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            on_gpu.record(&mut encoder);
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+            stencils.apply(&moved, &mut set).unwrap();
+            assert_gpu_equals_cpu_after_record(&format!("{cage} frame {frame}"), &set, &gpu, &plan, &Uniform);
+        }
+        // Not vacuous: the surface did move.
+        let after = gpu.read_mesh(ctx, &set).unwrap();
+        assert_eq!(after.positions.len(), before.positions.len());
+        let far = 0.01 * lo.distance(hi) as f32;
+        assert!(
+            after.positions.iter().zip(&before.positions).any(|(a, b)| (a[2] - b[2]).abs() > far),
+            "{cage}"
+        );
+        if cage != "catmark_torus" {
+            continue;
+        }
+        // Refusals: other vertex counts, NaN, a tessellator made for another set.
+        let e = on_gpu.write_positions(ctx, &mesh.positions[1..]).unwrap_err();
+        assert!(e.to_string().contains("positions for a cage of"), "{e}");
+        let mut nan = mesh.positions.clone();
+        nan[0].x = f64::NAN;
+        assert!(on_gpu.write_positions(ctx, &nan).unwrap_err().to_string().contains("not finite"));
+        let cube_path = data_dir().join("subdivision/catmark_cube.obj");
+        let cube = tessera::io::obj::read_obj(&cube_path).unwrap();
+        let cube_set =
+            tessera::surface::SurfaceSet::from_subdivision_cage(&cube, &cube_path, CageOptions::default())
+                .unwrap();
+        let e = GpuStencils::new(ctx, &stencils, &set, &tessellator(&cube_set)).unwrap_err();
+        assert!(e.to_string().contains("it was made for a set of"), "{e}");
     }
-    // Not vacuous: the surface did move.
-    let after = gpu.read_mesh(ctx, &set).unwrap();
-    assert_eq!(after.positions.len(), before.positions.len());
-    assert!(after.positions.iter().zip(&before.positions).any(|(a, b)| (a[0] - b[0]).abs() > 0.1));
-    // Refusals: other vertex counts, NaN, a cage with isolated faces.
-    let e = on_gpu.write_positions(ctx, &mesh.positions[1..]).unwrap_err();
-    assert!(e.to_string().contains("positions for a cage of"), "{e}");
-    let mut nan = mesh.positions.clone();
-    nan[0].x = f64::NAN;
-    assert!(on_gpu.write_positions(ctx, &nan).unwrap_err().to_string().contains("not finite"));
-    let cube_path = data_dir().join("subdivision/catmark_cube.obj");
-    let cube = tessera::io::obj::read_obj(&cube_path).unwrap();
-    let (cube_set, cube_stencils) = CageStencils::build(&cube, &cube_path, CageOptions::default()).unwrap();
-    let e = GpuStencils::new(ctx, &cube_stencils, &cube_set, &gpu).unwrap_err();
-    assert!(e.to_string().contains("not one bicubic net"), "{e}");
 }

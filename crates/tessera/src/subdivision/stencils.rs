@@ -26,7 +26,7 @@ use super::catmull_clark::{assemble, is_split, oriented_cage, Built};
 use super::isolation::PatchTree;
 use super::CageOptions;
 use crate::error::{Error, Result};
-use crate::surface::{Patch, PolygonMesh, RationalBicubic, SurfaceSet};
+use crate::surface::{Patch, PatchOrigin, PolygonMesh, RationalBicubic, SurfaceSet};
 
 /// Sparse rows: row `r`'s terms are `vertices[k]` with `weights[k]` for `k` in
 /// `starts[r]..starts[r + 1]`; `starts` has one more entry than there are rows.
@@ -81,6 +81,16 @@ enum FaceShape {
     Regular(usize),
     /// The isolation's trees (one per sub-face of a face that is not a quad).
     Isolated(Vec<PatchTree>),
+}
+
+/// Which of its face's trees a subdivision patch views: the one tree of a quad (its quarters
+/// are views of it), else its sub-face's.
+fn tree_index(origin: &PatchOrigin) -> usize {
+    if origin.corners == 4 {
+        0
+    } else {
+        usize::from(origin.subface)
+    }
 }
 
 /// The stencils of a cage's [`SurfaceSet`] ([`CageStencils::build`]): one sparse row per
@@ -207,43 +217,43 @@ impl CageStencils {
                     let at = self.face_rows[f] as usize + 16 * piece;
                     *b = RationalBicubic::polynomial(std::array::from_fn(|k| points[at + k]));
                 }
-                Patch::Subdivision(tree) => {
-                    let tree_index = if origin.corners == 4 { 0 } else { piece };
-                    **tree = tree.with_tree_of(&trees[f][tree_index]);
-                }
+                Patch::Subdivision(tree) => **tree = tree.with_tree_of(&trees[f][tree_index(origin)]),
                 _ => unreachable!("checked by check_set"),
             }
         });
         Ok(())
     }
 
-    /// The rows of every patch's 16 control points in patch order (row `16 p + k` is point
-    /// `k` of patch `p`), for an engine that recomputes them itself, e.g. the GPU's.
+    /// Where each patch's points are among [`CageStencils::rows`], patch by patch: a bicubic
+    /// patch's 16 control points (`points[4*i + j]`), or the leaf points of the isolated
+    /// face's tree the patch views, in [`PatchTree::leaf_points`] order (the views of one
+    /// tree — a split quad's quarters — have the same range). For an engine that recomputes
+    /// the points itself, e.g. the GPU's.
     ///
-    /// Errors: [`Error::InvalidParameter`] when `set` is not this cage's, or has a patch that
-    /// is not a bicubic (an isolated face's pieces are no single net). Cost: O(entries).
-    pub fn bicubic_rows(&self, set: &SurfaceSet) -> Result<SparseRows> {
+    /// Errors: [`Error::InvalidParameter`] when `set` is not this cage's. Cost: O(patches +
+    /// leaves).
+    pub fn point_ranges(&self, set: &SurfaceSet) -> Result<Vec<std::ops::Range<usize>>> {
         self.check_set(set)?;
-        let mut out = SparseRows { starts: vec![0], ..Default::default() };
-        for (p, (patch, origin)) in set.patches.iter().zip(&set.origins).enumerate() {
-            if !matches!(patch, Patch::Bicubic(_)) {
-                return Err(Error::InvalidParameter {
-                    name: "set",
-                    reason: format!(
-                        "patch {p} (face {}) is an isolated face's pieces, not one bicubic net",
-                        origin.face + 1
-                    ),
-                });
-            }
-            let first = self.face_rows[origin.face as usize] as usize + 16 * usize::from(origin.subface);
-            for r in first..first + 16 {
-                let range = self.rows.starts[r] as usize..self.rows.starts[r + 1] as usize;
-                out.vertices.extend_from_slice(&self.rows.vertices[range.clone()]);
-                out.weights.extend_from_slice(&self.rows.weights[range]);
-                out.starts.push(out.vertices.len() as u32);
-            }
-        }
-        Ok(out)
+        Ok(set
+            .origins
+            .iter()
+            .map(|origin| {
+                let f = origin.face as usize;
+                let start = self.face_rows[f] as usize;
+                match &self.shapes[f] {
+                    FaceShape::Regular(_) => {
+                        let first = start + 16 * usize::from(origin.subface);
+                        first..first + 16
+                    }
+                    FaceShape::Isolated(trees) => {
+                        let t = tree_index(origin);
+                        let first = start + trees[..t].iter().map(PatchTree::leaf_point_count).sum::<usize>();
+                        first..first + trees[t].leaf_point_count()
+                    }
+                    FaceShape::Hole => start..start,
+                }
+            })
+            .collect())
     }
 
     /// Whether `set` has the patches these stencils were made for: the count, and each
@@ -432,27 +442,44 @@ mod tests {
                 .unwrap();
         let e = stencils.apply(&mesh.positions, &mut torus).unwrap_err();
         assert!(e.to_string().contains("patches"), "{e}");
-        // The cube's faces are all isolated: no bicubic rows.
-        let e = stencils.bicubic_rows(&set).unwrap_err();
-        assert!(e.to_string().contains("not one bicubic net"), "{e}");
+        let e = stencils.point_ranges(&torus).unwrap_err();
+        assert!(e.to_string().contains("patches"), "{e}");
     }
 
-    /// A regular cage's bicubic rows reproduce its control points.
+    /// Each patch's point ranges reproduce its points: a regular cage's control points, and
+    /// the leaf points of isolated faces' trees (a split quad's quarters sharing one range).
     #[test]
-    fn bicubic_rows_give_the_control_points() {
-        let path = data("subdivision/catmark_torus.obj");
-        let mesh = read_obj(&path).unwrap();
-        let (set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
-        let rows = stencils.bicubic_rows(&set).unwrap();
-        assert_eq!(rows.len(), 16 * set.patches.len());
-        for (p, patch) in set.patches.iter().enumerate() {
-            let Patch::Bicubic(b) = patch else { panic!("the torus is regular") };
-            for k in 0..16 {
-                let d = rows.apply_row(16 * p + k, &mesh.positions).distance(b.points[k]);
-                assert!(d < 1e-12, "patch {p} point {k}: {d:e}");
+    fn point_ranges_give_every_patchs_points() {
+        for (cage, split) in
+            [("catmark_torus", false), ("catmark_torus_creases0", false), ("catmark_pyramid_creases0", true)]
+        {
+            let path = data(&format!("subdivision/{cage}.obj"));
+            let mesh = read_obj(&path).unwrap();
+            let (set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+            let ranges = stencils.point_ranges(&set).unwrap();
+            assert_eq!(ranges.len(), set.patches.len());
+            let rows = stencils.rows();
+            let mut shared = 0;
+            for (p, (patch, range)) in set.patches.iter().zip(&ranges).enumerate() {
+                let want = match patch {
+                    Patch::Bicubic(b) => b.points.to_vec(),
+                    Patch::Subdivision(t) => {
+                        let mut points = Vec::new();
+                        t.leaf_points(&mut points);
+                        points
+                    }
+                    _ => unreachable!("a cage's patches"),
+                };
+                assert_eq!(range.len(), want.len(), "{cage} patch {p}");
+                for (r, w) in range.clone().zip(&want) {
+                    let d = rows.apply_row(r, &mesh.positions).distance(*w);
+                    assert!(d < 1e-12, "{cage} patch {p} row {r}: {d:e}");
+                }
+                shared += ranges[..p].iter().filter(|q| *q == range).count();
             }
+            // Only the pyramid's quad (split, isolated: its corners have valence 3) has
+            // quarters that view one tree.
+            assert_eq!(shared > 0, split, "{cage}: {shared} patches share an earlier one's range");
         }
-        // B-spline stencils: 16 terms at most per point of a regular net.
-        assert!((0..rows.len()).all(|r| rows.starts[r + 1] - rows.starts[r] <= 16));
     }
 }
