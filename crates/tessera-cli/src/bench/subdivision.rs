@@ -56,7 +56,7 @@ pub fn bfr_program(given: Option<&Path>) -> Option<PathBuf> {
 }
 
 pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
-    let runs = if ctx.quick { 3 } else { 9 };
+    let runs = if ctx.quick { 3 } else { 5 };
     let bfr = bfr_program(bfr);
     if bfr.is_none() {
         ctx.note(
