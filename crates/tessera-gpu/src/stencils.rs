@@ -63,7 +63,7 @@ impl GpuStencils {
         let ranges = stencils.point_ranges(set)?;
         let (patches, tree_blocks) = tessellator.layout();
         let trees = set.patches.iter().filter(|p| matches!(p, Patch::Subdivision(_))).count();
-        if patches as usize != set.patches.len() || (trees > 0) != !tree_blocks.is_empty() {
+        if patches as usize != set.patches.len() || (trees > 0) == tree_blocks.is_empty() {
             return Err(tessera::Error::InvalidParameter {
                 name: "tessellator",
                 reason: format!(

@@ -56,7 +56,7 @@ pub struct PackedSet {
     /// Whether any patch is a subdivision patch (then the vertex passes walk trees).
     pub has_trees: bool,
     /// Each packed tree: the first patch that views it and its block's first row in the
-    /// control points ([`pack_trees`]).
+    /// control points (laid out as the module's documentation says).
     pub tree_blocks: Vec<(usize, u32)>,
 }
 
