@@ -139,14 +139,6 @@ impl Patch {
     }
 }
 
-/// A unit normal from the first derivatives, falling back to the limit normal where they are
-/// parallel (a boundary curve collapsed to a point, as at the teapot's lid apex).
-///
-/// `second` supplies the mixed derivative `S_uv` used by the limit: near a collapsed `u = u0`
-/// boundary `S_v ≈ (u-u0)·S_uv`, so the normal tends to `±S_u × S_uv`, with the sign that
-/// points the same way as the normals just inside the domain (and likewise for `v`).
-/// `inside` gives the direction towards the domain's interior at `uv` (used for those signs
-/// and for the last-resort nudge).
 /// A subdivision patch's point at `uv` from its position and derivatives there.
 #[inline(always)]
 fn subdivision_point(t: &PatchTree, uv: DVec2, (position, du, dv): (DVec3, DVec3, DVec3)) -> SurfacePoint {
@@ -165,6 +157,14 @@ fn subdivision_point(t: &PatchTree, uv: DVec2, (position, du, dv): (DVec3, DVec3
     SurfacePoint { position, normal }
 }
 
+/// A unit normal from the first derivatives, falling back to the limit normal where they are
+/// parallel (a boundary curve collapsed to a point, as at the teapot's lid apex).
+///
+/// `second` supplies the mixed derivative `S_uv` used by the limit: near a collapsed `u = u0`
+/// boundary `S_v ≈ (u-u0)·S_uv`, so the normal tends to `±S_u × S_uv`, with the sign that
+/// points the same way as the normals just inside the domain (and likewise for `v`).
+/// `inside` gives the direction towards the domain's interior at `uv` (used for those signs
+/// and for the last-resort nudge).
 #[inline(always)]
 pub(crate) fn robust_normal(
     du: DVec3,

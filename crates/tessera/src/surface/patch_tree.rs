@@ -348,11 +348,12 @@ impl PatchTree {
 
     /// [`PatchTree::derivatives`] at each of `uvs`, handed to `each(k, derivatives)` in
     /// order, with the same values. Why a batch: a tessellation's points mostly fall in
-    /// different leaves (at factor 8 a grid step is 8 of the deepest leaves), each leaf's
-    /// data (a few hundred bytes) is a cache miss, and one point's arithmetic is too short
-    /// for the processor to overlap the next miss on its own. So the leaves of eight
-    /// points are found from the quadtree first and their loads started, then evaluated.
-    /// Cost: as many [`PatchTree::derivatives`], with the misses overlapped.
+    /// different leaves (at factor 8 a grid step is 8 of the deepest leaves), and profiles
+    /// show the load of each point's leaf (a few hundred bytes) stalling. So the leaves of
+    /// eight points are found from the quadtree first and their loads started, then
+    /// evaluated. (On the noisy 2-core machine this was written on, the prefetch alone gave
+    /// no gain that stood out of the noise; the batch as a whole, inlined into the engines'
+    /// AVX2 path, did.) Cost: as many [`PatchTree::derivatives`].
     #[inline(always)]
     pub fn derivatives_each(&self, uvs: &[DVec2], mut each: impl FnMut(usize, (DVec3, DVec3, DVec3))) {
         let mut found = [(0, DVec2::ZERO); AHEAD];
@@ -486,8 +487,8 @@ pub fn rotate(uv: DVec2, quarters: u8) -> DVec2 {
     p
 }
 
-/// Points whose leaves [`PatchTree::derivatives_each`] looks up before evaluating any: enough
-/// misses in flight to cover a memory latency, few enough that the leaves stay in L1.
+/// Points whose leaves [`PatchTree::derivatives_each`] looks up before evaluating any: a few
+/// loads in flight, few enough that their leaves (eight of 424 bytes) stay in L1.
 const AHEAD: usize = 8;
 
 /// Starts loading `leaf` into the cache (a hint: no effect on results).
