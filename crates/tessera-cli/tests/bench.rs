@@ -122,6 +122,15 @@ fn quick_bench_writes_every_table_and_counts_repeat() {
     let speed = first["speed_uniform"]["rows"].as_array().unwrap();
     let torus4 = speed.iter().find(|r| r["model"] == "torus_64x32" && r["factor"] == 4).unwrap();
     assert_eq!(torus4["triangles"], 2048 * 2 * 16);
+    // Every CPU row's output rate against the machine's measured fill bandwidth: the frame's
+    // output bytes (36 a vertex, 16 a triangle) over its time, and a share of the fill rate.
+    for r in speed.iter().filter(|r| r["engine"] == "cpu") {
+        let (rate, share) = (r["output GB/s"].as_f64().unwrap(), r["% of fill bandwidth"].as_f64().unwrap());
+        let bytes = 36.0 * r["vertices"].as_f64().unwrap() + 16.0 * r["triangles"].as_f64().unwrap();
+        let expected = bytes / r["frame ms"].as_f64().unwrap() / 1e6;
+        assert!((rate - expected).abs() <= 0.02 * expected + 0.01, "{r}: {rate} GB/s, expected {expected}");
+        assert!(share > 0.0 && share.is_finite(), "{r}");
+    }
     // OpenSubdiv's Bfr at rate 16 makes exactly tessera's uniform triangles (factor 16 on
     // whole quads); at 0.5 px it tessellated the cages with the rates of tessera's plan.
     for r in first["subdivision_bfr"]["rows"].as_array().unwrap() {

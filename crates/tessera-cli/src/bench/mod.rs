@@ -8,6 +8,7 @@
 
 mod adaptive;
 mod frame;
+mod memory;
 mod paper;
 mod plot;
 mod scenes;
@@ -237,13 +238,15 @@ fn machine() -> serde_json::Value {
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|l| l.split_whitespace().next().and_then(|x| x.parse::<f64>().ok()));
-    serde_json::json!({ "cpu": cpu, "cores": cores, "load_1min_at_start": load })
+    let l3 = memory::l3_bytes();
+    serde_json::json!({ "cpu": cpu, "cores": cores, "l3_bytes": l3, "load_1min_at_start": load })
 }
 
 fn machine_line(m: &serde_json::Value) -> String {
     let load = m["load_1min_at_start"].as_f64().map_or("unknown".into(), |l| format!("{l:.2}"));
+    let l3 = m["l3_bytes"].as_u64().map_or("L3 size unknown".into(), |b| format!("L3 {} MiB", b >> 20));
     format!(
-        "{}, {} cores available, 1-minute load average {load} at the start",
+        "{}, {} cores available, {l3}, 1-minute load average {load} at the start",
         m["cpu"].as_str().unwrap_or("?"),
         m["cores"]
     )

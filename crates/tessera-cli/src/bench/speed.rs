@@ -1,7 +1,10 @@
 //! `speed`: uniform tessellation throughput per stage — torus_64x32 and the teapot at
-//! factors 4/8/16/32, PN triangles on the three largest meshes — for each `--threads` count
-//! (rayon pools), and the GPU engine on the same plans when an adapter exists.
+//! factors 4/8/16/32 (and the torus at 64, an output far larger than any cache), PN
+//! triangles on the three largest meshes — for each `--threads` count (rayon pools), each
+//! row's output rate against the machine's measured fill bandwidth ([`super::memory`]), and
+//! the GPU engine on the same plans when an adapter exists.
 
+use super::memory;
 use super::plot::{self, Axes, Series};
 use super::table::{num, Cell, Table};
 use super::{frames, median_p95, scenes, BenchResult, Ctx, StageSeries};
@@ -37,7 +40,8 @@ fn cases(quick: bool) -> Vec<Case> {
         ];
     }
     vec![
-        case("bench/torus_64x32.patches", &[4, 8, 16, 32], &[4, 8, 16]),
+        // Factor 64: 16.8 M triangles, 0.6 GB of output, beyond every L3.
+        case("bench/torus_64x32.patches", &[4, 8, 16, 32, 64], &[4, 8, 16]),
         case("patches/teapot.patches", &[4, 8, 16, 32], &[16]),
         // The three largest meshes of the shared folder (88.9k, 69.5k and 52k triangles).
         case("meshes/elephant_refined.obj", &[4], &[4]),
@@ -53,9 +57,18 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     let gpu_steps: usize = cases.iter().map(|c| c.gpu_factors.len()).sum();
     ctx.plan_steps((cpu_steps + gpu_steps) as u64);
     let adapter = if ctx.gpu { gpu_adapter(ctx) } else { None };
+    // The fill rate of each pool, measured before the rows (a GiB: beyond any L3 today).
+    let fill_bytes = if ctx.quick { 256 << 20 } else { 1 << 30 };
+    ctx.plan_steps(ctx.threads.len() as u64);
+    let mut fill = Vec::new();
+    for &threads in &ctx.threads {
+        ctx.step(&format!("speed: memory fill bandwidth, {threads} threads"));
+        fill.push(ctx.on_threads(threads, || memory::fill_bandwidth(fill_bytes, 5))?);
+    }
 
     let mut columns = vec!["model", "patches", "factor", "engine", "threads"];
     columns.extend(STAGE_COLUMNS);
+    columns.extend(["output GB/s", "% of fill bandwidth"]);
     let mut table = Table::new("speed_uniform", "speed: uniform tessellation, medians per stage", &columns);
     let pass_columns: Vec<String> = ["model", "factor", "adapter"]
         .iter()
@@ -71,7 +84,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     for case in &cases {
         let set = scenes::load(ctx, case.model)?;
         let name = short(case.model);
-        for &threads in &ctx.threads {
+        for (&threads, &fill) in ctx.threads.iter().zip(&fill) {
             let mut curve = Series { name: format!("{name}, {threads} thr"), points: Vec::new() };
             for &factor in &case.factors {
                 ctx.step(&format!("speed: {name} factor {factor}, {threads} threads"));
@@ -94,6 +107,10 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                     threads.into(),
                 ];
                 row.extend(cells);
+                let bytes =
+                    tessera::mesh::output_bytes(series.vertices[0] as u64, series.triangles[0] as u64, false);
+                let rate = bytes as f64 / median_p95(&series.total).0 / 1e6;
+                row.extend([num(rate, 2), num(100.0 * rate / fill, 0)]);
                 table.row(row);
             }
             curves.push(curve);
@@ -128,6 +145,8 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
                 num(p95, 3),
                 num(mtri, 1),
                 num(total * 1e6 / vert as f64, 2),
+                Cell::None,
+                Cell::None,
             ]);
             if !gpu.passes_ms.is_empty() {
                 let mut row: Vec<Cell> =
@@ -145,6 +164,17 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         "Medians of {runs} frames after one warm-up frame, each a whole `Tessellator::frame` into reused buffers \
          (criterion → resolve → layout → write, the stages `tessera mesh --stats` reports); Mtri/s = triangles / \
          frame median; ns/vertex = frame median / vertices. CPU rows run in rayon pools of the given size."
+    ));
+    let l3 = memory::l3_bytes().map_or("unknown (no sysfs)".to_string(), |b| format!("{} MiB", b >> 20));
+    let rates: Vec<String> =
+        ctx.threads.iter().zip(&fill).map(|(t, f)| format!("{f:.1} GB/s with {t} thread(s)")).collect();
+    table.note(format!(
+        "Memory: L3 {l3}; fill bandwidth {} (median of 5 in-process fills of a {} MiB buffer, `slice::fill` = \
+         memset, one contiguous share a thread). Output GB/s = the frame's output bytes (36 a vertex: position, \
+         normal, uv, patch; 16 a triangle: indices, patch) / frame median; a frame whose output exceeds the L3 \
+         is bounded by the fill bandwidth, one that fits may exceed it.",
+        rates.join(", "),
+        fill_bytes >> 20
     ));
     match &adapter {
         Some(a) => table.note(format!(
@@ -280,7 +310,8 @@ fn schemes_table(ctx: &Ctx, runs: usize) -> BenchResult<Table> {
         }
     }
     t.note(format!(
-        "Medians of {runs} frames from the framing camera (1280×720), after a warm-up frame; criteria as          `tessera mesh` takes them (silhouetteness for transition and semi-uniform, vertex silhouettes for SD-2)."
+        "Medians of {runs} frames from the framing camera (1280×720), after a warm-up frame; criteria as \
+         `tessera mesh` takes them (silhouetteness for transition and semi-uniform, vertex silhouettes for SD-2)."
     ));
     Ok(t)
 }

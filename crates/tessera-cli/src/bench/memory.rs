@@ -1,0 +1,81 @@
+//! The machine's memory as the speed suite reports it: the last-level cache's size and the
+//! rate at which one or more threads fill memory. A uniform frame writes its output once, so
+//! once the output is larger than the cache its speed is bounded by that fill rate; the
+//! rows give their output bytes per second as a share of it, which says how far a frame is
+//! from memory speed on *this* machine (whose cache may hold a whole frame, or not).
+
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// The size of the last-level (L3) cache of CPU 0 in bytes, from Linux's sysfs; None where
+/// it does not say (another system, or a processor without one).
+pub fn l3_bytes() -> Option<u64> {
+    let dir = std::path::Path::new("/sys/devices/system/cpu/cpu0/cache");
+    std::fs::read_dir(dir).ok()?.flatten().find_map(|entry| {
+        let level = std::fs::read_to_string(entry.path().join("level")).ok()?;
+        if level.trim() != "3" {
+            return None;
+        }
+        parse_cache_size(&std::fs::read_to_string(entry.path().join("size")).ok()?)
+    })
+}
+
+/// A sysfs cache size (`"36608K"`, `"260M"`, `"512"`) in bytes.
+fn parse_cache_size(text: &str) -> Option<u64> {
+    let t = text.trim();
+    let (digits, unit) = match t.char_indices().find(|(_, c)| !c.is_ascii_digit()) {
+        Some((i, _)) => t.split_at(i),
+        None => (t, ""),
+    };
+    let n: u64 = digits.parse().ok()?;
+    let scale = match unit.trim() {
+        "" => 1,
+        "K" | "k" => 1 << 10,
+        "M" => 1 << 20,
+        "G" => 1 << 30,
+        _ => return None,
+    };
+    n.checked_mul(scale)
+}
+
+/// Memory fill bandwidth in GB/s (10⁹ bytes a second) with the threads of the current rayon
+/// pool: the median of `runs` timed fills of a `bytes` buffer (`slice::fill`, that is
+/// `memset`, each thread filling one contiguous share), after one untimed fill that maps
+/// the pages. Choose `bytes` well above the L3 size, or this measures the cache.
+/// Cost: `bytes` of memory for the call and `runs + 1` fills.
+pub fn fill_bandwidth(bytes: usize, runs: usize) -> f64 {
+    let mut buffer = vec![0u8; bytes];
+    let share = bytes.div_ceil(rayon::current_num_threads()).max(1);
+    let mut fill = |value: u8| buffer.par_chunks_mut(share).for_each(|c| c.fill(value));
+    fill(1);
+    let mut rates: Vec<f64> = (0..runs.max(1))
+        .map(|r| {
+            let start = Instant::now();
+            fill(r as u8);
+            bytes as f64 / start.elapsed().as_secs_f64() / 1e9
+        })
+        .collect();
+    std::hint::black_box(&buffer);
+    rates.sort_by(f64::total_cmp);
+    rates[rates.len() / 2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sysfs_cache_sizes_parse() {
+        assert_eq!(parse_cache_size("36608K\n"), Some(36608 * 1024));
+        assert_eq!(parse_cache_size("260M"), Some(260 << 20));
+        assert_eq!(parse_cache_size("512"), Some(512));
+        assert_eq!(parse_cache_size("big"), None);
+        assert_eq!(parse_cache_size("12X"), None);
+    }
+
+    #[test]
+    fn a_fill_has_a_finite_positive_rate() {
+        let rate = fill_bandwidth(1 << 20, 3);
+        assert!(rate.is_finite() && rate > 0.0, "{rate}");
+    }
+}
