@@ -8,7 +8,7 @@ use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
 use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
-use tessera_gpu::tessellator::{PassTimer, ScreenCriterion, PASSES};
+use tessera_gpu::tessellator::{Capacity, PassTimer, ScreenCriterion, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator, ScreenReport};
 
 /// What a GPU run gives back beside the mesh.
@@ -52,6 +52,10 @@ pub fn tessellate_from_camera(
     let ctx = GpuContext::new()?;
     let mut gpu = GpuTessellator::new(&ctx, set)?;
     let prepared = Prepared::new(set, true);
+    // One frame, not a loop: room for the frame's likely size, grown to what it needs after
+    // an overflow (one read-back), rather than buffers for the worst case a camera could
+    // ask, which for a large set is the device's whole buffer limit.
+    let screen = ScreenCriterion { capacity: screen.capacity.or(Some(FIRST_ROOM)), ..screen };
     gpu.prepare_screen(&ctx, set, &prepared, camera, screen)?;
     let mut run = frames(&ctx, &mut gpu, repeat, times)?;
     if gpu.grow_if_overflowed(&ctx)? {
@@ -63,6 +67,10 @@ pub fn tessellate_from_camera(
     run.culled = gpu.read_visible(&ctx)?.iter().filter(|&&v| v == 0).count();
     Ok(run)
 }
+
+/// The output room a frame planned on the GPU starts with (`tessellate_from_camera`):
+/// 4 M triangles, about 110 MB of vertex and index buffers.
+const FIRST_ROOM: Capacity = Capacity { vertices: 2 << 20, triangles: 4 << 20 };
 
 /// Records `repeat` frames of `gpu`'s prepared work, timing each; with more than one, after
 /// an untimed warm-up frame (drivers compile pipelines and fault buffers in at first use).

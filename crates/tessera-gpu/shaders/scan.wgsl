@@ -4,6 +4,11 @@
 // `sums`, the totals are scanned the same way (recursively), and `scan_blocks` scans each
 // block in workgroup memory and adds its block's prefix. Portable: workgroup memory and
 // barriers only, no subgroup operations.
+//
+// Sums saturate at 0xffffffff instead of wrapping (saturating addition is associative, so
+// every level may add in any grouping): a frame whose counts pass the u32 range ends with a
+// total of 0xffffffff, which no output buffer holds, so the frame is refused as overflowing
+// (`indirect_args.wgsl`) instead of wrapping to a small total that would seem to fit.
 
 struct Params {
     // Elements to scan.
@@ -26,6 +31,11 @@ const BLOCK: u32 = WG * ITEMS;
 var<workgroup> partial: array<u32, WG>;
 var<workgroup> tile: array<u32, BLOCK>;
 
+// a + b, or 0xffffffff where that passes the u32 range.
+fn add(a: u32, b: u32) -> u32 {
+    return select(a + b, 0xffffffffu, b > 0xffffffffu - a);
+}
+
 // Workgroups are laid out in 2D when one dimension is not enough (65,535 at most).
 fn block_index(wid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return wid.y * nwg.x + wid.x;
@@ -40,7 +50,7 @@ fn scan_partial(lid: u32) {
             left = partial[lid - offset];
         }
         workgroupBarrier();
-        partial[lid] = partial[lid] + left;
+        partial[lid] = add(partial[lid], left);
         workgroupBarrier();
     }
 }
@@ -58,14 +68,14 @@ fn reduce(
     for (var i = 0u; i < ITEMS; i = i + 1u) {
         let k = first + i * WG + lid;
         if (k < params.len) {
-            total = total + data[k];
+            total = add(total, data[k]);
         }
     }
     partial[lid] = total;
     workgroupBarrier();
     for (var stride = WG / 2u; stride > 0u; stride = stride / 2u) {
         if (lid < stride) {
-            partial[lid] = partial[lid] + partial[lid + stride];
+            partial[lid] = add(partial[lid], partial[lid + stride]);
         }
         workgroupBarrier();
     }
@@ -94,19 +104,24 @@ fn scan_blocks(
     // Each invocation owns ITEMS consecutive elements of the tile.
     var run = 0u;
     for (var i = 0u; i < ITEMS; i = i + 1u) {
-        run = run + tile[lid * ITEMS + i];
+        run = add(run, tile[lid * ITEMS + i]);
     }
     partial[lid] = run;
     workgroupBarrier();
     scan_partial(lid);
-    var prefix = partial[lid] - run + params.base;
+    // The exclusive prefix is the previous invocation's inclusive one (not the own one minus
+    // `run`, which a saturated sum would not give back).
+    var prefix = params.base;
+    if (lid > 0u) {
+        prefix = add(prefix, partial[lid - 1u]);
+    }
     if (params.has_prefix != 0u && first < params.len) {
-        prefix = prefix + sums[block];
+        prefix = add(prefix, sums[block]);
     }
     for (var i = 0u; i < ITEMS; i = i + 1u) {
         let x = tile[lid * ITEMS + i];
         tile[lid * ITEMS + i] = prefix;
-        prefix = prefix + x;
+        prefix = add(prefix, x);
     }
     workgroupBarrier();
     for (var i = 0u; i < ITEMS; i = i + 1u) {

@@ -50,6 +50,39 @@ fn scan_of_any_length_equals_a_cpu_scan() {
     }
 }
 
+/// Counts whose sums pass the u32 range: every prefix from there on is `u32::MAX` (the scan
+/// saturates, so a frame that large reads as overflowing instead of wrapping to a small
+/// total), and the prefixes before it are exact — over one block and over several levels.
+#[test]
+fn scan_saturates_past_the_u32_range() {
+    let ctx = ctx();
+    let pipelines = ScanPipelines::new(&ctx.device);
+    let mut rng = Lcg(7);
+    for (len, largest) in [(5u32, u32::MAX), (1_025, 1 << 24), (300_007, 1 << 16), (2_000_003, 1 << 13)] {
+        let input: Vec<u32> = (0..len).map(|_| rng.next() % largest).collect();
+        let base = 3u32;
+        let mut expected = Vec::with_capacity(len as usize);
+        let mut sum = base;
+        for &x in &input {
+            expected.push(sum);
+            sum = sum.saturating_add(x);
+        }
+        assert_eq!(sum, u32::MAX, "length {len}: the test's counts must pass the u32 range");
+        let buffer = tessera_gpu::upload::storage_buffer(&ctx.device, "scan test", &input);
+        let scan = Scan::new(&ctx.device, &pipelines, &buffer, len, base);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            scan.record(&pipelines, &mut pass);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let got: Vec<u32> = readback::read(ctx, &buffer, len as usize).unwrap();
+        if let Some(i) = (0..len as usize).find(|&i| got[i] != expected[i]) {
+            panic!("length {len}: element {i} is {} instead of {}", got[i], expected[i]);
+        }
+    }
+}
+
 #[test]
 fn uniform_tessellation_equals_the_cpu_engine_on_every_patch_model() {
     for model in patch_models() {
@@ -640,6 +673,57 @@ fn capacity_at_the_cap_on_the_torus() {
         Err(GpuError::OutputTooLarge { triangles, limit, .. }) => {
             assert!(triangles * 12 > limit, "refused {triangles} triangles under the limit {limit}")
         }
+        other => panic!("expected OutputTooLarge, got {other:?}"),
+    }
+}
+
+/// A cap whose worst case passes the u32 range of the scans (the teapot's 32 patches at
+/// factor 16,384: 2³⁴ triangles) is prepared, not refused: a camera that asks for a small
+/// frame gets it whole, equal to the CPU plan's layout, in the room the caller gave; a
+/// camera that drives every patch to the cap overflows (the saturated totals fit no buffer;
+/// wrapped, they would sum to 0 mod 2³²), draws nothing, and growing refuses with the sizes.
+#[test]
+fn a_worst_case_past_the_u32_range_is_drawn_when_the_frame_fits() {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    let ctx = ctx();
+    let set = load("patches/teapot.patches");
+    let prepared = tessera::scheme::Prepared::new(&set, true);
+    let cap = tessera::criterion::MAX_FACTOR;
+    let room = Capacity { vertices: 1 << 20, triangles: 1 << 20 };
+    let screen = |pixels| ScreenCriterion {
+        scheme: Scheme::Uniform,
+        criterion: Criterion::PixelError(pixels),
+        max_factor: cap,
+        capacity: Some(room),
+    };
+    // The framing camera at 1 px: a frame of thousands of triangles.
+    let (lo, hi) = set.bounds();
+    let camera = tessera::camera::Camera::framing(lo, hi, 1280, 720);
+    let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+    let cpu =
+        Scheme::Uniform.plan_prepared(&set, &prepared, &Criterion::PixelError(1.0), &options).unwrap().plan;
+    let mut layout = Layout::default();
+    layout.build(&set, &cpu, &Uniform, &EngineOptions::default()).unwrap();
+    let mut gpu = tessellator(&set);
+    gpu.prepare_screen(ctx, &set, &prepared, &camera, screen(1.0)).unwrap();
+    assert_eq!(record_until_complete(&mut gpu, "teapot at 1 px"), 0, "the frame fits the room given");
+    assert_eq!(gpu.read_plan(ctx).unwrap().segments, cpu.segments, "factors");
+    let (_, _, triangle_offsets) = gpu.read_layout(ctx).unwrap();
+    assert_eq!(triangle_offsets, layout.triangle_offsets, "triangle offsets");
+    assert!(*layout.triangle_offsets.last().unwrap() > 1000);
+
+    // Every patch at the cap: 32 · 2 · 16,384² triangles.
+    screen_frame(&mut gpu, &set, &prepared, &close_camera(&set), screen(1e-6));
+    let plan = gpu.read_plan(ctx).unwrap();
+    let at_cap = plan.segments.iter().filter(|&&s| s == cap).count();
+    assert!(at_cap > 20, "the close camera drives {at_cap} edges to the cap");
+    let (overflow, vertices, triangles) = gpu.read_status(ctx).unwrap();
+    assert!(overflow, "{vertices} vertices and {triangles} triangles seemed to fit");
+    assert_eq!(triangles, u32::MAX, "the triangle total saturates");
+    let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
+    assert_eq!(draw[0], 0, "an overflowing frame drew {} indices", draw[0]);
+    match gpu.grow_if_overflowed(ctx) {
+        Err(GpuError::OutputTooLarge { triangles, .. }) => assert_eq!(triangles, u32::MAX as u64),
         other => panic!("expected OutputTooLarge, got {other:?}"),
     }
 }

@@ -122,9 +122,10 @@ fn hardware_uniform_plan(set: &SurfaceSet, partitioning: Partitioning, factor: f
 }
 
 impl GpuTessellator {
-    /// The largest output the device's limits allow: `(vertices, triangles)`.
+    /// The largest output the device's limits allow: `(vertices, triangles)`. Below the u32
+    /// range: a saturated scan total (`u32::MAX`, `shaders/scan.wgsl`) always overflows.
     pub(super) fn most(&self) -> (u64, u64) {
-        let vertices = (self.buffer_limit / VERTEX_STRIDE).min(u32::MAX as u64);
+        let vertices = (self.buffer_limit / VERTEX_STRIDE).min(u32::MAX as u64 - 1);
         let triangles = (self.buffer_limit / 12).min(u32::MAX as u64 / 3);
         (vertices, triangles)
     }
@@ -145,8 +146,8 @@ impl GpuTessellator {
         if !overflow {
             return Ok(false);
         }
-        // The counts are the scans' totals, exact unless they wrapped past u32 (then the
-        // need is beyond the index range anyway).
+        // The counts are the scans' totals, exact unless they saturated at u32::MAX (then
+        // the need is beyond the index range anyway, and refused below).
         let need = Capacity { vertices: vertices as u64, triangles: triangles as u64 };
         let have = self.capacity().unwrap_or_default();
         let (most_vertices, most_triangles) = self.most();
@@ -169,31 +170,24 @@ impl GpuTessellator {
     }
 
     /// Sizes the output of frames planned on the GPU whose largest output is `worst`:
-    /// `capacity`, or `worst` within the device's buffer limits (past them the frames that
-    /// need more overflow and are reported; the ones that fit draw completely). Errors with
-    /// [`GpuError::OutputTooLarge`] when `worst` passes the u32 range of the scans, or as
-    /// [`GpuTessellator::reserve`]. Cost: as `reserve`.
+    /// `capacity` (at most `worst`), or `worst` within the device's buffer limits (past them the frames that
+    /// need more overflow and are reported; the ones that fit draw completely). A worst case
+    /// past the u32 range is no reason to refuse: the scans saturate there, so a frame that
+    /// large overflows and is reported, and the frames a camera actually asks for draw.
+    /// Errors as [`GpuTessellator::reserve`]. Cost: as `reserve`.
     pub(super) fn reserve_screen(
         &mut self,
         ctx: &GpuContext,
         worst: Capacity,
         capacity: Option<Capacity>,
     ) -> Result<()> {
-        // The scans count in u32: a set whose worst frame could pass that range is refused
-        // here, before any frame could wrap.
-        if worst.vertices > u32::MAX as u64 || worst.triangles > u32::MAX as u64 / 3 {
-            return Err(GpuError::OutputTooLarge {
-                vertices: worst.vertices,
-                triangles: worst.triangles,
-                bytes: (worst.vertices * VERTEX_STRIDE).max(worst.triangles * 12),
-                limit: self.buffer_limit,
-            });
-        }
         let (most_vertices, most_triangles) = self.most();
-        let capacity = capacity.unwrap_or(Capacity {
-            vertices: worst.vertices.min(most_vertices),
-            triangles: worst.triangles.min(most_triangles),
-        });
+        // Never more than the worst case: no frame of these needs it.
+        let capacity = capacity.unwrap_or(Capacity { vertices: most_vertices, triangles: most_triangles });
+        let capacity = Capacity {
+            vertices: capacity.vertices.min(worst.vertices),
+            triangles: capacity.triangles.min(worst.triangles),
+        };
         self.reserve(ctx, capacity)
     }
 

@@ -243,9 +243,10 @@ impl GpuTessellator {
     /// transition scheme's pixel error with a `max_factor` above [`CHECK_MAX_FACTOR`];
     /// [`tessera::Error::InvalidParameter`] and [`tessera::Error::FactorOutOfRange`] for the
     /// ranges, as [`Scheme::plan`] refuses them); [`GpuError::Unsupported`] for a `prepared`
-    /// without bounds or transition factors past this adapter's loop budget;
-    /// [`GpuError::OutputTooLarge`] when the worst case passes the u32 range of the scans,
-    /// or as [`GpuTessellator::reserve`]. Cost: the first call O(E + P) cone computations,
+    /// without bounds or transition factors past this adapter's loop budget; as
+    /// [`GpuTessellator::reserve`] for the output (a worst case past the u32 range is not
+    /// refused: the frames that need that much overflow and are reported). Cost: the first
+    /// call O(E + P) cone computations,
     /// the edge midpoints' evaluations when `prepared` has none yet, and an upload of 128
     /// bytes a patch and 52 an edge; later calls (another camera, criterion or cap) O(P)
     /// pattern counts for the capacity and a 112-byte upload.
