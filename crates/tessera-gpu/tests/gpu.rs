@@ -21,32 +21,44 @@ fn no_adapter_error_names_the_packages() {
     assert!(e.to_string().contains("apt-get install -y mesa-vulkan-drivers libvulkan1"), "{e}");
 }
 
+/// Scans `input` with `base` on the GPU and compares every element with the CPU's exclusive
+/// scan, whose sums `add` makes.
+fn assert_scan_equals_the_cpus(
+    pipelines: &ScanPipelines,
+    input: &[u32],
+    base: u32,
+    add: fn(u32, u32) -> u32,
+) {
+    let ctx = ctx();
+    let len = input.len();
+    let mut expected = Vec::with_capacity(len);
+    let mut sum = base;
+    for &x in input {
+        expected.push(sum);
+        sum = add(sum, x);
+    }
+    let buffer = tessera_gpu::upload::storage_buffer(&ctx.device, "scan test", input);
+    let scan = Scan::new(&ctx.device, pipelines, &buffer, len as u32, base);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        scan.record(pipelines, &mut pass);
+    }
+    ctx.queue.submit([encoder.finish()]);
+    let got: Vec<u32> = readback::read(ctx, &buffer, len).unwrap();
+    if let Some(i) = (0..len).find(|&i| got[i] != expected[i]) {
+        panic!("length {len}: element {i} is {} instead of {}", got[i], expected[i]);
+    }
+}
+
 #[test]
 fn scan_of_any_length_equals_a_cpu_scan() {
-    let ctx = ctx();
-    let pipelines = ScanPipelines::new(&ctx.device);
+    let pipelines = ScanPipelines::new(&ctx().device);
     let mut rng = Lcg(12);
     for len in [0u32, 1, 255, 256, 257, 65_535, 1_000_003, (1 << 24) + 3] {
         let base = rng.next() % 1000;
         let input: Vec<u32> = (0..len).map(|_| rng.next() % 16).collect();
-        let mut expected = Vec::with_capacity(len as usize);
-        let mut sum = base;
-        for &x in &input {
-            expected.push(sum);
-            sum += x;
-        }
-        let buffer = tessera_gpu::upload::storage_buffer(&ctx.device, "scan test", &input);
-        let scan = Scan::new(&ctx.device, &pipelines, &buffer, len, base);
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            scan.record(&pipelines, &mut pass);
-        }
-        ctx.queue.submit([encoder.finish()]);
-        let got: Vec<u32> = readback::read(ctx, &buffer, len as usize).unwrap();
-        if let Some(i) = (0..len as usize).find(|&i| got[i] != expected[i]) {
-            panic!("length {len}: element {i} is {} instead of {}", got[i], expected[i]);
-        }
+        assert_scan_equals_the_cpus(&pipelines, &input, base, |a, b| a + b);
     }
 }
 
@@ -55,31 +67,13 @@ fn scan_of_any_length_equals_a_cpu_scan() {
 /// total), and the prefixes before it are exact — over one block and over several levels.
 #[test]
 fn scan_saturates_past_the_u32_range() {
-    let ctx = ctx();
-    let pipelines = ScanPipelines::new(&ctx.device);
+    let pipelines = ScanPipelines::new(&ctx().device);
     let mut rng = Lcg(7);
     for (len, largest) in [(5u32, u32::MAX), (1_025, 1 << 24), (300_007, 1 << 16), (2_000_003, 1 << 13)] {
         let input: Vec<u32> = (0..len).map(|_| rng.next() % largest).collect();
-        let base = 3u32;
-        let mut expected = Vec::with_capacity(len as usize);
-        let mut sum = base;
-        for &x in &input {
-            expected.push(sum);
-            sum = sum.saturating_add(x);
-        }
-        assert_eq!(sum, u32::MAX, "length {len}: the test's counts must pass the u32 range");
-        let buffer = tessera_gpu::upload::storage_buffer(&ctx.device, "scan test", &input);
-        let scan = Scan::new(&ctx.device, &pipelines, &buffer, len, base);
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            scan.record(&pipelines, &mut pass);
-        }
-        ctx.queue.submit([encoder.finish()]);
-        let got: Vec<u32> = readback::read(ctx, &buffer, len as usize).unwrap();
-        if let Some(i) = (0..len as usize).find(|&i| got[i] != expected[i]) {
-            panic!("length {len}: element {i} is {} instead of {}", got[i], expected[i]);
-        }
+        let total = input.iter().fold(3u32, |a, &b| a.saturating_add(b));
+        assert_eq!(total, u32::MAX, "length {len}: the test's counts must pass the u32 range");
+        assert_scan_equals_the_cpus(&pipelines, &input, 3, u32::saturating_add);
     }
 }
 
