@@ -112,6 +112,29 @@ impl TriangleErrors {
 }
 
 impl TriangleErrors {
+    /// [`TriangleErrors::error`] of `t` where it exceeds `at_least`, else None: the largest
+    /// error over many triangles ([`crate::criterion::tolerance`]'s a-posteriori check) needs
+    /// no more. The cheaper bounds go first, and a triangle stops as soon as one of them is
+    /// at most `at_least` (the error is their minimum). The value, when given, is `error`'s,
+    /// bit for bit (the same operations in the same order). Cost: at most `error`'s.
+    #[inline(always)]
+    pub fn exceeds(&self, t: [DVec2; 3], at_least: f64) -> Option<f64> {
+        let axis = self.bound.axis_aligned_error(t);
+        if axis.is_some_and(|a| a <= at_least) {
+            return None;
+        }
+        let mut general = f64::INFINITY;
+        for (s, lambda) in self.scales.iter().zip(self.lambdas) {
+            let r = enclosing_radius(t.map(|p| p * *s));
+            general = general.min(lambda * r * r / 2.0);
+            if general <= at_least {
+                return None;
+            }
+        }
+        let error = general.min(axis.unwrap_or(f64::INFINITY));
+        (error > at_least).then_some(error)
+    }
+
     /// [`TriangleErrors::error`] of a half cell of a grid — a right triangle with legs `hu`
     /// along `u` and `hv` along `v` — in closed form: its smallest enclosing disc in every
     /// scaling is the one on its hypotenuse, and Filip's bound applies. Equal to `error` on
@@ -459,6 +482,44 @@ mod tests {
         assert!((enclosing_radius(eq) - 1.0 / 3f64.sqrt()).abs() < 1e-12);
         let obtuse = [DVec2::ZERO, DVec2::new(2.0, 0.0), DVec2::new(1.0, 0.1)];
         assert!((enclosing_radius(obtuse) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn exceeds_gives_the_error_bit_for_bit_exactly_where_it_passes_the_threshold() {
+        // A small seeded generator: triangles of every shape (slivers, right triangles along
+        // the axes, obtuse ones) and thresholds below, at and above their errors.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut above, mut below) = (0, 0);
+        for k in 0..4000 {
+            let m = HessianBound { uu: 10.0 * next(), uv: 3.0 * next(), vv: 10.0 * next() }.triangle_errors();
+            let mut t = [0; 3].map(|_| DVec2::new(next(), next()));
+            if k % 4 == 0 {
+                // A grid half cell, whose axis-aligned bound applies.
+                let (h, w) = (next() * 0.2 + 0.01, next() * 0.2 + 0.01);
+                t = [t[0], t[0] + DVec2::new(h, 0.0), t[0] + DVec2::new(0.0, w)];
+            }
+            let error = m.error(t);
+            for at_least in [0.0, error * 0.5, error, error * (1.0 - 1e-15), error * 2.0] {
+                match m.exceeds(t, at_least) {
+                    Some(e) => {
+                        assert_eq!(e.to_bits(), error.to_bits(), "triangle {k}");
+                        assert!(error > at_least);
+                        above += 1;
+                    }
+                    None => {
+                        assert!(error <= at_least, "triangle {k}: {error} > {at_least} but none given");
+                        below += 1;
+                    }
+                }
+            }
+        }
+        assert!(above > 1000 && below > 1000, "{above} above, {below} below");
     }
 
     #[test]

@@ -157,7 +157,10 @@ fn triangles_bound(
     params: &[glam::DVec2],
     at_least: f64,
 ) -> f64 {
-    triangles.iter().map(|t| errors.error(t.map(|l| params[l as usize]))).fold(at_least, f64::max)
+    // The running largest error skips what cannot raise it ([`TriangleErrors::exceeds`]).
+    triangles
+        .iter()
+        .fold(at_least, |most, t| errors.exceeds(t.map(|l| params[l as usize]), most).unwrap_or(most))
 }
 
 /// [`params_bound`] of a pattern whose first triangles are core cells
