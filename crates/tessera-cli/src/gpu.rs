@@ -59,7 +59,7 @@ pub fn tessellate_from_camera(
     gpu.prepare_screen(&ctx, set, &prepared, camera, screen)?;
     let mut run = frames(&ctx, &mut gpu, repeat, times)?;
     if gpu.grow_if_overflowed(&ctx)? {
-        // Sized within the device's limits below the worst case: grown to what it needed.
+        // The first room was too small: grown to what the frame needed.
         run = frames(&ctx, &mut gpu, repeat, times)?;
     }
     *mesh = gpu.read_mesh(&ctx, set)?;

@@ -170,8 +170,9 @@ impl GpuTessellator {
     }
 
     /// Sizes the output of frames planned on the GPU whose largest output is `worst`:
-    /// `capacity` (at most `worst`), or `worst` within the device's buffer limits (past them the frames that
-    /// need more overflow and are reported; the ones that fit draw completely). A worst case
+    /// `capacity` (at most `worst`), or `worst` within the device's buffer limits (past them
+    /// the frames that need more overflow and are reported; the ones that fit draw
+    /// completely). A worst case
     /// past the u32 range is no reason to refuse: the scans saturate there, so a frame that
     /// large overflows and is reported, and the frames a camera actually asks for draw.
     /// Errors as [`GpuTessellator::reserve`]. Cost: as `reserve`.

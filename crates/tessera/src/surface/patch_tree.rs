@@ -552,13 +552,7 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
     #[cfg(target_arch = "x86_64")]
     {
         let start = (leaf as *const Leaf).cast::<i8>();
-        let line = |offset: usize| {
-            // SAFETY: a prefetch never faults and changes nothing but the cache; the address
-            // is inside `leaf`.
-            unsafe {
-                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(start.add(offset));
-            }
-        };
+        let line = |offset: usize| prefetch_line(start.wrapping_add(offset));
         line(0);
         let point = std::mem::size_of::<DVec3>();
         let rows = live(st.x);
@@ -585,15 +579,20 @@ fn prefetch_nodes(nodes: &[[Slot; 4]]) {
         let bytes = std::mem::size_of_val(nodes).min(64 * NODE_LINES);
         let start = nodes.as_ptr().cast::<i8>();
         for offset in (0..bytes).step_by(64) {
-            // SAFETY: a prefetch never faults and changes nothing but the cache; the address
-            // is inside `nodes`.
-            unsafe {
-                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(start.add(offset))
-            };
+            prefetch_line(start.wrapping_add(offset));
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = nodes;
+}
+
+/// Asks for the cache line holding `at` (a hint: a prefetch never faults, whatever the
+/// address, and changes nothing but the cache).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn prefetch_line(at: *const i8) {
+    // SAFETY: see above; nothing is read or written through `at`.
+    unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at) }
 }
 
 /// The most node lines [`prefetch_nodes`] asks for (4 KiB: the nodes of a deep tree).
