@@ -689,8 +689,20 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
         assert_eq!(g[key], c[key], "fractional-odd planned on the GPU: {key}");
     }
-    let refused =
-        tessera(&["mesh", input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--engine", "gpu"], &dir);
+    // Semi-uniform (paper 000, compacted): a CPU plan drawn on the GPU, and the frame planned
+    // on the GPU from the camera (the levels and their a-posteriori check).
+    for (criterion, value, planned_on) in [("--tolerance", "0.01", "cpu"), ("--pixel-error", "0.5", "gpu")] {
+        let args = ["mesh", input, "--scheme", "semi-uniform", criterion, value, "--cull", "--stats"];
+        let cpu = tessera(&args, &dir);
+        let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
+        assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+        let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+        assert_eq!(g["planned_on"], planned_on, "{g}");
+        for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
+            assert_eq!(g[key], c[key], "semi-uniform {criterion}: {key}");
+        }
+    }
+    let refused = tessera(&["mesh", input, "--scheme", "esc", "--level", "1", "--engine", "gpu"], &dir);
     assert!(!refused.status.success());
     assert!(text(&refused.stderr).contains("does not support"), "{}", text(&refused.stderr));
 }

@@ -1,6 +1,6 @@
-// The a-posteriori check of an error-bounded transition plan, from the camera alone: the
-// GPU form of `tessera::criterion::tolerance::plan_limited` after its proposals (the
-// pixel-error proposals and the first resolve are `factors.wgsl`'s).
+// The a-posteriori check of an error-bounded transition or semi-uniform plan, from the camera
+// alone: the GPU form of `tessera::criterion::tolerance::plan_limited` after its proposals
+// (the pixel-error proposals and the first resolve are `factors.wgsl`'s).
 //
 // A patch's transition strips follow its edges, so a grid that meets the bound in the core
 // can miss it next to a coarse edge: each patch builds its pattern and bounds every
@@ -74,15 +74,20 @@ fn check_patch(p: u32) -> bool {
     var s = vec4<u32>(1u);
     for (var l = 0u; l < nc; l = l + 1u) { s[l] = segments[patch_edge(p, l)]; }
     let minimum = patch_views[PATCH_VIEW_ROW * p + 7u];
+    let level = view.interior_rule == INTERIOR_LEVEL;
     var first: vec2<u32>;
-    if (nc == 3u) {
+    if (level) {
+        first = vec2<u32>(semi_uniform_first_level(p));
+    } else if (nc == 3u) {
         let n = max(s.x, max(s.y, s.z));
         first = vec2<u32>(n, n);
     } else {
         let own = max(vec2<u32>(min(proposals[p].xy, vec2<f32>(view.cap))), vec2<u32>(1u));
         first = vec2<u32>(min(own.x, min(s.x, s.z)), min(own.y, min(s.y, s.w)));
     }
-    first = max(first, vec2<u32>(minimum.xy));
+    if (!level) {
+        first = max(first, vec2<u32>(minimum.xy));
+    }
     let eps = checks[p].eps;
     if (eps < 0.0) {
         // Culled: the first interior, nothing to bound.
@@ -97,21 +102,11 @@ fn check_patch(p: u32) -> bool {
     var bound = 0.0;
     var missed = false;
     loop {
-        // Every core triangle is half a grid cell: one cell's triangle bounds them all
-        // (`Pattern::grid_cells`, `tolerance::grid_bound`); the walk takes the strips. The
-        // core is never walked, which also keeps a check within lavapipe's 65,535 loop
-        // iterations an invocation (`local.wgsl`): a strip has at most 2 · 64 steps.
-        let input = pattern_input(p, factors);
-        let l = input.core;
-        var out = sink(SINK_CHECK, 0u);
-        out.errors = errors;
-        let core_cells = select((l.i_hi - l.i_lo) * (l.j_hi - l.j_lo), l.m, input.local.nc == 3u);
-        if (core_cells > 0u) {
-            let cell = vec2<f32>(1.0 / f32(l.nu), 1.0 / f32(l.nv));
-            out.worst = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+        if (level) {
+            bound = semi_uniform_bound(p, factors.x, errors);
+        } else {
+            bound = transition_bound(p, factors, errors);
         }
-        build_transition(input, &out);
-        bound = out.worst;
         if (bound <= eps) { break; }
         // No progress means the worst triangles follow the edges, not the core.
         let stuck = bound >= previous;
@@ -127,6 +122,7 @@ fn check_patch(p: u32) -> bool {
             var raised = grown_105(n);
             if (grow > 1.05) { raised = u32(ceil(f32(n) * grow)); }
             next[k] = clamp(raised, n + 1u, cap);
+            if (level) { next[k] = min(next_power_of_two(next[k]), cap); }
         }
         factors = next;
     }
@@ -149,6 +145,62 @@ fn check_patch(p: u32) -> bool {
         proposals[p] = wish;
     }
     return missed;
+}
+
+// The largest error bound over patch p's transition pattern with interior `factors`. Every
+// core triangle is half a grid cell: one cell's triangle bounds them all
+// (`Pattern::grid_cells`, `tolerance::grid_bound`); the walk takes the strips. The core is
+// never walked, which also keeps a check within lavapipe's 65,535 loop iterations an
+// invocation (`local.wgsl`): a strip has at most 2 · 64 steps.
+fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors) -> f32 {
+    let input = pattern_input(p, factors);
+    let l = input.core;
+    var out = sink(SINK_CHECK, 0u);
+    out.errors = errors;
+    let core_cells = select((l.i_hi - l.i_lo) * (l.j_hi - l.j_lo), l.m, input.local.nc == 3u);
+    if (core_cells > 0u) {
+        let cell = vec2<f32>(1.0 / f32(l.nu), 1.0 / f32(l.nv));
+        out.worst = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+    }
+    build_transition(input, &out);
+    return out.worst;
+}
+
+// The largest error bound over patch p's semi-uniform pattern at level n (`params_bound` over
+// `SemiUniform::build`'s triangles): the triangles with a corner on the boundary one by one,
+// after the snap (those it collapses are not in the pattern); the others are halves of grid
+// cells, bounded by one cell's triangle as `transition_bound` bounds a core. Cost: O(n)
+// triangles (`semi_uniform.wgsl` says which ones can touch the boundary).
+fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
+    let input = local_numbering(p);
+    let m = countTrailingZeros(n);
+    let tri = input.nc == 3u;
+    var worst = 0.0;
+    var cells = false;
+    for (var j = 0u; j < n; j = j + 1u) {
+        let len = row_length(tri, n, j);
+        let whole = j == 0u || j + 1u >= n;
+        for (var q = 0u; q < len; q = q + 1u) {
+            if (!whole && q >= 2u && q + 2u < len) {
+                // The middle of a middle row: off the boundary, jump to its last two.
+                cells = true;
+                q = len - 3u;
+                continue;
+            }
+            let g = row_triangle(tri, j, q);
+            let t = semi_uniform_triangle(input, n, m, j, q);
+            if (t.x == t.y) { continue; }
+            let a = semi_uniform_param(input, n, m, g[0].x, g[0].y);
+            let b = semi_uniform_param(input, n, m, g[1].x, g[1].y);
+            let c = semi_uniform_param(input, n, m, g[2].x, g[2].y);
+            worst = max(worst, triangle_error(errors, a, b, c));
+        }
+    }
+    if (cells) {
+        let h = 1.0 / f32(n);
+        worst = max(worst, triangle_error(errors, vec2<f32>(0.0), vec2<f32>(h, 0.0), vec2<f32>(0.0, h)));
+    }
+    return worst;
 }
 
 // The first check of every patch, after the first resolve.

@@ -12,8 +12,10 @@ struct Params {
     // The hardware pattern's partitioning (`hardware_partition.wgsl`'s PARTITIONING_*); 0 for
     // the other patterns.
     partitioning: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // Invocations a patch in the per-patch triangle pass: the semi-uniform pattern's largest
+    // patch level n, one per row of its grid (`semi_uniform.wgsl`); 1 for the other patterns.
+    rows: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;

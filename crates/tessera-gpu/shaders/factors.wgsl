@@ -4,19 +4,21 @@
 // - `Criterion::PixelError`: per visible patch the object-space tolerance of
 //   `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
 //   `uniform_factor`, or for the transition scheme's quads `quad_grid`, and `curve_factor`
-//   from the prepared bounds); the transition scheme's interiors then come from the
-//   a-posteriori check (`check.wgsl`);
+//   from the prepared bounds); the transition and semi-uniform schemes' interiors then come
+//   from the a-posteriori check (`check.wgsl`);
 // - `Criterion::View` with `ViewCriterion::Silhouetteness` (`view::edge_factors_into`): every
-//   patch proposes each of its edges' silhouetteness factor in [lo, hi];
+//   patch proposes each of its edges' silhouetteness factor in [lo, hi] (for the semi-uniform
+//   scheme taken between the levels of lo and hi, `view::plan_into`);
 // - `Criterion::Factor` for the hardware schemes (`view::EdgeFactors::Fixed`): every patch
 //   proposes the factor for each of its edges;
 //
 // then per edge the maximum over the patches sharing it, read through the topology's edge
-// uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer` or,
-// for the hardware schemes, `EdgeRule::Fractional(Spacing::Hardware(_))`: the hull shader's
+// uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer`,
+// `EdgeRule::PowerOfTwo` for the semi-uniform scheme or, for the hardware schemes, `EdgeRule::Fractional(Spacing::Hardware(_))`: the hull shader's
 // pow2 rounding and `settled_factor`, segments by the partition), then the interiors
 // (`resolve::interiors`): the global factor on every edge and patch (`InteriorRule::Global`),
-// CudaTess's core rule (`InteriorRule::Core`) or the largest edge (`InteriorRule::MaxEdge`).
+// CudaTess's core rule (`InteriorRule::Core`), the largest edge (`InteriorRule::MaxEdge`) or
+// the semi-uniform level (`InteriorRule::Level`).
 //
 // f32 where the CPU computes in f64: a pixel-error factor is `ceil` of a square root, a
 // silhouetteness factor is rounded, so the two can differ by one where that value lies within
@@ -119,6 +121,16 @@ fn silhouetteness_factor(e: u32) -> f32 {
     return clamp(view.lo + s * (view.hi - view.lo), view.lo, view.hi);
 }
 
+// `view::plan_into` for `EdgeRule::PowerOfTwo`: the factor f's place in [lo, hi] taken
+// between the levels of lo and hi (paper 000: level ⌈s·M⌉ for silhouetteness s), as a factor.
+fn between_levels(f: f32) -> f32 {
+    let span = view.hi - view.lo;
+    var t = 1.0;
+    if (span > 0.0) { t = clamp((f - view.lo) / span, 0.0, 1.0); }
+    let lo = log2(view.lo);
+    return exp2(lo + t * (log2(view.hi) - lo));
+}
+
 // Per patch: its proposal for each local edge, and its minimum interior into the global
 // factor.
 @compute @workgroup_size(WORKGROUP)
@@ -142,6 +154,7 @@ fn patch_proposals(
         // Every patch, culled or not, proposes its edges' factors (`from_edge_factors`).
         for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
             out[l] = silhouetteness_factor(patch_edge(p, l));
+            if (view.edge_rule == EDGE_RULE_POWER_OF_TWO) { out[l] = between_levels(out[l]); }
         }
     } else if (visible[p] != 0u) {
         let eps = patch_tolerance(p);
@@ -165,6 +178,19 @@ fn patch_proposals(
     proposals[p] = out;
 }
 
+// `resolve::interiors` with `InteriorRule::Level` for patch p (and the a-posteriori check's
+// first level, `check_patches`' `first`): its largest edge or minimum interior, the next
+// power of two, within the cap.
+fn semi_uniform_first_level(p: u32) -> u32 {
+    var largest = 1u;
+    for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
+        largest = max(largest, segments[patch_edge(p, l)]);
+    }
+    let minimum = patch_views[PATCH_VIEW_ROW * p + 7u];
+    let n = max(largest, max(u32(minimum.x), u32(minimum.y)));
+    return min(next_power_of_two(n), u32(view.cap));
+}
+
 // `resolve::edges`' wish for edge e: the maximum of the proposals over its uses, capped.
 fn wanted_factor(e: u32) -> f32 {
     var wanted = 0.0;
@@ -175,9 +201,17 @@ fn wanted_factor(e: u32) -> f32 {
 }
 
 // `resolve::edges` with `EdgeRule::Integer` for edge e: its wish rounded half away from zero
-// as `f64::round`, at least the minimum.
+// as `f64::round`, at least the minimum; with `EdgeRule::PowerOfTwo`: the level of its wish
+// rounded up, `⌈log2 f⌉` (the CPU's margin of 1e-9 is 1e-5 in f32: a whole wish of a pixel
+// error is still exactly its next power of two, up to the largest cap), at least the
+// minimum, within the cap (a power of two).
 fn resolved_segments(e: u32) -> u32 {
-    return max(u32(floor(wanted_factor(e) + 0.5)), max(minimum_segments(e), 1u));
+    let minimum = max(minimum_segments(e), 1u);
+    if (view.edge_rule == EDGE_RULE_POWER_OF_TWO) {
+        let level = u32(max(ceil(log2(max(wanted_factor(e), 1.0)) - 1e-5), 0.0));
+        return min(next_power_of_two(max(1u << level, minimum)), u32(view.cap));
+    }
+    return max(u32(floor(wanted_factor(e) + 0.5)), minimum);
 }
 
 // Per edge: `resolve::edges` — the maximum over its uses, capped; then `EdgeRule::Integer`
@@ -211,7 +245,8 @@ fn edge_segments(
 // patch interior. `InteriorRule::Core`: a quad takes the smaller segments of its two edges
 // along each direction (at least its minimum), a triangle its largest edge.
 // `InteriorRule::MaxEdge`: every patch its largest edge (the hardware pattern itself reads
-// only the edges' factors).
+// only the edges' factors). `InteriorRule::Level`: the largest edge or the minimum interior,
+// the next power of two, within the cap.
 @compute @workgroup_size(WORKGROUP)
 fn interiors(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -229,6 +264,10 @@ fn interiors(
     let s0 = segments[patch_edge(x, 0u)];
     let s1 = segments[patch_edge(x, 1u)];
     let s2 = segments[patch_edge(x, 2u)];
+    if (view.interior_rule == INTERIOR_LEVEL) {
+        interior[x] = vec2<u32>(semi_uniform_first_level(x));
+        return;
+    }
     if (view.interior_rule == INTERIOR_MAX_EDGE && !patch_is_tri(x)) {
         let n = max(max(s0, s1), max(s2, segments[patch_edge(x, 3u)]));
         interior[x] = vec2<u32>(n, n);

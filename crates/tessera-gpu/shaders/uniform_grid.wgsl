@@ -74,19 +74,31 @@ fn cell_triangle(i: u32, j: u32, half: u32) -> array<vec2<u32>, 3> {
 
 // Pattern triangle t (grid points) of the uniform pattern, in `uniform::grid`'s order. Quads:
 // two per cell, cells row after row. Triangles: row j holds 2(n − j) − 1, the rows before it
-// j(2n − j); within a row, [a, b, d] then [b, (i + 1, j + 1), d] for each i.
+// j(2n − j).
 fn pattern_triangle(tri: bool, n: u32, t: u32) -> array<vec2<u32>, 3> {
     if (!tri) {
-        let cell = t / 2u;
-        return cell_triangle(cell % n, cell / n, t % 2u);
+        return row_triangle(false, t / (2u * n), t % (2u * n));
     }
     // The row from the inverse of j(2n − j), then corrected for rounding.
     var j = u32(max(0.0, f32(n) - sqrt(max(0.0, f32(n * n - min(t, n * n))))));
     j = min(j, n - 1u);
     while (j > 0u && j * (2u * n - j) > t) { j = j - 1u; }
     while (j + 1u < n && (j + 1u) * (2u * n - j - 1u) <= t) { j = j + 1u; }
-    let q = t - j * (2u * n - j);
+    return row_triangle(true, j, t - j * (2u * n - j));
+}
+
+// Triangles in row j of the uniform pattern's n-grid: 2n on quads, 2(n − j) − 1 on triangles.
+fn row_length(tri: bool, n: u32, j: u32) -> u32 {
+    return select(2u * n, 2u * (n - j) - 1u, tri);
+}
+
+// Triangle q of row j (grid points), in `uniform::grid`'s order. Quads: cell (q / 2, j), half
+// q mod 2. Triangles: [a, b, d] then [b, (i + 1, j + 1), d] for each i = q / 2.
+fn row_triangle(tri: bool, j: u32, q: u32) -> array<vec2<u32>, 3> {
     let i = q / 2u;
+    if (!tri) {
+        return cell_triangle(i, j, q % 2u);
+    }
     if (q % 2u == 0u) {
         return array<vec2<u32>, 3>(vec2<u32>(i, j), vec2<u32>(i + 1u, j), vec2<u32>(i, j + 1u));
     }

@@ -14,17 +14,18 @@ struct View {
     tan_x: f32,
     tan_y: f32,
     // `Camera::focal_pixels`, the pixel error, the factor cap (`PlanOptions::max_factor`),
-    // the interior rule (INTERIOR_GLOBAL, INTERIOR_CORE or INTERIOR_MAX_EDGE; with a pixel
-    // error, INTERIOR_CORE means the a-posteriori check of `check.wgsl` decides the
-    // interiors).
+    // the interior rule (INTERIOR_GLOBAL, INTERIOR_CORE, INTERIOR_MAX_EDGE or INTERIOR_LEVEL;
+    // with a pixel error, INTERIOR_CORE and INTERIOR_LEVEL mean the a-posteriori check of
+    // `check.wgsl` decides the interiors).
     focal: f32,
     pixels: f32,
     cap: f32,
     interior_rule: u32,
     // The criterion (CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS or CRITERION_FIXED) and
     // the view criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap
-    // applied; a fixed factor is lo = hi); the edge rule (EDGE_RULE_INTEGER or
-    // EDGE_RULE_HARDWARE, whose partitioning is `params.partitioning`).
+    // applied; a fixed factor is lo = hi); the edge rule (EDGE_RULE_INTEGER,
+    // EDGE_RULE_POWER_OF_TWO or EDGE_RULE_HARDWARE, whose partitioning is
+    // `params.partitioning`).
     criterion: u32,
     lo: f32,
     hi: f32,
@@ -78,12 +79,20 @@ const PATCH_VIEW_ROW: u32 = {{PATCH_VIEW_ROW}}u;
 const INTERIOR_GLOBAL: u32 = {{INTERIOR_GLOBAL}}u;
 const INTERIOR_CORE: u32 = {{INTERIOR_CORE}}u;
 const INTERIOR_MAX_EDGE: u32 = {{INTERIOR_MAX_EDGE}}u;
+const INTERIOR_LEVEL: u32 = {{INTERIOR_LEVEL}}u;
 const CRITERION_PIXEL_ERROR: u32 = {{CRITERION_PIXEL_ERROR}}u;
 const CRITERION_SILHOUETTENESS: u32 = {{CRITERION_SILHOUETTENESS}}u;
 const CRITERION_FIXED: u32 = {{CRITERION_FIXED}}u;
 const EDGE_RULE_INTEGER: u32 = {{EDGE_RULE_INTEGER}}u;
 const EDGE_RULE_HARDWARE: u32 = {{EDGE_RULE_HARDWARE}}u;
+const EDGE_RULE_POWER_OF_TWO: u32 = {{EDGE_RULE_POWER_OF_TWO}}u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
+
+// `u32::next_power_of_two` (x ≤ 2³¹).
+fn next_power_of_two(x: u32) -> u32 {
+    if (x <= 1u) { return 1u; }
+    return 1u << (32u - countLeadingZeros(x - 1u));
+}
 
 // `Prepared::minimum_segments` of edge e, kept in the w of its first edge row (a whole
 // number, exact in f32).

@@ -63,6 +63,7 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("vertex_capacity", offset_of!(Params, vertex_capacity)),
             ("triangle_capacity", offset_of!(Params, triangle_capacity)),
             ("partitioning", offset_of!(Params, partitioning)),
+            ("rows", offset_of!(Params, rows)),
         ],
         size_of::<Params>(),
     );
@@ -135,9 +136,13 @@ fn the_codes_the_shaders_compare_against_come_from_rust() {
         assert_eq!(value(name), rust, "{name}");
     }
     // Distinct codes: two rules with one code would be one rule to the shader.
-    let mut codes: Vec<(&str, u32)> =
-        constants().into_iter().filter(|(n, _)| n.starts_with("INTERIOR_")).collect();
-    codes.sort_by_key(|&(_, v)| v);
-    codes.dedup_by_key(|&mut (_, v)| v);
-    assert_eq!(codes.len(), 3, "{codes:?}");
+    for prefix in ["INTERIOR_", "CRITERION_", "EDGE_RULE_"] {
+        let mut codes: Vec<(&str, u32)> =
+            constants().into_iter().filter(|(n, _)| n.starts_with(prefix)).collect();
+        let named = codes.len();
+        codes.sort_by_key(|&(_, v)| v);
+        codes.dedup_by_key(|&mut (_, v)| v);
+        assert_eq!(codes.len(), named, "{prefix}: {codes:?}");
+        assert!(named >= 3, "{prefix}: {codes:?}");
+    }
 }

@@ -50,6 +50,7 @@ pub mod sources {
     pub(crate) const GRID_VERTICES: &str = include_str!("../shaders/grid_vertices.wgsl");
     pub(crate) const HARDWARE_PARTITION: &str = include_str!("../shaders/hardware_partition.wgsl");
     pub(crate) const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
+    pub(crate) const SEMI_UNIFORM: &str = include_str!("../shaders/semi_uniform.wgsl");
 }
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],

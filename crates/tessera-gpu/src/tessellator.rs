@@ -7,10 +7,10 @@
 //! 0. **cull** (`cull.wgsl`, with a culling camera) and **factors** (`factors.wgsl`, after
 //!    [`GpuTessellator::prepare_screen`]): the visibility row and the plan's segments, real
 //!    factors and interior factors from the camera alone, from view-independent rows
-//!    uploaded once; for the transition scheme's pixel error also the a-posteriori check
+//!    uploaded once; for the transition and semi-uniform schemes' pixel error also the a-posteriori check
 //!    (`check.wgsl`, `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds
 //!    that size themselves on the GPU raise interiors and edges until the bounds hold;
-//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `hardware.wgsl`): per edge and per
+//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `semi_uniform.wgsl`, `hardware.wgsl`): per edge and per
 //!    patch, the counts `tessera::engine::Layout::build` scans, in place in the offset
 //!    buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
@@ -22,7 +22,8 @@
 //!    interior vertices;
 //! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
 //!    triangle; transition (`transition.wgsl`) one invocation per patch walking its core
-//!    and strips in the CPU's order; the Direct3D 11 partitionings (`hardware.wgsl`) one
+//!    and strips in the CPU's order; semi-uniform (`semi_uniform.wgsl`) one invocation per
+//!    row of a patch's dyadic grid; the Direct3D 11 partitionings (`hardware.wgsl`) one
 //!    invocation per patch walking its rings and stitches in the CPU's order (parallel over
 //!    patches only: the next step is a per-triangle form).
 //!
@@ -118,6 +119,31 @@ fn check_hardware_plan(plan: &Plan, partitioning: Partitioning) -> Result<()> {
     Ok(())
 }
 
+/// The semi-uniform pattern's preconditions on `plan` (`tessera::pattern::semi_uniform::
+/// SemiUniform`, [`tessera::pattern::semi_uniform::check_input`]) for every visible patch,
+/// which the shaders rely on; returns the largest patch level `n` (the triangle pass's rows a
+/// patch). Errors: [`tessera::Error::PlanMismatch`] naming the first patch that breaks one;
+/// [`GpuError::Unsupported`] for more rows in all than one dispatch numbers (2³²). Cost: O(P).
+fn check_semi_uniform_plan(set: &SurfaceSet, plan: &Plan) -> Result<u32> {
+    let mut rows = 1;
+    for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+        let input = tessera::engine::layout::pattern_input(set, plan, p);
+        if let Err(why) = tessera::pattern::semi_uniform::check_input(&input) {
+            return Err(tessera::Error::PlanMismatch { what: format!("patch {p}: {why}") }.into());
+        }
+        rows = rows.max(input.interior[0]);
+    }
+    if set.patches.len() as u64 * rows as u64 > u32::MAX as u64 {
+        return Err(GpuError::Unsupported {
+            what: format!(
+                "{} semi-uniform patches at level {rows} (one invocation a row of each: past 2^32)",
+                set.patches.len()
+            ),
+        });
+    }
+    Ok(rows)
+}
+
 /// Buffers whose size depends on the output capacity, and their bind groups.
 #[derive(Debug)]
 struct Output {
@@ -169,6 +195,9 @@ pub struct GpuTessellator {
     check_rounds: u32,
     /// Whether the adapter's shader compiler stops long loops ([`loop_limited`]).
     loop_limited: bool,
+    /// `Params::rows`: invocations a patch in the per-patch triangle pass (the semi-uniform
+    /// pattern's largest patch level; 1 for the other patterns).
+    rows: u32,
 }
 
 /// The loop iterations one invocation gets in all on Mesa's llvmpipe (lavapipe): its compiler
@@ -254,12 +283,14 @@ impl GpuTessellator {
             buffer_limit: ctx.limits.max_buffer_size.min(ctx.limits.max_storage_buffer_binding_size),
             check_rounds: DEFAULT_CHECK_ROUNDS,
             loop_limited: loop_limited(&ctx.info),
+            rows: 1,
             set: gpu_set,
             pipelines,
         })
     }
 
-    /// Uploads `plan` (made for `pattern`: the uniform, the transition or a hardware pattern)
+    /// Uploads `plan` (made for `pattern`: the uniform, the transition, the semi-uniform or a
+    /// hardware pattern)
     /// for the next [`GpuTessellator::record`] (ending [`GpuTessellator::prepare_screen`]'s
     /// own planning), growing the output buffers to its worst case ([`Capacity::of_plan`])
     /// when they are too small.
@@ -289,7 +320,7 @@ impl GpuTessellator {
         let Some(kind) = GpuPattern::of(pattern) else {
             return Err(GpuError::Unsupported {
                 what: format!(
-                    "the {} pattern (uniform, transition and the Direct3D 11 partitionings integer, \
+                    "the {} pattern (uniform, transition, semi-uniform and the Direct3D 11 partitionings integer, \
                      pow2, fractional_odd and fractional_even are on the GPU)",
                     pattern.name()
                 ),
@@ -300,7 +331,7 @@ impl GpuTessellator {
                 tessera::Error::PlanMismatch { what: "a set other than the tessellator's".into() }.into()
             );
         }
-        if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, kind == GpuPattern::Uniform) {
+        if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, pattern.cut_through_corners_0_and_2()) {
             return Err(GpuError::Unsupported { what: tessera::scheme::pinched_on_gpu(p) });
         }
         let expected_kind = match kind {
@@ -315,6 +346,7 @@ impl GpuTessellator {
         if let GpuPattern::Hardware(p) = kind {
             check_hardware_plan(plan, p)?;
         }
+        let rows = if kind == GpuPattern::SemiUniform { check_semi_uniform_plan(set, plan)? } else { 1 };
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
             if kind == GpuPattern::Uniform
@@ -334,14 +366,13 @@ impl GpuTessellator {
         }
         let capacity = Capacity::of_plan(set, plan, pattern, self.camera.is_some());
         self.reserve(ctx, capacity)?;
-        if let GpuPattern::Hardware(_) = kind {
-            self.pipelines.hardware(&ctx.device);
-        }
+        self.pipelines.compile(&ctx.device, kind);
         if self.set.has_trees {
             self.pipelines.with_trees(&ctx.device, kind);
         }
         self.screen = None;
         self.pattern = kind;
+        self.rows = rows;
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.segments, 4 * self.set.edges as u64, bytemuck::cast_slice(&plan.factors));

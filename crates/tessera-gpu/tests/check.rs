@@ -12,7 +12,7 @@ use common::*;
 use tessera::pattern::transition::Transition;
 use tessera::scheme::Prepared;
 
-/// What a sweep of [`checked_transition_frame`]s saw: the tallies, the most fix rounds of a
+/// What a sweep of [`checked_frame`]s saw: the tallies, the most fix rounds of a
 /// frame and the largest core (cells) of a visible patch.
 struct Sweep {
     counts: SweepCounts,
@@ -20,7 +20,7 @@ struct Sweep {
     largest_core: u32,
 }
 
-/// [`checked_transition_frame`] on `models`, `cameras_per_model` seeded cameras each, every
+/// [`checked_frame`] on `models`, `cameras_per_model` seeded cameras each, every
 /// pixel error of `pixel_errors`, factor cap `cap`; each frame's output against the CPU
 /// engine's for the plan the GPU drew.
 fn sweep(models: &[&str], cameras_per_model: usize, seed: u64, pixel_errors: &[f64], cap: u32) -> Sweep {
@@ -33,8 +33,9 @@ fn sweep(models: &[&str], cameras_per_model: usize, seed: u64, pixel_errors: &[f
             for &pixels in pixel_errors {
                 let name = format!("{model} camera {c} {pixels} px");
                 let counts = &mut sweep.counts;
+                let scheme = tessera::scheme::Scheme::Transition;
                 let plan =
-                    checked_transition_frame(&name, &set, &prepared, &mut gpu, &camera, pixels, cap, counts);
+                    checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, pixels, cap, counts);
                 sweep.most_rounds = sweep.most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
                 let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
                 let visible = (0..set.patches.len()).filter(|&p| plan.is_visible(p));

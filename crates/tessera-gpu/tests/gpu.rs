@@ -406,8 +406,8 @@ fn uniform_pixel_error_root(
     root
 }
 
-/// The acceptance sweep on `models`: `cameras_per_model` seeded cameras each, two frames
-/// per camera, each against the CPU library:
+/// The acceptance sweep on `models`: `cameras_per_model` seeded cameras each, two or three
+/// frames per camera, each against the CPU library:
 ///
 /// - **uniform, from the camera alone**: the GPU culls and computes the pixel-error factor
 ///   ([`GpuTessellator::prepare_screen`]); its culled set and plan (segments, interior
@@ -418,8 +418,11 @@ fn uniform_pixel_error_root(
 ///   silhouetteness factors (per edge, maximum over the edge's patches, the core rule);
 ///   its plan equals `Scheme::Transition`'s on the CPU but for counted rounding ties;
 ///   even cameras, the pixel error: CudaTess's per-edge factors and the a-posteriori check
-///   on the GPU ([`checked_transition_frame`]: the plan, the rounds and the capped patches
-///   equal the CPU's but for counted ties, and every bound verified in f64).
+///   on the GPU ([`checked_frame`]: the plan, the rounds and the capped patches
+///   equal the CPU's but for counted ties, and every bound verified in f64);
+/// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
+///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
+///   transition).
 ///
 /// Then the whole output equals the CPU engine's for the plan the GPU drew
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
@@ -526,7 +529,9 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             } else {
                 let name = format!("{model} camera {c} transition {pixels} px");
                 let cap = options.max_factor;
-                let plan = checked_transition_frame(
+                let scheme = Scheme::Transition;
+                let plan = checked_frame(
+                    scheme,
                     &name,
                     &set,
                     &prepared,
@@ -542,6 +547,28 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             let s = &plan.segments;
             counts.strips += s.iter().any(|&x| x != s[0]) as usize;
             counts.frames += 2;
+
+            // Semi-uniform on every fourth camera: the pixel error's levels checked a
+            // posteriori on the GPU, under the largest power-of-two cap within the cap.
+            if c % 4 == 0 {
+                let name = format!("{model} camera {c} semi-uniform {pixels} px");
+                let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
+                let cap = 1 << cap.max(2).ilog2();
+                let plan = checked_frame(
+                    scheme,
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    cap,
+                    &mut counts,
+                );
+                let pattern = tessera::pattern::semi_uniform::SemiUniform;
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
+                counts.frames += 1;
+            }
         }
         assert!(
             counts.culled > culled_before,
@@ -569,7 +596,7 @@ fn acceptance_sweep_on_the_small_models() {
 }
 
 #[test]
-#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform and transition"]
+#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition and semi-uniform"]
 fn acceptance_sweep_on_every_model_20_cameras() {
     // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).
@@ -798,7 +825,7 @@ fn gpu_pixel_error_factors_equal_the_cpu_plans_on_20_more_cameras() {
 /// [`near_cull_tie`]s — and every `mesh_every`-th frame's output equals the CPU engine's for
 /// the plan drawn.
 fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u64, mesh_every: usize) {
-    use tessera::criterion::resolve::{self, InteriorRule};
+    use tessera::criterion::resolve::InteriorRule;
     use tessera::criterion::view::ViewCriterion;
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
@@ -842,15 +869,7 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                     ties += 1;
                 }
             }
-            let mut interior = Vec::new();
-            resolve::interiors(
-                &set,
-                &drawn.segments,
-                InteriorRule::Core,
-                &prepared.caps(cap as f64),
-                &mut interior,
-            );
-            assert_eq!(drawn.interior, interior, "{name}: interior factors");
+            assert_interiors_follow_the_edges(&name, &set, &prepared, &drawn, InteriorRule::Core, cap);
             if drawn.segments == cpu.segments {
                 assert_eq!(drawn.interior, cpu.interior, "{name}: interior factors");
             }
@@ -948,8 +967,17 @@ fn subdivision_cages_equal_the_cpu_engine(cages: &[String], factors: &[u32], cam
         let mut counts = SweepCounts::default();
         for (c, camera) in cameras(&set, camera_count, 11).into_iter().enumerate() {
             let name = format!("{cage} camera {c} transition 1 px");
-            let plan =
-                checked_transition_frame(&name, &set, &prepared, &mut gpu, &camera, 1.0, 16, &mut counts);
+            let plan = checked_frame(
+                Scheme::Transition,
+                &name,
+                &set,
+                &prepared,
+                &mut gpu,
+                &camera,
+                1.0,
+                16,
+                &mut counts,
+            );
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
         }
     }

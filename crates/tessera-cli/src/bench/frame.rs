@@ -23,13 +23,18 @@ pub struct Scene {
 
 impl Scene {
     pub fn describe(&self) -> String {
+        self.describe_as(self.scheme)
+    }
+
+    /// [`Scene::describe`] with `scheme` in place of the scene's.
+    pub fn describe_as(&self, scheme: Scheme) -> String {
         let what = match self.criterion {
             Criterion::PixelError(px) => format!("{px} px"),
             Criterion::Esc { threshold: Threshold::Medium, .. } => "medium quality".into(),
             Criterion::Esc { threshold: Threshold::High, .. } => "high quality".into(),
             _ => "-".into(),
         };
-        format!("{} {what}{}", self.scheme.name(), if self.cull { ", cull" } else { "" })
+        format!("{} {what}{}", scheme.name(), if self.cull { ", cull" } else { "" })
     }
 
     /// The tessellator options of the scene (culling as set, factors up to 64).
@@ -223,17 +228,22 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
 }
 
 /// The first frames of the scenes the GPU plans itself (the torus grid and the herd: the
-/// transition scheme's pixel error), from the camera alone on the GPU — culling, factors, the
-/// a-posteriori check, counts, scans and writes — with the GPU's per-pass times; None (and a
-/// note) without an adapter.
+/// transition scheme's pixel error, and the same with the semi-uniform scheme), from the
+/// camera alone on the GPU — culling, factors, the a-posteriori check, counts, scans and
+/// writes — with the GPU's per-pass times; None (and a note) without an adapter.
 fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<Option<Table>> {
     let Some(adapter) = super::speed::gpu_adapter(ctx) else { return Ok(None) };
+    let semi_uniform = Scheme::SemiUniform { max_level: Scheme::DEFAULT_SEMI_UNIFORM_LEVEL };
     let screens: Vec<_> = scenes
         .iter()
-        .filter_map(|scene| {
+        .flat_map(|scene| {
+            let also = (scene.scheme == Scheme::Transition).then_some(semi_uniform);
+            std::iter::once(scene.scheme).chain(also).map(move |scheme| (scene, scheme))
+        })
+        .filter_map(|(scene, scheme)| {
             let options = scene.options().plan;
-            crate::gpu::screen_criterion(&scene.set, scene.scheme, &scene.criterion, &options)
-                .map(|s| (scene, s))
+            crate::gpu::screen_criterion(&scene.set, scheme, &scene.criterion, &options)
+                .map(|s| (scene, scheme, s))
         })
         .collect();
     ctx.plan_steps(screens.len() as u64);
@@ -247,8 +257,8 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();
     let title = format!("frame: the walk's first frame planned and tessellated on the GPU ({adapter})");
     let mut table = Table::new("frame_gpu", &title, &names);
-    for (scene, screen) in screens {
-        ctx.step(&format!("frame: {} first frame on the GPU", scene.name));
+    for (scene, scheme, screen) in screens {
+        ctx.step(&format!("frame: {} first frame on the GPU, {}", scene.name, scheme.name()));
         let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
         let run = crate::gpu::tessellate_from_camera(
             &scene.set,
@@ -262,7 +272,7 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
         let mut row: Vec<super::table::Cell> = vec![
             scene.name.into(),
             scene.set.patches.len().into(),
-            format!("{}, planned on the GPU", scene.describe()).into(),
+            format!("{}, planned on the GPU", scene.describe_as(scheme)).into(),
             mesh.triangle_count().into(),
             (check.rounds as usize).into(),
             (check.failing_patches as usize).into(),

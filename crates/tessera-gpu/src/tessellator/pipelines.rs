@@ -4,8 +4,8 @@
 
 use super::screen::{
     CRITERION_FIXED, CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER,
-    EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING,
-    STATE_BINDING,
+    EDGE_RULE_POWER_OF_TWO, EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE,
+    PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING,
 };
 use super::VERTEX_FLOATS;
 use crate::context::GpuContext;
@@ -15,6 +15,7 @@ use crate::shader::sources::*;
 use crate::shader::{self, Binding};
 use crate::upload;
 use tessera::pattern::hardware::{Hardware, Partitioning};
+use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
@@ -82,11 +83,13 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("INTERIOR_GLOBAL", INTERIOR_GLOBAL),
         ("INTERIOR_CORE", INTERIOR_CORE),
         ("INTERIOR_MAX_EDGE", INTERIOR_MAX_EDGE),
+        ("INTERIOR_LEVEL", INTERIOR_LEVEL),
         ("CRITERION_PIXEL_ERROR", CRITERION_PIXEL_ERROR),
         ("CRITERION_SILHOUETTENESS", CRITERION_SILHOUETTENESS),
         ("CRITERION_FIXED", CRITERION_FIXED),
         ("EDGE_RULE_INTEGER", EDGE_RULE_INTEGER),
         ("EDGE_RULE_HARDWARE", EDGE_RULE_HARDWARE),
+        ("EDGE_RULE_POWER_OF_TWO", EDGE_RULE_POWER_OF_TWO),
         ("PARTITIONING_INTEGER", partitioning_code(Partitioning::Integer)),
         ("PARTITIONING_POW2", partitioning_code(Partitioning::Pow2)),
         ("PARTITIONING_FRACTIONAL_ODD", partitioning_code(Partitioning::FractionalOdd)),
@@ -117,6 +120,9 @@ pub enum GpuPattern {
     /// partitionings (`integer`, `pow2`, `fractional_odd`, `fractional_even`) on quads and
     /// triangles: one invocation per patch walks its rings and stitches serially.
     Hardware(Partitioning),
+    /// [`tessera::pattern::semi_uniform::SemiUniform`] (paper 000, compacted) on quads and
+    /// triangles: one invocation per row of a patch's grid (`semi_uniform.wgsl`).
+    SemiUniform,
 }
 
 impl GpuPattern {
@@ -125,6 +131,7 @@ impl GpuPattern {
         match pattern.name() {
             n if n == Uniform.name() => Some(GpuPattern::Uniform),
             n if n == Transition.name() => Some(GpuPattern::Transition),
+            n if n == SemiUniform.name() => Some(GpuPattern::SemiUniform),
             n => PARTITIONINGS
                 .into_iter()
                 .find(|&p| Hardware { partitioning: p }.name() == n)
@@ -138,6 +145,7 @@ impl GpuPattern {
             GpuPattern::Uniform => &Uniform,
             GpuPattern::Transition => &Transition,
             GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
+            GpuPattern::SemiUniform => &SemiUniform,
         }
     }
 
@@ -238,6 +246,36 @@ const HARDWARE_SHADERS: PatternShaders = PatternShaders {
     write_collapsed_triangles: None,
 };
 
+/// The semi-uniform pattern: counts and triangles in one module, the interior on the uniform
+/// grid of the patch level.
+const SEMI_UNIFORM_SHADERS: PatternShaders = PatternShaders {
+    count: ("semi-uniform", &[COMMON, UNIFORM_GRID, LOCAL, SEMI_UNIFORM, COUNT]),
+    vertices: (
+        "vertices semi-uniform",
+        &[
+            COMMON,
+            BICUBIC,
+            NO_TREE,
+            BEZIER_TRIANGLE,
+            UNIFORM_GRID,
+            LOCAL,
+            SEMI_UNIFORM,
+            GRID_VERTICES,
+            WRITE_VERTICES,
+        ],
+    ),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "semi_uniform_patch_counts"),
+        // The uniform grid of the patch level: its interior points never move.
+        ("INTERIOR_GRID", "uniform_interior_grid"),
+        ("EDGE_PARAM", "grid_edge_param"),
+        ("INTERIOR_POINT", "grid_interior_point"),
+    ],
+    write_triangles: "write_semi_uniform_triangles",
+    write_collapsed_triangles: None,
+};
+
 impl PatternShaders {
     /// Compiles the pattern's modules and makes its pipelines with group 0 laid out by
     /// `layout`. Cost: two or three WGSL compilations.
@@ -325,6 +363,8 @@ pub struct Pipelines {
     /// The hardware pattern's, compiled on first use ([`Pipelines::hardware`]): a frame of
     /// the integer patterns does not wait for them.
     hardware: std::sync::OnceLock<PatternPipelines>,
+    /// The semi-uniform pattern's, compiled on first use ([`Pipelines::semi_uniform`]).
+    semi_uniform: std::sync::OnceLock<PatternPipelines>,
     main_pipeline_layout: wgpu::PipelineLayout,
 }
 
@@ -393,7 +433,19 @@ impl Pipelines {
         let uniform = UNIFORM_SHADERS.pipelines(device, &one);
         let transition = TRANSITION_SHADERS.pipelines(device, &one);
         let check = {
-            let parts = [COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS, LOCAL, BOUNDS, TRANSITION, CHECK];
+            let parts = [
+                COMMON,
+                VIEW,
+                CULL,
+                HARDWARE_PARTITION,
+                FACTORS,
+                LOCAL,
+                BOUNDS,
+                TRANSITION,
+                UNIFORM_GRID,
+                SEMI_UNIFORM,
+                CHECK,
+            ];
             let m = module(device, "check", &parts);
             CheckPipelines {
                 check_all: make(&with_view, &m, "check_all"),
@@ -415,6 +467,7 @@ impl Pipelines {
             uniform,
             transition,
             hardware: std::sync::OnceLock::new(),
+            semi_uniform: std::sync::OnceLock::new(),
             main_pipeline_layout: one,
             main_layout,
             args_layout,
@@ -432,6 +485,26 @@ impl Pipelines {
         })
     }
 
+    /// The semi-uniform pattern's pipelines (`semi_uniform.wgsl`), compiled on the first
+    /// call. Cost: the first call two WGSL compilations; later calls nothing.
+    pub(super) fn semi_uniform(&self, device: &wgpu::Device) -> &PatternPipelines {
+        self.semi_uniform.get_or_init(|| SEMI_UNIFORM_SHADERS.pipelines(device, &self.main_pipeline_layout))
+    }
+
+    /// The pipelines a frame of `pattern` needs, compiled now if they are compiled on first
+    /// use (the hardware and semi-uniform patterns'). Cost: as [`Pipelines::hardware`].
+    pub(super) fn compile(&self, device: &wgpu::Device, pattern: GpuPattern) {
+        match pattern {
+            GpuPattern::Hardware(_) => {
+                self.hardware(device);
+            }
+            GpuPattern::SemiUniform => {
+                self.semi_uniform(device);
+            }
+            GpuPattern::Uniform | GpuPattern::Transition => {}
+        }
+    }
+
     /// Compiles the vertex passes that evaluate subdivision patches for `pattern` (whose own
     /// pipelines exist: [`Pipelines::hardware`] first for a hardware pattern). Cost: the
     /// first call per pattern one WGSL compilation; later calls nothing.
@@ -440,6 +513,7 @@ impl Pipelines {
             GpuPattern::Uniform => &UNIFORM_SHADERS,
             GpuPattern::Transition => &TRANSITION_SHADERS,
             GpuPattern::Hardware(_) => &HARDWARE_SHADERS,
+            GpuPattern::SemiUniform => &SEMI_UNIFORM_SHADERS,
         };
         if let Some(p) = self.of(pattern) {
             p.with_trees.get_or_init(|| shaders.vertex_pipelines(device, &self.main_pipeline_layout, true));
@@ -453,6 +527,7 @@ impl Pipelines {
             GpuPattern::Uniform => Some(&self.uniform),
             GpuPattern::Transition => Some(&self.transition),
             GpuPattern::Hardware(_) => self.hardware.get(),
+            GpuPattern::SemiUniform => self.semi_uniform.get(),
         }
     }
 }
@@ -478,15 +553,20 @@ pub(crate) struct Params {
     pub(crate) vertex_capacity: u32,
     pub(crate) triangle_capacity: u32,
     pub(crate) partitioning: u32,
-    pub(crate) _pad: [u32; 2],
+    pub(crate) rows: u32,
+    pub(crate) _pad: u32,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const ROWS: [(&str, &PatternShaders); 3] =
-        [("uniform", &UNIFORM_SHADERS), ("transition", &TRANSITION_SHADERS), ("hardware", &HARDWARE_SHADERS)];
+    const ROWS: [(&str, &PatternShaders); 4] = [
+        ("uniform", &UNIFORM_SHADERS),
+        ("transition", &TRANSITION_SHADERS),
+        ("hardware", &HARDWARE_SHADERS),
+        ("semi-uniform", &SEMI_UNIFORM_SHADERS),
+    ];
 
     /// The modules of `row` (count, vertices, triangles), expanded with `functions` as
     /// [`PatternShaders::pipelines`] expands them, parsed by naga.

@@ -7,12 +7,12 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::readback;
 
-/// What the a-posteriori check of a pixel-error transition frame achieved
+/// What the a-posteriori check of a pixel-error transition or semi-uniform frame achieved
 /// ([`GpuTessellator::read_screen_report`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ScreenReport {
     /// Whether the frame had an a-posteriori check on the GPU (a pixel error with the
-    /// transition scheme, planned by [`GpuTessellator::prepare_screen`]); the other fields are
+    /// transition or semi-uniform scheme, planned by [`GpuTessellator::prepare_screen`]); the other fields are
     /// 0, 0 and true otherwise.
     pub checked: bool,
     /// Fix rounds run after the first check (the CPU's loop iterations that changed edges).
@@ -62,7 +62,7 @@ pub(crate) struct CheckRow {
 
 impl GpuTessellator {
     /// Reads the last frame's a-posteriori check back (after
-    /// [`GpuTessellator::prepare_screen`] with a pixel error and the transition scheme; the
+    /// [`GpuTessellator::prepare_screen`] with a pixel error and the transition or semi-uniform scheme; the
     /// other frames report no rounds and no failing patch): for statistics and tests, never
     /// in a frame loop. Cost: a queue wait.
     pub fn read_screen_report(&self, ctx: &GpuContext) -> Result<ScreenReport> {

@@ -36,9 +36,10 @@ pub(super) const PATCH_VIEW_ROW: u32 = 8;
 /// with `PlanOptions::max_factor = max_factor`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScreenCriterion {
-    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`] or [`Scheme::Hardware`].
+    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`], [`Scheme::SemiUniform`] or
+    /// [`Scheme::Hardware`].
     pub scheme: Scheme,
-    /// [`Criterion::PixelError`] (uniform and transition schemes), [`Criterion::View`] with
+    /// [`Criterion::PixelError`] (uniform, transition and semi-uniform schemes), [`Criterion::View`] with
     /// [`ViewCriterion::Silhouetteness`], or [`Criterion::Factor`] (hardware schemes).
     pub criterion: Criterion,
     /// The factor cap, `1..=MAX_FACTOR`.
@@ -78,11 +79,13 @@ pub(crate) struct ViewUniform {
 pub(super) const INTERIOR_GLOBAL: u32 = 0;
 pub(super) const INTERIOR_CORE: u32 = 1;
 pub(super) const INTERIOR_MAX_EDGE: u32 = 2;
+pub(super) const INTERIOR_LEVEL: u32 = 3;
 pub(super) const CRITERION_PIXEL_ERROR: u32 = 0;
 pub(super) const CRITERION_SILHOUETTENESS: u32 = 1;
 pub(super) const CRITERION_FIXED: u32 = 2;
 pub(super) const EDGE_RULE_INTEGER: u32 = 0;
 pub(super) const EDGE_RULE_HARDWARE: u32 = 1;
+pub(super) const EDGE_RULE_POWER_OF_TWO: u32 = 2;
 /// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
 pub(super) const EDGE_VIEW_ROW: usize = 3;
 
@@ -101,9 +104,10 @@ pub(super) struct Screen {
 
 impl Screen {
     /// Whether the frame's interiors come from the a-posteriori check (a pixel error with
-    /// the transition scheme's core rule).
+    /// the transition scheme's core rule or the semi-uniform scheme's level).
     pub(super) fn checked(&self) -> bool {
-        self.criterion == CRITERION_PIXEL_ERROR && self.interior == INTERIOR_CORE
+        self.criterion == CRITERION_PIXEL_ERROR
+            && (self.interior == INTERIOR_CORE || self.interior == INTERIOR_LEVEL)
     }
 }
 
@@ -222,9 +226,12 @@ impl GpuTessellator {
     /// the largest over the visible patches) or [`Scheme::Transition`] (CudaTess: per-edge
     /// factors and the a-posteriori check of `check.wgsl`, which raises interiors and, round
     /// by round, edges until every visible patch's bound holds; see
-    /// [`GpuTessellator::read_screen_report`]); [`Criterion::View`] with
-    /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`] or [`Scheme::Transition`]
-    /// (per-edge factors, CudaTess's core rule) or a [`Scheme::Hardware`] partitioning (real
+    /// [`GpuTessellator::read_screen_report`]) or [`Scheme::SemiUniform`] (each edge at the
+    /// next power of two of its wish, each patch's level checked the same way,
+    /// `InteriorRule::Level`); [`Criterion::View`] with
+    /// [`ViewCriterion::Silhouetteness`] with [`Scheme::Uniform`], [`Scheme::Transition`]
+    /// (per-edge factors, CudaTess's core rule), [`Scheme::SemiUniform`] (the factors taken
+    /// between the levels, as paper 000) or a [`Scheme::Hardware`] partitioning (real
     /// per-edge factors by `EdgeRule::Fractional`: the cap, the minimum segments, the hull
     /// shader's pow2 rounding and `settled_factor`; Direct3D's `max` inside reduction in the
     /// pattern); and [`Criterion::Factor`] with a [`Scheme::Hardware`] partitioning (one real
@@ -276,12 +283,13 @@ impl GpuTessellator {
         self.screen = Some(screen);
         self.pattern = match scheme {
             Scheme::Uniform => GpuPattern::Uniform,
-            Scheme::Hardware(p) => {
-                self.pipelines.hardware(&ctx.device);
-                GpuPattern::Hardware(p)
-            }
+            Scheme::Hardware(p) => GpuPattern::Hardware(p),
+            // Every edge and level within the cap, a power of two (`validate`).
+            Scheme::SemiUniform { .. } => GpuPattern::SemiUniform,
             _ => GpuPattern::Transition,
         };
+        self.pipelines.compile(&ctx.device, self.pattern);
+        self.rows = screen.cap as u32;
         if self.set.has_trees {
             self.pipelines.with_trees(&ctx.device, self.pattern);
         }
@@ -396,10 +404,11 @@ fn screen_of(
         InteriorRule::Global => INTERIOR_GLOBAL,
         InteriorRule::Core => INTERIOR_CORE,
         InteriorRule::MaxEdge => INTERIOR_MAX_EDGE,
-        InteriorRule::Level => unreachable!("validate refuses the level schemes on the GPU"),
+        InteriorRule::Level => INTERIOR_LEVEL,
     };
     let edge_rule = match accepted.edge_rule {
         Some(EdgeRule::Fractional(Spacing::Hardware(_))) => EDGE_RULE_HARDWARE,
+        Some(EdgeRule::PowerOfTwo) => EDGE_RULE_POWER_OF_TWO,
         _ => EDGE_RULE_INTEGER,
     };
     Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule })

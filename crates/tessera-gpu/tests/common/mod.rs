@@ -295,21 +295,23 @@ pub fn all_models() -> Vec<String> {
     models
 }
 
-/// The transition scheme's pixel-error frame for `camera`, planned on the GPU from the camera
-/// alone (culling, CudaTess's per-edge factors, the a-posteriori check of `check.wgsl`) and
-/// recorded, against `Scheme::Transition`'s plan on the CPU with the same options:
+/// `scheme`'s pixel-error frame for `camera` (the transition or the semi-uniform scheme),
+/// planned on the GPU from the camera alone (culling, per-edge factors, the a-posteriori check
+/// of `check.wgsl`) and recorded, against `scheme`'s plan on the CPU with the same options:
 ///
 /// - the culled set equals the CPU's but for counted [`near_cull_tie`]s ([`check_culling`]);
 /// - the rounds converged within `DEFAULT_CHECK_ROUNDS`;
-/// - every visible patch of the GPU's plan meets its tolerance, its bound computed in f64 by
-///   the CPU library on that plan (`tolerance::patch_bound`), but for at most the patches
-///   the GPU reports failing (at the cap, as the CPU reports them);
+/// - every visible patch's bound from the GPU's check is the CPU library's on the GPU's plan
+///   (`tolerance::patch_bound`, f64) within 1e-4 relative, and the patch meets its tolerance
+///   by the CPU's bound but for at most the patches the GPU reports failing (at the cap, as
+///   the CPU reports them);
 /// - with the same culled set, the plan (segments, interior factors), the fix rounds and the
 ///   capped patches equal the CPU's; a plan that differs is a counted `check_ties` frame.
 ///
 /// Returns the GPU's plan, for comparing its output with the CPU engine's.
 #[allow(clippy::too_many_arguments)]
-pub fn checked_transition_frame(
+pub fn checked_frame(
+    scheme: tessera::scheme::Scheme,
     name: &str,
     set: &SurfaceSet,
     prepared: &tessera::scheme::Prepared,
@@ -319,18 +321,14 @@ pub fn checked_transition_frame(
     cap: u32,
     counts: &mut SweepCounts,
 ) -> Plan {
-    use tessera::scheme::{Criterion, PlanOptions, Scheme};
+    use tessera::scheme::{Criterion, PlanOptions};
     let ctx = ctx();
     let criterion = Criterion::PixelError(pixels);
     let options = PlanOptions { camera: Some(*camera), cull: true, max_factor: cap, ..Default::default() };
-    let cpu = Scheme::Transition.plan_prepared(set, prepared, &criterion, &options).unwrap();
+    let cpu = scheme.plan_prepared(set, prepared, &criterion, &options).unwrap();
     let cpu_report = cpu.report.unwrap();
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion,
-        max_factor: cap,
-        capacity: None,
-    };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
     screen_frame(gpu, set, prepared, camera, screen);
     let visible = check_culling(name, set, gpu, &cpu.plan.visible, camera, counts);
     let drawn = gpu.read_plan(ctx).unwrap();
@@ -340,6 +338,7 @@ pub fn checked_transition_frame(
     let view = camera.view();
     let views = prepared.views(set);
     let mut scratch = tessera::pattern::LocalTessellation::default();
+    let gpu_bounds = gpu.read_check_bounds(ctx).unwrap();
     let missed = (0..set.patches.len())
         .filter(|&p| drawn.is_visible(p))
         .filter(|&p| {
@@ -348,8 +347,14 @@ pub fn checked_transition_frame(
             let bound = tessera::criterion::tolerance::patch_bound(
                 &prepared.hessians[p],
                 &input,
-                &tessera::pattern::transition::Transition,
+                &cpu.pattern,
                 &mut scratch,
+            );
+            // The GPU's bound is the same bound over the same triangles, in f32.
+            let gpu_bound = gpu_bounds[p] as f64;
+            assert!(
+                (gpu_bound - bound).abs() <= 1e-4 * bound + 1e-30,
+                "{name}: patch {p}'s bound is {gpu_bound:e} on the GPU, {bound:e} on the CPU"
             );
             bound > eps * (1.0 + 1e-4)
         })
@@ -370,6 +375,27 @@ pub fn checked_transition_frame(
     }
     counts.check_rounds += (report.rounds > 0) as usize;
     drawn
+}
+
+/// Asserts that `plan`'s interior factors are those `rule` gives its segments within the cap
+/// (`resolve::interiors`): what the GPU's interiors pass computes from the edges it planned.
+pub fn assert_interiors_follow_the_edges(
+    name: &str,
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    plan: &Plan,
+    rule: tessera::criterion::resolve::InteriorRule,
+    cap: u32,
+) {
+    let mut interior = Vec::new();
+    tessera::criterion::resolve::interiors(
+        set,
+        &plan.segments,
+        rule,
+        &prepared.caps(cap as f64),
+        &mut interior,
+    );
+    assert_eq!(plan.interior, interior, "{name}: interior factors");
 }
 
 /// Records one frame of `gpu`'s prepared work and submits it.

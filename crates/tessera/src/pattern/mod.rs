@@ -187,6 +187,16 @@ pub trait Pattern: Sync {
         None
     }
 
+    /// True when every triangle the pattern makes at a quad's corners 0 and 2 has a vertex off
+    /// the two edges there (cells of a grid cut from corner 0 to corner 2), so a patch
+    /// pinched at those corners needs no cut ([`cut_pinched_corners`] finds nothing to do):
+    /// an engine that does not run the cut (the GPU's, `scheme::pinched_beyond_the_gpu`)
+    /// still draws such a patch as the CPU does. False (the default) promises nothing.
+    /// Cost: O(1).
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        false
+    }
+
     /// True when [`Pattern::build`] depends on `input.patch` (patterns holding per-patch
     /// decisions); false lets the engine reuse one build for every patch with the same
     /// input otherwise.

@@ -60,6 +60,12 @@ impl Pattern for Uniform {
         (input.domain == Domain::Quad).then_some(input.interior)
     }
 
+    /// Every cell is cut from its corner `(i, j)` to `(i + 1, j + 1)`, so the domain's
+    /// diagonal from corner 0 to corner 2 is in the pattern.
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        true
+    }
+
     /// The `n`-grid, `n = interior[0]`, on both domains.
     fn grid_cells(&self, input: &PatternInput) -> Option<[u32; 2]> {
         let n = input.interior[0];

@@ -152,6 +152,9 @@ impl Pattern for SchemePattern {
     fn depends_on_patch(&self) -> bool {
         self.inner().depends_on_patch()
     }
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        self.inner().cut_through_corners_0_and_2()
+    }
     fn strips(&self, input: &PatternInput, out: &mut Vec<u32>) -> bool {
         self.inner().strips(input, out)
     }

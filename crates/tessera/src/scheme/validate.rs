@@ -14,7 +14,9 @@ use crate::criterion::view::ViewCriterion;
 use crate::criterion::MAX_FACTOR;
 use crate::domain::Domain;
 use crate::error::{Error, Result};
-use crate::pattern::semi_uniform::MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL;
+use crate::pattern::semi_uniform::{SemiUniform, MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL};
+use crate::pattern::uniform::Uniform;
+use crate::pattern::Pattern;
 use crate::surface::{Patch, SurfaceSet};
 
 /// The engine that is to draw a request.
@@ -22,13 +24,13 @@ use crate::surface::{Patch, SurfaceSet};
 pub enum Engine {
     /// The CPU engine ([`crate::engine`]): every scheme and criterion.
     Cpu,
-    /// The GPU engine (tessera-gpu) drawing a plan made on the CPU: the uniform, transition
-    /// and Direct3D 11 schemes.
+    /// The GPU engine (tessera-gpu) drawing a plan made on the CPU: the uniform, transition,
+    /// semi-uniform (compacted) and Direct3D 11 schemes.
     Gpu,
     /// The GPU engine planning every frame itself from the camera (CudaTess's frame): culling
-    /// on, and a pixel error with the uniform or transition scheme (the transition scheme's
-    /// a-posteriori check with caps up to [`GPU_CHECK_MAX_FACTOR`]), silhouetteness with
-    /// those or a Direct3D 11 partitioning, or a fixed factor with a partitioning.
+    /// on, and a pixel error with the uniform, transition or semi-uniform scheme (the latter
+    /// two's a-posteriori check with caps up to [`GPU_CHECK_MAX_FACTOR`]), silhouetteness
+    /// with those or a Direct3D 11 partitioning, or a fixed factor with a partitioning.
     GpuFromCamera,
 }
 
@@ -85,7 +87,12 @@ pub fn validate(
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
     if engine != Engine::Cpu {
-        if let Some(p) = pinched_beyond_the_gpu(set, scheme == Scheme::Uniform) {
+        let grid = match scheme {
+            Scheme::Uniform => Uniform.cut_through_corners_0_and_2(),
+            Scheme::SemiUniform { .. } => SemiUniform.cut_through_corners_0_and_2(),
+            _ => false,
+        };
+        if let Some(p) = pinched_beyond_the_gpu(set, grid) {
             return Err(Error::EngineNotSupported { engine: engine.name(), what: pinched_on_gpu(p) });
         }
     }
@@ -222,18 +229,19 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
 
 /// The first patch whose pinched corner (an interior vertex of valence 2 of a Catmull-Clark
 /// cage, [`crate::topology::Topology::pinched_corners`]) the GPU's patterns would not cut:
-/// they do not run `pattern::cut_pinched_corners`, so only the uniform grid, whose cells are
-/// already cut through corners 0 and 2 (where the cage's patches are turned to have them),
-/// draws such a patch as the CPU does. Cost: O(P) when the set has pinched corners, else O(1).
-pub fn pinched_beyond_the_gpu(set: &SurfaceSet, uniform: bool) -> Option<usize> {
-    set.topology.patch_pinched.iter().position(|c| if uniform { c[1] || c[3] } else { c.iter().any(|&x| x) })
+/// they do not run `pattern::cut_pinched_corners`, so only a pattern whose triangles are
+/// already cut through corners 0 and 2 (`grid`: `Pattern::cut_through_corners_0_and_2`;
+/// the cage's patches are turned to have their pinched corners there) draws such a patch as
+/// the CPU does. Cost: O(P) when the set has pinched corners, else O(1).
+pub fn pinched_beyond_the_gpu(set: &SurfaceSet, grid: bool) -> Option<usize> {
+    set.topology.patch_pinched.iter().position(|c| if grid { c[1] || c[3] } else { c.iter().any(|&x| x) })
 }
 
 /// What the GPU engine refuses for [`pinched_beyond_the_gpu`]'s patch `p`.
 pub fn pinched_on_gpu(p: usize) -> String {
     format!(
         "patch {p}'s corner at an interior vertex of valence 2 with this scheme (the GPU's patterns \
-         do not cut such corners yet: use the uniform scheme or the CPU engine)"
+         do not cut such corners yet: use the uniform or semi-uniform scheme or the CPU engine)"
     )
 }
 
@@ -274,21 +282,27 @@ fn check_surface_kinds(scheme: Scheme, set: &SurfaceSet) -> Result<()> {
 /// The engine part of [`validate`].
 fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, engine: Engine) -> Result<()> {
     let refuse = |what: String| Err(Error::EngineNotSupported { engine: engine.name(), what });
-    let gpu_scheme = matches!(scheme, Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_));
+    let gpu_scheme = matches!(
+        scheme,
+        Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_) | Scheme::SemiUniform { .. }
+    );
     match engine {
         Engine::Cpu => Ok(()),
         Engine::Gpu | Engine::GpuFromCamera if !gpu_scheme => refuse(format!(
-            "the {} scheme (it draws the uniform, transition, integer, pow2, fractional-odd and \
-             fractional-even schemes)",
+            "the {} scheme (it draws the uniform, transition, semi-uniform, integer, pow2, \
+             fractional-odd and fractional-even schemes)",
             scheme.name()
         )),
         Engine::Gpu => Ok(()),
         Engine::GpuFromCamera => {
             let planned_on_gpu = matches!(
                 (scheme, criterion),
-                (Scheme::Uniform | Scheme::Transition, Criterion::PixelError(_))
+                (Scheme::Uniform | Scheme::Transition | Scheme::SemiUniform { .. }, Criterion::PixelError(_))
                     | (
-                        Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_),
+                        Scheme::Uniform
+                            | Scheme::Transition
+                            | Scheme::SemiUniform { .. }
+                            | Scheme::Hardware(_),
                         Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
                     )
                     | (Scheme::Hardware(_), Criterion::Factor(_))
@@ -303,7 +317,8 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
             if !options.cull {
                 return refuse("a frame without culling (it culls every frame it plans)".into());
             }
-            let checked = scheme == Scheme::Transition && matches!(criterion, Criterion::PixelError(_));
+            let checked = matches!(scheme, Scheme::Transition | Scheme::SemiUniform { .. })
+                && matches!(criterion, Criterion::PixelError(_));
             if checked && options.max_factor > GPU_CHECK_MAX_FACTOR {
                 return refuse(format!(
                     "the a-posteriori check on the GPU with a factor cap of {} (it takes caps up to \
@@ -338,14 +353,10 @@ mod tests {
         v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Cpu).unwrap();
         let esc = Criterion::Esc { threshold: Threshold::High, level: Some(1) };
         v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Cpu).unwrap();
-        // The GPU: three scheme families; from the camera, four pairings, culled.
+        // The GPU: four scheme families; from the camera, four pairings, culled.
         let engine_refused = |r: Result<Accepted>| matches!(r, Err(Error::EngineNotSupported { .. }));
-        assert!(engine_refused(v(
-            Scheme::SemiUniform { max_level: 5 },
-            Criterion::Factor(8.0),
-            &o,
-            Engine::Gpu
-        )));
+        v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Gpu).unwrap();
+        assert!(engine_refused(v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Gpu)));
         v(odd, Criterion::Factor(5.5), &o, Engine::Gpu).unwrap();
         v(odd, Criterion::Factor(5.5), &culled, Engine::GpuFromCamera).unwrap();
         assert!(engine_refused(v(odd, Criterion::Factor(5.5), &o, Engine::GpuFromCamera)), "no culling");

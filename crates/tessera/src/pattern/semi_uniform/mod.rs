@@ -49,7 +49,7 @@ pub const MAX_LEVEL: u32 = 8;
 
 /// The semi-uniform pattern for triangles and quads.
 ///
-/// Preconditions (checked by `debug_assert!`): every `segments[e]` is a power of two, and
+/// Preconditions ([`check_input`], asserted in debug builds): every `segments[e]` is a power of two, and
 /// `interior[0]` (for quads also `interior[1]`, which must equal it) is a power of two at least
 /// as large as every `segments[e]`. The paper's choice is `interior[0] = max_e segments[e]`.
 /// Edge samples are uniform (`t_k = k / segments[e]`).
@@ -78,6 +78,30 @@ pub fn snap_index(p: u32, m: u32, k: u32) -> u32 {
     // midpoint of the edge and towards 1 from it on, as in equation (1).
     let up = 2 * r > s || (2 * r == s && 2 * k >= n);
     (q + u64::from(up)) as u32
+}
+
+/// The pattern's preconditions on `input`, checked: every edge's segments a power of two, the
+/// interior `[n, n]` (triangles: `n` in `interior[0]`) with `n` a power of two at least as
+/// large as every edge's segments and at most `2^MAX_LEVEL`. The GPU engine, whose shaders
+/// assume them, checks a plan with it; the CPU pattern asserts it in debug builds. Errors: the
+/// first broken one, said. Cost: O(1).
+pub fn check_input(input: &PatternInput) -> Result<(), String> {
+    let n = input.interior[0];
+    let top = 1u32 << MAX_LEVEL;
+    if !n.is_power_of_two() || n > top {
+        return Err(format!("the semi-uniform patch level {n} is not a power of two up to {top}"));
+    }
+    if input.domain == Domain::Quad && input.interior[1] != n {
+        return Err(format!("semi-uniform quads need equal interior factors, not {:?}", input.interior));
+    }
+    let nc = input.domain.corner_count();
+    if let Some(e) = (0..nc).find(|&e| !input.segments[e].is_power_of_two() || input.segments[e] > n) {
+        return Err(format!(
+            "edge {e}'s {} segments are not a power of two up to the patch level {n}",
+            input.segments[e]
+        ));
+    }
+    Ok(())
 }
 
 /// The level `p` with `2^p = x`.
@@ -110,19 +134,14 @@ struct Layout {
 
 impl Layout {
     fn new(input: &PatternInput) -> Self {
+        debug_assert!(check_input(input).is_ok(), "{:?}: {input:?}", check_input(input));
         let nc = input.domain.corner_count();
         let n = input.interior[0];
         let m = level(n);
-        debug_assert!(
-            input.domain == Domain::Tri || input.interior[1] == n,
-            "semi-uniform quads need interior[0] == interior[1] ({:?})",
-            input.interior
-        );
         let mut p = [0; 4];
         let mut edge_base = [0; 4];
         for e in 0..nc {
             p[e] = level(input.segments[e]);
-            debug_assert!(p[e] <= m, "semi-uniform: edge {e} finer than the patch level ({input:?})");
             edge_base[e] = input.edge_base(e);
         }
         Layout {
@@ -211,6 +230,14 @@ impl Pattern for SemiUniform {
     /// points snap.
     fn interior_grid(&self, input: &PatternInput) -> Option<[u32; 2]> {
         (input.domain == Domain::Quad).then(|| [Layout::new(input).n; 2])
+    }
+
+    /// The uniform grid's cells, cut from corner 0 to corner 2: a triangle at either corner
+    /// keeps the grid's vertex next to it inside the patch (for `n ≥ 2`; at `n = 1` the
+    /// diagonal itself), wherever the boundary points snap. The GPU tests draw the valence-2
+    /// cage's pinched patches at random levels as the CPU does.
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        true
     }
 
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
