@@ -12,9 +12,10 @@ struct Params {
     // The hardware pattern's partitioning (`hardware_partition.wgsl`'s PARTITIONING_*); 0 for
     // the other patterns.
     partitioning: u32,
-    // Invocations a patch in the per-patch triangle pass: the semi-uniform pattern's largest
-    // patch level n, one per row of its grid (`semi_uniform.wgsl`); 1 for the other patterns.
-    rows: u32,
+    // Invocations a patch in the per-patch triangle pass: for the semi-uniform pattern up to
+    // ROW_BLOCKS, each writing a block of its grid's rows (`semi_uniform.wgsl`); 1 for the
+    // other patterns.
+    blocks: u32,
     _pad: u32,
 }
 

@@ -53,6 +53,6 @@ fn write_args() {
     set_grid(0u, vertex_offsets[edges] - params.corners);
     set_grid(1u, vertices_total - vertex_offsets[edges]);
     set_grid(2u, triangles_total);
-    set_grid(3u, params.patches * params.rows);
+    set_grid(3u, params.patches * params.blocks);
     draw = DrawIndexedIndirect(3u * triangles_total, 1u, 0u, 0, 0u);
 }

@@ -8,10 +8,12 @@
 // and a collapsed curve's points are boundary points too): on a quad the cells of the outer
 // ring, on a triangle the first two and last two triangles of a row, and the whole first
 // and last rows. A row's kept triangles are therefore counted in O(1) but for those two rows
-// (O(n)), and the triangle pass runs one invocation per row of a patch (`Params::rows`
-// invocations a patch): its first output triangle follows from the rows before it in O(n),
-// so no invocation walks a whole pattern (2n² triangles, past lavapipe's loop limit at level
-// 8) and a patch's rows are written in parallel.
+// (O(n)), and the triangle pass splits a patch's rows into `Params::blocks` blocks (at most
+// ROW_BLOCKS), one invocation each: a block's first output triangle follows from the rows
+// before it in O(n), so no invocation walks a whole pattern (2n² triangles, past lavapipe's
+// loop limit at level 8) and the blocks are written in parallel. Blocks rather than one
+// invocation a row: most patches of a frame have few rows, and a dispatch sized for the
+// cap's rows left most invocations idle (6× the transition pattern's pass on lavapipe).
 
 // `semi_uniform::snap_index`: `σ_p(k / 2^m) = K / 2^p`, ties towards the nearer corner.
 fn snap_index(p: u32, m: u32, k: u32) -> u32 {
@@ -107,8 +109,9 @@ fn semi_uniform_patch_counts(p: u32) -> vec2<u32> {
     return vec2<u32>(uniform_counts(input.nc == 3u, n).x, triangles);
 }
 
-// One invocation per row of a patch (`Params::rows` rows a patch, those past the patch's n
-// idle): the row's kept triangles, after those of the rows before it. Cost: O(n).
+// One invocation per block of a patch's rows (`Params::blocks` blocks a patch, of ⌈n / blocks⌉
+// rows each; blocks past the patch's rows idle): the block's kept triangles, after those of
+// the rows before it. Cost: O(n) for the rows before, O(n² / blocks) for its own.
 @compute @workgroup_size(WORKGROUP)
 fn write_semi_uniform_triangles(
     @builtin(workgroup_id) wid: vec3<u32>,
@@ -116,23 +119,27 @@ fn write_semi_uniform_triangles(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let x = thread_index(wid, nwg, lid);
-    let p = x / params.rows;
-    let j = x % params.rows;
+    let p = x / params.blocks;
     if (p >= params.patches) { return; }
     if (visible[p] == 0u) { return; }
     let n = interior[p].x;
-    if (j >= n) { return; }
+    let per_block = (n + params.blocks - 1u) / params.blocks;
+    let start = (x % params.blocks) * per_block;
+    let end = min(n, start + per_block);
+    if (start >= end) { return; }
     let m = countTrailingZeros(n);
     let input = local_numbering(p);
     var first = triangle_offsets[p];
-    for (var r = 0u; r < j; r = r + 1u) {
+    for (var r = 0u; r < start; r = r + 1u) {
         first = first + semi_uniform_row_kept(input, n, m, r);
     }
     var kept = 0u;
-    for (var q = 0u; q < row_length(input.nc == 3u, n, j); q = q + 1u) {
-        let t = semi_uniform_triangle(input, n, m, j, q);
-        if (t.x != t.y) {
-            emit(input, t, true, first, &kept);
+    for (var j = start; j < end; j = j + 1u) {
+        for (var q = 0u; q < row_length(input.nc == 3u, n, j); q = q + 1u) {
+            let t = semi_uniform_triangle(input, n, m, j, q);
+            if (t.x != t.y) {
+                emit(input, t, true, first, &kept);
+            }
         }
     }
 }

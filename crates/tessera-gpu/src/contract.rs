@@ -63,7 +63,7 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("vertex_capacity", offset_of!(Params, vertex_capacity)),
             ("triangle_capacity", offset_of!(Params, triangle_capacity)),
             ("partitioning", offset_of!(Params, partitioning)),
-            ("rows", offset_of!(Params, rows)),
+            ("blocks", offset_of!(Params, blocks)),
         ],
         size_of::<Params>(),
     );

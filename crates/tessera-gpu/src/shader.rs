@@ -51,6 +51,7 @@ pub mod sources {
     pub(crate) const HARDWARE_PARTITION: &str = include_str!("../shaders/hardware_partition.wgsl");
     pub(crate) const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
     pub(crate) const SEMI_UNIFORM: &str = include_str!("../shaders/semi_uniform.wgsl");
+    pub(crate) const SD2: &str = include_str!("../shaders/sd2.wgsl");
 }
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],

@@ -10,7 +10,8 @@
 //!    uploaded once; for the transition and semi-uniform schemes' pixel error also the a-posteriori check
 //!    (`check.wgsl`, `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds
 //!    that size themselves on the GPU raise interiors and edges until the bounds hold;
-//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `semi_uniform.wgsl`, `hardware.wgsl`): per edge and per
+//! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `semi_uniform.wgsl`, `sd2.wgsl`,
+//!    `hardware.wgsl`): per edge and per
 //!    patch, the counts `tessera::engine::Layout::build` scans, in place in the offset
 //!    buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
@@ -20,10 +21,12 @@
 //!    arguments and the `DrawIndexedIndirect` arguments from the totals;
 //! 4. **vertices** (`write_vertices.wgsl`): corners, edge samples (once per shared edge),
 //!    interior vertices;
-//! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) one invocation per
-//!    triangle; transition (`transition.wgsl`) one invocation per patch walking its core
-//!    and strips in the CPU's order; semi-uniform (`semi_uniform.wgsl`) one invocation per
-//!    row of a patch's dyadic grid; the Direct3D 11 partitionings (`hardware.wgsl`) one
+//! 5. **triangles**: indices — uniform (`write_triangles_uniform.wgsl`) and SD-2
+//!    (`sd2.wgsl`) one invocation per triangle (then the patches at a collapsed corner one
+//!    invocation each); transition (`transition.wgsl`) one invocation per patch walking its
+//!    core and strips in the CPU's order; semi-uniform (`semi_uniform.wgsl`) up to
+//!    [`ROW_BLOCKS`] invocations per patch, each a block of its dyadic grid's rows; the
+//!    Direct3D 11 partitionings (`hardware.wgsl`) one
 //!    invocation per patch walking its rings and stitches in the CPU's order (parallel over
 //!    patches only: the next step is a per-triangle form).
 //!
@@ -51,7 +54,7 @@ use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
 use tessera::pattern::hardware::Partitioning;
 use tessera::pattern::Pattern;
-use tessera::sampling::{SamplingKind, Spacing};
+use tessera::sampling::SamplingKind;
 use tessera::surface::SurfaceSet;
 
 mod capacity;
@@ -63,7 +66,7 @@ mod timer;
 
 pub use capacity::Capacity;
 pub use frame::{DEFAULT_CHECK_ROUNDS, MAX_CHECK_ROUNDS, PASSES};
-pub use pipelines::{GpuPattern, Pipelines, STORAGE_BUFFERS};
+pub use pipelines::{GpuPattern, Pipelines, ROW_BLOCKS, STORAGE_BUFFERS};
 pub use report::ScreenReport;
 pub use screen::{ScreenCriterion, CHECK_MAX_FACTOR};
 pub use timer::PassTimer;
@@ -121,9 +124,8 @@ fn check_hardware_plan(plan: &Plan, partitioning: Partitioning) -> Result<()> {
 
 /// The semi-uniform pattern's preconditions on `plan` (`tessera::pattern::semi_uniform::
 /// SemiUniform`, [`tessera::pattern::semi_uniform::check_input`]) for every visible patch,
-/// which the shaders rely on; returns the largest patch level `n` (the triangle pass's rows a
-/// patch). Errors: [`tessera::Error::PlanMismatch`] naming the first patch that breaks one;
-/// [`GpuError::Unsupported`] for more rows in all than one dispatch numbers (2³²). Cost: O(P).
+/// which the shaders rely on; returns the largest patch level `n` (the most rows of a patch).
+/// Errors: [`tessera::Error::PlanMismatch`] naming the first patch that breaks one. Cost: O(P).
 fn check_semi_uniform_plan(set: &SurfaceSet, plan: &Plan) -> Result<u32> {
     let mut rows = 1;
     for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
@@ -132,14 +134,6 @@ fn check_semi_uniform_plan(set: &SurfaceSet, plan: &Plan) -> Result<u32> {
             return Err(tessera::Error::PlanMismatch { what: format!("patch {p}: {why}") }.into());
         }
         rows = rows.max(input.interior[0]);
-    }
-    if set.patches.len() as u64 * rows as u64 > u32::MAX as u64 {
-        return Err(GpuError::Unsupported {
-            what: format!(
-                "{} semi-uniform patches at level {rows} (one invocation a row of each: past 2^32)",
-                set.patches.len()
-            ),
-        });
     }
     Ok(rows)
 }
@@ -195,8 +189,8 @@ pub struct GpuTessellator {
     check_rounds: u32,
     /// Whether the adapter's shader compiler stops long loops ([`loop_limited`]).
     loop_limited: bool,
-    /// `Params::rows`: invocations a patch in the per-patch triangle pass (the semi-uniform
-    /// pattern's largest patch level; 1 for the other patterns).
+    /// The semi-uniform pattern's largest patch level in the plan (its cap when the GPU plans):
+    /// the most rows a patch has, which bounds `Params::blocks`.
     rows: u32,
 }
 
@@ -334,10 +328,14 @@ impl GpuTessellator {
         if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, pattern.cut_through_corners_0_and_2()) {
             return Err(GpuError::Unsupported { what: tessera::scheme::pinched_on_gpu(p) });
         }
-        let expected_kind = match kind {
-            GpuPattern::Hardware(p) => SamplingKind::Fractional(Spacing::Hardware(p)),
-            _ => SamplingKind::Uniform,
-        };
+        if pattern.depends_on_patch() {
+            // The SD-2 pattern with the reverse projection: per-patch corner depths the GPU
+            // does not have.
+            return Err(GpuError::Unsupported {
+                what: format!("the {} pattern with per-patch data (SD-2's --warp)", pattern.name()),
+            });
+        }
+        let expected_kind = kind.sampling_kind();
         if plan.kind != expected_kind {
             return Err(GpuError::Unsupported {
                 what: format!("{:?} samplings with the {} pattern", plan.kind, pattern.name()),
@@ -347,6 +345,9 @@ impl GpuTessellator {
             check_hardware_plan(plan, p)?;
         }
         let rows = if kind == GpuPattern::SemiUniform { check_semi_uniform_plan(set, plan)? } else { 1 };
+        if kind == GpuPattern::Sd2 {
+            self.check_sd2_plan(set, plan)?;
+        }
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
             if kind == GpuPattern::Uniform
@@ -379,6 +380,55 @@ impl GpuTessellator {
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
         self.write_params(ctx);
+        Ok(())
+    }
+
+    /// The SD-2 pattern's preconditions on `plan` (`tessera::pattern::sd2::Sd2`), which the
+    /// shaders rely on: every edge's segments those of its factor's symmetric cut
+    /// ([`tessera::sampling::symmetric_segments`], the sampling the plan's kind names), every
+    /// visible patch with at most two different factors (the CPU pattern falls back to the
+    /// transition pattern for three; the SD-2 criterion never makes them), and on an adapter
+    /// that stops loops ([`loop_limited`]) no patch at a collapsed corner, whose triangles
+    /// one invocation walks, past [`LOOP_LIMIT`] triangles. Errors:
+    /// [`tessera::Error::PlanMismatch`] or [`GpuError::Unsupported`] naming the edge or patch.
+    /// Cost: O(E + P).
+    fn check_sd2_plan(&self, set: &SurfaceSet, plan: &Plan) -> Result<()> {
+        for (e, (&s, &f)) in plan.segments.iter().zip(&plan.factors).enumerate() {
+            let cut = tessera::sampling::symmetric_segments(f as f64);
+            if !(f.is_finite() && f >= 1.0) || s != cut {
+                return Err(tessera::Error::PlanMismatch {
+                    what: format!("edge {e}: {s} segments for the factor {f}, which SD-2 cuts into {cut}"),
+                }
+                .into());
+            }
+        }
+        for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+            let input = tessera::engine::layout::pattern_input(set, plan, p);
+            let f = input.factors;
+            if input.domain != tessera::surface::Domain::Tri || (f[0] != f[1] && f[1] != f[2] && f[2] != f[0])
+            {
+                return Err(GpuError::Unsupported {
+                    what: format!(
+                        "patch {p} with the SD-2 pattern: a quad or three different factors {:?} (SD-2 takes \
+                         triangles with at most two)",
+                        &f[..input.domain.corner_count()]
+                    ),
+                });
+            }
+            let triangles = GpuPattern::Sd2.cpu_pattern().counts(&input).1;
+            if self.loop_limited
+                && tessera::engine::layout::has_repeated_corner(set, p)
+                && triangles > LOOP_LIMIT
+            {
+                return Err(GpuError::Unsupported {
+                    what: format!(
+                        "patch {p}'s {triangles} SD-2 triangles at a collapsed corner on this adapter: its shader \
+                         compiler stops every loop of an invocation after {LOOP_LIMIT} iterations (use lower factors \
+                         or a hardware GPU)"
+                    ),
+                });
+            }
+        }
         Ok(())
     }
 
@@ -421,8 +471,8 @@ impl GpuTessellator {
         let rows: Vec<u32> = readback::read(ctx, &self.segments, 2 * e)?;
         let interior: Vec<[u32; 2]> = readback::read(ctx, &self.interior, p)?;
         let mut plan = Plan::integer(rows[..e].to_vec(), interior, p);
-        if let GpuPattern::Hardware(partitioning) = self.pattern {
-            plan.kind = SamplingKind::Fractional(Spacing::Hardware(partitioning));
+        plan.kind = self.pattern.sampling_kind();
+        if plan.kind != SamplingKind::Uniform {
             plan.factors = rows[e..].iter().map(|&bits| f32::from_bits(bits)).collect();
         }
         plan.visible = self.read_visible(ctx)?;

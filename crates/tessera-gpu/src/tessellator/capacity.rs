@@ -3,7 +3,7 @@
 //! [`GpuTessellator::grow_if_overflowed`]).
 
 use super::screen::{Screen, INTERIOR_CORE};
-use super::{buffer, GpuPattern, GpuTessellator, Output, Params, VERTEX_STRIDE};
+use super::{buffer, GpuPattern, GpuTessellator, Output, Params, ROW_BLOCKS, VERTEX_STRIDE};
 use crate::context::GpuContext;
 use crate::error::{GpuError, Result};
 use crate::shader;
@@ -255,7 +255,7 @@ impl GpuTessellator {
             vertex_capacity: capacity.vertices as u32,
             triangle_capacity: capacity.triangles as u32,
             partitioning: self.pattern.partitioning_code(),
-            rows: if self.pattern == GpuPattern::SemiUniform { self.rows } else { 1 },
+            blocks: if self.pattern == GpuPattern::SemiUniform { self.rows.min(ROW_BLOCKS) } else { 1 },
             _pad: 0,
         };
         ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));

@@ -3,7 +3,7 @@
 //! check within the factors pass. Nothing here reads back.
 
 use super::timer::begin_pass;
-use super::{GpuPattern, GpuTessellator, PassTimer};
+use super::{GpuTessellator, PassTimer};
 use crate::shader;
 
 /// The compute passes of a frame, in order ("cull" only with a culling camera,
@@ -116,9 +116,11 @@ impl GpuTessellator {
         {
             let mut c = begin_pass(encoder, timer, 6);
             c.set_bind_group(0, &out.main, &[]);
-            // Per-patch passes take the fourth dispatch, which the args pass zeroes on overflow.
-            match (&k.collapsed_triangles, self.pattern) {
-                (Some(collapsed), GpuPattern::Uniform) => {
+            // Per-triangle passes take the third dispatch, per-patch passes the fourth, which
+            // the args pass zeroes on overflow. A pattern with a collapsed-corner pass writes
+            // triangle by triangle, then the patches at a collapsed corner one by one.
+            match &k.collapsed_triangles {
+                Some(collapsed) => {
                     c.set_pipeline(&k.triangles);
                     c.dispatch_workgroups_indirect(&self.dispatch_args, 24);
                     if self.set.any_repeated_corner {
@@ -126,7 +128,7 @@ impl GpuTessellator {
                         c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
                     }
                 }
-                _ => {
+                None => {
                     c.set_pipeline(&k.triangles);
                     c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
                 }

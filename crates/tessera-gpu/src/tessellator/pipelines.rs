@@ -15,10 +15,12 @@ use crate::shader::sources::*;
 use crate::shader::{self, Binding};
 use crate::upload;
 use tessera::pattern::hardware::{Hardware, Partitioning};
+use tessera::pattern::sd2::Sd2;
 use tessera::pattern::semi_uniform::SemiUniform;
 use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
 use tessera::pattern::Pattern;
+use tessera::sampling::{SamplingKind, Spacing};
 
 /// Storage buffers in group 0 (all of `common.wgsl`'s but the uniform).
 const MAIN_STORAGE: u32 = 12;
@@ -43,9 +45,18 @@ const fn max_u32(a: u32, b: u32) -> u32 {
     }
 }
 
+/// The most invocations a patch in the semi-uniform triangle pass (`Params::blocks`), each
+/// writing a block of the patch's grid rows. Four keeps one invocation within lavapipe's loop
+/// limit at the top level (64 rows of 512 triangles) while idle invocations stay few: a
+/// frame's patches mostly have one or two rows.
+pub const ROW_BLOCKS: u32 = 4;
+
 /// The Direct3D 11 partitionings, in the order of their codes ([`partitioning_code`]).
 const PARTITIONINGS: [Partitioning; 4] =
     [Partitioning::Integer, Partitioning::Pow2, Partitioning::FractionalOdd, Partitioning::FractionalEven];
+
+/// The CPU's SD-2 pattern without the reverse projection, the one the GPU draws.
+static SD2_PATTERN: Sd2 = Sd2 { corner_depths: None };
 
 /// The CPU pattern of each partitioning, in the same order.
 static HARDWARE_PATTERNS: [Hardware; 4] = [
@@ -123,6 +134,9 @@ pub enum GpuPattern {
     /// [`tessera::pattern::semi_uniform::SemiUniform`] (paper 000, compacted) on quads and
     /// triangles: one invocation per row of a patch's grid (`semi_uniform.wgsl`).
     SemiUniform,
+    /// [`tessera::pattern::sd2::Sd2`] (paper 001) on triangles, without the reverse
+    /// projection: one invocation per triangle (`sd2.wgsl`).
+    Sd2,
 }
 
 impl GpuPattern {
@@ -132,6 +146,7 @@ impl GpuPattern {
             n if n == Uniform.name() => Some(GpuPattern::Uniform),
             n if n == Transition.name() => Some(GpuPattern::Transition),
             n if n == SemiUniform.name() => Some(GpuPattern::SemiUniform),
+            n if n == Sd2::default().name() => Some(GpuPattern::Sd2),
             n => PARTITIONINGS
                 .into_iter()
                 .find(|&p| Hardware { partitioning: p }.name() == n)
@@ -146,6 +161,17 @@ impl GpuPattern {
             GpuPattern::Transition => &Transition,
             GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
             GpuPattern::SemiUniform => &SemiUniform,
+            GpuPattern::Sd2 => &SD2_PATTERN,
+        }
+    }
+
+    /// The sampling kind of the plans the pattern draws: the hardware's own spacing, the
+    /// symmetric remainder for SD-2, equal steps for the integer patterns.
+    pub(super) fn sampling_kind(self) -> SamplingKind {
+        match self {
+            GpuPattern::Hardware(p) => SamplingKind::Fractional(Spacing::Hardware(p)),
+            GpuPattern::Sd2 => SamplingKind::Fractional(Spacing::Symmetric),
+            GpuPattern::Uniform | GpuPattern::Transition | GpuPattern::SemiUniform => SamplingKind::Uniform,
         }
     }
 
@@ -276,6 +302,21 @@ const SEMI_UNIFORM_SHADERS: PatternShaders = PatternShaders {
     write_collapsed_triangles: None,
 };
 
+/// The SD-2 pattern: counts and triangles in one module; triangles one invocation each, then
+/// the patches at a collapsed corner one invocation each.
+const SD2_SHADERS: PatternShaders = PatternShaders {
+    count: ("sd2", &[COMMON, LOCAL, SD2, COUNT]),
+    vertices: ("vertices sd2", &[COMMON, BICUBIC, NO_TREE, BEZIER_TRIANGLE, LOCAL, SD2, WRITE_VERTICES]),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "sd2_patch_counts"),
+        ("EDGE_PARAM", "sd2_edge_param"),
+        ("INTERIOR_POINT", "sd2_interior_point"),
+    ],
+    write_triangles: "write_sd2_triangles",
+    write_collapsed_triangles: Some("write_sd2_collapsed_triangles"),
+};
+
 impl PatternShaders {
     /// Compiles the pattern's modules and makes its pipelines with group 0 laid out by
     /// `layout`. Cost: two or three WGSL compilations.
@@ -363,8 +404,10 @@ pub struct Pipelines {
     /// The hardware pattern's, compiled on first use ([`Pipelines::hardware`]): a frame of
     /// the integer patterns does not wait for them.
     hardware: std::sync::OnceLock<PatternPipelines>,
-    /// The semi-uniform pattern's, compiled on first use ([`Pipelines::semi_uniform`]).
+    /// The semi-uniform pattern's, compiled on first use ([`Pipelines::compile`]).
     semi_uniform: std::sync::OnceLock<PatternPipelines>,
+    /// The SD-2 pattern's, compiled on first use ([`Pipelines::compile`]).
+    sd2: std::sync::OnceLock<PatternPipelines>,
     main_pipeline_layout: wgpu::PipelineLayout,
 }
 
@@ -468,6 +511,7 @@ impl Pipelines {
             transition,
             hardware: std::sync::OnceLock::new(),
             semi_uniform: std::sync::OnceLock::new(),
+            sd2: std::sync::OnceLock::new(),
             main_pipeline_layout: one,
             main_layout,
             args_layout,
@@ -485,21 +529,20 @@ impl Pipelines {
         })
     }
 
-    /// The semi-uniform pattern's pipelines (`semi_uniform.wgsl`), compiled on the first
-    /// call. Cost: the first call two WGSL compilations; later calls nothing.
-    pub(super) fn semi_uniform(&self, device: &wgpu::Device) -> &PatternPipelines {
-        self.semi_uniform.get_or_init(|| SEMI_UNIFORM_SHADERS.pipelines(device, &self.main_pipeline_layout))
-    }
-
     /// The pipelines a frame of `pattern` needs, compiled now if they are compiled on first
-    /// use (the hardware and semi-uniform patterns'). Cost: as [`Pipelines::hardware`].
+    /// use (the hardware, semi-uniform and SD-2 patterns'). Cost: the first call per pattern
+    /// two WGSL compilations; later calls nothing.
     pub(super) fn compile(&self, device: &wgpu::Device, pattern: GpuPattern) {
+        let layout = &self.main_pipeline_layout;
         match pattern {
             GpuPattern::Hardware(_) => {
                 self.hardware(device);
             }
             GpuPattern::SemiUniform => {
-                self.semi_uniform(device);
+                self.semi_uniform.get_or_init(|| SEMI_UNIFORM_SHADERS.pipelines(device, layout));
+            }
+            GpuPattern::Sd2 => {
+                self.sd2.get_or_init(|| SD2_SHADERS.pipelines(device, layout));
             }
             GpuPattern::Uniform | GpuPattern::Transition => {}
         }
@@ -514,6 +557,7 @@ impl Pipelines {
             GpuPattern::Transition => &TRANSITION_SHADERS,
             GpuPattern::Hardware(_) => &HARDWARE_SHADERS,
             GpuPattern::SemiUniform => &SEMI_UNIFORM_SHADERS,
+            GpuPattern::Sd2 => &SD2_SHADERS,
         };
         if let Some(p) = self.of(pattern) {
             p.with_trees.get_or_init(|| shaders.vertex_pipelines(device, &self.main_pipeline_layout, true));
@@ -528,6 +572,7 @@ impl Pipelines {
             GpuPattern::Transition => Some(&self.transition),
             GpuPattern::Hardware(_) => self.hardware.get(),
             GpuPattern::SemiUniform => self.semi_uniform.get(),
+            GpuPattern::Sd2 => self.sd2.get(),
         }
     }
 }
@@ -553,7 +598,7 @@ pub(crate) struct Params {
     pub(crate) vertex_capacity: u32,
     pub(crate) triangle_capacity: u32,
     pub(crate) partitioning: u32,
-    pub(crate) rows: u32,
+    pub(crate) blocks: u32,
     pub(crate) _pad: u32,
 }
 
@@ -561,11 +606,12 @@ pub(crate) struct Params {
 mod tests {
     use super::*;
 
-    const ROWS: [(&str, &PatternShaders); 4] = [
+    const ROWS: [(&str, &PatternShaders); 5] = [
         ("uniform", &UNIFORM_SHADERS),
         ("transition", &TRANSITION_SHADERS),
         ("hardware", &HARDWARE_SHADERS),
         ("semi-uniform", &SEMI_UNIFORM_SHADERS),
+        ("sd2", &SD2_SHADERS),
     ];
 
     /// The modules of `row` (count, vertices, triangles), expanded with `functions` as

@@ -475,6 +475,13 @@ mod tests {
         assert_eq!(Scheme::from_name(""), None);
     }
 
+    /// One flat cubic Bézier triangle.
+    pub(super) fn triangles() -> SurfaceSet {
+        let points = std::array::from_fn(|k| DVec3::new(k as f64, (k * k % 7) as f64, 0.0));
+        let patch = Patch::BezierTriangle(crate::surface::BezierTriangle { points });
+        SurfaceSet::from_patches(vec![patch], Default::default())
+    }
+
     pub(super) fn flat() -> SurfaceSet {
         let points = std::array::from_fn(|k| DVec3::new((k / 4) as f64, (k % 4) as f64, 0.0));
         SurfaceSet::from_patches(

@@ -25,7 +25,7 @@ pub enum Engine {
     /// The CPU engine ([`crate::engine`]): every scheme and criterion.
     Cpu,
     /// The GPU engine (tessera-gpu) drawing a plan made on the CPU: the uniform, transition,
-    /// semi-uniform (compacted) and Direct3D 11 schemes.
+    /// semi-uniform (compacted), SD-2 (without `--warp`) and Direct3D 11 schemes.
     Gpu,
     /// The GPU engine planning every frame itself from the camera (CudaTess's frame): culling
     /// on, and a pixel error with the uniform, transition or semi-uniform scheme (the latter
@@ -284,15 +284,22 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
     let refuse = |what: String| Err(Error::EngineNotSupported { engine: engine.name(), what });
     let gpu_scheme = matches!(
         scheme,
-        Scheme::Uniform | Scheme::Transition | Scheme::Hardware(_) | Scheme::SemiUniform { .. }
+        Scheme::Uniform
+            | Scheme::Transition
+            | Scheme::Hardware(_)
+            | Scheme::SemiUniform { .. }
+            | Scheme::Sd2 { .. }
     );
     match engine {
         Engine::Cpu => Ok(()),
         Engine::Gpu | Engine::GpuFromCamera if !gpu_scheme => refuse(format!(
-            "the {} scheme (it draws the uniform, transition, semi-uniform, integer, pow2, \
+            "the {} scheme (it draws the uniform, transition, semi-uniform, SD-2, integer, pow2, \
              fractional-odd and fractional-even schemes)",
             scheme.name()
         )),
+        Engine::Gpu | Engine::GpuFromCamera if scheme == (Scheme::Sd2 { warp: true }) => {
+            refuse("SD-2's reverse projection (--warp: per-patch corner depths)".into())
+        }
         Engine::Gpu => Ok(()),
         Engine::GpuFromCamera => {
             let planned_on_gpu = matches!(
@@ -357,6 +364,10 @@ mod tests {
         let engine_refused = |r: Result<Accepted>| matches!(r, Err(Error::EngineNotSupported { .. }));
         v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Gpu).unwrap();
         assert!(engine_refused(v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Gpu)));
+        let tris = crate::scheme::tests::triangles();
+        let on_tris = |s, c: Criterion, e| validate(s, &c, &o, &tris, e);
+        on_tris(Scheme::Sd2 { warp: false }, Criterion::Factor(3.5), Engine::Gpu).unwrap();
+        assert!(engine_refused(on_tris(Scheme::Sd2 { warp: true }, Criterion::Factor(3.5), Engine::Gpu)));
         v(odd, Criterion::Factor(5.5), &o, Engine::Gpu).unwrap();
         v(odd, Criterion::Factor(5.5), &culled, Engine::GpuFromCamera).unwrap();
         assert!(engine_refused(v(odd, Criterion::Factor(5.5), &o, Engine::GpuFromCamera)), "no culling");

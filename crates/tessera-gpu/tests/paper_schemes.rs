@@ -1,14 +1,16 @@
-//! The semi-uniform pattern (paper 000, compacted: `tessera::pattern::semi_uniform`) on the
-//! GPU engine against the CPU engine, on lavapipe in CI: the CPU's own plans and arbitrary
-//! power-of-two plans, on bicubic patches, PN and Bézier triangles and Catmull-Clark cages
-//! (collapsed curves, pinched corners and isolated faces included). Every expected value comes
-//! from the CPU library, never from the GPU itself.
+//! The seed papers' own patterns on the GPU engine against the CPU engine, on lavapipe in CI:
+//! semi-uniform (paper 000, compacted: `tessera::pattern::semi_uniform`) from the CPU's own
+//! plans, arbitrary power-of-two plans and the camera, on bicubic patches, PN and Bézier
+//! triangles and Catmull-Clark cages (collapsed curves, pinched corners and isolated faces
+//! included); SD-2 (paper 001: `tessera::pattern::sd2`) from the CPU's plans on triangle
+//! meshes. Every expected value comes from the CPU library, never from the GPU itself.
 //!
 //! No adapter is a failure, not a skip: the message names the packages to install.
 
 mod common;
 
 use common::*;
+use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::criterion::Plan;
 use tessera::io::{LoadOptions, SurfaceKind};
 use tessera::pattern::semi_uniform::SemiUniform;
@@ -210,7 +212,6 @@ fn pixel_error_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
 #[test]
 fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
     use tessera::criterion::resolve::InteriorRule;
-    use tessera::criterion::view::ViewCriterion;
     let ctx = ctx();
     let scheme = Scheme::SemiUniform { max_level: 5 };
     let (cap, fmin, fmax) = (16, 1.0, 16.0);
@@ -260,4 +261,87 @@ fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
     eprintln!("semi-uniform silhouetteness: {frames} frames, {edges} edges, {ties} rounding ties, {mixed} with mixed levels");
     assert!(mixed * 2 >= frames, "too few frames with two levels: {mixed} of {frames}");
     assert!(1000 * ties <= edges, "{ties} rounding ties in {edges} edges");
+}
+
+/// SD-2 (paper 001) from the CPU's plans on triangle meshes, PN and cubic Bézier triangles:
+/// the level function of the distance (linear and quadratic mappings) and of the vertex
+/// silhouettes on three cameras each, and fixed real factors; the GPU's frame equals the CPU
+/// engine's index for index (the symmetric cut and the parallel × radial interior in f32,
+/// within 1e-5 of the diagonal). Each plan has at most two different factors per triangle
+/// (the criterion's promise, checked here on every visible patch) and several factors in all.
+#[test]
+fn sd2_equals_the_cpu_engine_on_triangle_meshes() {
+    let scheme = Scheme::Sd2 { warp: false };
+    let criteria = [
+        Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax: 9.5 },
+        Criterion::View { criterion: ViewCriterion::Distance(Mapping::Quadratic), fmin: 2.0, fmax: 7.25 },
+        Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 12.0 },
+    ];
+    for model in ["meshes/blob.obj", "awkward/teapot_tri_nonmanifold.obj", "meshes/spool.obj"] {
+        let pn = load(model);
+        for (kind, set) in [("PN", &pn), ("Bézier", &as_bezier_triangles(&pn))] {
+            let mut gpu = tessellator(set);
+            let mut factors = std::collections::BTreeSet::new();
+            for (c, camera) in cameras(set, 3, 41).into_iter().enumerate() {
+                for (k, criterion) in criteria.iter().enumerate() {
+                    let name = format!("{model} as {kind} triangles, camera {c}, criterion {k}");
+                    let options = PlanOptions { camera: Some(camera), ..Default::default() };
+                    let planned = scheme.plan(set, criterion, &options).unwrap();
+                    let plan = &planned.plan;
+                    for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+                        let f = tessera::engine::layout::pattern_input(set, plan, p).factors;
+                        assert!(
+                            f[0] == f[1] || f[1] == f[2] || f[2] == f[0],
+                            "{name}: patch {p} 3-different {f:?}"
+                        );
+                    }
+                    factors.extend(plan.factors.iter().map(|f| f.to_bits()));
+                    assert_pattern_equals_cpu(&name, set, &mut gpu, plan, &planned.pattern);
+                }
+            }
+            let planned = scheme.plan(set, &Criterion::Factor(4.6), &PlanOptions::default()).unwrap();
+            assert_pattern_equals_cpu(
+                &format!("{model} factor 4.6"),
+                set,
+                &mut gpu,
+                &planned.plan,
+                &planned.pattern,
+            );
+            assert!(factors.len() >= 6, "{model}: factors {factors:?}, too few to test the cut");
+        }
+    }
+}
+
+/// What the GPU does not draw for SD-2 is refused by name, never drawn wrong: the reverse
+/// projection (per-patch corner depths) and a plan with three different factors on a
+/// triangle, which the CPU pattern draws as a transition fallback.
+#[test]
+fn sd2_plans_the_gpu_cannot_draw_are_refused() {
+    let set = load("meshes/blob.obj");
+    let mut gpu = tessellator(&set);
+    let ctx = ctx();
+    let camera = cameras(&set, 1, 5)[0];
+    let options = PlanOptions { camera: Some(camera), ..Default::default() };
+    let warped = Scheme::Sd2 { warp: true }.plan(&set, &Criterion::Factor(3.0), &options).unwrap();
+    let e = gpu.prepare(ctx, &set, &warped.plan, &warped.pattern).unwrap_err().to_string();
+    assert!(e.contains("--warp"), "{e}");
+    let e = tessera::scheme::validate(
+        Scheme::Sd2 { warp: true },
+        &Criterion::Factor(3.0),
+        &options,
+        &set,
+        tessera::scheme::Engine::Gpu,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--warp"), "{e}");
+    let mut plan = Scheme::Sd2 { warp: false }.plan(&set, &Criterion::Factor(3.0), &options).unwrap().plan;
+    let edges = set.topology.patch_edges[0];
+    for (l, f) in [(1, 4.5f32), (2, 5.5)] {
+        let e = edges[l].edge as usize;
+        plan.factors[e] = f;
+        plan.segments[e] = tessera::sampling::symmetric_segments(f as f64);
+    }
+    let e = gpu.prepare(ctx, &set, &plan, &tessera::pattern::sd2::Sd2::default()).unwrap_err().to_string();
+    assert!(e.contains("three different factors"), "{e}");
 }
