@@ -51,10 +51,11 @@ pub struct MeshArgs {
     pub instanced: Option<PathBuf>,
     /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform, transition,
     /// semi-uniform, integer, pow2, fractional-odd and fractional-even schemes on every
-    /// surface kind, SD-2 without --warp on triangles; with --cull and a pixel error (uniform, transition, semi-uniform;
-    /// --max-factor up to 64), silhouetteness, or a hardware scheme's --factor, the GPU plans
-    /// the frame from the camera itself, else it draws the CPU's plan; --stats adds per-pass
-    /// GPU times).
+    /// surface kind, SD-2 without --warp on triangles; with --cull and a pixel error
+    /// (uniform, transition, semi-uniform; --max-factor up to 64), silhouetteness, a hardware
+    /// scheme's --factor or SD-2's --distance, --silhouette or --factor, the GPU plans the
+    /// frame from the camera itself, else it draws the CPU's plan; --stats adds per-pass GPU
+    /// times).
     #[arg(long, value_enum, default_value = "cpu")]
     pub engine: plan::EngineArg,
     /// Let -o name the input file itself (it is replaced once the new mesh is complete).

@@ -702,14 +702,19 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
             assert_eq!(g[key], c[key], "semi-uniform {criterion}: {key}");
         }
     }
-    // SD-2 (paper 001) from the CPU's plan; its reverse projection is refused by name.
+    // SD-2 (paper 001) from the CPU's plan, and with --cull planned on the GPU from the
+    // camera; its reverse projection is refused by name.
     let args = ["mesh", blob.to_str().unwrap(), "--scheme", "sd2", "--distance", "1:9.5", "--stats"];
-    let cpu = tessera(&args, &dir);
-    let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
-    assert!(gpu.status.success(), "{}", text(&gpu.stderr));
-    let (c, g) = (stats_of(&cpu), stats_of(&gpu));
-    for key in ["triangles", "vertices", "boundary_edges", "nonmanifold_edges", "euler_characteristic"] {
-        assert_eq!(g[key], c[key], "sd2: {key}");
+    for (cull, planned_on) in [(None, "cpu"), (Some("--cull"), "gpu")] {
+        let args: Vec<&str> = args.iter().copied().chain(cull).collect();
+        let cpu = tessera(&args, &dir);
+        let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
+        assert!(gpu.status.success(), "{}", text(&gpu.stderr));
+        let (c, g) = (stats_of(&cpu), stats_of(&gpu));
+        assert_eq!(g["planned_on"], planned_on, "{g}");
+        for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
+            assert_eq!(g[key], c[key], "sd2 {cull:?}: {key}");
+        }
     }
     let warped = tessera(&[&args[..], &["--warp", "--engine", "gpu"]].concat(), &dir);
     assert!(!warped.status.success());

@@ -1,5 +1,5 @@
 // Screen-space factors from the camera alone, the GPU form of `tessera::scheme::Scheme::
-// plan_into` for three criteria:
+// plan_into` for four kinds of criteria:
 //
 // - `Criterion::PixelError`: per visible patch the object-space tolerance of
 //   `screen::PatchView::tolerance` and its proposals (`tolerance::plan_limited`:
@@ -11,10 +11,13 @@
 //   scheme taken between the levels of lo and hi, `view::plan_into`);
 // - `Criterion::Factor` for the hardware schemes (`view::EdgeFactors::Fixed`): every patch
 //   proposes the factor for each of its edges;
+// - SD-2's level functions (`criterion::sd2::plan`): each edge's factor from its two end
+//   vertices, the larger of their distance factors or the silhouette's crossing;
 //
 // then per edge the maximum over the patches sharing it, read through the topology's edge
 // uses, within the cap and the minimum segments (`resolve::edges`, `EdgeRule::Integer`,
-// `EdgeRule::PowerOfTwo` for the semi-uniform scheme or, for the hardware schemes, `EdgeRule::Fractional(Spacing::Hardware(_))`: the hull shader's
+// `EdgeRule::PowerOfTwo` for the semi-uniform scheme, `EdgeRule::Fractional(Spacing::Symmetric)`
+// for SD-2 or, for the hardware schemes, `EdgeRule::Fractional(Spacing::Hardware(_))`: the hull shader's
 // pow2 rounding and `settled_factor`, segments by the partition), then the interiors
 // (`resolve::interiors`): the global factor on every edge and patch (`InteriorRule::Global`),
 // CudaTess's core rule (`InteriorRule::Core`), the largest edge (`InteriorRule::MaxEdge`) or
@@ -131,6 +134,86 @@ fn between_levels(f: f32) -> f32 {
     return exp2(lo + t * (log2(view.hi) - lo));
 }
 
+// SD-2's level functions (`criterion::sd2::plan`) from the vertex rows after the edge rows
+// (`patch_view_rows`): the depth along the view direction mapped by g onto [hi, lo] over the
+// frame's depth range (linear or quadratic), or the vertices' front/back classification.
+
+// An f32's bits as a u32 in the same order (atomics on depths): negative numbers
+// complemented, positive ones with the top bit set.
+fn ordered_bits(x: f32) -> u32 {
+    let b = bitcast<u32>(x);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn from_ordered_bits(o: u32) -> f32 {
+    return bitcast<f32>(select(~o, o & 0x7fffffffu, (o & 0x80000000u) != 0u));
+}
+
+fn vertex_row(v: u32) -> u32 {
+    return PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * params.edges + VERTEX_VIEW_ROW * v;
+}
+
+// The vertex's depth along the view direction (`sd2::plan`'s `depth`).
+fn vertex_depth(v: u32) -> f32 {
+    return dot(patch_views[vertex_row(v)].xyz - view.eye.xyz, view.forward.xyz);
+}
+
+// Per topology vertex: its depth into the frame's range (the distance level function's).
+@compute @workgroup_size(WORKGROUP)
+fn vertex_depths(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let v = thread_index(wid, nwg, lid);
+    if (v >= (arrayLength(&patch_views) - vertex_row(0u)) / VERTEX_VIEW_ROW) { return; }
+    let d = ordered_bits(vertex_depth(v));
+    atomicMax(&state.depth_far, d);
+    atomicMax(&state.depth_near_complement, ~d);
+}
+
+// The distance level function's factor of vertex v: g of its depth, linear
+// `hi (dmax − d)/span + lo (d − dmin)/span` or quadratic `(hi − lo)((d − dmax)/span)² + lo`,
+// within [lo, hi].
+fn level_factor(v: u32) -> f32 {
+    let d = vertex_depth(v);
+    let dmin = from_ordered_bits(~atomicLoad(&state.depth_near_complement));
+    let dmax = from_ordered_bits(atomicLoad(&state.depth_far));
+    let span = max(dmax - dmin, 1e-30);
+    var f: f32;
+    if (view.criterion == CRITERION_DISTANCE_LINEAR) {
+        f = view.hi * (dmax - d) / span + view.lo * (d - dmin) / span;
+    } else {
+        let x = (d - dmax) / span;
+        f = (view.hi - view.lo) * x * x + view.lo;
+    }
+    return clamp(f, view.lo, view.hi);
+}
+
+// `n · (eye − v) ≥ 0`: the vertex faces the eye.
+fn vertex_front(v: u32) -> bool {
+    let r = vertex_row(v);
+    return dot(patch_views[r + 1u].xyz, view.eye.xyz - patch_views[r].xyz) >= 0.0;
+}
+
+// SD-2's factor of edge e from its end vertices (in the w of its second and third rows): the
+// larger of their level factors (g decreases with depth: g of the nearer end), or hi for an
+// edge the silhouette crosses and lo otherwise. Never three different in a triangle.
+fn level_edge_factor(e: u32) -> f32 {
+    let row = PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * e;
+    let a = bitcast<u32>(patch_views[row + 1u].w);
+    let b = bitcast<u32>(patch_views[row + 2u].w);
+    if (view.criterion == CRITERION_VERTEX_SILHOUETTE) {
+        return select(view.lo, view.hi, vertex_front(a) != vertex_front(b));
+    }
+    return max(level_factor(a), level_factor(b));
+}
+
+fn is_level_function(criterion: u32) -> bool {
+    return criterion == CRITERION_DISTANCE_LINEAR || criterion == CRITERION_DISTANCE_QUADRATIC
+        || criterion == CRITERION_VERTEX_SILHOUETTE;
+}
+
 // Per patch: its proposal for each local edge, and its minimum interior into the global
 // factor.
 @compute @workgroup_size(WORKGROUP)
@@ -150,6 +233,11 @@ fn patch_proposals(
     if (view.criterion == CRITERION_FIXED) {
         // Every patch, culled or not, proposes the factor (`from_edge_factors`).
         out = vec4<f32>(view.lo);
+    } else if (is_level_function(view.criterion)) {
+        // Every patch, culled or not, proposes its edges' factors (`from_edge_factors`).
+        for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
+            out[l] = level_edge_factor(patch_edge(p, l));
+        }
     } else if (view.criterion == CRITERION_SILHOUETTENESS) {
         // Every patch, culled or not, proposes its edges' factors (`from_edge_factors`).
         for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {
@@ -231,6 +319,14 @@ fn edge_segments(
         let minimum = f32(max(minimum_segments(e), 1u));
         let f = settled_factor(hull_factor(max(wanted_factor(e), minimum), mode), mode);
         segments[e] = hardware_edge_segments(f, mode);
+        segments[params.edges + e] = bitcast<u32>(f);
+        return;
+    }
+    if (view.edge_rule == EDGE_RULE_SYMMETRIC) {
+        // `EdgeRule::Fractional(Spacing::Symmetric)`: the real factor kept, at least the
+        // minimum; segments by the symmetric cut (`symmetric_segments`).
+        let f = max(wanted_factor(e), f32(max(minimum_segments(e), 1u)));
+        segments[e] = u32(ceil(max(f, 1.0)));
         segments[params.edges + e] = bitcast<u32>(f);
         return;
     }

@@ -21,7 +21,8 @@ struct View {
     pixels: f32,
     cap: f32,
     interior_rule: u32,
-    // The criterion (CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS or CRITERION_FIXED) and
+    // The criterion (CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_FIXED or one of
+    // SD-2's level functions, CRITERION_DISTANCE_LINEAR, _QUADRATIC, CRITERION_VERTEX_SILHOUETTE) and
     // the view criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap
     // applied; a fixed factor is lo = hi); the edge rule (EDGE_RULE_INTEGER,
     // EDGE_RULE_POWER_OF_TWO or EDGE_RULE_HARDWARE, whose partitioning is
@@ -57,9 +58,11 @@ struct FrameState {
     changed: atomic<u32>,
     done: atomic<u32>,
     rounds: atomic<u32>,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // The frame's vertex depths for SD-2's distance level function, as `ordered_bits`: the
+    // largest, and the complement of the smallest (both raised from the cleared 0).
+    depth_far: atomic<u32>,
+    depth_near_complement: atomic<u32>,
+    _pad: u32,
 }
 @group(1) @binding(3) var<storage, read_write> state: FrameState;
 
@@ -83,10 +86,15 @@ const INTERIOR_LEVEL: u32 = {{INTERIOR_LEVEL}}u;
 const CRITERION_PIXEL_ERROR: u32 = {{CRITERION_PIXEL_ERROR}}u;
 const CRITERION_SILHOUETTENESS: u32 = {{CRITERION_SILHOUETTENESS}}u;
 const CRITERION_FIXED: u32 = {{CRITERION_FIXED}}u;
+const CRITERION_DISTANCE_LINEAR: u32 = {{CRITERION_DISTANCE_LINEAR}}u;
+const CRITERION_DISTANCE_QUADRATIC: u32 = {{CRITERION_DISTANCE_QUADRATIC}}u;
+const CRITERION_VERTEX_SILHOUETTE: u32 = {{CRITERION_VERTEX_SILHOUETTE}}u;
 const EDGE_RULE_INTEGER: u32 = {{EDGE_RULE_INTEGER}}u;
 const EDGE_RULE_HARDWARE: u32 = {{EDGE_RULE_HARDWARE}}u;
 const EDGE_RULE_POWER_OF_TWO: u32 = {{EDGE_RULE_POWER_OF_TWO}}u;
+const EDGE_RULE_SYMMETRIC: u32 = {{EDGE_RULE_SYMMETRIC}}u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
+const VERTEX_VIEW_ROW: u32 = {{VERTEX_VIEW_ROW}}u;
 
 // `u32::next_power_of_two` (x ≤ 2³¹).
 fn next_power_of_two(x: u32) -> u32 {

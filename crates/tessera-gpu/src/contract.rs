@@ -99,6 +99,8 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("changed", offset_of!(FrameState, changed)),
             ("done", offset_of!(FrameState, done)),
             ("rounds", offset_of!(FrameState, rounds)),
+            ("depth_far", offset_of!(FrameState, depth_far)),
+            ("depth_near_complement", offset_of!(FrameState, depth_near_complement)),
         ],
         size_of::<FrameState>(),
     );

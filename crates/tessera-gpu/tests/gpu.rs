@@ -422,13 +422,16 @@ fn uniform_pixel_error_root(
 ///   equal the CPU's but for counted ties, and every bound verified in f64);
 /// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
 ///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
-///   transition).
+///   transition);
+/// - **SD-2** on the triangle models, every fourth camera (the others): the CPU's plan from
+///   the distance level function (real factors, never three different a triangle), drawn on
+///   the GPU.
 ///
 /// Then the whole output equals the CPU engine's for the plan the GPU drew
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
 /// index, positions within 1e-5 of the diagonal, the watertightness report).
 fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
-    use tessera::criterion::view::ViewCriterion;
+    use tessera::criterion::view::{Mapping, ViewCriterion};
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
     let mut counts = SweepCounts::default();
@@ -569,6 +572,20 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
                 counts.frames += 1;
             }
+            // SD-2 on triangle models, every fourth camera (the others): the CPU's plan from
+            // the distance level function, drawn on the GPU.
+            let triangles = set.patches.iter().all(|p| p.domain() == tessera::surface::Domain::Tri);
+            if c % 4 == 2 && triangles {
+                let name = format!("{model} camera {c} sd2");
+                let fmax = options.max_factor as f64 + 0.5;
+                let criterion =
+                    Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax };
+                let options = PlanOptions { max_factor: options.max_factor + 1, ..options };
+                let planned = Scheme::Sd2 { warp: false }.plan(&set, &criterion, &options).unwrap();
+                assert_eq!(tessera::criterion::sd2::three_different(&set, &planned.plan), 0, "{name}");
+                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+                counts.frames += 1;
+            }
         }
         assert!(
             counts.culled > culled_before,
@@ -596,7 +613,7 @@ fn acceptance_sweep_on_the_small_models() {
 }
 
 #[test]
-#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition and semi-uniform"]
+#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition, semi-uniform and SD-2"]
 fn acceptance_sweep_on_every_model_20_cameras() {
     // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).

@@ -345,3 +345,74 @@ fn sd2_plans_the_gpu_cannot_draw_are_refused() {
     let e = gpu.prepare(ctx, &set, &plan, &tessera::pattern::sd2::Sd2::default()).unwrap_err().to_string();
     assert!(e.contains("three different factors"), "{e}");
 }
+
+/// SD-2 planned on the GPU from the camera alone (paper 001's level functions: the vertex
+/// depths' range reduced on the GPU and mapped linearly or quadratically, or the vertices'
+/// front/back classification; culling; the symmetric cut of each edge's real factor) against
+/// `Scheme::Sd2`'s plan on the CPU: the culled set but for `near_cull_tie`s, every real factor
+/// within 1e-5 relative (f32 depths against f64), the segments equal but where the CPU's
+/// factor lies within that of a whole number (counted, one off), the interiors the largest
+/// edge's, never three different factors in a triangle of the GPU's plan; and the frame's
+/// output equals the CPU engine's for the plan drawn.
+#[test]
+fn sd2_planned_on_the_gpu_equals_the_cpu_plan() {
+    let ctx = ctx();
+    let scheme = Scheme::Sd2 { warp: false };
+    let criteria = [
+        Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax: 9.5 },
+        Criterion::View { criterion: ViewCriterion::Distance(Mapping::Quadratic), fmin: 2.0, fmax: 7.25 },
+        Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 12.0 },
+        Criterion::Factor(3.3),
+    ];
+    let (mut frames, mut edges, mut ties, mut culled) = (0, 0, 0, 0);
+    for model in ["meshes/blob.obj", "meshes/spool.obj", "awkward/teapot_tri_nonmanifold.obj"] {
+        let set = load(model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, 3, 61).into_iter().enumerate() {
+            for (k, &criterion) in criteria.iter().enumerate() {
+                let name = format!("{model} camera {c} criterion {k}");
+                let options = PlanOptions { camera: Some(camera), cull: true, ..Default::default() };
+                let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+                let screen =
+                    ScreenCriterion { scheme, criterion, max_factor: options.max_factor, capacity: None };
+                screen_frame(&mut gpu, &set, &prepared, &camera, screen);
+                let drawn = gpu.read_plan(ctx).unwrap();
+                for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
+                    assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
+                }
+                culled += cpu.visible.iter().filter(|&&v| v == 0).count();
+                for e in 0..cpu.segments.len() {
+                    let (want, got) = (cpu.factors[e] as f64, drawn.factors[e] as f64);
+                    assert!(
+                        (got - want).abs() <= 1e-5 * want,
+                        "{name}: edge {e} factor {got}, the CPU's {want}"
+                    );
+                    if drawn.segments[e] != cpu.segments[e] {
+                        let tie = (want - want.round()).abs() <= 1e-5 * want;
+                        assert!(
+                            tie && drawn.segments[e].abs_diff(cpu.segments[e]) == 1,
+                            "{name}: edge {e} segments"
+                        );
+                        ties += 1;
+                    }
+                }
+                assert_eq!(tessera::criterion::sd2::three_different(&set, &drawn), 0, "{name}");
+                let rule = tessera::criterion::resolve::InteriorRule::MaxEdge;
+                assert_interiors_follow_the_edges(&name, &set, &prepared, &drawn, rule, options.max_factor);
+                assert_gpu_equals_cpu_after_record(
+                    &name,
+                    &set,
+                    &gpu,
+                    &drawn,
+                    &tessera::pattern::sd2::Sd2::default(),
+                );
+                edges += cpu.segments.len();
+                frames += 1;
+            }
+        }
+    }
+    eprintln!("sd2 from the camera: {frames} frames, {edges} edges, {ties} rounding ties, {culled} culled");
+    assert!(culled > 0, "nothing culled");
+    assert!(1000 * ties <= edges, "{ties} rounding ties in {edges} edges");
+}

@@ -77,13 +77,15 @@ fn hardware_worst_case(
 /// The largest output a frame planned on the GPU by `screen` can have
 /// ([`GpuTessellator::prepare_screen`]): every patch at the cap `max_factor`, or at the
 /// largest of `prepared`'s minimums when that is higher; for the transition scheme's core
-/// rule its strips' triangles too; for a hardware partitioning [`hardware_worst_case`].
+/// rule its strips' triangles too; for a hardware partitioning [`hardware_worst_case`]; for
+/// SD-2 its own pattern with every edge at that factor (`nd (2 ns − 1)` triangles grow with
+/// both counts, so no two-factor plan within it has more).
 /// Errors as [`Plan::uniform`]. Cost: O(E + P) pattern counts.
 pub(super) fn screen_worst_case(
     set: &SurfaceSet,
     prepared: &Prepared,
     screen: &Screen,
-    hardware: Option<Partitioning>,
+    pattern: GpuPattern,
     max_factor: u32,
 ) -> Result<Capacity> {
     let patches = set.patches.len();
@@ -99,8 +101,14 @@ pub(super) fn screen_worst_case(
         worst_case = Capacity::of_plan(set, &Plan::uniform(set, w as u32)?, &Uniform, true);
         worst_case.triangles += 8 * w * patches as u64;
     }
-    if let Some(p) = hardware {
-        worst_case = hardware_worst_case(set, prepared, p, screen.cap);
+    match pattern {
+        GpuPattern::Hardware(p) => worst_case = hardware_worst_case(set, prepared, p, screen.cap),
+        GpuPattern::Sd2 => {
+            let mut plan = Plan::uniform(set, worst)?;
+            plan.kind = SamplingKind::Fractional(Spacing::Symmetric);
+            worst_case = Capacity::of_plan(set, &plan, pattern.cpu_pattern(), true);
+        }
+        GpuPattern::Uniform | GpuPattern::Transition | GpuPattern::SemiUniform => {}
     }
     Ok(worst_case)
 }

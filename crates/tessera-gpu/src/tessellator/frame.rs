@@ -60,6 +60,11 @@ impl GpuTessellator {
             if screen {
                 c.set_bind_group(0, &out.main, &[]);
                 c.set_bind_group(1, &self.view.bind, &[]);
+                if self.screen.is_some_and(|s| s.reads_depths()) {
+                    c.set_pipeline(&p.vertex_depths);
+                    let (x, y) = grid(self.view.vertices);
+                    c.dispatch_workgroups(x, y, 1);
+                }
                 c.set_pipeline(&p.patch_proposals);
                 let (x, y) = grid(patches);
                 c.dispatch_workgroups(x, y, 1);

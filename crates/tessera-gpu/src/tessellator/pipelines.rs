@@ -3,9 +3,10 @@
 //! ([`constants`]), the bind group layouts, and `common.wgsl`'s uniform [`Params`].
 
 use super::screen::{
-    CRITERION_FIXED, CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER,
-    EDGE_RULE_POWER_OF_TWO, EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE,
-    PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING,
+    CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_FIXED, CRITERION_PIXEL_ERROR,
+    CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE, EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER,
+    EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL,
+    INTERIOR_LEVEL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING, VERTEX_VIEW_ROW,
 };
 use super::VERTEX_FLOATS;
 use crate::context::GpuContext;
@@ -91,6 +92,7 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("VERTEX_FLOATS", VERTEX_FLOATS),
         ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
         ("EDGE_VIEW_ROW", EDGE_VIEW_ROW as u32),
+        ("VERTEX_VIEW_ROW", VERTEX_VIEW_ROW as u32),
         ("INTERIOR_GLOBAL", INTERIOR_GLOBAL),
         ("INTERIOR_CORE", INTERIOR_CORE),
         ("INTERIOR_MAX_EDGE", INTERIOR_MAX_EDGE),
@@ -98,9 +100,13 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("CRITERION_PIXEL_ERROR", CRITERION_PIXEL_ERROR),
         ("CRITERION_SILHOUETTENESS", CRITERION_SILHOUETTENESS),
         ("CRITERION_FIXED", CRITERION_FIXED),
+        ("CRITERION_DISTANCE_LINEAR", CRITERION_DISTANCE_LINEAR),
+        ("CRITERION_DISTANCE_QUADRATIC", CRITERION_DISTANCE_QUADRATIC),
+        ("CRITERION_VERTEX_SILHOUETTE", CRITERION_VERTEX_SILHOUETTE),
         ("EDGE_RULE_INTEGER", EDGE_RULE_INTEGER),
         ("EDGE_RULE_HARDWARE", EDGE_RULE_HARDWARE),
         ("EDGE_RULE_POWER_OF_TWO", EDGE_RULE_POWER_OF_TWO),
+        ("EDGE_RULE_SYMMETRIC", EDGE_RULE_SYMMETRIC),
         ("PARTITIONING_INTEGER", partitioning_code(Partitioning::Integer)),
         ("PARTITIONING_POW2", partitioning_code(Partitioning::Pow2)),
         ("PARTITIONING_FRACTIONAL_ODD", partitioning_code(Partitioning::FractionalOdd)),
@@ -392,6 +398,7 @@ pub struct Pipelines {
     pub(super) args_layout: wgpu::BindGroupLayout,
     pub(super) view_layout: wgpu::BindGroupLayout,
     pub(super) cull: wgpu::ComputePipeline,
+    pub(super) vertex_depths: wgpu::ComputePipeline,
     pub(super) patch_proposals: wgpu::ComputePipeline,
     pub(super) edge_segments: wgpu::ComputePipeline,
     pub(super) interiors: wgpu::ComputePipeline,
@@ -502,6 +509,7 @@ impl Pipelines {
             check,
             rounds_layout,
             cull: make(&with_view, &cull, "cull"),
+            vertex_depths: make(&with_view, &factors, "vertex_depths"),
             patch_proposals: make(&with_view, &factors, "patch_proposals"),
             edge_segments: make(&with_view, &factors, "edge_segments"),
             interiors: make(&with_view, &factors, "interiors"),

@@ -45,7 +45,11 @@ pub(crate) struct FrameState {
     pub(crate) done: u32,
     /// Fix rounds run after the first check.
     pub(crate) rounds: u32,
-    pub(crate) _pad: [u32; 3],
+    /// The frame's vertex depths (SD-2's distance level function), as ordered bits: the
+    /// largest, and the complement of the smallest.
+    pub(crate) depth_far: u32,
+    pub(crate) depth_near_complement: u32,
+    pub(crate) _pad: u32,
 }
 
 /// `view.wgsl`'s `CheckRow`, one per patch (the contract test checks the offsets): the

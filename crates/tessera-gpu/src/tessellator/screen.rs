@@ -14,8 +14,7 @@ use crate::shader;
 use crate::upload;
 use tessera::camera::Camera;
 use tessera::criterion::resolve::{EdgeRule, InteriorRule};
-#[cfg(doc)]
-use tessera::criterion::view::ViewCriterion;
+use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::sampling::Spacing;
 use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
@@ -83,11 +82,17 @@ pub(super) const INTERIOR_LEVEL: u32 = 3;
 pub(super) const CRITERION_PIXEL_ERROR: u32 = 0;
 pub(super) const CRITERION_SILHOUETTENESS: u32 = 1;
 pub(super) const CRITERION_FIXED: u32 = 2;
+pub(super) const CRITERION_DISTANCE_LINEAR: u32 = 3;
+pub(super) const CRITERION_DISTANCE_QUADRATIC: u32 = 4;
+pub(super) const CRITERION_VERTEX_SILHOUETTE: u32 = 5;
 pub(super) const EDGE_RULE_INTEGER: u32 = 0;
 pub(super) const EDGE_RULE_HARDWARE: u32 = 1;
 pub(super) const EDGE_RULE_POWER_OF_TWO: u32 = 2;
+pub(super) const EDGE_RULE_SYMMETRIC: u32 = 3;
 /// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
 pub(super) const EDGE_VIEW_ROW: usize = 3;
+/// `vec4<f32>` per topology vertex after the edge rows ([`patch_view_rows`]).
+pub(super) const VERTEX_VIEW_ROW: usize = 2;
 
 /// The criterion of [`GpuTessellator::prepare_screen`], as `view.wgsl` reads it.
 #[derive(Debug, Clone, Copy)]
@@ -103,6 +108,12 @@ pub(super) struct Screen {
 }
 
 impl Screen {
+    /// Whether the frame's factors read the range of its vertex depths (SD-2's distance level
+    /// function: the `vertex_depths` pass first).
+    pub(super) fn reads_depths(&self) -> bool {
+        self.criterion == CRITERION_DISTANCE_LINEAR || self.criterion == CRITERION_DISTANCE_QUADRATIC
+    }
+
     /// Whether the frame's interiors come from the a-posteriori check (a pixel error with
     /// the transition scheme's core rule or the semi-uniform scheme's level).
     pub(super) fn checked(&self) -> bool {
@@ -128,6 +139,8 @@ pub(super) struct ViewBuffers {
     /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
     /// device.
     pub(super) bounds_uploaded: bool,
+    /// The set's topology vertices (their rows follow the edges').
+    pub(super) vertices: u32,
 }
 
 impl ViewBuffers {
@@ -160,7 +173,18 @@ impl ViewBuffers {
             rounds_layout,
             &[(STATE_BINDING, &state), (ROUND_ARGS_BINDING, &round_args)],
         );
-        ViewBuffers { uniform, patch_views, state, checks, bind, round_args, rounds, bounds_uploaded: false }
+        let vertices = set.topology.vertex_count;
+        ViewBuffers {
+            uniform,
+            patch_views,
+            state,
+            checks,
+            bind,
+            round_args,
+            rounds,
+            bounds_uploaded: false,
+            vertices,
+        }
     }
 }
 
@@ -171,7 +195,10 @@ impl ViewBuffers {
 /// (zero without it) the second-derivative bound `(uu, uv, vv, 0)`, the four boundary
 /// curves' bounds and the minimum interior factors; after the patches, [`EDGE_VIEW_ROW`]
 /// per edge from `Prepared::edge_midpoints` (the midpoint as its first patch sees it, with
-/// the edge's `Prepared::minimum_segments` in w; the normals of its first and last patch).
+/// the edge's `Prepared::minimum_segments` in w; the normals of its first and last patch,
+/// with the edge's two end vertices in w as u32 bits); after the edges, [`VERTEX_VIEW_ROW`]
+/// per topology vertex from `view::vertex_data` (its position and its normal: SD-2's level
+/// functions read them).
 /// View-independent: computed once. Cost: O(P) cone
 /// computations, the midpoints' evaluations when `prepared` has none yet.
 fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
@@ -196,15 +223,27 @@ fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4
             None => out.extend([[0.0; 4]; 3]),
         }
     }
-    let edges = set.topology.edges.len();
+    let edges = &set.topology.edges;
+    let with_end = |v: glam::DVec3, end: u32| {
+        let mut row = v4(v, 0.0);
+        row[3] = f32::from_bits(end);
+        row
+    };
     match prepared {
         Some(prepared) => {
             let minimum = &prepared.minimum_segments;
             for (e, [(mid, nl), (_, nr)]) in prepared.edge_midpoints(set).iter().enumerate() {
-                out.extend([v4(*mid, minimum[e] as f64), v4(*nl, 0.0), v4(*nr, 0.0)]);
+                let [a, b] = edges[e].ends;
+                out.extend([v4(*mid, minimum[e] as f64), with_end(*nl, a), with_end(*nr, b)]);
+            }
+            for (position, normal) in tessera::criterion::view::vertex_data(set) {
+                out.extend([v4(position, 0.0), v4(normal, 0.0)]);
             }
         }
-        None => out.resize(out.len() + EDGE_VIEW_ROW * edges, [0.0; 4]),
+        None => {
+            let rows = EDGE_VIEW_ROW * edges.len() + VERTEX_VIEW_ROW * set.topology.vertex_count as usize;
+            out.resize(out.len() + rows, [0.0; 4]);
+        }
     }
     out
 }
@@ -235,11 +274,15 @@ impl GpuTessellator {
     /// per-edge factors by `EdgeRule::Fractional`: the cap, the minimum segments, the hull
     /// shader's pow2 rounding and `settled_factor`; Direct3D's `max` inside reduction in the
     /// pattern); and [`Criterion::Factor`] with a [`Scheme::Hardware`] partitioning (one real
-    /// factor, resolved the same way, with the GPU's culling). A silhouetteness strictly
+    /// factor, resolved the same way, with the GPU's culling); and [`Scheme::Sd2`] without
+    /// the warp with paper 001's level functions ([`ViewCriterion::Distance`], the vertex
+    /// depths' range reduced on the GPU, [`ViewCriterion::SilhouetteVertices`]) or a fixed
+    /// factor (real per-edge factors by `EdgeRule::Fractional(Spacing::Symmetric)`; f32
+    /// depths, so a factor may differ from the CPU's in its last bits). A silhouetteness strictly
     /// between 0 and 1 is computed in f32 from f32 copies of the CPU's data, so such an edge's
     /// real factor may differ from the CPU's in its last bits (`factors.wgsl`). The distance
-    /// and vertex-silhouette criteria are planned on the CPU (their plans draw on the GPU
-    /// through [`GpuTessellator::prepare`]). The output is sized for the worst case, every
+    /// and vertex-silhouette criteria of the other schemes are planned on the CPU (their
+    /// plans draw on the GPU through [`GpuTessellator::prepare`]). The output is sized for the worst case, every
     /// patch at the cap (or at the largest minimum when that is higher), within the device's
     /// buffer limits, or as `criterion.capacity` says; a frame that needs more draws nothing
     /// and is reported ([`GpuTessellator::grow_if_overflowed`]).
@@ -268,11 +311,15 @@ impl GpuTessellator {
         let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
         let screen = screen_of(set, camera, scheme, criterion, max_factor)?;
         self.check_screen_support(set, prepared, scheme, max_factor)?;
-        let hardware = match scheme {
-            Scheme::Hardware(p) => Some(p),
-            _ => None,
+        let pattern = match scheme {
+            Scheme::Uniform => GpuPattern::Uniform,
+            Scheme::Hardware(p) => GpuPattern::Hardware(p),
+            // Every edge and level within the cap, a power of two (`validate`).
+            Scheme::SemiUniform { .. } => GpuPattern::SemiUniform,
+            Scheme::Sd2 { .. } => GpuPattern::Sd2,
+            _ => GpuPattern::Transition,
         };
-        let worst = screen_worst_case(set, prepared, &screen, hardware, max_factor)?;
+        let worst = screen_worst_case(set, prepared, &screen, pattern, max_factor)?;
         self.reserve_screen(ctx, worst, capacity)?;
         if !self.view.bounds_uploaded {
             // View-independent and the same for every `Prepared` of the set: uploaded once.
@@ -281,13 +328,7 @@ impl GpuTessellator {
             self.view.bounds_uploaded = true;
         }
         self.screen = Some(screen);
-        self.pattern = match scheme {
-            Scheme::Uniform => GpuPattern::Uniform,
-            Scheme::Hardware(p) => GpuPattern::Hardware(p),
-            // Every edge and level within the cap, a power of two (`validate`).
-            Scheme::SemiUniform { .. } => GpuPattern::SemiUniform,
-            _ => GpuPattern::Transition,
-        };
+        self.pattern = pattern;
         self.pipelines.compile(&ctx.device, self.pattern);
         self.rows = screen.cap as u32;
         if self.set.has_trees {
@@ -390,15 +431,29 @@ fn screen_of(
     let options = PlanOptions { camera: Some(*camera), cull: true, max_factor, ..PlanOptions::default() };
     let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
     let cap = accepted.cap;
-    let (kind, pixels, lo, hi) = match criterion {
-        Criterion::PixelError(px) => (CRITERION_PIXEL_ERROR, px, 1.0, 1.0),
-        Criterion::View { fmin, fmax, .. } => {
+    let (kind, pixels, lo, hi) = match (scheme, criterion) {
+        (_, Criterion::PixelError(px)) => (CRITERION_PIXEL_ERROR, px, 1.0, 1.0),
+        // SD-2's level functions (`criterion::sd2::plan`, the range as `Scheme::plan_sd2`
+        // bounds it); a fixed factor is the linear distance function with fmin = fmax.
+        (Scheme::Sd2 { .. }, Criterion::View { criterion, fmin, fmax }) => {
+            let fmax = fmax.min(cap);
+            let kind = match criterion {
+                ViewCriterion::Distance(Mapping::Linear) => CRITERION_DISTANCE_LINEAR,
+                ViewCriterion::Distance(Mapping::Quadratic) => CRITERION_DISTANCE_QUADRATIC,
+                _ => CRITERION_VERTEX_SILHOUETTE,
+            };
+            (kind, 1.0, fmin.min(fmax), fmax)
+        }
+        (Scheme::Sd2 { .. }, Criterion::Factor(f)) => (CRITERION_DISTANCE_LINEAR, 1.0, f, f),
+        (_, Criterion::View { fmin, fmax, .. }) => {
             let fmax = fmax.min(cap);
             let lo = fmin.min(fmax).max(1.0);
             (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
         }
-        Criterion::Factor(f) => (CRITERION_FIXED, 1.0, f, f),
-        Criterion::Tolerance(_) | Criterion::Esc { .. } => unreachable!("validate refuses them on the GPU"),
+        (_, Criterion::Factor(f)) => (CRITERION_FIXED, 1.0, f, f),
+        (_, Criterion::Tolerance(_) | Criterion::Esc { .. }) => {
+            unreachable!("validate refuses them on the GPU")
+        }
     };
     let interior = match accepted.interior_rule {
         InteriorRule::Global => INTERIOR_GLOBAL,
@@ -409,6 +464,7 @@ fn screen_of(
     let edge_rule = match accepted.edge_rule {
         Some(EdgeRule::Fractional(Spacing::Hardware(_))) => EDGE_RULE_HARDWARE,
         Some(EdgeRule::PowerOfTwo) => EDGE_RULE_POWER_OF_TWO,
+        Some(EdgeRule::Fractional(Spacing::Symmetric)) => EDGE_RULE_SYMMETRIC,
         _ => EDGE_RULE_INTEGER,
     };
     Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule })

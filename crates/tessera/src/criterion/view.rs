@@ -39,7 +39,7 @@ pub enum ViewCriterion {
 
 /// Position and normal of each topology vertex, from the first patch corner at it:
 /// view-independent, kept by [`super::Prepared::vertex_data`]. Cost: O(V) evaluations.
-pub(crate) fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
+pub fn vertex_data(set: &SurfaceSet) -> Vec<(DVec3, DVec3)> {
     let topo = &set.topology;
     let mut out = vec![(DVec3::ZERO, DVec3::Z); topo.vertex_count as usize];
     for e in topo.corner_entries.iter().rev() {

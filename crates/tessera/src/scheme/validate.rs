@@ -30,7 +30,8 @@ pub enum Engine {
     /// The GPU engine planning every frame itself from the camera (CudaTess's frame): culling
     /// on, and a pixel error with the uniform, transition or semi-uniform scheme (the latter
     /// two's a-posteriori check with caps up to [`GPU_CHECK_MAX_FACTOR`]), silhouetteness
-    /// with those or a Direct3D 11 partitioning, or a fixed factor with a partitioning.
+    /// with those or a Direct3D 11 partitioning, a fixed factor with a partitioning, or
+    /// SD-2's level functions (distance, vertex silhouettes) and fixed factor without `--warp`.
     GpuFromCamera,
 }
 
@@ -313,6 +314,14 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                         Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
                     )
                     | (Scheme::Hardware(_), Criterion::Factor(_))
+                    | (
+                        Scheme::Sd2 { warp: false },
+                        Criterion::Factor(_)
+                            | Criterion::View {
+                                criterion: ViewCriterion::Distance(_) | ViewCriterion::SilhouetteVertices,
+                                ..
+                            }
+                    )
             );
             if !planned_on_gpu {
                 return refuse(format!(
