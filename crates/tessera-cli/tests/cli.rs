@@ -689,33 +689,29 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
         assert_eq!(g[key], c[key], "fractional-odd planned on the GPU: {key}");
     }
-    // Semi-uniform (paper 000, compacted): a CPU plan drawn on the GPU, and the frame planned
-    // on the GPU from the camera (the levels and their a-posteriori check).
-    for (criterion, value, planned_on) in [("--tolerance", "0.01", "cpu"), ("--pixel-error", "0.5", "gpu")] {
-        let args = ["mesh", input, "--scheme", "semi-uniform", criterion, value, "--cull", "--stats"];
+    // The seed papers' schemes: semi-uniform (paper 000, compacted) and SD-2 (paper 001), a
+    // CPU plan drawn on the GPU, and with --cull the frame planned on the GPU from the camera
+    // (semi-uniform's levels with their a-posteriori check, SD-2's level function).
+    let blob = blob.to_str().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&[input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--cull"], "cpu"),
+        (&[input, "--scheme", "semi-uniform", "--pixel-error", "0.5", "--cull"], "gpu"),
+        (&[blob, "--scheme", "sd2", "--distance", "1:9.5"], "cpu"),
+        (&[blob, "--scheme", "sd2", "--distance", "1:9.5", "--cull"], "gpu"),
+    ];
+    for (case, planned_on) in cases {
+        let args = [&["mesh"], case, &["--stats"]].concat();
         let cpu = tessera(&args, &dir);
         let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
         assert!(gpu.status.success(), "{}", text(&gpu.stderr));
         let (c, g) = (stats_of(&cpu), stats_of(&gpu));
         assert_eq!(g["planned_on"], planned_on, "{g}");
         for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
-            assert_eq!(g[key], c[key], "semi-uniform {criterion}: {key}");
+            assert_eq!(g[key], c[key], "{case:?}: {key}");
         }
     }
-    // SD-2 (paper 001) from the CPU's plan, and with --cull planned on the GPU from the
-    // camera; its reverse projection is refused by name.
-    let args = ["mesh", blob.to_str().unwrap(), "--scheme", "sd2", "--distance", "1:9.5", "--stats"];
-    for (cull, planned_on) in [(None, "cpu"), (Some("--cull"), "gpu")] {
-        let args: Vec<&str> = args.iter().copied().chain(cull).collect();
-        let cpu = tessera(&args, &dir);
-        let gpu = tessera(&[&args[..], &["--engine", "gpu"]].concat(), &dir);
-        assert!(gpu.status.success(), "{}", text(&gpu.stderr));
-        let (c, g) = (stats_of(&cpu), stats_of(&gpu));
-        assert_eq!(g["planned_on"], planned_on, "{g}");
-        for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
-            assert_eq!(g[key], c[key], "sd2 {cull:?}: {key}");
-        }
-    }
+    // SD-2's reverse projection is refused by name.
+    let args = ["mesh", blob, "--scheme", "sd2", "--distance", "1:9.5"];
     let warped = tessera(&[&args[..], &["--warp", "--engine", "gpu"]].concat(), &dir);
     assert!(!warped.status.success());
     assert!(text(&warped.stderr).contains("--warp"), "{}", text(&warped.stderr));
