@@ -51,7 +51,7 @@ pub struct MeshArgs {
     pub instanced: Option<PathBuf>,
     /// Engine: `cpu` (rayon) or `gpu` (tessera-gpu on wgpu: the uniform, transition,
     /// semi-uniform, integer, pow2, fractional-odd and fractional-even schemes on every
-    /// surface kind, SD-2 without --warp on triangles; with --cull and a pixel error
+    /// surface kind, SD-2 on triangles; with --cull and a pixel error
     /// (uniform, transition, semi-uniform; --max-factor up to 64), silhouetteness, a hardware
     /// scheme's --factor or SD-2's --distance, --silhouette or --factor, the GPU plans the
     /// frame from the camera itself, else it draws the CPU's plan; --stats adds per-pass GPU

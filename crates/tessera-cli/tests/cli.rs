@@ -693,11 +693,12 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     // CPU plan drawn on the GPU, and with --cull the frame planned on the GPU from the camera
     // (semi-uniform's levels with their a-posteriori check, SD-2's level function).
     let blob = blob.to_str().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&[input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--cull"], "cpu"),
         (&[input, "--scheme", "semi-uniform", "--pixel-error", "0.5", "--cull"], "gpu"),
         (&[blob, "--scheme", "sd2", "--distance", "1:9.5"], "cpu"),
         (&[blob, "--scheme", "sd2", "--distance", "1:9.5", "--cull"], "gpu"),
+        (&[blob, "--scheme", "sd2", "--silhouette", "2:8", "--warp", "--cull"], "gpu"),
     ];
     for (case, planned_on) in cases {
         let args = [&["mesh"], case, &["--stats"]].concat();
@@ -710,11 +711,6 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
             assert_eq!(g[key], c[key], "{case:?}: {key}");
         }
     }
-    // SD-2's reverse projection is refused by name.
-    let args = ["mesh", blob, "--scheme", "sd2", "--distance", "1:9.5"];
-    let warped = tessera(&[&args[..], &["--warp", "--engine", "gpu"]].concat(), &dir);
-    assert!(!warped.status.success());
-    assert!(text(&warped.stderr).contains("--warp"), "{}", text(&warped.stderr));
     let refused = tessera(&["mesh", input, "--scheme", "esc", "--level", "1", "--engine", "gpu"], &dir);
     assert!(!refused.status.success());
     assert!(text(&refused.stderr).contains("does not support"), "{}", text(&refused.stderr));

@@ -16,7 +16,9 @@ struct Params {
     // ROW_BLOCKS, each writing a block of its grid's rows (`semi_uniform.wgsl`); 1 for the
     // other patterns.
     blocks: u32,
-    _pad: u32,
+    // 1 for a reverse-projected SD-2 plan (`SamplingKind::Warped`: the edge depths follow the
+    // factors in `segments`, `sd2.wgsl`), else 0.
+    warped: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -27,8 +29,9 @@ struct Params {
 @group(0) @binding(4) var<storage, read_write> edge_uses: array<u32>;
 @group(0) @binding(5) var<storage, read_write> corner_rows: array<u32>;
 // The plan: `tessera::criterion::Plan::{segments, interior, visible}` byte for byte;
-// `segments[E..2E]` holds `Plan::factors` (the f32 bits, `edge_factor`), which only the
-// hardware pattern reads (one buffer for both keeps the frame within 16 storage buffers).
+// `segments[E..2E]` holds `Plan::factors` (the f32 bits, `edge_factor`), which the hardware
+// and SD-2 patterns read, and `segments[2E..4E]` a warped plan's `Plan::depths` (SD-2's
+// reverse projection); one buffer for all keeps the frame within 16 storage buffers.
 @group(0) @binding(6) var<storage, read_write> segments: array<u32>;
 @group(0) @binding(7) var<storage, read_write> interior: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read_write> visible: array<u32>;

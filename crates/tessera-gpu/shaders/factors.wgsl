@@ -200,13 +200,17 @@ fn vertex_front(v: u32) -> bool {
 // larger of their level factors (g decreases with depth: g of the nearer end), or hi for an
 // edge the silhouette crosses and lo otherwise. Never three different in a triangle.
 fn level_edge_factor(e: u32) -> f32 {
-    let row = PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * e;
-    let a = bitcast<u32>(patch_views[row + 1u].w);
-    let b = bitcast<u32>(patch_views[row + 2u].w);
+    let ends = edge_ends(e);
     if (view.criterion == CRITERION_VERTEX_SILHOUETTE) {
-        return select(view.lo, view.hi, vertex_front(a) != vertex_front(b));
+        return select(view.lo, view.hi, vertex_front(ends.x) != vertex_front(ends.y));
     }
-    return max(level_factor(a), level_factor(b));
+    return max(level_factor(ends.x), level_factor(ends.y));
+}
+
+// Edge e's end vertices, canonical order (in the w of its second and third view rows).
+fn edge_ends(e: u32) -> vec2<u32> {
+    let row = PATCH_VIEW_ROW * params.patches + EDGE_VIEW_ROW * e;
+    return vec2<u32>(bitcast<u32>(patch_views[row + 1u].w), bitcast<u32>(patch_views[row + 2u].w));
 }
 
 fn is_level_function(criterion: u32) -> bool {
@@ -328,6 +332,14 @@ fn edge_segments(
         let f = max(wanted_factor(e), f32(max(minimum_segments(e), 1u)));
         segments[e] = u32(ceil(max(f, 1.0)));
         segments[params.edges + e] = bitcast<u32>(f);
+        if (params.warped != 0u) {
+            // SD-2's reverse projection: the ends' depths, clamped to the near plane
+            // (`Plan::depths` of `sd2::plan`).
+            let ends = edge_ends(e);
+            let at = 2u * params.edges + 2u * e;
+            segments[at] = bitcast<u32>(max(vertex_depth(ends.x), view.near));
+            segments[at + 1u] = bitcast<u32>(max(vertex_depth(ends.y), view.near));
+        }
         return;
     }
     let s = resolved_segments(e);

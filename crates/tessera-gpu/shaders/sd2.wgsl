@@ -3,8 +3,9 @@
 // parallel to the *diff* edge cuts them at their samples (rows i = 0 at the tip … ns at the
 // diff edge), radial lines run from the tip to the diff edge's samples (j = 0 … nd), and each
 // radial sector is one strip from the tip outwards. Edges are cut by the symmetric remainder
-// (`sampling::symmetric_param`). Numbered as every pattern is (`local.wgsl`). Without the
-// reverse projection (`--warp`), which the GPU does not draw.
+// (`sampling::symmetric_param`). Numbered as every pattern is (`local.wgsl`). With the
+// reverse projection (`--warp`, `params.warped`), the edge points and the interior are warped
+// by the plan's depths (§3.3).
 //
 // No compaction: triangle t of a patch is strip triangle t mod (2ns − 1) of sector
 // t div (2ns − 1), so the triangle pass runs one invocation per output triangle; only the
@@ -25,6 +26,36 @@ fn symmetric_param(factor: f32, k: u32) -> f32 {
     let remainder = f - f32(n - 1u);
     let t = f32(kk) / f - 0.5 * (1.0 - remainder) / f;
     return select(t, 1.0 - t, mirrored);
+}
+
+// Edge e's depths at its canonical ends (`Plan::depths`, after the factors).
+fn edge_depths(e: u32) -> vec2<f32> {
+    let at = 2u * params.edges + 2u * e;
+    return vec2<f32>(bitcast<f32>(segments[at]), bitcast<f32>(segments[at + 1u]));
+}
+
+// `sampling::warped_param`: t warped by reverse projection between ends of depths za and zb.
+fn warped_param(t: f32, za: f32, zb: f32) -> f32 {
+    if (t <= 0.0) { return 0.0; }
+    if (t >= 1.0) { return 1.0; }
+    let a = (1.0 - t) / za;
+    let b = t / zb;
+    return b / (a + b);
+}
+
+// The depth at patch p's corner c: its local edge c's depth where that edge starts
+// (`sd2::plan`'s corner depths are the same f32 values).
+fn corner_depth(p: u32, c: u32) -> f32 {
+    let z = edge_depths(patch_edge(p, c));
+    return select(z.x, z.y, patch_edge_reversed(p, c));
+}
+
+// `Sd2::warp`: a domain point's barycentric weights divided by the corner depths, normalised.
+fn sd2_warp(p: u32, q: vec2<f32>) -> vec2<f32> {
+    let w = vec3<f32>(1.0 - q.x - q.y, q.x, q.y)
+        / vec3<f32>(corner_depth(p, 0u), corner_depth(p, 1u), corner_depth(p, 2u));
+    let s = w.x + w.y + w.z;
+    return vec2<f32>(w.y / s, w.z / s);
 }
 
 // One SD-2 triangle's layout (`sd2::Layout`): the diff edge d (corner d → d + 1; the tip is
@@ -107,9 +138,15 @@ fn sd2_patch_counts(p: u32) -> vec2<u32> {
     return vec2<u32>((l.ns - 1u) * (l.nd - 1u), triangles);
 }
 
-// The vertex passes' EDGE_PARAM: the symmetric cut of the edge's real factor.
+// The vertex passes' EDGE_PARAM: the symmetric cut of the edge's real factor, warped with
+// the edge's depths in a warped plan (`sampling::param` of `SamplingKind::Warped`).
 fn sd2_edge_param(e: u32, k: u32) -> f32 {
-    return symmetric_param(edge_factor(e), k);
+    let t = symmetric_param(edge_factor(e), k);
+    if (params.warped != 0u) {
+        let z = edge_depths(e);
+        return warped_param(t, z.x, z.y);
+    }
+    return t;
 }
 
 // The vertex passes' INTERIOR_POINT: interior vertex jj is row i, radial line j, at fraction
@@ -122,7 +159,9 @@ fn sd2_interior_point(p: u32, jj: u32) -> vec2<f32> {
     let s = symmetric_param(l.fd, j);
     let tip = domain_corner(p, (l.d + 2u) % 3u);
     let on_diff = domain_corner(p, l.d) * (1.0 - s) + domain_corner(p, (l.d + 1u) % 3u) * s;
-    return tip * (1.0 - r) + on_diff * r;
+    let q = tip * (1.0 - r) + on_diff * r;
+    if (params.warped != 0u) { return sd2_warp(p, q); }
+    return q;
 }
 
 // One invocation per output triangle, for the patches without a repeated corner (every

@@ -64,6 +64,7 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("triangle_capacity", offset_of!(Params, triangle_capacity)),
             ("partitioning", offset_of!(Params, partitioning)),
             ("blocks", offset_of!(Params, blocks)),
+            ("warped", offset_of!(Params, warped)),
         ],
         size_of::<Params>(),
     );

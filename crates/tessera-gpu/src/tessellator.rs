@@ -189,6 +189,8 @@ pub struct GpuTessellator {
     check_rounds: u32,
     /// Whether the adapter's shader compiler stops long loops ([`loop_limited`]).
     loop_limited: bool,
+    /// Whether the SD-2 plan is reverse-projected (`Params::warped`).
+    warped: bool,
     /// The semi-uniform pattern's largest patch level in the plan (its cap when the GPU plans):
     /// the most rows a patch has, which bounds `Params::blocks`.
     rows: u32,
@@ -257,8 +259,9 @@ impl GpuTessellator {
         let view = ViewBuffers::new(device, &pipelines.view_layout, &pipelines.rounds_layout, set);
         Ok(GpuTessellator {
             params: buffer(device, "params", std::mem::size_of::<Params>() as u64, U::UNIFORM | U::COPY_DST),
-            // The plan's segments, then its factors (`common.wgsl`'s `edge_factor`).
-            segments: buffer(device, "segments and factors", 8 * e, plan_usage),
+            // The plan's segments, then its factors (`common.wgsl`'s `edge_factor`), then its
+            // depths (`sd2.wgsl`'s `edge_depths`, warped plans).
+            segments: buffer(device, "segments, factors and depths", 16 * e, plan_usage),
             interior: buffer(device, "interior", 8 * p, plan_usage),
             visible: buffer(device, "visible", 4 * p, plan_usage),
             vertex_offsets,
@@ -278,6 +281,7 @@ impl GpuTessellator {
             check_rounds: DEFAULT_CHECK_ROUNDS,
             loop_limited: loop_limited(&ctx.info),
             rows: 1,
+            warped: false,
             set: gpu_set,
             pipelines,
         })
@@ -328,14 +332,15 @@ impl GpuTessellator {
         if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, pattern.cut_through_corners_0_and_2()) {
             return Err(GpuError::Unsupported { what: tessera::scheme::pinched_on_gpu(p) });
         }
-        if pattern.depends_on_patch() {
-            // The SD-2 pattern with the reverse projection: per-patch corner depths the GPU
-            // does not have.
+        // SD-2's reverse projection is the one per-patch pattern the GPU draws: its corner
+        // depths are the plan's edge depths at the patch's corners (`sd2.wgsl`).
+        let warped = kind == GpuPattern::Sd2 && plan.kind == SamplingKind::Warped;
+        if pattern.depends_on_patch() && !warped {
             return Err(GpuError::Unsupported {
-                what: format!("the {} pattern with per-patch data (SD-2's --warp)", pattern.name()),
+                what: format!("the {} pattern with per-patch data", pattern.name()),
             });
         }
-        let expected_kind = kind.sampling_kind();
+        let expected_kind = if warped { SamplingKind::Warped } else { kind.sampling_kind() };
         if plan.kind != expected_kind {
             return Err(GpuError::Unsupported {
                 what: format!("{:?} samplings with the {} pattern", plan.kind, pattern.name()),
@@ -377,6 +382,10 @@ impl GpuTessellator {
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.segments, 4 * self.set.edges as u64, bytemuck::cast_slice(&plan.factors));
+        if warped {
+            queue.write_buffer(&self.segments, 8 * self.set.edges as u64, bytemuck::cast_slice(&plan.depths));
+        }
+        self.warped = warped;
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
         self.write_params(ctx);
@@ -395,6 +404,13 @@ impl GpuTessellator {
     fn check_sd2_plan(&self, set: &SurfaceSet, plan: &Plan) -> Result<()> {
         for (e, (&s, &f)) in plan.segments.iter().zip(&plan.factors).enumerate() {
             let cut = tessera::sampling::symmetric_segments(f as f64);
+            let depths = plan.depths.get(e).copied().unwrap_or([1.0; 2]);
+            if !depths.iter().all(|&z| z.is_finite() && z > 0.0) {
+                return Err(tessera::Error::PlanMismatch {
+                    what: format!("edge {e}: the depths {depths:?} (a warped plan's are positive)"),
+                }
+                .into());
+            }
             if !(f.is_finite() && f >= 1.0) || s != cut {
                 return Err(tessera::Error::PlanMismatch {
                     what: format!("edge {e}: {s} segments for the factor {f}, which SD-2 cuts into {cut}"),
@@ -468,12 +484,16 @@ impl GpuTessellator {
     /// tests and statistics. Cost: a queue wait.
     pub fn read_plan(&self, ctx: &GpuContext) -> Result<Plan> {
         let (e, p) = (self.set.edges as usize, self.set.patches as usize);
-        let rows: Vec<u32> = readback::read(ctx, &self.segments, 2 * e)?;
+        let rows: Vec<u32> = readback::read(ctx, &self.segments, 4 * e)?;
         let interior: Vec<[u32; 2]> = readback::read(ctx, &self.interior, p)?;
         let mut plan = Plan::integer(rows[..e].to_vec(), interior, p);
-        plan.kind = self.pattern.sampling_kind();
+        plan.kind = if self.warped { SamplingKind::Warped } else { self.pattern.sampling_kind() };
         if plan.kind != SamplingKind::Uniform {
-            plan.factors = rows[e..].iter().map(|&bits| f32::from_bits(bits)).collect();
+            plan.factors = rows[e..2 * e].iter().map(|&bits| f32::from_bits(bits)).collect();
+        }
+        if self.warped {
+            let depth = |k: usize| f32::from_bits(rows[2 * e + k]);
+            plan.depths = (0..e).map(|i| [depth(2 * i), depth(2 * i + 1)]).collect();
         }
         plan.visible = self.read_visible(ctx)?;
         Ok(plan)

@@ -265,9 +265,9 @@ fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
 
 /// SD-2 (paper 001) from the CPU's plans on triangle meshes, PN and cubic Bézier triangles:
 /// the level function of the distance (linear and quadratic mappings) and of the vertex
-/// silhouettes on three cameras each, and fixed real factors; the GPU's frame equals the CPU
-/// engine's index for index (the symmetric cut and the parallel × radial interior in f32,
-/// within 1e-5 of the diagonal). Each plan has at most two different factors per triangle
+/// silhouettes on three cameras each, the first also reverse-projected (`--warp`), and fixed
+/// real factors; the GPU's frame equals the CPU engine's index for index (the symmetric cut,
+/// the warp and the parallel × radial interior in f32, within 1e-5 of the diagonal). Each plan has at most two different factors per triangle
 /// (the criterion's promise, checked here on every visible patch) and several factors in all.
 #[test]
 fn sd2_equals_the_cpu_engine_on_triangle_meshes() {
@@ -283,7 +283,10 @@ fn sd2_equals_the_cpu_engine_on_triangle_meshes() {
             let mut gpu = tessellator(set);
             let mut factors = std::collections::BTreeSet::new();
             for (c, camera) in cameras(set, 3, 41).into_iter().enumerate() {
-                for (k, criterion) in criteria.iter().enumerate() {
+                let warped = (Scheme::Sd2 { warp: true }, &criteria[0]);
+                for (k, (scheme, criterion)) in
+                    criteria.iter().map(|c| (scheme, c)).chain([warped]).enumerate()
+                {
                     let name = format!("{model} as {kind} triangles, camera {c}, criterion {k}");
                     let options = PlanOptions { camera: Some(camera), ..Default::default() };
                     let planned = scheme.plan(set, criterion, &options).unwrap();
@@ -312,9 +315,9 @@ fn sd2_equals_the_cpu_engine_on_triangle_meshes() {
     }
 }
 
-/// What the GPU does not draw for SD-2 is refused by name, never drawn wrong: the reverse
-/// projection (per-patch corner depths) and a plan with three different factors on a
-/// triangle, which the CPU pattern draws as a transition fallback.
+/// What the GPU does not draw for SD-2 is refused by name, never drawn wrong: a plan with
+/// three different factors on a triangle (which the CPU pattern draws as a transition
+/// fallback), and a warped plan with a depth that is not positive.
 #[test]
 fn sd2_plans_the_gpu_cannot_draw_are_refused() {
     let set = load("meshes/blob.obj");
@@ -322,19 +325,10 @@ fn sd2_plans_the_gpu_cannot_draw_are_refused() {
     let ctx = ctx();
     let camera = cameras(&set, 1, 5)[0];
     let options = PlanOptions { camera: Some(camera), ..Default::default() };
-    let warped = Scheme::Sd2 { warp: true }.plan(&set, &Criterion::Factor(3.0), &options).unwrap();
+    let mut warped = Scheme::Sd2 { warp: true }.plan(&set, &Criterion::Factor(3.0), &options).unwrap();
+    warped.plan.depths[7][1] = 0.0;
     let e = gpu.prepare(ctx, &set, &warped.plan, &warped.pattern).unwrap_err().to_string();
-    assert!(e.contains("--warp"), "{e}");
-    let e = tessera::scheme::validate(
-        Scheme::Sd2 { warp: true },
-        &Criterion::Factor(3.0),
-        &options,
-        &set,
-        tessera::scheme::Engine::Gpu,
-    )
-    .unwrap_err()
-    .to_string();
-    assert!(e.contains("--warp"), "{e}");
+    assert!(e.contains("edge 7") && e.contains("depths"), "{e}");
     let mut plan = Scheme::Sd2 { warp: false }.plan(&set, &Criterion::Factor(3.0), &options).unwrap().plan;
     let edges = set.topology.patch_edges[0];
     for (l, f) in [(1, 4.5f32), (2, 5.5)] {
@@ -348,8 +342,9 @@ fn sd2_plans_the_gpu_cannot_draw_are_refused() {
 
 /// SD-2 planned on the GPU from the camera alone (paper 001's level functions: the vertex
 /// depths' range reduced on the GPU and mapped linearly or quadratically, or the vertices'
-/// front/back classification; culling; the symmetric cut of each edge's real factor) against
-/// `Scheme::Sd2`'s plan on the CPU: the culled set but for `near_cull_tie`s, every real factor
+/// front/back classification; culling; the symmetric cut of each edge's real factor; the
+/// reverse projection's edge depths with the first criterion) against `Scheme::Sd2`'s plan on
+/// the CPU: the culled set but for `near_cull_tie`s, every real factor and depth
 /// within 1e-5 relative (f32 depths against f64), the segments equal but where the CPU's
 /// factor lies within that of a whole number (counted, one off), the interiors the largest
 /// edge's, never three different factors in a triangle of the GPU's plan; and the frame's
@@ -370,10 +365,13 @@ fn sd2_planned_on_the_gpu_equals_the_cpu_plan() {
         let prepared = tessera::scheme::Prepared::new(&set, true);
         let mut gpu = tessellator(&set);
         for (c, camera) in cameras(&set, 3, 61).into_iter().enumerate() {
-            for (k, &criterion) in criteria.iter().enumerate() {
+            let warped = (Scheme::Sd2 { warp: true }, &criteria[0]);
+            for (k, (scheme, &criterion)) in criteria.iter().map(|c| (scheme, c)).chain([warped]).enumerate()
+            {
                 let name = format!("{model} camera {c} criterion {k}");
                 let options = PlanOptions { camera: Some(camera), cull: true, ..Default::default() };
-                let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+                let planned = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
+                let cpu = &planned.plan;
                 let screen =
                     ScreenCriterion { scheme, criterion, max_factor: options.max_factor, capacity: None };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
@@ -397,16 +395,22 @@ fn sd2_planned_on_the_gpu_equals_the_cpu_plan() {
                         ties += 1;
                     }
                 }
+                assert_eq!(drawn.kind, cpu.kind, "{name}");
+                for (e, (got, want)) in drawn.depths.iter().zip(&cpu.depths).enumerate() {
+                    for (g, w) in got.iter().zip(want) {
+                        assert!(
+                            (g - w).abs() <= 1e-5 * w,
+                            "{name}: edge {e} depths {got:?}, the CPU's {want:?}"
+                        );
+                    }
+                }
+                assert_eq!(drawn.depths.len(), cpu.depths.len(), "{name}");
                 assert_eq!(tessera::criterion::sd2::three_different(&set, &drawn), 0, "{name}");
                 let rule = tessera::criterion::resolve::InteriorRule::MaxEdge;
                 assert_interiors_follow_the_edges(&name, &set, &prepared, &drawn, rule, options.max_factor);
-                assert_gpu_equals_cpu_after_record(
-                    &name,
-                    &set,
-                    &gpu,
-                    &drawn,
-                    &tessera::pattern::sd2::Sd2::default(),
-                );
+                // The CPU's pattern: with the warp, its corner depths are the CPU's, within
+                // f32 rounding of the GPU's.
+                assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &drawn, &planned.pattern);
                 edges += cpu.segments.len();
                 frames += 1;
             }

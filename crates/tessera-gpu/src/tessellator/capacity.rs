@@ -264,7 +264,7 @@ impl GpuTessellator {
             triangle_capacity: capacity.triangles as u32,
             partitioning: self.pattern.partitioning_code(),
             blocks: if self.pattern == GpuPattern::SemiUniform { self.rows.min(ROW_BLOCKS) } else { 1 },
-            _pad: 0,
+            warped: u32::from(self.warped),
         };
         ctx.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
     }

@@ -56,7 +56,8 @@ pub const ROW_BLOCKS: u32 = 4;
 const PARTITIONINGS: [Partitioning; 4] =
     [Partitioning::Integer, Partitioning::Pow2, Partitioning::FractionalOdd, Partitioning::FractionalEven];
 
-/// The CPU's SD-2 pattern without the reverse projection, the one the GPU draws.
+/// The CPU's SD-2 pattern without the reverse projection (for counts: the warp moves points,
+/// not counts).
 static SD2_PATTERN: Sd2 = Sd2 { corner_depths: None };
 
 /// The CPU pattern of each partitioning, in the same order.
@@ -140,7 +141,7 @@ pub enum GpuPattern {
     /// [`tessera::pattern::semi_uniform::SemiUniform`] (paper 000, compacted) on quads and
     /// triangles: one invocation per row of a patch's grid (`semi_uniform.wgsl`).
     SemiUniform,
-    /// [`tessera::pattern::sd2::Sd2`] (paper 001) on triangles, without the reverse
+    /// [`tessera::pattern::sd2::Sd2`] (paper 001) on triangles, with or without the reverse
     /// projection: one invocation per triangle (`sd2.wgsl`).
     Sd2,
 }
@@ -607,7 +608,7 @@ pub(crate) struct Params {
     pub(crate) triangle_capacity: u32,
     pub(crate) partitioning: u32,
     pub(crate) blocks: u32,
-    pub(crate) _pad: u32,
+    pub(crate) warped: u32,
 }
 
 #[cfg(test)]

@@ -274,8 +274,8 @@ impl GpuTessellator {
     /// per-edge factors by `EdgeRule::Fractional`: the cap, the minimum segments, the hull
     /// shader's pow2 rounding and `settled_factor`; Direct3D's `max` inside reduction in the
     /// pattern); and [`Criterion::Factor`] with a [`Scheme::Hardware`] partitioning (one real
-    /// factor, resolved the same way, with the GPU's culling); and [`Scheme::Sd2`] without
-    /// the warp with paper 001's level functions ([`ViewCriterion::Distance`], the vertex
+    /// factor, resolved the same way, with the GPU's culling); and [`Scheme::Sd2`] (with
+    /// or without the warp, whose edge depths the GPU writes too) with paper 001's level functions ([`ViewCriterion::Distance`], the vertex
     /// depths' range reduced on the GPU, [`ViewCriterion::SilhouetteVertices`]) or a fixed
     /// factor (real per-edge factors by `EdgeRule::Fractional(Spacing::Symmetric)`; f32
     /// depths, so a factor may differ from the CPU's in its last bits). A silhouetteness strictly
@@ -329,6 +329,7 @@ impl GpuTessellator {
         }
         self.screen = Some(screen);
         self.pattern = pattern;
+        self.warped = scheme == (Scheme::Sd2 { warp: true });
         self.pipelines.compile(&ctx.device, self.pattern);
         self.rows = screen.cap as u32;
         if self.set.has_trees {

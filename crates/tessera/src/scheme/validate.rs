@@ -25,13 +25,13 @@ pub enum Engine {
     /// The CPU engine ([`crate::engine`]): every scheme and criterion.
     Cpu,
     /// The GPU engine (tessera-gpu) drawing a plan made on the CPU: the uniform, transition,
-    /// semi-uniform (compacted), SD-2 (without `--warp`) and Direct3D 11 schemes.
+    /// semi-uniform (compacted), SD-2 and Direct3D 11 schemes.
     Gpu,
     /// The GPU engine planning every frame itself from the camera (CudaTess's frame): culling
     /// on, and a pixel error with the uniform, transition or semi-uniform scheme (the latter
     /// two's a-posteriori check with caps up to [`GPU_CHECK_MAX_FACTOR`]), silhouetteness
     /// with those or a Direct3D 11 partitioning, a fixed factor with a partitioning, or
-    /// SD-2's level functions (distance, vertex silhouettes) and fixed factor without `--warp`.
+    /// SD-2's level functions (distance, vertex silhouettes) and fixed factor.
     GpuFromCamera,
 }
 
@@ -298,9 +298,6 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
              fractional-odd and fractional-even schemes)",
             scheme.name()
         )),
-        Engine::Gpu | Engine::GpuFromCamera if scheme == (Scheme::Sd2 { warp: true }) => {
-            refuse("SD-2's reverse projection (--warp: per-patch corner depths)".into())
-        }
         Engine::Gpu => Ok(()),
         Engine::GpuFromCamera => {
             let planned_on_gpu = matches!(
@@ -315,7 +312,7 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     )
                     | (Scheme::Hardware(_), Criterion::Factor(_))
                     | (
-                        Scheme::Sd2 { warp: false },
+                        Scheme::Sd2 { .. },
                         Criterion::Factor(_)
                             | Criterion::View {
                                 criterion: ViewCriterion::Distance(_) | ViewCriterion::SilhouetteVertices,
@@ -376,7 +373,7 @@ mod tests {
         let tris = crate::scheme::tests::triangles();
         let on_tris = |s, c: Criterion, e| validate(s, &c, &o, &tris, e);
         on_tris(Scheme::Sd2 { warp: false }, Criterion::Factor(3.5), Engine::Gpu).unwrap();
-        assert!(engine_refused(on_tris(Scheme::Sd2 { warp: true }, Criterion::Factor(3.5), Engine::Gpu)));
+        on_tris(Scheme::Sd2 { warp: true }, Criterion::Factor(3.5), Engine::Gpu).unwrap();
         v(odd, Criterion::Factor(5.5), &o, Engine::Gpu).unwrap();
         v(odd, Criterion::Factor(5.5), &culled, Engine::GpuFromCamera).unwrap();
         assert!(engine_refused(v(odd, Criterion::Factor(5.5), &o, Engine::GpuFromCamera)), "no culling");
