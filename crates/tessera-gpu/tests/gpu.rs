@@ -423,9 +423,10 @@ fn uniform_pixel_error_root(
 /// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
 ///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
 ///   transition);
-/// - **SD-2** on the triangle models, every fourth camera (the others): the CPU's plan from
-///   the distance level function (real factors, never three different a triangle), drawn on
-///   the GPU.
+/// - **SD-2, from the camera alone**, on the triangle models, every fourth camera (the
+///   others): the distance level function, every other time with the reverse projection
+///   ([`sd2_frame_from_the_camera`]: real factors and depths as the CPU's, never three
+///   different a triangle).
 ///
 /// Then the whole output equals the CPU engine's for the plan the GPU drew
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
@@ -572,19 +573,16 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
                 counts.frames += 1;
             }
-            // SD-2 on triangle models, every fourth camera (the others): the CPU's plan from
-            // the distance level function, drawn on the GPU.
+            // SD-2 on triangle models, every fourth camera (the others), from the camera
+            // alone: the distance level function, every other time reverse-projected.
             let triangles = set.patches.iter().all(|p| p.domain() == tessera::surface::Domain::Tri);
             if c % 4 == 2 && triangles {
                 let name = format!("{model} camera {c} sd2");
                 let fmax = options.max_factor as f64 + 0.5;
                 let criterion =
                     Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax };
-                let options = PlanOptions { max_factor: options.max_factor + 1, ..options };
-                let planned = Scheme::Sd2 { warp: false }.plan(&set, &criterion, &options).unwrap();
-                assert_eq!(tessera::criterion::sd2::three_different(&set, &planned.plan), 0, "{name}");
-                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
-                counts.frames += 1;
+                let frame = Sd2Frame { warp: c % 8 == 6, criterion, max_factor: options.max_factor + 1 };
+                sd2_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, frame, &mut counts);
             }
         }
         assert!(

@@ -398,6 +398,70 @@ pub fn assert_interiors_follow_the_edges(
     assert_eq!(plan.interior, interior, "{name}: interior factors");
 }
 
+/// An SD-2 frame from the camera: the level function or fixed factor, the warp, the cap.
+#[derive(Debug, Clone, Copy)]
+pub struct Sd2Frame {
+    pub warp: bool,
+    pub criterion: tessera::scheme::Criterion,
+    pub max_factor: u32,
+}
+
+/// SD-2 planned on the GPU from `camera` alone (paper 001's level functions: the vertex
+/// depths' range reduced on the GPU and mapped linearly or quadratically, or the vertices'
+/// front/back classification; culling; the symmetric cut of each edge's real factor; with the
+/// warp the edge depths) against `Scheme::Sd2`'s plan on the CPU: the culled set but for
+/// [`near_cull_tie`]s, every real factor and depth within 1e-5 relative (f32 depths against
+/// f64), the segments equal but where the CPU's factor lies within that of a whole number
+/// (counted in `factor_ties`, one off), the interiors the largest edge's, never three
+/// different factors in a triangle of the GPU's plan; then the frame's output equals the CPU
+/// engine's for the plan drawn (the CPU's pattern: with the warp its corner depths are the
+/// CPU's, within f32 rounding of the GPU's).
+pub fn sd2_frame_from_the_camera(
+    name: &str,
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    gpu: &mut GpuTessellator,
+    camera: &tessera::camera::Camera,
+    frame: Sd2Frame,
+    counts: &mut SweepCounts,
+) {
+    use tessera::scheme::{PlanOptions, Scheme};
+    let Sd2Frame { warp, criterion, max_factor } = frame;
+    let scheme = Scheme::Sd2 { warp };
+    let options = PlanOptions { camera: Some(*camera), cull: true, max_factor, ..Default::default() };
+    let planned = scheme.plan_prepared(set, prepared, &criterion, &options).unwrap();
+    let cpu = &planned.plan;
+    let screen = tessera_gpu::tessellator::ScreenCriterion { scheme, criterion, max_factor, capacity: None };
+    screen_frame(gpu, set, prepared, camera, screen);
+    let drawn = gpu.read_plan(ctx()).unwrap();
+    check_culling(name, set, gpu, &cpu.visible, camera, counts);
+    let close = |got: f64, want: f64| (got - want).abs() <= 1e-5 * want;
+    for e in 0..cpu.segments.len() {
+        let (want, got) = (cpu.factors[e] as f64, drawn.factors[e] as f64);
+        assert!(close(got, want), "{name}: edge {e} factor {got}, the CPU's {want}");
+        if drawn.segments[e] != cpu.segments[e] {
+            let tie = close(want.round(), want) && drawn.segments[e].abs_diff(cpu.segments[e]) == 1;
+            assert!(
+                tie,
+                "{name}: edge {e} has {} segments, the CPU's {}",
+                drawn.segments[e], cpu.segments[e]
+            );
+            counts.factor_ties += 1;
+        }
+    }
+    assert_eq!(drawn.kind, cpu.kind, "{name}");
+    assert_eq!(drawn.depths.len(), cpu.depths.len(), "{name}");
+    for (e, (got, want)) in drawn.depths.iter().zip(&cpu.depths).enumerate() {
+        let both = got.iter().zip(want).all(|(&g, &w)| close(g as f64, w as f64));
+        assert!(both, "{name}: edge {e} depths {got:?}, the CPU's {want:?}");
+    }
+    assert_eq!(tessera::criterion::sd2::three_different(set, &drawn), 0, "{name}");
+    let rule = tessera::criterion::resolve::InteriorRule::MaxEdge;
+    assert_interiors_follow_the_edges(name, set, prepared, &drawn, rule, max_factor);
+    assert_gpu_equals_cpu_after_record(name, set, gpu, &drawn, &planned.pattern);
+    counts.frames += 1;
+}
+
 /// Records one frame of `gpu`'s prepared work and submits it.
 pub fn record_frame(gpu: &GpuTessellator) {
     let ctx = ctx();
