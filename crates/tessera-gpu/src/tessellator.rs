@@ -123,12 +123,14 @@ fn check_hardware_plan(plan: &Plan, partitioning: Partitioning) -> Result<()> {
 }
 
 /// The semi-uniform pattern's preconditions on `plan` (`tessera::pattern::semi_uniform::
-/// SemiUniform`, [`tessera::pattern::semi_uniform::check_input`]) for every visible patch,
-/// which the shaders rely on; returns the largest patch level `n` (the most rows of a patch).
-/// Errors: [`tessera::Error::PlanMismatch`] naming the first patch that breaks one. Cost: O(P).
-fn check_semi_uniform_plan(set: &SurfaceSet, plan: &Plan) -> Result<u32> {
+/// SemiUniform`, [`tessera::pattern::semi_uniform::check_input`]) for every visible patch
+/// (every patch with `all_visible`, when the GPU culls and may draw a patch the plan left
+/// out), which the shaders rely on; returns the largest patch level `n` (the most rows of a
+/// patch). Errors: [`tessera::Error::PlanMismatch`] naming the first patch that breaks one.
+/// Cost: O(P).
+fn check_semi_uniform_plan(set: &SurfaceSet, plan: &Plan, all_visible: bool) -> Result<u32> {
     let mut rows = 1;
-    for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+    for p in (0..set.patches.len()).filter(|&p| all_visible || plan.is_visible(p)) {
         let input = tessera::engine::layout::pattern_input(set, plan, p);
         if let Err(why) = tessera::pattern::semi_uniform::check_input(&input) {
             return Err(tessera::Error::PlanMismatch { what: format!("patch {p}: {why}") }.into());
@@ -349,7 +351,11 @@ impl GpuTessellator {
         if let GpuPattern::Hardware(p) = kind {
             check_hardware_plan(plan, p)?;
         }
-        let rows = if kind == GpuPattern::SemiUniform { check_semi_uniform_plan(set, plan)? } else { 1 };
+        let rows = if kind == GpuPattern::SemiUniform {
+            check_semi_uniform_plan(set, plan, self.camera.is_some())?
+        } else {
+            1
+        };
         if kind == GpuPattern::Sd2 {
             self.check_sd2_plan(set, plan)?;
         }
@@ -395,7 +401,7 @@ impl GpuTessellator {
     /// The SD-2 pattern's preconditions on `plan` (`tessera::pattern::sd2::Sd2`), which the
     /// shaders rely on: every edge's segments those of its factor's symmetric cut
     /// ([`tessera::sampling::symmetric_segments`], the sampling the plan's kind names), every
-    /// visible patch with at most two different factors (the CPU pattern falls back to the
+    /// visible patch (every patch when the GPU culls) with at most two different factors (the CPU pattern falls back to the
     /// transition pattern for three; the SD-2 criterion never makes them), and on an adapter
     /// that stops loops ([`loop_limited`]) no patch at a collapsed corner, whose triangles
     /// one invocation walks, past [`LOOP_LIMIT`] triangles. Errors:
@@ -418,7 +424,8 @@ impl GpuTessellator {
                 .into());
             }
         }
-        for p in (0..set.patches.len()).filter(|&p| plan.is_visible(p)) {
+        let all_visible = self.camera.is_some();
+        for p in (0..set.patches.len()).filter(|&p| all_visible || plan.is_visible(p)) {
             let input = tessera::engine::layout::pattern_input(set, plan, p);
             let f = input.factors;
             if input.domain != tessera::surface::Domain::Tri || (f[0] != f[1] && f[1] != f[2] && f[2] != f[0])

@@ -149,9 +149,13 @@ fn a_plan_outside_the_patterns_preconditions_is_refused_by_name() {
     finer_edge.interior[5] = [2, 2];
     let e = gpu.prepare(ctx, &set, &finer_edge, &SemiUniform).unwrap_err().to_string();
     assert!(e.contains("patch 5") && e.contains("up to the patch level 2"), "{e}");
-    // Culled patches are not drawn, so their interiors do not matter.
+    // Culled patches are not drawn, so their interiors do not matter...
     finer_edge.visible[5] = 0;
     assert_pattern_equals_cpu("teacup, the odd patch culled", &set, &mut gpu, &finer_edge, &SemiUniform);
+    // ...unless the GPU culls for a camera of its own, and may draw it.
+    gpu.set_cull_camera(ctx, Some(&cameras(&set, 1, 3)[0]));
+    let e = gpu.prepare(ctx, &set, &finer_edge, &SemiUniform).unwrap_err().to_string();
+    assert!(e.contains("patch 5"), "{e}");
 }
 
 /// The semi-uniform pixel-error frame planned on the GPU from the camera alone (culling, the
