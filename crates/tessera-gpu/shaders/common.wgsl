@@ -115,6 +115,20 @@ fn find_triangle_range(lo: u32, hi: u32, x: u32) -> u32 {
     return a;
 }
 
+// The two triangle passes of a pattern that drops triangles only where a patch has a
+// repeated corner (uniform, SD-2): output triangle t's patch, or params.patches when t is past
+// the frame or its patch has a repeated corner (the per-patch pass writes those); and whether
+// patch p is one that pass writes (visible, with a repeated corner).
+fn plain_triangle_patch(t: u32) -> u32 {
+    if (t >= triangle_offsets[params.patches]) { return params.patches; }
+    let p = find_triangle_range(0u, params.patches, t);
+    return select(p, params.patches, patch_repeated_corner(p));
+}
+
+fn collapsed_patch(p: u32) -> bool {
+    return p < params.patches && visible[p] != 0u && patch_repeated_corner(p);
+}
+
 // Corner c of the quad domain: `tessera::domain::Domain::corner`.
 fn quad_corner(c: u32) -> vec2<f32> {
     switch c {

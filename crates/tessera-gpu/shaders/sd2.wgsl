@@ -173,9 +173,8 @@ fn write_sd2_triangles(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let t = thread_index(wid, nwg, lid);
-    if (t >= triangle_offsets[params.patches]) { return; }
-    let p = find_triangle_range(0u, params.patches, t);
-    if (patch_repeated_corner(p)) { return; }
+    let p = plain_triangle_patch(t);
+    if (p == params.patches) { return; }
     let l = sd2_layout(p);
     let local = t - triangle_offsets[p];
     let per_sector = 2u * l.ns - 1u;
@@ -194,7 +193,6 @@ fn write_sd2_collapsed_triangles(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let p = thread_index(wid, nwg, lid);
-    if (p >= params.patches) { return; }
-    if (visible[p] == 0u || !patch_repeated_corner(p)) { return; }
+    if (!collapsed_patch(p)) { return; }
     _ = sd2_walk(p, true, triangle_offsets[p]);
 }

@@ -10,9 +10,8 @@ fn write_uniform_triangles(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let t = thread_index(wid, nwg, lid);
-    if (t >= triangle_offsets[params.patches]) { return; }
-    let p = find_triangle_range(0u, params.patches, t);
-    if (patch_repeated_corner(p)) { return; }
+    let p = plain_triangle_patch(t);
+    if (p == params.patches) { return; }
     let local = t - triangle_offsets[p];
     let n = interior[p].x;
     let tri = pattern_triangle(patch_is_tri(p), n, local);
@@ -32,8 +31,7 @@ fn write_uniform_collapsed_triangles(
     @builtin(local_invocation_index) lid: u32,
 ) {
     let p = thread_index(wid, nwg, lid);
-    if (p >= params.patches) { return; }
-    if (visible[p] == 0u || !patch_repeated_corner(p)) { return; }
+    if (!collapsed_patch(p)) { return; }
     let n = interior[p].x;
     let is_tri = patch_is_tri(p);
     var t = triangle_offsets[p];
