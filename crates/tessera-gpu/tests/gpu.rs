@@ -688,28 +688,38 @@ fn capacity_at_the_cap_fits_or_grows_and_the_output_is_complete() {
 #[ignore = "slow tier: the torus at factor cap 64 (a worst case past the storage binding limit)"]
 fn capacity_at_the_cap_on_the_torus() {
     capacity_at_the_cap("bench/torus_64x32.patches", 64);
-    // At cap 256 the frame needs several times the storage binding limit: it overflows,
-    // draws nothing (zero indirect counts, no partial mesh) and growing refuses with the
-    // sizes, so no patch is dropped silently.
-    use tessera::scheme::Scheme;
+    // A frame past the storage binding limit overflows, draws nothing (zero indirect counts,
+    // no partial mesh) and growing refuses with the sizes, so no patch is dropped silently.
+    // The limit is the adapter's (lavapipe 128 MiB, an H200 2 GiB), so the cap is raised
+    // until the CPU plan's frame itself needs more than the limit.
+    use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
     let set = load("bench/torus_64x32.patches");
     let prepared = tessera::scheme::Prepared::new(&set, true);
-    let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion {
-        scheme: Scheme::Uniform,
-        criterion: tessera::scheme::Criterion::PixelError(0.001),
-        max_factor: 256,
-        capacity: None,
+    let camera = close_camera(&set);
+    let criterion = Criterion::PixelError(0.001);
+    let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
+    let frame_triangles = |cap: u32| {
+        let options = PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+        let plan = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
+        let mut layout = Layout::default();
+        layout.build(&set, &plan, &Uniform, &EngineOptions::default()).unwrap();
+        u64::from(*layout.triangle_offsets.last().unwrap())
     };
-    screen_frame(&mut gpu, &set, &prepared, &close_camera(&set), screen);
+    let cap = [256, 512, 1024, 2048]
+        .into_iter()
+        .find(|&cap| frame_triangles(cap) * 12 > limit)
+        .unwrap_or_else(|| panic!("no cap up to 2048 passes the binding limit of {limit} bytes"));
+    let mut gpu = tessellator(&set);
+    let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion, max_factor: cap, capacity: None };
+    screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
-    assert_eq!(draw[0], 0, "an overflowing frame drew {} indices", draw[0]);
+    assert_eq!(draw[0], 0, "cap {cap}: an overflowing frame drew {} indices", draw[0]);
     match gpu.grow_if_overflowed(ctx) {
         Err(GpuError::OutputTooLarge { triangles, limit, .. }) => {
             assert!(triangles * 12 > limit, "refused {triangles} triangles under the limit {limit}")
         }
-        other => panic!("expected OutputTooLarge, got {other:?}"),
+        other => panic!("cap {cap}: expected OutputTooLarge, got {other:?}"),
     }
 }
 
