@@ -689,11 +689,14 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     for key in ["triangles", "vertices", "boundary_edges", "culled_patches", "euler_characteristic"] {
         assert_eq!(g[key], c[key], "fractional-odd planned on the GPU: {key}");
     }
-    // The seed papers' schemes: semi-uniform (paper 000, compacted) and SD-2 (paper 001), a
-    // CPU plan drawn on the GPU, and with --cull the frame planned on the GPU from the camera
-    // (semi-uniform's levels with their a-posteriori check, SD-2's level function).
+    // The seed papers' schemes: semi-uniform (paper 000, compacted), SD-2 (paper 001) and
+    // ESC (paper 002), a CPU plan drawn on the GPU, and with --cull the frame planned on the
+    // GPU from the camera (semi-uniform's levels with their a-posteriori check, SD-2's level
+    // function).
     let blob = blob.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 7] = [
+        (&[input, "--scheme", "esc", "--level", "2", "--quality", "medium"], "cpu"),
+        (&[input, "--scheme", "esc", "--threshold", "0.01"], "cpu"),
         (&[input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--cull"], "cpu"),
         (&[input, "--scheme", "semi-uniform", "--pixel-error", "0.5", "--cull"], "gpu"),
         (&[blob, "--scheme", "sd2", "--distance", "1:9.5"], "cpu"),
@@ -711,7 +714,8 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
             assert_eq!(g[key], c[key], "{case:?}: {key}");
         }
     }
-    let refused = tessera(&["mesh", input, "--scheme", "esc", "--level", "1", "--engine", "gpu"], &dir);
+    let refused =
+        tessera(&["mesh", input, "--scheme", "esc", "--level", "1", "--engine", "gpu", "--strips"], &dir);
     assert!(!refused.status.success());
-    assert!(text(&refused.stderr).contains("does not support"), "{}", text(&refused.stderr));
+    assert!(text(&refused.stderr).contains("no corner parameters or strips"), "{}", text(&refused.stderr));
 }

@@ -52,6 +52,8 @@ pub mod sources {
     pub(crate) const HARDWARE: &str = include_str!("../shaders/hardware.wgsl");
     pub(crate) const SEMI_UNIFORM: &str = include_str!("../shaders/semi_uniform.wgsl");
     pub(crate) const SD2: &str = include_str!("../shaders/sd2.wgsl");
+    /// The ESC pattern (`tessera::pattern::esc::Esc`): counts, vertex places, triangles.
+    pub(crate) const ESC: &str = include_str!("../shaders/esc.wgsl");
 }
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],

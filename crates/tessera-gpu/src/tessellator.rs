@@ -58,6 +58,7 @@ use tessera::sampling::SamplingKind;
 use tessera::surface::SurfaceSet;
 
 mod capacity;
+mod esc;
 mod frame;
 mod pipelines;
 mod report;
@@ -196,6 +197,9 @@ pub struct GpuTessellator {
     /// The semi-uniform pattern's largest patch level in the plan (its cap when the GPU plans):
     /// the most rows a patch has, which bounds `Params::blocks`.
     rows: u32,
+    /// An ESC plan's pattern triangles per patch (the read-back's count of triangles left out
+    /// at collapsed curves: the ESC pattern is not the plan's alone).
+    esc_triangles: Option<Vec<u32>>,
 }
 
 /// The loop iterations one invocation gets in all on Mesa's llvmpipe (lavapipe): its compiler
@@ -284,6 +288,7 @@ impl GpuTessellator {
             loop_limited: loop_limited(&ctx.info),
             rows: 1,
             warped: false,
+            esc_triangles: None,
             set: gpu_set,
             pipelines,
         })
@@ -334,10 +339,11 @@ impl GpuTessellator {
         if let Some(p) = tessera::scheme::pinched_beyond_the_gpu(set, pattern.cut_through_corners_0_and_2()) {
             return Err(GpuError::Unsupported { what: tessera::scheme::pinched_on_gpu(p) });
         }
-        // SD-2's reverse projection is the one per-patch pattern the GPU draws: its corner
-        // depths are the plan's edge depths at the patch's corners (`sd2.wgsl`).
+        // The per-patch patterns the GPU draws: SD-2's reverse projection, whose corner depths
+        // are the plan's edge depths at the patch's corners (`sd2.wgsl`), and ESC, whose
+        // insertion grids are uploaded with the plan (`esc.wgsl`).
         let warped = kind == GpuPattern::Sd2 && plan.kind == SamplingKind::Warped;
-        if pattern.depends_on_patch() && !warped {
+        if pattern.depends_on_patch() && !warped && kind != GpuPattern::Esc {
             return Err(GpuError::Unsupported {
                 what: format!("the {} pattern with per-patch data", pattern.name()),
             });
@@ -359,6 +365,16 @@ impl GpuTessellator {
         if kind == GpuPattern::Sd2 {
             self.check_sd2_plan(set, plan)?;
         }
+        let esc = if kind == GpuPattern::Esc {
+            if self.camera.is_some() {
+                return Err(GpuError::Unsupported {
+                    what: "ESC with a culling camera (ESC culls nothing; prepare without one)".into(),
+                });
+            }
+            Some(esc::pack(set, plan, pattern)?)
+        } else {
+            None
+        };
         for (p, &[n, _]) in plan.interior.iter().enumerate() {
             let edges = &set.topology.patch_edges[p][..set.patches[p].domain().corner_count()];
             if kind == GpuPattern::Uniform
@@ -385,6 +401,9 @@ impl GpuTessellator {
         self.screen = None;
         self.pattern = kind;
         self.rows = rows;
+        if esc.is_some() {
+            self.reserve_esc_grids(ctx);
+        }
         let queue = &ctx.queue;
         queue.write_buffer(&self.segments, 0, bytemuck::cast_slice(&plan.segments));
         queue.write_buffer(&self.segments, 4 * self.set.edges as u64, bytemuck::cast_slice(&plan.factors));
@@ -392,6 +411,12 @@ impl GpuTessellator {
             queue.write_buffer(&self.segments, 8 * self.set.edges as u64, bytemuck::cast_slice(&plan.depths));
         }
         self.warped = warped;
+        if let Some(esc) = &esc {
+            let e = self.set.edges as u64;
+            queue.write_buffer(&self.segments, 8 * e, bytemuck::cast_slice(&esc.masks));
+            queue.write_buffer(&self.segments, 16 * e, bytemuck::cast_slice(&esc.grids));
+        }
+        self.esc_triangles = esc.map(|esc| esc.triangles);
         queue.write_buffer(&self.interior, 0, bytemuck::cast_slice(&plan.interior));
         queue.write_buffer(&self.visible, 0, bytemuck::cast_slice(&plan.visible));
         self.write_params(ctx);
@@ -438,7 +463,7 @@ impl GpuTessellator {
                     ),
                 });
             }
-            let triangles = GpuPattern::Sd2.cpu_pattern().counts(&input).1;
+            let triangles = tessera::pattern::sd2::Sd2::default().counts(&input).1;
             if self.loop_limited
                 && tessera::engine::layout::has_repeated_corner(set, p)
                 && triangles > LOOP_LIMIT
@@ -595,11 +620,13 @@ impl GpuTessellator {
         }
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
         let plan = self.read_plan(ctx)?;
-        let kind = self.pattern.cpu_pattern();
-        let pattern: u64 = (0..set.patches.len())
-            .filter(|&p| plan.is_visible(p))
-            .map(|p| kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64)
-            .sum();
+        let pattern_triangles = |p: usize| match (self.pattern.cpu_pattern(), &self.esc_triangles) {
+            (Some(kind), _) => kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64,
+            (None, Some(esc)) => esc[p] as u64,
+            (None, None) => 0,
+        };
+        let pattern: u64 =
+            (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(pattern_triangles).sum();
         mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
         Ok(mesh)
     }

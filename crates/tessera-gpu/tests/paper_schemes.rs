@@ -375,3 +375,75 @@ fn sd2_planned_on_the_gpu_equals_the_cpu_plan() {
     assert!(counts.culled > 0, "nothing culled");
     assert!(100 * counts.factor_ties <= counts.frames, "{counts:?}");
 }
+
+/// ESC (paper 002) drawn on the GPU from the CPU's plan and insertion grids equals the CPU
+/// engine index for index on every patch model: fixed levels 0–6 (6 is `MAX_LEVEL`, the
+/// largest lattice the shader holds) with the three kinds of threshold, and levels per object
+/// from three cameras. The teapots' lids and bottoms have collapsed curves, whose coarse
+/// triangles ESC fills and whose degenerate triangles the engine leaves out.
+#[test]
+fn esc_equals_the_cpu_engine_on_every_patch_model() {
+    use tessera::criterion::esc::Threshold;
+    let scheme = Scheme::Esc { max_level: 3 };
+    let mut virtual_vertices = 0;
+    for model in patch_models() {
+        let set = load(&model);
+        let mut gpu = tessellator(&set);
+        let d = diagonal(&set);
+        let fixed = [
+            (0, Threshold::High),
+            (1, Threshold::Medium),
+            (2, Threshold::Absolute(0.0)),
+            (3, Threshold::High),
+            (4, Threshold::Absolute(2e-3 * d)),
+            (6, Threshold::Medium),
+        ];
+        let mut cases: Vec<(Option<u32>, Threshold, Option<tessera::camera::Camera>)> =
+            fixed.into_iter().map(|(l, t)| (Some(l), t, None)).collect();
+        cases.extend(cameras(&set, 3, 17).into_iter().map(|c| (None, Threshold::Medium, Some(c))));
+        for (level, threshold, camera) in cases {
+            let name =
+                format!("{model}, level {level:?}, threshold {threshold:?}, camera {}", camera.is_some());
+            let options = PlanOptions { camera, ..Default::default() };
+            let planned = scheme.plan(&set, &Criterion::Esc { threshold, level }, &options).unwrap();
+            // A plan whose patterns are all complete would not test the virtual vertices.
+            let full: u64 = planned.plan.interior.iter().map(|&[s, _]| 2 * s as u64 * s as u64).sum();
+            let drawn = tessera::engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default())
+                .unwrap()
+                .triangle_count() as u64;
+            virtual_vertices += u32::from(drawn < full);
+            assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+        }
+    }
+    assert!(virtual_vertices >= 10, "only {virtual_vertices} frames left candidates out");
+}
+
+/// What the GPU does not draw for ESC is refused by name, never drawn wrong: a plan with
+/// another pattern, an ESC pattern whose grid disagrees with the plan's edge samples, and a
+/// plan of the wrong sampling kind.
+#[test]
+fn esc_plans_the_gpu_cannot_draw_are_refused() {
+    use tessera::criterion::esc::Threshold;
+    let set = load("patches/teacup.patches");
+    let mut gpu = tessellator(&set);
+    let ctx = ctx();
+    let criterion = Criterion::Esc { threshold: Threshold::Medium, level: Some(2) };
+    let planned = Scheme::Esc { max_level: 3 }.plan(&set, &criterion, &PlanOptions::default()).unwrap();
+    let e = gpu.prepare(ctx, &set, &planned.plan, &SemiUniform).unwrap_err().to_string();
+    assert!(e.contains("Lattice"), "{e}");
+    // Drop one inserted candidate from an edge's samples: the grid still has it.
+    let mut plan = planned.plan.clone();
+    let e0 = (0..plan.segments.len()).find(|&e| plan.segments[e] > 3).expect("an edge with a candidate");
+    let start = plan.lattice_offsets[e0] as usize;
+    let dropped = (1..plan.segments[e0] as usize).find(|&k| plan.lattice[start + k] % 3 != 0).unwrap();
+    plan.lattice.remove(start + dropped);
+    plan.segments[e0] -= 1;
+    for offset in &mut plan.lattice_offsets[e0 + 1..] {
+        *offset -= 1;
+    }
+    let e = gpu.prepare(ctx, &set, &plan, &planned.pattern).unwrap_err().to_string();
+    assert!(e.contains("disagree"), "{e}");
+    let uniform = Plan::uniform(&set, 6).unwrap();
+    let e = gpu.prepare(ctx, &set, &uniform, &planned.pattern).unwrap_err().to_string();
+    assert!(e.contains("Uniform samplings"), "{e}");
+}

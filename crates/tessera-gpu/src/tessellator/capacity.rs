@@ -2,6 +2,7 @@
 //! the output buffers' growth ([`GpuTessellator::reserve`],
 //! [`GpuTessellator::grow_if_overflowed`]).
 
+use super::pipelines::ESC_GRID_WORDS;
 use super::screen::{Screen, INTERIOR_CORE};
 use super::{buffer, GpuPattern, GpuTessellator, Output, Params, ROW_BLOCKS, VERTEX_STRIDE};
 use crate::context::GpuContext;
@@ -106,7 +107,10 @@ pub(super) fn screen_worst_case(
         GpuPattern::Sd2 => {
             let mut plan = Plan::uniform(set, worst)?;
             plan.kind = SamplingKind::Fractional(Spacing::Symmetric);
-            worst_case = Capacity::of_plan(set, &plan, pattern.cpu_pattern(), true);
+            worst_case = Capacity::of_plan(set, &plan, &tessera::pattern::sd2::Sd2::default(), true);
+        }
+        GpuPattern::Esc => {
+            return Err(GpuError::Unsupported { what: "ESC planned on the GPU from the camera".into() })
         }
         GpuPattern::Uniform | GpuPattern::Transition | GpuPattern::SemiUniform => {}
     }
@@ -227,8 +231,21 @@ impl GpuTessellator {
         let usage = U::STORAGE | U::COPY_SRC;
         let vertices = buffer(device, "tessera vertices", vertex_bytes, usage | U::VERTEX);
         let indices = buffer(device, "tessera indices", index_bytes, usage | U::INDEX);
+        let main = self.bind_main(device, &vertices, &indices);
+        self.output = Some(Output { capacity, vertices, indices, main });
+        self.write_params(ctx);
+        Ok(())
+    }
+
+    /// Group 0 of every tessellation pass, over the output buffers `vertices` and `indices`.
+    fn bind_main(
+        &self,
+        device: &wgpu::Device,
+        vertices: &wgpu::Buffer,
+        indices: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
         let s = &self.set;
-        let main = shader::bind(
+        shader::bind(
             device,
             &self.pipelines.main_layout,
             &[
@@ -243,13 +260,34 @@ impl GpuTessellator {
                 &self.visible,
                 &self.vertex_offsets,
                 &self.triangle_offsets,
-                &vertices,
-                &indices,
+                vertices,
+                indices,
             ],
+        )
+    }
+
+    /// Makes the segments buffer hold the ESC pattern's insertion grids after the plan's
+    /// rows (`esc.wgsl`), binding the larger buffer. Cost: a reallocation and a bind group
+    /// the first time; nothing after.
+    pub(super) fn reserve_esc_grids(&mut self, ctx: &GpuContext) {
+        let (e, p) = (self.set.edges as u64, self.set.patches as u64);
+        let bytes = 16 * e + 4 * ESC_GRID_WORDS as u64 * p;
+        if self.segments.size() >= bytes {
+            return;
+        }
+        use wgpu::BufferUsages as U;
+        self.segments = buffer(
+            &ctx.device,
+            "segments, factors, lattice masks and ESC grids",
+            bytes,
+            U::STORAGE | U::COPY_DST | U::COPY_SRC,
         );
-        self.output = Some(Output { capacity, vertices, indices, main });
-        self.write_params(ctx);
-        Ok(())
+        if let Some(out) = &self.output {
+            let main = self.bind_main(&ctx.device, &out.vertices, &out.indices);
+            if let Some(out) = &mut self.output {
+                out.main = main;
+            }
+        }
     }
 
     /// Writes `common.wgsl`'s `Params` for the output capacity and the pattern. Cost: a

@@ -15,6 +15,7 @@ use crate::scan::ScanPipelines;
 use crate::shader::sources::*;
 use crate::shader::{self, Binding};
 use crate::upload;
+use tessera::pattern::esc::Esc;
 use tessera::pattern::hardware::{Hardware, Partitioning};
 use tessera::pattern::sd2::Sd2;
 use tessera::pattern::semi_uniform::SemiUniform;
@@ -51,6 +52,15 @@ const fn max_u32(a: u32, b: u32) -> u32 {
 /// limit at the top level (64 rows of 512 triangles) while idle invocations stay few: a
 /// frame's patches mostly have one or two rows.
 pub const ROW_BLOCKS: u32 = 4;
+
+/// The largest ESC lattice side `3n`, at [`tessera::pattern::esc::MAX_LEVEL`] (`esc.wgsl`'s
+/// private rows hold one more).
+pub(crate) const ESC_MAX_SIDE: u32 =
+    3 * tessera::pattern::esc::segments_for_level(tessera::pattern::esc::MAX_LEVEL);
+
+/// Words a patch of an ESC insertion grid takes in the segments buffer: `(3n + 1)²` bits at
+/// the largest level.
+pub(crate) const ESC_GRID_WORDS: u32 = ((ESC_MAX_SIDE + 1) * (ESC_MAX_SIDE + 1)).div_ceil(32);
 
 /// The Direct3D 11 partitionings, in the order of their codes ([`partitioning_code`]).
 const PARTITIONINGS: [Partitioning; 4] =
@@ -119,6 +129,8 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("FRACTIONAL_EVEN_LO", range(Partitioning::FractionalEven, false)),
         ("FRACTIONAL_EVEN_HI", range(Partitioning::FractionalEven, true)),
         ("OUTPUT_GAP_INVERSE", gap_inverse as u32),
+        ("ESC_MAX_SIDE", ESC_MAX_SIDE),
+        ("ESC_GRID_WORDS", ESC_GRID_WORDS),
     ]
 }
 
@@ -144,6 +156,10 @@ pub enum GpuPattern {
     /// [`tessera::pattern::sd2::Sd2`] (paper 001) on triangles, with or without the reverse
     /// projection: one invocation per triangle (`sd2.wgsl`).
     Sd2,
+    /// [`tessera::pattern::esc::Esc`] (paper 002) on bicubic patches, from the insertion
+    /// grids of the pattern the plan came with: one invocation per patch walks its 18
+    /// coarse triangles' strips (`esc.wgsl`).
+    Esc,
 }
 
 impl GpuPattern {
@@ -154,6 +170,7 @@ impl GpuPattern {
             n if n == Transition.name() => Some(GpuPattern::Transition),
             n if n == SemiUniform.name() => Some(GpuPattern::SemiUniform),
             n if n == Sd2::default().name() => Some(GpuPattern::Sd2),
+            n if n == Esc::default().name() => Some(GpuPattern::Esc),
             n => PARTITIONINGS
                 .into_iter()
                 .find(|&p| Hardware { partitioning: p }.name() == n)
@@ -161,14 +178,16 @@ impl GpuPattern {
         }
     }
 
-    /// The CPU pattern this draws (for counts read back, [`GpuTessellator::read_mesh`]).
-    pub(super) fn cpu_pattern(self) -> &'static dyn Pattern {
+    /// The CPU pattern this draws (for counts read back, [`GpuTessellator::read_mesh`]);
+    /// None for ESC, whose pattern holds per-patch decisions.
+    pub(super) fn cpu_pattern(self) -> Option<&'static dyn Pattern> {
         match self {
-            GpuPattern::Uniform => &Uniform,
-            GpuPattern::Transition => &Transition,
-            GpuPattern::Hardware(p) => &HARDWARE_PATTERNS[partitioning_code(p) as usize],
-            GpuPattern::SemiUniform => &SemiUniform,
-            GpuPattern::Sd2 => &SD2_PATTERN,
+            GpuPattern::Uniform => Some(&Uniform),
+            GpuPattern::Transition => Some(&Transition),
+            GpuPattern::Hardware(p) => Some(&HARDWARE_PATTERNS[partitioning_code(p) as usize]),
+            GpuPattern::SemiUniform => Some(&SemiUniform),
+            GpuPattern::Sd2 => Some(&SD2_PATTERN),
+            GpuPattern::Esc => None,
         }
     }
 
@@ -178,6 +197,7 @@ impl GpuPattern {
         match self {
             GpuPattern::Hardware(p) => SamplingKind::Fractional(Spacing::Hardware(p)),
             GpuPattern::Sd2 => SamplingKind::Fractional(Spacing::Symmetric),
+            GpuPattern::Esc => SamplingKind::Lattice,
             GpuPattern::Uniform | GpuPattern::Transition | GpuPattern::SemiUniform => SamplingKind::Uniform,
         }
     }
@@ -324,6 +344,20 @@ const SD2_SHADERS: PatternShaders = PatternShaders {
     write_collapsed_triangles: Some("write_sd2_collapsed_triangles"),
 };
 
+/// The ESC pattern: counts and triangles in one module, one invocation a patch.
+const ESC_SHADERS: PatternShaders = PatternShaders {
+    count: ("esc", &[COMMON, LOCAL, ESC, COUNT]),
+    vertices: ("vertices esc", &[COMMON, BICUBIC, NO_TREE, BEZIER_TRIANGLE, LOCAL, ESC, WRITE_VERTICES]),
+    triangles: None,
+    functions: &[
+        ("PATCH_COUNTS", "esc_patch_counts"),
+        ("EDGE_PARAM", "esc_edge_param"),
+        ("INTERIOR_POINT", "esc_interior_point"),
+    ],
+    write_triangles: "write_esc_triangles",
+    write_collapsed_triangles: None,
+};
+
 impl PatternShaders {
     /// Compiles the pattern's modules and makes its pipelines with group 0 laid out by
     /// `layout`. Cost: two or three WGSL compilations.
@@ -416,6 +450,8 @@ pub struct Pipelines {
     semi_uniform: std::sync::OnceLock<PatternPipelines>,
     /// The SD-2 pattern's, compiled on first use ([`Pipelines::compile`]).
     sd2: std::sync::OnceLock<PatternPipelines>,
+    /// The ESC pattern's, compiled on first use ([`Pipelines::compile`]).
+    esc: std::sync::OnceLock<PatternPipelines>,
     main_pipeline_layout: wgpu::PipelineLayout,
 }
 
@@ -521,6 +557,7 @@ impl Pipelines {
             hardware: std::sync::OnceLock::new(),
             semi_uniform: std::sync::OnceLock::new(),
             sd2: std::sync::OnceLock::new(),
+            esc: std::sync::OnceLock::new(),
             main_pipeline_layout: one,
             main_layout,
             args_layout,
@@ -553,6 +590,9 @@ impl Pipelines {
             GpuPattern::Sd2 => {
                 self.sd2.get_or_init(|| SD2_SHADERS.pipelines(device, layout));
             }
+            GpuPattern::Esc => {
+                self.esc.get_or_init(|| ESC_SHADERS.pipelines(device, layout));
+            }
             GpuPattern::Uniform | GpuPattern::Transition => {}
         }
     }
@@ -567,6 +607,7 @@ impl Pipelines {
             GpuPattern::Hardware(_) => &HARDWARE_SHADERS,
             GpuPattern::SemiUniform => &SEMI_UNIFORM_SHADERS,
             GpuPattern::Sd2 => &SD2_SHADERS,
+            GpuPattern::Esc => &ESC_SHADERS,
         };
         if let Some(p) = self.of(pattern) {
             p.with_trees.get_or_init(|| shaders.vertex_pipelines(device, &self.main_pipeline_layout, true));
@@ -582,6 +623,7 @@ impl Pipelines {
             GpuPattern::Hardware(_) => self.hardware.get(),
             GpuPattern::SemiUniform => self.semi_uniform.get(),
             GpuPattern::Sd2 => self.sd2.get(),
+            GpuPattern::Esc => self.esc.get(),
         }
     }
 }
@@ -615,12 +657,13 @@ pub(crate) struct Params {
 mod tests {
     use super::*;
 
-    const ROWS: [(&str, &PatternShaders); 5] = [
+    const ROWS: [(&str, &PatternShaders); 6] = [
         ("uniform", &UNIFORM_SHADERS),
         ("transition", &TRANSITION_SHADERS),
         ("hardware", &HARDWARE_SHADERS),
         ("semi-uniform", &SEMI_UNIFORM_SHADERS),
         ("sd2", &SD2_SHADERS),
+        ("esc", &ESC_SHADERS),
     ];
 
     /// The modules of `row` (count, vertices, triangles), expanded with `functions` as

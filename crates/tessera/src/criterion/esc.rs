@@ -198,7 +198,7 @@ fn bicubic(set: &SurfaceSet, p: usize) -> Result<&RationalBicubic> {
 }
 
 /// Lattice point `kl` (`0..=3n`) along local edge `e` of a patch, in the edge's direction.
-fn edge_lattice(e: usize, kl: u32, side: u32) -> (u32, u32) {
+pub fn edge_lattice(e: usize, kl: u32, side: u32) -> (u32, u32) {
     match e {
         0 => (kl, 0),
         1 => (side, kl),

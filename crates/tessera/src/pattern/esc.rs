@@ -73,7 +73,7 @@ use glam::DVec2;
 pub const MAX_LEVEL: u32 = 6;
 
 /// Candidate segments per coarse-triangle edge at level `level` (paper Fig. 3: `L + 1`).
-pub fn segments_for_level(level: u32) -> u32 {
+pub const fn segments_for_level(level: u32) -> u32 {
     level + 1
 }
 
@@ -433,6 +433,11 @@ impl Esc {
         Esc { layouts, grids }
     }
 
+    /// How many patches the pattern holds grids for.
+    pub fn patches(&self) -> usize {
+        self.grids.len()
+    }
+
     /// The insertion grid of patch `p`.
     pub fn grid(&self, p: usize) -> &PatchGrid {
         &self.grids[p]
@@ -455,6 +460,10 @@ impl Pattern for Esc {
 
     fn depends_on_patch(&self) -> bool {
         true // each patch's own insertion grid
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 
     fn counts(&self, input: &PatternInput) -> (u32, u32) {

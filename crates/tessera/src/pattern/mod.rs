@@ -204,6 +204,14 @@ pub trait Pattern: Sync {
         false
     }
 
+    /// The pattern itself as [`std::any::Any`], for an engine that draws a pattern with
+    /// per-patch decisions from the pattern's own data (the GPU engine reads ESC's insertion
+    /// grids, [`crate::pattern::esc::Esc::grid`]). None (the default) for the patterns whose
+    /// output follows from the plan alone.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
+
     /// Appends the pattern's triangles as triangle strips over local indices, strips
     /// separated by [`crate::mesh::strips::RESTART`], and returns true; a pattern without a
     /// strip form returns false and appends nothing. Contract: decoding the strips

@@ -161,6 +161,9 @@ impl Pattern for SchemePattern {
     fn name(&self) -> &'static str {
         self.inner().name()
     }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        self.inner().as_any()
+    }
 }
 
 impl Scheme {

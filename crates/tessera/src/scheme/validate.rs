@@ -290,11 +290,12 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
             | Scheme::Hardware(_)
             | Scheme::SemiUniform { .. }
             | Scheme::Sd2 { .. }
+            | Scheme::Esc { .. }
     );
     match engine {
         Engine::Cpu => Ok(()),
         Engine::Gpu | Engine::GpuFromCamera if !gpu_scheme => refuse(format!(
-            "the {} scheme (it draws the uniform, transition, semi-uniform, SD-2, integer, pow2, \
+            "the {} scheme (it draws the uniform, transition, semi-uniform, SD-2, ESC, integer, pow2, \
              fractional-odd and fractional-even schemes)",
             scheme.name()
         )),
@@ -369,7 +370,8 @@ mod tests {
         // The GPU: four scheme families; from the camera, four pairings, culled.
         let engine_refused = |r: Result<Accepted>| matches!(r, Err(Error::EngineNotSupported { .. }));
         v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Gpu).unwrap();
-        assert!(engine_refused(v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Gpu)));
+        v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Gpu).unwrap();
+        assert!(engine_refused(v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::GpuFromCamera)));
         let tris = crate::scheme::tests::triangles();
         let on_tris = |s, c: Criterion, e| validate(s, &c, &o, &tris, e);
         on_tris(Scheme::Sd2 { warp: false }, Criterion::Factor(3.5), Engine::Gpu).unwrap();
