@@ -584,6 +584,20 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let frame = Sd2Frame { warp: c % 8 == 6, criterion, max_factor: options.max_factor + 1 };
                 sd2_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, frame, &mut counts);
             }
+            // ESC on bicubic models, every fourth camera (c % 4 == 1): the levels per object
+            // and the distance tests of the CPU's plan, drawn on the GPU from the plan and its
+            // insertion grids (ESC culls nothing, so without the culling camera).
+            let bicubic = set.patches.iter().all(|p| matches!(p, tessera::surface::Patch::Bicubic(_)));
+            if c % 4 == 1 && bicubic {
+                let name = format!("{model} camera {c} esc");
+                gpu.set_cull_camera(ctx, None);
+                let criterion =
+                    Criterion::Esc { threshold: tessera::criterion::esc::Threshold::Medium, level: None };
+                let esc_options = PlanOptions { camera: Some(camera), ..Default::default() };
+                let planned = Scheme::Esc { max_level: 3 }.plan(&set, &criterion, &esc_options).unwrap();
+                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+                counts.frames += 1;
+            }
         }
         assert!(
             counts.culled > culled_before,
@@ -611,7 +625,7 @@ fn acceptance_sweep_on_the_small_models() {
 }
 
 #[test]
-#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition, semi-uniform and SD-2"]
+#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition, semi-uniform, SD-2 and ESC"]
 fn acceptance_sweep_on_every_model_20_cameras() {
     // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).
