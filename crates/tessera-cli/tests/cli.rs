@@ -692,11 +692,12 @@ fn mesh_engine_gpu_gives_the_cpu_mesh_counts_and_refuses_what_it_cannot_draw() {
     // The seed papers' schemes: semi-uniform (paper 000, compacted), SD-2 (paper 001) and
     // ESC (paper 002), a CPU plan drawn on the GPU, and with --cull the frame planned on the
     // GPU from the camera (semi-uniform's levels with their a-posteriori check, SD-2's level
-    // function).
+    // function); ESC, which culls nothing, is always planned on the GPU (its levels per object
+    // and distance tests).
     let blob = blob.to_str().unwrap();
     let cases: [(&[&str], &str); 7] = [
-        (&[input, "--scheme", "esc", "--level", "2", "--quality", "medium"], "cpu"),
-        (&[input, "--scheme", "esc", "--threshold", "0.01"], "cpu"),
+        (&[input, "--scheme", "esc", "--level", "2", "--quality", "medium"], "gpu"),
+        (&[input, "--scheme", "esc", "--threshold", "0.01"], "gpu"),
         (&[input, "--scheme", "semi-uniform", "--tolerance", "0.01", "--cull"], "cpu"),
         (&[input, "--scheme", "semi-uniform", "--pixel-error", "0.5", "--cull"], "gpu"),
         (&[blob, "--scheme", "sd2", "--distance", "1:9.5"], "cpu"),

@@ -26,7 +26,8 @@ struct View {
     // the view criterion's factor range [lo, hi] (`view::edge_factors_into`'s, the cap
     // applied; a fixed factor is lo = hi); the edge rule (EDGE_RULE_INTEGER,
     // EDGE_RULE_POWER_OF_TWO or EDGE_RULE_HARDWARE, whose partitioning is
-    // `params.partitioning`).
+    // `params.partitioning`). ESC (CRITERION_ESC) reads lo, hi, cap, pixels and edge_rule
+    // its own way (`esc_plan.wgsl`).
     criterion: u32,
     lo: f32,
     hi: f32,
@@ -38,7 +39,8 @@ struct View {
 // sphere's centre and radius; (sin α, cos α, 1 with a cone / 0 without, 0); the control
 // points' box lo and hi (`screen::PatchView`); the second-derivative bound (uu, uv, vv, 0)
 // (`Prepared::hessians`); the boundary curves' bounds (`Prepared::curves`); the minimum
-// interior factors (`Prepared::minimum_interior`, as f32), 0, 0. After the P patch rows,
+// interior factors (`Prepared::minimum_interior`, as f32), 0, 0; its ESC object's box lo
+// with the box's diagonal in w, and hi (`criterion::esc::Objects`). After the P patch rows,
 // EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it with the edge's
 // minimum segments in w (`minimum_segments`), the normals there of its first and its last
 // patch (`Prepared::edge_midpoints`).
@@ -89,6 +91,8 @@ const CRITERION_FIXED: u32 = {{CRITERION_FIXED}}u;
 const CRITERION_DISTANCE_LINEAR: u32 = {{CRITERION_DISTANCE_LINEAR}}u;
 const CRITERION_DISTANCE_QUADRATIC: u32 = {{CRITERION_DISTANCE_QUADRATIC}}u;
 const CRITERION_VERTEX_SILHOUETTE: u32 = {{CRITERION_VERTEX_SILHOUETTE}}u;
+// ESC's own criterion: its planning passes (`esc_plan.wgsl`) read the uniform their way.
+const CRITERION_ESC: u32 = {{CRITERION_ESC}}u;
 const EDGE_RULE_INTEGER: u32 = {{EDGE_RULE_INTEGER}}u;
 const EDGE_RULE_HARDWARE: u32 = {{EDGE_RULE_HARDWARE}}u;
 const EDGE_RULE_POWER_OF_TWO: u32 = {{EDGE_RULE_POWER_OF_TWO}}u;

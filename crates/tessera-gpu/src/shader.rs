@@ -54,6 +54,8 @@ pub mod sources {
     pub(crate) const SD2: &str = include_str!("../shaders/sd2.wgsl");
     /// The ESC pattern (`tessera::pattern::esc::Esc`): counts, vertex places, triangles.
     pub(crate) const ESC: &str = include_str!("../shaders/esc.wgsl");
+    /// ESC planned from the camera: levels, distance tests, insertion grids.
+    pub(crate) const ESC_PLAN: &str = include_str!("../shaders/esc_plan.wgsl");
 }
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],

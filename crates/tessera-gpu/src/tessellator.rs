@@ -527,8 +527,32 @@ impl GpuTessellator {
             let depth = |k: usize| f32::from_bits(rows[2 * e + k]);
             plan.depths = (0..e).map(|i| [depth(2 * i), depth(2 * i + 1)]).collect();
         }
+        if plan.kind == SamplingKind::Lattice {
+            // ESC: each edge's numerators from its lattice mask (`esc.wgsl`).
+            for &mask in &rows[2 * e..3 * e] {
+                plan.lattice_offsets.push(plan.lattice.len() as u32);
+                plan.lattice.extend((0..32).filter(|k| mask >> k & 1 != 0));
+            }
+        }
         plan.visible = self.read_visible(ctx)?;
         Ok(plan)
+    }
+
+    /// Reads an ESC frame's insertion grids back as the CPU's pattern (with
+    /// [`GpuTessellator::read_plan`], what the CPU engine draws for comparison). Errors:
+    /// [`GpuError::Unsupported`] when the last frame was not ESC's. Cost: a queue wait and
+    /// O(P · (3n + 1)²).
+    pub fn read_esc_pattern(&self, ctx: &GpuContext) -> Result<tessera::pattern::esc::Esc> {
+        if self.pattern != GpuPattern::Esc {
+            return Err(GpuError::Unsupported {
+                what: "reading ESC grids of a frame of another pattern".into(),
+            });
+        }
+        let (e, p) = (self.set.edges as usize, self.set.patches as usize);
+        let words = pipelines::ESC_GRID_WORDS as usize;
+        let rows: Vec<u32> = readback::read(ctx, &self.segments, 4 * e + words * p)?;
+        let interior: Vec<[u32; 2]> = readback::read(ctx, &self.interior, p)?;
+        Ok(esc::unpack(&rows[4 * e..], &interior))
     }
 
     /// Reads the plan's visibility row back (the GPU's, when it culls). For tests. Cost: a
@@ -620,10 +644,18 @@ impl GpuTessellator {
         }
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
         let plan = self.read_plan(ctx)?;
-        let pattern_triangles = |p: usize| match (self.pattern.cpu_pattern(), &self.esc_triangles) {
-            (Some(kind), _) => kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64,
-            (None, Some(esc)) => esc[p] as u64,
-            (None, None) => 0,
+        // ESC planned on the GPU: its pattern is the grids it made.
+        let esc_triangles = match (&self.esc_triangles, self.pattern) {
+            (Some(t), _) => t.clone(),
+            (None, GpuPattern::Esc) => {
+                let esc = self.read_esc_pattern(ctx)?;
+                (0..set.patches.len()).map(|p| esc.triangles(p)).collect()
+            }
+            (None, _) => Vec::new(),
+        };
+        let pattern_triangles = |p: usize| match self.pattern.cpu_pattern() {
+            Some(kind) => kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64,
+            None => esc_triangles[p] as u64,
         };
         let pattern: u64 =
             (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(pattern_triangles).sum();

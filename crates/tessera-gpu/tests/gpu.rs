@@ -584,18 +584,15 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let frame = Sd2Frame { warp: c % 8 == 6, criterion, max_factor: options.max_factor + 1 };
                 sd2_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, frame, &mut counts);
             }
-            // ESC on bicubic models, every fourth camera (c % 4 == 1): the levels per object
-            // and the distance tests of the CPU's plan, drawn on the GPU from the plan and its
-            // insertion grids (ESC culls nothing, so without the culling camera).
+            // ESC on bicubic models, every fourth camera (c % 4 == 1), planned on the GPU from
+            // the camera alone (levels per object, distance tests, grids).
             let bicubic = set.patches.iter().all(|p| matches!(p, tessera::surface::Patch::Bicubic(_)));
             if c % 4 == 1 && bicubic {
                 let name = format!("{model} camera {c} esc");
-                gpu.set_cull_camera(ctx, None);
-                let criterion =
-                    Criterion::Esc { threshold: tessera::criterion::esc::Threshold::Medium, level: None };
-                let esc_options = PlanOptions { camera: Some(camera), ..Default::default() };
-                let planned = Scheme::Esc { max_level: 3 }.plan(&set, &criterion, &esc_options).unwrap();
-                assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+                let threshold = tessera::criterion::esc::Threshold::Medium;
+                let criterion = Criterion::Esc { threshold, level: None };
+                let ties = &mut counts.esc_ties;
+                esc_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, criterion, ties);
                 counts.frames += 1;
             }
         }
@@ -639,6 +636,7 @@ fn acceptance_sweep_on_every_model_20_cameras() {
     assert!(counts.below_cap > 0, "no uniform frame below the cap: the GPU factor was never tested");
     // Rounding ties must stay rare: at most one frame or patch in a hundred.
     assert!(100 * counts.factor_ties <= counts.frames, "{counts:?}");
+    assert!(counts.esc_ties <= counts.frames, "{counts:?}");
     assert!(100 * counts.cull_ties <= counts.culled.max(100), "{counts:?}");
 }
 

@@ -447,3 +447,57 @@ fn esc_plans_the_gpu_cannot_draw_are_refused() {
     let e = gpu.prepare(ctx, &set, &uniform, &planned.pattern).unwrap_err().to_string();
     assert!(e.contains("Uniform samplings"), "{e}");
 }
+
+/// ESC planned on the GPU from the camera alone (`esc_plan.wgsl`: each object's level, the
+/// distance test on every candidate, the candidates forced at collapsed curves, the grids)
+/// equals the CPU's plan on every patch model — the levels exactly, every patch's grid up to
+/// f32 ties of the distance test (a patch whose grid differs must have a candidate within
+/// 1e-5 of the diagonal of its threshold) — and the frame equals the CPU engine's on the
+/// GPU's own plan and grids, index for index.
+#[test]
+fn esc_planned_on_the_gpu_equals_the_cpu_plan() {
+    use tessera::criterion::esc::Threshold;
+    let (mut frames, mut differing) = (0, 0);
+    for model in patch_models() {
+        let set = load(&model);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        let d = diagonal(&set);
+        let by_camera = |threshold| Criterion::Esc { threshold, level: None };
+        let near = cameras(&set, 4, 23);
+        // The level rule needs eyes past the objects' near distance (12 diagonals): the
+        // second and third cameras again, 18 and 30 diagonals from the target.
+        let far = |c: tessera::camera::Camera, diagonals: f64| tessera::camera::Camera {
+            eye: c.target + (c.eye - c.target).normalize() * diagonals * d,
+            far: c.far.max(2.0 * diagonals * d),
+            ..c
+        };
+        let cases = [
+            (near[0], by_camera(Threshold::Medium)),
+            (near[1], by_camera(Threshold::High)),
+            (far(near[1], 18.0), by_camera(Threshold::Medium)),
+            (far(near[2], 30.0), by_camera(Threshold::High)),
+            (near[2], Criterion::Esc { threshold: Threshold::Absolute(2e-3 * d), level: Some(2) }),
+            (near[3], Criterion::Esc { threshold: Threshold::Medium, level: Some(6) }),
+        ];
+        let mut levels = std::collections::BTreeSet::new();
+        for (c, (camera, criterion)) in cases.into_iter().enumerate() {
+            let name = format!("{model} camera {c} {criterion:?}");
+            let plan = esc_frame_from_the_camera(
+                &name,
+                &set,
+                &prepared,
+                &mut gpu,
+                &camera,
+                criterion,
+                &mut differing,
+            );
+            levels.extend(plan.interior.iter().map(|l| l[0]));
+            frames += 1;
+        }
+        eprintln!("{model}: levels {levels:?}");
+        assert!(levels.len() >= 4, "{model}: levels {levels:?}, too few to test the level rule");
+    }
+    eprintln!("{differing} patches differ in {frames} frames");
+    assert!(differing <= frames, "{differing} patches differ in {frames} frames");
+}

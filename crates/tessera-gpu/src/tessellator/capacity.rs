@@ -80,7 +80,10 @@ fn hardware_worst_case(
 /// largest of `prepared`'s minimums when that is higher; for the transition scheme's core
 /// rule its strips' triangles too; for a hardware partitioning [`hardware_worst_case`]; for
 /// SD-2 its own pattern with every edge at that factor (`nd (2 ns − 1)` triangles grow with
-/// both counts, so no two-factor plan within it has more).
+/// both counts, so no two-factor plan within it has more); for ESC every patch's complete
+/// pattern at the highest level the frame can give (its `3n`-grid: every candidate
+/// inserted is the uniform pattern of factor `3n`, and leaving candidates out only removes
+/// vertices and triangles).
 /// Errors as [`Plan::uniform`]. Cost: O(E + P) pattern counts.
 pub(super) fn screen_worst_case(
     set: &SurfaceSet,
@@ -90,6 +93,11 @@ pub(super) fn screen_worst_case(
     max_factor: u32,
 ) -> Result<Capacity> {
     let patches = set.patches.len();
+    if pattern == GpuPattern::Esc {
+        let level = if screen.lo >= 0.0 { screen.lo } else { screen.hi } as u32;
+        let side = 3 * tessera::pattern::esc::segments_for_level(level);
+        return Ok(Capacity::of_plan(set, &Plan::uniform(set, side)?, &Uniform, true));
+    }
     // The largest global factor a frame can reach: the cap, or a minimum above it.
     let minimum = prepared.minimum_segments.iter().chain(prepared.minimum_interior.iter().flatten());
     let worst = minimum.copied().fold(max_factor, u32::max);
@@ -109,10 +117,7 @@ pub(super) fn screen_worst_case(
             plan.kind = SamplingKind::Fractional(Spacing::Symmetric);
             worst_case = Capacity::of_plan(set, &plan, &tessera::pattern::sd2::Sd2::default(), true);
         }
-        GpuPattern::Esc => {
-            return Err(GpuError::Unsupported { what: "ESC planned on the GPU from the camera".into() })
-        }
-        GpuPattern::Uniform | GpuPattern::Transition | GpuPattern::SemiUniform => {}
+        GpuPattern::Uniform | GpuPattern::Esc | GpuPattern::Transition | GpuPattern::SemiUniform => {}
     }
     Ok(worst_case)
 }

@@ -7,7 +7,7 @@ use super::pipelines::{ESC_GRID_WORDS, ESC_MAX_SIDE};
 use crate::error::{GpuError, Result};
 use tessera::criterion::esc::edge_lattice;
 use tessera::criterion::Plan;
-use tessera::pattern::esc::Esc;
+use tessera::pattern::esc::{Esc, PatchGrid};
 use tessera::pattern::Pattern;
 use tessera::surface::{Domain, SurfaceSet};
 
@@ -99,4 +99,26 @@ pub(super) fn pack(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) -> Resu
         triangles.push(esc.triangles(p));
     }
     Ok(EscData { masks, grids, triangles })
+}
+
+/// The [`Esc`] pattern of grids packed as [`pack`] packs them (`words`, [`ESC_GRID_WORDS`] a
+/// patch) with each patch's lattice `3n` its interior factor. Cost: O(P · (3n + 1)²).
+pub(super) fn unpack(words: &[u32], interior: &[[u32; 2]]) -> Esc {
+    let per_patch = ESC_GRID_WORDS as usize;
+    let grids = interior
+        .iter()
+        .enumerate()
+        .map(|(p, &[side, _])| {
+            let mut grid = PatchGrid::coarse((side / 3).max(1));
+            let side = grid.side();
+            for j in 0..=side {
+                for i in 0..=side {
+                    let bit = (j * (side + 1) + i) as usize;
+                    grid.set(i, j, words[per_patch * p + bit / 32] >> (bit % 32) & 1 != 0);
+                }
+            }
+            grid
+        })
+        .collect();
+    Esc::new(grids)
 }

@@ -60,23 +60,32 @@ impl GpuTessellator {
             if screen {
                 c.set_bind_group(0, &out.main, &[]);
                 c.set_bind_group(1, &self.view.bind, &[]);
-                if self.screen.is_some_and(|s| s.reads_depths()) {
-                    c.set_pipeline(&p.vertex_depths);
-                    let (x, y) = grid(self.view.vertices);
-                    c.dispatch_workgroups(x, y, 1);
-                }
-                c.set_pipeline(&p.patch_proposals);
-                let (x, y) = grid(patches);
-                c.dispatch_workgroups(x, y, 1);
-                c.set_pipeline(&p.edge_segments);
-                let (x, y) = grid(e);
-                c.dispatch_workgroups(x, y, 1);
-                if self.screen.is_some_and(|s| s.checked()) {
-                    self.record_check(&mut c);
+                if let Some(esc) = p.esc_plan_compiled().filter(|_| self.screen.is_some_and(|s| s.is_esc())) {
+                    // ESC: levels, then edges, then grids (each pass reads the last's writes).
+                    for (pipeline, n) in [(&esc.levels, patches), (&esc.edges, e), (&esc.grids, patches)] {
+                        c.set_pipeline(pipeline);
+                        let (x, y) = grid(n);
+                        c.dispatch_workgroups(x, y, 1);
+                    }
                 } else {
-                    c.set_pipeline(&p.interiors);
-                    let (x, y) = grid(e.max(patches));
+                    if self.screen.is_some_and(|s| s.reads_depths()) {
+                        c.set_pipeline(&p.vertex_depths);
+                        let (x, y) = grid(self.view.vertices);
+                        c.dispatch_workgroups(x, y, 1);
+                    }
+                    c.set_pipeline(&p.patch_proposals);
+                    let (x, y) = grid(patches);
                     c.dispatch_workgroups(x, y, 1);
+                    c.set_pipeline(&p.edge_segments);
+                    let (x, y) = grid(e);
+                    c.dispatch_workgroups(x, y, 1);
+                    if self.screen.is_some_and(|s| s.checked()) {
+                        self.record_check(&mut c);
+                    } else {
+                        c.set_pipeline(&p.interiors);
+                        let (x, y) = grid(e.max(patches));
+                        c.dispatch_workgroups(x, y, 1);
+                    }
                 }
             }
         }

@@ -3,10 +3,11 @@
 //! ([`constants`]), the bind group layouts, and `common.wgsl`'s uniform [`Params`].
 
 use super::screen::{
-    CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_FIXED, CRITERION_PIXEL_ERROR,
-    CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE, EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER,
-    EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW, INTERIOR_CORE, INTERIOR_GLOBAL,
-    INTERIOR_LEVEL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING, VERTEX_VIEW_ROW,
+    CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_ESC, CRITERION_FIXED,
+    CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE, EDGE_RULE_HARDWARE,
+    EDGE_RULE_INTEGER, EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW, ESC_THRESHOLD_ABSOLUTE,
+    INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING,
+    STATE_BINDING, VERTEX_VIEW_ROW,
 };
 use super::VERTEX_FLOATS;
 use crate::context::GpuContext;
@@ -114,6 +115,8 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("CRITERION_DISTANCE_LINEAR", CRITERION_DISTANCE_LINEAR),
         ("CRITERION_DISTANCE_QUADRATIC", CRITERION_DISTANCE_QUADRATIC),
         ("CRITERION_VERTEX_SILHOUETTE", CRITERION_VERTEX_SILHOUETTE),
+        ("CRITERION_ESC", CRITERION_ESC),
+        ("ESC_THRESHOLD_ABSOLUTE", ESC_THRESHOLD_ABSOLUTE),
         ("EDGE_RULE_INTEGER", EDGE_RULE_INTEGER),
         ("EDGE_RULE_HARDWARE", EDGE_RULE_HARDWARE),
         ("EDGE_RULE_POWER_OF_TWO", EDGE_RULE_POWER_OF_TWO),
@@ -452,6 +455,10 @@ pub struct Pipelines {
     sd2: std::sync::OnceLock<PatternPipelines>,
     /// The ESC pattern's, compiled on first use ([`Pipelines::compile`]).
     esc: std::sync::OnceLock<PatternPipelines>,
+    /// ESC's planning passes from the camera (`esc_plan.wgsl`), compiled on first use
+    /// ([`Pipelines::esc_plan`]).
+    esc_plan: std::sync::OnceLock<EscPlanPipelines>,
+    view_pipeline_layout: wgpu::PipelineLayout,
     main_pipeline_layout: wgpu::PipelineLayout,
 }
 
@@ -558,7 +565,9 @@ impl Pipelines {
             semi_uniform: std::sync::OnceLock::new(),
             sd2: std::sync::OnceLock::new(),
             esc: std::sync::OnceLock::new(),
+            esc_plan: std::sync::OnceLock::new(),
             main_pipeline_layout: one,
+            view_pipeline_layout: with_view,
             main_layout,
             args_layout,
             view_layout,
@@ -614,6 +623,26 @@ impl Pipelines {
         }
     }
 
+    /// ESC's planning passes (`esc_plan.wgsl`), compiled now the first time. Cost: the first
+    /// call one WGSL compilation; later calls nothing.
+    pub(super) fn esc_plan(&self, device: &wgpu::Device) -> &EscPlanPipelines {
+        self.esc_plan.get_or_init(|| {
+            let parts = [COMMON, BICUBIC, NO_TREE, BEZIER_TRIANGLE, VIEW, LOCAL, ESC, ESC_PLAN];
+            let m = module(device, "esc plan", &parts);
+            let make = |entry: &str| compute_pipeline(device, &self.view_pipeline_layout, &m, entry);
+            EscPlanPipelines {
+                levels: make("esc_levels"),
+                edges: make("esc_edges"),
+                grids: make("esc_grids"),
+            }
+        })
+    }
+
+    /// ESC's planning passes, once [`Pipelines::esc_plan`] compiled them.
+    pub(super) fn esc_plan_compiled(&self) -> Option<&EscPlanPipelines> {
+        self.esc_plan.get()
+    }
+
     /// The pipelines of `pattern`; None for the hardware pattern before
     /// [`Pipelines::hardware`] compiled them.
     pub(super) fn of(&self, pattern: GpuPattern) -> Option<&PatternPipelines> {
@@ -626,6 +655,15 @@ impl Pipelines {
             GpuPattern::Esc => self.esc.get(),
         }
     }
+}
+
+/// ESC's planning passes from the camera (`esc_plan.wgsl`): each object's level, each edge's
+/// candidates, each patch's insertion grid.
+#[derive(Debug)]
+pub(super) struct EscPlanPipelines {
+    pub(super) levels: wgpu::ComputePipeline,
+    pub(super) edges: wgpu::ComputePipeline,
+    pub(super) grids: wgpu::ComputePipeline,
 }
 
 /// The a-posteriori check's pipelines (`check.wgsl`): the first check, then per round the

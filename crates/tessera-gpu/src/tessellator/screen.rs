@@ -29,14 +29,14 @@ pub(super) const ROUND_ARGS_BINDING: u32 = 5;
 pub const CHECK_MAX_FACTOR: u32 = tessera::scheme::GPU_CHECK_MAX_FACTOR;
 
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
-pub(super) const PATCH_VIEW_ROW: u32 = 8;
+pub(super) const PATCH_VIEW_ROW: u32 = 10;
 
 /// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under `criterion`
 /// with `PlanOptions::max_factor = max_factor`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScreenCriterion {
-    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`], [`Scheme::SemiUniform`] or
-    /// [`Scheme::Hardware`].
+    /// The scheme: [`Scheme::Uniform`], [`Scheme::Transition`], [`Scheme::SemiUniform`],
+    /// [`Scheme::Hardware`], [`Scheme::Sd2`] or [`Scheme::Esc`].
     pub scheme: Scheme,
     /// [`Criterion::PixelError`] (uniform, transition and semi-uniform schemes), [`Criterion::View`] with
     /// [`ViewCriterion::Silhouetteness`], or [`Criterion::Factor`] (hardware schemes).
@@ -85,6 +85,11 @@ pub(super) const CRITERION_FIXED: u32 = 2;
 pub(super) const CRITERION_DISTANCE_LINEAR: u32 = 3;
 pub(super) const CRITERION_DISTANCE_QUADRATIC: u32 = 4;
 pub(super) const CRITERION_VERTEX_SILHOUETTE: u32 = 5;
+/// ESC's own criterion (`esc_plan.wgsl`): levels per object and the distance test.
+pub(super) const CRITERION_ESC: u32 = 6;
+/// ESC's threshold in the view uniform's `edge_rule`: a distance (else a fraction of each
+/// object's diagonal).
+pub(super) const ESC_THRESHOLD_ABSOLUTE: u32 = 1;
 pub(super) const EDGE_RULE_INTEGER: u32 = 0;
 pub(super) const EDGE_RULE_HARDWARE: u32 = 1;
 pub(super) const EDGE_RULE_POWER_OF_TWO: u32 = 2;
@@ -112,6 +117,11 @@ impl Screen {
     /// function: the `vertex_depths` pass first).
     pub(super) fn reads_depths(&self) -> bool {
         self.criterion == CRITERION_DISTANCE_LINEAR || self.criterion == CRITERION_DISTANCE_QUADRATIC
+    }
+
+    /// Whether the frame is ESC's (its own planning passes, `esc_plan.wgsl`).
+    pub(super) fn is_esc(&self) -> bool {
+        self.criterion == CRITERION_ESC
     }
 
     /// Whether the frame's interiors come from the a-posteriori check (a pixel error with
@@ -198,12 +208,14 @@ impl ViewBuffers {
 /// the edge's `Prepared::minimum_segments` in w; the normals of its first and last patch,
 /// with the edge's two end vertices in w as u32 bits); after the edges, [`VERTEX_VIEW_ROW`]
 /// per topology vertex from `view::vertex_data` (its position and its normal: SD-2's level
-/// functions read them).
+/// functions read them). Rows 8 and 9 of a patch are its ESC object's box
+/// (`criterion::esc::Objects`): lo with the box's diagonal in w, hi.
 /// View-independent: computed once. Cost: O(P) cone
 /// computations, the midpoints' evaluations when `prepared` has none yet.
 fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
     let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
     let mut out = Vec::with_capacity(PATCH_VIEW_ROW as usize * set.patches.len());
+    let objects = prepared.map(|_| tessera::criterion::esc::Objects::of(set));
     for (p, patch) in set.patches.iter().enumerate() {
         let view = tessera::criterion::screen::PatchView::new(patch);
         let (axis, alpha) = view.cone.unwrap_or((glam::DVec3::Z, 0.0));
@@ -219,8 +231,11 @@ fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4
                 out.push(prepared.curves[p].map(|c| c as f32));
                 let [u, v] = prepared.minimum_interior[p];
                 out.push([u as f32, v as f32, 0.0, 0.0]);
+                let (lo, hi) =
+                    objects.as_ref().map_or(Default::default(), |o| o.boxes[o.component[p] as usize]);
+                out.extend([v4(lo, lo.distance(hi)), v4(hi, 0.0)]);
             }
-            None => out.extend([[0.0; 4]; 3]),
+            None => out.extend([[0.0; 4]; 5]),
         }
     }
     let edges = &set.topology.edges;
@@ -278,7 +293,10 @@ impl GpuTessellator {
     /// or without the warp, whose edge depths the GPU writes too) with paper 001's level functions ([`ViewCriterion::Distance`], the vertex
     /// depths' range reduced on the GPU, [`ViewCriterion::SilhouetteVertices`]) or a fixed
     /// factor (real per-edge factors by `EdgeRule::Fractional(Spacing::Symmetric)`; f32
-    /// depths, so a factor may differ from the CPU's in its last bits). A silhouetteness strictly
+    /// depths, so a factor may differ from the CPU's in its last bits); and [`Scheme::Esc`]
+    /// with [`Criterion::Esc`] (`esc_plan.wgsl`: each object's level, the distance test on
+    /// every candidate, the insertion grids; no culling, every patch drawn; f32 distances, so
+    /// a candidate at the threshold may be decided unlike the CPU). A silhouetteness strictly
     /// between 0 and 1 is computed in f32 from f32 copies of the CPU's data, so such an edge's
     /// real factor may differ from the CPU's in its last bits (`factors.wgsl`). The distance
     /// and vertex-silhouette criteria of the other schemes are planned on the CPU (their
@@ -312,6 +330,7 @@ impl GpuTessellator {
         let screen = screen_of(set, camera, scheme, criterion, max_factor)?;
         self.check_screen_support(set, prepared, scheme, max_factor)?;
         let pattern = match scheme {
+            Scheme::Esc { .. } => GpuPattern::Esc,
             Scheme::Uniform => GpuPattern::Uniform,
             Scheme::Hardware(p) => GpuPattern::Hardware(p),
             // Every edge and level within the cap, a power of two (`validate`).
@@ -327,6 +346,11 @@ impl GpuTessellator {
             ctx.queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
             self.view.bounds_uploaded = true;
         }
+        if pattern == GpuPattern::Esc {
+            self.pipelines.esc_plan(&ctx.device);
+            self.reserve_esc_grids(ctx);
+        }
+        self.esc_triangles = None;
         self.screen = Some(screen);
         self.pattern = pattern;
         self.warped = scheme == (Scheme::Sd2 { warp: true });
@@ -429,7 +453,9 @@ fn screen_of(
     criterion: Criterion,
     max_factor: u32,
 ) -> Result<Screen> {
-    let options = PlanOptions { camera: Some(*camera), cull: true, max_factor, ..PlanOptions::default() };
+    // ESC culls nothing (its levels are per object); every other frame culls on the GPU.
+    let cull = !matches!(scheme, Scheme::Esc { .. });
+    let options = PlanOptions { camera: Some(*camera), cull, max_factor, ..PlanOptions::default() };
     let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
     let cap = accepted.cap;
     let (kind, pixels, lo, hi) = match (scheme, criterion) {
@@ -452,6 +478,28 @@ fn screen_of(
             (CRITERION_SILHOUETTENESS, 1.0, lo, fmax.max(lo))
         }
         (_, Criterion::Factor(f)) => (CRITERION_FIXED, 1.0, f, f),
+        // ESC: the threshold in `pixels` (its kind in the edge rule), the fixed level or −1
+        // in `lo`, Lmax in `hi`, the near distance in diagonals as the cap (`esc_plan.wgsl`).
+        (Scheme::Esc { max_level }, Criterion::Esc { threshold, level }) => {
+            use tessera::criterion::esc::{EscOptions, Threshold};
+            let (rho, rule) = match threshold {
+                Threshold::High => (Threshold::HIGH_FRACTION, 0),
+                Threshold::Medium => (Threshold::MEDIUM_FRACTION, 0),
+                Threshold::Absolute(r) => (r, ESC_THRESHOLD_ABSOLUTE),
+            };
+            let level = level.map_or(-1.0, f64::from);
+            let near = EscOptions::default().near_diagonals;
+            let interior = INTERIOR_GLOBAL;
+            return Ok(Screen {
+                criterion: CRITERION_ESC,
+                pixels: rho,
+                lo: level,
+                hi: max_level as f64,
+                cap: near,
+                interior,
+                edge_rule: rule,
+            });
+        }
         (_, Criterion::Tolerance(_) | Criterion::Esc { .. }) => {
             unreachable!("validate refuses them on the GPU")
         }

@@ -267,6 +267,9 @@ pub struct SweepCounts {
     pub check_ties: usize,
     /// Pixel-error transition frames that needed fix rounds after the first check.
     pub check_rounds: usize,
+    /// Patches whose ESC grid planned on the GPU differs from the CPU's at an f32 tie of the
+    /// distance test ([`esc_frame_from_the_camera`]).
+    pub esc_ties: usize,
 }
 
 /// The GPU's culled set against the CPU plan's: equal but for [`near_cull_tie`]s, which
@@ -462,6 +465,81 @@ pub fn sd2_frame_from_the_camera(
     counts.frames += 1;
 }
 
+/// How far candidate `(i, j)` of bicubic patch `p` (a lattice point on a coarse edge, not a
+/// coarse vertex) is from deciding the other way: `|V_B − V_S| − ρ` (equation (9)), or None
+/// for a point inside a coarse triangle (decided by its row, not tested).
+fn esc_margin(set: &SurfaceSet, p: usize, side: u32, (i, j): (u32, u32), rho: f64) -> Option<f64> {
+    let tessera::surface::Patch::Bicubic(b) = &set.patches[p] else { return None };
+    let n = side / 3;
+    // The coarse edge through (i, j): a vertical or horizontal cell edge, or a cell diagonal,
+    // from coarse vertex a; s the fraction along it.
+    let (a, c, s) = if i % n == 0 && j % n != 0 {
+        ((i, j / n * n), (i, j / n * n + n), j % n)
+    } else if j % n == 0 && i % n != 0 {
+        ((i / n * n, j), (i / n * n + n, j), i % n)
+    } else if i % n == j % n && i % n != 0 {
+        ((i / n * n, j / n * n), (i / n * n + n, j / n * n + n), i % n)
+    } else {
+        return None;
+    };
+    let s = s as f64 / n as f64;
+    let point = |(x, y): (u32, u32)| b.point((x / n) as usize, (y / n) as usize);
+    let mesh = point(a) * (1.0 - s) + point(c) * s;
+    let uv = glam::DVec2::new(i as f64 / side as f64, j as f64 / side as f64);
+    Some(b.position(uv).distance(mesh) - rho)
+}
+
+/// ESC planned on the GPU from `camera` alone (`esc_plan.wgsl`: each object's level, the
+/// distance test on every candidate, the candidates forced at collapsed curves, the grids)
+/// against `Scheme::Esc`'s plan on the CPU: the levels exactly, every patch's grid equal but
+/// for f32 ties of the distance test (a patch whose grid differs must have a candidate within
+/// 1e-5 of the diagonal of its threshold; counted in `differing`); then the frame equals the
+/// CPU engine's on the GPU's own plan and grids, index for index. Returns the GPU's plan.
+pub fn esc_frame_from_the_camera(
+    name: &str,
+    set: &SurfaceSet,
+    prepared: &tessera::scheme::Prepared,
+    gpu: &mut GpuTessellator,
+    camera: &tessera::camera::Camera,
+    criterion: tessera::scheme::Criterion,
+    differing: &mut usize,
+) -> Plan {
+    use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePattern};
+    let ctx = ctx();
+    let scheme = Scheme::Esc { max_level: 3 };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion { scheme, criterion, max_factor: 64, capacity: None };
+    screen_frame(gpu, set, prepared, camera, screen);
+    let plan = gpu.read_plan(ctx).unwrap();
+    let esc = gpu.read_esc_pattern(ctx).unwrap();
+    let options = PlanOptions { camera: Some(*camera), ..Default::default() };
+    let cpu = scheme.plan(set, &criterion, &options).unwrap();
+    assert_eq!(plan.interior, cpu.plan.interior, "{name}: levels");
+    let (Criterion::Esc { threshold, .. }, SchemePattern::Esc(cpu_esc)) = (criterion, &cpu.pattern) else {
+        unreachable!("ESC's criterion and pattern")
+    };
+    let objects = tessera::criterion::esc::Objects::of(set);
+    let d = diagonal(set);
+    for p in 0..set.patches.len() {
+        let (g, w) = (esc.grid(p), cpu_esc.grid(p));
+        if g == w {
+            continue;
+        }
+        *differing += 1;
+        let side = g.side();
+        let (lo, hi) = objects.boxes[objects.component[p] as usize];
+        let rho = threshold.rho(lo.distance(hi));
+        let margin = (0..=side)
+            .flat_map(|j| (0..=side).map(move |i| (i, j)))
+            .filter_map(|ij| esc_margin(set, p, side, ij, rho))
+            .map(f64::abs)
+            .fold(f64::INFINITY, f64::min);
+        assert!(margin <= 1e-5 * d, "{name}: patch {p}'s grid differs with no tie (margin {margin})");
+    }
+    assert_gpu_equals_cpu_after_record(name, set, gpu, &plan, &esc);
+    plan
+}
+
 /// Records one frame of `gpu`'s prepared work and submits it.
 pub fn record_frame(gpu: &GpuTessellator) {
     let ctx = ctx();
@@ -548,5 +626,6 @@ impl SweepCounts {
         self.strips += other.strips;
         self.check_ties += other.check_ties;
         self.check_rounds += other.check_rounds;
+        self.esc_ties += other.esc_ties;
     }
 }

@@ -269,17 +269,38 @@ fn forced_candidates(set: &SurfaceSet, p: usize, n: u32) -> Option<PatchGrid> {
     Some(forced)
 }
 
+/// ESC's objects: each patch's connected component of the patch adjacency, and each
+/// component's control-point box `(lo, hi)` — what the level rule and `ρ` read
+/// (view-independent: the GPU engine uploads the boxes once per set).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Objects {
+    /// The component of every patch.
+    pub component: Vec<u32>,
+    /// Every component's box.
+    pub boxes: Vec<(DVec3, DVec3)>,
+}
+
+impl Objects {
+    /// The objects of `set`. Cost: O(P + E) (a union-find over the edge uses).
+    pub fn of(set: &SurfaceSet) -> Objects {
+        let (component, count) = components(set);
+        let mut boxes = vec![(DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)); count];
+        for (p, patch) in set.patches.iter().enumerate() {
+            let b = &mut boxes[component[p] as usize];
+            for &c in patch.control_points() {
+                *b = (b.0.min(c), b.1.max(c));
+            }
+        }
+        Objects { component, boxes }
+    }
+}
+
 /// Levels per patch from the camera (or the fixed level), and `ρ` per patch.
 fn levels_and_thresholds(set: &SurfaceSet, camera: &Camera, options: &EscOptions) -> (Vec<u32>, Vec<f64>) {
-    let (comp, count) = components(set);
-    let mut lo = vec![DVec3::splat(f64::INFINITY); count];
-    let mut hi = vec![DVec3::splat(f64::NEG_INFINITY); count];
-    for (p, patch) in set.patches.iter().enumerate() {
-        for &c in patch.control_points() {
-            lo[comp[p] as usize] = lo[comp[p] as usize].min(c);
-            hi[comp[p] as usize] = hi[comp[p] as usize].max(c);
-        }
-    }
+    let Objects { component: comp, boxes } = Objects::of(set);
+    let count = boxes.len();
+    let lo: Vec<DVec3> = boxes.iter().map(|b| b.0).collect();
+    let hi: Vec<DVec3> = boxes.iter().map(|b| b.1).collect();
     let level: Vec<u32> = (0..count)
         .map(|c| {
             options.level.unwrap_or_else(|| {

@@ -312,6 +312,7 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                         Criterion::View { criterion: ViewCriterion::Silhouetteness, .. }
                     )
                     | (Scheme::Hardware(_), Criterion::Factor(_))
+                    | (Scheme::Esc { .. }, Criterion::Esc { .. })
                     | (
                         Scheme::Sd2 { .. },
                         Criterion::Factor(_)
@@ -328,7 +329,9 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     scheme.name()
                 ));
             }
-            if !options.cull {
+            // ESC's levels are per object and it culls nothing; every other frame planned on
+            // the GPU culls.
+            if !options.cull && !matches!(scheme, Scheme::Esc { .. }) {
                 return refuse("a frame without culling (it culls every frame it plans)".into());
             }
             let checked = matches!(scheme, Scheme::Transition | Scheme::SemiUniform { .. })
@@ -371,7 +374,7 @@ mod tests {
         let engine_refused = |r: Result<Accepted>| matches!(r, Err(Error::EngineNotSupported { .. }));
         v(Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(8.0), &o, Engine::Gpu).unwrap();
         v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::Gpu).unwrap();
-        assert!(engine_refused(v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::GpuFromCamera)));
+        v(Scheme::Esc { max_level: 3 }, esc, &o, Engine::GpuFromCamera).unwrap();
         let tris = crate::scheme::tests::triangles();
         let on_tris = |s, c: Criterion, e| validate(s, &c, &o, &tris, e);
         on_tris(Scheme::Sd2 { warp: false }, Criterion::Factor(3.5), Engine::Gpu).unwrap();
