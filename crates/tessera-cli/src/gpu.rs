@@ -40,11 +40,13 @@ pub fn screen_criterion(
 /// Plans and tessellates the frame of `camera` on the GPU `repeat` times (frames, from the
 /// camera alone: nothing goes to the GPU between them), reads the last one back into `mesh`
 /// and returns the per-pass times and wall times (seconds, submit to finished) and the
-/// check's report.
+/// check's report. With `strips`, the GPU writes the strips of SD-2 and ESC too
+/// (`Mesh::strips`).
 pub fn tessellate_from_camera(
     set: &SurfaceSet,
     camera: &Camera,
     screen: ScreenCriterion,
+    strips: bool,
     repeat: u32,
     mesh: &mut Mesh,
     times: &mut Vec<f64>,
@@ -57,9 +59,13 @@ pub fn tessellate_from_camera(
     // ask, which for a large set is the device's whole buffer limit.
     let screen = ScreenCriterion { capacity: screen.capacity.or(Some(FIRST_ROOM)), ..screen };
     gpu.prepare_screen(&ctx, set, &prepared, camera, screen)?;
+    start_strips(&ctx, &mut gpu, strips)?;
     let mut run = frames(&ctx, &mut gpu, repeat, times)?;
-    if gpu.grow_if_overflowed(&ctx)? {
-        // The first room was too small: grown to what the frame needed.
+    // The first room (triangles, then strips) too small: grown to what the frame needed.
+    for _ in 0..2 {
+        if !gpu.grow_if_overflowed(&ctx)? {
+            break;
+        }
         run = frames(&ctx, &mut gpu, repeat, times)?;
     }
     *mesh = gpu.read_mesh(&ctx, set)?;
@@ -111,11 +117,13 @@ fn frames(
 }
 
 /// Tessellates `plan` on the GPU `repeat` times (frames), reads the last one back into
-/// `mesh` and returns the per-pass times and wall times (seconds, submit to finished).
+/// `mesh` and returns the per-pass times and wall times (seconds, submit to finished). With
+/// `strips`, the GPU writes the strips of SD-2 and ESC too (`Mesh::strips`).
 pub fn tessellate(
     set: &SurfaceSet,
     plan: &Plan,
     pattern: &dyn tessera::pattern::Pattern,
+    strips: bool,
     repeat: u32,
     mesh: &mut Mesh,
     times: &mut Vec<f64>,
@@ -123,7 +131,23 @@ pub fn tessellate(
     let ctx = GpuContext::new()?;
     let mut gpu = GpuTessellator::new(&ctx, set)?;
     gpu.prepare(&ctx, set, plan, pattern)?;
-    let run = frames(&ctx, &mut gpu, repeat, times)?;
+    start_strips(&ctx, &mut gpu, strips)?;
+    let mut run = frames(&ctx, &mut gpu, repeat, times)?;
+    // The strips' first room too small (the triangles' is the plan's worst case): grown.
+    if gpu.grow_if_overflowed(&ctx)? {
+        run = frames(&ctx, &mut gpu, repeat, times)?;
+    }
     *mesh = gpu.read_mesh(&ctx, set)?;
     Ok(run)
+}
+
+/// Turns `gpu`'s strip output on when `strips` asks for it, with room for twice the
+/// triangles it has room for (SD-2's strips take about one entry a triangle, ESC's more
+/// where candidates are missing; a frame that needs more grows once).
+fn start_strips(ctx: &GpuContext, gpu: &mut GpuTessellator, strips: bool) -> Result<(), GpuError> {
+    if !strips {
+        return Ok(());
+    }
+    let triangles = gpu.capacity().map_or(0, |c| c.triangles);
+    gpu.set_strips(ctx, Some(2 * triangles + 1024))
 }

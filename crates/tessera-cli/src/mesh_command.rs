@@ -189,11 +189,8 @@ fn check_flags(a: &MeshArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.max_triangles == Some(0) {
         return Err("--max-triangles 0: use 1 or more".into());
     }
-    if a.engine == EngineArg::Gpu && (a.measure_error || a.strips) {
-        return Err(
-            "--engine gpu gives no corner parameters or strips: leave out --measure-error and --strips"
-                .into(),
-        );
+    if a.engine == EngineArg::Gpu && a.measure_error {
+        return Err("--engine gpu gives no corner parameters: leave out --measure-error".into());
     }
     if let Some(out) = &a.output {
         tessera::io::check_output_path(out)?;
@@ -261,7 +258,8 @@ fn draw_on_gpu(
     let mut times = Vec::new();
     let from_camera = options.camera.zip(gpu::screen_criterion(set, scheme, &criterion, &options));
     if let Some((camera, screen)) = from_camera {
-        let run = gpu::tessellate_from_camera(set, &camera, screen, a.repeat, &mut mesh, &mut times)?;
+        let run =
+            gpu::tessellate_from_camera(set, &camera, screen, a.strips, a.repeat, &mut mesh, &mut times)?;
         let culled = run.culled;
         let gpu = Some((run, times));
         return Ok(Drawn {
@@ -282,7 +280,7 @@ fn draw_on_gpu(
     crate::announce_large_output(layout, &opts, a.output.as_deref());
     let (plan, pattern) =
         (tess.plan().expect("a frame was planned"), tess.pattern().expect("a frame was planned"));
-    let run = gpu::tessellate(set, plan, pattern, a.repeat, &mut mesh, &mut times)?;
+    let run = gpu::tessellate(set, plan, pattern, a.strips, a.repeat, &mut mesh, &mut times)?;
     let culled = plan.culled_count();
     let frames = vec![tess.timings()];
     Ok(Drawn {

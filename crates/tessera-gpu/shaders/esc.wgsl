@@ -205,6 +205,34 @@ fn esc_upper_fill(t: u32, a: u32, b: u32) {
     }
 }
 
+// Strip b of coarse triangle t, whose previous non-empty row is a, into esc_strip:
+// `CoarseTriangle::strips`'s entries (row b's stand-ins interleaved with the upper fill)
+// after the alternation rules.
+fn esc_build_strip(t: u32, a: u32, b: u32) {
+    esc_upper_fill(t, a, b);
+    esc_strip_len = 0u;
+    for (var i = 0u; i <= b; i = i + 1u) {
+        let lower = esc_stand_in(t, b, i) & 255u;
+        esc_push(lower, (lower >> 3u) <= a);
+        if (i < b) {
+            let upper = esc_fill[i];
+            esc_push(upper, (upper >> 3u) <= a);
+        }
+    }
+}
+
+// Whether esc_strip draws a triangle (a window of three different vertices): the CPU keeps
+// only such strips (`CoarseTriangle::strips`).
+fn esc_strip_draws() -> bool {
+    for (var w = 0u; w + 2u < esc_strip_len; w = w + 1u) {
+        let x = esc_strip[w];
+        let y = esc_strip[w + 1u];
+        let z = esc_strip[w + 2u];
+        if (x != y && y != z && x != z) { return true; }
+    }
+    return false;
+}
+
 // Every triangle of patch p in order, through `emit` (counted, and with `write` written from
 // output triangle `first` on); returns the kept ones. Cost: O(n²) a coarse triangle, serial.
 fn esc_walk(p: u32, write: bool, first: u32) -> u32 {
@@ -216,16 +244,7 @@ fn esc_walk(p: u32, write: bool, first: u32) -> u32 {
         var a = 0u;
         for (var b = 1u; b <= n; b = b + 1u) {
             if (!esc_row_present(t, b)) { continue; }
-            esc_upper_fill(t, a, b);
-            esc_strip_len = 0u;
-            for (var i = 0u; i <= b; i = i + 1u) {
-                let lower = esc_stand_in(t, b, i) & 255u;
-                esc_push(lower, (lower >> 3u) <= a);
-                if (i < b) {
-                    let upper = esc_fill[i];
-                    esc_push(upper, (upper >> 3u) <= a);
-                }
-            }
+            esc_build_strip(t, a, b);
             // `mesh::strips::decode`: window w, flipped at odd w, kept with three corners.
             for (var w = 0u; w + 2u < esc_strip_len; w = w + 1u) {
                 let x = esc_strip[w];

@@ -56,6 +56,8 @@ pub mod sources {
     pub(crate) const ESC: &str = include_str!("../shaders/esc.wgsl");
     /// ESC planned from the camera: levels, distance tests, insertion grids.
     pub(crate) const ESC_PLAN: &str = include_str!("../shaders/esc_plan.wgsl");
+    /// The strips of the patterns with a strip form (SD-2, ESC).
+    pub(crate) const STRIPS: &str = include_str!("../shaders/strips.wgsl");
 }
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],

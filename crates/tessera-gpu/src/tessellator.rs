@@ -63,6 +63,7 @@ mod frame;
 mod pipelines;
 mod report;
 mod screen;
+mod strips;
 mod timer;
 
 pub use capacity::Capacity;
@@ -200,6 +201,8 @@ pub struct GpuTessellator {
     /// An ESC plan's pattern triangles per patch (the read-back's count of triangles left out
     /// at collapsed curves: the ESC pattern is not the plan's alone).
     esc_triangles: Option<Vec<u32>>,
+    /// The strip output, when on ([`GpuTessellator::set_strips`]).
+    strips: Option<strips::StripBuffers>,
 }
 
 /// The loop iterations one invocation gets in all on Mesa's llvmpipe (lavapipe): its compiler
@@ -289,6 +292,7 @@ impl GpuTessellator {
             rows: 1,
             warped: false,
             esc_triangles: None,
+            strips: None,
             set: gpu_set,
             pipelines,
         })
@@ -395,6 +399,9 @@ impl GpuTessellator {
         let capacity = Capacity::of_plan(set, plan, pattern, self.camera.is_some());
         self.reserve(ctx, capacity)?;
         self.pipelines.compile(&ctx.device, kind);
+        if self.strips.is_some() {
+            self.pipelines.strips(&ctx.device, kind);
+        }
         if self.set.has_trees {
             self.pipelines.with_trees(&ctx.device, kind);
         }
@@ -660,6 +667,7 @@ impl GpuTessellator {
         let pattern: u64 =
             (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(pattern_triangles).sum();
         mesh.collapsed_triangles = (pattern - triangles as u64) as usize;
+        mesh.strips = self.read_strips(ctx)?;
         Ok(mesh)
     }
 }

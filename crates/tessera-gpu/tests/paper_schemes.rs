@@ -501,3 +501,90 @@ fn esc_planned_on_the_gpu_equals_the_cpu_plan() {
     eprintln!("{differing} patches differ in {frames} frames");
     assert!(differing <= frames, "{differing} patches differ in {frames} frames");
 }
+
+/// The GPU's strips (`strips.wgsl`) equal the CPU engine's `Mesh::strips` entry for entry,
+/// and decode to the GPU's own triangle list: SD-2 (from CPU plans, with the warp, and from
+/// the camera) and ESC (from a CPU plan and from the camera), on models with collapsed
+/// curves (the teapot's lid and bottom, the spool) whose degenerate strip triangles decode
+/// to nothing. The strips start with one entry of room, overflow, grow and are redrawn.
+#[test]
+fn strips_written_on_the_gpu_equal_the_cpu_engines() {
+    use tessera::criterion::esc::Threshold;
+    use tessera::engine::EngineOptions;
+    let ctx = ctx();
+    let check = |name: &str,
+                 set: &SurfaceSet,
+                 gpu: &mut tessera_gpu::GpuTessellator,
+                 plan: &Plan,
+                 pattern: &dyn tessera::pattern::Pattern| {
+        gpu.set_strips(ctx, Some(1)).unwrap();
+        let grown = record_until_complete(gpu, name);
+        assert!(grown >= 1, "{name}: one entry of room and no overflow");
+        let got = gpu.read_mesh(ctx, set).unwrap();
+        let options = EngineOptions { strips: true, ..EngineOptions::default() };
+        let want = tessera::engine::tessellate(set, plan, pattern, options).unwrap();
+        let (g, w) = (got.strips.as_ref().unwrap(), want.strips.as_ref().unwrap());
+        assert!(!w.is_empty(), "{name}: no strips");
+        if let Some(i) = (0..g.len().min(w.len())).find(|&i| g[i] != w[i]) {
+            panic!(
+                "{name}: strip entry {i} is {}, the CPU's {} ({} and {} entries)",
+                g[i],
+                w[i],
+                g.len(),
+                w.len()
+            );
+        }
+        assert_eq!(g.len(), w.len(), "{name}: strip entries");
+        let decoded: Vec<[u32; 3]> = tessera::mesh::strips::decode(g);
+        let list: Vec<[u32; 3]> = (0..got.triangle_count()).map(|t| got.triangle(t)).collect();
+        assert_eq!(decoded, list, "{name}: the strips decode to the triangle list");
+        gpu.set_strips(ctx, None).unwrap();
+    };
+    for model in ["meshes/spool.obj", "meshes/blob.obj"] {
+        let set = load(model);
+        let mut gpu = tessellator(&set);
+        let camera = cameras(&set, 1, 7)[0];
+        for warp in [false, true] {
+            let scheme = Scheme::Sd2 { warp };
+            let criterion =
+                Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax: 6.5 };
+            let options = PlanOptions { camera: Some(camera), ..Default::default() };
+            let planned = scheme.plan(&set, &criterion, &options).unwrap();
+            gpu.prepare(ctx, &set, &planned.plan, &planned.pattern).unwrap();
+            check(&format!("{model} sd2 warp {warp}"), &set, &mut gpu, &planned.plan, &planned.pattern);
+        }
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let criterion =
+            Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 7.0 };
+        let screen =
+            ScreenCriterion { scheme: Scheme::Sd2 { warp: false }, criterion, max_factor: 8, capacity: None };
+        gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+        record_frame(&gpu);
+        let plan = gpu.read_plan(ctx).unwrap();
+        check(
+            &format!("{model} sd2 from the camera"),
+            &set,
+            &mut gpu,
+            &plan,
+            &tessera::pattern::sd2::Sd2::default(),
+        );
+    }
+    for model in ["patches/teapot.patches", "patches/teacup.patches"] {
+        let set = load(model);
+        let mut gpu = tessellator(&set);
+        let camera = cameras(&set, 1, 9)[0];
+        let criterion = Criterion::Esc { threshold: Threshold::Medium, level: None };
+        let scheme = Scheme::Esc { max_level: 4 };
+        let options = PlanOptions { camera: Some(camera), ..Default::default() };
+        let planned = scheme.plan(&set, &criterion, &options).unwrap();
+        gpu.prepare(ctx, &set, &planned.plan, &planned.pattern).unwrap();
+        check(&format!("{model} esc"), &set, &mut gpu, &planned.plan, &planned.pattern);
+        let prepared = tessera::scheme::Prepared::new(&set, true);
+        let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity: None };
+        gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
+        record_frame(&gpu);
+        let plan = gpu.read_plan(ctx).unwrap();
+        let esc = gpu.read_esc_pattern(ctx).unwrap();
+        check(&format!("{model} esc from the camera"), &set, &mut gpu, &plan, &esc);
+    }
+}

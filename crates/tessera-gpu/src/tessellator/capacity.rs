@@ -161,7 +161,7 @@ impl GpuTessellator {
     pub fn grow_if_overflowed(&mut self, ctx: &GpuContext) -> Result<bool> {
         let (overflow, vertices, triangles) = self.read_status(ctx)?;
         if !overflow {
-            return Ok(false);
+            return self.grow_strips_if_overflowed(ctx);
         }
         // The counts are the scans' totals, exact unless they saturated at u32::MAX (then
         // the need is beyond the index range anyway, and refused below).

@@ -147,6 +147,8 @@ impl GpuTessellator {
                     c.dispatch_workgroups_indirect(&self.dispatch_args, 36);
                 }
             }
+            // The strips (SD-2, ESC), when on: timed with the triangles.
+            self.record_strips(&mut c, &out.main);
         }
         if let Some(t) = timer {
             encoder.resolve_query_set(&t.queries, 0..2 * PASSES.len() as u32, &t.resolved, 0);

@@ -31,6 +31,9 @@ const MAIN_STORAGE: u32 = 12;
 const ARGS_STORAGE: u32 = 3;
 /// Storage buffers in group 1 of the view passes (`view.wgsl`).
 const VIEW_STORAGE: u32 = 4;
+/// Storage buffers in group 1 of the strip passes (`strips.wgsl`: offsets, indices, state,
+/// and the frame's status).
+const STRIP_STORAGE: u32 = 4;
 /// Storage buffers in group 1 of the check rounds' decisions (the frame state and the rounds'
 /// dispatch arguments, at the frame state's binding and one of their own).
 const ROUND_STORAGE: u32 = 2;
@@ -38,7 +41,8 @@ const ROUND_STORAGE: u32 = 2;
 /// Storage buffers per shader stage a frame needs: group 0's and the largest group 1. Within
 /// 16, what most adapters give (not the WebGPU default of 8, which no GPU engine of this
 /// shape fits: the prepared set, the plan, the layout and the outputs are 12 on their own).
-pub const STORAGE_BUFFERS: u32 = MAIN_STORAGE + max_u32(ARGS_STORAGE, max_u32(VIEW_STORAGE, ROUND_STORAGE));
+pub const STORAGE_BUFFERS: u32 =
+    MAIN_STORAGE + max_u32(ARGS_STORAGE, max_u32(VIEW_STORAGE, max_u32(ROUND_STORAGE, STRIP_STORAGE)));
 
 const fn max_u32(a: u32, b: u32) -> u32 {
     if a > b {
@@ -459,6 +463,12 @@ pub struct Pipelines {
     /// ([`Pipelines::esc_plan`]).
     esc_plan: std::sync::OnceLock<EscPlanPipelines>,
     view_pipeline_layout: wgpu::PipelineLayout,
+    /// Group 1 of the strip passes (`strips.wgsl`).
+    pub(super) strips_layout: wgpu::BindGroupLayout,
+    strips_pipeline_layout: wgpu::PipelineLayout,
+    /// The strip passes of SD-2 and of ESC, compiled on first use ([`Pipelines::strips`]).
+    sd2_strips: std::sync::OnceLock<StripPipelines>,
+    esc_strips: std::sync::OnceLock<StripPipelines>,
     main_pipeline_layout: wgpu::PipelineLayout,
 }
 
@@ -518,6 +528,8 @@ impl Pipelines {
         let two = pipeline_layout(&[Some(&main_layout), Some(&args_layout)]);
         let with_view = pipeline_layout(&[Some(&main_layout), Some(&view_layout)]);
         let with_rounds = pipeline_layout(&[Some(&main_layout), Some(&rounds_layout)]);
+        let strips_layout = shader::layout(device, &[Write; STRIP_STORAGE as usize]);
+        let with_strips = pipeline_layout(&[Some(&main_layout), Some(&strips_layout)]);
         let make = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
             compute_pipeline(device, layout, module, entry)
         };
@@ -568,6 +580,10 @@ impl Pipelines {
             esc_plan: std::sync::OnceLock::new(),
             main_pipeline_layout: one,
             view_pipeline_layout: with_view,
+            strips_layout,
+            strips_pipeline_layout: with_strips,
+            sd2_strips: std::sync::OnceLock::new(),
+            esc_strips: std::sync::OnceLock::new(),
             main_layout,
             args_layout,
             view_layout,
@@ -638,6 +654,39 @@ impl Pipelines {
         })
     }
 
+    /// The strip passes of `pattern` (`strips.wgsl` with the pattern's walk), compiled now
+    /// the first time; None for a pattern without a strip form. Cost: the first call per
+    /// pattern one WGSL compilation.
+    pub(super) fn strips(&self, device: &wgpu::Device, pattern: GpuPattern) -> Option<&StripPipelines> {
+        let walk = super::strips::walk_of(pattern)?;
+        let cell = if pattern == GpuPattern::Sd2 { &self.sd2_strips } else { &self.esc_strips };
+        Some(cell.get_or_init(|| {
+            let parts = [COMMON, LOCAL, SD2, ESC, STRIPS];
+            let m = shader::module_with_functions(
+                device,
+                "strips",
+                &parts,
+                &constants(),
+                &[("PATCH_STRIPS", walk)],
+            );
+            let make = |entry: &str| compute_pipeline(device, &self.strips_pipeline_layout, &m, entry);
+            StripPipelines {
+                count: make("count_strips"),
+                args: make("strip_args"),
+                write: make("write_strips"),
+            }
+        }))
+    }
+
+    /// The strip passes of `pattern`, once [`Pipelines::strips`] compiled them.
+    pub(super) fn strips_compiled(&self, pattern: GpuPattern) -> Option<&StripPipelines> {
+        match pattern {
+            GpuPattern::Sd2 => self.sd2_strips.get(),
+            GpuPattern::Esc => self.esc_strips.get(),
+            _ => None,
+        }
+    }
+
     /// ESC's planning passes, once [`Pipelines::esc_plan`] compiled them.
     pub(super) fn esc_plan_compiled(&self) -> Option<&EscPlanPipelines> {
         self.esc_plan.get()
@@ -655,6 +704,14 @@ impl Pipelines {
             GpuPattern::Esc => self.esc.get(),
         }
     }
+}
+
+/// The strip passes of one pattern (`strips.wgsl`): counts, the draw's arguments, writes.
+#[derive(Debug)]
+pub(super) struct StripPipelines {
+    pub(super) count: wgpu::ComputePipeline,
+    pub(super) args: wgpu::ComputePipeline,
+    pub(super) write: wgpu::ComputePipeline,
 }
 
 /// ESC's planning passes from the camera (`esc_plan.wgsl`): each object's level, each edge's

@@ -355,6 +355,9 @@ impl GpuTessellator {
         self.pattern = pattern;
         self.warped = scheme == (Scheme::Sd2 { warp: true });
         self.pipelines.compile(&ctx.device, self.pattern);
+        if self.strips.is_some() {
+            self.pipelines.strips(&ctx.device, self.pattern);
+        }
         self.rows = screen.cap as u32;
         if self.set.has_trees {
             self.pipelines.with_trees(&ctx.device, self.pattern);
