@@ -67,15 +67,32 @@ pub struct ViewArgs {
     input_args: crate::InputArgs,
 }
 
-/// The schemes key S cycles through and `--scheme` starts in: those taking a pixel error, and
-/// the hardware tessellator at the factor derived from it ([`criterion_for`]).
-const SCHEMES: [Scheme; 5] = [
+/// The schemes key S cycles through and `--scheme` starts in: those taking a pixel error, the
+/// hardware tessellator and SD-2 at the factor derived from it, and ESC with its own criterion
+/// ([`criterion_for`]); SD-2 on triangle sets and ESC on bicubic ones only ([`shows`]).
+const SCHEMES: [Scheme; 7] = [
     Scheme::Transition,
     Scheme::Uniform,
     Scheme::SemiUniform { max_level: Scheme::DEFAULT_SEMI_UNIFORM_LEVEL },
     Scheme::Hardware(Partitioning::FractionalOdd),
     Scheme::Hardware(Partitioning::Integer),
+    Scheme::Sd2 { warp: false },
+    Scheme::Esc { max_level: Scheme::DEFAULT_ESC_LEVEL },
 ];
+
+/// ESC's criterion in the viewer: levels per object from the camera, the medium preset.
+const ESC_CRITERION: Criterion =
+    Criterion::Esc { threshold: tessera::criterion::esc::Threshold::Medium, level: None };
+
+/// Whether the viewer can show `scheme` on `set` (`validate`'s surface rules: SD-2 takes
+/// triangles, ESC bicubic patches); the reason when not.
+fn shows(scheme: Scheme, set: &SurfaceSet) -> Result<(), tessera::Error> {
+    let criterion = match scheme {
+        Scheme::Esc { .. } => ESC_CRITERION,
+        _ => Criterion::Factor(2.0),
+    };
+    validate(scheme, &criterion, &PlanOptions::default(), set, Engine::Cpu).map(|_| ())
+}
 
 /// What the keys change.
 struct Settings {
@@ -269,7 +286,8 @@ impl App {
         let scheme = SCHEMES[settings.scheme];
         let options = PlanOptions {
             camera: Some(camera),
-            cull: settings.cull,
+            // ESC culls nothing (one level per object).
+            cull: settings.cull && !matches!(scheme, Scheme::Esc { .. }),
             max_factor: self.args.max_factor,
             ..Default::default()
         };
@@ -521,8 +539,10 @@ fn criterion_for(
     options: &PlanOptions,
 ) -> Result<Criterion, tessera::Error> {
     let criterion = Criterion::PixelError(pixel_error);
-    if !matches!(scheme, Scheme::Hardware(_)) {
-        return Ok(criterion);
+    match scheme {
+        Scheme::Esc { .. } => return Ok(ESC_CRITERION),
+        Scheme::Hardware(_) | Scheme::Sd2 { .. } => {}
+        _ => return Ok(criterion),
     }
     Scheme::Uniform.plan_into(
         set,
@@ -533,12 +553,20 @@ fn criterion_for(
         &mut state.planned,
     )?;
     let factor = state.planned.plan.segments.iter().copied().max().unwrap_or(1) as f64;
-    Ok(Criterion::Factor(factor.clamp(1.0, scheme.cap(options))))
+    let factor = factor.clamp(1.0, scheme.cap(options));
+    if let Scheme::Sd2 { .. } = scheme {
+        // Paper 001's distance level function up to that factor: near edges get it.
+        let distance =
+            tessera::criterion::view::ViewCriterion::Distance(tessera::criterion::view::Mapping::Linear);
+        return Ok(Criterion::View { criterion: distance, fmin: 1.0, fmax: factor.max(1.0) });
+    }
+    Ok(Criterion::Factor(factor))
 }
 
 /// The keys, for `tessera view --help`.
 pub const KEYS: &str = "Keys: S scheme (transition, uniform, semi-uniform; fractional-odd, integer at the factor \
-the pixel error needs), + / - pixel error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
+the pixel error needs; sd2 on triangles, its distance levels up to that factor; esc on bicubic patches, its own \
+levels and medium threshold), + / - pixel error /2 or x2, W wireframe, L level colours, P patch colours (CPU engine), C culling, E engine (GPU or CPU), \
 arrows or mouse drag orbit, wheel zoom, Q or Esc quit. The window needs an X11 display (no Wayland backend; \
 XWayland works); headless: xvfb-run -a tessera view IN --frames N --screenshot OUT.png";
 
@@ -613,7 +641,12 @@ impl ApplicationHandler for App {
                     Key::Named(NamedKey::ArrowDown) => self.orbit.pitch = (self.orbit.pitch - 0.1).max(-1.5),
                     Key::Character(c) => match c.to_lowercase().as_str() {
                         "q" => event_loop.exit(),
-                        "s" => s.scheme = (s.scheme + 1) % SCHEMES.len(),
+                        "s" => {
+                            // The next scheme this set can be shown in (the first always can).
+                            let next = (1..=SCHEMES.len()).map(|k| (s.scheme + k) % SCHEMES.len());
+                            s.scheme =
+                                next.into_iter().find(|&i| shows(SCHEMES[i], self.set).is_ok()).unwrap_or(0);
+                        }
                         "+" | "=" => s.pixel_error = (s.pixel_error / 2.0).max(1.0 / 64.0),
                         "-" => s.pixel_error = (s.pixel_error * 2.0).min(256.0),
                         "w" => s.wireframe = !s.wireframe,
@@ -699,6 +732,7 @@ pub fn run(a: ViewArgs) -> crate::CliResult {
         let names: Vec<&str> = SCHEMES.iter().map(|s| s.name()).collect();
         format!("--scheme {}: the viewer shows {}", scheme.name(), names.join(", "))
     })?;
+    shows(SCHEMES[first], set).map_err(|e| format!("--scheme {}: {e}", scheme.name()))?;
     // The adapter's limits before any window exists: a refused size never reaches winit or
     // wgpu (the surface's adapter is asked for again once there is a window to present to).
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());

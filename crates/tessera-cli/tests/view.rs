@@ -113,18 +113,25 @@ fn viewer_refuses_sizes_it_cannot_draw_before_opening_a_window() {
 #[test]
 fn viewer_starts_in_every_scheme_its_help_and_errors_list() {
     let dir = scratch("viewer-schemes");
-    let schemes = ["transition", "uniform", "semi-uniform", "fractional-odd", "integer"];
+    let schemes = ["transition", "uniform", "semi-uniform", "fractional-odd", "integer", "sd2", "esc"];
     let help = common::tessera(&["view", "--help"], &dir);
     let help = text(&help.stdout);
     // A scheme the viewer does not show: its error names exactly the ones it does.
-    let out = view("meshes/blob.obj", &["--scheme", "sd2", "--frames", "1"], &[], &dir);
+    let out = view("meshes/blob.obj", &["--scheme", "pow2", "--frames", "1"], &[], &dir);
     let refusal = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{refusal}");
     assert!(refusal.contains(&format!("the viewer shows {}", schemes.join(", "))), "{refusal}");
+    // One it shows, on a set it cannot draw: the library's reason.
+    let out = view("patches/teapot.patches", &["--scheme", "sd2", "--frames", "1"], &[], &dir);
+    let refusal = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{refusal}");
+    assert!(refusal.contains("does not tessellate quad patches"), "{refusal}");
     for scheme in schemes {
         assert!(help.contains(scheme), "--help does not name {scheme}: {help}");
+        // ESC takes bicubic patches, the others the triangle mesh.
+        let model = if scheme == "esc" { "patches/teapot.patches" } else { "meshes/blob.obj" };
         let out = view(
-            "meshes/blob.obj",
+            model,
             &["--scheme", scheme, "--frames", "2", "--screenshot", "s.png", "--size", "160x120"],
             &[],
             &dir,
@@ -132,6 +139,8 @@ fn viewer_starts_in_every_scheme_its_help_and_errors_list() {
         let stderr = text(&out.stderr);
         assert!(out.status.success(), "--scheme {scheme}: {stderr}");
         assert!(stderr.contains(&format!("after 2 frames: {scheme} ")), "{scheme}: {stderr}");
+        // The GPU engine draws every scheme of the viewer (semi-uniform by the instanced path).
+        assert!(stderr.contains("GPU ENGINE") || stderr.contains("INSTANCED"), "{scheme}: {stderr}");
         if scheme == "fractional-odd" || scheme == "integer" {
             // The hardware tessellator takes a factor: the one derived from the pixel error.
             assert!(stderr.contains("(FACTOR "), "{scheme}: {stderr}");
