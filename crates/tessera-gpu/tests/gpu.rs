@@ -552,9 +552,9 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             counts.strips += s.iter().any(|&x| x != s[0]) as usize;
             counts.frames += 2;
 
-            // Semi-uniform on every fourth camera: the pixel error's levels checked a
-            // posteriori on the GPU, under the largest power-of-two cap within the cap.
-            if c % 4 == 0 {
+            // Semi-uniform: the pixel error's levels checked a posteriori on the GPU, under the
+            // largest power-of-two cap within the cap.
+            {
                 let name = format!("{model} camera {c} semi-uniform {pixels} px");
                 let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
                 let cap = 1 << cap.max(2).ilog2();
@@ -573,23 +573,29 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
                 counts.frames += 1;
             }
-            // SD-2 on triangle models, every fourth camera (the others), from the camera
-            // alone: the distance level function, every other time reverse-projected.
+            // SD-2 on triangle models, from the camera alone: paper 001's three level functions
+            // in turn (the distance's linear and quadratic mappings, the vertex silhouettes),
+            // every other time reverse-projected.
             let triangles = set.patches.iter().all(|p| p.domain() == tessera::surface::Domain::Tri);
-            if c % 4 == 2 && triangles {
+            if triangles {
                 let name = format!("{model} camera {c} sd2");
                 let fmax = options.max_factor as f64 + 0.5;
-                let criterion =
-                    Criterion::View { criterion: ViewCriterion::Distance(Mapping::Linear), fmin: 1.0, fmax };
-                let frame = Sd2Frame { warp: c % 8 == 6, criterion, max_factor: options.max_factor + 1 };
+                let level = [
+                    ViewCriterion::Distance(Mapping::Linear),
+                    ViewCriterion::Distance(Mapping::Quadratic),
+                    ViewCriterion::SilhouetteVertices,
+                ][c % 3];
+                let criterion = Criterion::View { criterion: level, fmin: 1.0, fmax };
+                let frame = Sd2Frame { warp: c % 2 == 1, criterion, max_factor: options.max_factor + 1 };
                 sd2_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, frame, &mut counts);
             }
-            // ESC on bicubic models, every fourth camera (c % 4 == 1), planned on the GPU from
-            // the camera alone (levels per object, distance tests, grids).
+            // ESC on bicubic models, planned on the GPU from the camera alone (levels per
+            // object, distance tests, grids), the two presets in turn.
             let bicubic = set.patches.iter().all(|p| matches!(p, tessera::surface::Patch::Bicubic(_)));
-            if c % 4 == 1 && bicubic {
+            if bicubic {
                 let name = format!("{model} camera {c} esc");
-                let threshold = tessera::criterion::esc::Threshold::Medium;
+                use tessera::criterion::esc::Threshold;
+                let threshold = if c % 2 == 0 { Threshold::Medium } else { Threshold::High };
                 let criterion = Criterion::Esc { threshold, level: None };
                 let ties = &mut counts.esc_ties;
                 esc_frame_from_the_camera(&name, &set, &prepared, &mut gpu, &camera, criterion, ties);

@@ -200,7 +200,7 @@ fn hardware_plans_equal_the_cpu_engine_at_large_factors() {
         let large = set.patches.len() > 500;
         for p in PARTITIONINGS {
             let top = p.range().1 as f64;
-            let factors: &[f64] = if large { &[9.5, 16.2] } else { &[23.7, 47.1, top] };
+            let factors: &[f64] = if large { &[9.5, 16.2] } else { &[23.7, top] };
             for &factor in factors {
                 let plan = factor_plan(&set, p, factor);
                 assert_hardware_frame(
