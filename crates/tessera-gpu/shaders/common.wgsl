@@ -22,6 +22,15 @@ struct Params {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
+
+// `wgpu::util::DrawIndexedIndirectArgs`: the draws the args and strip passes write.
+struct DrawIndexedIndirect {
+    index_count: u32,
+    instance_count: u32,
+    first_index: u32,
+    base_vertex: i32,
+    first_instance: u32,
+}
 // The prepared set (src/upload.rs).
 @group(0) @binding(1) var<storage, read_write> control_points: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> patch_rows: array<u32>;

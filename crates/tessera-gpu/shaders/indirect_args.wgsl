@@ -4,14 +4,6 @@
 // `status.overflow` (never a truncated mesh); the host sizes buffers from a worst-case bound
 // beforehand, so this is a guard, not a path.
 
-struct DrawIndexedIndirect {
-    index_count: u32,
-    instance_count: u32,
-    first_index: u32,
-    base_vertex: i32,
-    first_instance: u32,
-}
-
 struct Status {
     overflow: u32,
     vertices: u32,

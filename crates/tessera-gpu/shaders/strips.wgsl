@@ -18,11 +18,7 @@ const RESTART: u32 = 0xffffffffu;
 // The strip draw's `DrawIndexedIndirect` (5 u32), then whether the strips overflowed, their
 // entries (the scan's total) and the room in `strip_indices` (written by the host).
 struct StripState {
-    index_count: u32,
-    instance_count: u32,
-    first_index: u32,
-    base_vertex: i32,
-    first_instance: u32,
+    draw: DrawIndexedIndirect,
     overflow: u32,
     entries: u32,
     capacity: u32,
@@ -103,11 +99,7 @@ fn strip_args() {
     strip_state.overflow = u32(overflow);
     strip_state.entries = total;
     let drawn = !overflow && frame_status[0] == 0u && total > 1u;
-    strip_state.index_count = select(0u, total - 1u, drawn);
-    strip_state.instance_count = 1u;
-    strip_state.first_index = 1u;
-    strip_state.base_vertex = 0;
-    strip_state.first_instance = 0u;
+    strip_state.draw = DrawIndexedIndirect(select(0u, total - 1u, drawn), 1u, 1u, 0, 0u);
 }
 
 // Write pass: one invocation a patch writes its RESTART and strips at its offset.

@@ -258,8 +258,20 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
         .collect();
     // ESC also drawn on the GPU from the CPU's plan and insertion grids: the same triangles,
     // the GPU frame alone timed.
-    let esc_scenes: Vec<&Scene> = scenes.iter().filter(|s| matches!(s.scheme, Scheme::Esc { .. })).collect();
-    ctx.plan_steps((screens.len() + esc_scenes.len()) as u64);
+    let mut frames: Vec<(&Scene, String, GpuFrame)> = screens
+        .into_iter()
+        .map(|(scene, scheme, criterion, screen)| {
+            let label = format!("{}, planned on the GPU", scene.describe_as(scheme, &criterion));
+            (scene, label, GpuFrame::FromCamera(screen))
+        })
+        .collect();
+    for scene in scenes.iter().filter(|s| matches!(s.scheme, Scheme::Esc { .. })) {
+        let options = PlanOptions { camera: Some(scene.cameras[0]), ..scene.options().plan };
+        let planned = scene.scheme.plan(&scene.set, &scene.criterion, &options)?;
+        let label = format!("{}, planned on the CPU (not timed)", scene.describe());
+        frames.push((scene, label, GpuFrame::FromPlan(Box::new(planned))));
+    }
+    ctx.plan_steps(frames.len() as u64);
     let passes = tessera_gpu::tessellator::PASSES;
     let mut columns: Vec<String> =
         ["scene", "patches", "scheme", "triangles", "fix rounds", "capped patches"]
@@ -271,66 +283,36 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
     let title = format!("frame: the walk's first frame planned and tessellated on the GPU ({adapter})");
     let mut table = Table::new("frame_gpu", &title, &names);
     let mut refused = Vec::new();
-    for (scene, scheme, criterion, screen) in screens {
-        ctx.step(&format!("frame: {} first frame on the GPU, {}", scene.name, scheme.name()));
+    for (scene, label, frame) in frames {
+        ctx.step(&format!("frame: {} first frame on the GPU, {label}", scene.name));
         let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
-        let run = crate::gpu::tessellate_from_camera(
-            &scene.set,
-            &scene.cameras[0],
-            screen,
-            false,
-            repeats as u32,
-            &mut mesh,
-            &mut times,
-        );
+        let (set, camera, repeat) = (&scene.set, &scene.cameras[0], repeats as u32);
+        let run = match &frame {
+            GpuFrame::FromCamera(screen) => {
+                crate::gpu::tessellate_from_camera(set, camera, *screen, false, repeat, &mut mesh, &mut times)
+            }
+            GpuFrame::FromPlan(p) => {
+                crate::gpu::tessellate(set, &p.plan, &p.pattern, false, repeat, &mut mesh, &mut times)
+            }
+        };
         // A frame this adapter cannot hold is said in the table's note, not fatal to the suite.
         let run = match run {
             Ok(run) => run,
             Err(e) => {
-                refused.push(format!("{} ({}): {e}", scene.name, scene.describe_as(scheme, &criterion)));
+                refused.push(format!("{} ({label}): {e}", scene.name));
                 continue;
             }
         };
-        let check = run.screen.expect("planned from the camera");
-        let mut row: Vec<super::table::Cell> = vec![
-            scene.name.into(),
-            scene.set.patches.len().into(),
-            format!("{}, planned on the GPU", scene.describe_as(scheme, &criterion)).into(),
-            mesh.triangle_count().into(),
-            (check.rounds as usize).into(),
-            (check.failing_patches as usize).into(),
-        ];
-        row.extend(timing_cells(&run, &times));
-        table.row(row);
-    }
-    for scene in esc_scenes {
-        ctx.step(&format!("frame: {} first frame on the GPU, {}", scene.name, scene.scheme.name()));
-        let options = PlanOptions { camera: Some(scene.cameras[0]), ..scene.options().plan };
-        let planned = scene.scheme.plan(&scene.set, &scene.criterion, &options)?;
-        let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
-        let run = crate::gpu::tessellate(
-            &scene.set,
-            &planned.plan,
-            &planned.pattern,
-            false,
-            repeats as u32,
-            &mut mesh,
-            &mut times,
-        );
-        let run = match run {
-            Ok(run) => run,
-            Err(e) => {
-                refused.push(format!("{} ({}): {e}", scene.name, scene.describe()));
-                continue;
-            }
+        let check = |f: fn(&tessera_gpu::tessellator::ScreenReport) -> u32| {
+            run.screen.as_ref().map_or("-".into(), |c| (f(c) as usize).into())
         };
         let mut row: Vec<super::table::Cell> = vec![
             scene.name.into(),
             scene.set.patches.len().into(),
-            format!("{}, planned on the CPU (not timed)", scene.describe()).into(),
+            label.into(),
             mesh.triangle_count().into(),
-            "-".into(),
-            "-".into(),
+            check(|c| c.rounds),
+            check(|c| c.failing_patches),
         ];
         row.extend(timing_cells(&run, &times));
         table.row(row);
@@ -360,4 +342,11 @@ fn timing_cells(run: &crate::gpu::GpuRun, times: &[f64]) -> Vec<super::table::Ce
     }
     cells.push(num(median_p95(times).0 * 1e3, 2));
     cells
+}
+
+/// How a GPU row's frame is planned: on the GPU from the camera, or on the CPU (the plan and
+/// its pattern uploaded).
+enum GpuFrame {
+    FromCamera(tessera_gpu::tessellator::ScreenCriterion),
+    FromPlan(Box<tessera::scheme::SchemePlan>),
 }
