@@ -1022,6 +1022,12 @@ fn subdivision_cages_equal_the_cpu_engine(cages: &[String], factors: &[u32], cam
                 &mut counts,
             );
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &Transition);
+            // And semi-uniform (paper 000): each patch's level checked a posteriori.
+            let name = format!("{cage} camera {c} semi-uniform 1 px");
+            let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
+            let plan = checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, 1.0, 16, &mut counts);
+            let pattern = tessera::pattern::semi_uniform::SemiUniform;
+            assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
         }
     }
     assert!(trees > 0, "no isolated face among {cages:?}");
