@@ -9,9 +9,11 @@
 //!    factors and interior factors from the camera alone, from view-independent rows
 //!    uploaded once; for the transition and semi-uniform schemes' pixel error also the a-posteriori check
 //!    (`check.wgsl`, `bounds.wgsl`): every patch bounds its pattern's triangles, and rounds
-//!    that size themselves on the GPU raise interiors and edges until the bounds hold;
+//!    that size themselves on the GPU raise interiors and edges until the bounds hold; for
+//!    ESC its own planning passes (`esc_plan.wgsl`: levels per object, distance tests,
+//!    insertion grids);
 //! 1. **count** (`count_uniform.wgsl`, `transition.wgsl`, `semi_uniform.wgsl`, `sd2.wgsl`,
-//!    `hardware.wgsl`): per edge and per
+//!    `esc.wgsl`, `hardware.wgsl`): per edge and per
 //!    patch, the counts `tessera::engine::Layout::build` scans, in place in the offset
 //!    buffers;
 //! 2. **scan** (`scan.wgsl`): exclusive scans turning them into the layout's offsets — the
@@ -28,7 +30,10 @@
 //!    [`ROW_BLOCKS`] invocations per patch, each a block of its dyadic grid's rows; the
 //!    Direct3D 11 partitionings (`hardware.wgsl`) one
 //!    invocation per patch walking its rings and stitches in the CPU's order (parallel over
-//!    patches only: the next step is a per-triangle form).
+//!    patches only: the next step is a per-triangle form); ESC (`esc.wgsl`) one invocation
+//!    per patch walking its coarse triangles' strips; then, when strips are on
+//!    ([`GpuTessellator::set_strips`]), SD-2's and ESC's strips (`strips.wgsl`: count, scan,
+//!    arguments, write).
 //!
 //! **No read-back in the frame path, by construction**: [`GpuTessellator::record`] only
 //! records compute passes; the buffers it writes are read by the GPU (indirect dispatch and
@@ -155,13 +160,16 @@ struct Output {
 /// frame into device buffers that a render pipeline binds directly (see the module doc for
 /// the passes).
 ///
-/// Supported now, on every patch kind (bicubic, Bézier triangles, PN triangles):
-/// [`SamplingKind::Uniform`] plans for the uniform pattern (every edge of a visible patch cut
-/// into its interior factor, as `Scheme::Uniform` plans are) and the transition pattern (any
-/// per-edge segments and core factors, as `Scheme::Transition` plans); and
+/// Supported on every patch kind (bicubic, Bézier triangles, PN triangles, subdivision
+/// patches): [`SamplingKind::Uniform`] plans for the uniform pattern (every edge of a visible
+/// patch cut into its interior factor, as `Scheme::Uniform` plans are), the transition pattern
+/// (any per-edge segments and core factors, as `Scheme::Transition` plans) and the
+/// semi-uniform pattern (powers of two, as `Scheme::SemiUniform` plans); and
 /// `SamplingKind::Fractional(Spacing::Hardware(p))` plans for the Direct3D 11 pattern of
-/// partitioning `p` (real per-edge factors, as `Scheme::Hardware(p)` plans). Anything else is
-/// refused with [`GpuError::Unsupported`].
+/// partitioning `p` (real per-edge factors, as `Scheme::Hardware(p)` plans). On triangles,
+/// SD-2 plans (`SamplingKind::Fractional(Spacing::Symmetric)`, or `Warped`); on bicubic
+/// patches, ESC plans (`SamplingKind::Lattice`, with the pattern's insertion grids). Anything
+/// else is refused with [`GpuError::Unsupported`].
 #[derive(Debug)]
 pub struct GpuTessellator {
     set: GpuSet,
@@ -298,8 +306,8 @@ impl GpuTessellator {
         })
     }
 
-    /// Uploads `plan` (made for `pattern`: the uniform, the transition, the semi-uniform or a
-    /// hardware pattern)
+    /// Uploads `plan` (made for `pattern`: the uniform, the transition, the semi-uniform, a
+    /// hardware, the SD-2 or the ESC pattern)
     /// for the next [`GpuTessellator::record`] (ending [`GpuTessellator::prepare_screen`]'s
     /// own planning), growing the output buffers to its worst case ([`Capacity::of_plan`])
     /// when they are too small.
@@ -329,7 +337,7 @@ impl GpuTessellator {
         let Some(kind) = GpuPattern::of(pattern) else {
             return Err(GpuError::Unsupported {
                 what: format!(
-                    "the {} pattern (uniform, transition, semi-uniform and the Direct3D 11 partitionings integer, \
+                    "the {} pattern (uniform, transition, semi-uniform, SD-2, ESC and the Direct3D 11 partitionings integer, \
                      pow2, fractional_odd and fractional_even are on the GPU)",
                     pattern.name()
                 ),
