@@ -335,6 +335,9 @@ impl App {
             settings.pixel_error,
             match criterion {
                 Criterion::Factor(f) => format!(" (FACTOR {f})"),
+                Criterion::View { fmax, .. } => format!(" (FACTORS UP TO {fmax})"),
+                // ESC's own criterion: the pixel error does not drive it.
+                Criterion::Esc { .. } => " (ESC LEVELS, MEDIUM THRESHOLD)".into(),
                 _ => String::new(),
             },
             triangles,
