@@ -155,19 +155,20 @@ fn esc_edges(
     let side = esc_s;
     let le = use_local(owner);
     let rho = esc_rho(p);
+    // Forced on the curve when forced in any patch on it (one object: one level), each
+    // patch's forced coarse triangles found once.
     var mask = 0u;
+    for (var u = owner; u < edge_end_use(e); u = u + 1u) {
+        let forced = esc_forced_triangles(use_patch(u));
+        if (forced == 0u) { continue; }
+        for (var k = 0u; k <= side; k = k + 1u) {
+            let kq = select(k, side - k, use_reversed(u));
+            if (esc_forced_at(forced, esc_edge_lattice(use_local(u), kq))) { mask = mask | (1u << k); }
+        }
+    }
     for (var k = 0u; k <= side; k = k + 1u) {
         let kl = select(k, side - k, use_reversed(owner));
-        var present = kl % n == 0u;
-        // Forced on the curve when forced in any patch on it (one object: one level).
-        for (var u = owner; u < edge_end_use(e) && !present; u = u + 1u) {
-            let q = use_patch(u);
-            let forced = esc_forced_triangles(q);
-            if (forced != 0u) {
-                let kq = select(k, side - k, use_reversed(u));
-                present = esc_forced_at(forced, esc_edge_lattice(use_local(u), kq));
-            }
-        }
+        var present = kl % n == 0u || ((mask >> k) & 1u) != 0u;
         if (!present) {
             let c = kl / n;
             let s = f32(kl % n) / f32(n);

@@ -660,13 +660,15 @@ impl GpuTessellator {
         // The pattern's triangles left out at collapsed curves, as `Layout` reports them.
         let plan = self.read_plan(ctx)?;
         // ESC planned on the GPU: its pattern is the grids it made.
-        let esc_triangles = match (&self.esc_triangles, self.pattern) {
-            (Some(t), _) => t.clone(),
+        let read_back: Vec<u32>;
+        let esc_triangles: &[u32] = match (&self.esc_triangles, self.pattern) {
+            (Some(t), _) => t,
             (None, GpuPattern::Esc) => {
                 let esc = self.read_esc_pattern(ctx)?;
-                (0..set.patches.len()).map(|p| esc.triangles(p)).collect()
+                read_back = (0..set.patches.len()).map(|p| esc.triangles(p)).collect();
+                &read_back
             }
-            (None, _) => Vec::new(),
+            (None, _) => &[],
         };
         let pattern_triangles = |p: usize| match self.pattern.cpu_pattern() {
             Some(kind) => kind.counts(&tessera::engine::layout::pattern_input(set, &plan, p)).1 as u64,

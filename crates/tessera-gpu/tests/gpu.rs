@@ -889,9 +889,7 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
-            for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
-                assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
-            }
+            check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
             if drawn.segments != cpu.segments {
                 let real = tessera::criterion::view::edge_factors(
                     &set,

@@ -233,9 +233,7 @@ fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
             let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
-            for p in (0..cpu.visible.len()).filter(|&p| drawn.visible[p] != cpu.visible[p]) {
-                assert!(near_cull_tie(&set, p, &camera), "{name}: patch {p} culled unlike the CPU");
-            }
+            check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
             let real = tessera::criterion::view::edge_factors(
                 &set,
                 &camera,
