@@ -32,6 +32,7 @@ pub(crate) mod fast_evaluator;
 pub mod layout;
 pub(crate) mod point_blocks;
 pub mod render_queues;
+pub(crate) mod tree_points;
 pub(crate) mod uniform_quads;
 pub(crate) mod uniform_triangles;
 

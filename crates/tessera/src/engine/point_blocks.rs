@@ -219,12 +219,12 @@ pub(crate) fn has_avx2_fma() -> bool {
 }
 
 /// `L` points of one patch in structure-of-arrays form.
-struct Block<const L: usize> {
-    pos: [[f32; L]; 3],
-    nrm: [[f32; L]; 3],
+pub(crate) struct Block<const L: usize> {
+    pub(crate) pos: [[f32; L]; 3],
+    pub(crate) nrm: [[f32; L]; 3],
     /// Positive where the f32 normal is reliable; elsewhere (zero, negative or NaN) the point
     /// must be evaluated in f64.
-    margin: [f32; L],
+    pub(crate) margin: [f32; L],
 }
 
 /// `a · b + c`, fused in the kernels compiled for FMA (elsewhere `mul_add` would be a slow
@@ -343,7 +343,7 @@ fn tensor_sums<const FMA: bool, const L: usize, const C: usize>(
 
 /// A polynomial bicubic at each lane's `(u, v)`.
 #[inline(always)]
-fn bicubic_block<const FMA: bool, const L: usize>(
+pub(crate) fn bicubic_block<const FMA: bool, const L: usize>(
     patch: &LocalPatch,
     u: &[f32; L],
     v: &[f32; L],
@@ -577,6 +577,11 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
+        if let (Local::Generic, Patch::Subdivision(tree)) = (&self.locals[p], &set.patches[p]) {
+            if super::tree_points::worth_grouping(tree, uvs.len()) {
+                return super::tree_points::eval::<FMA>(set, p, tree, uvs, out);
+            }
+        }
         if matches!(self.locals[p], Local::Generic) {
             // In f64 as the generic evaluation, compiled here for the wider instructions
             // (Rust never fuses a multiply and an add by itself, so the values are the same).
@@ -649,7 +654,7 @@ fn push<T>(v: &mut Vec<T>, x: T) -> u32 {
 /// The generic f64 evaluation, for the rare points f32 cannot resolve.
 #[cold]
 #[inline(never)]
-fn exact(set: &SurfaceSet, p: usize, uv: DVec2) -> SurfacePoint {
+pub(crate) fn exact(set: &SurfaceSet, p: usize, uv: DVec2) -> SurfacePoint {
     set.patches[p].eval(uv)
 }
 
@@ -997,6 +1002,86 @@ mod tests {
         let w = crate::verify::watertight(&mesh);
         let r = crate::verify::watertight(&reference);
         assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");
+    }
+
+    /// Subdivision cages: the grouped leaf kernels (`tree_points`, for dense points) and the
+    /// f64 path they fall back to, with both instruction sets, against the generic engine on
+    /// every cage of `subdivision/` — uniform at a factor where the isolated faces' points
+    /// are dense next to their leaves, and transition at a pixel error, whose factors mix
+    /// both paths. On the denser factor, the kernels must have made some normals.
+    #[test]
+    fn subdivision_cages_match_the_generic_engine() {
+        use crate::engine::{EngineOptions, Layout};
+        use crate::scheme::{Criterion, PlanOptions, Scheme};
+        let folder = crate::test_support::data("subdivision");
+        let mut cages: Vec<_> = std::fs::read_dir(&folder)
+            .unwrap_or_else(|e| panic!("{}: {e} (set TESSERA_DATA)", folder.display()))
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+            .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("catmark")))
+            .collect();
+        cages.sort();
+        assert!(cages.len() >= 30, "{cages:?}");
+        let (mut compared, mut grouped) = (0, 0);
+        for path in &cages {
+            let mesh = crate::io::obj::read_obj(path).unwrap();
+            // A few cages are refused (non-manifold ones; `tests/catmull_clark.rs` checks why).
+            let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, path, Default::default()) else {
+                continue;
+            };
+            let trees = set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_)));
+            let (lo, hi) = set.bounds();
+            let mut camera = crate::camera::Camera::framing(lo, hi, 1280, 720);
+            camera.eye = camera.target + (camera.eye - camera.target) * 0.6;
+            for (scheme, criterion) in
+                [(Scheme::Uniform, Criterion::Factor(24.0)), (Scheme::Transition, Criterion::PixelError(1.0))]
+            {
+                let options = PlanOptions { camera: Some(camera), max_factor: 32, ..PlanOptions::default() };
+                let planned = scheme.plan(&set, &criterion, &options).unwrap();
+                let (plan, pattern) = (&planned.plan, &planned.pattern);
+                let mut layout = Layout::default();
+                layout.build(&set, plan, pattern, &EngineOptions::default()).unwrap();
+                for avx2_fma in [false, true] {
+                    let mut evaluator =
+                        super::super::fast_evaluator::FastEvaluator::with_kernels(&set, plan, avx2_fma);
+                    evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                    let what = format!("{} {scheme:?} {criterion:?} avx2_fma={avx2_fma}", path.display());
+                    let size = lo.distance(hi);
+                    assert_fast_equals_generic(&what, &set, plan, pattern, &layout, &evaluator, size, false);
+                    if trees && matches!(scheme, Scheme::Uniform) {
+                        // Isolated faces' normals from the kernels: some differ in their rounding.
+                        let mut fast = crate::mesh::Mesh::default();
+                        let opts = EngineOptions::default();
+                        crate::engine::write_with(
+                            &set,
+                            plan,
+                            pattern,
+                            &layout,
+                            opts,
+                            &mut fast,
+                            Some(&evaluator),
+                        )
+                        .unwrap();
+                        let mut generic = crate::mesh::Mesh::default();
+                        crate::engine::write_with(&set, plan, pattern, &layout, opts, &mut generic, None)
+                            .unwrap();
+                        let from_trees = |k: usize| {
+                            matches!(set.patches[fast.vertex_patch[k] as usize], Patch::Subdivision(_))
+                        };
+                        grouped += usize::from(
+                            (0..fast.normals.len())
+                                .any(|k| from_trees(k) && fast.normals[k] != generic.normals[k]),
+                        );
+                    }
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared >= 30 * 2, "only {compared} cage runs compared");
+        assert!(
+            grouped >= 20,
+            "the leaf kernels changed isolated faces' normals on only {grouped} cage runs"
+        );
     }
 
     #[test]

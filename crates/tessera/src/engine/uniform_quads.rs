@@ -43,6 +43,7 @@ use super::point_blocks::{
 };
 use crate::sampling::uniform_param;
 use crate::surface::{RationalBicubic, SurfacePoint};
+use glam::DVec3;
 
 /// Cubic Bernstein polynomials and their derivatives at `t`, in f64 (rounded once to f32 by
 /// the caller).
@@ -111,7 +112,14 @@ pub(crate) const MIN_WEIGHT_RATIO: f64 = 1.0 / 256.0;
 impl LocalPatch {
     /// The polynomial bicubic `patch` (weights ignored) in its local frame.
     pub(crate) fn new(patch: &RationalBicubic) -> LocalPatch {
-        LocalPatch::with_weights(patch, |_| 1.0)
+        LocalPatch::with_weights(&patch.points, |_| 1.0)
+    }
+
+    /// The polynomial Bézier net `points` (`points[4*i + j]`, `i` along `u`, as a
+    /// [`RationalBicubic`]'s) in its local frame.
+    #[inline(always)]
+    pub(crate) fn from_net(points: &[DVec3; 16]) -> LocalPatch {
+        LocalPatch::with_weights(points, |_| 1.0)
     }
 }
 
@@ -123,20 +131,22 @@ impl LocalPatch<4> {
     pub(crate) fn rational(patch: &RationalBicubic) -> Option<LocalPatch<4>> {
         let (lo, hi) =
             patch.weights.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &w| (lo.min(w), hi.max(w)));
-        (lo >= hi * MIN_WEIGHT_RATIO).then(|| LocalPatch::with_weights(patch, |k| patch.weights[k] / hi))
+        (lo >= hi * MIN_WEIGHT_RATIO)
+            .then(|| LocalPatch::with_weights(&patch.points, |k| patch.weights[k] / hi))
     }
 }
 
 impl<const C: usize> LocalPatch<C> {
     /// `patch` in its local frame; where `C = 4`, homogeneous with the weights `weight(k)` of
     /// its control points `k`.
-    fn with_weights(patch: &RationalBicubic, weight: impl Fn(usize) -> f64) -> LocalPatch<C> {
-        let (origin, scale) = local_frame(&patch.points);
+    #[inline(always)]
+    fn with_weights(points: &[DVec3; 16], weight: impl Fn(usize) -> f64) -> LocalPatch<C> {
+        let (origin, scale) = local_frame(points);
         // Exact: a power of two.
         let inv = 1.0 / scale;
         let mut local =
             LocalPatch { origin: origin.as_vec3().to_array(), scale: scale as f32, by_v: [[[0.0; 4]; 4]; C] };
-        for (k, &q) in patch.points.iter().enumerate() {
+        for (k, &q) in points.iter().enumerate() {
             let (i, j) = (k / 4, k % 4);
             let w = if C == 4 { weight(k) } else { 1.0 };
             let q = ((q - origin) * (inv * w)).as_vec3().to_array();

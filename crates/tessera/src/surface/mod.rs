@@ -157,7 +157,11 @@ impl Patch {
 
 /// A subdivision patch's point at `uv` from its position and derivatives there.
 #[inline(always)]
-fn subdivision_point(t: &PatchTree, uv: DVec2, (position, du, dv): (DVec3, DVec3, DVec3)) -> SurfacePoint {
+pub(crate) fn subdivision_point(
+    t: &PatchTree,
+    uv: DVec2,
+    (position, du, dv): (DVec3, DVec3, DVec3),
+) -> SurfacePoint {
     let inside = DVec2::new(0.5 - uv.x, 0.5 - uv.y);
     let normal = robust_normal(
         du,

@@ -299,7 +299,7 @@ impl PatchTree {
     /// square is the cell the walk ends in (dyadic, so exact), so its data is not touched
     /// here and a caller can start loading it before it is needed
     /// ([`PatchTree::derivatives_each`]).
-    fn find(&self, uv: DVec2) -> (usize, DVec2, f64) {
+    pub(crate) fn find(&self, uv: DVec2) -> (usize, DVec2, f64) {
         let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
         let uv = rotate(uv, self.rotation);
         let uv = self.view_origin + uv * self.view_size;
@@ -400,6 +400,43 @@ impl PatchTree {
                 });
             }
         }
+    }
+
+    /// [`PatchTree::derivatives`] of the point [`PatchTree::find`] placed at `st` in leaf
+    /// `leaf` (of side `size`), for callers compiled for AVX as
+    /// [`PatchTree::derivatives_each_avx`] is: the same values.
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) unsafe fn found_derivatives_avx(
+        &self,
+        leaf: usize,
+        st: DVec2,
+        size: f64,
+    ) -> (DVec3, DVec3, DVec3) {
+        // SAFETY: the caller's precondition.
+        unsafe { self.leaf_derivatives_with::<true>(&self.data.leaves[leaf], st, size) }
+    }
+
+    /// [`PatchTree::found_derivatives_avx`] for any CPU: the same values.
+    #[inline(always)]
+    pub(crate) fn found_derivatives(&self, leaf: usize, st: DVec2, size: f64) -> (DVec3, DVec3, DVec3) {
+        self.leaf_derivatives(&self.data.leaves[leaf], st, size)
+    }
+
+    /// Starts loading what evaluating leaf `leaf` at `st` reads (a hint, as in
+    /// [`PatchTree::derivatives_each`]).
+    #[inline(always)]
+    pub(crate) fn prefetch_leaf(&self, leaf: usize, st: DVec2) {
+        prefetch(&self.data.leaves[leaf], st);
+    }
+
+    /// Starts loading the quadtree's nodes (a hint, as in [`PatchTree::derivatives_each`]).
+    #[inline(always)]
+    pub(crate) fn prefetch_nodes(&self) {
+        prefetch_nodes(&self.data.nodes);
     }
 
     /// Position and derivatives with respect to the view's `uv` at `st` in `leaf`, whose
