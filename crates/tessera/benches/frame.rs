@@ -16,7 +16,12 @@
 //!   the smallest weight);
 //! - `cow/…`: the cow as PN triangles with paper 001's silhouette criteria (transition 4:7,
 //!   semi-uniform 4:8) and the fractional-odd partitioning at factor 6.4;
-//! - `{elephant_refined,bunny,armadillo}/pn_uniform_4`: PN triangles at uniform factor 4.
+//! - `{elephant_refined,bunny,armadillo}/pn_uniform_4`: PN triangles at uniform factor 4;
+//! - Catmull-Clark cages (OpenSubdiv's Bfr defaults): `catmark_rook/uniform_8` (a cage with
+//!   triangles, so sub-faces: Bfr's rate 16; creases isolate faces six levels deep, most
+//!   leaves hold one point), `catmark_rook/pixel_0.5` (transition), and
+//!   `catmark_cube_creases0/uniform_64` (few, shallow-enough leaves with many points each:
+//!   the isolated faces' points grouped by leaf, `engine::tree_points`).
 //!
 //! The scenes are built in code from the shared models, not stored. Criterion reports
 //! triangles per second; run with `RAYON_NUM_THREADS=1` and `=2` to compare thread counts.
@@ -107,6 +112,18 @@ fn frames(c: &mut Criterion) {
         let four = scheme::Criterion::Factor(4.0);
         bench_frames(c, &format!("{name}/pn_uniform_4"), &set, Scheme::Uniform, four, false);
     }
+    let cage = |rel: &str| {
+        let path = data_dir().join(rel);
+        let mesh = tessera::io::obj::read_obj(&path).expect("benchmark model");
+        SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default()).expect("benchmark model")
+    };
+    let rook = cage("subdivision/catmark_rook.obj");
+    bench_frames(c, "catmark_rook/uniform_8", &rook, Scheme::Uniform, scheme::Criterion::Factor(8.0), false);
+    bench_frames(c, "catmark_rook/pixel_0.5", &rook, Scheme::Transition, pixel, false);
+    drop(rook);
+    let cube = cage("subdivision/catmark_cube_creases0.obj");
+    let sixty_four = scheme::Criterion::Factor(64.0);
+    bench_frames(c, "catmark_cube_creases0/uniform_64", &cube, Scheme::Uniform, sixty_four, false);
 }
 
 criterion_group!(benches, frames);
