@@ -227,6 +227,29 @@ pub(crate) struct Block<const L: usize> {
     pub(crate) margin: [f32; L],
 }
 
+impl<const L: usize> Block<L> {
+    /// Lane `l`'s position and normal where its f32 normal is reliable; else those of the
+    /// generic f64 evaluation of patch `p` of `set` at `uv` (the lane's parameters).
+    #[inline(always)]
+    pub(crate) fn lane_or_exact(
+        &self,
+        l: usize,
+        set: &SurfaceSet,
+        p: usize,
+        uv: DVec2,
+    ) -> ([f32; 3], [f32; 3]) {
+        if self.margin[l] > 0.0 {
+            (
+                [self.pos[0][l], self.pos[1][l], self.pos[2][l]],
+                [self.nrm[0][l], self.nrm[1][l], self.nrm[2][l]],
+            )
+        } else {
+            let q = exact(set, p, uv);
+            (q.position.as_vec3().to_array(), q.normal.as_vec3().to_array())
+        }
+    }
+}
+
 /// `a · b + c`, fused in the kernels compiled for FMA (elsewhere `mul_add` would be a slow
 /// library call). Fusing changes only the rounding.
 #[inline(always)]
@@ -630,14 +653,7 @@ impl PointBlocks {
                 FormRef::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
-                if block.margin[l] > 0.0 {
-                    *pos = [block.pos[0][l], block.pos[1][l], block.pos[2][l]];
-                    *nrm = [block.nrm[0][l], block.nrm[1][l], block.nrm[2][l]];
-                } else {
-                    let q = exact(set, p, uv[l]);
-                    *pos = q.position.as_vec3().to_array();
-                    *nrm = q.normal.as_vec3().to_array();
-                }
+                (*pos, *nrm) = block.lane_or_exact(l, set, p, uv[l]);
             }
         }
         out.uv.iter_mut().zip(uvs).for_each(|(x, uv)| *x = uv.as_vec2().to_array());
@@ -654,7 +670,7 @@ fn push<T>(v: &mut Vec<T>, x: T) -> u32 {
 /// The generic f64 evaluation, for the rare points f32 cannot resolve.
 #[cold]
 #[inline(never)]
-pub(crate) fn exact(set: &SurfaceSet, p: usize, uv: DVec2) -> SurfacePoint {
+fn exact(set: &SurfaceSet, p: usize, uv: DVec2) -> SurfacePoint {
     set.patches[p].eval(uv)
 }
 
@@ -956,7 +972,8 @@ mod tests {
     /// indices, uvs and vertex patches identical, positions within 1e-6 of `size` (the
     /// diagonal), normals within 1e-5, the same boundary edges; with `kernels_ran`, more
     /// than a quarter of the normals differ from the f64 path's in their rounding (so the
-    /// f32 kernels, not their f64 fallback, made them).
+    /// f32 kernels, not their f64 fallback, made them). Returns the two meshes (fast,
+    /// generic).
     #[allow(clippy::too_many_arguments)]
     fn assert_fast_equals_generic(
         what: &str,
@@ -967,7 +984,7 @@ mod tests {
         evaluator: &super::super::fast_evaluator::FastEvaluator<'_>,
         size: f64,
         kernels_ran: bool,
-    ) {
+    ) -> (crate::mesh::Mesh, crate::mesh::Mesh) {
         use crate::engine::{write_with, EngineOptions};
         use crate::mesh::Mesh;
         let opts = EngineOptions::default();
@@ -1002,6 +1019,7 @@ mod tests {
         let w = crate::verify::watertight(&mesh);
         let r = crate::verify::watertight(&reference);
         assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");
+        (mesh, reference)
     }
 
     /// Subdivision cages: the grouped leaf kernels (`tree_points`, for dense points) and the
@@ -1047,24 +1065,11 @@ mod tests {
                     evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
                     let what = format!("{} {scheme:?} {criterion:?} avx2_fma={avx2_fma}", path.display());
                     let size = lo.distance(hi);
-                    assert_fast_equals_generic(&what, &set, plan, pattern, &layout, &evaluator, size, false);
+                    let (fast, generic) = assert_fast_equals_generic(
+                        &what, &set, plan, pattern, &layout, &evaluator, size, false,
+                    );
                     if trees && matches!(scheme, Scheme::Uniform) {
                         // Isolated faces' normals from the kernels: some differ in their rounding.
-                        let mut fast = crate::mesh::Mesh::default();
-                        let opts = EngineOptions::default();
-                        crate::engine::write_with(
-                            &set,
-                            plan,
-                            pattern,
-                            &layout,
-                            opts,
-                            &mut fast,
-                            Some(&evaluator),
-                        )
-                        .unwrap();
-                        let mut generic = crate::mesh::Mesh::default();
-                        crate::engine::write_with(&set, plan, pattern, &layout, opts, &mut generic, None)
-                            .unwrap();
                         let from_trees = |k: usize| {
                             matches!(set.patches[fast.vertex_patch[k] as usize], Patch::Subdivision(_))
                         };

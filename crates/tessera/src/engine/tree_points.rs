@@ -26,9 +26,9 @@
 
 use std::cell::RefCell;
 
-use glam::{DVec2, Vec3};
+use glam::DVec2;
 
-use super::point_blocks::{bicubic_block, exact, LANES};
+use super::point_blocks::{bicubic_block, LANES};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
@@ -113,8 +113,8 @@ pub(super) fn eval<const FMA: bool>(
         found.push(Found { leaf, k: k as u32, st, size });
     }
     grouped.clear();
-    let leaves = tree.leaves().len();
-    if found.len() < leaves {
+    let leaf_count = tree.leaves().len();
+    if found.len() < leaf_count {
         // Fewer points than leaves: a comparison sort, O(n log n), costs less than a pass
         // over every leaf's counter.
         grouped.extend_from_slice(found);
@@ -122,7 +122,7 @@ pub(super) fn eval<const FMA: bool>(
     } else {
         // A counting sort, O(points + leaves); each leaf's points stay in the list's order.
         starts.clear();
-        starts.resize(leaves + 1, 0);
+        starts.resize(leaf_count + 1, 0);
         for f in found.iter() {
             starts[f.leaf as usize + 1] += 1;
         }
@@ -198,18 +198,11 @@ fn blocks<const FMA: bool, const L: usize>(
         let block = bicubic_block::<FMA, L>(local, &u, &v);
         for (l, f) in chunk.iter().enumerate() {
             let k = f.k as usize;
-            let (pos, nrm) = if block.margin[l] > 0.0 {
-                let n = Vec3::new(block.nrm[0][l], block.nrm[1][l], block.nrm[2][l]);
-                (
-                    [block.pos[0][l], block.pos[1][l], block.pos[2][l]],
-                    if flip { (-n).to_array() } else { n.to_array() },
-                )
-            } else {
-                let q = exact(set, p, uvs[k]);
-                (q.position.as_vec3().to_array(), q.normal.as_vec3().to_array())
-            };
+            let (pos, nrm) = block.lane_or_exact(l, set, p, uvs[k]);
+            // The kernel's normal is the leaf's; the f64 fallback's is already the view's.
+            let turn = flip && block.margin[l] > 0.0;
             out.pos[k] = pos;
-            out.nrm[k] = nrm;
+            out.nrm[k] = if turn { nrm.map(|x| -x) } else { nrm };
         }
     }
 }
@@ -219,6 +212,7 @@ mod tests {
     use super::*;
     use crate::engine::point_blocks::has_avx2_fma;
     use crate::surface::Patch;
+    use glam::Vec3;
 
     /// Every view of an isolated face's tree (turned, transposed, a quarter) evaluated by
     /// [`eval`] at dense points — groups of every size, single points, end caps — against
