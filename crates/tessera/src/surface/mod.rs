@@ -15,6 +15,7 @@ mod gregory_patch;
 pub mod patch_tree;
 mod pn_triangle;
 pub(crate) mod polygon_mesh;
+mod quartic_triangle;
 mod set;
 pub mod subdivision_tags;
 
@@ -26,6 +27,7 @@ pub use gregory_patch::GregoryPatch;
 pub use patch_tree::{PatchOrigin, PatchTree};
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
 pub use polygon_mesh::{PolygonFace, PolygonMesh};
+pub use quartic_triangle::QuarticTriangle;
 pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
 
