@@ -12,6 +12,7 @@
 mod bezier_triangle;
 mod bicubic;
 mod gregory_patch;
+mod gregory_triangle;
 pub mod patch_tree;
 mod pn_triangle;
 pub(crate) mod polygon_mesh;
@@ -24,6 +25,7 @@ pub use crate::domain::Domain;
 pub use bezier_triangle::BezierTriangle;
 pub use bicubic::RationalBicubic;
 pub use gregory_patch::GregoryPatch;
+pub use gregory_triangle::GregoryTriangle;
 pub use patch_tree::{PatchOrigin, PatchTree};
 pub use pn_triangle::{crease_edge_point, pn_edge_points, PnTriangle};
 pub use polygon_mesh::{PolygonFace, PolygonMesh};
