@@ -16,7 +16,7 @@
 //! separately and divide by the smallest weight (in the spirit of Zheng & Sederberg 2000; the
 //! quotient-rule expansion is in [`bicubic_hessian`]).
 
-use crate::surface::{BezierTriangle, Patch, RationalBicubic};
+use crate::surface::{BezierTriangle, Patch, QuarticTriangle, RationalBicubic};
 use glam::{DVec2, DVec3};
 
 /// Bounds on the second partial derivatives of a patch over its whole domain.
@@ -312,6 +312,28 @@ pub fn triangle_hessian(t: &BezierTriangle) -> HessianBound {
     m
 }
 
+/// Second-derivative bounds of a quartic Bézier triangle in its `(u, v)` parameters, over the
+/// whole triangle. Cost: 6 × 3 second differences.
+///
+/// Derivation: differentiating the Bernstein form twice along the parameter directions
+/// (`∂/∂u` moves weight from `λ0` to `λ1`, `∂/∂v` from `λ0` to `λ2`) gives quadratic Bézier
+/// triangles, `S_uu = 4·3 Σ_{i+j+k=2} (b_{i,j+2,k} − 2b_{i+1,j+1,k} + b_{i+2,j,k}) B²_ijk`,
+/// `S_uv = 12 Σ (b_{i,j+1,k+1} − b_{i+1,j,k+1} − b_{i+1,j+1,k} + b_{i+2,j,k}) B²_ijk` and
+/// `S_vv` likewise with `k` ([`QuarticTriangle::second_differences`]). On the triangle the
+/// `B²_ijk` are non-negative and sum to 1, so each derivative is a convex combination of its
+/// six Bézier points and its norm is at most their largest: `n(n−1)·max|Δ²b|` with `n = 4`.
+/// The bound is attained wherever a derivative's largest point is a corner point (at that
+/// corner), e.g. for every quadratic surface raised to degree 4.
+pub fn quartic_triangle_hessian(t: &QuarticTriangle) -> HessianBound {
+    let mut m = HessianBound::default();
+    for [uu, uv, vv] in t.second_differences() {
+        m.uu = m.uu.max(12.0 * uu.length());
+        m.uv = m.uv.max(12.0 * uv.length());
+        m.vv = m.vv.max(12.0 * vv.length());
+    }
+    m
+}
+
 /// Second-derivative bounds of any patch (PN triangles: their cubic geometry).
 pub fn hessian(p: &Patch) -> HessianBound {
     match p {
@@ -468,6 +490,71 @@ mod tests {
                 assert!(suv.length() <= tight.uv * (1.0 + 1e-4) + 1e-6);
             }
         }
+    }
+
+    /// The quartic triangle's bound holds at every sampled point of random nets (exact second
+    /// derivatives, and central differences of the position as an independent check), and is
+    /// attained by a quadratic surface raised to degree 4, so its factor is not too large.
+    #[test]
+    fn quartic_triangle_hessian_bounds_the_second_derivatives() {
+        let mut rng = crate::test_support::Lcg(12);
+        let mut ratio = 0.0f64;
+        for _ in 0..200 {
+            let scale = 10f64.powf(4.0 * rng.unit() - 2.0);
+            let t = QuarticTriangle {
+                points: std::array::from_fn(|_| {
+                    (DVec3::new(rng.unit53(), rng.unit53(), rng.unit53()) * 2.0 - DVec3::ONE) * scale
+                }),
+            };
+            let m = quartic_triangle_hessian(&t);
+            let h = 1e-3;
+            for a in 0..=24 {
+                for b in 0..=24 - a {
+                    let uv = DVec2::new(a as f64, b as f64) / 24.0;
+                    let (uu, uv_, vv) = t.second_derivatives(uv);
+                    let slack = 1.0 + 1e-12;
+                    assert!(uu.length() <= m.uu * slack, "{uv}: |S_uu| {} > {}", uu.length(), m.uu);
+                    assert!(uv_.length() <= m.uv * slack, "{uv}: |S_uv| {} > {}", uv_.length(), m.uv);
+                    assert!(vv.length() <= m.vv * slack, "{uv}: |S_vv| {} > {}", vv.length(), m.vv);
+                    ratio = ratio.max(uu.length() / m.uu).max(vv.length() / m.vv);
+                    // Differences of the position (out of the triangle by up to h, where the
+                    // polynomial is still defined): error h²/12·|S_uuuu|, |S_uuuu| ≤ 4!·16·max|b|.
+                    let at = |du: f64, dv: f64| t.position(uv + DVec2::new(du, dv));
+                    let fd_uu = (at(h, 0.0) - 2.0 * at(0.0, 0.0) + at(-h, 0.0)) / (h * h);
+                    let fd_uv = (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4.0 * h * h);
+                    let fd_vv = (at(0.0, h) - 2.0 * at(0.0, 0.0) + at(0.0, -h)) / (h * h);
+                    let tolerance = 1e-3 * scale;
+                    assert!(fd_uu.length() <= m.uu + tolerance, "{uv}");
+                    assert!(fd_uv.length() <= m.uv + tolerance, "{uv}");
+                    assert!(fd_vv.length() <= m.vv + tolerance, "{uv}");
+                }
+            }
+        }
+        // Random nets come near the bound (a corner's point is often the largest).
+        assert!(ratio > 0.999, "{ratio}");
+        // S = (u², uv, v²) written as a quartic: S_uu = (2,0,0), S_uv = (0,1,0), S_vv = (0,0,2).
+        // Its Bézier points are the polar forms at the corners: with j arguments at corner 1
+        // and k at corner 2, u² → j(j−1)/12, uv → jk/12, v² → k(k−1)/12.
+        let mut quadratic = QuarticTriangle { points: [DVec3::ZERO; 15] };
+        for i in 0..=4usize {
+            for j in 0..=4 - i {
+                let k = 4 - i - j;
+                let (j, k, n) = (j as f64, k as f64, QuarticTriangle::index(i, j, k));
+                quadratic.points[n] = DVec3::new(j * (j - 1.0), j * k, k * (k - 1.0)) / 12.0;
+            }
+        }
+        let uv = DVec2::new(0.2, 0.3);
+        let p = quadratic.position(uv);
+        assert!((p - DVec3::new(uv.x * uv.x, uv.x * uv.y, uv.y * uv.y)).length() < 1e-15, "{p}");
+        let (uu, uv_, vv) = quadratic.second_derivatives(uv);
+        assert!((uu - DVec3::new(2.0, 0.0, 0.0)).length() < 1e-12, "{uu}");
+        assert!((uv_ - DVec3::new(0.0, 1.0, 0.0)).length() < 1e-12, "{uv_}");
+        assert!((vv - DVec3::new(0.0, 0.0, 2.0)).length() < 1e-12, "{vv}");
+        let m = quartic_triangle_hessian(&quadratic);
+        assert!(
+            (m.uu - 2.0).abs() < 1e-12 && (m.uv - 1.0).abs() < 1e-12 && (m.vv - 2.0).abs() < 1e-12,
+            "{m:?}"
+        );
     }
 
     #[test]
