@@ -20,15 +20,18 @@
 //! Loop's irregular weights involve `cos` and `sin`; they are evaluated in `f64` with the
 //! same operations in the same order as Sdc's, so that with the platform's C library (which
 //! both Rust's and C++'s `cos`/`sin` call) the weights agree with OpenSubdiv's to the bit.
-//! The regular valence 6 takes Sdc's exact special cases (5/8 and 1/16, 1/2 and 1/12, the
-//! cosines of multiples of 60° as halves), not the general formula, which rounds there.
+//! The regular valence 6 takes Sdc's special cases (⅝ and 1/16, ½ and 1/12, tangent weights
+//! of exact halves and √3/2). For the position weights the general formula happens to give
+//! the same `f64` values; for the tangents it does not (`cos` 60° rounds to
+//! 0.5000000000000001).
 //!
 //! # What the caller prepares
 //!
 //! The refinement masks take the sharpness a refinement level *stores*, at the base level the
 //! cage's tags after Far's sharpening ([`super::sdc::base_edge_sharpness`],
 //! [`super::sdc::base_vertex_sharpness`]): a boundary vertex is recognised by its
-//! infinitely sharp boundary edges, and a non-manifold vertex is a corner. Faces are
+//! infinitely sharp boundary edges, and a non-manifold vertex is a corner or (on an interior
+//! non-manifold crease) a crease, never smooth. Faces are
 //! triangles: an edge's "faces" are the triangles beside it, and the smooth edge mask weighs
 //! the vertex of each that is opposite the edge (Far's reading of Sdc's Loop face weights;
 //! Sdc's other reading, face centres, is not Far's and is not offered here).
@@ -614,8 +617,12 @@ mod tests {
         // Valence 3: Loop's β is 3/16 (cos 120° = −½ makes the bracket ¼).
         let (v, e) = smooth_vertex_weights(3);
         assert!((e - 3.0 / 16.0).abs() < 1e-16 && (v - 7.0 / 16.0).abs() < 1e-16, "{v} {e}");
-        // The general formula agrees with the special case at valence 6, up to rounding.
-        assert!((loop_beta(6) - 0.0625).abs() < 1e-16);
+        // The general formula gives the special case's β at valence 6 to the bit; the
+        // tangents' special case is the one that matters.
+        assert_eq!(loop_beta(6), 0.0625);
+        let t = limit_masks(VertexRule::Smooth, &[0.0; 6], 6);
+        assert_eq!(t.tangent1.edges, [1.0, 0.5, -0.5, -1.0, -0.5, 0.5]);
+        assert_ne!((std::f64::consts::PI / 3.0).cos(), 0.5);
     }
 
     #[test]
