@@ -31,10 +31,10 @@
 //! cage's tags after Far's sharpening ([`super::sdc::base_edge_sharpness`],
 //! [`super::sdc::base_vertex_sharpness`]): a boundary vertex is recognised by its
 //! infinitely sharp boundary edges, and a non-manifold vertex is a corner or (on an interior
-//! non-manifold crease) a crease, never smooth. Faces are
-//! triangles: an edge's "faces" are the triangles beside it, and the smooth edge mask weighs
-//! the vertex of each that is opposite the edge (Far's reading of Sdc's Loop face weights;
-//! Sdc's other reading, face centres, is not Far's and is not offered here).
+//! non-manifold crease) a crease, never smooth. Faces are triangles: an edge's "faces" are
+//! the triangles beside it, and the smooth edge mask weighs the vertex of each that is
+//! opposite the edge (Far's reading of Sdc's Loop face weights; Sdc's other reading, face
+//! centres, is not Far's and is not offered here).
 //!
 //! # Ordering
 //!
@@ -55,7 +55,8 @@
 //!   `GetSharpEdgePairOfCrease` picks them), the first tangent runs along the crease towards
 //!   edge `c0`, and the second crosses the triangles of the counter-clockwise span from `c0`
 //!   to `c1` (the edges strictly between them), pointing into it. For a boundary vertex that
-//!   span is its whole fan and `c0 = 0`.
+//!   span is its whole fan and `c0 = 0`;
+//! * at a corner, the first tangent points along edge 0 and the second along edge 1.
 //!
 //! The second tangent is oriented so that the normal is tangent 1 × tangent 2. Tangent
 //! magnitudes are OpenSubdiv's: unscaled at a smooth vertex, scaled at creases and corners
