@@ -42,7 +42,7 @@ use super::{BoundaryInterpolation, CreaseMethod, TriangleRule, INFINITELY_SHARP}
 const SMOOTH: f32 = 0.0;
 
 /// Whether `s` makes an edge or vertex sharp at all (Sdc's `IsSharp`).
-fn is_sharp(s: f32) -> bool {
+pub(crate) fn is_sharp(s: f32) -> bool {
     s > SMOOTH
 }
 
@@ -90,7 +90,7 @@ impl VertexRule {
     }
 
     /// Whether the vertex takes the smooth mask (smooth or dart).
-    fn is_smooth(self) -> bool {
+    pub(crate) fn is_smooth(self) -> bool {
         matches!(self, Self::Smooth | Self::Dart)
     }
 }
@@ -204,9 +204,10 @@ pub fn child_vertex_sharpness(vertex_sharpness: f32) -> f32 {
 }
 
 /// Chaikin's view of one vertex's edges: the sum and count of the semi-sharp ones, from
-/// which each edge's child sharpness follows without a buffer.
+/// which each edge's child sharpness follows without a buffer. Shared with the Loop rules
+/// (`super::loop_sdc`), whose sharpness decays the same way.
 #[derive(Clone, Copy)]
-struct EdgesAtVertex {
+pub(crate) struct EdgesAtVertex {
     method: CreaseMethod,
     /// Incident edges.
     count: usize,
@@ -217,7 +218,7 @@ struct EdgesAtVertex {
 }
 
 impl EdgesAtVertex {
-    fn new(edge_sharpness: &[f32], method: CreaseMethod) -> Self {
+    pub(crate) fn new(edge_sharpness: &[f32], method: CreaseMethod) -> Self {
         let mut at = Self { method, count: edge_sharpness.len(), semi_sharp_sum: 0.0, semi_sharp: 0 };
         if method == CreaseMethod::Chaikin {
             for &s in edge_sharpness.iter().filter(|&&s| is_semi_sharp(s)) {
@@ -230,7 +231,7 @@ impl EdgesAtVertex {
 
     /// The child sharpness, at this vertex, of one of its edges of sharpness `s` (Sdc's
     /// `SubdivideEdgeSharpnessAtVertex`, `opensubdiv/sdc/crease.cpp`).
-    fn child(&self, s: f32) -> f32 {
+    pub(crate) fn child(&self, s: f32) -> f32 {
         if self.method == CreaseMethod::Uniform || self.count < 2 {
             return subdivide_sharpness(s);
         }
@@ -313,7 +314,7 @@ pub fn fractional_weight_at_vertex(
 }
 
 /// [`fractional_weight_at_vertex`] with the child edges' sharpness computed on demand.
-fn fractional_weight(
+pub(crate) fn fractional_weight(
     parent_vertex: f32,
     child_vertex: f32,
     parent_edges: &[f32],
@@ -564,6 +565,18 @@ impl VertexMask {
 /// Two crease edges (indices into a vertex's incident edges) and the weight of each.
 type CreasePair = ([usize; 2], f64);
 
+/// The two edges of a crease at a vertex of `valence` edges whose sharp edges are `sharp(i)`:
+/// the first and the last sharp edge in the given order, as Sdc's `GetSharpEdgePairOfCrease`
+/// (`opensubdiv/sdc/crease.h`) finds them (a crease has exactly two). `None` without a sharp
+/// edge. Shared with the Loop rules, whose crease tangents depend on which end comes first.
+///
+/// Cost: O(edges).
+pub(crate) fn sharp_edge_pair_of_crease(valence: usize, sharp: impl Fn(usize) -> bool) -> Option<[usize; 2]> {
+    let first = (0..valence).find(|&i| sharp(i))?;
+    let last = (0..valence).rev().find(|&i| sharp(i))?;
+    Some([first, last])
+}
+
 /// One rule's mask before blending; `None` edges or faces mean the mask has no such weights
 /// (Sdc's sparse masks, which blend differently from weights of 0).
 #[derive(Clone, Copy)]
@@ -584,11 +597,8 @@ impl RuleMask {
                 Self { vertex: (n - 2.0) / n, edges: Some((w, None)), face: Some(w) }
             }
             VertexRule::Crease => {
-                // The first and the last sharp edge, as Sdc's GetSharpEdgePairOfCrease finds
-                // them; a crease has exactly two.
-                let first = (0..valence).find(|&i| sharp(i)).unwrap_or(0);
-                let last = (0..valence).rev().find(|&i| sharp(i)).unwrap_or(0);
-                Self { vertex: 0.75, edges: Some((0.0, Some(([first, last], 0.125)))), face: None }
+                let ends = sharp_edge_pair_of_crease(valence, sharp).unwrap_or([0, 0]);
+                Self { vertex: 0.75, edges: Some((0.0, Some((ends, 0.125)))), face: None }
             }
             VertexRule::Corner => Self { vertex: 1.0, edges: None, face: None },
         }
