@@ -83,7 +83,9 @@ struct Fan {
     }
 };
 
-static Cage fan(std::string name, int n, int k, bool closed, int level = 2) {
+// rot turns every triangle's vertex list, so that an unrefined fan's centre is corner rot of
+// its triangles (refinement picks its own order).
+static Cage fan(std::string name, int n, int k, bool closed, int level = 2, int rot = 0) {
     Cage c;
     c.name = name;
     c.level = level;
@@ -101,9 +103,11 @@ static Cage fan(std::string name, int n, int k, bool closed, int level = 2) {
         for (int a = 0; a < k; ++a)
             for (int b = 0; a + b < k; ++b) {
                 int t[3] = {f.g(j, a, b), f.g(j, a + 1, b), f.g(j, a, b + 1)};
+                std::rotate(t, t + (3 - rot) % 3, t + 3);
                 c.tris.insert(c.tris.end(), t, t + 3);
                 if (a + b + 2 <= k) {
                     int u[3] = {f.g(j, a + 1, b), f.g(j, a + 1, b + 1), f.g(j, a, b + 1)};
+                    std::rotate(u, u + (3 - rot) % 3, u + 3);
                     c.tris.insert(c.tris.end(), u, u + 3);
                 }
             }
@@ -382,6 +386,19 @@ int main() {
     Cage corner5b = fan("fan5_base_corner", 5, 2, true, 0);
     corner5b.corners.push_back(0);
     cages.push_back(corner5b);
+    // An unrefined valence-3 centre as each corner of its triangles (a neighbour without
+    // points of its own in the source patch), and two adjacent sharp corners (face-point
+    // corrections outside the points of P and E are dropped).
+    for (int rot = 0; rot < 3; ++rot) {
+        cages.push_back(fan("fan3_base_rot" + std::to_string(rot), 3, 2, true, 0, rot));
+        Cage two = fan("fan5_base_two_corners_rot" + std::to_string(rot), 5, 2, true, 0, rot);
+        two.corners = {0, 1};
+        cages.push_back(two);
+    }
+    Cage ico2 = icosahedron();
+    ico2.name = "icosahedron_two_corners";
+    ico2.corners = {0, 1};
+    cages.push_back(ico2);
     // Irregular corners at isolation level 1.
     cages.push_back(fan("fan5_level1", 5, 2, true, 1));
     cages.push_back(fan("open2_level1", 2, 2, false, 1));

@@ -835,16 +835,17 @@ mod tests {
     }
 
     /// OpenSubdiv's Gregory triangles (`tools/osd-oracle/loop_gregory_check.sh`, OpenSubdiv
-    /// 3.6.0's `Far::LoopPatchBuilder` under Bfr's options; 146 distinct source patches from
+    /// 3.6.0's `Far::LoopPatchBuilder` under Bfr's options; 194 distinct source patches from
     /// interior valences 3–12, smooth boundary corners of 1, 2, 4 and 5 faces, sharp corners
     /// from corner tags and edge-and-corner boundaries, corner spans of creases, a dart,
     /// valence-2 interior corners, and unrefined cages with several irregular corners per
-    /// triangle): for every patch and three seeded sets of source points, tessera's 18
-    /// points equal OpenSubdiv's matrix applied to them within 1e-12 of their scale.
+    /// triangle, among them a valence-3 corner in each position and adjacent sharp corners):
+    /// for every patch and three seeded sets of source points, tessera's 18 points equal
+    /// OpenSubdiv's matrix applied to them within 1e-12 of their scale.
     #[test]
     fn loop_gregory_matches_opensubdiv_matrices() {
         let patches = fixture();
-        assert_eq!(patches.len(), 146);
+        assert_eq!(patches.len(), 194);
         let mut worst = 0.0f64;
         for (k, patch) in patches.iter().enumerate() {
             for seed in 0..3 {
