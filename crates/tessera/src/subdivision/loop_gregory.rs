@@ -381,7 +381,9 @@ fn boundary_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
     p[1] = 1.0 / 6.0;
     p[last] = 1.0 / 6.0;
 
-    // The cross tangent, the crease running along edges 0 and valence − 1.
+    // The cross tangent, the crease running along edges 0 and valence − 1. (The converter
+    // never reaches the arms for 0 and 2 interior edges — a one-face corner has its own rule
+    // and a smooth three-face one is regular — but they complete Sdc's mask.)
     let mut cross = vec![0.0; width];
     let interior_edges = valence - 2;
     match interior_edges {
@@ -539,7 +541,9 @@ fn regular_face_point(c: usize, kind: &CornerKind, ring: &[usize]) -> Stencil {
 /// (`GregoryTriConverter::computeIrregularFacePoint`, `far/loopPatchBuilder.cpp`):
 /// [`blend_face_point`] with `d = 4` and a correction `±7/72` on the two ring points beside
 /// the interior edge `edge` (OpenSubdiv's stand-in for the published term built from the
-/// midpoints of the neighbouring edges and faces).
+/// midpoints of the neighbouring edges and faces). Corrections outside the points of P and
+/// the two E are dropped, as [`blend_face_point`] says; two adjacent sharp corners do that
+/// (the fixture's unrefined cages with two corner tags).
 #[allow(clippy::too_many_arguments)]
 fn face_point(
     kinds: &[CornerKind; 3],
