@@ -115,7 +115,9 @@ pub struct GregorySource {
     pub corners: [GregoryCorner; 4],
 }
 
-/// A way in which a [`GregorySource`] does not describe a leaf quad consistently.
+/// A way in which a source patch — a leaf quad's [`GregorySource`] or a leaf triangle's
+/// [`LoopGregorySource`](super::loop_gregory::LoopGregorySource) — does not describe its leaf
+/// consistently.
 #[derive(Debug, Clone, PartialEq)]
 pub enum GregorySourceError {
     /// A corner's fan counts are impossible (no faces, a patch face out of range, or an
@@ -124,7 +126,8 @@ pub enum GregorySourceError {
         /// The corner.
         corner: usize,
     },
-    /// A corner's ring does not have [`GregoryCorner::expected_ring_len`] points.
+    /// A corner's ring does not have the number of points its fan implies
+    /// ([`GregoryCorner::expected_ring_len`], `LoopCorner::expected_ring_len`).
     RingLength {
         /// The corner.
         corner: usize,
@@ -305,7 +308,98 @@ impl SourceLayout {
 }
 
 /// A patch point as a combination of source points: (source index, weight), repeats allowed.
-type Stencil = Vec<(usize, f64)>;
+pub(super) type Stencil = Vec<(usize, f64)>;
+
+/// How a corner's two edge points and two face points relate to the patch's boundary and to
+/// its neighbours' regularity (the second pass of `GregoryConverter::Initialize`,
+/// `far/catmarkPatchBuilder.cpp`; `GregoryTriConverter::Initialize`,
+/// `far/loopPatchBuilder.cpp`, applies the same rule to triangles).
+#[derive(Clone, Copy, Default)]
+pub(super) struct FacePointFlags {
+    /// Ep lies on a boundary edge (the patch face is the first of an open fan).
+    pub ep_on_boundary: bool,
+    /// Em lies on a boundary edge (the patch face is the last of an open fan).
+    pub em_on_boundary: bool,
+    /// Fp takes the regular (B-spline or box-spline) face point.
+    pub fp_regular: bool,
+    /// Fm takes the regular face point.
+    pub fm_regular: bool,
+    /// Fp is a copy of Fm.
+    pub fp_copied: bool,
+    /// Fm is a copy of Fp.
+    pub fm_copied: bool,
+}
+
+impl FacePointFlags {
+    /// The flags of a corner whose fan has `num_faces` faces, the patch face at `face_in_ring`,
+    /// given whether the corner and its next and previous neighbours are regular.
+    pub(super) fn new(boundary: bool, num_faces: usize, face_in_ring: usize, regular: [bool; 3]) -> Self {
+        let [this, next, prev] = regular;
+        let mut f = FacePointFlags {
+            fp_regular: this && next,
+            fm_regular: this && prev,
+            ..FacePointFlags::default()
+        };
+        if boundary {
+            f.ep_on_boundary = face_in_ring == 0;
+            f.em_on_boundary = face_in_ring + 1 == num_faces;
+            if num_faces > 1 {
+                // Across a boundary edge the two face points of the corner coincide: the one
+                // by the boundary copies the other (or both are regular).
+                if f.ep_on_boundary {
+                    f.fp_regular = f.fm_regular;
+                    f.fp_copied = !f.fp_regular;
+                }
+                if f.em_on_boundary {
+                    f.fm_regular = f.fp_regular;
+                    f.fm_copied = !f.fm_regular;
+                }
+            } else {
+                // A one-face corner takes the regular face points.
+                f.fp_regular = true;
+                f.fm_regular = true;
+            }
+        }
+        f
+    }
+}
+
+/// The irregular face point rule shared by quads (`d = 3`, `GregoryConverter`) and triangles
+/// (`d = 4`, `GregoryTriConverter`): `(cos θ_far·P + (d − 2cos θ_near − cos θ_far)·E_near +
+/// 2cos θ_near·E_far)/d` plus the `corrections` (source index, weight).
+///
+/// OpenSubdiv assembles the row over the union of the source points that P, E_near and E_far
+/// use, and adds the corrections into that row only: a correction on a point outside the
+/// union is dropped. So the result depends on which ring slots are the same source point,
+/// which is why sources are numbered as OpenSubdiv numbers them. Cost: O(`num_points`).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn blend_face_point(
+    num_points: usize,
+    d: f64,
+    cos_near: f64,
+    cos_far: f64,
+    p: &Stencil,
+    e_near: &Stencil,
+    e_far: &Stencil,
+    corrections: &[(usize, f64)],
+) -> Stencil {
+    let p_coeff = cos_far / d;
+    let near_coeff = (d - 2.0 * cos_near - cos_far) / d;
+    let far_coeff = 2.0 * cos_near / d;
+
+    let mut row = vec![0.0; num_points];
+    let mut used = vec![false; num_points];
+    for (stencil, s) in [(p, p_coeff), (e_near, near_coeff), (e_far, far_coeff)] {
+        for &(i, w) in stencil {
+            row[i] += s * w;
+            used[i] = true;
+        }
+    }
+    for &(i, w) in corrections {
+        row[i] += w;
+    }
+    (0..num_points).filter(|&i| used[i]).map(|i| (i, row[i])).collect()
+}
 
 /// What the converter needs of each corner (`GregoryConverter::CornerTopology`,
 /// `far/catmarkPatchBuilder.cpp`), including how its face points relate to its neighbours.
@@ -350,28 +444,18 @@ fn corner_kinds(corners: &[GregoryCorner; 4]) -> [CornerKind; 4] {
     });
     let regular = kinds.map(|k| k.regular);
     for (i, k) in kinds.iter_mut().enumerate() {
-        k.fp_regular = k.regular && regular[(i + 1) % 4];
-        k.fm_regular = k.regular && regular[(i + 3) % 4];
-        if k.boundary {
-            k.ep_on_boundary = k.face_in_ring == 0;
-            k.em_on_boundary = k.face_in_ring + 1 == k.num_faces;
-            if k.num_faces > 1 {
-                // Across a boundary edge the two face points of the corner coincide: the one
-                // by the boundary copies the other (or both are regular).
-                if k.ep_on_boundary {
-                    k.fp_regular = k.fm_regular;
-                    k.fp_copied = !k.fp_regular;
-                }
-                if k.em_on_boundary {
-                    k.fm_regular = k.fp_regular;
-                    k.fm_copied = !k.fm_regular;
-                }
-            } else {
-                // A one-face corner takes the regular (bilinear-weighted) face points.
-                k.fp_regular = true;
-                k.fm_regular = true;
-            }
-        }
+        let f = FacePointFlags::new(
+            k.boundary,
+            k.num_faces,
+            k.face_in_ring,
+            [k.regular, regular[(i + 1) % 4], regular[(i + 3) % 4]],
+        );
+        k.ep_on_boundary = f.ep_on_boundary;
+        k.em_on_boundary = f.em_on_boundary;
+        k.fp_regular = f.fp_regular;
+        k.fm_regular = f.fm_regular;
+        k.fp_copied = f.fp_copied;
+        k.fm_copied = f.fm_copied;
     }
     kinds
 }
@@ -530,7 +614,7 @@ fn boundary_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
 }
 
 /// Weights over `[vertex, ring…]` as a stencil on source points.
-fn ring_stencil(corner: usize, ring: &[usize], weights: &[f64]) -> Stencil {
+pub(super) fn ring_stencil(corner: usize, ring: &[usize], weights: &[f64]) -> Stencil {
     std::iter::once(corner).chain(ring.iter().copied()).zip(weights.iter().copied()).collect()
 }
 
@@ -629,14 +713,14 @@ fn irregular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stenci
 
 /// An irregular face point next to the edge point `e_near` of corner `near`
 /// (`GregoryConverter::computeIrregularFacePoint`, `far/catmarkPatchBuilder.cpp`):
-/// `(cos θ_far·P + (3 − 2cos θ_near − cos θ_far)·E_near + 2cos θ_near·E_far)/3`, plus a
-/// correction `±(1/9, 1/18)` on the four ring points beside the interior edge `edge`.
+/// [`blend_face_point`] with `d = 3` and a correction `±(1/9, 1/18)` on the four ring points
+/// beside the interior edge `edge`.
 ///
-/// OpenSubdiv assembles the row over the union of the source points that P, E_near and E_far
-/// use, and adds the correction into that row only: a correction on a point outside the union
-/// is dropped. That can only happen when `near` is sharp (P is the vertex alone) and `far` is
-/// sharp or a one-face corner — not a configuration adaptive refinement produces at level ≥ 1,
-/// and so not covered by OpenSubdiv's fixture — but it is reproduced here by index.
+/// A correction outside the union of P, E_near and E_far's points is dropped (see
+/// [`blend_face_point`]). That can only happen when `near` is sharp (P is the vertex alone)
+/// and `far` is sharp or a one-face corner — not a configuration adaptive refinement produces
+/// at level ≥ 1, and so not covered by OpenSubdiv's fixture — but it is reproduced here by
+/// index.
 #[allow(clippy::too_many_arguments)]
 fn face_point(
     kinds: &[CornerKind; 4],
@@ -650,27 +734,25 @@ fn face_point(
     e_far: &Stencil,
     sign: f64,
 ) -> Stencil {
-    let (cos_near, cos_far) = (kinds[near].cos_face_angle, kinds[far].cos_face_angle);
-    let p_coeff = cos_far / 3.0;
-    let near_coeff = (3.0 - 2.0 * cos_near - cos_far) / 3.0;
-    let far_coeff = 2.0 * cos_near / 3.0;
-
-    let mut row = vec![0.0; num_points];
-    let mut used = vec![false; num_points];
-    for (stencil, s) in [(p, p_coeff), (e_near, near_coeff), (e_far, far_coeff)] {
-        for &(i, w) in stencil {
-            row[i] += s * w;
-            used[i] = true;
-        }
-    }
     let valence = kinds[near].valence;
     let ring = &rings[near];
     let (e_prev, e_next) = ((edge + valence - 1) % valence, (edge + 1) % valence);
-    row[ring[2 * e_prev]] += -sign / 9.0;
-    row[ring[2 * e_prev + 1]] += -sign / 18.0;
-    row[ring[2 * edge + 1]] += sign / 18.0;
-    row[ring[2 * e_next]] += sign / 9.0;
-    (0..num_points).filter(|&i| used[i]).map(|i| (i, row[i])).collect()
+    let corrections = [
+        (ring[2 * e_prev], -sign / 9.0),
+        (ring[2 * e_prev + 1], -sign / 18.0),
+        (ring[2 * edge + 1], sign / 18.0),
+        (ring[2 * e_next], sign / 9.0),
+    ];
+    blend_face_point(
+        num_points,
+        3.0,
+        kinds[near].cos_face_angle,
+        kinds[far].cos_face_angle,
+        p,
+        e_near,
+        e_far,
+        &corrections,
+    )
 }
 
 /// The 20 stencils of a source patch over its [`SourceLayout`] numbering, in the module's

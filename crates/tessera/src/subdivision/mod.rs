@@ -16,6 +16,7 @@ pub mod cage;
 mod catmull_clark;
 pub mod gregory;
 pub mod isolation;
+pub mod loop_gregory;
 pub mod loop_sdc;
 pub mod sdc;
 pub mod stencils;
