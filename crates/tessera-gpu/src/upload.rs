@@ -23,7 +23,7 @@
 //!   subdivision patch's bounding-box corners, twice. After every patch's 16, the subdivision
 //!   patches' view records and trees (`pack_trees`).
 
-use crate::error::Result;
+use crate::error::{GpuError, Result};
 use tessera::surface::{Patch, SurfaceSet};
 use wgpu::util::DeviceExt;
 
@@ -80,6 +80,9 @@ impl PackedSet {
             packed.any_repeated_corner |= repeated;
             let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
             let (tri, pn, tree) = match patch {
+                Patch::Loop(_) => {
+                    return Err(GpuError::Unsupported { what: tessera::scheme::loop_on_gpu(p) });
+                }
                 Patch::Subdivision(t) => {
                     // The box around its pieces twice (what culling reads); the pieces
                     // themselves follow all patches ([`pack_trees`]).

@@ -1,12 +1,13 @@
-//! Catmull-Clark cages through every scheme: the output is watertight bit for bit with the
-//! cage's own topology (its boundary refined by the factors, no non-manifold edge, the cage's
-//! Euler characteristic) on seeded random cameras, and the error bounds hold when measured.
-//! (The patches themselves are compared with OpenSubdiv in `catmull_clark_oracle.rs`, so the
-//! error measured against them is the error against Bfr's limit surface.)
+//! Subdivision cages (Catmull-Clark and Loop) through every scheme: the output is watertight
+//! bit for bit with the cage's own topology (its boundary refined by the factors, no
+//! non-manifold edge, the cage's Euler characteristic) on seeded random cameras, and the error
+//! bounds hold when measured. (The patches themselves are compared with OpenSubdiv in
+//! `catmull_clark_oracle.rs` and `loop_oracle.rs`, so the error measured against them is the
+//! error against Bfr's limit surface.)
 //!
 //! The fast tier takes a few cages that cover the cases (extraordinary vertices, non-quads,
 //! creases, holes, boundaries of each rule); the slow tier (`#[ignore]`d, run by
-//! `scripts/test`) every manifold `catmark_*` cage with 20 cameras.
+//! `scripts/test`) every manifold `catmark_*` and `loop_*` cage with 20 cameras.
 
 mod common;
 
@@ -25,8 +26,10 @@ use tessera::surface::{Patch, SurfaceSet};
 use tessera::verify;
 use tessera::Error;
 
-/// Cages tessera refuses so far (non-manifold edges or vertices).
-const NON_MANIFOLD: &[&str] = &["catmark_fan.obj", "catmark_gregory_test4.obj", "catmark_nonman_edges.obj"];
+/// Cages tessera refuses so far (non-manifold edges or vertices; `loop_val2_interior`'s third
+/// shape has an edge of four triangles).
+const NON_MANIFOLD: &[&str] =
+    &["catmark_fan.obj", "catmark_gregory_test4.obj", "catmark_nonman_edges.obj", "loop_val2_interior.obj"];
 
 const FAST: &[&str] = &[
     "catmark_cube.obj",
@@ -39,20 +42,36 @@ const FAST: &[&str] = &[
     "catmark_edgenone.obj",
 ];
 
-fn cages(fast: bool) -> Vec<PathBuf> {
+const FAST_LOOP: &[&str] = &[
+    "loop_cube_creases0.obj",
+    "loop_icosahedron.obj",
+    "loop_triangle_edgeonly.obj",
+    "loop_xord_boundary.obj",
+    "loop_pole8.obj",
+];
+
+/// The Catmull-Clark cages (`catmark_*`, loaded with `--surface catmull-clark`) and the
+/// Loop cages (`loop_*`, with `--surface loop`) of the shared data.
+fn cages(fast: bool) -> Vec<(PathBuf, SurfaceKind)> {
     let all = common::models_in("subdivision", "obj");
     all.into_iter()
-        .filter(|p| {
-            let name = p.file_name().unwrap().to_string_lossy();
-            name.starts_with("catmark_")
-                && !NON_MANIFOLD.contains(&name.as_ref())
-                && (!fast || FAST.contains(&name.as_ref()))
+        .filter_map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            let (kind, fast_set) = if name.starts_with("catmark_") {
+                (SurfaceKind::CatmullClark, FAST)
+            } else if name.starts_with("loop_") {
+                (SurfaceKind::Loop, FAST_LOOP)
+            } else {
+                return None;
+            };
+            (!NON_MANIFOLD.contains(&name.as_str()) && (!fast || fast_set.contains(&name.as_str())))
+                .then_some((p, kind))
         })
         .collect()
 }
 
-fn load_cage(path: &Path) -> SurfaceSet {
-    let options = LoadOptions { surface: SurfaceKind::CatmullClark, ..Default::default() };
+fn load_cage(path: &Path, surface: SurfaceKind) -> SurfaceSet {
+    let options = LoadOptions { surface, ..Default::default() };
     tessera::io::load(path, options).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -97,9 +116,9 @@ fn scheme_case(k: usize, diagonal: f64) -> (Scheme, Criterion) {
 
 fn watertight_through_every_scheme(fast: bool) {
     let cameras = if fast { 8 } else { 20 };
-    for path in cages(fast) {
+    for (path, kind) in cages(fast) {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let set = load_cage(&path);
+        let set = load_cage(&path, kind);
         let t = set.topology.report;
         assert_eq!(t.nonmanifold_edges, 0, "{name}");
         assert_eq!(t.inconsistently_oriented_edges, 0, "{name}");
@@ -137,10 +156,23 @@ fn watertight_through_every_scheme(fast: bool) {
                 Ok(())
             })
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        // SD-2 is for triangles; ESC takes cages whose faces are all regular only.
+        // SD-2 is for triangles: Loop's, not Catmull-Clark's quads; ESC takes Catmull-Clark
+        // cages whose faces are all regular only.
         let options =
             PlanOptions { camera: Some(Camera::framing(lo, hi, 800, 600)), ..PlanOptions::default() };
         let sd2 = Scheme::Sd2 { warp: false }.plan(&set, &Criterion::Factor(2.0), &options);
+        if kind == SurfaceKind::Loop {
+            let SchemePlan { plan, pattern, .. } = sd2.unwrap_or_else(|e| panic!("{name}: {e}"));
+            let mesh = tessellate(&set, &plan, &pattern, EngineOptions::default()).unwrap();
+            common::expect_topology(&set, &plan, &mesh, &format!("{name} sd2"));
+            let esc = Scheme::Esc { max_level: 3 }.plan(
+                &set,
+                &Criterion::Esc { threshold: tessera::criterion::esc::Threshold::Medium, level: None },
+                &options,
+            );
+            assert!(matches!(esc, Err(Error::PatchKindNotAccepted { .. })), "{name}: {esc:?}");
+            continue;
+        }
         assert!(matches!(sd2, Err(Error::PatchKindNotAccepted { .. })), "{name}: {sd2:?}");
         let esc = Scheme::Esc { max_level: 3 }.plan(
             &set,
@@ -174,9 +206,9 @@ fn every_cage_is_watertight_through_every_scheme() {
 }
 
 fn tolerance_bounds_hold(fast: bool) {
-    for path in cages(fast) {
+    for (path, kind) in cages(fast) {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let set = load_cage(&path);
+        let set = load_cage(&path, kind);
         let (lo, hi) = set.bounds();
         let prepared = Prepared::new(&set, true);
         for share in [1e-2, 1e-3, 1e-4] {
@@ -214,16 +246,21 @@ fn tolerance_bounds_hold_on_every_cage() {
     tolerance_bounds_hold(false);
 }
 
-/// The GPU engine takes every cage: regular faces as bicubic patches, isolated faces as their
-/// trees of pieces (`tessera-gpu`'s `tree.wgsl`; its tests compare the frames with the CPU's).
+/// The GPU engine takes every Catmull-Clark cage: regular faces as bicubic patches, isolated
+/// faces as their trees of pieces (`tessera-gpu`'s `tree.wgsl`; its tests compare the frames
+/// with the CPU's). Loop cages are refused by name until the GPU evaluates their triangles.
 #[test]
-fn the_gpu_engine_takes_every_cage() {
+fn the_gpu_engine_takes_every_catmull_clark_cage_and_refuses_loop_cages() {
     let criterion = Criterion::Factor(4.0);
     let options = PlanOptions::default();
     for cage in ["subdivision/catmark_torus.obj", "subdivision/catmark_cube.obj"] {
-        let set = load_cage(&common::model(cage));
+        let set = load_cage(&common::model(cage), SurfaceKind::CatmullClark);
         validate(Scheme::Uniform, &criterion, &options, &set, Engine::Gpu).unwrap();
     }
+    let set = load_cage(&common::model("subdivision/loop_cube.obj"), SurfaceKind::Loop);
+    validate(Scheme::Uniform, &criterion, &options, &set, Engine::Cpu).unwrap();
+    let e = validate(Scheme::Uniform, &criterion, &options, &set, Engine::Gpu).unwrap_err();
+    assert!(matches!(e, Error::EngineNotSupported { .. }) && e.to_string().contains("Loop"), "{e}");
 }
 
 /// Bad cages are refused with the file, the line and the reason; never a panic.
@@ -381,7 +418,8 @@ fn stencils_give_every_moved_cage_its_surface() {
 fn stencils_give_moved_cages(fast: bool) {
     use tessera::subdivision::{CageOptions, CageStencils};
     use tessera::surface::Orientation;
-    for path in cages(fast) {
+    // Catmull-Clark's stencils (Loop cages have none yet).
+    for (path, _) in cages(fast).into_iter().filter(|(_, kind)| *kind == SurfaceKind::CatmullClark) {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         let mesh = tessera::io::obj::read_obj(&path).unwrap();
         let start = std::time::Instant::now();

@@ -341,6 +341,7 @@ pub fn hessian(p: &Patch) -> HessianBound {
         Patch::BezierTriangle(t) => triangle_hessian(t),
         Patch::Pn(pn) => triangle_hessian(&pn.geometry),
         Patch::Subdivision(t) => tree_hessian(t),
+        Patch::Loop(t) => loop_tree_hessian(t),
     }
 }
 
@@ -400,6 +401,65 @@ pub fn gregory_hessian(g: &crate::surface::GregoryPatch) -> HessianBound {
         m.uu += 18.0 * d;
         m.uv += 9.0 * d;
         m.vv += 18.0 * d;
+    }
+    m
+}
+
+/// Second-derivative bounds of a Loop patch: the largest of its leaves', each in the tree's
+/// parameters. A leaf of side `h` scales second derivatives by `1/h²`, and a turned leaf's
+/// parameters run against the tree's on both axes, which leaves second derivatives as they
+/// are; a swapped tree exchanges `u` and `v`. What this proves is what [`tree_hessian`]
+/// proves for Catmull-Clark trees: a bound on every piece, whose pieces meet with continuous
+/// tangents where they are box splines and approximately at Gregory triangles.
+pub fn loop_tree_hessian(t: &crate::surface::TriangleTree) -> HessianBound {
+    use crate::surface::triangle_tree::TriangleLeafPatch;
+    let mut m = HessianBound::default();
+    for leaf in t.leaves() {
+        let h = match &leaf.patch {
+            TriangleLeafPatch::Quartic(q) => quartic_triangle_hessian(q),
+            TriangleLeafPatch::Gregory(g) => gregory_triangle_hessian(g),
+        };
+        let s = 1.0 / (leaf.size * leaf.size);
+        m.uu = m.uu.max(h.uu * s);
+        m.uv = m.uv.max(h.uv * s);
+        m.vv = m.vv.max(h.vv * s);
+    }
+    if t.is_swapped() {
+        std::mem::swap(&mut m.uu, &mut m.vv);
+    }
+    m
+}
+
+/// Second-derivative bounds of a Gregory triangle ([`crate::surface::GregoryTriangle`]).
+///
+/// The patch is the quartic triangle `S⁻` whose three interior points are the corners' `Fm`,
+/// plus, per corner `c`, `h_c(s,t)·(Fp_c − Fm_c)` where `h_c` is the interior point's
+/// Bernstein polynomial times its rational blend: `12·w²st·s/(s+t)` at corner 0,
+/// `12·s²tw·t/(t+w)` at corner 1, `12·st²w·w/(w+s)` at corner 2 (`w = 1 − s − t`). So
+/// `|S_ss| ≤ |S⁻_ss| + Σ sup|∂ss h_c|·|Fp_c − Fm_c|`, likewise for `st` and `tt`. The suprema
+/// are approached at each blend's singular corner, where the second derivatives (homogeneous
+/// of degree 0 there) depend on the direction only: (24, 12, 24) for corner 0,
+/// (24, 36, 48) for corner 1 and (48, 24, 24) for corner 2 (`ss`, `st`, `tt`; corner 0's is
+/// the quads' `9·(2, 1, 2)` with 12 for 9, the others are the same function in turned
+/// coordinates). Sampled on 20,001 rays at 10⁻⁶ from each singular corner they reach these
+/// values to 5·10⁻⁶, and on a 1200² grid of the triangle they stay below them.
+pub fn gregory_triangle_hessian(g: &crate::surface::GregoryTriangle) -> HessianBound {
+    use crate::surface::QuarticTriangle;
+    let p = &g.points;
+    // The net with Fm inside: b(1,1), b(2,1), b(1,2) in (s, t) steps (the Gregory
+    // triangle's module doc), exponents (w, s, t) for `QuarticTriangle::index`.
+    let mut minus = g.blended(glam::DVec2::splat(0.25));
+    for (c, (i, j, k)) in [(2, 1, 1), (1, 2, 1), (1, 1, 2)].into_iter().enumerate() {
+        minus.points[QuarticTriangle::index(i, j, k)] = p[5 * c + 4];
+    }
+    let mut m = quartic_triangle_hessian(&minus);
+    for (c, [uu, uv, vv]) in
+        [[24.0, 12.0, 24.0], [24.0, 36.0, 48.0], [48.0, 24.0, 24.0]].into_iter().enumerate()
+    {
+        let d = (p[5 * c + 3] - p[5 * c + 4]).length();
+        m.uu += uu * d;
+        m.uv += uv * d;
+        m.vv += vv * d;
     }
     m
 }

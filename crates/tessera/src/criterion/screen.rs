@@ -162,7 +162,9 @@ pub fn culled(patch: &Patch, camera: &Camera) -> bool {
 /// cross products of control-net differences `Δu × Δv`, so it lies in their cone. Returns
 /// `(axis, half-angle)`, or None for rational patches and cones wider than a half-space.
 pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
-    if matches!(patch, Patch::Bicubic(b) if !b.is_polynomial()) || matches!(patch, Patch::Subdivision(_)) {
+    if matches!(patch, Patch::Bicubic(b) if !b.is_polynomial())
+        || matches!(patch, Patch::Subdivision(_) | Patch::Loop(_))
+    {
         // (A piecewise subdivision patch has no single net whose differences bound its
         // normals; it is never culled by its cone.)
         return None;
@@ -181,12 +183,12 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
                 }
             }
         }
-        Patch::Subdivision(_) => {}
+        Patch::Subdivision(_) | Patch::Loop(_) => {}
         Patch::BezierTriangle(_) | Patch::Pn(_) => {
             let t = match patch {
                 Patch::BezierTriangle(t) => t,
                 Patch::Pn(p) => &p.geometry,
-                Patch::Bicubic(_) | Patch::Subdivision(_) => unreachable!(),
+                Patch::Bicubic(_) | Patch::Subdivision(_) | Patch::Loop(_) => unreachable!(),
             };
             // The six control-net differences along each parameter direction.
             let (mut du, mut dv) = ([DVec3::ZERO; 6], [DVec3::ZERO; 6]);

@@ -110,14 +110,14 @@ fn curve_factor(m_edge: f64, eps: f64) -> f64 {
 
 /// The four control points (and weights) of a patch's boundary curve `local`, from corner
 /// `local` to corner `local + 1`; `None` for a subdivision patch, whose boundary is
-/// piecewise.
+/// piecewise (a Loop patch's also quartic).
 pub fn edge_control_points(patch: &Patch, local: usize) -> Option<([glam::DVec3; 4], [f64; 4])> {
     let idx = crate::surface::corner_and_edge_points(patch.domain()).1[local];
     let points = patch.control_points();
     match patch {
         Patch::Bicubic(b) => Some((idx.map(|i| points[i]), idx.map(|i| b.weights[i]))),
         Patch::BezierTriangle(_) | Patch::Pn(_) => Some((idx.map(|i| points[i]), [1.0; 4])),
-        Patch::Subdivision(_) => None,
+        Patch::Subdivision(_) | Patch::Loop(_) => None,
     }
 }
 
@@ -462,9 +462,14 @@ pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]
                 *o = match edge_control_points(patch, l) {
                     Some((points, weights)) => bounds::curve_second_derivative(points, weights),
                     // A piecewise boundary: the patch's own bound along the edge's direction
-                    // bounds the curve's second derivative (edges 0 and 2 run along u).
-                    None if l % 2 == 0 => h.uu,
-                    None => h.vv,
+                    // bounds the curve's second derivative. A quad's edges 0 and 2 run along
+                    // u; a triangle's edge 0 along u, edge 2 along v and edge 1 along
+                    // (−1, 1), where |S_uu − 2 S_uv + S_vv| ≤ uu + 2 uv + vv.
+                    None => match (patch.domain(), l) {
+                        (Domain::Quad, 0 | 2) | (Domain::Tri, 0) => h.uu,
+                        (Domain::Tri, 1) => h.uu + 2.0 * h.uv + h.vv,
+                        _ => h.vv,
+                    },
                 };
             }
             out

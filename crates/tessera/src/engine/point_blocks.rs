@@ -524,8 +524,9 @@ impl PointBlocks {
                 Patch::Bicubic(b) => LocalPatch::rational(b).map_or(Form::Generic, Form::Rational),
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
-                // Piecewise (isolated) subdivision patches take the generic evaluation.
-                Patch::Subdivision(_) => Form::Generic,
+                // Piecewise (isolated) subdivision patches take the generic evaluation, and
+                // Loop patches (the quartic kernels are not written yet).
+                Patch::Subdivision(_) | Patch::Loop(_) => Form::Generic,
             })
             .collect::<Vec<_>>();
         let mut blocks = PointBlocks {

@@ -75,17 +75,19 @@ impl Built {
 
 /// Keys for the topology: cage vertices keep their index; every curve between two keyed
 /// points gets two inner keys of its own, read in the curve's direction.
-struct Keys {
+pub(super) struct Keys {
     next: u32,
     curves: HashMap<(u32, u32), u32>,
 }
 
 impl Keys {
-    fn new(points: usize) -> Keys {
+    /// Keys after the first `points` (those of the cage's vertices and of any other keyed
+    /// point).
+    pub(super) fn new(points: usize) -> Keys {
         Keys { next: points as u32, curves: HashMap::new() }
     }
 
-    fn curve(&mut self, a: u32, b: u32) -> [u32; 4] {
+    pub(super) fn curve(&mut self, a: u32, b: u32) -> [u32; 4] {
         let next = &mut self.next;
         let inner = *self.curves.entry((a.min(b), a.max(b))).or_insert_with(|| {
             *next += 2;

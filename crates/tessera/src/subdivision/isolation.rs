@@ -51,6 +51,39 @@ impl Default for IsolationLevels {
 /// is 10.
 pub const MAX_ISOLATION_LEVEL: u8 = 10;
 
+/// The subdivision scheme whose regular topology the tags and features below measure
+/// against: OpenSubdiv's regular face size and vertex valences (`Sdc::SchemeTypeTraits`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scheme {
+    /// Catmull-Clark: quads, 4 faces around an interior vertex, 2 at a boundary.
+    Catmark,
+    /// Loop: triangles, 6 faces around an interior vertex, 3 at a boundary.
+    Loop,
+}
+
+impl Scheme {
+    /// Corners of a regular face.
+    pub(crate) fn face_size(self) -> usize {
+        match self {
+            Scheme::Catmark => 4,
+            Scheme::Loop => 3,
+        }
+    }
+
+    /// Faces around a regular interior vertex.
+    fn interior_faces(self) -> usize {
+        2 * self.boundary_faces()
+    }
+
+    /// Faces around a regular boundary vertex.
+    fn boundary_faces(self) -> usize {
+        match self {
+            Scheme::Catmark => 2,
+            Scheme::Loop => 3,
+        }
+    }
+}
+
 /// Builds the patch trees of face `face` of `cage`: one for a quad, one per corner sub-face
 /// (in corner order) for any other face.
 ///
@@ -143,10 +176,10 @@ impl Context {
         // the reduced one after; refining `f` makes level `level + 1`.
         let more = level < self.levels.sharp && {
             let full = level < self.levels.smooth;
-            face_has_features(mesh, f, level, full)
+            face_has_features(mesh, f, level, full, Scheme::Catmark)
         };
         if !more {
-            let patch = if self.is_patch_regular(mesh, f, level) {
+            let patch = if is_patch_regular(mesh, f, level, self.has_irregular_faces, Scheme::Catmark) {
                 let grid = super::bspline::grid(mesh, f, boundary_mask(mesh, f));
                 LeafPatch::Bezier(super::bspline::to_bezier(&grid))
             } else {
@@ -166,64 +199,72 @@ impl Context {
         }
         Slot::Node(index as u32)
     }
+}
 
-    /// `PatchBuilder::IsPatchRegular` (`far/patchBuilder.cpp`) with Bfr's options.
-    fn is_patch_regular(&self, mesh: &Cage, f: usize, level: u8) -> bool {
-        let tags: Vec<VTag> = mesh.face(f).iter().map(|&v| vertex_tag(mesh, v as usize)).collect();
-        let comp = VTag::union(&tags);
-        if !comp.inf_sharp && !comp.inf_sharp_edges {
-            return !comp.xordinary;
+/// `PatchBuilder::IsPatchRegular` (`far/patchBuilder.cpp`) with Bfr's options, for face `f`
+/// of a local mesh of `scheme` at `level` (`has_irregular_faces`: the neighbourhood of the
+/// root has a face of another size than the scheme's regular one).
+pub(super) fn is_patch_regular(
+    mesh: &Cage,
+    f: usize,
+    level: u8,
+    has_irregular_faces: bool,
+    scheme: Scheme,
+) -> bool {
+    let tags: Vec<VTag> = mesh.face(f).iter().map(|&v| vertex_tag(mesh, v as usize, scheme)).collect();
+    let comp = VTag::union(&tags);
+    if !comp.inf_sharp && !comp.inf_sharp_edges {
+        return !comp.xordinary;
+    }
+    if !comp.xordinary && !comp.inf_irregular {
+        return true;
+    }
+    let needs_extra_level = u8::from(comp.xordinary && has_irregular_faces);
+    if level > needs_extra_level && !(comp.inf_irregular && comp.inf_sharp_edges) {
+        return !comp.inf_irregular;
+    }
+    for (i, t) in tags.iter().enumerate() {
+        if !t.xordinary && !t.inf_irregular {
+            continue;
         }
-        if !comp.xordinary && !comp.inf_irregular {
-            return true;
+        if t.xordinary && !t.inf_sharp_edges {
+            return false;
         }
-        let needs_extra_level = u8::from(comp.xordinary && self.has_irregular_faces);
-        if level > needs_extra_level && !(comp.inf_irregular && comp.inf_sharp_edges) {
-            return !comp.inf_irregular;
-        }
-        for (i, t) in tags.iter().enumerate() {
-            if !t.xordinary && !t.inf_irregular {
-                continue;
-            }
-            if t.xordinary && !t.inf_sharp_edges {
+        if t.inf_irregular {
+            if !t.inf_sharp_edges {
                 return false;
             }
-            if t.inf_irregular {
-                if !t.inf_sharp_edges {
-                    return false;
-                }
-                if t.inf_sharp_crease && t.boundary {
-                    return false;
-                }
-                let span = corner_span(mesh, f, i);
-                let wanted = if t.inf_sharp_crease { 2 } else { 1 };
-                if span.faces != wanted {
-                    return false;
-                }
+            if t.inf_sharp_crease && t.boundary {
+                return false;
+            }
+            let span = corner_span(mesh, f, i);
+            let wanted = if t.inf_sharp_crease { 2 } else { 1 };
+            if span.faces != wanted {
+                return false;
             }
         }
-        true
     }
+    true
 }
 
 /// The tags Far keeps per vertex (`Vtr::internal::Level::VTag`), for the complete vertices
 /// of a local mesh. They are recomputed from the vertex's ring at every level; Far inherits
 /// them from level to level, which gives the same values for manifold cages.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct VTag {
-    boundary: bool,
-    corner: bool,
-    xordinary: bool,
-    inf_sharp: bool,
-    semi_sharp: bool,
-    inf_sharp_edges: bool,
-    semi_sharp_edges: bool,
-    inf_sharp_crease: bool,
-    inf_irregular: bool,
-    incident_irregular_face: bool,
+pub(super) struct VTag {
+    pub(super) boundary: bool,
+    pub(super) corner: bool,
+    pub(super) xordinary: bool,
+    pub(super) inf_sharp: bool,
+    pub(super) semi_sharp: bool,
+    pub(super) inf_sharp_edges: bool,
+    pub(super) semi_sharp_edges: bool,
+    pub(super) inf_sharp_crease: bool,
+    pub(super) inf_irregular: bool,
+    pub(super) incident_irregular_face: bool,
     /// Bit set of the rules (`1` smooth, `2` dart, `4` crease, `8` corner), so that a union
     /// over corners says which rules occur, as Far's composite tag does.
-    rules: u8,
+    pub(super) rules: u8,
 }
 
 impl VTag {
@@ -246,10 +287,10 @@ impl VTag {
     }
 }
 
-const SMOOTH: u8 = 1;
-const DART: u8 = 2;
-const CREASE: u8 = 4;
-const CORNER: u8 = 8;
+pub(super) const SMOOTH: u8 = 1;
+pub(super) const DART: u8 = 2;
+pub(super) const CREASE: u8 = 4;
+pub(super) const CORNER: u8 = 8;
 
 fn rule_bit(rule: VertexRule) -> u8 {
     match rule {
@@ -260,13 +301,13 @@ fn rule_bit(rule: VertexRule) -> u8 {
     }
 }
 
-fn is_infinite(s: f32) -> bool {
+pub(super) fn is_infinite(s: f32) -> bool {
     s >= INFINITELY_SHARP
 }
 
 /// Far's vertex tags (`far/topologyRefinerFactory.cpp`, `prepareComponentTagsAndSharpness`)
-/// of a complete vertex.
-fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
+/// of a complete vertex of a local mesh of `scheme`.
+pub(super) fn vertex_tag(mesh: &Cage, v: usize, scheme: Scheme) -> VTag {
     let edges = mesh.vertex_edges(v);
     let faces = mesh.vertex_faces(v);
     let sharpness: Vec<f32> = edges.iter().map(|&e| mesh.edge_sharpness[e as usize]).collect();
@@ -281,11 +322,18 @@ fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
         inf_sharp_edges: inf_edges > 0,
         semi_sharp_edges: semi_edges > 0,
         rules: rule_bit(VertexRule::from_sharp_edge_count(vs, inf_edges + semi_edges)),
-        incident_irregular_face: faces.iter().any(|fc| mesh.face(fc.face as usize).len() != 4),
+        incident_irregular_face: faces
+            .iter()
+            .any(|fc| mesh.face(fc.face as usize).len() != scheme.face_size()),
         ..VTag::default()
     };
     t.corner = faces.len() == 1 && edges.len() == 2 && t.inf_sharp;
-    t.xordinary = !t.corner && if boundary { faces.len() != 2 } else { faces.len() != 4 };
+    t.xordinary = !t.corner
+        && if boundary {
+            faces.len() != scheme.boundary_faces()
+        } else {
+            faces.len() != scheme.interior_faces()
+        };
     t.inf_irregular = t.inf_sharp || t.inf_sharp_edges;
     if t.inf_sharp_edges {
         let inf_rule = VertexRule::from_sharp_edge_count(if t.inf_sharp { vs } else { 0.0 }, inf_edges);
@@ -293,8 +341,14 @@ fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
             VertexRule::Crease => {
                 t.inf_sharp_crease = true;
                 if !t.xordinary {
-                    t.inf_irregular =
-                        if boundary { false } else { is_infinite(sharpness[0]) != is_infinite(sharpness[2]) };
+                    // A regular crease bisects the ring: its sharp edges are opposite.
+                    let opposite =
+                        |a: usize| is_infinite(sharpness[a]) != is_infinite(sharpness[a + edges.len() / 2]);
+                    t.inf_irregular = !boundary
+                        && match scheme {
+                            Scheme::Catmark => opposite(0),
+                            Scheme::Loop => opposite(0) || opposite(1),
+                        };
                 }
             }
             // A regular set of infinitely sharp corners: every edge sharp, not a smooth corner.
@@ -308,14 +362,15 @@ fn vertex_tag(mesh: &Cage, v: usize) -> VTag {
 }
 
 /// `doesFaceHaveFeatures` (`far/topologyRefiner.cpp`) with Bfr's adaptive options
-/// (`useInfSharpPatch`, no single-crease patches): `full` is the feature set of the levels up
-/// to the smooth depth, else the reduced one of the deeper levels.
-fn face_has_features(mesh: &Cage, f: usize, level: u8, full: bool) -> bool {
+/// (`useInfSharpPatch`, no single-crease patches), for a face of a local mesh of `scheme`:
+/// `full` is the feature set of the levels up to the smooth depth, else the reduced one of
+/// the deeper levels.
+pub(super) fn face_has_features(mesh: &Cage, f: usize, level: u8, full: bool, scheme: Scheme) -> bool {
     let corners = mesh.face(f);
-    if corners.len() != 4 {
+    if corners.len() != scheme.face_size() {
         return true;
     }
-    let tags: Vec<VTag> = corners.iter().map(|&v| vertex_tag(mesh, v as usize)).collect();
+    let tags: Vec<VTag> = corners.iter().map(|&v| vertex_tag(mesh, v as usize, scheme)).collect();
     let comp = VTag::union(&tags);
     if comp.incident_irregular_face && level == 0 {
         return true;
@@ -361,7 +416,7 @@ fn inf_sharp_tag_has_features(t: &VTag, full: bool) -> bool {
     }
 }
 
-/// `doesInfSharpFaceHaveFeatures` for quads.
+/// `doesInfSharpFaceHaveFeatures`.
 fn inf_sharp_face_has_features(comp: &VTag, tags: &[VTag], full: bool) -> bool {
     if comp.rules & SMOOTH != 0 {
         return inf_sharp_tag_has_features(comp, full);
@@ -374,7 +429,7 @@ fn inf_sharp_face_has_features(comp: &VTag, tags: &[VTag], full: bool) -> bool {
 /// edge `k`.
 fn boundary_mask(mesh: &Cage, f: usize) -> u8 {
     let corners = mesh.face(f);
-    let any_inf = corners.iter().any(|&v| vertex_tag(mesh, v as usize).inf_sharp_edges);
+    let any_inf = corners.iter().any(|&v| vertex_tag(mesh, v as usize, Scheme::Catmark).inf_sharp_edges);
     if !any_inf {
         return 0;
     }
@@ -389,18 +444,18 @@ fn boundary_mask(mesh: &Cage, f: usize) -> u8 {
 
 /// The faces around a corner between the singular (boundary or infinitely sharp) edges that
 /// enclose face `f` (`identifyManifoldCornerSpan`, `far/patchBuilder.cpp`).
-struct Span {
+pub(super) struct Span {
     /// Index into the vertex's faces of the span's first face (the one after its leading
     /// singular edge).
-    start: usize,
-    faces: usize,
+    pub(super) start: usize,
+    pub(super) faces: usize,
     /// Where `f` is in the span.
-    corner_in_span: usize,
+    pub(super) corner_in_span: usize,
     /// No singular edge was found: the span is the whole (interior) ring.
-    periodic: bool,
+    pub(super) periodic: bool,
 }
 
-fn corner_span(mesh: &Cage, f: usize, corner: usize) -> Span {
+pub(super) fn corner_span(mesh: &Cage, f: usize, corner: usize) -> Span {
     let v = mesh.face(f)[corner] as usize;
     let edges = mesh.vertex_edges(v);
     let n = edges.len();
@@ -444,7 +499,7 @@ fn corner_span(mesh: &Cage, f: usize, corner: usize) -> Span {
 fn gregory_source(mesh: &Cage, f: usize) -> GregorySource {
     let corners: [GregoryCorner; 4] = std::array::from_fn(|i| {
         let v = mesh.face(f)[i] as usize;
-        let t = vertex_tag(mesh, v);
+        let t = vertex_tag(mesh, v, Scheme::Catmark);
         let fan = mesh.vertex_faces(v);
         let dart = t.rules & DART != 0 && t.inf_sharp_edges;
         let test_edges = t.inf_sharp_edges && t.rules != DART;
@@ -605,7 +660,7 @@ fn refine(mesh: &Cage, f: usize, aligned: bool) -> (Cage, Vec<usize>) {
 
 /// The sharpness of edge `e`'s child at its end `v` (a complete vertex): Sdc's rule for
 /// semi-sharp edges (uniform or Chaikin), smooth and infinitely sharp edges unchanged.
-fn child_sharpness(mesh: &Cage, e: u32, v: u32) -> f32 {
+pub(super) fn child_sharpness(mesh: &Cage, e: u32, v: u32) -> f32 {
     let s = mesh.edge_sharpness[e as usize];
     if s <= 0.0 || is_infinite(s) {
         return s;
@@ -662,7 +717,7 @@ fn vertex_point(mesh: &Cage, v: usize, face_point: &dyn Fn(usize) -> DVec3) -> D
 
 /// The neighbourhood of face `face` of the cage as a local mesh (the faces around its
 /// corners), and the face's index in it.
-fn neighbourhood(cage: &Cage, face: usize) -> (Cage, usize) {
+pub(super) fn neighbourhood(cage: &Cage, face: usize) -> (Cage, usize) {
     let corners = cage.face(face);
     let mut faces = vec![face as u32];
     for &v in corners {

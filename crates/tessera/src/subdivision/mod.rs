@@ -17,7 +17,9 @@ mod catmull_clark;
 pub mod gregory;
 pub mod isolation;
 pub mod loop_gregory;
+pub mod loop_isolation;
 pub mod loop_sdc;
+mod loop_surface;
 pub mod sdc;
 pub mod stencils;
 

@@ -19,6 +19,7 @@ pub(crate) mod polygon_mesh;
 mod quartic_triangle;
 mod set;
 pub mod subdivision_tags;
+pub mod triangle_tree;
 
 /// The parameter domains live in [`crate::domain`]; re-exported here for the surfaces' users.
 pub use crate::domain::Domain;
@@ -32,6 +33,7 @@ pub use polygon_mesh::{PolygonFace, PolygonMesh};
 pub use quartic_triangle::QuarticTriangle;
 pub(crate) use set::corner_and_edge_points;
 pub use set::{split_normal_vertices, BuildOptions, Orientation, Repairs, SurfaceSet};
+pub use triangle_tree::TriangleTree;
 
 use glam::{DVec2, DVec3};
 
@@ -66,6 +68,11 @@ pub enum Patch {
     /// isolation, B-spline patches and Gregory end caps, over the unit square
     /// ([`crate::subdivision::isolation`], [`patch_tree`]).
     Subdivision(Box<PatchTree>),
+    /// The Loop limit surface over a triangle of a cage: the pieces of its feature-adaptive
+    /// isolation, quartic box-spline triangles and Gregory triangles, over the unit triangle
+    /// ([`crate::subdivision::loop_isolation`], [`triangle_tree`]); a regular triangle is one
+    /// piece.
+    Loop(Box<TriangleTree>),
 }
 
 impl Patch {
@@ -73,7 +80,7 @@ impl Patch {
     pub fn domain(&self) -> Domain {
         match self {
             Patch::Bicubic(_) | Patch::Subdivision(_) => Domain::Quad,
-            Patch::BezierTriangle(_) | Patch::Pn(_) => Domain::Tri,
+            Patch::BezierTriangle(_) | Patch::Pn(_) | Patch::Loop(_) => Domain::Tri,
         }
     }
 
@@ -84,6 +91,7 @@ impl Patch {
             Patch::BezierTriangle(p) => p.eval(uv),
             Patch::Pn(p) => p.eval(uv),
             Patch::Subdivision(t) => subdivision_point(t, uv, t.derivatives(uv)),
+            Patch::Loop(t) => loop_point(t, uv),
         }
     }
 
@@ -121,6 +129,7 @@ impl Patch {
             Patch::BezierTriangle(p) => p.position(uv),
             Patch::Pn(p) => p.geometry.position(uv),
             Patch::Subdivision(t) => t.position(uv),
+            Patch::Loop(t) => t.position(uv),
         }
     }
 
@@ -134,6 +143,7 @@ impl Patch {
                 let (position, du, dv) = t.derivatives(uv);
                 SurfaceDerivatives { position, du, dv }
             }
+            Patch::Loop(t) => t.derivatives(uv),
         }
     }
 
@@ -145,6 +155,7 @@ impl Patch {
             Patch::BezierTriangle(p) => Patch::BezierTriangle(p.swapped_uv()),
             Patch::Pn(p) => Patch::Pn(p.flipped()),
             Patch::Subdivision(t) => Patch::Subdivision(Box::new(t.transposed())),
+            Patch::Loop(t) => Patch::Loop(Box::new(t.swapped())),
         }
     }
 
@@ -155,6 +166,7 @@ impl Patch {
             Patch::BezierTriangle(p) => &p.points,
             Patch::Pn(p) => &p.geometry.points,
             Patch::Subdivision(t) => t.control_points(),
+            Patch::Loop(t) => t.control_points(),
         }
     }
 }
@@ -179,6 +191,25 @@ pub(crate) fn subdivision_point(
         },
     );
     SurfacePoint { position, normal }
+}
+
+/// A Loop patch's point at `uv`, its normal from its derivatives (the limit normal where they
+/// degenerate, as for the other triangles).
+fn loop_point(t: &TriangleTree, uv: DVec2) -> SurfacePoint {
+    let d = t.derivatives(uv);
+    let inside = DVec2::splat(1.0 / 3.0) - uv;
+    let normal = robust_normal(
+        d.du,
+        d.dv,
+        uv,
+        inside,
+        || DVec3::ZERO,
+        |q| {
+            let d = t.derivatives(q);
+            d.du.cross(d.dv)
+        },
+    );
+    SurfacePoint { position: d.position, normal }
 }
 
 /// A unit normal from the first derivatives, falling back to the limit normal where they are

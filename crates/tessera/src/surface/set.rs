@@ -250,7 +250,7 @@ impl SurfaceSet {
                     Patch::Pn(b) => b.geometry.points.copy_from_slice(&snapped),
                     // A subdivision patch's points are its pieces', not one net to snap;
                     // cages are tied by their own topology, not by welding.
-                    Patch::Subdivision(_) => {}
+                    Patch::Subdivision(_) | Patch::Loop(_) => {}
                 }
             }
             let (corners, edges) = corner_and_edge_points(p.domain());

@@ -1,6 +1,8 @@
 //! Shared helpers for the integration tests: where the models are, and loading them.
 #![allow(dead_code)]
 
+pub mod osd;
+
 use glam::DVec3;
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,233 @@
+//! Piecewise patches of Loop subdivision surfaces: the leaves of a triangle's
+//! feature-adaptive isolation (quartic Bézier pieces of the regular box splines and Gregory
+//! triangle end caps) in a triangle quadtree, evaluated as OpenSubdiv's Bfr evaluates its
+//! `PatchTree` for triangles (`bfr/patchTree.cpp`). Built by
+//! [`crate::subdivision::loop_isolation`].
+//!
+//! **The quadtree.** A node covers a triangle of its square `origin + [0, size]²`: *upright*,
+//! the lower-left half (corners `origin`, `origin + (size, 0)`, `origin + (0, size)`), or
+//! *turned* by 180°, the upper-right half (its right-angle corner at `origin + (size, size)`).
+//! Its children, by Bfr's quadrant numbers: 0, 1, 2 the triangles at its own corners 0, 1, 2
+//! (upright for an upright node, turned for a turned one), and 3 the middle triangle, turned
+//! the other way. A leaf's own parameters `st` are measured from its right-angle corner along
+//! its legs, so a turned leaf's `st` run against the face's `uv` and its derivatives change
+//! sign (`Far::PatchParam::NormalizeTriangle`, `Far::internal::EvaluatePatchBasis`).
+//!
+//! **Bfr's search, quirk included.** [`TriangleTree::find`] walks the nodes as
+//! `bfr/patchTree.cpp` does, including where that walk differs from the geometry: Bfr's copy
+//! of `transformUVToTriQuadrant` keeps its "turned" flag set when it takes the middle child of
+//! a turned node (upright), where `far/patchMap.h`'s original clears it. A point whose path
+//! takes the middle child twice and goes deeper is then sent to a neighbouring leaf, whose
+//! polynomial is evaluated a little outside its triangle. The surfaces of neighbouring leaves
+//! agree to the isolation's accuracy there, and tessera follows Bfr so that its points are
+//! Bfr's (the oracle of issue 28); see `tools/osd-oracle/NOTES.md`, section 10.
+
+use glam::{DVec2, DVec3};
+
+use super::{GregoryTriangle, QuarticTriangle, SurfaceDerivatives};
+
+/// One leaf of a triangle's patch tree.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleLeaf {
+    /// The lower-left corner of the leaf's square.
+    pub origin: DVec2,
+    /// The square's side, `2^-level`.
+    pub size: f64,
+    /// The refinement level the leaf was made at (0: the face itself).
+    pub level: u8,
+    /// The leaf is the upper-right half of its square (module doc).
+    pub turned: bool,
+    pub patch: TriangleLeafPatch,
+}
+
+/// The surface over a leaf.
+#[derive(Debug, Clone, PartialEq)]
+// Quartic leaves are nearly all the leaves: inline, so evaluating one reads one block.
+#[allow(clippy::large_enum_variant)]
+pub enum TriangleLeafPatch {
+    /// A regular piece: its box spline as a quartic Bézier triangle.
+    Quartic(QuarticTriangle),
+    /// An end cap. Boxed: end caps are few, and inline every leaf would take their size.
+    Gregory(Box<GregoryTriangle>),
+}
+
+impl TriangleLeafPatch {
+    /// The piece's points: a quartic triangle's 15, or a Gregory triangle's 18.
+    pub fn points(&self) -> &[DVec3] {
+        match self {
+            TriangleLeafPatch::Quartic(q) => &q.points,
+            TriangleLeafPatch::Gregory(g) => &g.points,
+        }
+    }
+
+    /// Position and derivatives with respect to the leaf's own parameters.
+    fn derivatives(&self, st: DVec2) -> SurfaceDerivatives {
+        match self {
+            TriangleLeafPatch::Quartic(q) => q.derivatives(st),
+            TriangleLeafPatch::Gregory(g) => g.derivatives(st),
+        }
+    }
+}
+
+/// A child slot of a node: another node or a leaf, by index.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TriangleSlot {
+    Node(u32),
+    Leaf(u32),
+}
+
+/// The piecewise surface over one triangle of a Loop cage, with parameters in the triangle
+/// `u, v ≥ 0, u + v ≤ 1`: the leaves of its isolation and the quadtree that finds the leaf of
+/// a parameter point, as Bfr's `PatchTree` does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleTree {
+    leaves: std::sync::Arc<[TriangleLeaf]>,
+    nodes: std::sync::Arc<[[TriangleSlot; 4]]>,
+    root: TriangleSlot,
+    /// `u` and `v` are exchanged on the way in and out: the surface with the opposite
+    /// orientation ([`TriangleTree::swapped`]).
+    swapped: bool,
+    /// The bounding box of the leaves' points (the surface lies in their convex hull).
+    hull: [DVec3; 8],
+}
+
+impl TriangleTree {
+    /// A tree of `leaves` with quadtree `nodes` under `root` (children by Bfr's quadrant
+    /// numbers, module doc). Precondition: the leaves tile the unit triangle as the nodes
+    /// say. Cost: O(leaves).
+    pub(crate) fn from_parts(
+        leaves: Vec<TriangleLeaf>,
+        nodes: Vec<[TriangleSlot; 4]>,
+        root: TriangleSlot,
+    ) -> Self {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in leaves.iter().flat_map(|l| l.patch.points()) {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let hull = std::array::from_fn(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        });
+        TriangleTree { leaves: leaves.into(), nodes: nodes.into(), root, swapped: false, hull }
+    }
+
+    /// A tree of one leaf covering the whole triangle: a regular face.
+    pub fn single(patch: TriangleLeafPatch) -> Self {
+        let leaf = TriangleLeaf { origin: DVec2::ZERO, size: 1.0, level: 0, turned: false, patch };
+        Self::from_parts(vec![leaf], Vec::new(), TriangleSlot::Leaf(0))
+    }
+
+    /// The leaves.
+    pub fn leaves(&self) -> &[TriangleLeaf] {
+        &self.leaves
+    }
+
+    /// The corners of the bounding box of every leaf's points: the surface lies in their
+    /// convex hull.
+    pub fn control_points(&self) -> &[DVec3] {
+        &self.hull
+    }
+
+    /// Appends every leaf's points to `out`, leaf by leaf (15 for a quartic leaf, 18 for a
+    /// Gregory one). Cost: O(leaves).
+    pub fn leaf_points(&self, out: &mut Vec<DVec3>) {
+        for leaf in self.leaves.iter() {
+            out.extend_from_slice(leaf.patch.points());
+        }
+    }
+
+    /// Whether `u` and `v` are exchanged ([`TriangleTree::swapped`]).
+    pub fn is_swapped(&self) -> bool {
+        self.swapped
+    }
+
+    /// The same surface with `u` and `v` exchanged: the opposite orientation.
+    pub fn swapped(&self) -> TriangleTree {
+        TriangleTree { swapped: !self.swapped, ..self.clone() }
+    }
+
+    /// The leaf Bfr's search finds for `uv` (module doc: its quirk included), and `uv` in
+    /// that leaf's own parameters. Points on a border between leaves go where Bfr's
+    /// comparisons send them. Cost: O(depth).
+    pub fn find(&self, uv: DVec2) -> (usize, DVec2) {
+        let uv = if self.swapped { DVec2::new(uv.y, uv.x) } else { uv };
+        let (mut u, mut v) = (uv.x, uv.y);
+        let mut slot = self.root;
+        let mut median = 0.5;
+        // Bfr's flag, which is not always the node's own orientation (module doc).
+        let mut turned = false;
+        let leaf = loop {
+            match slot {
+                TriangleSlot::Leaf(i) => break i as usize,
+                TriangleSlot::Node(n) => {
+                    let quadrant = if !turned {
+                        if u >= median {
+                            u -= median;
+                            1
+                        } else if v >= median {
+                            v -= median;
+                            2
+                        } else if u + v >= median {
+                            turned = true;
+                            3
+                        } else {
+                            0
+                        }
+                    } else if u < median {
+                        v -= median;
+                        1
+                    } else if v < median {
+                        u -= median;
+                        2
+                    } else {
+                        u -= median;
+                        v -= median;
+                        // Bfr keeps the flag here (module doc).
+                        if u + v < median {
+                            3
+                        } else {
+                            0
+                        }
+                    };
+                    slot = self.nodes[n as usize][quadrant];
+                    median *= 0.5;
+                }
+            }
+        };
+        (leaf, Self::leaf_st(&self.leaves[leaf], uv))
+    }
+
+    /// `uv` (the tree's own, not swapped) in `leaf`'s parameters.
+    #[inline]
+    fn leaf_st(leaf: &TriangleLeaf, uv: DVec2) -> DVec2 {
+        if leaf.turned {
+            (leaf.origin + DVec2::splat(leaf.size) - uv) / leaf.size
+        } else {
+            (uv - leaf.origin) / leaf.size
+        }
+    }
+
+    /// Position and first derivatives with respect to the patch's `uv`. Cost: a tree walk and
+    /// one leaf's evaluation.
+    pub fn derivatives(&self, uv: DVec2) -> SurfaceDerivatives {
+        let (leaf, st) = self.find(uv);
+        let leaf = &self.leaves[leaf];
+        let d = leaf.patch.derivatives(st);
+        let scale = if leaf.turned { -1.0 / leaf.size } else { 1.0 / leaf.size };
+        let (du, dv) = (d.du * scale, d.dv * scale);
+        if self.swapped {
+            SurfaceDerivatives { position: d.position, du: dv, dv: du }
+        } else {
+            SurfaceDerivatives { position: d.position, du, dv }
+        }
+    }
+
+    /// Position at `uv`.
+    pub fn position(&self, uv: DVec2) -> DVec3 {
+        self.derivatives(uv).position
+    }
+}
