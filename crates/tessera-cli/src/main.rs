@@ -88,15 +88,16 @@ pub struct InputArgs {
     allow_outside_uris: bool,
     /// The surface a mesh input stands for. `auto`: the Catmull-Clark limit surface of an
     /// OBJ with any face that is not a triangle (a subdivision cage, with OpenSubdiv's tags),
-    /// PN triangles for everything else.
+    /// PN triangles for everything else. `loop`: the Loop limit surface of a triangle cage
+    /// (CPU engine only, so far).
     #[arg(long, value_enum, default_value_t = SurfaceArg::Auto)]
     surface: SurfaceArg,
-    /// How many levels Catmull-Clark cages isolate smooth features (extraordinary vertices,
+    /// How many levels subdivision cages isolate smooth features (extraordinary vertices,
     /// smooth boundary corners) before Gregory end caps; 2 is OpenSubdiv Bfr's default, more
     /// comes closer to the exact limit surface.
     #[arg(long, value_name = "LEVELS", default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=10))]
     isolation_smooth: u8,
-    /// How many levels Catmull-Clark cages isolate sharp features (semi-sharp creases and
+    /// How many levels subdivision cages isolate sharp features (semi-sharp creases and
     /// corners); 6 is OpenSubdiv Bfr's default.
     #[arg(long, value_name = "LEVELS", default_value_t = 6, value_parser = clap::value_parser!(u8).range(1..=10))]
     isolation_sharp: u8,

@@ -114,7 +114,7 @@ impl SurfaceSet {
         }
     }
 
-    /// Whether the set is the Catmull-Clark limit surface of a subdivision cage.
+    /// Whether the set is the limit surface of a subdivision cage (Catmull-Clark or Loop).
     #[getter]
     fn is_subdivision_cage(&self) -> bool {
         !self.set.origins.is_empty()

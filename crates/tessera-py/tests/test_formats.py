@@ -125,4 +125,7 @@ def test_surface_kinds(data):
     with pytest.raises(tessera.ParameterError, match="surface"):
         tessera.load(cube, surface="bezier")
     with pytest.raises(tessera.UnsupportedInputError, match="catmark_cube.obj"):
-        tessera.load(cube, surface="loop")
+        tessera.load(cube, surface="loop")  # Loop subdivides triangles only
+    tri = tessera.load(data / "subdivision" / "loop_cube.obj", surface="loop")
+    assert tri.is_subdivision_cage and tri.patch_count == 24
+    assert sorted(set(tri.patch_faces)) == list(range(24))

@@ -66,7 +66,8 @@ pub enum SurfaceKind {
     /// The Catmull-Clark limit surface of the mesh as a cage, as OpenSubdiv's Bfr evaluates
     /// it ([`SurfaceSet::from_subdivision_cage`]); triangles too (OpenSubdiv's rule).
     CatmullClark,
-    /// The Loop limit surface of a triangle cage (not implemented yet: refused).
+    /// The Loop limit surface of the mesh as a triangle cage, as OpenSubdiv's Bfr evaluates
+    /// it ([`SurfaceSet::from_loop_cage`]); any other face is refused.
     Loop,
 }
 
@@ -108,12 +109,12 @@ fn mesh_surfaces(
         k => k,
     };
     match kind {
-        SurfaceKind::CatmullClark => {
+        SurfaceKind::CatmullClark | SurfaceKind::Loop => {
             if split > 0 {
                 return Err(Error::unsupported(
                     path,
                     0,
-                    format!("{split} polygons of this format are read as triangle fans; give the cage as .obj for its Catmull-Clark surface"),
+                    format!("{split} polygons of this format are read as triangle fans; give the cage as .obj for its subdivision surface"),
                 ));
             }
             let cage = crate::subdivision::CageOptions {
@@ -121,15 +122,14 @@ fn mesh_surfaces(
                 flip: options.build.flip,
                 isolation: options.isolation,
             };
-            let mut set = SurfaceSet::from_subdivision_cage(&mesh, path, cage)?;
+            let mut set = if kind == SurfaceKind::Loop {
+                SurfaceSet::from_loop_cage(&mesh, path, cage)?
+            } else {
+                SurfaceSet::from_subdivision_cage(&mesh, path, cage)?
+            };
             set.repairs.unknown_tag_lines = mesh.tags.unknown.len();
             Ok(set)
         }
-        SurfaceKind::Loop => Err(Error::unsupported(
-            path,
-            0,
-            "Loop subdivision surfaces are not implemented yet (--surface catmull-clark or pn)",
-        )),
         SurfaceKind::Pn | SurfaceKind::Auto => {
             let mut mesh = mesh;
             let split = split + mesh.split_polygons();
