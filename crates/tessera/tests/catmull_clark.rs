@@ -320,14 +320,16 @@ fn bad_cages_are_refused_naming_the_line() {
 }
 
 /// Random cages — pieces of a grid of quads and triangles with random creases, corners, holes
-/// and boundary rules — build and tessellate without a panic, and the output is watertight
-/// with the cage's topology whenever the cage is accepted.
+/// and boundary rules, as Catmull-Clark cages and, quads split, as Loop cages — build and
+/// tessellate without a panic, and the output is watertight with the cage's topology
+/// whenever the cage is accepted.
 #[test]
 fn random_cages_build_and_are_watertight() {
     use tessera::io::obj::parse_obj;
     use tessera::subdivision::CageOptions;
     let mut rng = tessera::test_support::Lcg(11);
     let file = Path::new("random.obj");
+    let mut tessellated = [0; 2];
     for case in 0..60 {
         let (w, h) = (2 + rng.below(4), 2 + rng.below(4));
         let mut text = String::new();
@@ -380,25 +382,42 @@ fn random_cages_build_and_are_watertight() {
             text += &format!("t hole 1/0/0 {}\n", rng.below(faces));
         }
         text += &format!("t interpolateboundary 1/0/0 {}\n", rng.below(3));
-        let Ok(mesh) = parse_obj(&text, file) else { continue };
-        let set = match SurfaceSet::from_subdivision_cage(&mesh, file, CageOptions::default()) {
-            Ok(set) => set,
-            // Pieces that touch at a vertex only are non-manifold; all holes leave nothing.
-            Err(e) => {
-                let e = e.to_string();
-                assert!(
-                    e.contains("more than one fan") || e.contains("no face of the cage"),
-                    "case {case}: {e}\n{text}"
-                );
-                continue;
-            }
-        };
-        let plan = tessera::criterion::Plan::uniform(&set, 1 + rng.below(4) as u32).unwrap();
-        let mesh =
-            tessellate(&set, &plan, &tessera::pattern::uniform::Uniform, EngineOptions::default()).unwrap();
-        common::expect_topology(&set, &plan, &mesh, &format!("case {case}"));
-        assert!(mesh.positions.iter().all(|p| p.iter().all(|c| c.is_finite())), "case {case}");
+        // The same cage as Catmull-Clark, and with its quads split in two as a Loop cage.
+        let triangles: String = text
+            .lines()
+            .map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+                ["f", a, b, c, d] => format!("f {a} {b} {c}\nf {a} {c} {d}\n"),
+                _ => format!("{l}\n"),
+            })
+            .collect();
+        for (kind, text) in [(SurfaceKind::CatmullClark, &text), (SurfaceKind::Loop, &triangles)] {
+            let Ok(mesh) = parse_obj(text, file) else { continue };
+            let built = if kind == SurfaceKind::Loop {
+                SurfaceSet::from_loop_cage(&mesh, file, CageOptions::default())
+            } else {
+                SurfaceSet::from_subdivision_cage(&mesh, file, CageOptions::default())
+            };
+            let set = match built {
+                Ok(set) => set,
+                // Pieces that touch at a vertex only are non-manifold; all holes leave nothing.
+                Err(e) => {
+                    let e = e.to_string();
+                    assert!(
+                        e.contains("more than one fan") || e.contains("no face of the cage"),
+                        "case {case} {kind:?}: {e}\n{text}"
+                    );
+                    continue;
+                }
+            };
+            let plan = tessera::criterion::Plan::uniform(&set, 1 + rng.below(4) as u32).unwrap();
+            let mesh = tessellate(&set, &plan, &tessera::pattern::uniform::Uniform, EngineOptions::default())
+                .unwrap();
+            common::expect_topology(&set, &plan, &mesh, &format!("case {case} {kind:?}"));
+            assert!(mesh.positions.iter().all(|p| p.iter().all(|c| c.is_finite())), "case {case} {kind:?}");
+            tessellated[usize::from(kind == SurfaceKind::Loop)] += 1;
+        }
     }
+    assert!(tessellated.iter().all(|&n| n >= 20), "too few cages built: {tessellated:?}");
 }
 
 /// The cages' stencils (`CageStencils`): moved vertices give the surface of the moved cage

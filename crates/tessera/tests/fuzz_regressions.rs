@@ -303,6 +303,8 @@ fn parser_checks_survive_mutated_real_files() {
     check_mutations("obj", "catmark_cube", &model_bytes("cages/catmark_cube.obj"), 64);
     // OpenSubdiv's tag lines (creases, corners, holes, boundary rule).
     check_mutations("obj", "hole_test2", &model_bytes("subdivision/catmark_hole_test2.obj"), 48);
+    // A creased triangle cage: its mutations take the Loop rules' paths too.
+    check_mutations("obj", "loop_cube_creases0", &model_bytes("subdivision/loop_cube_creases0.obj"), 48);
     check_mutations("obj", "dragknob", &model_bytes("meshes/dragknob.obj"), 32);
     check_mutations("patches", "teapot", &model_bytes("patches/teapot.patches"), 48);
     check_mutations("patches", "teacup", &model_bytes("patches/teacup.patches"), 16);

@@ -74,3 +74,62 @@ fn every_loop_face_agrees_with_bfr() {
     assert!(compared >= 11, "only {compared} Loop cages compared");
     assert!(worst_overall.0 < 1e-6, "worst {:.3e} at {}", worst_overall.0, worst_overall.1);
 }
+
+/// tessera's output itself, in f32: the uniform tessellation at factor N of every manifold
+/// Loop cage has, vertex for vertex, Bfr's tessellation points at rate N (every patch is one
+/// triangle over Bfr's own parameters) within 1e-5 of the diagonal, and as many vertices as
+/// Bfr's distinct points.
+#[test]
+fn the_f32_output_is_bfrs_tessellation() {
+    use glam::DVec3;
+    use tessera::criterion::Plan;
+    use tessera::engine::{tessellate, EngineOptions};
+    use tessera::pattern::uniform::Uniform;
+    let mut worst = (0.0f64, String::new());
+    for path in loop_cages() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name == NON_MANIFOLD {
+            continue;
+        }
+        let mesh = read_obj(&path).unwrap();
+        let options = CageOptions { orientation: Orientation::AsGiven, ..Default::default() };
+        let set = SurfaceSet::from_loop_cage(&mesh, &path, options).unwrap();
+        let diagonal = cage_diagonal(&mesh);
+        for n in [1u32, 2, 3, 5] {
+            let faces = run_oracle(&path, n);
+            let plan = Plan::uniform(&set, n).unwrap();
+            let out = tessellate(&set, &plan, &Uniform, EngineOptions::default()).unwrap();
+            let grid = |x: f64| (x * n as f64).round() as i64;
+            let bfr: std::collections::HashMap<(u32, i64, i64), DVec3> = faces
+                .iter()
+                .enumerate()
+                .flat_map(|(f, face)| {
+                    face.points.iter().map(move |&(uv, p)| ((f as u32, grid(uv.x), grid(uv.y)), p))
+                })
+                .collect();
+            for (v, q) in out.positions.iter().enumerate() {
+                let face = set.origins[out.vertex_patch[v] as usize].face;
+                let key = (face, grid(out.uvs[v][0] as f64), grid(out.uvs[v][1] as f64));
+                let expected = *bfr
+                    .get(&key)
+                    .unwrap_or_else(|| panic!("{name} n={n}: output vertex {v} at {key:?} is no Bfr point"));
+                let d = (DVec3::new(q[0] as f64, q[1] as f64, q[2] as f64) - expected).length() / diagonal;
+                if d > worst.0 {
+                    worst = (d, format!("{name} n={n} face {face}"));
+                }
+            }
+            // Bfr writes a shared point once per face; the output once.
+            let mut distinct: Vec<[i64; 3]> =
+                bfr.values().map(|p| (*p / (1e-9 * diagonal)).round().as_i64vec3().to_array()).collect();
+            distinct.sort_unstable();
+            distinct.dedup();
+            assert_eq!(
+                out.positions.len(),
+                distinct.len(),
+                "{name} n={n}: vertices against Bfr's distinct points"
+            );
+        }
+    }
+    eprintln!("worst f32 output vertex: {:.3e} of the diagonal ({})", worst.0, worst.1);
+    assert!(worst.0 < 1e-5, "worst {:.3e} at {}", worst.0, worst.1);
+}

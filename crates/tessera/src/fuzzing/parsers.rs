@@ -22,9 +22,9 @@ use super::*;
 
 /// Checks the OBJ reader: [`obj::parse_obj`] on the bytes (decoded as `read_obj` does, with
 /// invalid UTF-8 replaced). A parsed mesh must keep its documented invariants, must build its
-/// Catmull-Clark surface (a cage with tags) and PN triangles or refuse them with an error, and,
-/// as a triangle list, must survive [`write_obj`] → [`obj::parse_obj`] with the same positions
-/// and triangles.
+/// Catmull-Clark and Loop surfaces (a cage with tags) and PN triangles or refuse them with an
+/// error, and, as a triangle list, must survive [`write_obj`] → [`obj::parse_obj`] with the
+/// same positions and triangles.
 pub fn check_obj(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let Ok(mesh) = obj::parse_obj(&text, label()) else { return };
@@ -32,6 +32,11 @@ pub fn check_obj(data: &[u8]) {
     if mesh.faces.len() <= ENGINE_PATCH_LIMIT {
         let options = crate::subdivision::CageOptions::default();
         if let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, label(), options) {
+            tessellate_small(&set);
+        }
+        // The same cage under Loop's rules (refused, not a panic, where a face is not a
+        // triangle).
+        if let Ok(set) = SurfaceSet::from_loop_cage(&mesh, label(), options) {
             tessellate_small(&set);
         }
     }

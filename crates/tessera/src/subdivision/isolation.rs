@@ -494,35 +494,54 @@ pub(super) fn corner_span(mesh: &Cage, f: usize, corner: usize) -> Span {
     span
 }
 
+/// The fan of faces around corner `i` of face `f` that a Gregory end cap reads, and how the
+/// corner is treated (`PatchBuilder::GetIrregularPatchCornerSpans`, `far/patchBuilder.cpp`):
+/// the whole ring, or, where infinitely sharp edges cut it (and the vertex is not a dart),
+/// the span between the two sharp edges around `f`, which is then an open fan.
+pub(super) struct CornerFan {
+    pub(super) faces: Vec<FaceCorner>,
+    /// Where `f` is in `faces`.
+    pub(super) patch_face: usize,
+    /// The fan is open (the mesh's boundary, or a span).
+    pub(super) boundary: bool,
+    /// The corner is treated as infinitely sharp.
+    pub(super) sharp: bool,
+    /// The vertex is a dart with an infinitely sharp edge.
+    pub(super) dart: bool,
+}
+
+/// [`CornerFan`] of corner `i` of face `f` of a local mesh of `scheme`. Cost: O(faces around
+/// the corner).
+pub(super) fn corner_fan(mesh: &Cage, f: usize, i: usize, scheme: Scheme) -> CornerFan {
+    let v = mesh.face(f)[i] as usize;
+    let t = vertex_tag(mesh, v, scheme);
+    let fan = mesh.vertex_faces(v);
+    let dart = t.rules & DART != 0 && t.inf_sharp_edges;
+    let test_edges = t.inf_sharp_edges && t.rules != DART;
+    let k = fan.iter().position(|fc| fc.face as usize == f).expect("the face is at its corner");
+    let (faces, patch_face, boundary) = match test_edges.then(|| corner_span(mesh, f, i)) {
+        Some(span) if !span.periodic => {
+            let picked = (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
+            (picked, span.corner_in_span, true)
+        }
+        _ => (fan.to_vec(), k, t.boundary),
+    };
+    let sharp = if t.corner {
+        true
+    } else if test_edges {
+        !t.inf_sharp_crease
+    } else {
+        t.inf_sharp
+    };
+    CornerFan { faces, patch_face, boundary, sharp, dart }
+}
+
 /// The source patch of a leaf for its Gregory end cap (`PatchBuilder::GetIrregularPatchCornerSpans`
 /// and `assembleIrregularSourcePatch`, `far/patchBuilder.cpp`).
 fn gregory_source(mesh: &Cage, f: usize) -> GregorySource {
     let corners: [GregoryCorner; 4] = std::array::from_fn(|i| {
         let v = mesh.face(f)[i] as usize;
-        let t = vertex_tag(mesh, v, Scheme::Catmark);
-        let fan = mesh.vertex_faces(v);
-        let dart = t.rules & DART != 0 && t.inf_sharp_edges;
-        let test_edges = t.inf_sharp_edges && t.rules != DART;
-        let k = fan.iter().position(|fc| fc.face as usize == f).expect("the face is at its corner");
-        let (faces, patch_face, boundary): (Vec<FaceCorner>, usize, bool) = if test_edges {
-            let span = corner_span(mesh, f, i);
-            if span.periodic {
-                (fan.to_vec(), k, t.boundary)
-            } else {
-                let picked: Vec<FaceCorner> =
-                    (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
-                (picked, span.corner_in_span, true)
-            }
-        } else {
-            (fan.to_vec(), k, t.boundary)
-        };
-        let sharp = if t.corner {
-            true
-        } else if test_edges {
-            !t.inf_sharp_crease
-        } else {
-            t.inf_sharp
-        };
+        let CornerFan { faces, patch_face, boundary, sharp, dart } = corner_fan(mesh, f, i, Scheme::Catmark);
         let mut ring = Vec::with_capacity(2 * faces.len() + 1);
         for fc in &faces {
             let q = mesh.face(fc.face as usize);

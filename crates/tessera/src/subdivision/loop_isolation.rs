@@ -21,8 +21,8 @@ use glam::{DVec2, DVec3};
 
 use super::cage::{Cage, FaceCorner};
 use super::isolation::{
-    child_sharpness, corner_span, face_has_features, is_infinite, is_patch_regular, neighbourhood,
-    vertex_tag, IsolationLevels, Scheme, DART, MAX_ISOLATION_LEVEL,
+    child_sharpness, corner_fan, face_has_features, is_infinite, is_patch_regular, neighbourhood, vertex_tag,
+    CornerFan, IsolationLevels, Scheme, MAX_ISOLATION_LEVEL,
 };
 use super::loop_gregory::{gregory_triangle_points, LoopCorner, LoopGregorySource};
 use super::loop_sdc::{self, EdgeNeighborhood, VertexNeighborhood};
@@ -199,30 +199,7 @@ fn decode_mask(mask: u8) -> (u8, u8) {
 fn gregory_source(mesh: &Cage, f: usize) -> LoopGregorySource {
     let corners: [LoopCorner; 3] = std::array::from_fn(|i| {
         let v = mesh.face(f)[i] as usize;
-        let t = vertex_tag(mesh, v, Scheme::Loop);
-        let fan = mesh.vertex_faces(v);
-        let dart = t.rules & DART != 0 && t.inf_sharp_edges;
-        let test_edges = t.inf_sharp_edges && t.rules != DART;
-        let k = fan.iter().position(|fc| fc.face as usize == f).expect("the face is at its corner");
-        let (faces, patch_face, boundary): (Vec<FaceCorner>, usize, bool) = if test_edges {
-            let span = corner_span(mesh, f, i);
-            if span.periodic {
-                (fan.to_vec(), k, t.boundary)
-            } else {
-                let picked: Vec<FaceCorner> =
-                    (0..span.faces).map(|s| fan[(span.start + s) % fan.len()]).collect();
-                (picked, span.corner_in_span, true)
-            }
-        } else {
-            (fan.to_vec(), k, t.boundary)
-        };
-        let sharp = if t.corner {
-            true
-        } else if test_edges {
-            !t.inf_sharp_crease
-        } else {
-            t.inf_sharp
-        };
+        let CornerFan { faces, patch_face, boundary, sharp, dart } = corner_fan(mesh, f, i, Scheme::Loop);
         // Per triangle of the fan the far end of its leading edge; an open fan adds the far
         // end of its last triangle's trailing edge.
         let mut ring = Vec::with_capacity(faces.len() + 1);

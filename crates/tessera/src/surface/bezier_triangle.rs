@@ -1,6 +1,6 @@
 //! Cubic Bézier triangles.
 
-use super::{robust_normal, SurfaceDerivatives, SurfacePoint};
+use super::{triangle_point, SurfaceDerivatives, SurfacePoint};
 use glam::{DVec2, DVec3};
 
 /// A cubic Bézier triangle `S(λ) = Σ_{i+j+k=3} 3!/(i!j!k!) λ0^i λ1^j λ2^k b_ijk` with
@@ -82,20 +82,7 @@ impl BezierTriangle {
 
     /// Position and unit normal `S_u × S_v` (limit normal at collapsed edges).
     pub fn eval(&self, uv: DVec2) -> SurfacePoint {
-        let d = self.derivatives(uv);
-        let inside = DVec2::splat(1.0 / 3.0) - uv;
-        let normal = robust_normal(
-            d.du,
-            d.dv,
-            uv,
-            inside,
-            || self.mixed_derivative(uv),
-            |q| {
-                let d = self.derivatives(q);
-                d.du.cross(d.dv)
-            },
-        );
-        SurfacePoint { position: d.position, normal }
+        triangle_point(self.derivatives(uv), uv, || self.mixed_derivative(uv), |q| self.derivatives(q))
     }
 
     /// The same surface with `u` and `v` exchanged (`b_ijk → b_ikj`): opposite orientation,

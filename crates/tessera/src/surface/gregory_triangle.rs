@@ -12,7 +12,7 @@
 //! concerns the quad Gregory patch), so off the edges these are not the exact derivatives of
 //! the position; on the edges and at the corners they are.
 
-use super::{robust_normal, QuarticTriangle, SurfaceDerivatives, SurfacePoint};
+use super::{triangle_point, QuarticTriangle, SurfaceDerivatives, SurfacePoint};
 use glam::{DVec2, DVec3};
 
 /// A quartic Gregory triangle in OpenSubdiv's `GREGORY_TRIANGLE` point order: per corner
@@ -102,20 +102,7 @@ impl GregoryTriangle {
     /// where they are parallel).
     pub fn eval(&self, uv: DVec2) -> SurfacePoint {
         let net = self.blended(uv);
-        let d = net.derivatives(uv);
-        let inside = DVec2::splat(1.0 / 3.0) - uv;
-        let normal = robust_normal(
-            d.du,
-            d.dv,
-            uv,
-            inside,
-            || net.mixed_derivative(uv),
-            |q| {
-                let d = self.derivatives(q);
-                d.du.cross(d.dv)
-            },
-        );
-        SurfacePoint { position: d.position, normal }
+        triangle_point(net.derivatives(uv), uv, || net.mixed_derivative(uv), |q| self.derivatives(q))
     }
 }
 

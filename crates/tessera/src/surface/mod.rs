@@ -193,22 +193,28 @@ pub(crate) fn subdivision_point(
     SurfacePoint { position, normal }
 }
 
-/// A Loop patch's point at `uv`, its normal from its derivatives (the limit normal where they
-/// degenerate, as for the other triangles).
+/// A Loop patch's point at `uv` ([`triangle_point`]; a piecewise patch offers no single
+/// mixed derivative, so a degenerate corner takes the nudged normal).
 fn loop_point(t: &TriangleTree, uv: DVec2) -> SurfacePoint {
-    let d = t.derivatives(uv);
+    triangle_point(t.derivatives(uv), uv, || DVec3::ZERO, |q| t.derivatives(q))
+}
+
+/// The point of a triangle patch at `uv` from its derivatives `d` there: the unit normal
+/// `S_u × S_v`, or [`robust_normal`]'s limit normal where they are parallel, with `mixed` the
+/// mixed derivative at `uv` and `derivatives` the patch's derivatives elsewhere. The one
+/// normal rule of every triangle kind (cubic, quartic, Gregory, Loop).
+#[inline]
+pub(crate) fn triangle_point(
+    d: SurfaceDerivatives,
+    uv: DVec2,
+    mixed: impl Fn() -> DVec3,
+    derivatives: impl Fn(DVec2) -> SurfaceDerivatives,
+) -> SurfacePoint {
     let inside = DVec2::splat(1.0 / 3.0) - uv;
-    let normal = robust_normal(
-        d.du,
-        d.dv,
-        uv,
-        inside,
-        || DVec3::ZERO,
-        |q| {
-            let d = t.derivatives(q);
-            d.du.cross(d.dv)
-        },
-    );
+    let normal = robust_normal(d.du, d.dv, uv, inside, mixed, |q| {
+        let d = derivatives(q);
+        d.du.cross(d.dv)
+    });
     SurfacePoint { position: d.position, normal }
 }
 

@@ -22,7 +22,7 @@
 //! parameterisation is tessera's and OpenSubdiv's alike: `λ = (1−u−v, u, v)`, corner 0 at
 //! `(0,0)`, corner 1 at `(1,0)`, corner 2 at `(0,1)` (`far/patchBasis.cpp`'s triangle notes).
 
-use super::{robust_normal, BezierTriangle, SurfaceDerivatives, SurfacePoint};
+use super::{triangle_point, BezierTriangle, SurfaceDerivatives, SurfacePoint};
 use glam::{DVec2, DVec3};
 
 /// A quartic Bézier triangle `S(λ) = Σ_{i+j+k=4} 4!/(i!j!k!) λ0^i λ1^j λ2^k b_ijk` with
@@ -299,20 +299,7 @@ impl QuarticTriangle {
 
     /// Position and unit normal `S_u × S_v` (limit normal at collapsed edges).
     pub fn eval(&self, uv: DVec2) -> SurfacePoint {
-        let d = self.derivatives(uv);
-        let inside = DVec2::splat(1.0 / 3.0) - uv;
-        let normal = robust_normal(
-            d.du,
-            d.dv,
-            uv,
-            inside,
-            || self.mixed_derivative(uv),
-            |q| {
-                let d = self.derivatives(q);
-                d.du.cross(d.dv)
-            },
-        );
-        SurfacePoint { position: d.position, normal }
+        triangle_point(self.derivatives(uv), uv, || self.mixed_derivative(uv), |q| self.derivatives(q))
     }
 }
 
