@@ -7,6 +7,15 @@
 //! with them agrees with OpenSubdiv's own refinement, and so with Bfr, which refines a face's
 //! neighbourhood the same way.
 //!
+//! # Shared with Loop
+//!
+//! What OpenSubdiv writes once for every scheme (`opensubdiv/sdc/scheme.h`, `crease.cpp`)
+//! is written once here too, and [`super::loop_sdc`] calls it: the rules, sharpness decay and
+//! fractional weights, and the derivation of an edge's and a vertex's parent and child rules
+//! with their crease and corner masks and the blending of the two. A scheme supplies only its
+//! own smooth masks (Catmark's here, after `opensubdiv/sdc/catmarkScheme.h`; Loop's after
+//! `opensubdiv/sdc/loopScheme.h`).
+//!
 //! # Arithmetic
 //!
 //! Sharpness is `f32` and everything derived from sharpness alone (child sharpness, the
@@ -453,12 +462,21 @@ pub fn edge_mask(
     face_sizes: &[usize],
     triangles: TriangleRule,
 ) -> EdgeMask {
-    let smooth = smooth_edge_mask(face_sizes, triangles);
+    edge_mask_with(sharpness, child_rule, smooth_edge_mask(face_sizes, triangles))
+}
+
+/// Sdc's `ComputeEdgeVertexMask` (`opensubdiv/sdc/scheme.h`), which every scheme shares, for
+/// a scheme whose smooth edge mask is `smooth` (Sdc's `assignSmoothMaskForEdge`); the rules
+/// are [`edge_mask`]'s (Catmark's, which calls it, as does [`super::loop_sdc::edge_mask`],
+/// whose `face` weights are its triangles' opposite vertices).
+///
+/// Cost: O(1).
+pub(crate) fn edge_mask_with(sharpness: f32, child_rule: VertexRule, smooth: EdgeMask) -> EdgeMask {
     if !is_sharp(sharpness) {
         return smooth;
     }
     if child_rule == VertexRule::Crease {
-        return EdgeMask { vertex: 0.5, face: 0.0, faces: face_sizes.len() };
+        return EdgeMask { vertex: 0.5, face: 0.0, faces: smooth.faces };
     }
     let parent = f64::from(sharpness);
     let child = 1.0 - parent;
@@ -577,6 +595,20 @@ pub(crate) fn sharp_edge_pair_of_crease(valence: usize, sharp: impl Fn(usize) ->
     Some([first, last])
 }
 
+/// A scheme's smooth vertex mask at one valence (Sdc's `assignSmoothMaskForVertex`), the only
+/// part of a vertex mask that differs between Catmark and Loop: their crease and corner masks
+/// and the derivation and blending of rules are the same ([`vertex_mask_with`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SmoothVertexMask {
+    /// Weight of the vertex itself.
+    pub(crate) vertex: f64,
+    /// Weight of the far end of each incident edge.
+    pub(crate) edge: f64,
+    /// Weight of each incident face's face point; `None` for a scheme whose vertex masks weigh
+    /// no faces (Loop), which blends differently from a weight of 0.
+    pub(crate) face: Option<f64>,
+}
+
 /// One rule's mask before blending; `None` edges or faces mean the mask has no such weights
 /// (Sdc's sparse masks, which blend differently from weights of 0).
 #[derive(Clone, Copy)]
@@ -587,14 +619,20 @@ struct RuleMask {
 }
 
 impl RuleMask {
-    /// Catmark's mask for `rule` at a vertex of `valence` edges whose sharp edges are
-    /// `sharp(i)` (`opensubdiv/sdc/catmarkScheme.h`, `opensubdiv/sdc/scheme.h`).
-    fn new(rule: VertexRule, valence: usize, sharp: impl Fn(usize) -> bool) -> Self {
+    /// The mask for `rule` at a vertex of `valence` edges whose sharp edges are `sharp(i)`:
+    /// the scheme's `smooth` mask, or the crease and corner masks that Catmark and Loop
+    /// specialise alike (`opensubdiv/sdc/catmarkScheme.h`, `opensubdiv/sdc/loopScheme.h`,
+    /// `assignCreaseMaskForVertex`; `opensubdiv/sdc/scheme.h`, `assignCornerMaskForVertex`).
+    fn new(
+        rule: VertexRule,
+        valence: usize,
+        sharp: impl Fn(usize) -> bool,
+        smooth: &impl Fn(usize) -> SmoothVertexMask,
+    ) -> Self {
         match rule {
             VertexRule::Smooth | VertexRule::Dart => {
-                let n = valence as f64;
-                let w = 1.0 / (n * n);
-                Self { vertex: (n - 2.0) / n, edges: Some((w, None)), face: Some(w) }
+                let m = smooth(valence);
+                Self { vertex: m.vertex, edges: Some((m.edge, None)), face: m.face }
             }
             VertexRule::Crease => {
                 let ends = sharp_edge_pair_of_crease(valence, sharp).unwrap_or([0, 0]);
@@ -612,6 +650,95 @@ impl RuleMask {
             None => 0.0,
         }
     }
+}
+
+/// Sdc's `ComputeVertexVertexMask` (`opensubdiv/sdc/scheme.h`), which every scheme shares, for
+/// a scheme whose smooth mask at valence n is `smooth(n)`; the arguments and the rules are
+/// [`vertex_mask`]'s (Catmark's, which calls it, as does [`super::loop_sdc::vertex_mask`]). A
+/// scheme without face weights gets `face` 0.
+///
+/// # Panics
+///
+/// In debug builds, if a smooth rule meets `faces != edge_sharpness.len()`.
+///
+/// Cost: O(edges), no allocation, and `smooth` at most twice.
+pub(crate) fn vertex_mask_with(
+    vertex_sharpness: f32,
+    edge_sharpness: &[f32],
+    faces: usize,
+    crease: CreaseMethod,
+    smooth: impl Fn(usize) -> SmoothVertexMask,
+) -> VertexMask {
+    let n = edge_sharpness.len();
+    let rule = vertex_rule(vertex_sharpness, edge_sharpness);
+    // Neither scheme has a smooth rule for a boundary or non-manifold vertex (Sdc sizes the
+    // smooth masks by the face count), and Far's sharpening never leaves one smooth.
+    let smooth_ok = |r: VertexRule| {
+        debug_assert!(
+            !r.is_smooth() || faces == n,
+            "the smooth rule needs as many faces as edges ({n} edges, {faces} faces)"
+        );
+    };
+    let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]), &smooth);
+    let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
+        let (edge, crease) = m.edges.unwrap_or((0.0, None));
+        VertexMask {
+            vertex: m.vertex,
+            edge,
+            crease,
+            face: m.face.unwrap_or(0.0),
+            rule,
+            child_rule,
+            parent_weight,
+        }
+    };
+    let at = EdgesAtVertex::new(edge_sharpness, crease);
+    let child_edge = |i: usize| at.child(edge_sharpness[i]);
+    let child_vertex = child_vertex_sharpness(vertex_sharpness);
+    let child_sharp = (0..n).filter(|&i| is_sharp(child_edge(i))).count();
+    let child_rule = VertexRule::from_sharp_edge_count(child_vertex, child_sharp);
+    // A smooth or dart parent keeps its mask whatever its child becomes (a dart's edge may
+    // decay): Sdc returns before looking at the child.
+    if rule.is_smooth() {
+        smooth_ok(rule);
+        return finish(parent, child_rule, 1.0);
+    }
+    if child_rule == rule {
+        return finish(parent, child_rule, 1.0);
+    }
+    smooth_ok(child_rule);
+    let child = RuleMask::new(child_rule, n, |i| is_sharp(child_edge(i)), &smooth);
+
+    let pw = f64::from(fractional_weight(vertex_sharpness, child_vertex, edge_sharpness, child_edge, crease));
+    let cw = 1.0 - pw;
+    // Sdc blends weight by weight, and a kind of weight the parent mask lacks (a corner's
+    // edges, a crease's faces) becomes the child's weight scaled by 1 − w. A blend always
+    // has a child with edge weights (a vertex never gains sharp edges), and at most one crease
+    // pair takes part: the parent's (a crease decaying to smooth) or the child's (a corner
+    // decaying to a crease).
+    let blend = |parent_has: bool, p: f64, c: f64| if parent_has { pw * p + cw * c } else { cw * c };
+    let has_edges = parent.edges.is_some();
+    let pair_of = |m: &RuleMask| m.edges.and_then(|(_, pair)| pair).map(|(ends, _)| ends);
+    let crease_pair = pair_of(&child).or(pair_of(&parent));
+    // The weight of an edge outside any pair, read from both masks at such an index.
+    let generic = |m: &RuleMask| m.edges.map_or(0.0, |(w, _)| w);
+    let mask = RuleMask {
+        vertex: pw * parent.vertex + cw * child.vertex,
+        edges: Some((
+            blend(has_edges, generic(&parent), generic(&child)),
+            crease_pair.map(|ends| (ends, blend(has_edges, parent.edge(ends[0]), child.edge(ends[0])))),
+        )),
+        face: child.face.map(|c| blend(parent.face.is_some(), parent.face.unwrap_or(0.0), c)),
+    };
+    finish(mask, child_rule, pw)
+}
+
+/// Catmark's smooth vertex mask (`opensubdiv/sdc/catmarkScheme.h`,
+/// `assignSmoothMaskForVertex`): (n − 2)/n the vertex, 1/n² each edge end and each face point.
+fn smooth_vertex_mask(valence: usize) -> SmoothVertexMask {
+    let n = valence as f64;
+    let w = 1.0 / (n * n);
+    SmoothVertexMask { vertex: (n - 2.0) / n, edge: w, face: Some(w) }
 }
 
 /// The mask of the vertex point of a vertex with sharpness `vertex_sharpness` whose incident
@@ -646,66 +773,7 @@ pub fn vertex_mask(
     faces: usize,
     crease: CreaseMethod,
 ) -> VertexMask {
-    let n = edge_sharpness.len();
-    let rule = vertex_rule(vertex_sharpness, edge_sharpness);
-    let smooth_ok = |r: VertexRule| {
-        debug_assert!(
-            !r.is_smooth() || faces == n,
-            "the smooth Catmark rule needs as many faces as edges ({n} edges, {faces} faces)"
-        );
-    };
-    let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]));
-    let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
-        let (edge, crease) = m.edges.unwrap_or((0.0, None));
-        VertexMask {
-            vertex: m.vertex,
-            edge,
-            crease,
-            face: m.face.unwrap_or(0.0),
-            rule,
-            child_rule,
-            parent_weight,
-        }
-    };
-    let at = EdgesAtVertex::new(edge_sharpness, crease);
-    let child_edge = |i: usize| at.child(edge_sharpness[i]);
-    let child_vertex = child_vertex_sharpness(vertex_sharpness);
-    let child_sharp = (0..n).filter(|&i| is_sharp(child_edge(i))).count();
-    let child_rule = VertexRule::from_sharp_edge_count(child_vertex, child_sharp);
-    // A smooth or dart parent keeps its mask whatever its child becomes (a dart's edge may
-    // decay): Sdc returns before looking at the child.
-    if rule.is_smooth() {
-        smooth_ok(rule);
-        return finish(parent, child_rule, 1.0);
-    }
-    if child_rule == rule {
-        return finish(parent, child_rule, 1.0);
-    }
-    smooth_ok(child_rule);
-    let child = RuleMask::new(child_rule, n, |i| is_sharp(child_edge(i)));
-
-    let pw = f64::from(fractional_weight(vertex_sharpness, child_vertex, edge_sharpness, child_edge, crease));
-    let cw = 1.0 - pw;
-    // Sdc blends weight by weight, and a kind of weight the parent mask lacks (a corner's
-    // edges, a crease's faces) becomes the child's weight scaled by 1 − w. A blend always
-    // has a child with edge weights (a vertex never gains sharp edges), and at most one crease
-    // pair takes part: the parent's (a crease decaying to smooth) or the child's (a corner
-    // decaying to a crease).
-    let blend = |parent_has: bool, p: f64, c: f64| if parent_has { pw * p + cw * c } else { cw * c };
-    let has_edges = parent.edges.is_some();
-    let pair_of = |m: &RuleMask| m.edges.and_then(|(_, pair)| pair).map(|(ends, _)| ends);
-    let crease_pair = pair_of(&child).or(pair_of(&parent));
-    // The weight of an edge outside any pair, read from both masks at such an index.
-    let generic = |m: &RuleMask| m.edges.map_or(0.0, |(w, _)| w);
-    let mask = RuleMask {
-        vertex: pw * parent.vertex + cw * child.vertex,
-        edges: Some((
-            blend(has_edges, generic(&parent), generic(&child)),
-            crease_pair.map(|ends| (ends, blend(has_edges, parent.edge(ends[0]), child.edge(ends[0])))),
-        )),
-        face: child.face.map(|c| blend(parent.face.is_some(), parent.face.unwrap_or(0.0), c)),
-    };
-    finish(mask, child_rule, pw)
+    vertex_mask_with(vertex_sharpness, edge_sharpness, faces, crease, smooth_vertex_mask)
 }
 
 /// The neighbourhood of a vertex, for [`vertex_point`].
