@@ -522,6 +522,7 @@ pub fn limit_masks(rule: VertexRule, edge_sharpness: &[f32], faces: usize) -> Li
 mod tests {
     use super::*;
     use crate::subdivision::sdc::child_edge_sharpness;
+    use crate::subdivision::sdc::tests::{each_fixture_line, Tokens};
     use crate::subdivision::INFINITELY_SHARP;
 
     const INF: f32 = INFINITELY_SHARP;
@@ -720,47 +721,13 @@ mod tests {
     /// and sharpness alone must agree to the bit.
     const WEIGHT_TOLERANCE: f64 = 1e-15;
 
-    struct Tokens<'a>(std::str::SplitAsciiWhitespace<'a>);
-
-    impl<'a> Tokens<'a> {
-        fn word(&mut self) -> &'a str {
-            self.0.next().expect("fixture line ends early")
-        }
-        fn expect(&mut self, w: &str) {
-            assert_eq!(self.word(), w, "fixture format");
-        }
-        fn f32(&mut self) -> f32 {
-            self.word().parse().unwrap()
-        }
-        fn f64(&mut self) -> f64 {
-            self.word().parse().unwrap()
-        }
-        fn usize(&mut self) -> usize {
-            self.word().parse().unwrap()
-        }
-        fn f32s(&mut self, n: usize) -> Vec<f32> {
-            (0..n).map(|_| self.f32()).collect()
-        }
-        fn f64s(&mut self, n: usize) -> Vec<f64> {
-            (0..n).map(|_| self.f64()).collect()
-        }
-        fn method(&mut self) -> CreaseMethod {
-            match self.word() {
-                "uniform" => CreaseMethod::Uniform,
-                "chaikin" => CreaseMethod::Chaikin,
-                w => panic!("crease method {w}"),
-            }
-        }
-        fn rule(&mut self) -> VertexRule {
-            match self.word() {
-                "smooth" => VertexRule::Smooth,
-                "dart" => VertexRule::Dart,
-                "crease" => VertexRule::Crease,
-                "corner" => VertexRule::Corner,
-                w => panic!("rule {w}"),
-            }
-        }
+    /// The Loop fixture's one kind of word that the Catmark fixture lacks.
+    trait MaskTokens {
         /// A labelled mask: `LABEL V E[n]`.
+        fn mask(&mut self, label: &str, n: usize) -> LimitMask;
+    }
+
+    impl MaskTokens for Tokens<'_> {
         fn mask(&mut self, label: &str, n: usize) -> LimitMask {
             self.expect(label);
             LimitMask { vertex: self.f64(), edges: self.f64s(n) }
@@ -881,16 +848,12 @@ mod tests {
     #[test]
     fn loop_sdc_masks_agree_with_opensubdiv() {
         let mut agree = Agreement::default();
-        for line in FIXTURE.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
-            let mut t = Tokens(line.split_ascii_whitespace());
-            match t.word() {
-                "vertex" => check_vertex(&mut t, line, &mut agree),
-                "limit" => check_limit(&mut t, line, &mut agree),
-                "edge" => check_edge(&mut t, line, &mut agree),
-                w => panic!("unknown fixture line kind {w}"),
-            }
-            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
-        }
+        each_fixture_line(FIXTURE, |kind, t, line| match kind {
+            "vertex" => check_vertex(t, line, &mut agree),
+            "limit" => check_limit(t, line, &mut agree),
+            "edge" => check_edge(t, line, &mut agree),
+            w => panic!("unknown fixture line kind {w}"),
+        });
         println!(
             "{} vertex masks, {} limit mask triples, {} edge masks ({} where Vtr's rules differ from Sdc's own); {} weights, {} not bit-exact, max difference {:e}",
             agree.vertices,

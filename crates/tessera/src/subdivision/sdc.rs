@@ -804,7 +804,7 @@ pub fn vertex_point(vertex: &VertexNeighborhood<'_>, crease: CreaseMethod) -> DV
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     const INF: f32 = INFINITELY_SHARP;
@@ -1058,38 +1058,39 @@ mod tests {
     /// in practice the agreement is exact.
     const WEIGHT_TOLERANCE: f64 = 1e-6;
 
-    struct Tokens<'a>(std::str::SplitAsciiWhitespace<'a>);
+    /// A fixture line's words, read in order (the Loop fixture's lines use the same words).
+    pub(crate) struct Tokens<'a>(pub(crate) std::str::SplitAsciiWhitespace<'a>);
 
     impl<'a> Tokens<'a> {
-        fn word(&mut self) -> &'a str {
+        pub(crate) fn word(&mut self) -> &'a str {
             self.0.next().expect("fixture line ends early")
         }
-        fn expect(&mut self, w: &str) {
+        pub(crate) fn expect(&mut self, w: &str) {
             assert_eq!(self.word(), w, "fixture format");
         }
-        fn f32(&mut self) -> f32 {
+        pub(crate) fn f32(&mut self) -> f32 {
             self.word().parse().unwrap()
         }
-        fn f64(&mut self) -> f64 {
+        pub(crate) fn f64(&mut self) -> f64 {
             self.word().parse().unwrap()
         }
-        fn usize(&mut self) -> usize {
+        pub(crate) fn usize(&mut self) -> usize {
             self.word().parse().unwrap()
         }
-        fn f32s(&mut self, n: usize) -> Vec<f32> {
+        pub(crate) fn f32s(&mut self, n: usize) -> Vec<f32> {
             (0..n).map(|_| self.f32()).collect()
         }
-        fn f64s(&mut self, n: usize) -> Vec<f64> {
+        pub(crate) fn f64s(&mut self, n: usize) -> Vec<f64> {
             (0..n).map(|_| self.f64()).collect()
         }
-        fn method(&mut self) -> CreaseMethod {
+        pub(crate) fn method(&mut self) -> CreaseMethod {
             match self.word() {
                 "uniform" => CreaseMethod::Uniform,
                 "chaikin" => CreaseMethod::Chaikin,
                 w => panic!("crease method {w}"),
             }
         }
-        fn rule(&mut self) -> VertexRule {
+        pub(crate) fn rule(&mut self) -> VertexRule {
             match self.word() {
                 "smooth" => VertexRule::Smooth,
                 "dart" => VertexRule::Dart,
@@ -1097,6 +1098,17 @@ mod tests {
                 "corner" => VertexRule::Corner,
                 w => panic!("rule {w}"),
             }
+        }
+    }
+
+    /// Runs `check` on each data line of `fixture` with its kind (the first word), the words
+    /// after it and the line, and makes sure that `check` reads every word.
+    pub(crate) fn each_fixture_line(fixture: &str, mut check: impl FnMut(&str, &mut Tokens<'_>, &str)) {
+        for line in fixture.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
+            let mut t = Tokens(line.split_ascii_whitespace());
+            let kind = t.word();
+            check(kind, &mut t, line);
+            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
         }
     }
 
@@ -1201,20 +1213,16 @@ mod tests {
     #[test]
     fn masks_and_sharpness_agree_with_opensubdiv_sdc() {
         let mut agree = Agreement::default();
-        for line in FIXTURE.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
-            let mut t = Tokens(line.split_ascii_whitespace());
-            match t.word() {
-                "vertex" => check_vertex(&mut t, line, &mut agree),
-                "edge" => check_edge(&mut t, line, &mut agree),
-                "uniform" => {
-                    let (s, c) = (t.f32(), t.f32());
-                    assert_eq!(subdivide_sharpness(s), c, "{line}");
-                    agree.uniform += 1;
-                }
-                w => panic!("unknown fixture line kind {w}"),
+        each_fixture_line(FIXTURE, |kind, t, line| match kind {
+            "vertex" => check_vertex(t, line, &mut agree),
+            "edge" => check_edge(t, line, &mut agree),
+            "uniform" => {
+                let (s, c) = (t.f32(), t.f32());
+                assert_eq!(subdivide_sharpness(s), c, "{line}");
+                agree.uniform += 1;
             }
-            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
-        }
+            w => panic!("unknown fixture line kind {w}"),
+        });
         println!(
             "{} vertex masks, {} edge masks ({} where Vtr's rules differ from Sdc's own), {} uniform decrements; max weight difference {:e}",
             agree.vertices, agree.edges, agree.vtr_only, agree.uniform, agree.max_weight_diff
