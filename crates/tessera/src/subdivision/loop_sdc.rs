@@ -522,7 +522,7 @@ pub fn limit_masks(rule: VertexRule, edge_sharpness: &[f32], faces: usize) -> Li
 mod tests {
     use super::*;
     use crate::subdivision::sdc::child_edge_sharpness;
-    use crate::subdivision::sdc::tests::{each_fixture_line, Tokens};
+    use crate::subdivision::sdc::tests::{each_fixture_line, read_edge_line, Tokens};
     use crate::subdivision::INFINITELY_SHARP;
 
     const INF: f32 = INFINITELY_SHARP;
@@ -813,35 +813,16 @@ mod tests {
     fn check_edge(t: &mut Tokens<'_>, line: &str, agree: &mut Agreement) {
         let method = t.method();
         let (s, nf) = (t.f32(), t.usize());
-        t.expect("ring0");
-        let k = t.usize();
-        let ring0 = t.f32s(k);
-        t.expect("ring1");
-        let k = t.usize();
-        let ring1 = t.f32s(k);
-        t.expect("child");
-        let child = [t.f32(), t.f32()];
-        t.expect("crule");
-        let c_rule = t.rule();
-        t.expect("w");
-        let (wv, wf) = (t.f64s(2), t.f64s(nf));
-        t.expect("sdc");
-        let (sv, sf) = (t.f64s(2), t.f64s(nf));
-
-        let ours = [child_edge_sharpness(s, &ring0, method), child_edge_sharpness(s, &ring1, method)];
-        assert_eq!(ours, child, "{line}");
-        assert_eq!(edge_child_rule(s, ours), c_rule, "{line}");
-        let m = edge_mask(s, c_rule, nf);
+        let theirs = read_edge_line(t, s, nf, method, line);
+        let m = edge_mask(s, theirs.child_rule, nf);
         assert_eq!(m.faces, nf);
-        for &w in &wv {
+        for &w in &theirs.ends {
             agree.weight(m.vertex, w, false, line);
         }
-        for &w in &wf {
+        for &w in &theirs.faces {
             agree.weight(m.opposite, w, false, line);
         }
-        if (wv, wf) != (sv, sf) {
-            agree.vtr_only += 1;
-        }
+        agree.vtr_only += usize::from(theirs.vtr_only);
         agree.edges += 1;
     }
 

@@ -1178,6 +1178,39 @@ pub(super) mod tests {
         };
         let (s, nf) = (t.f32(), t.usize());
         let sizes: Vec<usize> = (0..nf).map(|_| t.usize()).collect();
+        let theirs = read_edge_line(t, s, nf, method, line);
+        let m = edge_mask(s, theirs.child_rule, &sizes, triangles);
+        assert_eq!(m.faces, nf);
+        for &w in &theirs.ends {
+            agree.weight(m.vertex, w, line);
+        }
+        for &w in &theirs.faces {
+            agree.weight(m.face, w, line);
+        }
+        agree.vtr_only += usize::from(theirs.vtr_only);
+        agree.edges += 1;
+    }
+
+    /// OpenSubdiv's edge mask on an edge line: the child rule Vtr gives it, the weights of
+    /// each end and each face in Vtr's mask, and whether Sdc's own mask (no rules given)
+    /// differs from it.
+    pub(crate) struct EdgeLine {
+        pub(crate) child_rule: VertexRule,
+        pub(crate) ends: Vec<f64>,
+        pub(crate) faces: Vec<f64>,
+        pub(crate) vtr_only: bool,
+    }
+
+    /// Reads an edge line from its child edges' sharpness on (the words both fixtures share)
+    /// for an edge of sharpness `s` and `nf` faces, and checks our child sharpness at both
+    /// ends and the child rule against OpenSubdiv's.
+    pub(crate) fn read_edge_line(
+        t: &mut Tokens<'_>,
+        s: f32,
+        nf: usize,
+        method: CreaseMethod,
+        line: &str,
+    ) -> EdgeLine {
         t.expect("ring0");
         let k = t.usize();
         let ring0 = t.f32s(k);
@@ -1187,27 +1220,17 @@ pub(super) mod tests {
         t.expect("child");
         let child = [t.f32(), t.f32()];
         t.expect("crule");
-        let c_rule = t.rule();
+        let child_rule = t.rule();
         t.expect("w");
-        let (wv, wf) = (t.f64s(2), t.f64s(nf));
+        let (ends, faces) = (t.f64s(2), t.f64s(nf));
         t.expect("sdc");
-        let (sv, sf) = (t.f64s(2), t.f64s(nf));
+        let (sdc_ends, sdc_faces) = (t.f64s(2), t.f64s(nf));
 
         let ours = [child_edge_sharpness(s, &ring0, method), child_edge_sharpness(s, &ring1, method)];
         assert_eq!(ours, child, "{line}");
-        assert_eq!(edge_child_rule(s, ours), c_rule, "{line}");
-        let m = edge_mask(s, c_rule, &sizes, triangles);
-        assert_eq!(m.faces, nf);
-        for &w in &wv {
-            agree.weight(m.vertex, w, line);
-        }
-        for &w in &wf {
-            agree.weight(m.face, w, line);
-        }
-        if (wv, wf) != (sv, sf) {
-            agree.vtr_only += 1;
-        }
-        agree.edges += 1;
+        assert_eq!(edge_child_rule(s, ours), child_rule, "{line}");
+        let vtr_only = (&ends, &faces) != (&sdc_ends, &sdc_faces);
+        EdgeLine { child_rule, ends, faces, vtr_only }
     }
 
     #[test]
