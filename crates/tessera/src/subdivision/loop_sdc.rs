@@ -11,7 +11,9 @@
 //! ([`VertexRule`]), how sharpness decays from a level to the next, the fractional weight
 //! that blends a parent rule's mask with its child's, the rule of an edge's child vertex
 //! ([`edge_child_rule`]), the base level's sharpening of boundaries and non-manifold
-//! features — is Catmark's and lives in [`super::sdc`]; this module calls it.
+//! features, and, as in Sdc's `Scheme<>` template, the derivation of a mask's parent and
+//! child rules with their crease and corner masks and the blending of the two — is
+//! Catmark's and lives in [`super::sdc`]; this module supplies Loop's smooth weights to it.
 //!
 //! # Arithmetic
 //!
@@ -70,8 +72,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use super::sdc::{
-    child_vertex_sharpness, fractional_weight, is_sharp, sharp_edge_pair_of_crease, vertex_rule,
-    EdgesAtVertex,
+    self, edge_mask_with, is_sharp, sharp_edge_pair_of_crease, vertex_mask_with, SmoothVertexMask,
 };
 pub use super::sdc::{edge_child_rule, VertexRule};
 use super::CreaseMethod;
@@ -137,16 +138,8 @@ pub fn edge_mask(sharpness: f32, child_rule: VertexRule, faces: usize) -> EdgeMa
     debug_assert!(faces > 0 || is_sharp(sharpness), "a smooth edge needs a triangle");
     // The non-manifold case keeps the ratio of the ends' weight to the triangles' total.
     let opposite = if faces == 2 { 0.125 } else { 0.125 * (2.0 / faces as f64) };
-    let smooth = EdgeMask { vertex: 0.375, opposite, faces };
-    if !is_sharp(sharpness) {
-        return smooth;
-    }
-    if child_rule == VertexRule::Crease {
-        return EdgeMask { vertex: 0.5, opposite: 0.0, faces };
-    }
-    let parent = f64::from(sharpness);
-    let child = 1.0 - parent;
-    EdgeMask { vertex: parent * 0.5 + child * smooth.vertex, opposite: smooth.opposite * child, faces }
+    let m = edge_mask_with(sharpness, child_rule, sdc::EdgeMask { vertex: 0.375, face: opposite, faces });
+    EdgeMask { vertex: m.vertex, opposite: m.face, faces }
 }
 
 /// The neighbourhood of an edge, for [`edge_point`].
@@ -246,51 +239,13 @@ impl VertexMask {
     }
 }
 
-/// Two crease edges (indices into a vertex's incident edges) and the weight of each.
-type CreasePair = ([usize; 2], f64);
-
-/// One rule's mask before blending; `None` edges mean the mask has no edge weights (Sdc's
-/// sparse corner mask, which blends differently from weights of 0).
-#[derive(Clone, Copy)]
-struct RuleMask {
-    vertex: f64,
-    edges: Option<(f64, Option<CreasePair>)>,
-}
-
-impl RuleMask {
-    /// Loop's refinement mask for `rule` at a vertex of `valence` edges whose sharp edges are
-    /// `sharp(i)` (`opensubdiv/sdc/loopScheme.h`).
-    fn new(rule: VertexRule, valence: usize, sharp: impl Fn(usize) -> bool) -> Self {
-        match rule {
-            VertexRule::Smooth | VertexRule::Dart => {
-                let (vertex, edge) = smooth_vertex_weights(valence);
-                Self { vertex, edges: Some((edge, None)) }
-            }
-            VertexRule::Crease => {
-                let ends = sharp_edge_pair_of_crease(valence, sharp).unwrap_or([0, 0]);
-                Self { vertex: 0.75, edges: Some((0.0, Some((ends, 0.125)))) }
-            }
-            VertexRule::Corner => Self { vertex: 1.0, edges: None },
-        }
-    }
-
-    /// The weight of edge `i`.
-    fn edge(&self, i: usize) -> f64 {
-        match self.edges {
-            Some((_, Some((ends, w)))) if ends.contains(&i) => w,
-            Some((w, _)) => w,
-            None => 0.0,
-        }
-    }
-}
-
 /// The mask of the vertex point of a vertex with sharpness `vertex_sharpness` whose incident
 /// edges have `edge_sharpness` (values stored at this level, see the module documentation),
 /// with `faces` incident triangles. This is Sdc's `ComputeVertexVertexMask`
 /// (`opensubdiv/sdc/scheme.h`, `opensubdiv/sdc/loopScheme.h`), which derives the parent and
 /// child rules as Vtr's tags do:
 ///
-/// * the parent rule is [`vertex_rule`]; the child rule is the rule of the child vertex, with
+/// * the parent rule is [`super::sdc::vertex_rule`]; the child rule is the rule of the child vertex, with
 ///   the child sharpness of [`super::sdc`] ([`super::sdc::child_vertex_sharpness`],
 ///   [`super::sdc::child_edge_sharpnesses_around_vertex`] by `crease`);
 /// * smooth and dart: [`smooth_vertex_weights`] for the valence (requires
@@ -316,56 +271,20 @@ pub fn vertex_mask(
     faces: usize,
     crease: CreaseMethod,
 ) -> VertexMask {
-    let n = edge_sharpness.len();
-    let rule = vertex_rule(vertex_sharpness, edge_sharpness);
-    let smooth_ok = |r: VertexRule| {
-        debug_assert!(
-            !r.is_smooth() || faces == n,
-            "the smooth Loop rule needs as many triangles as edges ({n} edges, {faces} triangles)"
-        );
+    let smooth = |valence| {
+        let (vertex, edge) = smooth_vertex_weights(valence);
+        SmoothVertexMask { vertex, edge, face: None }
     };
-    let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]));
-    let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
-        let (edge, crease) = m.edges.unwrap_or((0.0, None));
-        VertexMask { vertex: m.vertex, edge, crease, rule, child_rule, parent_weight }
-    };
-    let at = EdgesAtVertex::new(edge_sharpness, crease);
-    let child_edge = |i: usize| at.child(edge_sharpness[i]);
-    let child_vertex = child_vertex_sharpness(vertex_sharpness);
-    let child_sharp = (0..n).filter(|&i| is_sharp(child_edge(i))).count();
-    let child_rule = VertexRule::from_sharp_edge_count(child_vertex, child_sharp);
-    // A smooth or dart parent keeps its mask whatever its child becomes: Sdc returns before
-    // looking at the child.
-    if rule.is_smooth() {
-        smooth_ok(rule);
-        return finish(parent, child_rule, 1.0);
+    // Loop's masks weigh no faces, so the shared mask's face weight is always 0.
+    let m = vertex_mask_with(vertex_sharpness, edge_sharpness, faces, crease, smooth);
+    VertexMask {
+        vertex: m.vertex,
+        edge: m.edge,
+        crease: m.crease,
+        rule: m.rule,
+        child_rule: m.child_rule,
+        parent_weight: m.parent_weight,
     }
-    if child_rule == rule {
-        return finish(parent, child_rule, 1.0);
-    }
-    smooth_ok(child_rule);
-    let child = RuleMask::new(child_rule, n, |i| is_sharp(child_edge(i)));
-
-    let pw = f64::from(fractional_weight(vertex_sharpness, child_vertex, edge_sharpness, child_edge, crease));
-    let cw = 1.0 - pw;
-    // Sdc blends weight by weight, and where the parent lacks edge weights (a corner) the
-    // child's are scaled by 1 − w alone. A blend always has a child with edge weights (a
-    // vertex never gains sharp edges), and at most one crease pair takes part: the parent's
-    // (a crease decaying to smooth) or the child's (a corner decaying to a crease).
-    let blend = |parent_has: bool, p: f64, c: f64| if parent_has { pw * p + cw * c } else { cw * c };
-    let has_edges = parent.edges.is_some();
-    let pair_of = |m: &RuleMask| m.edges.and_then(|(_, pair)| pair).map(|(ends, _)| ends);
-    let crease_pair = pair_of(&child).or(pair_of(&parent));
-    // The weight of an edge outside any pair, read from both masks at such an index.
-    let generic = |m: &RuleMask| m.edges.map_or(0.0, |(w, _)| w);
-    let mask = RuleMask {
-        vertex: pw * parent.vertex + cw * child.vertex,
-        edges: Some((
-            blend(has_edges, generic(&parent), generic(&child)),
-            crease_pair.map(|ends| (ends, blend(has_edges, parent.edge(ends[0]), child.edge(ends[0])))),
-        )),
-    };
-    finish(mask, child_rule, pw)
 }
 
 /// The neighbourhood of a vertex, for [`vertex_point`].
@@ -603,6 +522,7 @@ pub fn limit_masks(rule: VertexRule, edge_sharpness: &[f32], faces: usize) -> Li
 mod tests {
     use super::*;
     use crate::subdivision::sdc::child_edge_sharpness;
+    use crate::subdivision::sdc::tests::{each_fixture_line, read_edge_line, Tokens};
     use crate::subdivision::INFINITELY_SHARP;
 
     const INF: f32 = INFINITELY_SHARP;
@@ -801,47 +721,13 @@ mod tests {
     /// and sharpness alone must agree to the bit.
     const WEIGHT_TOLERANCE: f64 = 1e-15;
 
-    struct Tokens<'a>(std::str::SplitAsciiWhitespace<'a>);
-
-    impl<'a> Tokens<'a> {
-        fn word(&mut self) -> &'a str {
-            self.0.next().expect("fixture line ends early")
-        }
-        fn expect(&mut self, w: &str) {
-            assert_eq!(self.word(), w, "fixture format");
-        }
-        fn f32(&mut self) -> f32 {
-            self.word().parse().unwrap()
-        }
-        fn f64(&mut self) -> f64 {
-            self.word().parse().unwrap()
-        }
-        fn usize(&mut self) -> usize {
-            self.word().parse().unwrap()
-        }
-        fn f32s(&mut self, n: usize) -> Vec<f32> {
-            (0..n).map(|_| self.f32()).collect()
-        }
-        fn f64s(&mut self, n: usize) -> Vec<f64> {
-            (0..n).map(|_| self.f64()).collect()
-        }
-        fn method(&mut self) -> CreaseMethod {
-            match self.word() {
-                "uniform" => CreaseMethod::Uniform,
-                "chaikin" => CreaseMethod::Chaikin,
-                w => panic!("crease method {w}"),
-            }
-        }
-        fn rule(&mut self) -> VertexRule {
-            match self.word() {
-                "smooth" => VertexRule::Smooth,
-                "dart" => VertexRule::Dart,
-                "crease" => VertexRule::Crease,
-                "corner" => VertexRule::Corner,
-                w => panic!("rule {w}"),
-            }
-        }
+    /// The Loop fixture's one kind of word that the Catmark fixture lacks.
+    trait MaskTokens {
         /// A labelled mask: `LABEL V E[n]`.
+        fn mask(&mut self, label: &str, n: usize) -> LimitMask;
+    }
+
+    impl MaskTokens for Tokens<'_> {
         fn mask(&mut self, label: &str, n: usize) -> LimitMask {
             self.expect(label);
             LimitMask { vertex: self.f64(), edges: self.f64s(n) }
@@ -927,51 +813,28 @@ mod tests {
     fn check_edge(t: &mut Tokens<'_>, line: &str, agree: &mut Agreement) {
         let method = t.method();
         let (s, nf) = (t.f32(), t.usize());
-        t.expect("ring0");
-        let k = t.usize();
-        let ring0 = t.f32s(k);
-        t.expect("ring1");
-        let k = t.usize();
-        let ring1 = t.f32s(k);
-        t.expect("child");
-        let child = [t.f32(), t.f32()];
-        t.expect("crule");
-        let c_rule = t.rule();
-        t.expect("w");
-        let (wv, wf) = (t.f64s(2), t.f64s(nf));
-        t.expect("sdc");
-        let (sv, sf) = (t.f64s(2), t.f64s(nf));
-
-        let ours = [child_edge_sharpness(s, &ring0, method), child_edge_sharpness(s, &ring1, method)];
-        assert_eq!(ours, child, "{line}");
-        assert_eq!(edge_child_rule(s, ours), c_rule, "{line}");
-        let m = edge_mask(s, c_rule, nf);
+        let theirs = read_edge_line(t, s, nf, method, line);
+        let m = edge_mask(s, theirs.child_rule, nf);
         assert_eq!(m.faces, nf);
-        for &w in &wv {
+        for &w in &theirs.ends {
             agree.weight(m.vertex, w, false, line);
         }
-        for &w in &wf {
+        for &w in &theirs.faces {
             agree.weight(m.opposite, w, false, line);
         }
-        if (wv, wf) != (sv, sf) {
-            agree.vtr_only += 1;
-        }
+        agree.vtr_only += usize::from(theirs.vtr_only);
         agree.edges += 1;
     }
 
     #[test]
     fn loop_sdc_masks_agree_with_opensubdiv() {
         let mut agree = Agreement::default();
-        for line in FIXTURE.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
-            let mut t = Tokens(line.split_ascii_whitespace());
-            match t.word() {
-                "vertex" => check_vertex(&mut t, line, &mut agree),
-                "limit" => check_limit(&mut t, line, &mut agree),
-                "edge" => check_edge(&mut t, line, &mut agree),
-                w => panic!("unknown fixture line kind {w}"),
-            }
-            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
-        }
+        each_fixture_line(FIXTURE, |kind, t, line| match kind {
+            "vertex" => check_vertex(t, line, &mut agree),
+            "limit" => check_limit(t, line, &mut agree),
+            "edge" => check_edge(t, line, &mut agree),
+            w => panic!("unknown fixture line kind {w}"),
+        });
         println!(
             "{} vertex masks, {} limit mask triples, {} edge masks ({} where Vtr's rules differ from Sdc's own); {} weights, {} not bit-exact, max difference {:e}",
             agree.vertices,

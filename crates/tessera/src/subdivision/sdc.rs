@@ -7,6 +7,15 @@
 //! with them agrees with OpenSubdiv's own refinement, and so with Bfr, which refines a face's
 //! neighbourhood the same way.
 //!
+//! # Shared with Loop
+//!
+//! What OpenSubdiv writes once for every scheme (`opensubdiv/sdc/scheme.h`, `crease.cpp`)
+//! is written once here too, and [`super::loop_sdc`] calls it: the rules, sharpness decay and
+//! fractional weights, and the derivation of an edge's and a vertex's parent and child rules
+//! with their crease and corner masks and the blending of the two. A scheme supplies only its
+//! own smooth masks (Catmark's here, after `opensubdiv/sdc/catmarkScheme.h`; Loop's after
+//! `opensubdiv/sdc/loopScheme.h`).
+//!
 //! # Arithmetic
 //!
 //! Sharpness is `f32` and everything derived from sharpness alone (child sharpness, the
@@ -453,12 +462,21 @@ pub fn edge_mask(
     face_sizes: &[usize],
     triangles: TriangleRule,
 ) -> EdgeMask {
-    let smooth = smooth_edge_mask(face_sizes, triangles);
+    edge_mask_with(sharpness, child_rule, smooth_edge_mask(face_sizes, triangles))
+}
+
+/// Sdc's `ComputeEdgeVertexMask` (`opensubdiv/sdc/scheme.h`), which every scheme shares, for
+/// a scheme whose smooth edge mask is `smooth` (Sdc's `assignSmoothMaskForEdge`); the rules
+/// are [`edge_mask`]'s (Catmark's, which calls it, as does [`super::loop_sdc::edge_mask`],
+/// whose `face` weights are its triangles' opposite vertices).
+///
+/// Cost: O(1).
+pub(crate) fn edge_mask_with(sharpness: f32, child_rule: VertexRule, smooth: EdgeMask) -> EdgeMask {
     if !is_sharp(sharpness) {
         return smooth;
     }
     if child_rule == VertexRule::Crease {
-        return EdgeMask { vertex: 0.5, face: 0.0, faces: face_sizes.len() };
+        return EdgeMask { vertex: 0.5, face: 0.0, faces: smooth.faces };
     }
     let parent = f64::from(sharpness);
     let child = 1.0 - parent;
@@ -577,6 +595,20 @@ pub(crate) fn sharp_edge_pair_of_crease(valence: usize, sharp: impl Fn(usize) ->
     Some([first, last])
 }
 
+/// A scheme's smooth vertex mask at one valence (Sdc's `assignSmoothMaskForVertex`), the only
+/// part of a vertex mask that differs between Catmark and Loop: their crease and corner masks
+/// and the derivation and blending of rules are the same ([`vertex_mask_with`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SmoothVertexMask {
+    /// Weight of the vertex itself.
+    pub(crate) vertex: f64,
+    /// Weight of the far end of each incident edge.
+    pub(crate) edge: f64,
+    /// Weight of each incident face's face point; `None` for a scheme whose vertex masks weigh
+    /// no faces (Loop), which blends differently from a weight of 0.
+    pub(crate) face: Option<f64>,
+}
+
 /// One rule's mask before blending; `None` edges or faces mean the mask has no such weights
 /// (Sdc's sparse masks, which blend differently from weights of 0).
 #[derive(Clone, Copy)]
@@ -587,14 +619,20 @@ struct RuleMask {
 }
 
 impl RuleMask {
-    /// Catmark's mask for `rule` at a vertex of `valence` edges whose sharp edges are
-    /// `sharp(i)` (`opensubdiv/sdc/catmarkScheme.h`, `opensubdiv/sdc/scheme.h`).
-    fn new(rule: VertexRule, valence: usize, sharp: impl Fn(usize) -> bool) -> Self {
+    /// The mask for `rule` at a vertex of `valence` edges whose sharp edges are `sharp(i)`:
+    /// the scheme's `smooth` mask, or the crease and corner masks that Catmark and Loop
+    /// specialise alike (`opensubdiv/sdc/catmarkScheme.h`, `opensubdiv/sdc/loopScheme.h`,
+    /// `assignCreaseMaskForVertex`; `opensubdiv/sdc/scheme.h`, `assignCornerMaskForVertex`).
+    fn new(
+        rule: VertexRule,
+        valence: usize,
+        sharp: impl Fn(usize) -> bool,
+        smooth: &impl Fn(usize) -> SmoothVertexMask,
+    ) -> Self {
         match rule {
             VertexRule::Smooth | VertexRule::Dart => {
-                let n = valence as f64;
-                let w = 1.0 / (n * n);
-                Self { vertex: (n - 2.0) / n, edges: Some((w, None)), face: Some(w) }
+                let m = smooth(valence);
+                Self { vertex: m.vertex, edges: Some((m.edge, None)), face: m.face }
             }
             VertexRule::Crease => {
                 let ends = sharp_edge_pair_of_crease(valence, sharp).unwrap_or([0, 0]);
@@ -612,6 +650,95 @@ impl RuleMask {
             None => 0.0,
         }
     }
+}
+
+/// Sdc's `ComputeVertexVertexMask` (`opensubdiv/sdc/scheme.h`), which every scheme shares, for
+/// a scheme whose smooth mask at valence n is `smooth(n)`; the arguments and the rules are
+/// [`vertex_mask`]'s (Catmark's, which calls it, as does [`super::loop_sdc::vertex_mask`]). A
+/// scheme without face weights gets `face` 0.
+///
+/// # Panics
+///
+/// In debug builds, if a smooth rule meets `faces != edge_sharpness.len()`.
+///
+/// Cost: O(edges), no allocation, and `smooth` at most twice.
+pub(crate) fn vertex_mask_with(
+    vertex_sharpness: f32,
+    edge_sharpness: &[f32],
+    faces: usize,
+    crease: CreaseMethod,
+    smooth: impl Fn(usize) -> SmoothVertexMask,
+) -> VertexMask {
+    let n = edge_sharpness.len();
+    let rule = vertex_rule(vertex_sharpness, edge_sharpness);
+    // Neither scheme has a smooth rule for a boundary or non-manifold vertex (Sdc sizes the
+    // smooth masks by the face count), and Far's sharpening never leaves one smooth.
+    let smooth_ok = |r: VertexRule| {
+        debug_assert!(
+            !r.is_smooth() || faces == n,
+            "the smooth rule needs as many faces as edges ({n} edges, {faces} faces)"
+        );
+    };
+    let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]), &smooth);
+    let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
+        let (edge, crease) = m.edges.unwrap_or((0.0, None));
+        VertexMask {
+            vertex: m.vertex,
+            edge,
+            crease,
+            face: m.face.unwrap_or(0.0),
+            rule,
+            child_rule,
+            parent_weight,
+        }
+    };
+    let at = EdgesAtVertex::new(edge_sharpness, crease);
+    let child_edge = |i: usize| at.child(edge_sharpness[i]);
+    let child_vertex = child_vertex_sharpness(vertex_sharpness);
+    let child_sharp = (0..n).filter(|&i| is_sharp(child_edge(i))).count();
+    let child_rule = VertexRule::from_sharp_edge_count(child_vertex, child_sharp);
+    // A smooth or dart parent keeps its mask whatever its child becomes (a dart's edge may
+    // decay): Sdc returns before looking at the child.
+    if rule.is_smooth() {
+        smooth_ok(rule);
+        return finish(parent, child_rule, 1.0);
+    }
+    if child_rule == rule {
+        return finish(parent, child_rule, 1.0);
+    }
+    smooth_ok(child_rule);
+    let child = RuleMask::new(child_rule, n, |i| is_sharp(child_edge(i)), &smooth);
+
+    let pw = f64::from(fractional_weight(vertex_sharpness, child_vertex, edge_sharpness, child_edge, crease));
+    let cw = 1.0 - pw;
+    // Sdc blends weight by weight, and a kind of weight the parent mask lacks (a corner's
+    // edges, a crease's faces) becomes the child's weight scaled by 1 − w. A blend always
+    // has a child with edge weights (a vertex never gains sharp edges), and at most one crease
+    // pair takes part: the parent's (a crease decaying to smooth) or the child's (a corner
+    // decaying to a crease).
+    let blend = |parent_has: bool, p: f64, c: f64| if parent_has { pw * p + cw * c } else { cw * c };
+    let has_edges = parent.edges.is_some();
+    let pair_of = |m: &RuleMask| m.edges.and_then(|(_, pair)| pair).map(|(ends, _)| ends);
+    let crease_pair = pair_of(&child).or(pair_of(&parent));
+    // The weight of an edge outside any pair, read from both masks at such an index.
+    let generic = |m: &RuleMask| m.edges.map_or(0.0, |(w, _)| w);
+    let mask = RuleMask {
+        vertex: pw * parent.vertex + cw * child.vertex,
+        edges: Some((
+            blend(has_edges, generic(&parent), generic(&child)),
+            crease_pair.map(|ends| (ends, blend(has_edges, parent.edge(ends[0]), child.edge(ends[0])))),
+        )),
+        face: child.face.map(|c| blend(parent.face.is_some(), parent.face.unwrap_or(0.0), c)),
+    };
+    finish(mask, child_rule, pw)
+}
+
+/// Catmark's smooth vertex mask (`opensubdiv/sdc/catmarkScheme.h`,
+/// `assignSmoothMaskForVertex`): (n − 2)/n the vertex, 1/n² each edge end and each face point.
+fn smooth_vertex_mask(valence: usize) -> SmoothVertexMask {
+    let n = valence as f64;
+    let w = 1.0 / (n * n);
+    SmoothVertexMask { vertex: (n - 2.0) / n, edge: w, face: Some(w) }
 }
 
 /// The mask of the vertex point of a vertex with sharpness `vertex_sharpness` whose incident
@@ -646,66 +773,7 @@ pub fn vertex_mask(
     faces: usize,
     crease: CreaseMethod,
 ) -> VertexMask {
-    let n = edge_sharpness.len();
-    let rule = vertex_rule(vertex_sharpness, edge_sharpness);
-    let smooth_ok = |r: VertexRule| {
-        debug_assert!(
-            !r.is_smooth() || faces == n,
-            "the smooth Catmark rule needs as many faces as edges ({n} edges, {faces} faces)"
-        );
-    };
-    let parent = RuleMask::new(rule, n, |i| is_sharp(edge_sharpness[i]));
-    let finish = |m: RuleMask, child_rule: VertexRule, parent_weight: f64| {
-        let (edge, crease) = m.edges.unwrap_or((0.0, None));
-        VertexMask {
-            vertex: m.vertex,
-            edge,
-            crease,
-            face: m.face.unwrap_or(0.0),
-            rule,
-            child_rule,
-            parent_weight,
-        }
-    };
-    let at = EdgesAtVertex::new(edge_sharpness, crease);
-    let child_edge = |i: usize| at.child(edge_sharpness[i]);
-    let child_vertex = child_vertex_sharpness(vertex_sharpness);
-    let child_sharp = (0..n).filter(|&i| is_sharp(child_edge(i))).count();
-    let child_rule = VertexRule::from_sharp_edge_count(child_vertex, child_sharp);
-    // A smooth or dart parent keeps its mask whatever its child becomes (a dart's edge may
-    // decay): Sdc returns before looking at the child.
-    if rule.is_smooth() {
-        smooth_ok(rule);
-        return finish(parent, child_rule, 1.0);
-    }
-    if child_rule == rule {
-        return finish(parent, child_rule, 1.0);
-    }
-    smooth_ok(child_rule);
-    let child = RuleMask::new(child_rule, n, |i| is_sharp(child_edge(i)));
-
-    let pw = f64::from(fractional_weight(vertex_sharpness, child_vertex, edge_sharpness, child_edge, crease));
-    let cw = 1.0 - pw;
-    // Sdc blends weight by weight, and a kind of weight the parent mask lacks (a corner's
-    // edges, a crease's faces) becomes the child's weight scaled by 1 − w. A blend always
-    // has a child with edge weights (a vertex never gains sharp edges), and at most one crease
-    // pair takes part: the parent's (a crease decaying to smooth) or the child's (a corner
-    // decaying to a crease).
-    let blend = |parent_has: bool, p: f64, c: f64| if parent_has { pw * p + cw * c } else { cw * c };
-    let has_edges = parent.edges.is_some();
-    let pair_of = |m: &RuleMask| m.edges.and_then(|(_, pair)| pair).map(|(ends, _)| ends);
-    let crease_pair = pair_of(&child).or(pair_of(&parent));
-    // The weight of an edge outside any pair, read from both masks at such an index.
-    let generic = |m: &RuleMask| m.edges.map_or(0.0, |(w, _)| w);
-    let mask = RuleMask {
-        vertex: pw * parent.vertex + cw * child.vertex,
-        edges: Some((
-            blend(has_edges, generic(&parent), generic(&child)),
-            crease_pair.map(|ends| (ends, blend(has_edges, parent.edge(ends[0]), child.edge(ends[0])))),
-        )),
-        face: child.face.map(|c| blend(parent.face.is_some(), parent.face.unwrap_or(0.0), c)),
-    };
-    finish(mask, child_rule, pw)
+    vertex_mask_with(vertex_sharpness, edge_sharpness, faces, crease, smooth_vertex_mask)
 }
 
 /// The neighbourhood of a vertex, for [`vertex_point`].
@@ -736,7 +804,7 @@ pub fn vertex_point(vertex: &VertexNeighborhood<'_>, crease: CreaseMethod) -> DV
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     const INF: f32 = INFINITELY_SHARP;
@@ -990,38 +1058,39 @@ mod tests {
     /// in practice the agreement is exact.
     const WEIGHT_TOLERANCE: f64 = 1e-6;
 
-    struct Tokens<'a>(std::str::SplitAsciiWhitespace<'a>);
+    /// A fixture line's words, read in order (the Loop fixture's lines use the same words).
+    pub(crate) struct Tokens<'a>(pub(crate) std::str::SplitAsciiWhitespace<'a>);
 
     impl<'a> Tokens<'a> {
-        fn word(&mut self) -> &'a str {
+        pub(crate) fn word(&mut self) -> &'a str {
             self.0.next().expect("fixture line ends early")
         }
-        fn expect(&mut self, w: &str) {
+        pub(crate) fn expect(&mut self, w: &str) {
             assert_eq!(self.word(), w, "fixture format");
         }
-        fn f32(&mut self) -> f32 {
+        pub(crate) fn f32(&mut self) -> f32 {
             self.word().parse().unwrap()
         }
-        fn f64(&mut self) -> f64 {
+        pub(crate) fn f64(&mut self) -> f64 {
             self.word().parse().unwrap()
         }
-        fn usize(&mut self) -> usize {
+        pub(crate) fn usize(&mut self) -> usize {
             self.word().parse().unwrap()
         }
-        fn f32s(&mut self, n: usize) -> Vec<f32> {
+        pub(crate) fn f32s(&mut self, n: usize) -> Vec<f32> {
             (0..n).map(|_| self.f32()).collect()
         }
-        fn f64s(&mut self, n: usize) -> Vec<f64> {
+        pub(crate) fn f64s(&mut self, n: usize) -> Vec<f64> {
             (0..n).map(|_| self.f64()).collect()
         }
-        fn method(&mut self) -> CreaseMethod {
+        pub(crate) fn method(&mut self) -> CreaseMethod {
             match self.word() {
                 "uniform" => CreaseMethod::Uniform,
                 "chaikin" => CreaseMethod::Chaikin,
                 w => panic!("crease method {w}"),
             }
         }
-        fn rule(&mut self) -> VertexRule {
+        pub(crate) fn rule(&mut self) -> VertexRule {
             match self.word() {
                 "smooth" => VertexRule::Smooth,
                 "dart" => VertexRule::Dart,
@@ -1029,6 +1098,17 @@ mod tests {
                 "corner" => VertexRule::Corner,
                 w => panic!("rule {w}"),
             }
+        }
+    }
+
+    /// Runs `check` on each data line of `fixture` with its kind (the first word), the words
+    /// after it and the line, and makes sure that `check` reads every word.
+    pub(crate) fn each_fixture_line(fixture: &str, mut check: impl FnMut(&str, &mut Tokens<'_>, &str)) {
+        for line in fixture.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
+            let mut t = Tokens(line.split_ascii_whitespace());
+            let kind = t.word();
+            check(kind, &mut t, line);
+            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
         }
     }
 
@@ -1098,6 +1178,39 @@ mod tests {
         };
         let (s, nf) = (t.f32(), t.usize());
         let sizes: Vec<usize> = (0..nf).map(|_| t.usize()).collect();
+        let theirs = read_edge_line(t, s, nf, method, line);
+        let m = edge_mask(s, theirs.child_rule, &sizes, triangles);
+        assert_eq!(m.faces, nf);
+        for &w in &theirs.ends {
+            agree.weight(m.vertex, w, line);
+        }
+        for &w in &theirs.faces {
+            agree.weight(m.face, w, line);
+        }
+        agree.vtr_only += usize::from(theirs.vtr_only);
+        agree.edges += 1;
+    }
+
+    /// OpenSubdiv's edge mask on an edge line: the child rule Vtr gives it, the weights of
+    /// each end and each face in Vtr's mask, and whether Sdc's own mask (no rules given)
+    /// differs from it.
+    pub(crate) struct EdgeLine {
+        pub(crate) child_rule: VertexRule,
+        pub(crate) ends: Vec<f64>,
+        pub(crate) faces: Vec<f64>,
+        pub(crate) vtr_only: bool,
+    }
+
+    /// Reads an edge line from its child edges' sharpness on (the words both fixtures share)
+    /// for an edge of sharpness `s` and `nf` faces, and checks our child sharpness at both
+    /// ends and the child rule against OpenSubdiv's.
+    pub(crate) fn read_edge_line(
+        t: &mut Tokens<'_>,
+        s: f32,
+        nf: usize,
+        method: CreaseMethod,
+        line: &str,
+    ) -> EdgeLine {
         t.expect("ring0");
         let k = t.usize();
         let ring0 = t.f32s(k);
@@ -1107,46 +1220,32 @@ mod tests {
         t.expect("child");
         let child = [t.f32(), t.f32()];
         t.expect("crule");
-        let c_rule = t.rule();
+        let child_rule = t.rule();
         t.expect("w");
-        let (wv, wf) = (t.f64s(2), t.f64s(nf));
+        let (ends, faces) = (t.f64s(2), t.f64s(nf));
         t.expect("sdc");
-        let (sv, sf) = (t.f64s(2), t.f64s(nf));
+        let (sdc_ends, sdc_faces) = (t.f64s(2), t.f64s(nf));
 
         let ours = [child_edge_sharpness(s, &ring0, method), child_edge_sharpness(s, &ring1, method)];
         assert_eq!(ours, child, "{line}");
-        assert_eq!(edge_child_rule(s, ours), c_rule, "{line}");
-        let m = edge_mask(s, c_rule, &sizes, triangles);
-        assert_eq!(m.faces, nf);
-        for &w in &wv {
-            agree.weight(m.vertex, w, line);
-        }
-        for &w in &wf {
-            agree.weight(m.face, w, line);
-        }
-        if (wv, wf) != (sv, sf) {
-            agree.vtr_only += 1;
-        }
-        agree.edges += 1;
+        assert_eq!(edge_child_rule(s, ours), child_rule, "{line}");
+        let vtr_only = (&ends, &faces) != (&sdc_ends, &sdc_faces);
+        EdgeLine { child_rule, ends, faces, vtr_only }
     }
 
     #[test]
     fn masks_and_sharpness_agree_with_opensubdiv_sdc() {
         let mut agree = Agreement::default();
-        for line in FIXTURE.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
-            let mut t = Tokens(line.split_ascii_whitespace());
-            match t.word() {
-                "vertex" => check_vertex(&mut t, line, &mut agree),
-                "edge" => check_edge(&mut t, line, &mut agree),
-                "uniform" => {
-                    let (s, c) = (t.f32(), t.f32());
-                    assert_eq!(subdivide_sharpness(s), c, "{line}");
-                    agree.uniform += 1;
-                }
-                w => panic!("unknown fixture line kind {w}"),
+        each_fixture_line(FIXTURE, |kind, t, line| match kind {
+            "vertex" => check_vertex(t, line, &mut agree),
+            "edge" => check_edge(t, line, &mut agree),
+            "uniform" => {
+                let (s, c) = (t.f32(), t.f32());
+                assert_eq!(subdivide_sharpness(s), c, "{line}");
+                agree.uniform += 1;
             }
-            assert!(t.0.next().is_none(), "fixture line longer than expected: {line}");
-        }
+            w => panic!("unknown fixture line kind {w}"),
+        });
         println!(
             "{} vertex masks, {} edge masks ({} where Vtr's rules differ from Sdc's own), {} uniform decrements; max weight difference {:e}",
             agree.vertices, agree.edges, agree.vtr_only, agree.uniform, agree.max_weight_diff
