@@ -417,6 +417,7 @@ impl GregoryPatch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::subdivision::gregory_shared::{bspline, Rng};
     use std::collections::HashMap;
 
     /// A quad mesh with consistently counter-clockwise faces, for filling sources the way a
@@ -500,27 +501,12 @@ mod tests {
         }
     }
 
-    /// splitmix64, for reproducible jitter.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-        fn jitter(&mut self) -> DVec3 {
-            DVec3::new(self.next(), self.next(), self.next()) * 0.3
-        }
-    }
-
     /// An `n × n` quad grid with jittered vertices, vertex `(i, j)` at index `j·(n+1) + i`.
     fn grid(n: usize, seed: u64) -> Mesh {
         let mut rng = Rng(seed);
         let id = |i: usize, j: usize| j * (n + 1) + i;
         let pos = (0..(n + 1) * (n + 1))
-            .map(|k| DVec3::new((k % (n + 1)) as f64, (k / (n + 1)) as f64, 0.0) + rng.jitter())
+            .map(|k| DVec3::new((k % (n + 1)) as f64, (k / (n + 1)) as f64, 0.0) + rng.point(0.3))
             .collect();
         let mut faces = Vec::new();
         for j in 0..n {
@@ -569,21 +555,9 @@ mod tests {
             }
         }
         for p in &mut pos {
-            *p += rng.jitter();
+            *p += rng.point(0.3);
         }
         (Mesh::new(pos, faces), g)
-    }
-
-    /// The uniform cubic B-spline curve of four points at `t`.
-    fn bspline(p: [DVec3; 4], t: f64) -> DVec3 {
-        let tc = 1.0 - t;
-        let w = [
-            tc * tc * tc,
-            3.0 * t * t * t - 6.0 * t * t + 4.0,
-            -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
-            t * t * t,
-        ];
-        (p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3]) / 6.0
     }
 
     fn samples() -> impl Iterator<Item = (f64, f64)> {

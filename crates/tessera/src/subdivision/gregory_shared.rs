@@ -633,3 +633,38 @@ pub(super) fn corner_and_face_points<C: SchemeCorner, const N: usize>(
 pub(super) fn apply<const M: usize>(stencils: &[Stencil; M], points: &[DVec3]) -> [DVec3; M] {
     stencils.each_ref().map(|s| s.iter().map(|&(i, w)| points[i] * w).sum())
 }
+
+/// splitmix64, for reproducible test points in both converters' tests.
+#[cfg(test)]
+pub(super) struct Rng(pub u64);
+
+#[cfg(test)]
+impl Rng {
+    /// Uniform in [−½, ½).
+    pub(super) fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+
+    /// A point with coordinates uniform in [−scale/2, scale/2).
+    pub(super) fn point(&mut self, scale: f64) -> DVec3 {
+        DVec3::new(self.next(), self.next(), self.next()) * scale
+    }
+}
+
+/// The uniform cubic B-spline curve of four points at `t`, which both converters' boundary
+/// curves must follow.
+#[cfg(test)]
+pub(super) fn bspline(p: [DVec3; 4], t: f64) -> DVec3 {
+    let tc = 1.0 - t;
+    let w = [
+        tc * tc * tc,
+        3.0 * t * t * t - 6.0 * t * t + 4.0,
+        -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
+        t * t * t,
+    ];
+    (p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3]) / 6.0
+}

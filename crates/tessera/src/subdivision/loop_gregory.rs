@@ -427,22 +427,8 @@ pub fn gregory_triangle_points(source: &LoopGregorySource) -> [DVec3; 18] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::subdivision::gregory_shared::{bspline, Rng};
     use std::collections::HashMap;
-
-    /// splitmix64, for reproducible source points.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-        fn point(&mut self) -> DVec3 {
-            DVec3::new(self.next(), self.next(), self.next()) * 2.0
-        }
-    }
 
     /// One patch of `tools/osd-oracle/loop_gregory_check.cpp`'s fixture: the source patch's
     /// topology (rings as source-point indices) and OpenSubdiv's 18 matrix rows.
@@ -470,6 +456,17 @@ mod tests {
                 }
             });
             LoopGregorySource { corners }
+        }
+
+        /// Seeded random source points, the source on them and tessera's 18 stencils for it,
+        /// having checked that tessera numbers the source points as OpenSubdiv does.
+        fn stencils(&self, seed: u64) -> (Vec<DVec3>, LoopGregorySource, [Stencil; 18]) {
+            let points = random_points(self.num_points, seed);
+            let source = self.source(&points);
+            let layout = SourceLayout::new(&source.corners).unwrap();
+            assert_eq!(layout.num_points, self.num_points, "{}", self.header);
+            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            (points, source, rows)
         }
 
         fn points(&self, points: &[DVec3]) -> Vec<DVec3> {
@@ -509,7 +506,7 @@ mod tests {
 
     fn random_points(n: usize, seed: u64) -> Vec<DVec3> {
         let mut rng = Rng(seed);
-        (0..n).map(|_| rng.point()).collect()
+        (0..n).map(|_| rng.point(2.0)).collect()
     }
 
     /// A stencil's weights summed per source point.
@@ -558,11 +555,7 @@ mod tests {
     #[test]
     fn loop_gregory_weights_equal_opensubdiv_columns() {
         for patch in fixture() {
-            let points = random_points(patch.num_points, 7);
-            let source = patch.source(&points);
-            let layout = SourceLayout::new(&source.corners).unwrap();
-            assert_eq!(layout.num_points, patch.num_points, "{}", patch.header);
-            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            let (_, _, rows) = patch.stencils(7);
             for (i, (ours, theirs)) in rows.iter().zip(&patch.rows).enumerate() {
                 let (a, b) = (by_column(ours, patch.num_points), by_column(theirs, patch.num_points));
                 for (j, (x, y)) in a.iter().zip(&b).enumerate() {
@@ -577,10 +570,7 @@ mod tests {
     #[test]
     fn loop_gregory_weights_sum_to_one() {
         for patch in fixture() {
-            let points = random_points(patch.num_points, 11);
-            let source = patch.source(&points);
-            let layout = SourceLayout::new(&source.corners).unwrap();
-            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            let (points, source, rows) = patch.stencils(11);
             for (i, row) in rows.iter().enumerate() {
                 let sum: f64 = row.iter().map(|&(_, w)| w).sum();
                 assert!((sum - 1.0).abs() < 1e-13, "{}: row {i} sums to {sum}", patch.header);
@@ -678,7 +668,7 @@ mod tests {
         let mut f = HashMap::new();
         for i in -3..=4 {
             for j in -3..=4 {
-                let p = DVec3::new(i as f64 + 0.5 * j as f64, j as f64 * 0.866, 0.0) + rng.point() * 0.15;
+                let p = DVec3::new(i as f64 + 0.5 * j as f64, j as f64 * 0.866, 0.0) + rng.point(2.0) * 0.15;
                 f.insert((i, j), p);
             }
         }
@@ -739,19 +729,9 @@ mod tests {
         let c1 = &source.corners[1];
         assert!(c1.boundary && c1.patch_face + 1 == c1.num_faces);
         let b = [before, c0.position, c1.position, c1.ring[0]];
-        let cubic = |t: f64| {
-            let tc = 1.0 - t;
-            let w = [
-                tc * tc * tc,
-                3.0 * t * t * t - 6.0 * t * t + 4.0,
-                -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
-                t * t * t,
-            ];
-            (b[0] * w[0] + b[1] * w[1] + b[2] * w[2] + b[3] * w[3]) / 6.0
-        };
         for k in 0..=8 {
             let s = k as f64 / 8.0;
-            let d = (evaluate(&g, s, 0.0) - cubic(s)).length();
+            let d = (evaluate(&g, s, 0.0) - bspline(b, s)).length();
             assert!(d < 1e-12, "{}: s = {s}: {d}", patch.header);
         }
     }
