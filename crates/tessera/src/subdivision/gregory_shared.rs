@@ -9,13 +9,16 @@
 //!   (`far/loopPatchBuilder.cpp`) compute line for line alike but for the regular valence
 //!   ([`corner_kinds`], [`FacePointFlags`]);
 //! * the order in which both `Convert`s assemble corner, edge and face points, the dispatch of
-//!   `computeIrregularEdgePoints` (the sharp corner's approximation is the same in both) and
-//!   the irregular face point's blend ([`corner_and_face_points`], [`blend_face_point`]).
+//!   `computeIrregularEdgePoints` (the sharp corner's approximation is the same in both), the
+//!   boundary vertex's position and edge points around its tangent (`ComputeBoundaryPointWeights`
+//!   of `CatmarkLimits` and `LoopLimits`) and the irregular face point's blend
+//!   ([`corner_and_face_points`], [`blend_face_point`]).
 //!
 //! What differs between the two files stays with each converter, behind [`SchemeCorner`]: the
 //! limit masks and tangents (Catmull-Clark's eigenvalue table against Loop's Sdc masks), the
-//! regular points (B-spline against box spline), the face-point corrections and, for
-//! triangles only, the mid-edge points and the promotion to quartic.
+//! test for an edge point on the trailing boundary edge (Loop's never holds), the regular
+//! points (B-spline against box spline), the face-point corrections and, for triangles only,
+//! the mid-edge points and the promotion to quartic.
 
 use super::gregory::GregorySourceError;
 use glam::DVec3;
@@ -78,7 +81,11 @@ pub(super) trait SchemeCorner: Sized {
     fn ring(&self) -> &[DVec3];
 
     /// Limit-point weights of a smooth interior vertex over `[vertex, ring…]` and the edge
-    /// points along the patch face's leading and trailing edges.
+    /// points along the patch face's leading and trailing edges. The two implementations have
+    /// the same outline (a limit position plus a tangent rotated onto each edge) but not the
+    /// same rule — `CatmarkLimits` gathers three cosine terms per edge under a tabulated
+    /// eigenvalue scale, `LoopLimits` takes Sdc's first tangent with an exact valence-6 mask —
+    /// so only the outline's callers are shared, not the weights.
     fn interior_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3];
     /// The interior tangent of a smooth boundary vertex with `valence` edges over
     /// `[vertex, ring…]`, as [`boundary_weights`] mixes it into the edge points.
