@@ -174,10 +174,11 @@ pub(super) fn checked_layout<C: SchemeCorner, const N: usize>(
     what: &str,
 ) -> SourceLayout<N> {
     for c in corners {
+        let f = c.fan();
+        // Unlike `validate`, an interior fan of one face is let through, as before the
+        // converters shared this check.
         assert!(
-            c.fan().num_faces >= 1
-                && c.fan().patch_face < c.fan().num_faces
-                && c.ring().len() == c.implied_ring_len(),
+            f.num_faces >= 1 && f.patch_face < f.num_faces && c.ring().len() == c.implied_ring_len(),
             "inconsistent {what} source corner"
         );
     }
