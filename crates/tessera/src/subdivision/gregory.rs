@@ -29,6 +29,10 @@
 //! So with `u` along corner 0 → 1 and `v` along corner 0 → 3, the Bézier net's bottom row is
 //! `P0, Ep0, Em1, P1` and its left column `P0, Em0, Ep3, P3`.
 
+use super::gregory_shared::{
+    self, apply, checked_layout, corner_and_face_points, corner_fields, corner_kinds, CornerKind,
+    SchemeCorner, SourceLayout, Stencil,
+};
 pub use crate::surface::GregoryPatch;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -88,22 +92,12 @@ pub struct GregoryCorner {
 impl GregoryCorner {
     /// OpenSubdiv's valence-2 interior flag (`SourcePatch::Finalize`): two faces, no boundary.
     pub fn is_val2_interior(&self) -> bool {
-        self.num_faces == 2 && !self.boundary
+        self.fan().is_val2_interior()
     }
 
     /// The ring length this corner's fan implies: `2·num_faces`, plus one on a boundary.
     pub fn expected_ring_len(&self) -> usize {
-        2 * self.num_faces + usize::from(self.boundary)
-    }
-
-    /// Edges at the corner vertex within its fan (OpenSubdiv's corner "valence").
-    fn valence(&self) -> usize {
-        self.num_faces + usize::from(self.boundary)
-    }
-
-    /// A corner of a regular B-spline neighbourhood: four interior faces, or two on a boundary.
-    fn is_regular(&self) -> bool {
-        (self.num_faces << usize::from(self.boundary)) == 4 && !self.sharp
+        self.implied_ring_len()
     }
 }
 
@@ -176,288 +170,8 @@ impl GregorySource {
     /// Cost: linear in the total ring length. [`GregoryPatch::new`] assumes a source that
     /// passes this check; call it when filling sources from a new mesh walker.
     pub fn validate(&self) -> Result<(), GregorySourceError> {
-        for (i, c) in self.corners.iter().enumerate() {
-            if c.num_faces == 0 || c.patch_face >= c.num_faces || (c.num_faces == 1 && !c.boundary) {
-                return Err(GregorySourceError::BadFan { corner: i });
-            }
-            if c.ring.len() != c.expected_ring_len() {
-                return Err(GregorySourceError::RingLength {
-                    corner: i,
-                    len: c.ring.len(),
-                    expected: c.expected_ring_len(),
-                });
-            }
-        }
-        let layout = SourceLayout::new(&self.corners).ok_or(GregorySourceError::Layout)?;
-        let mut seen: Vec<Option<DVec3>> = vec![None; layout.num_points];
-        for (i, c) in self.corners.iter().enumerate() {
-            seen[i] = Some(c.position);
-        }
-        for (i, c) in self.corners.iter().enumerate() {
-            let indices = layout.ring_indices(&self.corners, i).ok_or(GregorySourceError::Layout)?;
-            for (k, (&index, &p)) in indices.iter().zip(&c.ring).enumerate() {
-                match seen[index] {
-                    Some(q) if q != p => {
-                        return Err(GregorySourceError::Mismatch { corner: i, ring_index: k })
-                    }
-                    _ => seen[index] = Some(p),
-                }
-            }
-        }
-        Ok(())
+        gregory_shared::validate(&self.corners)
     }
-}
-
-/// OpenSubdiv's numbering of a source patch's distinct points (`SourcePatch::Finalize` and
-/// `SourcePatch::GetCornerRingPoints`, `far/patchBuilder.cpp`): the 4 corners, then each
-/// corner's ring points not shared with a neighbour. The numbering matters beyond
-/// bookkeeping: an irregular face point keeps a ring point's contribution only if that point
-/// already contributes to the corner and edge points it is built from, so which ring slots
-/// are the *same* point decides the result (see `face_point`).
-struct SourceLayout {
-    num_points: usize,
-    ring_sizes: [usize; 4],
-    local_sizes: [usize; 4],
-    local_offsets: [usize; 4],
-    shares_prev: [bool; 4],
-    shares_next: [bool; 4],
-    val2: [bool; 4],
-}
-
-impl SourceLayout {
-    /// Sizes the rings and numbers the local points; `None` if the fans do not fit.
-    fn new(corners: &[GregoryCorner; 4]) -> Option<Self> {
-        let val2 = corners.each_ref().map(GregoryCorner::is_val2_interior);
-        let mut layout = SourceLayout {
-            num_points: 4,
-            ring_sizes: [0; 4],
-            local_sizes: [0; 4],
-            local_offsets: [0; 4],
-            shares_prev: [false; 4],
-            shares_next: [false; 4],
-            val2,
-        };
-        for i in 0..4 {
-            let (prev, next) = ((i + 3) % 4, (i + 1) % 4);
-            let c = &corners[i];
-            if c.valence() > 2 {
-                // A ring shares its first point past the previous corner with that corner's
-                // ring, and its last point before the next corner with the next one's, unless
-                // a boundary (or a dart's sharp edge) separates them.
-                let (share_prev, share_next) = if c.boundary {
-                    (c.patch_face != c.num_faces - 1, c.patch_face != 0)
-                } else if c.dart {
-                    let (p, n) = (&corners[prev], &corners[next]);
-                    let prev_on_dart_edge = p.boundary && p.patch_face == 0;
-                    let next_on_dart_edge = n.boundary && n.patch_face + 1 == n.num_faces;
-                    (!prev_on_dart_edge, !next_on_dart_edge)
-                } else {
-                    (true, true)
-                };
-                layout.shares_prev[i] = share_prev;
-                layout.shares_next[i] = share_next;
-                let ring = 2 * c.num_faces + usize::from(c.boundary);
-                // A valence-2 neighbour puts the opposite corner into this ring a second time.
-                let taken = 3
-                    + usize::from(share_prev)
-                    + usize::from(share_next)
-                    + usize::from(val2[prev])
-                    + usize::from(val2[next]);
-                layout.ring_sizes[i] = ring;
-                layout.local_sizes[i] = ring.checked_sub(taken)?;
-            } else if c.num_faces == 1 {
-                layout.ring_sizes[i] = 3;
-                layout.local_sizes[i] = 0;
-            } else {
-                layout.ring_sizes[i] = 4;
-                layout.local_sizes[i] = 1;
-            }
-            layout.local_offsets[i] = layout.num_points;
-            layout.num_points += layout.local_sizes[i];
-        }
-        Some(layout)
-    }
-
-    /// The source-point indices of corner `i`'s ring, in ring order; `None` if the pieces do
-    /// not add up to the ring's size.
-    fn ring_indices(&self, corners: &[GregoryCorner; 4], i: usize) -> Option<Vec<usize>> {
-        let (next, opp, prev) = ((i + 1) % 4, (i + 2) % 4, (i + 3) % 4);
-        // Assembled as if the patch face were face 0: the other three corners, then the points
-        // shared with the previous corner, the local points, those shared with the next one.
-        let mut ring = vec![next, opp, prev];
-        if self.val2[prev] {
-            ring.push(opp);
-        }
-        if self.shares_prev[i] {
-            ring.push(self.local_offsets[prev] + self.local_sizes[prev] - 1);
-        }
-        ring.extend(self.local_offsets[i]..self.local_offsets[i] + self.local_sizes[i]);
-        if self.shares_next[i] {
-            ring.push(self.local_offsets[next]);
-        }
-        if self.val2[next] {
-            ring.push(opp);
-        }
-        if ring.len() != self.ring_sizes[i] {
-            return None;
-        }
-        let rotation = (ring.len() - 2 * corners[i].patch_face) % ring.len();
-        ring.rotate_left(rotation);
-        Some(ring)
-    }
-}
-
-/// A patch point as a combination of source points: (source index, weight), repeats allowed.
-pub(super) type Stencil = Vec<(usize, f64)>;
-
-/// How a corner's two edge points and two face points relate to the patch's boundary and to
-/// its neighbours' regularity (the second pass of `GregoryConverter::Initialize`,
-/// `far/catmarkPatchBuilder.cpp`; `GregoryTriConverter::Initialize`,
-/// `far/loopPatchBuilder.cpp`, applies the same rule to triangles).
-#[derive(Clone, Copy, Default)]
-pub(super) struct FacePointFlags {
-    /// Ep lies on a boundary edge (the patch face is the first of an open fan).
-    pub ep_on_boundary: bool,
-    /// Em lies on a boundary edge (the patch face is the last of an open fan).
-    pub em_on_boundary: bool,
-    /// Fp takes the regular (B-spline or box-spline) face point.
-    pub fp_regular: bool,
-    /// Fm takes the regular face point.
-    pub fm_regular: bool,
-    /// Fp is a copy of Fm.
-    pub fp_copied: bool,
-    /// Fm is a copy of Fp.
-    pub fm_copied: bool,
-}
-
-impl FacePointFlags {
-    /// The flags of a corner whose fan has `num_faces` faces, the patch face at `face_in_ring`,
-    /// given whether the corner and its next and previous neighbours are regular.
-    pub(super) fn new(boundary: bool, num_faces: usize, face_in_ring: usize, regular: [bool; 3]) -> Self {
-        let [this, next, prev] = regular;
-        let mut f = FacePointFlags {
-            fp_regular: this && next,
-            fm_regular: this && prev,
-            ..FacePointFlags::default()
-        };
-        if boundary {
-            f.ep_on_boundary = face_in_ring == 0;
-            f.em_on_boundary = face_in_ring + 1 == num_faces;
-            if num_faces > 1 {
-                // Across a boundary edge the two face points of the corner coincide: the one
-                // by the boundary copies the other (or both are regular).
-                if f.ep_on_boundary {
-                    f.fp_regular = f.fm_regular;
-                    f.fp_copied = !f.fp_regular;
-                }
-                if f.em_on_boundary {
-                    f.fm_regular = f.fp_regular;
-                    f.fm_copied = !f.fm_regular;
-                }
-            } else {
-                // A one-face corner takes the regular face points.
-                f.fp_regular = true;
-                f.fm_regular = true;
-            }
-        }
-        f
-    }
-}
-
-/// The irregular face point rule shared by quads (`d = 3`, `GregoryConverter`) and triangles
-/// (`d = 4`, `GregoryTriConverter`): `(cos θ_far·P + (d − 2cos θ_near − cos θ_far)·E_near +
-/// 2cos θ_near·E_far)/d` plus the `corrections` (source index, weight).
-///
-/// OpenSubdiv assembles the row over the union of the source points that P, E_near and E_far
-/// use, and adds the corrections into that row only: a correction on a point outside the
-/// union is dropped. So the result depends on which ring slots are the same source point,
-/// which is why sources are numbered as OpenSubdiv numbers them. Cost: O(`num_points`).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn blend_face_point(
-    num_points: usize,
-    d: f64,
-    cos_near: f64,
-    cos_far: f64,
-    p: &Stencil,
-    e_near: &Stencil,
-    e_far: &Stencil,
-    corrections: &[(usize, f64)],
-) -> Stencil {
-    let p_coeff = cos_far / d;
-    let near_coeff = (d - 2.0 * cos_near - cos_far) / d;
-    let far_coeff = 2.0 * cos_near / d;
-
-    let mut row = vec![0.0; num_points];
-    let mut used = vec![false; num_points];
-    for (stencil, s) in [(p, p_coeff), (e_near, near_coeff), (e_far, far_coeff)] {
-        for &(i, w) in stencil {
-            row[i] += s * w;
-            used[i] = true;
-        }
-    }
-    for &(i, w) in corrections {
-        row[i] += w;
-    }
-    (0..num_points).filter(|&i| used[i]).map(|i| (i, row[i])).collect()
-}
-
-/// What the converter needs of each corner (`GregoryConverter::CornerTopology`,
-/// `far/catmarkPatchBuilder.cpp`), including how its face points relate to its neighbours.
-#[derive(Clone, Copy, Default)]
-struct CornerKind {
-    boundary: bool,
-    sharp: bool,
-    regular: bool,
-    valence: usize,
-    num_faces: usize,
-    face_in_ring: usize,
-    cos_face_angle: f64,
-    ep_on_boundary: bool,
-    em_on_boundary: bool,
-    fp_regular: bool,
-    fm_regular: bool,
-    fp_copied: bool,
-    fm_copied: bool,
-}
-
-fn corner_kinds(corners: &[GregoryCorner; 4]) -> [CornerKind; 4] {
-    let mut kinds = corners.each_ref().map(|c| {
-        let regular = c.is_regular();
-        // A regular corner's face angle is exactly a right angle (cos 0), not the rounded
-        // cosine of π/2.
-        let cos_face_angle = if regular {
-            0.0
-        } else {
-            let sweep = if c.boundary { PI } else { 2.0 * PI };
-            (sweep / c.num_faces as f64).cos()
-        };
-        CornerKind {
-            boundary: c.boundary,
-            sharp: c.sharp,
-            regular,
-            valence: c.valence(),
-            num_faces: c.num_faces,
-            face_in_ring: c.patch_face,
-            cos_face_angle,
-            ..CornerKind::default()
-        }
-    });
-    let regular = kinds.map(|k| k.regular);
-    for (i, k) in kinds.iter_mut().enumerate() {
-        let f = FacePointFlags::new(
-            k.boundary,
-            k.num_faces,
-            k.face_in_ring,
-            [k.regular, regular[(i + 1) % 4], regular[(i + 3) % 4]],
-        );
-        k.ep_on_boundary = f.ep_on_boundary;
-        k.em_on_boundary = f.em_on_boundary;
-        k.fp_regular = f.fp_regular;
-        k.fm_regular = f.fm_regular;
-        k.fp_copied = f.fp_copied;
-        k.fm_copied = f.fm_copied;
-    }
-    kinds
 }
 
 /// The scale of the limit tangents at an interior vertex of valence `n`, from the eigenvalues
@@ -508,64 +222,67 @@ fn tangent_scale(n: usize) -> f64 {
     16.0 * inv / ((c + 5.0) + ((c + 9.0) * (c + 1.0)).sqrt())
 }
 
-/// Limit-point weights of an interior vertex of valence `n` over `[vertex, ring…]`, and the
-/// edge points `P + tangent` along the patch face's leading (`ep`) and trailing (`em`) edges
-/// (`CatmarkLimits::ComputeInteriorPointWeights`, `far/catmarkPatchBuilder.cpp`). OpenSubdiv's
-/// tangent is not Sdc's: each edge's weight gathers three cosine terms and the scale is
-/// [`tangent_scale`]`·½/(n+5)`.
-fn interior_weights(n: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
-    let nf = n as f64;
-    let inv_n = 1.0 / nf;
-    let inv_n5 = 1.0 / (nf + 5.0);
-    let p_coeff = inv_n * inv_n5;
-    let tan_coeff = tangent_scale(n) * 0.5 * inv_n5;
-    let face_angle = 2.0 * PI * inv_n;
+impl SchemeCorner for GregoryCorner {
+    const RING_POINTS_PER_FACE: usize = 2;
+    const REGULAR_FACES: usize = 4;
+    // A regular corner's face angle is exactly a right angle (cos 0), not the rounded cosine
+    // of π/2.
+    const REGULAR_COS_FACE_ANGLE: f64 = 0.0;
+    const FACE_POINT_DENOMINATOR: f64 = 3.0;
+    const KEEPS_ZERO_ENTRIES: bool = false;
 
-    let width = 1 + 2 * n;
-    let mut p = vec![0.0; width];
-    // Tangent weights over the ring only (the vertex itself has none).
-    let mut tan = vec![0.0; 2 * n];
-    p[0] = nf * inv_n5;
-    for i in 0..n {
-        p[1 + 2 * i] = p_coeff * 4.0;
-        p[2 + 2 * i] = p_coeff;
-        let (prev, next) = ((i + n - 1) % n, (i + 1) % n);
-        let c = tan_coeff * (face_angle * i as f64).cos();
-        tan[2 * prev] += c * 2.0;
-        tan[2 * prev + 1] += c;
-        tan[2 * i] += c * 4.0;
-        tan[2 * i + 1] += c;
-        tan[2 * next] += c * 2.0;
+    corner_fields!();
+
+    /// Limit-point weights of an interior vertex of valence `n` over `[vertex, ring…]`, and the
+    /// edge points `P + tangent` along the patch face's leading (`ep`) and trailing (`em`) edges
+    /// (`CatmarkLimits::ComputeInteriorPointWeights`, `far/catmarkPatchBuilder.cpp`). OpenSubdiv's
+    /// tangent is not Sdc's: each edge's weight gathers three cosine terms and the scale is
+    /// [`tangent_scale`]`·½/(n+5)`.
+    fn interior_weights(n: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
+        let nf = n as f64;
+        let inv_n = 1.0 / nf;
+        let inv_n5 = 1.0 / (nf + 5.0);
+        let p_coeff = inv_n * inv_n5;
+        let tan_coeff = tangent_scale(n) * 0.5 * inv_n5;
+        let face_angle = 2.0 * PI * inv_n;
+
+        let width = 1 + 2 * n;
+        let mut p = vec![0.0; width];
+        // Tangent weights over the ring only (the vertex itself has none).
+        let mut tan = vec![0.0; 2 * n];
+        p[0] = nf * inv_n5;
+        for i in 0..n {
+            p[1 + 2 * i] = p_coeff * 4.0;
+            p[2 + 2 * i] = p_coeff;
+            let (prev, next) = ((i + n - 1) % n, (i + 1) % n);
+            let c = tan_coeff * (face_angle * i as f64).cos();
+            tan[2 * prev] += c * 2.0;
+            tan[2 * prev + 1] += c;
+            tan[2 * i] += c * 4.0;
+            tan[2 * i + 1] += c;
+            tan[2 * next] += c * 2.0;
+        }
+        // The tangent computed for edge 0 is rotated onto the patch face's two edges.
+        let ep_shift = 2 * ((n - face_in_ring) % n);
+        let em_shift = 2 * ((2 * n - face_in_ring - 1) % n);
+        let mut ep = p.clone();
+        let mut em = p.clone();
+        for k in 0..2 * n {
+            ep[1 + k] += tan[(k + ep_shift) % (2 * n)];
+            em[1 + k] += tan[(k + em_shift) % (2 * n)];
+        }
+        [p, ep, em]
     }
-    // The tangent computed for edge 0 is rotated onto the patch face's two edges.
-    let ep_shift = 2 * ((n - face_in_ring) % n);
-    let em_shift = 2 * ((2 * n - face_in_ring - 1) % n);
-    let mut ep = p.clone();
-    let mut em = p.clone();
-    for k in 0..2 * n {
-        ep[1 + k] += tan[(k + ep_shift) % (2 * n)];
-        em[1 + k] += tan[(k + em_shift) % (2 * n)];
-    }
-    [p, ep, em]
-}
 
-/// Limit-point and edge-point weights of a smooth boundary vertex with `valence` edges (one
-/// more than its faces) over `[vertex, ring…]` (`CatmarkLimits::ComputeBoundaryPointWeights`,
-/// `far/catmarkPatchBuilder.cpp`). The position is the boundary B-spline's; the edge points
-/// along interior edges mix the boundary tangent with an interior tangent of angle π/faces.
-fn boundary_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
-    let num_faces = valence - 1;
-    let theta = PI / num_faces as f64;
-    let width = 2 * valence;
-    let last = width - 1;
-
-    let mut p = vec![0.0; width];
-    p[0] = 4.0 / 6.0;
-    p[1] = 1.0 / 6.0;
-    p[last] = 1.0 / 6.0;
-
-    let mut tan = vec![0.0; width];
-    {
+    /// The interior tangent of a smooth boundary vertex with `valence` edges over
+    /// `[vertex, ring…]` (`CatmarkLimits::ComputeBoundaryPointWeights`,
+    /// `far/catmarkPatchBuilder.cpp`): OpenSubdiv's own eigenvector-based mask, not Sdc's.
+    fn boundary_tangent(valence: usize) -> Vec<f64> {
+        let num_faces = valence - 1;
+        let theta = PI / num_faces as f64;
+        let width = 2 * valence;
+        let last = width - 1;
+        let mut tan = vec![0.0; width];
         let k = num_faces as f64;
         let (s, c) = theta.sin_cos();
         let div3 = 1.0 / 3.0;
@@ -583,244 +300,86 @@ fn boundary_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
             tan[1 + 2 * i] = 4.0 * sin_i * div3kc * div3;
             tan[2 + 2 * i] = (sin_i + sin_i1) * div3kc * div3;
         }
+        tan
     }
 
-    // An edge point along an interior edge at angle `edge·θ` from the leading boundary edge.
-    let interior_edge_point = |edge: usize| {
-        let (sin_a, cos_a) = (theta * edge as f64).sin_cos();
-        let mut e: Vec<f64> = tan.iter().map(|t| t * sin_a).collect();
-        e[0] += p[0];
-        e[1] += p[1] + (1.0 / 6.0) * cos_a;
-        e[last] += p[last] + (-1.0 / 6.0) * cos_a;
-        e
-    };
-    let ep = if face_in_ring == 0 {
-        let mut e = vec![0.0; width];
-        e[0] = 2.0 / 3.0;
-        e[1] = 1.0 / 3.0;
-        e
-    } else {
-        interior_edge_point(face_in_ring)
-    };
-    let em = if face_in_ring == num_faces - 1 {
-        let mut e = vec![0.0; width];
-        e[0] = 2.0 / 3.0;
-        e[last] = 1.0 / 3.0;
-        e
-    } else {
-        interior_edge_point((face_in_ring + 1) % valence)
-    };
-    [p, ep, em]
-}
+    fn em_on_trailing_edge(valence: usize, face_in_ring: usize) -> bool {
+        face_in_ring == valence - 2
+    }
 
-/// Weights over `[vertex, ring…]` as a stencil on source points.
-pub(super) fn ring_stencil(corner: usize, ring: &[usize], weights: &[f64]) -> Stencil {
-    std::iter::once(corner).chain(ring.iter().copied()).zip(weights.iter().copied()).collect()
-}
-
-/// P, Ep and Em of a corner whose neighbourhood is regular: the B-spline patch's Bézier points
-/// (`GregoryConverter::assignRegularEdgePoints`, `far/catmarkPatchBuilder.cpp`).
-fn regular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
-    if !kind.boundary {
-        let r = |k: usize| ring[k];
-        let p = vec![
-            (c, 4.0 / 9.0),
-            (r(0), 1.0 / 9.0),
-            (r(2), 1.0 / 9.0),
-            (r(4), 1.0 / 9.0),
-            (r(6), 1.0 / 9.0),
-            (r(1), 1.0 / 36.0),
-            (r(3), 1.0 / 36.0),
-            (r(5), 1.0 / 36.0),
-            (r(7), 1.0 / 36.0),
-        ];
-        let f = kind.face_in_ring;
-        let (e_p, e_m) = (2 * f, 2 * ((f + 1) % 4));
-        let (o_p, o_m) = (2 * ((f + 2) % 4), 2 * ((f + 3) % 4));
-        let ep = vec![
-            (c, 4.0 / 9.0),
-            (r(e_p), 2.0 / 9.0),
-            (r(e_m), 1.0 / 9.0),
-            (r(o_m), 1.0 / 9.0),
-            (r(e_p + 1), 1.0 / 18.0),
-            (r(o_m + 1), 1.0 / 18.0),
-        ];
-        let em = vec![
-            (c, 4.0 / 9.0),
-            (r(e_m), 2.0 / 9.0),
-            (r(e_p), 1.0 / 9.0),
-            (r(o_p), 1.0 / 9.0),
-            (r(e_p + 1), 1.0 / 18.0),
-            (r(e_m + 1), 1.0 / 18.0),
-        ];
-        [p, ep, em]
-    } else {
-        let p = vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 6.0), (ring[4], 1.0 / 6.0)];
-        let along = if kind.ep_on_boundary { ring[0] } else { ring[4] };
-        let on_boundary = vec![(c, 2.0 / 3.0), (along, 1.0 / 3.0)];
-        let interior = vec![
-            (c, 4.0 / 9.0),
-            (ring[2], 2.0 / 9.0),
-            (ring[0], 1.0 / 9.0),
-            (ring[4], 1.0 / 9.0),
-            (ring[1], 1.0 / 18.0),
-            (ring[3], 1.0 / 18.0),
-        ];
-        if kind.ep_on_boundary {
-            [p, on_boundary, interior]
+    /// P, Ep and Em of a corner whose neighbourhood is regular: the B-spline patch's Bézier points
+    /// (`GregoryConverter::assignRegularEdgePoints`, `far/catmarkPatchBuilder.cpp`).
+    fn regular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
+        // An edge point along an interior edge, `ring[along]`'s: 2/9 on that end, 1/9 on the
+        // ends of the edges beside it, 1/18 on the diagonals beside it. Ep and Em are its
+        // mirror images, and a boundary corner's interior edge point is the same row.
+        let edge_point = |along: usize, beside: [usize; 2], diagonals: [usize; 2]| {
+            vec![
+                (c, 4.0 / 9.0),
+                (ring[along], 2.0 / 9.0),
+                (ring[beside[0]], 1.0 / 9.0),
+                (ring[beside[1]], 1.0 / 9.0),
+                (ring[diagonals[0]], 1.0 / 18.0),
+                (ring[diagonals[1]], 1.0 / 18.0),
+            ]
+        };
+        if !kind.boundary {
+            let mut p = vec![(c, 4.0 / 9.0)];
+            p.extend([0, 2, 4, 6].map(|k| (ring[k], 1.0 / 9.0)));
+            p.extend([1, 3, 5, 7].map(|k| (ring[k], 1.0 / 36.0)));
+            let f = kind.face_in_ring;
+            let (e_p, e_m) = (2 * f, 2 * ((f + 1) % 4));
+            let (o_p, o_m) = (2 * ((f + 2) % 4), 2 * ((f + 3) % 4));
+            let ep = edge_point(e_p, [e_m, o_m], [e_p + 1, o_m + 1]);
+            let em = edge_point(e_m, [e_p, o_p], [e_p + 1, e_m + 1]);
+            [p, ep, em]
         } else {
-            [p, interior, on_boundary]
+            let p = vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 6.0), (ring[4], 1.0 / 6.0)];
+            let along = if kind.flags.ep_on_boundary { ring[0] } else { ring[4] };
+            let on_boundary = vec![(c, 2.0 / 3.0), (along, 1.0 / 3.0)];
+            let interior = edge_point(2, [0, 4], [1, 3]);
+            if kind.flags.ep_on_boundary {
+                [p, on_boundary, interior]
+            } else {
+                [p, interior, on_boundary]
+            }
         }
     }
-}
 
-/// P, Ep and Em of an irregular corner (`GregoryConverter::computeIrregularEdgePoints` and
-/// the two functions it calls, `far/catmarkPatchBuilder.cpp`).
-fn irregular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
-    let (next, prev) = ((c + 1) % 4, (c + 3) % 4);
-    // OpenSubdiv's stated approximation for sharp and one-face corners: edge points a third
-    // of the way along the patch's own edges.
-    let third_along = |to: usize| vec![(c, 2.0 / 3.0), (to, 1.0 / 3.0)];
-    if kind.sharp {
-        [vec![(c, 1.0)], third_along(next), third_along(prev)]
-    } else if !kind.boundary {
-        let [p, ep, em] = interior_weights(kind.valence, kind.face_in_ring);
-        [ring_stencil(c, ring, &p), ring_stencil(c, ring, &ep), ring_stencil(c, ring, &em)]
-    } else if kind.num_faces > 1 {
-        let [p, ep, em] = boundary_weights(kind.valence, kind.face_in_ring);
-        let last = p.len() - 1;
-        let (first_nb, last_nb) = (ring[0], ring[2 * (kind.valence - 1)]);
-        let p = vec![(c, p[0]), (first_nb, p[1]), (last_nb, p[last])];
-        let ep = if kind.ep_on_boundary {
-            vec![(c, ep[0]), (first_nb, ep[1])]
-        } else {
-            ring_stencil(c, ring, &ep)
-        };
-        // (OpenSubdiv's loop for this row runs one entry past the ring; the stray entry lands
-        // in the next row's first slot, which is always overwritten, so it has no effect.)
-        let em = if kind.em_on_boundary {
-            vec![(c, em[0]), (last_nb, em[last])]
-        } else {
-            ring_stencil(c, ring, &em)
-        };
-        [p, ep, em]
-    } else {
-        // A smooth one-face corner (edge-only boundary): the boundary B-spline's position.
-        let p = vec![(c, 4.0 / 6.0), (next, 1.0 / 6.0), (prev, 1.0 / 6.0)];
-        [p, third_along(next), third_along(prev)]
+    /// The regular face point of corner `c`, the same for Fp and Fm: the bilinear-weighted one of
+    /// a B-spline neighbourhood (`GregoryConverter::assignRegularFacePoints`).
+    fn regular_face_point(c: usize, _: &CornerKind, _: &[usize]) -> Stencil {
+        let (next, opp, prev) = ((c + 1) % 4, (c + 2) % 4, (c + 3) % 4);
+        vec![(c, 4.0 / 9.0), (prev, 2.0 / 9.0), (next, 2.0 / 9.0), (opp, 1.0 / 9.0)]
     }
-}
 
-/// An irregular face point next to the edge point `e_near` of corner `near`
-/// (`GregoryConverter::computeIrregularFacePoint`, `far/catmarkPatchBuilder.cpp`):
-/// [`blend_face_point`] with `d = 3` and a correction `±(1/9, 1/18)` on the four ring points
-/// beside the interior edge `edge`.
-///
-/// A correction outside the union of P, E_near and E_far's points is dropped (see
-/// [`blend_face_point`]). That can only happen when `near` is sharp (P is the vertex alone)
-/// and `far` is sharp or a one-face corner — not a configuration adaptive refinement produces
-/// at level ≥ 1, and so not covered by OpenSubdiv's fixture — but it is reproduced here by
-/// index.
-#[allow(clippy::too_many_arguments)]
-fn face_point(
-    kinds: &[CornerKind; 4],
-    rings: &[Vec<usize>; 4],
-    num_points: usize,
-    near: usize,
-    edge: usize,
-    far: usize,
-    p: &Stencil,
-    e_near: &Stencil,
-    e_far: &Stencil,
-    sign: f64,
-) -> Stencil {
-    let valence = kinds[near].valence;
-    let ring = &rings[near];
-    let (e_prev, e_next) = ((edge + valence - 1) % valence, (edge + 1) % valence);
-    let corrections = [
-        (ring[2 * e_prev], -sign / 9.0),
-        (ring[2 * e_prev + 1], -sign / 18.0),
-        (ring[2 * edge + 1], sign / 18.0),
-        (ring[2 * e_next], sign / 9.0),
-    ];
-    blend_face_point(
-        num_points,
-        3.0,
-        kinds[near].cos_face_angle,
-        kinds[far].cos_face_angle,
-        p,
-        e_near,
-        e_far,
-        &corrections,
-    )
+    /// The irregular face point's correction (`GregoryConverter::computeIrregularFacePoint`,
+    /// `far/catmarkPatchBuilder.cpp`): `±(1/9, 1/18)` on the four ring points beside the interior
+    /// edge `edge`, with `d = 3` in the shared blend.
+    ///
+    /// A correction outside the union of P, E_near and E_far's points is dropped (see
+    /// [`blend_face_point`](gregory_shared::blend_face_point)). That can only happen when `near`
+    /// is sharp (P is the vertex alone) and `far` is sharp or a one-face corner — not a
+    /// configuration adaptive refinement produces at level ≥ 1, and so not covered by
+    /// OpenSubdiv's fixture — but it is reproduced here by index.
+    fn face_point_corrections(ring: &[usize], [e_prev, edge, e_next]: [usize; 3], sign: f64) -> Stencil {
+        vec![
+            (ring[2 * e_prev], -sign / 9.0),
+            (ring[2 * e_prev + 1], -sign / 18.0),
+            (ring[2 * edge + 1], sign / 18.0),
+            (ring[2 * e_next], sign / 9.0),
+        ]
+    }
 }
 
 /// The 20 stencils of a source patch over its [`SourceLayout`] numbering, in the module's
-/// point order (`GregoryConverter::Convert`, `far/catmarkPatchBuilder.cpp`).
-fn gregory_stencils(corners: &[GregoryCorner; 4], layout: &SourceLayout) -> Option<[Stencil; 20]> {
-    let kinds = corner_kinds(corners);
-    let rings = [0, 1, 2, 3].map(|i| layout.ring_indices(corners, i));
-    let rings = [rings[0].clone()?, rings[1].clone()?, rings[2].clone()?, rings[3].clone()?];
-    let mut rows: [Stencil; 20] = Default::default();
-
-    // Corner and edge points first: face points combine those of neighbouring corners.
-    for c in 0..4 {
-        let [p, ep, em] = if kinds[c].regular {
-            regular_edge_points(c, &kinds[c], &rings[c])
-        } else {
-            irregular_edge_points(c, &kinds[c], &rings[c])
-        };
-        rows[5 * c] = p;
-        rows[5 * c + 1] = ep;
-        rows[5 * c + 2] = em;
-    }
-    for c in 0..4 {
-        let k = &kinds[c];
-        let (next, opp, prev) = ((c + 1) % 4, (c + 2) % 4, (c + 3) % 4);
-        // The bilinear-weighted face point of a regular B-spline neighbourhood.
-        let regular = || vec![(c, 4.0 / 9.0), (prev, 2.0 / 9.0), (next, 2.0 / 9.0), (opp, 1.0 / 9.0)];
-        if k.fp_regular {
-            rows[5 * c + 3] = regular();
-        }
-        if k.fm_regular {
-            rows[5 * c + 4] = regular();
-        }
-        if !k.fp_regular && !k.fp_copied {
-            rows[5 * c + 3] = face_point(
-                &kinds,
-                &rings,
-                layout.num_points,
-                c,
-                k.face_in_ring,
-                next,
-                &rows[5 * c],
-                &rows[5 * c + 1],
-                &rows[5 * next + 2],
-                1.0,
-            );
-        }
-        if !k.fm_regular && !k.fm_copied {
-            rows[5 * c + 4] = face_point(
-                &kinds,
-                &rings,
-                layout.num_points,
-                c,
-                (k.face_in_ring + 1) % k.valence,
-                prev,
-                &rows[5 * c],
-                &rows[5 * c + 2],
-                &rows[5 * prev + 1],
-                -1.0,
-            );
-        }
-        if k.fp_copied {
-            rows[5 * c + 3] = rows[5 * c + 4].clone();
-        }
-        if k.fm_copied {
-            rows[5 * c + 4] = rows[5 * c + 3].clone();
-        }
-    }
-    Some(rows)
+/// point order (`GregoryConverter::Convert`, `far/catmarkPatchBuilder.cpp`): the shared
+/// corner, edge and face points are the whole patch.
+fn gregory_stencils(corners: &[GregoryCorner; 4], layout: &SourceLayout<4>) -> Option<[Stencil; 20]> {
+    let rings = layout.rings(corners)?;
+    corner_and_face_points::<GregoryCorner, 4>(&corner_kinds(corners), &rings, layout.num_points)
+        .try_into()
+        .ok()
 }
 
 /// The 20 points of a leaf's Gregory basis patch, in OpenSubdiv's order (see the module
@@ -848,32 +407,17 @@ impl GregoryPatch {
     /// If the fan counts or ring lengths are inconsistent.
     pub fn new(source: &GregorySource) -> Self {
         let corners = &source.corners;
-        for c in corners {
-            assert!(
-                c.num_faces >= 1 && c.patch_face < c.num_faces && c.ring.len() == c.expected_ring_len(),
-                "inconsistent Gregory source corner"
-            );
-        }
-        let layout = SourceLayout::new(corners).expect("Gregory source corners do not fit together");
+        let layout = checked_layout(corners, "Gregory");
         let stencils = gregory_stencils(corners, &layout).expect("Gregory source rings do not fit");
-        let mut source_points = vec![DVec3::ZERO; layout.num_points];
-        for (i, c) in corners.iter().enumerate() {
-            source_points[i] = c.position;
-        }
-        for (i, c) in corners.iter().enumerate() {
-            let indices = layout.ring_indices(corners, i).expect("checked by gregory_stencils");
-            for (&index, &p) in indices.iter().zip(&c.ring) {
-                source_points[index] = p;
-            }
-        }
-        let points = stencils.map(|s| s.iter().map(|&(i, w)| source_points[i] * w).sum());
-        GregoryPatch { points }
+        let points = gregory_shared::source_points(corners, &layout);
+        GregoryPatch { points: apply(&stencils, &points) }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::subdivision::gregory_shared::{bspline, Rng};
     use std::collections::HashMap;
 
     /// A quad mesh with consistently counter-clockwise faces, for filling sources the way a
@@ -957,27 +501,12 @@ mod tests {
         }
     }
 
-    /// splitmix64, for reproducible jitter.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-        fn jitter(&mut self) -> DVec3 {
-            DVec3::new(self.next(), self.next(), self.next()) * 0.3
-        }
-    }
-
     /// An `n × n` quad grid with jittered vertices, vertex `(i, j)` at index `j·(n+1) + i`.
     fn grid(n: usize, seed: u64) -> Mesh {
         let mut rng = Rng(seed);
         let id = |i: usize, j: usize| j * (n + 1) + i;
         let pos = (0..(n + 1) * (n + 1))
-            .map(|k| DVec3::new((k % (n + 1)) as f64, (k / (n + 1)) as f64, 0.0) + rng.jitter())
+            .map(|k| DVec3::new((k % (n + 1)) as f64, (k / (n + 1)) as f64, 0.0) + rng.point(0.3))
             .collect();
         let mut faces = Vec::new();
         for j in 0..n {
@@ -1026,21 +555,9 @@ mod tests {
             }
         }
         for p in &mut pos {
-            *p += rng.jitter();
+            *p += rng.point(0.3);
         }
         (Mesh::new(pos, faces), g)
-    }
-
-    /// The uniform cubic B-spline curve of four points at `t`.
-    fn bspline(p: [DVec3; 4], t: f64) -> DVec3 {
-        let tc = 1.0 - t;
-        let w = [
-            tc * tc * tc,
-            3.0 * t * t * t - 6.0 * t * t + 4.0,
-            -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
-            t * t * t,
-        ];
-        (p[0] * w[0] + p[1] * w[1] + p[2] * w[2] + p[3] * w[3]) / 6.0
     }
 
     fn samples() -> impl Iterator<Item = (f64, f64)> {

@@ -8,7 +8,9 @@
 //! patch*. This module computes that combination ([`gregory_triangle_points`], the counterpart
 //! of `GregoryTriConverter` in `far/loopPatchBuilder.cpp`, with the source patch of
 //! `Far::SourcePatch` in `far/patchBuilder.cpp`); it is the triangle sibling of
-//! [`super::gregory`] and shares its face-point rule.
+//! [`super::gregory`] and shares with it, as OpenSubdiv does, the source patch, the corner
+//! topology and the assembly of corner, edge and face points (the private module
+//! `gregory_shared`).
 //!
 //! OpenSubdiv first builds a cubic/quartic hybrid — corner and edge points from the Loop
 //! limit position and tangents of each corner (`LoopLimits`, which uses the masks of
@@ -44,7 +46,11 @@
 //! and `F2 = (w·Fp2 + s·Fm2)/(w + s)` (`EvalBasisGregoryTri`, `far/patchBasis.cpp`; each pair
 //! collapses to its first point where its denominator is 0).
 
-use super::gregory::{blend_face_point, ring_stencil, FacePointFlags, GregorySourceError, Stencil};
+use super::gregory::GregorySourceError;
+use super::gregory_shared::{
+    self, apply, checked_layout, corner_and_face_points, corner_fields, corner_kinds, CornerKind,
+    SchemeCorner, SourceLayout, Stencil,
+};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -104,24 +110,13 @@ pub struct LoopCorner {
 impl LoopCorner {
     /// OpenSubdiv's valence-2 interior flag (`SourcePatch::Finalize`): two faces, no boundary.
     pub fn is_val2_interior(&self) -> bool {
-        self.num_faces == 2 && !self.boundary
+        self.fan().is_val2_interior()
     }
 
     /// The ring length this corner's fan implies: `num_faces`, plus one on a boundary (which
     /// is also the corner's edge count, OpenSubdiv's "valence").
     pub fn expected_ring_len(&self) -> usize {
-        self.num_faces + usize::from(self.boundary)
-    }
-
-    /// Edges at the corner vertex within its fan.
-    fn valence(&self) -> usize {
-        self.expected_ring_len()
-    }
-
-    /// A corner of a regular box-spline neighbourhood: six interior faces, or three on a
-    /// boundary.
-    fn is_regular(&self) -> bool {
-        (self.num_faces << usize::from(self.boundary)) == 6 && !self.sharp
+        self.implied_ring_len()
     }
 }
 
@@ -143,172 +138,8 @@ impl LoopGregorySource {
     /// Cost: linear in the total ring length. [`gregory_triangle_points`] assumes a source
     /// that passes this check; call it when filling sources from a new mesh walker.
     pub fn validate(&self) -> Result<(), GregorySourceError> {
-        for (i, c) in self.corners.iter().enumerate() {
-            if c.num_faces == 0 || c.patch_face >= c.num_faces || (c.num_faces == 1 && !c.boundary) {
-                return Err(GregorySourceError::BadFan { corner: i });
-            }
-            if c.ring.len() != c.expected_ring_len() {
-                return Err(GregorySourceError::RingLength {
-                    corner: i,
-                    len: c.ring.len(),
-                    expected: c.expected_ring_len(),
-                });
-            }
-        }
-        let layout = TriLayout::new(&self.corners).ok_or(GregorySourceError::Layout)?;
-        let mut seen: Vec<Option<DVec3>> = vec![None; layout.num_points];
-        for (i, c) in self.corners.iter().enumerate() {
-            seen[i] = Some(c.position);
-        }
-        for (i, c) in self.corners.iter().enumerate() {
-            let indices = layout.ring_indices(&self.corners, i).ok_or(GregorySourceError::Layout)?;
-            for (k, (&index, &p)) in indices.iter().zip(&c.ring).enumerate() {
-                match seen[index] {
-                    Some(q) if q != p => {
-                        return Err(GregorySourceError::Mismatch { corner: i, ring_index: k })
-                    }
-                    _ => seen[index] = Some(p),
-                }
-            }
-        }
-        Ok(())
+        gregory_shared::validate(&self.corners)
     }
-}
-
-/// OpenSubdiv's numbering of a triangle's distinct source points (`SourcePatch::Finalize` and
-/// `GetCornerRingPoints` with three corners, `far/patchBuilder.cpp`): the 3 corners, then
-/// each corner's ring points not shared with a neighbour. Unlike quads, a triangle's ring
-/// shares only its last point (the vertex across the edge to the next corner) with the next
-/// corner, never its first with the previous one. As for quads, the numbering decides which
-/// face-point corrections survive (see [`blend_face_point`]).
-struct TriLayout {
-    num_points: usize,
-    ring_sizes: [usize; 3],
-    local_sizes: [usize; 3],
-    local_offsets: [usize; 3],
-    shares_next: [bool; 3],
-    val2: [bool; 3],
-}
-
-impl TriLayout {
-    /// Sizes the rings and numbers the local points; `None` if the fans do not fit.
-    fn new(corners: &[LoopCorner; 3]) -> Option<Self> {
-        let val2 = corners.each_ref().map(LoopCorner::is_val2_interior);
-        let mut layout = TriLayout {
-            num_points: 3,
-            ring_sizes: [0; 3],
-            local_sizes: [0; 3],
-            local_offsets: [0; 3],
-            shares_next: [false; 3],
-            val2,
-        };
-        for i in 0..3 {
-            let (next, prev) = ((i + 1) % 3, (i + 2) % 3);
-            let c = &corners[i];
-            if c.valence() > 2 {
-                // The last ring point, across the edge to the next corner, is the next
-                // corner's — unless a boundary (or a dart's sharp edge) separates them.
-                let share_next = if c.boundary {
-                    c.patch_face != 0
-                } else if c.dart {
-                    let n = &corners[next];
-                    !(n.boundary && n.patch_face + 1 == n.num_faces)
-                } else {
-                    true
-                };
-                layout.shares_next[i] = share_next;
-                let ring = c.valence();
-                // A valence-2 previous corner puts the next corner into this ring a second time.
-                let taken = 2 + usize::from(share_next) + usize::from(val2[prev]);
-                layout.ring_sizes[i] = ring;
-                layout.local_sizes[i] = ring.checked_sub(taken)?;
-            } else {
-                // A one-face corner or a valence-2 interior one: its ring is the other corners.
-                layout.ring_sizes[i] = 2;
-                layout.local_sizes[i] = 0;
-            }
-            layout.local_offsets[i] = layout.num_points;
-            layout.num_points += layout.local_sizes[i];
-        }
-        Some(layout)
-    }
-
-    /// The source-point indices of corner `i`'s ring, in ring order; `None` if the pieces do
-    /// not add up to the ring's size.
-    fn ring_indices(&self, corners: &[LoopCorner; 3], i: usize) -> Option<Vec<usize>> {
-        let (next, prev) = ((i + 1) % 3, (i + 2) % 3);
-        // Assembled as if the patch face were face 0: the other two corners, the point
-        // repeated by a valence-2 previous corner, the local points, the shared last point.
-        let mut ring = vec![next, prev];
-        if self.val2[prev] {
-            ring.push(next);
-        }
-        ring.extend(self.local_offsets[i]..self.local_offsets[i] + self.local_sizes[i]);
-        if self.shares_next[i] {
-            if self.val2[next] {
-                ring.push(prev);
-            } else if self.local_sizes[next] == 0 {
-                // The next corner has no points of its own (valence 3): the vertex across
-                // the edge is also across its other edge, so it is the previous corner's first.
-                if self.local_sizes[prev] == 0 {
-                    return None;
-                }
-                ring.push(self.local_offsets[prev]);
-            } else {
-                ring.push(self.local_offsets[next]);
-            }
-        }
-        if ring.len() != self.ring_sizes[i] {
-            return None;
-        }
-        let rotation = (ring.len() - corners[i].patch_face) % ring.len();
-        ring.rotate_left(rotation);
-        Some(ring)
-    }
-}
-
-/// What the converter needs of each corner (`GregoryTriConverter::CornerTopology`,
-/// `far/loopPatchBuilder.cpp`).
-#[derive(Clone, Copy)]
-struct CornerKind {
-    boundary: bool,
-    sharp: bool,
-    regular: bool,
-    valence: usize,
-    num_faces: usize,
-    face_in_ring: usize,
-    cos_face_angle: f64,
-    flags: FacePointFlags,
-}
-
-fn corner_kinds(corners: &[LoopCorner; 3]) -> [CornerKind; 3] {
-    let regular = corners.each_ref().map(LoopCorner::is_regular);
-    [0, 1, 2].map(|i| {
-        let c = &corners[i];
-        // A regular corner's face angle is taken as exactly π/3 (cos ½), not the rounded
-        // cosine.
-        let cos_face_angle = if regular[i] {
-            0.5
-        } else {
-            let sweep = if c.boundary { PI } else { 2.0 * PI };
-            (sweep / c.num_faces as f64).cos()
-        };
-        CornerKind {
-            boundary: c.boundary,
-            sharp: c.sharp,
-            regular: regular[i],
-            valence: c.valence(),
-            num_faces: c.num_faces,
-            face_in_ring: c.patch_face,
-            cos_face_angle,
-            flags: FacePointFlags::new(
-                c.boundary,
-                c.num_faces,
-                c.patch_face,
-                [regular[i], regular[(i + 1) % 3], regular[(i + 2) % 3]],
-            ),
-        }
-    })
 }
 
 /// Limit position of a smooth interior Loop vertex of valence `n` over `[vertex, ring…]`
@@ -327,251 +158,181 @@ fn smooth_limit_weights(n: usize) -> (f64, f64) {
     (1.0 - e * nf, e)
 }
 
-/// Limit-point weights of a smooth interior vertex of valence `n` over `[vertex, ring…]`, and
-/// the cubic edge points along the patch face's leading (`ep`) and trailing (`em`) edges
-/// (`LoopLimits::ComputeInteriorPointWeights`, `far/loopPatchBuilder.cpp`). The tangent is
-/// Sdc's first limit tangent (`cos(2πi/n)` per edge, the exact regular mask at valence 6)
-/// scaled by `(3 + 2cos(2π/n))/(6n)` — the subdominant eigenvalue, a normalisation and the
-/// cubic's ⅓ — and rotated onto each edge.
-fn interior_weights(n: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
-    let nf = n as f64;
-    let (vertex, edge) = smooth_limit_weights(n);
-    let mut p = vec![edge; n + 1];
-    p[0] = vertex;
+impl SchemeCorner for LoopCorner {
+    const RING_POINTS_PER_FACE: usize = 1;
+    const REGULAR_FACES: usize = 6;
+    // A regular corner's face angle is taken as exactly π/3 (cos ½), not the rounded cosine.
+    const REGULAR_COS_FACE_ANGLE: f64 = 0.5;
+    const FACE_POINT_DENOMINATOR: f64 = 4.0;
+    const KEEPS_ZERO_ENTRIES: bool = true;
 
-    const REGULAR_TANGENT: [f64; 6] = [1.0, 0.5, -0.5, -1.0, -0.5, 0.5];
-    let alpha = 2.0 * PI / nf;
-    let theta = 2.0 * PI / nf;
-    let tan_scale = (3.0 + 2.0 * theta.cos()) / (6.0 * nf);
-    // The point along edge 0; the vertex has no tangent weight.
-    let mut along = p.clone();
-    for i in 0..n {
-        let t = if n == 6 { REGULAR_TANGENT[i] } else { (alpha * i as f64).cos() };
-        along[1 + i] = p[1 + i] + t * tan_scale;
-    }
-    let rotated = |edge: usize| {
-        let mut e = vec![along[0]; n + 1];
-        for k in 0..n {
-            e[1 + k] = along[1 + (k + n - edge) % n];
-        }
-        e
-    };
-    let ep = rotated(face_in_ring);
-    let em = rotated((face_in_ring + 1) % n);
-    [p, ep, em]
-}
+    corner_fields!();
 
-/// Limit-point and cubic edge-point weights of a smooth boundary vertex with `valence` edges
-/// (one more than its faces) over `[vertex, ring…]`
-/// (`LoopLimits::ComputeBoundaryPointWeights`, `far/loopPatchBuilder.cpp`). The position is
-/// the boundary B-spline's (⅙, ⅔, ⅙); an edge point along an interior edge at angle `a` from
-/// the leading boundary edge mixes `cos a` times a boundary tangent (±⅙ on the two boundary
-/// neighbours) with `sin a / 24` times Sdc's crease cross tangent
-/// (`assignCreaseLimitTangentMasks`, `sdc/loopScheme.h`).
-///
-/// OpenSubdiv's test for an edge point on the *trailing* boundary edge compares the face
-/// index with the edge count and never holds, so that point also comes from the rotated
-/// tangent, at angle π: the same point as ⅔·v + ⅓·(last neighbour) up to rounding. It is
-/// reproduced as computed.
-fn boundary_weights(valence: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
-    let width = valence + 1;
-    let last = valence;
-    let mut p = vec![0.0; width];
-    p[0] = 4.0 / 6.0;
-    p[1] = 1.0 / 6.0;
-    p[last] = 1.0 / 6.0;
+    /// Limit-point weights of a smooth interior vertex of valence `n` over `[vertex, ring…]`, and
+    /// the cubic edge points along the patch face's leading (`ep`) and trailing (`em`) edges
+    /// (`LoopLimits::ComputeInteriorPointWeights`, `far/loopPatchBuilder.cpp`). The tangent is
+    /// Sdc's first limit tangent (`cos(2πi/n)` per edge, the exact regular mask at valence 6)
+    /// scaled by `(3 + 2cos(2π/n))/(6n)` — the subdominant eigenvalue, a normalisation and the
+    /// cubic's ⅓ — and rotated onto each edge.
+    fn interior_weights(n: usize, face_in_ring: usize) -> [Vec<f64>; 3] {
+        let nf = n as f64;
+        let (vertex, edge) = smooth_limit_weights(n);
+        let mut p = vec![edge; n + 1];
+        p[0] = vertex;
 
-    // The cross tangent, the crease running along edges 0 and valence − 1. (The converter
-    // never reaches the arms for 0 and 2 interior edges — a one-face corner has its own rule
-    // and a smooth three-face one is regular — but they complete Sdc's mask.)
-    let mut cross = vec![0.0; width];
-    let interior_edges = valence - 2;
-    match interior_edges {
-        0 => {
-            cross[0] = -6.0;
-            cross[1] = 3.0;
-            cross[2] = 3.0;
+        const REGULAR_TANGENT: [f64; 6] = [1.0, 0.5, -0.5, -1.0, -0.5, 0.5];
+        let alpha = 2.0 * PI / nf;
+        let theta = 2.0 * PI / nf;
+        let tan_scale = (3.0 + 2.0 * theta.cos()) / (6.0 * nf);
+        // The point along edge 0; the vertex has no tangent weight.
+        let mut along = p.clone();
+        for i in 0..n {
+            let t = if n == 6 { REGULAR_TANGENT[i] } else { (alpha * i as f64).cos() };
+            along[1 + i] = p[1 + i] + t * tan_scale;
         }
-        1 => {
-            cross[0] = -3.0;
-            cross[2] = 3.0;
-        }
-        2 => {
-            let root3 = 3.0f64.sqrt();
-            let root3_by_2 = root3 * 0.5;
-            cross[0] = -root3;
-            cross[1] = -root3_by_2;
-            cross[last] = -root3_by_2;
-            cross[2] = root3;
-            cross[3] = root3;
-        }
-        _ => {
-            let theta = PI / (interior_edges + 1) as f64;
-            let c = -3.0 * theta.sin();
-            cross[1] = c;
-            cross[last] = c;
-            let e_coeff = -3.0 * 2.0 * (theta.cos() - 1.0);
-            for i in 1..=interior_edges {
-                cross[1 + i] = e_coeff * (i as f64 * theta).sin();
+        let rotated = |edge: usize| {
+            let mut e = vec![along[0]; n + 1];
+            for k in 0..n {
+                e[1 + k] = along[1 + (k + n - edge) % n];
             }
-        }
-    }
-
-    let face_angle = PI / (valence - 1) as f64;
-    let interior_edge_point = |edge: usize| {
-        let (sin_a, cos_a) = ((face_angle * edge as f64).sin(), (face_angle * edge as f64).cos());
-        let mut e: Vec<f64> = cross.iter().map(|t| (1.0 / 24.0) * t * sin_a).collect();
-        e[0] += p[0];
-        e[1] += p[1] + (1.0 / 6.0) * cos_a;
-        e[last] += p[last] + (-1.0 / 6.0) * cos_a;
-        e
-    };
-    let ep = if face_in_ring == 0 {
-        let mut e = vec![0.0; width];
-        e[0] = 2.0 / 3.0;
-        e[1] = 1.0 / 3.0;
-        e
-    } else {
-        interior_edge_point(face_in_ring)
-    };
-    let em = interior_edge_point((face_in_ring + 1) % valence);
-    [p, ep, em]
-}
-
-/// P and the cubic Ep, Em of a corner whose neighbourhood is regular: the box spline's
-/// (`GregoryTriConverter::assignRegularEdgePoints`, `far/loopPatchBuilder.cpp`). The entry
-/// order matters: [`promote_edge_point`] reweights these rows by position.
-fn regular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
-    if !kind.boundary {
-        let mut p = vec![(c, 0.5)];
-        p.extend(ring.iter().map(|&r| (r, 1.0 / 12.0)));
-        const E_WEIGHTS: [f64; 6] = [7.0, 5.0, 1.0, -1.0, 1.0, 5.0];
-        let along = |edge: usize| {
-            let mut e = vec![(c, 0.5)];
-            e.extend((0..6).map(|j| (ring[(edge + j) % 6], (1.0 / 36.0) * E_WEIGHTS[j])));
             e
         };
-        let ep = along(kind.face_in_ring);
-        let em = along((kind.face_in_ring + 1) % 6);
+        let ep = rotated(face_in_ring);
+        let em = rotated((face_in_ring + 1) % n);
         [p, ep, em]
-    } else {
-        let (ep_b, em_b) = (kind.flags.ep_on_boundary, kind.flags.em_on_boundary);
-        let p = vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 6.0), (ring[3], 1.0 / 6.0)];
-        // Along an interior edge the boundary's phantom points fold into ½, ⅙, ⅙, ⅙.
-        let interior = |other_on_boundary: bool, first: usize| {
-            let (near, far) = if other_on_boundary { (3 - first, first) } else { (first, 3 - first) };
+    }
+
+    /// The interior tangent of a smooth boundary vertex with `valence` edges over
+    /// `[vertex, ring…]` (`LoopLimits::ComputeBoundaryPointWeights`,
+    /// `far/loopPatchBuilder.cpp`): `1/24` of Sdc's crease cross tangent
+    /// (`assignCreaseLimitTangentMasks`, `sdc/loopScheme.h`), the crease running along edges 0
+    /// and valence − 1.
+    fn boundary_tangent(valence: usize) -> Vec<f64> {
+        let width = valence + 1;
+        let last = valence;
+        // (The converter never reaches the arms for 0 and 2 interior edges — a one-face corner
+        // has its own rule and a smooth three-face one is regular — but they complete Sdc's
+        // mask.)
+        let mut cross = vec![0.0; width];
+        let interior_edges = valence - 2;
+        match interior_edges {
+            0 => {
+                cross[0] = -6.0;
+                cross[1] = 3.0;
+                cross[2] = 3.0;
+            }
+            1 => {
+                cross[0] = -3.0;
+                cross[2] = 3.0;
+            }
+            2 => {
+                let root3 = 3.0f64.sqrt();
+                let root3_by_2 = root3 * 0.5;
+                cross[0] = -root3;
+                cross[1] = -root3_by_2;
+                cross[last] = -root3_by_2;
+                cross[2] = root3;
+                cross[3] = root3;
+            }
+            _ => {
+                let theta = PI / (interior_edges + 1) as f64;
+                let c = -3.0 * theta.sin();
+                cross[1] = c;
+                cross[last] = c;
+                let e_coeff = -3.0 * 2.0 * (theta.cos() - 1.0);
+                for i in 1..=interior_edges {
+                    cross[1 + i] = e_coeff * (i as f64 * theta).sin();
+                }
+            }
+        }
+        cross.iter().map(|t| (1.0 / 24.0) * t).collect()
+    }
+
+    /// OpenSubdiv's test for an edge point on the *trailing* boundary edge compares the face
+    /// index with the edge count and never holds, so that point also comes from the rotated
+    /// tangent, at angle π: the same point as ⅔·v + ⅓·(last neighbour) up to rounding. It is
+    /// reproduced as computed.
+    fn em_on_trailing_edge(valence: usize, face_in_ring: usize) -> bool {
+        face_in_ring == valence - 1
+    }
+
+    /// P and the cubic Ep, Em of a corner whose neighbourhood is regular: the box spline's
+    /// (`GregoryTriConverter::assignRegularEdgePoints`, `far/loopPatchBuilder.cpp`). The entry
+    /// order matters: [`promote_edge_point`] reweights these rows by position.
+    fn regular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
+        if !kind.boundary {
+            let mut p = vec![(c, 0.5)];
+            p.extend(ring.iter().map(|&r| (r, 1.0 / 12.0)));
+            const E_WEIGHTS: [f64; 6] = [7.0, 5.0, 1.0, -1.0, 1.0, 5.0];
+            let along = |edge: usize| {
+                let mut e = vec![(c, 0.5)];
+                e.extend((0..6).map(|j| (ring[(edge + j) % 6], (1.0 / 36.0) * E_WEIGHTS[j])));
+                e
+            };
+            let ep = along(kind.face_in_ring);
+            let em = along((kind.face_in_ring + 1) % 6);
+            [p, ep, em]
+        } else {
+            let (ep_b, em_b) = (kind.flags.ep_on_boundary, kind.flags.em_on_boundary);
+            let p = vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 6.0), (ring[3], 1.0 / 6.0)];
+            // Along an interior edge the boundary's phantom points fold into ½, ⅙, ⅙, ⅙.
+            let interior = |other_on_boundary: bool, first: usize| {
+                let (near, far) = if other_on_boundary { (3 - first, first) } else { (first, 3 - first) };
+                vec![
+                    (c, 0.5),
+                    (ring[1], 1.0 / 6.0),
+                    (ring[2], 1.0 / 6.0),
+                    (ring[near], 1.0 / 6.0),
+                    (ring[far], 0.0),
+                ]
+            };
+            let ep = if ep_b {
+                vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 3.0), (ring[3], 0.0)]
+            } else {
+                interior(em_b, 0)
+            };
+            let em = if em_b {
+                vec![(c, 2.0 / 3.0), (ring[3], 1.0 / 3.0), (ring[0], 0.0)]
+            } else {
+                interior(ep_b, 3)
+            };
+            [p, ep, em]
+        }
+    }
+
+    /// The regular face point of corner `c`, the same for Fp and Fm
+    /// (`GregoryTriConverter::assignRegularFacePoints`, `far/loopPatchBuilder.cpp`).
+    fn regular_face_point(c: usize, kind: &CornerKind, ring: &[usize]) -> Stencil {
+        let (next, prev) = ((c + 1) % 3, (c + 2) % 3);
+        if kind.num_faces == 1 {
+            vec![(c, 0.5), (next, 0.25), (prev, 0.25)]
+        } else if kind.flags.ep_on_boundary {
+            vec![(c, 11.0 / 24.0), (ring[0], 7.0 / 24.0), (ring[1], 5.0 / 24.0), (ring[2], 1.0 / 24.0)]
+        } else if kind.flags.em_on_boundary {
+            vec![(c, 11.0 / 24.0), (ring[3], 7.0 / 24.0), (ring[2], 5.0 / 24.0), (ring[1], 1.0 / 24.0)]
+        } else {
+            let f = kind.face_in_ring;
+            let (e_next, e_prev) = if kind.boundary { (0, 3) } else { ((f + 5) % 6, (f + 2) % 6) };
             vec![
-                (c, 0.5),
-                (ring[1], 1.0 / 6.0),
-                (ring[2], 1.0 / 6.0),
-                (ring[near], 1.0 / 6.0),
-                (ring[far], 0.0),
+                (c, 10.0 / 24.0),
+                (prev, 0.25),
+                (next, 0.25),
+                (ring[e_prev], 1.0 / 24.0),
+                (ring[e_next], 1.0 / 24.0),
             ]
-        };
-        let ep =
-            if ep_b { vec![(c, 2.0 / 3.0), (ring[0], 1.0 / 3.0), (ring[3], 0.0)] } else { interior(em_b, 0) };
-        let em =
-            if em_b { vec![(c, 2.0 / 3.0), (ring[3], 1.0 / 3.0), (ring[0], 0.0)] } else { interior(ep_b, 3) };
-        [p, ep, em]
+        }
     }
-}
 
-/// P and the cubic Ep, Em of an irregular corner
-/// (`GregoryTriConverter::computeIrregularEdgePoints` and the two functions it calls,
-/// `far/loopPatchBuilder.cpp`).
-fn irregular_edge_points(c: usize, kind: &CornerKind, ring: &[usize]) -> [Stencil; 3] {
-    let (next, prev) = ((c + 1) % 3, (c + 2) % 3);
-    if kind.sharp {
-        // OpenSubdiv's stated approximation: edge points a third of the way along the edges.
-        [vec![(c, 1.0)], vec![(c, 2.0 / 3.0), (next, 1.0 / 3.0)], vec![(c, 2.0 / 3.0), (prev, 1.0 / 3.0)]]
-    } else if !kind.boundary {
-        let [p, ep, em] = interior_weights(kind.valence, kind.face_in_ring);
-        [ring_stencil(c, ring, &p), ring_stencil(c, ring, &ep), ring_stencil(c, ring, &em)]
-    } else if kind.num_faces > 1 {
-        let [p, ep, em] = boundary_weights(kind.valence, kind.face_in_ring);
-        let last = kind.valence;
-        let (first_nb, last_nb) = (ring[0], ring[kind.valence - 1]);
-        let p_row = vec![(c, p[0]), (first_nb, p[1]), (last_nb, p[last])];
-        let ep_row = if kind.flags.ep_on_boundary {
-            vec![(c, ep[0]), (first_nb, ep[1]), (last_nb, 0.0)]
-        } else {
-            ring_stencil(c, ring, &ep)
-        };
-        let em_row = if kind.flags.em_on_boundary {
-            vec![(c, em[0]), (last_nb, em[last]), (first_nb, 0.0)]
-        } else {
-            ring_stencil(c, ring, &em)
-        };
-        [p_row, ep_row, em_row]
-    } else {
-        // A smooth one-face corner (edge-only boundary): the boundary B-spline's position and
-        // the sharp corner's edge points.
-        [
-            vec![(c, 4.0 / 6.0), (next, 1.0 / 6.0), (prev, 1.0 / 6.0)],
-            vec![(c, 2.0 / 3.0), (next, 1.0 / 3.0), (prev, 0.0)],
-            vec![(c, 2.0 / 3.0), (prev, 1.0 / 3.0), (next, 0.0)],
-        ]
+    /// The irregular face point's correction (`GregoryTriConverter::computeIrregularFacePoint`,
+    /// `far/loopPatchBuilder.cpp`): `±7/72` on the two ring points beside the interior edge, with
+    /// `d = 4` in the shared blend (OpenSubdiv's stand-in for the published term built from the
+    /// midpoints of the neighbouring edges and faces). Corrections outside the points of P and
+    /// the two E are dropped, as [`blend_face_point`](gregory_shared::blend_face_point) says; two
+    /// adjacent sharp corners do that (the fixture's unrefined cages with two corner tags).
+    fn face_point_corrections(ring: &[usize], [e_prev, _, e_next]: [usize; 3], sign: f64) -> Stencil {
+        let r = 0.25 * (7.0 / 18.0);
+        vec![(ring[e_prev], -sign * r), (ring[e_next], sign * r)]
     }
-}
-
-/// The regular face point of corner `c`, the same for Fp and Fm
-/// (`GregoryTriConverter::assignRegularFacePoints`, `far/loopPatchBuilder.cpp`).
-fn regular_face_point(c: usize, kind: &CornerKind, ring: &[usize]) -> Stencil {
-    let (next, prev) = ((c + 1) % 3, (c + 2) % 3);
-    if kind.num_faces == 1 {
-        vec![(c, 0.5), (next, 0.25), (prev, 0.25)]
-    } else if kind.flags.ep_on_boundary {
-        vec![(c, 11.0 / 24.0), (ring[0], 7.0 / 24.0), (ring[1], 5.0 / 24.0), (ring[2], 1.0 / 24.0)]
-    } else if kind.flags.em_on_boundary {
-        vec![(c, 11.0 / 24.0), (ring[3], 7.0 / 24.0), (ring[2], 5.0 / 24.0), (ring[1], 1.0 / 24.0)]
-    } else {
-        let f = kind.face_in_ring;
-        let (e_next, e_prev) = if kind.boundary { (0, 3) } else { ((f + 5) % 6, (f + 2) % 6) };
-        vec![
-            (c, 10.0 / 24.0),
-            (prev, 0.25),
-            (next, 0.25),
-            (ring[e_prev], 1.0 / 24.0),
-            (ring[e_next], 1.0 / 24.0),
-        ]
-    }
-}
-
-/// An irregular face point next to the edge point `e_near` of corner `near`
-/// (`GregoryTriConverter::computeIrregularFacePoint`, `far/loopPatchBuilder.cpp`):
-/// [`blend_face_point`] with `d = 4` and a correction `±7/72` on the two ring points beside
-/// the interior edge `edge` (OpenSubdiv's stand-in for the published term built from the
-/// midpoints of the neighbouring edges and faces). Corrections outside the points of P and
-/// the two E are dropped, as [`blend_face_point`] says; two adjacent sharp corners do that
-/// (the fixture's unrefined cages with two corner tags).
-#[allow(clippy::too_many_arguments)]
-fn face_point(
-    kinds: &[CornerKind; 3],
-    rings: &[Vec<usize>; 3],
-    num_points: usize,
-    near: usize,
-    edge: usize,
-    far: usize,
-    p: &Stencil,
-    e_near: &Stencil,
-    e_far: &Stencil,
-    sign: f64,
-) -> Stencil {
-    let valence = kinds[near].valence;
-    let ring = &rings[near];
-    let (e_prev, e_next) = ((edge + valence - 1) % valence, (edge + 1) % valence);
-    let r = 0.25 * (7.0 / 18.0);
-    let corrections = [(ring[e_prev], -sign * r), (ring[e_next], sign * r)];
-    blend_face_point(
-        num_points,
-        4.0,
-        kinds[near].cos_face_angle,
-        kinds[far].cos_face_angle,
-        p,
-        e_near,
-        e_far,
-        &corrections,
-    )
 }
 
 /// The mid-edge point of edge `e` (corner `e` to `e+1`) of a regular pair of corners
@@ -612,82 +373,26 @@ fn promote_edge_point(kind: &CornerKind, on_boundary: bool, p: &Stencil, e: &Ste
     }
 }
 
-/// The 18 stencils of a source patch over its [`TriLayout`] numbering, in the module's point
-/// order (`GregoryTriConverter::Convert`, `far/loopPatchBuilder.cpp`).
-fn gregory_triangle_stencils(corners: &[LoopCorner; 3], layout: &TriLayout) -> Option<[Stencil; 18]> {
+/// The 18 stencils of a source patch over its [`SourceLayout`] numbering, in the module's point
+/// order (`GregoryTriConverter::Convert`, `far/loopPatchBuilder.cpp`): the shared corner, edge
+/// and face points, then the triangle's own mid-edge points, and only then the edge points
+/// raised to quartic, as the mid-edge points combine the cubic ones.
+fn gregory_triangle_stencils(corners: &[LoopCorner; 3], layout: &SourceLayout<3>) -> Option<[Stencil; 18]> {
     let kinds = corner_kinds(corners);
-    let rings = [0, 1, 2].map(|i| layout.ring_indices(corners, i));
-    let rings = [rings[0].clone()?, rings[1].clone()?, rings[2].clone()?];
-    let mut rows: [Stencil; 18] = Default::default();
-
-    // Corner and cubic edge points first: face and mid-edge points combine those of
-    // neighbouring corners, and only then are the edge points raised to quartic.
-    for c in 0..3 {
-        let [p, ep, em] = if kinds[c].regular {
-            regular_edge_points(c, &kinds[c], &rings[c])
-        } else {
-            irregular_edge_points(c, &kinds[c], &rings[c])
-        };
-        rows[5 * c] = p;
-        rows[5 * c + 1] = ep;
-        rows[5 * c + 2] = em;
-    }
-    for c in 0..3 {
-        let k = &kinds[c];
-        let f = k.flags;
-        let (next, prev) = ((c + 1) % 3, (c + 2) % 3);
-        if f.fp_regular {
-            rows[5 * c + 3] = regular_face_point(c, k, &rings[c]);
-        }
-        if f.fm_regular {
-            rows[5 * c + 4] = regular_face_point(c, k, &rings[c]);
-        }
-        if !f.fp_regular && !f.fp_copied {
-            rows[5 * c + 3] = face_point(
-                &kinds,
-                &rings,
-                layout.num_points,
-                c,
-                k.face_in_ring,
-                next,
-                &rows[5 * c],
-                &rows[5 * c + 1],
-                &rows[5 * next + 2],
-                1.0,
-            );
-        }
-        if !f.fm_regular && !f.fm_copied {
-            rows[5 * c + 4] = face_point(
-                &kinds,
-                &rings,
-                layout.num_points,
-                c,
-                (k.face_in_ring + 1) % k.valence,
-                prev,
-                &rows[5 * c],
-                &rows[5 * c + 2],
-                &rows[5 * prev + 1],
-                -1.0,
-            );
-        }
-        if f.fp_copied {
-            rows[5 * c + 3] = rows[5 * c + 4].clone();
-        }
-        if f.fm_copied {
-            rows[5 * c + 4] = rows[5 * c + 3].clone();
-        }
-    }
+    let rings = layout.rings(corners)?;
+    let mut rows = corner_and_face_points::<LoopCorner, 3>(&kinds, &rings, layout.num_points);
     for e in 0..3 {
         let (k0, k1) = (&kinds[e], &kinds[(e + 1) % 3]);
         let boundary_edge = k0.flags.ep_on_boundary && k1.flags.em_on_boundary;
         // One side ends on a boundary and the other does not: the edge is a dart's sharp edge.
         let dart_edge = k0.flags.ep_on_boundary != k1.flags.em_on_boundary;
-        rows[15 + e] = if boundary_edge || (k0.regular && k1.regular && !dart_edge) {
+        let mid = if boundary_edge || (k0.regular && k1.regular && !dart_edge) {
             regular_mid_edge_point(e, k0, &rings[e])
         } else {
             let (e0, e1) = (&rows[5 * e + 1], &rows[5 * ((e + 1) % 3) + 2]);
             e0.iter().chain(e1).map(|&(i, w)| (i, 0.5 * w)).collect()
         };
+        rows.push(mid);
     }
     for c in 0..3 {
         let k = &kinds[c];
@@ -696,22 +401,7 @@ fn gregory_triangle_stencils(corners: &[LoopCorner; 3], layout: &TriLayout) -> O
         rows[5 * c + 1] = ep;
         rows[5 * c + 2] = em;
     }
-    Some(rows)
-}
-
-/// The source points of a consistent source in [`TriLayout`] numbering.
-fn source_points(corners: &[LoopCorner; 3], layout: &TriLayout) -> Vec<DVec3> {
-    let mut points = vec![DVec3::ZERO; layout.num_points];
-    for (i, c) in corners.iter().enumerate() {
-        points[i] = c.position;
-    }
-    for (i, c) in corners.iter().enumerate() {
-        let indices = layout.ring_indices(corners, i).expect("checked by gregory_triangle_stencils");
-        for (&index, &p) in indices.iter().zip(&c.ring) {
-            points[index] = p;
-        }
-    }
-    points
+    rows.try_into().ok()
 }
 
 /// The 18 points of a leaf triangle's Gregory triangle, in OpenSubdiv's `GREGORY_TRIANGLE`
@@ -729,37 +419,16 @@ fn source_points(corners: &[LoopCorner; 3], layout: &TriLayout) -> Vec<DVec3> {
 /// (inconsistent shared points are not detected here and give a wrong patch instead).
 pub fn gregory_triangle_points(source: &LoopGregorySource) -> [DVec3; 18] {
     let corners = &source.corners;
-    for c in corners {
-        assert!(
-            c.num_faces >= 1 && c.patch_face < c.num_faces && c.ring.len() == c.expected_ring_len(),
-            "inconsistent Loop Gregory source corner"
-        );
-    }
-    let layout = TriLayout::new(corners).expect("Loop Gregory source corners do not fit together");
+    let layout = checked_layout(corners, "Loop Gregory");
     let stencils = gregory_triangle_stencils(corners, &layout).expect("Loop Gregory source rings do not fit");
-    let points = source_points(corners, &layout);
-    stencils.map(|s| s.iter().map(|&(i, w)| points[i] * w).sum())
+    apply(&stencils, &gregory_shared::source_points(corners, &layout))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::subdivision::gregory_shared::{bspline, Rng};
     use std::collections::HashMap;
-
-    /// splitmix64, for reproducible source points.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-        fn point(&mut self) -> DVec3 {
-            DVec3::new(self.next(), self.next(), self.next()) * 2.0
-        }
-    }
 
     /// One patch of `tools/osd-oracle/loop_gregory_check.cpp`'s fixture: the source patch's
     /// topology (rings as source-point indices) and OpenSubdiv's 18 matrix rows.
@@ -787,6 +456,17 @@ mod tests {
                 }
             });
             LoopGregorySource { corners }
+        }
+
+        /// Seeded random source points, the source on them and tessera's 18 stencils for it,
+        /// having checked that tessera numbers the source points as OpenSubdiv does.
+        fn stencils(&self, seed: u64) -> (Vec<DVec3>, LoopGregorySource, [Stencil; 18]) {
+            let points = random_points(self.num_points, seed);
+            let source = self.source(&points);
+            let layout = SourceLayout::new(&source.corners).unwrap();
+            assert_eq!(layout.num_points, self.num_points, "{}", self.header);
+            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            (points, source, rows)
         }
 
         fn points(&self, points: &[DVec3]) -> Vec<DVec3> {
@@ -826,7 +506,7 @@ mod tests {
 
     fn random_points(n: usize, seed: u64) -> Vec<DVec3> {
         let mut rng = Rng(seed);
-        (0..n).map(|_| rng.point()).collect()
+        (0..n).map(|_| rng.point(2.0)).collect()
     }
 
     /// A stencil's weights summed per source point.
@@ -875,11 +555,7 @@ mod tests {
     #[test]
     fn loop_gregory_weights_equal_opensubdiv_columns() {
         for patch in fixture() {
-            let points = random_points(patch.num_points, 7);
-            let source = patch.source(&points);
-            let layout = TriLayout::new(&source.corners).unwrap();
-            assert_eq!(layout.num_points, patch.num_points, "{}", patch.header);
-            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            let (_, _, rows) = patch.stencils(7);
             for (i, (ours, theirs)) in rows.iter().zip(&patch.rows).enumerate() {
                 let (a, b) = (by_column(ours, patch.num_points), by_column(theirs, patch.num_points));
                 for (j, (x, y)) in a.iter().zip(&b).enumerate() {
@@ -894,10 +570,7 @@ mod tests {
     #[test]
     fn loop_gregory_weights_sum_to_one() {
         for patch in fixture() {
-            let points = random_points(patch.num_points, 11);
-            let source = patch.source(&points);
-            let layout = TriLayout::new(&source.corners).unwrap();
-            let rows = gregory_triangle_stencils(&source.corners, &layout).unwrap();
+            let (points, source, rows) = patch.stencils(11);
             for (i, row) in rows.iter().enumerate() {
                 let sum: f64 = row.iter().map(|&(_, w)| w).sum();
                 assert!((sum - 1.0).abs() < 1e-13, "{}: row {i} sums to {sum}", patch.header);
@@ -995,7 +668,7 @@ mod tests {
         let mut f = HashMap::new();
         for i in -3..=4 {
             for j in -3..=4 {
-                let p = DVec3::new(i as f64 + 0.5 * j as f64, j as f64 * 0.866, 0.0) + rng.point() * 0.15;
+                let p = DVec3::new(i as f64 + 0.5 * j as f64, j as f64 * 0.866, 0.0) + rng.point(2.0) * 0.15;
                 f.insert((i, j), p);
             }
         }
@@ -1056,19 +729,9 @@ mod tests {
         let c1 = &source.corners[1];
         assert!(c1.boundary && c1.patch_face + 1 == c1.num_faces);
         let b = [before, c0.position, c1.position, c1.ring[0]];
-        let cubic = |t: f64| {
-            let tc = 1.0 - t;
-            let w = [
-                tc * tc * tc,
-                3.0 * t * t * t - 6.0 * t * t + 4.0,
-                -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
-                t * t * t,
-            ];
-            (b[0] * w[0] + b[1] * w[1] + b[2] * w[2] + b[3] * w[3]) / 6.0
-        };
         for k in 0..=8 {
             let s = k as f64 / 8.0;
-            let d = (evaluate(&g, s, 0.0) - cubic(s)).length();
+            let d = (evaluate(&g, s, 0.0) - bspline(b, s)).length();
             assert!(d < 1e-12, "{}: s = {s}: {d}", patch.header);
         }
     }

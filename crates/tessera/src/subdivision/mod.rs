@@ -15,6 +15,7 @@ pub mod bspline;
 pub mod cage;
 mod catmull_clark;
 pub mod gregory;
+mod gregory_shared;
 pub mod isolation;
 pub mod loop_gregory;
 pub mod loop_isolation;
