@@ -119,7 +119,8 @@ struct State {
     renderer: Renderer,
     overlay: Overlay,
     msaa: (wgpu::Texture, wgpu::Texture),
-    engine: GpuTessellator,
+    /// None where the GPU engine refused the set: every frame takes the CPU engine.
+    engine: Option<GpuTessellator>,
     timer: Option<PassTimer>,
     prepared: Prepared,
     scratch: PlanScratch,
@@ -230,9 +231,16 @@ impl App {
         let overlay =
             tessera_render::scoped(&ctx.device, "making the overlay", || Overlay::new(&ctx, config.format))?;
         let msaa = attachments(&ctx, config.format, config.width, config.height)?;
-        let engine = tessera_render::scoped(&ctx.device, "making the GPU engine", || {
+        // A set the GPU engine cannot take (Loop patches, so far) is drawn by the CPU engine.
+        let engine = match tessera_render::scoped(&ctx.device, "making the GPU engine", || {
             GpuTessellator::new(&ctx, self.set)
-        })??;
+        })? {
+            Ok(engine) => Some(engine),
+            Err(e) => {
+                eprintln!("note: {e}; the CPU engine draws it (E does not switch)");
+                None
+            }
+        };
         let timer = PassTimer::new(&ctx);
         let criterion = Criterion::PixelError(self.settings.pixel_error);
         Ok(State {
@@ -399,7 +407,7 @@ fn tessellate(
     let tess = state.tess.as_mut().expect("made above");
     let max_factor = options.plan.max_factor;
     let mut path = Path::Cpu;
-    if settings.gpu_engine {
+    if settings.gpu_engine && state.engine.is_some() {
         if let Scheme::SemiUniform { max_level } = scheme {
             if state.instanced.is_none() {
                 let made = InstancedDraw::new(&state.ctx, set, max_level, state.config.format, SAMPLES);
@@ -424,8 +432,9 @@ fn tessellate(
                 upload: None,
             });
         }
-        state.engine.prepare(&state.ctx, set, plan, pattern)?;
-        state.engine.record_timed(encoder, state.timer.as_ref());
+        let engine = state.engine.as_mut().expect("the GPU path is taken with an engine");
+        engine.prepare(&state.ctx, set, plan, pattern)?;
+        engine.record_timed(encoder, state.timer.as_ref());
         let levels = tessera_render::patch_levels(plan, max_factor);
         return Ok(Tessellated { path, stages: format!("PLAN {plan_ms:.1}"), levels, upload: None });
     }
@@ -481,14 +490,14 @@ fn record_draw(
     let parts = match &drawn.upload {
         Some((buffers, _)) => buffers.geometries(),
         None => {
-            let (Some(vertices), Some(indices)) = (state.engine.vertex_buffer(), state.engine.index_buffer())
-            else {
+            let Some(engine) = &state.engine else { return Ok(false) };
+            let (Some(vertices), Some(indices)) = (engine.vertex_buffer(), engine.index_buffer()) else {
                 return Ok(false);
             };
             vec![gpu::Geometry {
                 vertices,
                 indices,
-                indexed_args: state.engine.indirect_buffer(),
+                indexed_args: engine.indirect_buffer(),
                 // Patch colours of GPU output would need the engine's triangle offsets every
                 // frame (a read-back): they are drawn from the CPU engine instead.
                 triangle_patch: None,
@@ -525,7 +534,8 @@ fn triangles_drawn(
                     }
                 }
             }
-            Ok(state.engine.read_status(&state.ctx)?.2 as u64)
+            let engine = state.engine.as_ref().ok_or("no GPU engine")?;
+            Ok(engine.read_status(&state.ctx)?.2 as u64)
         }
     }
 }
