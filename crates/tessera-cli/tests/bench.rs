@@ -34,7 +34,11 @@ const EXPECTED_ROWS: [(&str, &str, &[&str]); 13] = [
     ("paper002_table1", "row", &["input surfaces", "non-adaptive", "adaptive high", "adaptive medium"]),
     ("paper003_table1", "scene", &["teapot", "torus_64x32", "teacups", "torus grid"]),
     ("paper003_table2", "scene", &["elephant", "elephant_refined", "killeroo herd"]),
-    ("subdivision_bfr", "model", &["catmark_torus", "catmark_torus_creases0", "catmark_pyramid_creases0"]),
+    (
+        "subdivision_bfr",
+        "model",
+        &["catmark_torus", "catmark_torus_creases0", "catmark_pyramid_creases0", "loop_cube_creases0"],
+    ),
 ];
 
 /// OpenSubdiv's Bfr benchmark, which `scripts/test` builds (as the oracle tests' program).

@@ -41,7 +41,8 @@ pub enum Suite {
     /// Papers 000 (Table 1), 001 (Tables 1–2), 002 (Table 1) and 003 (Tables 1–2) beside the
     /// papers' own figures.
     Paper,
-    /// Catmull-Clark cages copied past 50,000 faces (the regular torus, the creased rook):
+    /// Catmull-Clark and Loop cages copied past 50,000 faces (the regular torus, the creased
+    /// rook, Loop's extraordinary vertices):
     /// uniform at Bfr's rate 16 and adaptive at 0.5 px, beside OpenSubdiv's Bfr on the same
     /// cage and rates when `tools/osd-oracle/bfr_bench` is built (--bfr).
     Subdivision,

@@ -1,7 +1,8 @@
-//! `subdivision`: Catmull-Clark cages against OpenSubdiv's Bfr, the reference — uniform
-//! tessellation at Bfr's rate 16 and adaptive tessellation at half a pixel, on cages copied
-//! past 50,000 faces (`catmark_torus`, all regular; `catmark_rook`, triangles and semi-sharp
-//! creases), per thread count.
+//! `subdivision`: Catmull-Clark and Loop cages against OpenSubdiv's Bfr, the reference —
+//! uniform tessellation at Bfr's rate 16 and adaptive tessellation at half a pixel, on cages
+//! copied past 50,000 faces (`catmark_torus`, all regular; `catmark_rook`, triangles and
+//! semi-sharp creases; `loop_xord_interior`, Loop with extraordinary vertices), per thread
+//! count.
 //!
 //! Bfr's figures come from `tools/osd-oracle/bfr_bench` (a C++ program linked against
 //! OpenSubdiv, built by `tools/osd-oracle/bfr_bench.sh`; tessera does not link OpenSubdiv),
@@ -33,12 +34,16 @@ fn cases(quick: bool) -> Vec<Case> {
             Case { model: "subdivision/catmark_torus_creases0.obj", copies: 4 },
             // Triangles and a quad, so split into sub-faces, with creases.
             Case { model: "subdivision/catmark_pyramid_creases0.obj", copies: 16 },
+            // Loop, semi-sharp creases.
+            Case { model: "subdivision/loop_cube_creases0.obj", copies: 16 },
         ];
     }
     vec![
         // 32 faces × 1,563 = 50,016 and 777 × 65 = 50,505: the issue's "≥ 50k faces".
         Case { model: "subdivision/catmark_torus.obj", copies: 1563 },
         Case { model: "subdivision/catmark_rook.obj", copies: 65 },
+        // Loop (issue 28): 69 triangles with extraordinary vertices × 725 = 50,025.
+        Case { model: "subdivision/loop_xord_interior.obj", copies: 725 },
     ]
 }
 
@@ -93,7 +98,12 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
         ctx.step(&format!("subdivision: loading {name} × {}", case.copies));
         let start = std::time::Instant::now();
         let mesh = tessera::scene::mesh_grid(&tessera::io::obj::read_obj(&path)?, case.copies);
-        let set = SurfaceSet::from_subdivision_cage(&mesh, &path, CageOptions::default())?;
+        // `loop_*` cages are Loop's, as Bfr's benchmark takes them by the file name.
+        let set = if name.starts_with("loop_") {
+            SurfaceSet::from_loop_cage(&mesh, &path, CageOptions::default())?
+        } else {
+            SurfaceSet::from_subdivision_cage(&mesh, &path, CageOptions::default())?
+        };
         loads.push(format!("{name} × {}: {:.1} s", case.copies, start.elapsed().as_secs_f64()));
         let split = set.origins.iter().any(|o| o.is_subface);
         let factor = if split { BFR_RATE / 2 } else { BFR_RATE };
@@ -284,8 +294,9 @@ pub fn face_rates(set: &SurfaceSet, plan: &Plan, mesh: &PolygonMesh) -> Result<S
     for (p, origin) in set.origins.iter().enumerate() {
         let f = origin.face as usize;
         let corners = set.keys[p].corners;
-        for k in 0..4 {
-            let (a, b) = (corners[k], corners[(k + 1) % 4]);
+        let n = set.keys[p].domain.corner_count();
+        for k in 0..n {
+            let (a, b) = (corners[k], corners[(k + 1) % n]);
             let segments = plan.segments(set.topology.patch_edges[p][k].edge as usize);
             match (a < vertices, b < vertices) {
                 (true, true) => {
