@@ -536,32 +536,41 @@ pub(super) fn corner_fan(mesh: &Cage, f: usize, i: usize, scheme: Scheme) -> Cor
     CornerFan { faces, patch_face, boundary, sharp, dart }
 }
 
+impl CornerFan {
+    /// The fan's 1-ring in OpenSubdiv's order (`SourcePatch::GetCornerRingPoints`): per face,
+    /// its corners after the fan's vertex up to the one before it (a quad's far end of its
+    /// leading edge and its diagonal vertex; a triangle's far end of its leading edge); an
+    /// open fan adds the far end of its last face's trailing edge. Cost: O(ring).
+    pub(super) fn ring(&self, mesh: &Cage) -> Vec<DVec3> {
+        let mut ring = Vec::with_capacity(2 * self.faces.len() + 1);
+        for fc in &self.faces {
+            let q = mesh.face(fc.face as usize);
+            let c = fc.corner as usize;
+            ring.extend((1..q.len() - 1).map(|k| mesh.points[q[(c + k) % q.len()] as usize]));
+        }
+        if self.boundary {
+            let last = self.faces.last().expect("a corner has a face");
+            let q = mesh.face(last.face as usize);
+            ring.push(mesh.points[q[(last.corner as usize + q.len() - 1) % q.len()] as usize]);
+        }
+        ring
+    }
+}
+
 /// The source patch of a leaf for its Gregory end cap (`PatchBuilder::GetIrregularPatchCornerSpans`
 /// and `assembleIrregularSourcePatch`, `far/patchBuilder.cpp`).
 fn gregory_source(mesh: &Cage, f: usize) -> GregorySource {
     let corners: [GregoryCorner; 4] = std::array::from_fn(|i| {
         let v = mesh.face(f)[i] as usize;
-        let CornerFan { faces, patch_face, boundary, sharp, dart } = corner_fan(mesh, f, i, Scheme::Catmark);
-        let mut ring = Vec::with_capacity(2 * faces.len() + 1);
-        for fc in &faces {
-            let q = mesh.face(fc.face as usize);
-            let c = fc.corner as usize;
-            ring.push(mesh.points[q[(c + 1) % 4] as usize]);
-            ring.push(mesh.points[q[(c + 2) % 4] as usize]);
-        }
-        if boundary {
-            let last = faces.last().unwrap();
-            let q = mesh.face(last.face as usize);
-            ring.push(mesh.points[q[(last.corner as usize + 3) % 4] as usize]);
-        }
+        let fan = corner_fan(mesh, f, i, Scheme::Catmark);
         GregoryCorner {
             position: mesh.points[v],
-            num_faces: faces.len(),
-            patch_face,
-            boundary,
-            sharp,
-            dart,
-            ring,
+            num_faces: fan.faces.len(),
+            patch_face: fan.patch_face,
+            boundary: fan.boundary,
+            sharp: fan.sharp,
+            dart: fan.dart,
+            ring: fan.ring(mesh),
         }
     });
     GregorySource { corners }

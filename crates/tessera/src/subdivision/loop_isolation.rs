@@ -22,7 +22,7 @@ use glam::{DVec2, DVec3};
 use super::cage::{Cage, FaceCorner};
 use super::isolation::{
     child_sharpness, corner_fan, face_has_features, is_infinite, is_patch_regular, neighbourhood, vertex_tag,
-    CornerFan, IsolationLevels, Scheme, MAX_ISOLATION_LEVEL,
+    IsolationLevels, Scheme, MAX_ISOLATION_LEVEL,
 };
 use super::loop_gregory::{gregory_triangle_points, LoopCorner, LoopGregorySource};
 use super::loop_sdc::{self, EdgeNeighborhood, VertexNeighborhood};
@@ -199,27 +199,15 @@ fn decode_mask(mask: u8) -> (u8, u8) {
 fn gregory_source(mesh: &Cage, f: usize) -> LoopGregorySource {
     let corners: [LoopCorner; 3] = std::array::from_fn(|i| {
         let v = mesh.face(f)[i] as usize;
-        let CornerFan { faces, patch_face, boundary, sharp, dart } = corner_fan(mesh, f, i, Scheme::Loop);
-        // Per triangle of the fan the far end of its leading edge; an open fan adds the far
-        // end of its last triangle's trailing edge.
-        let mut ring = Vec::with_capacity(faces.len() + 1);
-        for fc in &faces {
-            let q = mesh.face(fc.face as usize);
-            ring.push(mesh.points[q[(fc.corner as usize + 1) % 3] as usize]);
-        }
-        if boundary {
-            let last = faces.last().expect("a corner has a face");
-            let q = mesh.face(last.face as usize);
-            ring.push(mesh.points[q[(last.corner as usize + 2) % 3] as usize]);
-        }
+        let fan = corner_fan(mesh, f, i, Scheme::Loop);
         LoopCorner {
             position: mesh.points[v],
-            num_faces: faces.len(),
-            patch_face,
-            boundary,
-            sharp,
-            dart,
-            ring,
+            num_faces: fan.faces.len(),
+            patch_face: fan.patch_face,
+            boundary: fan.boundary,
+            sharp: fan.sharp,
+            dart: fan.dart,
+            ring: fan.ring(mesh),
         }
     });
     LoopGregorySource { corners }

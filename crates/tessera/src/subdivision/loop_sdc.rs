@@ -71,10 +71,12 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::sdc::{
-    self, edge_mask_with, is_sharp, sharp_edge_pair_of_crease, vertex_mask_with, SmoothVertexMask,
-};
-pub use super::sdc::{edge_child_rule, VertexRule};
+use super::sdc::{edge_mask_with, is_sharp, sharp_edge_pair_of_crease, vertex_mask_with, SmoothVertexMask};
+
+/// Loop's edge masks have Catmark's shape, one weight for both ends and one for every
+/// triangle beside the edge; for Loop that weight is the vertex opposite the edge in each
+/// triangle (`EdgeMask::face`, applied to those vertices), where Catmark's is its face point.
+pub use super::sdc::{edge_child_rule, EdgeMask, VertexRule};
 use super::CreaseMethod;
 
 /// The valence of a regular Loop vertex, whose masks Sdc special-cases with exact fractions.
@@ -86,37 +88,6 @@ const ROOT3: f64 = 1.7320508075688772;
 // ---------------------------------------------------------------------------------------
 // Edge points
 // ---------------------------------------------------------------------------------------
-
-/// An edge point's mask: one weight for both of the edge's ends, one for the vertex opposite
-/// the edge in each triangle beside it. The weights sum to 1; with
-/// [`CreaseMethod::Chaikin`] they may leave [0, 1] (see [`edge_mask`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EdgeMask {
-    /// Weight of each end vertex.
-    pub vertex: f64,
-    /// Weight of each incident triangle's vertex opposite the edge; 0 for the crease rule.
-    pub opposite: f64,
-    /// Incident triangles the mask was made for.
-    pub faces: usize,
-}
-
-impl EdgeMask {
-    /// The edge point: `ends` are the edge's two vertices, `opposite` the vertex opposite the
-    /// edge in each of its triangles (as many as the mask was made for, any order), summed as
-    /// Far does (ends first).
-    ///
-    /// Cost: O(faces).
-    pub fn apply(&self, ends: [DVec3; 2], opposite: &[DVec3]) -> DVec3 {
-        debug_assert_eq!(opposite.len(), self.faces, "one opposite vertex per triangle of the edge");
-        let mut p = ends[0] * self.vertex + ends[1] * self.vertex;
-        if self.opposite != 0.0 {
-            for &o in opposite {
-                p += o * self.opposite;
-            }
-        }
-        p
-    }
-}
 
 /// The mask of the edge point of an edge with sharpness `sharpness` (as stored at this
 /// level) and `faces` incident triangles (two for a manifold interior edge; one or more than
@@ -138,8 +109,7 @@ pub fn edge_mask(sharpness: f32, child_rule: VertexRule, faces: usize) -> EdgeMa
     debug_assert!(faces > 0 || is_sharp(sharpness), "a smooth edge needs a triangle");
     // The non-manifold case keeps the ratio of the ends' weight to the triangles' total.
     let opposite = if faces == 2 { 0.125 } else { 0.125 * (2.0 / faces as f64) };
-    let m = edge_mask_with(sharpness, child_rule, sdc::EdgeMask { vertex: 0.375, face: opposite, faces });
-    EdgeMask { vertex: m.vertex, opposite: m.face, faces }
+    edge_mask_with(sharpness, child_rule, EdgeMask { vertex: 0.375, face: opposite, faces })
 }
 
 /// The neighbourhood of an edge, for [`edge_point`].
@@ -568,14 +538,11 @@ mod tests {
     #[test]
     fn edge_masks() {
         // Smooth: ⅜ ⅜ ⅛ ⅛.
-        assert_eq!(
-            edge_mask(0.0, VertexRule::Smooth, 2),
-            EdgeMask { vertex: 0.375, opposite: 0.125, faces: 2 }
-        );
+        assert_eq!(edge_mask(0.0, VertexRule::Smooth, 2), EdgeMask { vertex: 0.375, face: 0.125, faces: 2 });
         // Sharp: the midpoint.
-        assert_eq!(edge_mask(INF, VertexRule::Crease, 1), EdgeMask { vertex: 0.5, opposite: 0.0, faces: 1 });
+        assert_eq!(edge_mask(INF, VertexRule::Crease, 1), EdgeMask { vertex: 0.5, face: 0.0, faces: 1 });
         // Non-manifold: the opposite vertices share ¼.
-        assert_eq!(edge_mask(0.0, VertexRule::Smooth, 4).opposite, 0.0625);
+        assert_eq!(edge_mask(0.0, VertexRule::Smooth, 4).face, 0.0625);
         // Half sharp: half way between the two.
         let (a, b) = (DVec3::ZERO, DVec3::new(1.0, 0.0, 0.2));
         let opp = [DVec3::new(0.5, 1.0, 0.0), DVec3::new(0.5, -1.0, 0.3)];
@@ -820,7 +787,7 @@ mod tests {
             agree.weight(m.vertex, w, false, line);
         }
         for &w in &theirs.faces {
-            agree.weight(m.opposite, w, false, line);
+            agree.weight(m.face, w, false, line);
         }
         agree.vtr_only += usize::from(theirs.vtr_only);
         agree.edges += 1;
@@ -884,7 +851,7 @@ mod tests {
             let (s, nf) = (t.f32(), t.usize());
             for rule in [VertexRule::Smooth, VertexRule::Dart, VertexRule::Crease] {
                 let m = edge_mask(s, rule, nf);
-                let total = 2.0 * m.vertex + nf as f64 * m.opposite;
+                let total = 2.0 * m.vertex + nf as f64 * m.face;
                 assert!((total - 1.0).abs() < 1e-14, "edge mask sums to {total}: {line}");
             }
             cases += 1;

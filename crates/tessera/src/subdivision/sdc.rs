@@ -382,7 +382,9 @@ pub fn face_point(corners: &[DVec3]) -> DVec3 {
 const SMOOTH_TRIANGLE_EDGE_WEIGHT: f64 = 0.470;
 
 /// An edge point's mask: the same weight for both of the edge's ends and the same weight for
-/// the face point of every face beside it (Catmark's edge masks have no other shape). The
+/// each face beside it, applied to its face point (Catmark's edge masks have no other shape;
+/// Loop's, [`super::loop_sdc::edge_mask`], apply it to each triangle's vertex opposite the
+/// edge). The
 /// weights sum to 1; with [`CreaseMethod::Chaikin`] they may leave [0, 1] (see
 /// [`edge_mask`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

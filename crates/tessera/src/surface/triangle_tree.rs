@@ -115,12 +115,6 @@ impl TriangleTree {
         TriangleTree { leaves: leaves.into(), nodes: nodes.into(), root, swapped: false, hull }
     }
 
-    /// A tree of one leaf covering the whole triangle: a regular face.
-    pub fn single(patch: TriangleLeafPatch) -> Self {
-        let leaf = TriangleLeaf { origin: DVec2::ZERO, size: 1.0, level: 0, turned: false, patch };
-        Self::from_parts(vec![leaf], Vec::new(), TriangleSlot::Leaf(0))
-    }
-
     /// The leaves.
     pub fn leaves(&self) -> &[TriangleLeaf] {
         &self.leaves
@@ -130,14 +124,6 @@ impl TriangleTree {
     /// convex hull.
     pub fn control_points(&self) -> &[DVec3] {
         &self.hull
-    }
-
-    /// Appends every leaf's points to `out`, leaf by leaf (15 for a quartic leaf, 18 for a
-    /// Gregory one). Cost: O(leaves).
-    pub fn leaf_points(&self, out: &mut Vec<DVec3>) {
-        for leaf in self.leaves.iter() {
-            out.extend_from_slice(leaf.patch.points());
-        }
     }
 
     /// Whether `u` and `v` are exchanged ([`TriangleTree::swapped`]).
