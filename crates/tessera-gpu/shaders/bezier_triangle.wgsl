@@ -47,23 +47,33 @@ fn triangle_derivatives(p: u32, uv: vec2<f32>) -> Derivatives {
     return Derivatives(position, du, dv);
 }
 
-// The geometric normal, a step towards the centroid where the derivatives are parallel
-// (as `bicubic_eval` does; the CPU takes the limit).
+// A triangle patch's derivatives: a Loop patch's (its tree's, `tree.wgsl`) or a cubic
+// Bézier triangle's.
+fn any_triangle_derivatives(p: u32, uv: vec2<f32>) -> Derivatives {
+    if (patch_is_loop(p)) { return loop_derivatives(p, uv); }
+    return triangle_derivatives(p, uv);
+}
+
+// The geometric normal of any triangle patch (`surface::triangle_point`, the one rule of the
+// triangle kinds), a step towards the centroid where the derivatives are parallel (as
+// `bicubic_eval` does; the CPU takes the limit). One call site of the evaluation (each is
+// compiled inline, and a Loop patch's is a tree walk): step 0 is the point itself, then
+// steps 1e-4, 1e-3, 1e-2 and 1e-1 inside, each taken only where the cross product vanishes.
 fn triangle_eval(p: u32, uv: vec2<f32>) -> SurfacePoint {
-    let d = triangle_derivatives(p, uv);
-    var n = cross(d.du, d.dv);
-    let scale = max(dot(d.du, d.du), dot(d.dv, d.dv));
-    if (!(dot(n, n) > 1e-10 * scale * scale)) {
-        for (var step = 1e-4; step < 0.5; step = step * 10.0) {
-            let e = triangle_derivatives(p, uv + (vec2<f32>(1.0 / 3.0) - uv) * step);
-            n = cross(e.du, e.dv);
-            let s2 = max(dot(e.du, e.du), dot(e.dv, e.dv));
-            if (dot(n, n) > 1e-10 * s2 * s2) { break; }
-        }
+    var position = vec3<f32>(0.0);
+    var n = vec3<f32>(0.0);
+    var step = 0.0;
+    loop {
+        let d = any_triangle_derivatives(p, uv + (vec2<f32>(1.0 / 3.0) - uv) * step);
+        if (step == 0.0) { position = d.position; }
+        n = cross(d.du, d.dv);
+        let s2 = max(dot(d.du, d.du), dot(d.dv, d.dv));
+        if (dot(n, n) > 1e-10 * s2 * s2 || step > 0.05) { break; }
+        step = select(step * 10.0, 1e-4, step == 0.0);
     }
     let len2 = dot(n, n);
-    if (!(len2 > 0.0)) { return SurfacePoint(d.position, vec3<f32>(0.0, 0.0, 1.0)); }
-    return SurfacePoint(d.position, n * inverseSqrt(len2));
+    if (!(len2 > 0.0)) { return SurfacePoint(position, vec3<f32>(0.0, 0.0, 1.0)); }
+    return SurfacePoint(position, n * inverseSqrt(len2));
 }
 
 // `PnTriangle::eval`: the quadratic normal field where it does not vanish.
@@ -80,7 +90,8 @@ fn pn_eval(p: u32, uv: vec2<f32>) -> SurfacePoint {
     return triangle_eval(p, uv);
 }
 
-// Any patch at uv: bicubic, Bézier triangle or PN triangle (the patch row's kind bits).
+// Any patch at uv: bicubic, Bézier triangle, PN triangle, Loop or Catmull-Clark
+// subdivision patch (the patch row's kind bits).
 fn eval_patch(p: u32, uv: vec2<f32>) -> SurfacePoint {
     if (patch_has_pn_normals(p)) { return pn_eval(p, uv); }
     if (patch_is_tri(p)) { return triangle_eval(p, uv); }

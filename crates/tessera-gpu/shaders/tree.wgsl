@@ -141,3 +141,133 @@ fn tree_eval(p: u32, uv: vec2<f32>) -> SurfacePoint {
     }
     return SurfacePoint(position, n * inverseSqrt(len2));
 }
+
+// Loop subdivision patches: the GPU form of `tessera::surface::TriangleTree::derivatives`
+// (Bfr's triangle quadtree walked to the leaf, its quartic Bézier piece or Gregory triangle
+// evaluated, the derivatives scaled back and turned leaves' signs flipped). Patch row `[12]`
+// bit 4 marks such a patch (with bit 1, a triangle); its view record is `(0, 0, 1, swapped |
+// block << 3)` and its leaves' records carry kind bit 0 (Gregory triangle) and bit 1 (turned).
+
+fn patch_is_loop(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 16u) != 0u; }
+
+// `QuarticTriangle::derivatives`: position and first derivatives of the quartic net `b`
+// (`QuarticTriangle::index` order) at uv, by de Casteljau's steps down to the linear net
+// (the same polynomial; straight-line code with constant indices, which compiles to a
+// fraction of a Bernstein double loop's code on lavapipe).
+fn quartic_derivatives(b: array<vec3<f32>, 15>, uv: vec2<f32>) -> Derivatives {
+    let l = vec3<f32>(1.0 - uv.x - uv.y, uv.x, uv.y);
+    let c = array<vec3<f32>, 10>(
+        l.x * b[0] + l.y * b[1] + l.z * b[2],
+        l.x * b[1] + l.y * b[3] + l.z * b[4],
+        l.x * b[2] + l.y * b[4] + l.z * b[5],
+        l.x * b[3] + l.y * b[6] + l.z * b[7],
+        l.x * b[4] + l.y * b[7] + l.z * b[8],
+        l.x * b[5] + l.y * b[8] + l.z * b[9],
+        l.x * b[6] + l.y * b[10] + l.z * b[11],
+        l.x * b[7] + l.y * b[11] + l.z * b[12],
+        l.x * b[8] + l.y * b[12] + l.z * b[13],
+        l.x * b[9] + l.y * b[13] + l.z * b[14],
+    );
+    let d = array<vec3<f32>, 6>(
+        l.x * c[0] + l.y * c[1] + l.z * c[2],
+        l.x * c[1] + l.y * c[3] + l.z * c[4],
+        l.x * c[2] + l.y * c[4] + l.z * c[5],
+        l.x * c[3] + l.y * c[6] + l.z * c[7],
+        l.x * c[4] + l.y * c[7] + l.z * c[8],
+        l.x * c[5] + l.y * c[8] + l.z * c[9],
+    );
+    let e0 = l.x * d[0] + l.y * d[1] + l.z * d[2];
+    let e1 = l.x * d[1] + l.y * d[3] + l.z * d[4];
+    let e2 = l.x * d[2] + l.y * d[4] + l.z * d[5];
+    return Derivatives(l.x * e0 + l.y * e1 + l.z * e2, 4.0 * (e1 - e0), 4.0 * (e2 - e0));
+}
+
+// `GregoryTriangle::blend_weights`' pair: (a, b)/(a + b), or (1, 0) where a + b ≤ 0.
+fn gregory_pair(a: f32, b: f32) -> vec2<f32> {
+    if (a + b > 0.0) { return vec2<f32>(a / (a + b), b / (a + b)); }
+    return vec2<f32>(1.0, 0.0);
+}
+
+// The quartic net of the leaf at `at`: its 15 points, or a Gregory triangle's 18
+// (OpenSubdiv's order) as `GregoryTriangle::blended` makes it, its interior points blended
+// at uv.
+fn loop_leaf_net(at: u32, gregory: bool, uv: vec2<f32>) -> array<vec3<f32>, 15> {
+    if (!gregory) {
+        return array<vec3<f32>, 15>(
+            control_points[at].xyz, control_points[at + 1u].xyz, control_points[at + 2u].xyz,
+            control_points[at + 3u].xyz, control_points[at + 4u].xyz, control_points[at + 5u].xyz,
+            control_points[at + 6u].xyz, control_points[at + 7u].xyz, control_points[at + 8u].xyz,
+            control_points[at + 9u].xyz, control_points[at + 10u].xyz, control_points[at + 11u].xyz,
+            control_points[at + 12u].xyz, control_points[at + 13u].xyz, control_points[at + 14u].xyz,
+        );
+    }
+    let w = 1.0 - uv.x - uv.y;
+    let w0 = gregory_pair(uv.x, uv.y);
+    let w1 = gregory_pair(uv.y, w);
+    let w2 = gregory_pair(w, uv.x);
+    let g = at;
+    // b400, b310, b301, b220, b211, b202, b130, b121, b112, b103, b040, b031, b022, b013, b004.
+    return array<vec3<f32>, 15>(
+        control_points[g].xyz, control_points[g + 1u].xyz, control_points[g + 2u].xyz,
+        control_points[g + 15u].xyz,
+        control_points[g + 3u].xyz * w0.x + control_points[g + 4u].xyz * w0.y,
+        control_points[g + 17u].xyz, control_points[g + 7u].xyz,
+        control_points[g + 8u].xyz * w1.x + control_points[g + 9u].xyz * w1.y,
+        control_points[g + 13u].xyz * w2.x + control_points[g + 14u].xyz * w2.y,
+        control_points[g + 11u].xyz, control_points[g + 5u].xyz, control_points[g + 6u].xyz,
+        control_points[g + 16u].xyz, control_points[g + 12u].xyz, control_points[g + 10u].xyz,
+    );
+}
+
+fn loop_derivatives(p: u32, uv_in: vec2<f32>) -> Derivatives {
+    let bits = bitcast<u32>(control_points[patch_rows[p * PATCH_ROW + 13u]].w);
+    let swapped = (bits & 1u) != 0u;
+    let block = bits >> 3u;
+    var uv = uv_in;
+    if (swapped) { uv = uv.yx; }
+    // `TriangleTree::find`, Bfr's flag included (it stays set after a turned node's middle
+    // child).
+    var u = uv.x;
+    var v = uv.y;
+    var slot = bitcast<u32>(control_points[block].x);
+    var median = 0.5;
+    var turned = false;
+    loop {
+        if ((slot & LEAF_SLOT) != 0u) { break; }
+        var q = 0u;
+        if (!turned) {
+            if (u >= median) {
+                u = u - median;
+                q = 1u;
+            } else if (v >= median) {
+                v = v - median;
+                q = 2u;
+            } else if (u + v >= median) {
+                turned = true;
+                q = 3u;
+            }
+        } else if (u < median) {
+            v = v - median;
+            q = 1u;
+        } else if (v < median) {
+            u = u - median;
+            q = 2u;
+        } else {
+            u = u - median;
+            v = v - median;
+            q = select(0u, 3u, u + v < median);
+        }
+        slot = bitcast<u32>(control_points[block + 1u + slot][q]);
+        median = median * 0.5;
+    }
+    let at = block + (slot & ~LEAF_SLOT);
+    let leaf = control_points[at];
+    let kind = bitcast<u32>(leaf.w);
+    let leaf_turned = (kind & 2u) != 0u;
+    var st = (uv - leaf.xy) / leaf.z;
+    if (leaf_turned) { st = (leaf.xy + vec2<f32>(leaf.z) - uv) / leaf.z; }
+    let d = quartic_derivatives(loop_leaf_net(at + 1u, (kind & 1u) != 0u, st), st);
+    let scale = select(1.0, -1.0, leaf_turned) / leaf.z;
+    if (swapped) { return Derivatives(d.position, d.dv * scale, d.du * scale); }
+    return Derivatives(d.position, d.du * scale, d.dv * scale);
+}

@@ -62,7 +62,8 @@ impl GpuStencils {
     ) -> Result<GpuStencils> {
         let ranges = stencils.point_ranges(set)?;
         let (patches, tree_blocks) = tessellator.layout();
-        let trees = set.patches.iter().filter(|p| matches!(p, Patch::Subdivision(_))).count();
+        let trees =
+            set.patches.iter().filter(|p| matches!(p, Patch::Subdivision(_) | Patch::Loop(_))).count();
         if patches as usize != set.patches.len() || (trees > 0) == tree_blocks.is_empty() {
             return Err(tessera::Error::InvalidParameter {
                 name: "tessellator",
@@ -89,12 +90,9 @@ impl GpuStencils {
             }
         }
         for &(p, block) in tree_blocks {
-            let Patch::Subdivision(tree) = &set.patches[p] else {
-                unreachable!("a tree block is a subdivision patch's")
-            };
             let mut r = ranges[p].start;
-            for (leaf, at) in tree.leaves().iter().zip(crate::upload::leaf_offsets(tree)) {
-                for j in 0..leaf.patch.points().len() {
+            for (at, points) in crate::upload::leaf_offsets(&set.patches[p]) {
+                for j in 0..points as usize {
                     push(r, (block + at + 1) as usize + j);
                     r += 1;
                 }

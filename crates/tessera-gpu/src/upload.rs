@@ -9,8 +9,9 @@
 //!   edge is collapsed, bits 8..16 the normal variant; `[8..12]` corner entry of each corner
 //!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`],
 //!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots), bit 3
-//!   a subdivision patch (a tree of pieces); `[13]` a subdivision patch's view record in the
-//!   control points (`pack_trees`); the rest 0. Triangles fill three of the four edge and corner slots.
+//!   a Catmull-Clark subdivision patch (a tree of pieces), bit 4 a Loop subdivision patch (a
+//!   triangle tree; bit 1 set too); `[13]` a subdivision patch's view record in the control
+//!   points (`pack_trees`); the rest 0. Triangles fill three of the four edge and corner slots.
 //! - **edge row** ([`EDGE_ROW`] u32): first use, end of uses (`edges[e].uses`), variants,
 //!   collapsed.
 //! - **edge use** ([`USE_ROW`] u32): patch; local edge | reversed << 8 | variant << 16.
@@ -23,7 +24,7 @@
 //!   subdivision patch's bounding-box corners, twice. After every patch's 16, the subdivision
 //!   patches' view records and trees (`pack_trees`).
 
-use crate::error::{GpuError, Result};
+use crate::error::Result;
 use tessera::surface::{Patch, SurfaceSet};
 use wgpu::util::DeviceExt;
 
@@ -80,16 +81,15 @@ impl PackedSet {
             packed.any_repeated_corner |= repeated;
             let point = |q: &glam::DVec3, w: f64| [q.x as f32, q.y as f32, q.z as f32, w as f32];
             let (tri, pn, tree) = match patch {
-                Patch::Loop(_) => {
-                    return Err(GpuError::Unsupported { what: tessera::scheme::loop_on_gpu(p) });
-                }
-                Patch::Subdivision(t) => {
-                    // The box around its pieces twice (what culling reads); the pieces
-                    // themselves follow all patches ([`pack_trees`]).
-                    let hull = t.control_points();
+                Patch::Subdivision(_) | Patch::Loop(_) => {
+                    // The box around its pieces twice (what culling reads: a triangle's first
+                    // ten slots hold all eight corners too); the pieces themselves follow all
+                    // patches ([`pack_trees`]).
+                    let hull = patch.control_points();
                     packed.control_points.extend(hull.iter().chain(hull).map(|q| point(q, 1.0)));
                     trees.push(p);
-                    (false, false, true)
+                    let tri = matches!(patch, Patch::Loop(_));
+                    (tri, false, true)
                 }
                 Patch::Bicubic(b) => {
                     packed.control_points.extend(b.points.iter().zip(&b.weights).map(|(q, &w)| point(q, w)));
@@ -106,7 +106,12 @@ impl PackedSet {
                     (true, true, false)
                 }
             };
-            row[12] = repeated as u32 | (tri as u32) << 1 | (pn as u32) << 2 | (tree as u32) << 3;
+            let loop_tree = tri && tree;
+            row[12] = repeated as u32
+                | (tri as u32) << 1
+                | (pn as u32) << 2
+                | (tree as u32 & !tri as u32) << 3
+                | (loop_tree as u32) << 4;
             packed.patch_rows.extend_from_slice(&row);
         }
         pack_trees(set, &trees, &mut packed);
@@ -141,55 +146,130 @@ impl PackedSet {
 /// Appends the subdivision patches' pieces to the control points (after every patch's 16
 /// slots) and points their patch rows at them (`row[13]`), as `tree.wgsl` reads them:
 ///
-/// - per patch in `trees`, a **view record** `(origin.x, origin.y, size, bits)`: the square
-///   of the tree it covers ([`tessera::surface::PatchTree::view_square`]), and `bits` (f32
-///   bits) = transposed | rotation << 1 | the tree block's index << 3;
+/// - per patch in `trees`, a **view record** `(origin.x, origin.y, size, bits)`: for a
+///   Catmull-Clark patch the square of the tree it covers
+///   ([`tessera::surface::PatchTree::view_square`]) and `bits` (f32 bits) = transposed |
+///   rotation << 1 | the tree block's index << 3; for a Loop patch `(0, 0, 1, bits)` with
+///   `bits` = swapped | the block's index << 3 ([`tessera::surface::TriangleTree::is_swapped`]);
 /// - per tree (views of one tree share it), a **block**: a header whose `x` bits are the root
 ///   slot, then each node's four child slots (bits), then each leaf: `(origin.x, origin.y,
-///   size, kind bits: 0 Bézier, 1 Gregory)` and its 16 or 20 points (`w = 1`). A slot is a
-///   node index or `LEAF_SLOT |` the leaf's offset in the block.
+///   size, kind bits)` and its points (`w = 1`): a Catmull-Clark leaf's 16 or 20 (kind 0
+///   Bézier, 1 Gregory), a Loop leaf's 15 or 18 (kind bit 0 Gregory triangle, bit 1 turned).
+///   A slot is a node index or `LEAF_SLOT |` the leaf's offset in the block.
 fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
-    use tessera::surface::patch_tree::{LeafPatch, LEAF_SLOT};
+    use tessera::surface::patch_tree::LEAF_SLOT;
     let bits = |u: u32| f32::from_bits(u);
     let records = packed.control_points.len();
     packed.control_points.resize(records + trees.len(), [0.0; 4]);
     let mut blocks: std::collections::HashMap<usize, u32> = Default::default();
     for (k, &p) in trees.iter().enumerate() {
-        let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("trees are subdivision patches") };
+        let tree = PackedTree::of(&set.patches[p]);
         let block = *blocks.entry(tree.leaves_id()).or_insert_with(|| {
             let block = packed.control_points.len() as u32;
             packed.tree_blocks.push((p, block));
             let (root, nodes) = tree.quadtree();
-            let leaf_at = leaf_offsets(tree);
-            let slot =
-                |s: u32| if s & LEAF_SLOT != 0 { LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize] } else { s };
+            let leaf_at = leaf_offsets(&set.patches[p]);
+            let slot = |s: u32| {
+                if s & LEAF_SLOT != 0 {
+                    LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize].0
+                } else {
+                    s
+                }
+            };
             let out = &mut packed.control_points;
             out.push([bits(slot(root)), 0.0, 0.0, 0.0]);
             out.extend(nodes.iter().map(|n| n.map(|s| bits(slot(s)))));
-            for leaf in tree.leaves() {
-                let kind = u32::from(matches!(leaf.patch, LeafPatch::Gregory(_)));
-                out.push([leaf.origin.x as f32, leaf.origin.y as f32, leaf.size as f32, bits(kind)]);
-                out.extend(leaf.patch.points().iter().map(|q| [q.x as f32, q.y as f32, q.z as f32, 1.0]));
-            }
+            tree.push_leaves(out);
             block
         });
-        let (origin, size) = tree.view_square();
-        let view = tree.is_transposed() as u32 | u32::from(tree.rotation()) << 1 | block << 3;
-        packed.control_points[records + k] = [origin.x as f32, origin.y as f32, size as f32, bits(view)];
+        packed.control_points[records + k] = tree.view_record(block);
         packed.patch_rows[p * PATCH_ROW as usize + 13] = (records + k) as u32;
     }
 }
 
-/// Where each leaf of `tree` starts in its block ([`pack_trees`]): after the header and the
-/// nodes, each leaf's record and then its points. Cost: O(leaves).
-pub(crate) fn leaf_offsets(tree: &tessera::surface::PatchTree) -> Vec<u32> {
-    let mut at = 1 + tree.quadtree().1.len() as u32;
-    tree.leaves()
-        .iter()
-        .map(|leaf| {
+/// A Catmull-Clark or Loop patch's tree, as [`pack_trees`] lays it out.
+enum PackedTree<'a> {
+    CatmullClark(&'a tessera::surface::PatchTree),
+    Loop(&'a tessera::surface::TriangleTree),
+}
+
+impl<'a> PackedTree<'a> {
+    fn of(patch: &'a Patch) -> PackedTree<'a> {
+        match patch {
+            Patch::Subdivision(t) => PackedTree::CatmullClark(t),
+            Patch::Loop(t) => PackedTree::Loop(t),
+            _ => unreachable!("trees are subdivision patches"),
+        }
+    }
+
+    fn leaves_id(&self) -> usize {
+        match self {
+            PackedTree::CatmullClark(t) => t.leaves_id(),
+            PackedTree::Loop(t) => t.leaves_id(),
+        }
+    }
+
+    fn quadtree(&self) -> (u32, Vec<[u32; 4]>) {
+        match self {
+            PackedTree::CatmullClark(t) => t.quadtree(),
+            PackedTree::Loop(t) => t.quadtree(),
+        }
+    }
+
+    /// Each leaf's record and points ([`pack_trees`]).
+    fn push_leaves(&self, out: &mut Vec<[f32; 4]>) {
+        use tessera::surface::patch_tree::LeafPatch;
+        use tessera::surface::triangle_tree::TriangleLeafPatch;
+        let bits = |u: u32| f32::from_bits(u);
+        let mut leaf = |origin: glam::DVec2, size: f64, kind: u32, points: &[glam::DVec3]| {
+            out.push([origin.x as f32, origin.y as f32, size as f32, bits(kind)]);
+            out.extend(points.iter().map(|q| [q.x as f32, q.y as f32, q.z as f32, 1.0]));
+        };
+        match self {
+            PackedTree::CatmullClark(t) => t.leaves().iter().for_each(|l| {
+                let kind = u32::from(matches!(l.patch, LeafPatch::Gregory(_)));
+                leaf(l.origin, l.size, kind, l.patch.points())
+            }),
+            PackedTree::Loop(t) => t.leaves().iter().for_each(|l| {
+                let kind =
+                    u32::from(matches!(l.patch, TriangleLeafPatch::Gregory(_))) | u32::from(l.turned) << 1;
+                leaf(l.origin, l.size, kind, l.patch.points())
+            }),
+        }
+    }
+
+    /// The patch's view record ([`pack_trees`]) for its tree's block at `block`.
+    fn view_record(&self, block: u32) -> [f32; 4] {
+        match self {
+            PackedTree::CatmullClark(t) => {
+                let (origin, size) = t.view_square();
+                let view = t.is_transposed() as u32 | u32::from(t.rotation()) << 1 | block << 3;
+                [origin.x as f32, origin.y as f32, size as f32, f32::from_bits(view)]
+            }
+            PackedTree::Loop(t) => [0.0, 0.0, 1.0, f32::from_bits(t.is_swapped() as u32 | block << 3)],
+        }
+    }
+}
+
+/// Where each leaf of `patch`'s tree (a Catmull-Clark or Loop patch) starts in its block
+/// ([`pack_trees`]), after the header and the nodes, and how many points follow its record.
+/// Cost: O(leaves).
+pub(crate) fn leaf_offsets(patch: &Patch) -> Vec<(u32, u32)> {
+    let (nodes, points): (usize, Vec<usize>) = match PackedTree::of(patch) {
+        PackedTree::CatmullClark(t) => {
+            (t.quadtree().1.len(), t.leaves().iter().map(|l| l.patch.points().len()).collect())
+        }
+        PackedTree::Loop(t) => {
+            (t.quadtree().1.len(), t.leaves().iter().map(|l| l.patch.points().len()).collect())
+        }
+    };
+    let mut at = 1 + nodes as u32;
+    points
+        .into_iter()
+        .map(|n| {
             let start = at;
-            at += 1 + leaf.patch.points().len() as u32;
-            start
+            at += 1 + n as u32;
+            (start, n as u32)
         })
         .collect()
 }

@@ -958,19 +958,36 @@ fn transition_from_the_camera_on_the_gpu_on_10_cameras() {
     );
 }
 
-/// Catmull-Clark cages tessellate on the GPU index for index as on the CPU, uniform and
-/// transition: regular faces as exact bicubic Bézier patches, the faces next to extraordinary
-/// vertices, creases and n-gons as their trees of B-spline pieces and Gregory end caps
-/// (`tree.wgsl`), views of one tree (a split quad's quarters, turned patches) included.
-fn subdivision_cages_equal_the_cpu_engine(cages: &[String], factors: &[u32], camera_count: usize) {
-    use tessera::io::{LoadOptions, SurfaceKind};
+/// Subdivision cages tessellate on the GPU index for index as on the CPU, uniform and
+/// transition. Catmull-Clark: regular faces as exact bicubic Bézier patches, the faces next to
+/// extraordinary vertices, creases and n-gons as their trees of B-spline pieces and Gregory
+/// end caps (`tree.wgsl`), views of one tree (a split quad's quarters, turned patches)
+/// included. Loop: every triangle a tree of quartic Bézier triangles and Gregory triangles,
+/// walked as Bfr walks it.
+fn subdivision_cages_equal_the_cpu_engine(
+    surface: tessera::io::SurfaceKind,
+    cages: &[String],
+    factors: &[u32],
+    camera_count: usize,
+) {
+    use tessera::io::LoadOptions;
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
-    let options = LoadOptions { surface: SurfaceKind::CatmullClark, ..Default::default() };
+    use tessera::surface::Patch;
+    let options = LoadOptions { surface, ..Default::default() };
     let mut trees = 0;
     for cage in cages {
         let path = tessera::test_support::data(cage);
         let set = tessera::io::load(&path, options).unwrap();
-        trees += set.patches.iter().filter(|p| matches!(p, tessera::surface::Patch::Subdivision(_))).count();
+        trees += set
+            .patches
+            .iter()
+            .filter(|p| match p {
+                Patch::Subdivision(_) => true,
+                // A Loop tree of more than one leaf: an isolated face.
+                Patch::Loop(t) => t.leaves().len() > 1,
+                _ => false,
+            })
+            .count();
         let mut gpu = tessellator(&set);
         for &n in factors {
             let plan = Plan::uniform(&set, n).unwrap();
@@ -1043,7 +1060,7 @@ fn subdivision_cages_equal_the_cpu_engine_on_the_feature_cages() {
         "catmark_hole_test1",
     ];
     let cages: Vec<String> = cages.iter().map(|c| format!("subdivision/{c}.obj")).collect();
-    subdivision_cages_equal_the_cpu_engine(&cages, &[1, 4], 2);
+    subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::CatmullClark, &cages, &[1, 4], 2);
 }
 
 #[test]
@@ -1058,7 +1075,23 @@ fn subdivision_cages_equal_the_cpu_engine_on_every_cage() {
         .collect();
     cages.sort();
     assert!(cages.len() >= 30, "{cages:?}");
-    subdivision_cages_equal_the_cpu_engine(&cages, &[3], 1);
+    subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::CatmullClark, &cages, &[3], 1);
+}
+
+/// Every manifold Loop cage (`loop_val2_interior` has an edge of four triangles, which the
+/// Loop surface refuses) on the GPU as on the CPU: uniform at factors 1, 3 and 8, transition
+/// at a tolerance, and transition and semi-uniform planned on the GPU from two cameras.
+#[test]
+fn loop_cages_equal_the_cpu_engine() {
+    let mut cages: Vec<String> = std::fs::read_dir(data_dir().join("subdivision"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with("loop_") && n.ends_with(".obj") && n != "loop_val2_interior.obj")
+        .map(|n| format!("subdivision/{n}"))
+        .collect();
+    cages.sort();
+    assert!(cages.len() >= 11, "{cages:?}");
+    subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::Loop, &cages, &[1, 3, 8], 2);
 }
 
 /// A deforming Catmull-Clark cage on the GPU (`GpuStencils`): each frame uploads the moved

@@ -46,7 +46,7 @@ use rayon::prelude::*;
 pub mod domain_pattern;
 mod validate;
 pub use validate::{
-    loop_on_gpu, pinched_beyond_the_gpu, pinched_on_gpu, validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR,
+    pinched_beyond_the_gpu, pinched_on_gpu, validate, Accepted, Engine, GPU_CHECK_MAX_FACTOR,
 };
 
 /// A tessellation scheme: a pattern with the rules that feed it.

@@ -88,9 +88,6 @@ pub fn validate(
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
     if engine != Engine::Cpu {
-        if let Some(p) = set.patches.iter().position(|p| matches!(p, Patch::Loop(_))) {
-            return Err(Error::EngineNotSupported { engine: engine.name(), what: loop_on_gpu(p) });
-        }
         let grid = match scheme {
             Scheme::Uniform => Uniform.cut_through_corners_0_and_2(),
             Scheme::SemiUniform { .. } => SemiUniform.cut_through_corners_0_and_2(),
@@ -239,14 +236,6 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
 /// the CPU does. Cost: O(P) when the set has pinched corners, else O(1).
 pub fn pinched_beyond_the_gpu(set: &SurfaceSet, grid: bool) -> Option<usize> {
     set.topology.patch_pinched.iter().position(|c| if grid { c[1] || c[3] } else { c.iter().any(|&x| x) })
-}
-
-/// What the GPU engine refuses for a set whose patch `p` is a Loop patch.
-pub fn loop_on_gpu(p: usize) -> String {
-    format!(
-        "patch {p}: Loop subdivision surfaces (the GPU has no evaluator of their quartic and Gregory \
-         triangles yet: use the CPU engine)"
-    )
 }
 
 /// What the GPU engine refuses for [`pinched_beyond_the_gpu`]'s patch `p`.

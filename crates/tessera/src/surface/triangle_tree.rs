@@ -126,6 +126,25 @@ impl TriangleTree {
         &self.hull
     }
 
+    /// The quadtree as plain rows, for an engine that walks it itself (the GPU's): the root
+    /// slot and each node's four child slots by Bfr's quadrant numbers (module doc), a slot
+    /// being a node index or [`LEAF_SLOT`](super::patch_tree::LEAF_SLOT) `|` a leaf index
+    /// into [`TriangleTree::leaves`]. The walk must be [`TriangleTree::find`]'s, quirk
+    /// included. Cost: O(nodes).
+    pub fn quadtree(&self) -> (u32, Vec<[u32; 4]>) {
+        let code = |s: TriangleSlot| match s {
+            TriangleSlot::Node(n) => n,
+            TriangleSlot::Leaf(l) => super::patch_tree::LEAF_SLOT | l,
+        };
+        (code(self.root), self.nodes.iter().map(|n| n.map(code)).collect())
+    }
+
+    /// An identity of the tree's leaves: equal for a tree and its [`TriangleTree::swapped`]
+    /// copies, so that an engine stores them once.
+    pub fn leaves_id(&self) -> usize {
+        self.leaves.as_ptr() as usize
+    }
+
     /// Whether `u` and `v` are exchanged ([`TriangleTree::swapped`]).
     pub fn is_swapped(&self) -> bool {
         self.swapped
