@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use super::cage::Cage;
 use super::catmull_clark::{oriented_cage, CageOptions, Keys};
+use super::isolation::IsolationLevels;
 use super::loop_isolation::isolate_triangle;
 use super::PatchOrigin;
 use crate::error::{Error, Result};
@@ -34,28 +35,46 @@ impl SurfaceSet {
     /// Cost: O(corners) for the adjacency and a local refinement of a few dozen triangles
     /// per level of isolation for every face (none for a regular one).
     pub fn from_loop_cage(mesh: &PolygonMesh, file: &Path, options: CageOptions) -> Result<SurfaceSet> {
-        if let Some(face) = mesh.faces.iter().find(|f| f.positions.len() != 3) {
-            return Err(Error::unsupported(
-                file,
-                face.line,
-                format!(
-                    "face has {} corners; Loop subdivision needs triangles (use --surface catmull-clark for this cage)",
-                    face.positions.len()
-                ),
-            ));
-        }
-        let (cage, repairs) = oriented_cage(mesh, file, options)?;
-        let trees: Vec<Option<TriangleTree>> = (0..cage.face_count())
-            .into_par_iter()
-            .map(|f| (!cage.holes[f]).then(|| isolate_triangle(&cage, f, options.isolation)))
-            .collect();
+        let (cage, repairs) = oriented_loop_cage(mesh, file, options)?;
+        let trees: Vec<Option<TriangleTree>> =
+            (0..cage.face_count()).into_par_iter().map(|f| loop_face(&cage, f, options.isolation)).collect();
         assemble(&cage, trees, repairs, file)
     }
 }
 
+/// The Loop cage of `mesh`, its faces oriented as `options` ask (as
+/// [`super::catmull_clark`]'s `oriented_cage`). Errors as [`SurfaceSet::from_loop_cage`]
+/// (before the last: a face that is not a triangle, a cage [`Cage::new`] refuses). Cost:
+/// O(corners).
+pub(super) fn oriented_loop_cage(
+    mesh: &PolygonMesh,
+    file: &Path,
+    options: CageOptions,
+) -> Result<(Cage, crate::surface::Repairs)> {
+    if let Some(face) = mesh.faces.iter().find(|f| f.positions.len() != 3) {
+        return Err(Error::unsupported(
+            file,
+            face.line,
+            format!(
+                "face has {} corners; Loop subdivision needs triangles (use --surface catmull-clark for this cage)",
+                face.positions.len()
+            ),
+        ));
+    }
+    oriented_cage(mesh, file, options)
+}
+
+/// Triangle `f` of `cage` built: its tree, or None for a hole. The one rule for a Loop
+/// face's surface, shared by [`SurfaceSet::from_loop_cage`] and the stencils
+/// ([`super::stencils`]), which rely on it being linear in `cage.points`. Cost: that of
+/// [`isolate_triangle`].
+pub(super) fn loop_face(cage: &Cage, f: usize, isolation: IsolationLevels) -> Option<TriangleTree> {
+    (!cage.holes[f]).then(|| isolate_triangle(cage, f, isolation))
+}
+
 /// The set of `cage`'s triangles in face order. Errors: [`Error::Unsupported`] when every
 /// face is a hole. Cost: O(P).
-fn assemble(
+pub(super) fn assemble(
     cage: &Cage,
     trees: Vec<Option<TriangleTree>>,
     repairs: crate::surface::Repairs,

@@ -171,6 +171,24 @@ impl Patch {
     }
 }
 
+/// The corners of the bounding box of `points` (corner `k` at the upper bound of x, y, z
+/// where bit 0, 1, 2 of `k` is set): a hull of control points for a tree's
+/// `control_points`. Cost: O(points).
+pub(crate) fn box_corners<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> [DVec3; 8] {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    std::array::from_fn(|k| {
+        DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
 /// A subdivision patch's point at `uv` from its position and derivatives there.
 #[inline(always)]
 pub(crate) fn subdivision_point(

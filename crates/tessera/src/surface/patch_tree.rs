@@ -271,20 +271,7 @@ impl PatchTree {
 
     /// The bounding box corners of the visible leaves' points.
     fn visible_hull(&self) -> [DVec3; 8] {
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for (leaf, _, _) in self.visible_leaves() {
-            for p in leaf.patch.points() {
-                lo = lo.min(*p);
-                hi = hi.max(*p);
-            }
-        }
-        std::array::from_fn(|k| {
-            DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
+        super::box_corners(self.visible_leaves().flat_map(|(leaf, _, _)| leaf.patch.points()))
     }
 
     /// The leaf holding `uv`, with `uv` in the leaf's own `[0,1]²`. Points on a border

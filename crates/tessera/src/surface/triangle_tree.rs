@@ -100,18 +100,7 @@ impl TriangleTree {
         nodes: Vec<[TriangleSlot; 4]>,
         root: TriangleSlot,
     ) -> Self {
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for p in leaves.iter().flat_map(|l| l.patch.points()) {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let hull = std::array::from_fn(|k| {
-            DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            )
-        });
+        let hull = super::box_corners(leaves.iter().flat_map(|l| l.patch.points()));
         TriangleTree { leaves: leaves.into(), nodes: nodes.into(), root, swapped: false, hull }
     }
 
@@ -143,6 +132,49 @@ impl TriangleTree {
     /// copies, so that an engine stores them once.
     pub fn leaves_id(&self) -> usize {
         self.leaves.as_ptr() as usize
+    }
+
+    /// Appends every leaf's points to `out`, leaf by leaf (a quartic leaf's 15, a Gregory
+    /// leaf's 18). Cost: O(leaves).
+    pub fn leaf_points(&self, out: &mut Vec<DVec3>) {
+        for leaf in self.leaves.iter() {
+            out.extend_from_slice(leaf.patch.points());
+        }
+    }
+
+    /// How many points [`TriangleTree::leaf_points`] appends.
+    pub fn leaf_point_count(&self) -> usize {
+        self.leaves.iter().map(|l| l.patch.points().len()).sum()
+    }
+
+    /// The same tree (nodes, leaves' places and kinds, [`TriangleTree::is_swapped`]) with leaf
+    /// points `points`, in [`TriangleTree::leaf_points`] order, and their hull: the surface of
+    /// a moved cage. Precondition: `points.len()` is [`TriangleTree::leaf_point_count`].
+    /// Cost: O(leaves).
+    pub fn with_leaf_points(&self, points: &[DVec3]) -> TriangleTree {
+        assert_eq!(points.len(), self.leaf_point_count(), "one point per leaf point");
+        let mut next = points.iter().copied();
+        let mut take = || next.next().expect("counted above");
+        let leaves: Vec<TriangleLeaf> = self
+            .leaves
+            .iter()
+            .map(|leaf| TriangleLeaf {
+                patch: match &leaf.patch {
+                    TriangleLeafPatch::Quartic(_) => TriangleLeafPatch::Quartic(QuarticTriangle {
+                        points: std::array::from_fn(|_| take()),
+                    }),
+                    TriangleLeafPatch::Gregory(_) => TriangleLeafPatch::Gregory(Box::new(GregoryTriangle {
+                        points: std::array::from_fn(|_| take()),
+                    })),
+                },
+                ..*leaf
+            })
+            .collect();
+        TriangleTree {
+            hull: super::box_corners(leaves.iter().flat_map(|l| l.patch.points())),
+            leaves: leaves.into(),
+            ..self.clone()
+        }
     }
 
     /// Whether `u` and `v` are exchanged ([`TriangleTree::swapped`]).
