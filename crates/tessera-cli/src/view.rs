@@ -231,7 +231,7 @@ impl App {
         let overlay =
             tessera_render::scoped(&ctx.device, "making the overlay", || Overlay::new(&ctx, config.format))?;
         let msaa = attachments(&ctx, config.format, config.width, config.height)?;
-        // A set the GPU engine cannot take (Loop patches, so far) is drawn by the CPU engine.
+        // A set the GPU engine cannot take is drawn by the CPU engine.
         let engine = match tessera_render::scoped(&ctx.device, "making the GPU engine", || {
             GpuTessellator::new(&ctx, self.set)
         })? {

@@ -1,10 +1,11 @@
-//! An animated Catmull-Clark cage on the GPU: the cage's stencils are made and uploaded
-//! once; each frame uploads only the moved cage vertices, the stencil pass recomputes the
+//! An animated subdivision cage (Catmull-Clark or Loop) on the GPU: the cage's stencils are
+//! made and uploaded once; each frame uploads only the moved cage vertices, the stencil pass recomputes the
 //! patches' control points on the GPU, and the same command buffer tessellates them.
 //!
 //! `cargo run --release -p tessera-gpu --example deforming_cage -- [CAGE.obj] [FRAMES]
-//! [FACTOR] [OUT_DIR]` (defaults: `$TESSERA_DATA/subdivision/catmark_torus.obj`, 60 frames,
-//! factor 8, `frames/`). The cage bends and breathes over the frames; each frame's mesh is
+//! [FACTOR] [OUT_DIR] [catmull-clark|loop]` (defaults: `$TESSERA_DATA/subdivision/catmark_torus.obj`,
+//! 60 frames, factor 8, `frames/`, Catmull-Clark; a Loop cage is a triangle cage such as
+//! `subdivision/loop_xord_interior.obj`). The cage bends and breathes over the frames; each frame's mesh is
 //! read back and written as `OUT_DIR/cage_NNN.ply` (a headless app's stand-in for drawing
 //! it: the vertex and index buffers are the engine's own, as `tessera-render`'s examples
 //! draw them), and a line per frame gives the vertices uploaded and the GPU time of the
@@ -32,11 +33,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: usize = args.get(2).map_or(Ok(60), |s| s.parse())?;
     let factor: u32 = args.get(3).map_or(Ok(8), |s| s.parse())?;
     let out = PathBuf::from(args.get(4).map_or("frames", String::as_str));
+    let build = match args.get(5).map_or("catmull-clark", String::as_str) {
+        "catmull-clark" => CageStencils::build,
+        "loop" => CageStencils::build_loop,
+        other => return Err(format!("unknown surface {other:?}: catmull-clark or loop").into()),
+    };
     std::fs::create_dir_all(&out)?;
 
     let mesh = tessera::io::obj::read_obj(&cage_path)?;
     let start = Instant::now();
-    let (mut set, stencils) = CageStencils::build(&mesh, &cage_path, CageOptions::default())?;
+    let (mut set, stencils) = build(&mesh, &cage_path, CageOptions::default())?;
     println!(
         "{}: {} faces, {} patches, stencils of {} terms made in {:.1} ms",
         cage_path.display(),

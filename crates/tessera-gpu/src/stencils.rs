@@ -1,11 +1,12 @@
-//! Animated Catmull-Clark cages on the GPU: the cage's stencils
+//! Animated subdivision cages (Catmull-Clark and Loop) on the GPU: the cage's stencils
 //! ([`tessera::subdivision::CageStencils`]) uploaded once, and a pass that recomputes every
 //! patch's points from the cage's vertices, so that a deforming cage re-tessellates each frame
 //! with only its vertices uploaded (16 bytes a vertex).
 //!
 //! The rows are the library's ([`CageStencils::rows`], placed by
-//! [`CageStencils::point_ranges`]): a regular face's 16 control points, and every leaf point
-//! of an isolated face's tree where [`crate::upload`] packed it (each tree once, however many
+//! [`CageStencils::point_ranges`]): a regular Catmull-Clark face's 16 control points, and
+//! every leaf point of an isolated face's tree or a Loop triangle's where [`crate::upload`]
+//! packed it (each tree once, however many
 //! patches view it). `stencils.wgsl` applies them in f32 as `SparseRows::apply_row` does in
 //! f64. What the pass does not refresh: an isolated patch's 16 slots (the bounding box of its
 //! pieces, which culling reads) and the view passes' per-patch bounds (culling's boxes and

@@ -1094,7 +1094,7 @@ fn loop_cages_equal_the_cpu_engine() {
     subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::Loop, &cages, &[1, 3, 8], 2);
 }
 
-/// A deforming Catmull-Clark cage on the GPU (`GpuStencils`): each frame uploads the moved
+/// A deforming Catmull-Clark or Loop cage on the GPU (`GpuStencils`): each frame uploads the moved
 /// cage vertices only, the stencil pass recomputes the control points and the isolated faces'
 /// pieces, and the frame equals the CPU engine's on the set the CPU's stencils give for the
 /// same vertices.
@@ -1106,10 +1106,26 @@ fn stencils_deform_a_cage_on_the_gpu_as_on_the_cpu() {
     let ctx = ctx();
     // A regular cage (control points only), one with creases (isolated quads: their trees'
     // leaf points) and one split into sub-faces (an isolated quad's quarters view one tree).
-    for cage in ["catmark_torus", "catmark_torus_creases0", "catmark_pyramid_creases0"] {
+    // Loop cages: every triangle a tree (one leaf where regular), creased, and with
+    // extraordinary vertices inside and on the boundary.
+    type Build = fn(
+        &tessera::surface::PolygonMesh,
+        &std::path::Path,
+        CageOptions,
+    ) -> tessera::Result<(tessera::surface::SurfaceSet, CageStencils)>;
+    let catmull_clark: Build = CageStencils::build;
+    let loop_: Build = CageStencils::build_loop;
+    for (cage, build) in [
+        ("catmark_torus", catmull_clark),
+        ("catmark_torus_creases0", catmull_clark),
+        ("catmark_pyramid_creases0", catmull_clark),
+        ("loop_cube_creases0", loop_),
+        ("loop_xord_interior", loop_),
+        ("loop_xord_boundary", loop_),
+    ] {
         let path = data_dir().join(format!("subdivision/{cage}.obj"));
         let mesh = tessera::io::obj::read_obj(&path).unwrap();
-        let (mut set, stencils) = CageStencils::build(&mesh, &path, CageOptions::default()).unwrap();
+        let (mut set, stencils) = build(&mesh, &path, CageOptions::default()).unwrap();
         let mut gpu = tessellator(&set);
         let on_gpu = GpuStencils::new(ctx, &stencils, &set, &gpu).unwrap();
         let plan = Plan::uniform(&set, 5).unwrap();

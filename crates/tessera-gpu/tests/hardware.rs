@@ -141,6 +141,29 @@ fn hardware_plans_equal_the_cpu_engine_on_every_patch_model() {
     }
 }
 
+/// Loop cages (triangle trees of quartic and Gregory triangles, `tree.wgsl`): every
+/// partitioning at its fixed factor and on random factors, culling included.
+#[test]
+fn hardware_plans_equal_the_cpu_engine_on_loop_cages() {
+    let options = tessera::io::LoadOptions { surface: tessera::io::SurfaceKind::Loop, ..Default::default() };
+    let mut rng = Lcg(29);
+    for cage in ["loop_cube_creases0", "loop_xord_interior", "loop_triangle_edgecorner"] {
+        let set = tessera::io::load(&data_dir().join(format!("subdivision/{cage}.obj")), options).unwrap();
+        let mut gpu = tessellator(&set);
+        for (i, p) in PARTITIONINGS.into_iter().enumerate() {
+            let plan = factor_plan(&set, p, real_factor(p));
+            assert_hardware_frame(
+                &format!("{cage} {} factor {}", p.name(), real_factor(p)),
+                &set,
+                &mut gpu,
+                &plan,
+            );
+            let plan = random_plan(&set, p, 9.0, &mut rng, i % 2 == 1);
+            assert_hardware_frame(&format!("{cage} {} random", p.name()), &set, &mut gpu, &plan);
+        }
+    }
+}
+
 #[test]
 fn hardware_plans_equal_the_cpu_engine_on_triangle_patches() {
     // PN triangles: the meshes under 40 kB (the blob, the knob, the non-manifold and the

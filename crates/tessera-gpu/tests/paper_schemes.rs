@@ -317,6 +317,35 @@ fn sd2_equals_the_cpu_engine_on_triangle_meshes() {
     }
 }
 
+/// SD-2 on Loop cages (every triangle a tree of quartic and Gregory triangles): silhouette
+/// vertices from two cameras and a fixed real factor, index for index as on the CPU.
+#[test]
+fn sd2_equals_the_cpu_engine_on_loop_cages() {
+    let options = LoadOptions { surface: SurfaceKind::Loop, ..Default::default() };
+    let scheme = Scheme::Sd2 { warp: false };
+    let criterion = Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 12.0 };
+    for cage in ["loop_cube_creases0", "loop_xord_boundary", "loop_pole8"] {
+        let set =
+            tessera::io::load(&tessera::test_support::data(&format!("subdivision/{cage}.obj")), options)
+                .unwrap();
+        let mut gpu = tessellator(&set);
+        for (c, camera) in cameras(&set, 2, 43).into_iter().enumerate() {
+            let options = PlanOptions { camera: Some(camera), ..Default::default() };
+            let planned = scheme.plan(&set, &criterion, &options).unwrap();
+            let name = format!("{cage} camera {c} silhouette vertices");
+            assert_pattern_equals_cpu(&name, &set, &mut gpu, &planned.plan, &planned.pattern);
+        }
+        let planned = scheme.plan(&set, &Criterion::Factor(4.6), &PlanOptions::default()).unwrap();
+        assert_pattern_equals_cpu(
+            &format!("{cage} factor 4.6"),
+            &set,
+            &mut gpu,
+            &planned.plan,
+            &planned.pattern,
+        );
+    }
+}
+
 /// What the GPU does not draw for SD-2 is refused by name, never drawn wrong: a plan with
 /// three different factors on a triangle (which the CPU pattern draws as a transition
 /// fallback), and a warped plan with a depth that is not positive.
