@@ -188,35 +188,29 @@ fn gregory_pair(a: f32, b: f32) -> vec2<f32> {
     return vec2<f32>(1.0, 0.0);
 }
 
-// The quartic net of the leaf at `at`: its 15 points, or a Gregory triangle's 18
-// (OpenSubdiv's order) as `GregoryTriangle::blended` makes it, its interior points blended
-// at uv.
+// Where each point of a quartic net (`QuarticTriangle::index` order: b400, b310, b301, b220,
+// b211, b202, b130, b121, b112, b103, b040, b031, b022, b013, b004) is among a Gregory
+// triangle's 18 (OpenSubdiv's order); the interior points b211, b121, b112 are its face
+// points Fp0, Fp1, Fp2, blended with Fm0, Fm1, Fm2 (points 4, 9, 14) by `loop_leaf_net`.
+const QUARTIC_OF_GREGORY = array<u32, 15>(0u, 1u, 2u, 15u, 3u, 17u, 7u, 8u, 13u, 11u, 5u, 6u, 16u, 12u, 10u);
+
+// The quartic net of the leaf whose points start at `at`: its 15 points, or a Gregory
+// triangle's 18 as `GregoryTriangle::blended` makes them, the interior points blended at uv.
 fn loop_leaf_net(at: u32, gregory: bool, uv: vec2<f32>) -> array<vec3<f32>, 15> {
-    if (!gregory) {
-        return array<vec3<f32>, 15>(
-            control_points[at].xyz, control_points[at + 1u].xyz, control_points[at + 2u].xyz,
-            control_points[at + 3u].xyz, control_points[at + 4u].xyz, control_points[at + 5u].xyz,
-            control_points[at + 6u].xyz, control_points[at + 7u].xyz, control_points[at + 8u].xyz,
-            control_points[at + 9u].xyz, control_points[at + 10u].xyz, control_points[at + 11u].xyz,
-            control_points[at + 12u].xyz, control_points[at + 13u].xyz, control_points[at + 14u].xyz,
-        );
+    var b: array<vec3<f32>, 15>;
+    for (var k = 0u; k < 15u; k = k + 1u) {
+        b[k] = control_points[at + select(k, QUARTIC_OF_GREGORY[k], gregory)].xyz;
     }
-    let w = 1.0 - uv.x - uv.y;
-    let w0 = gregory_pair(uv.x, uv.y);
-    let w1 = gregory_pair(uv.y, w);
-    let w2 = gregory_pair(w, uv.x);
-    let g = at;
-    // b400, b310, b301, b220, b211, b202, b130, b121, b112, b103, b040, b031, b022, b013, b004.
-    return array<vec3<f32>, 15>(
-        control_points[g].xyz, control_points[g + 1u].xyz, control_points[g + 2u].xyz,
-        control_points[g + 15u].xyz,
-        control_points[g + 3u].xyz * w0.x + control_points[g + 4u].xyz * w0.y,
-        control_points[g + 17u].xyz, control_points[g + 7u].xyz,
-        control_points[g + 8u].xyz * w1.x + control_points[g + 9u].xyz * w1.y,
-        control_points[g + 13u].xyz * w2.x + control_points[g + 14u].xyz * w2.y,
-        control_points[g + 11u].xyz, control_points[g + 5u].xyz, control_points[g + 6u].xyz,
-        control_points[g + 16u].xyz, control_points[g + 12u].xyz, control_points[g + 10u].xyz,
-    );
+    if (gregory) {
+        let w = 1.0 - uv.x - uv.y;
+        let w0 = gregory_pair(uv.x, uv.y);
+        let w1 = gregory_pair(uv.y, w);
+        let w2 = gregory_pair(w, uv.x);
+        b[4] = b[4] * w0.x + control_points[at + 4u].xyz * w0.y;
+        b[7] = b[7] * w1.x + control_points[at + 9u].xyz * w1.y;
+        b[8] = b[8] * w2.x + control_points[at + 14u].xyz * w2.y;
+    }
+    return b;
 }
 
 fn loop_derivatives(p: u32, uv_in: vec2<f32>) -> Derivatives {
