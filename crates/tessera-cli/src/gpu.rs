@@ -6,7 +6,7 @@
 use tessera::camera::Camera;
 use tessera::criterion::Plan;
 use tessera::mesh::Mesh;
-use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme, SchemePattern};
 use tessera::surface::SurfaceSet;
 use tessera_gpu::tessellator::{Capacity, PassTimer, ScreenCriterion, PASSES};
 use tessera_gpu::{GpuContext, GpuError, GpuTessellator, ScreenReport};
@@ -46,11 +46,12 @@ pub fn tessellate_from_camera(
     set: &SurfaceSet,
     camera: &Camera,
     screen: ScreenCriterion,
-    strips: bool,
+    output: Output,
     repeat: u32,
     mesh: &mut Mesh,
     times: &mut Vec<f64>,
 ) -> Result<GpuRun, GpuError> {
+    let Output { strips, corner_params } = output;
     let ctx = GpuContext::new()?;
     let mut gpu = GpuTessellator::new(&ctx, set)?;
     let prepared = Prepared::new(set, true);
@@ -71,7 +72,58 @@ pub fn tessellate_from_camera(
     *mesh = gpu.read_mesh(&ctx, set)?;
     run.screen = Some(gpu.read_screen_report(&ctx)?);
     run.culled = gpu.read_visible(&ctx)?.iter().filter(|&&v| v == 0).count();
+    if corner_params {
+        // The plan the GPU drew and its pattern, for the CPU's rule of the parameters: ESC's
+        // insertion grids read back, the warped SD-2's corner depths from the camera.
+        let plan = gpu.read_plan(&ctx)?;
+        let pattern = match screen.scheme {
+            Scheme::Esc { .. } => SchemePattern::Esc(gpu.read_esc_pattern(&ctx)?),
+            scheme => match scheme.fixed_pattern() {
+                Some(pattern) => pattern,
+                None => {
+                    let options = PlanOptions {
+                        camera: Some(*camera),
+                        cull: true,
+                        max_factor: screen.max_factor,
+                        ..PlanOptions::default()
+                    };
+                    scheme.plan(set, &screen.criterion, &options)?.pattern
+                }
+            },
+        };
+        add_corner_params(set, &plan, &pattern, mesh)?;
+    }
     Ok(run)
+}
+
+/// What a GPU frame's read-back holds beside its triangles.
+#[derive(Debug, Clone, Copy)]
+pub struct Output {
+    /// The strips of SD-2 and ESC (`Mesh::strips`).
+    pub strips: bool,
+    /// The per-corner patch parameters (`Mesh::corner_params`, a `.ply`'s `patch_uv`).
+    pub corner_params: bool,
+}
+
+impl Output {
+    /// The triangles and vertices only.
+    pub const TRIANGLES: Output = Output { strips: false, corner_params: false };
+}
+
+/// Gives `mesh`, the GPU's frame of `plan` under `pattern`, its per-corner patch parameters:
+/// the GPU writes the CPU engine's triangles index for index, so the CPU's rule gives them
+/// (`tessera::engine::corner_params`, no evaluation).
+fn add_corner_params(
+    set: &SurfaceSet,
+    plan: &Plan,
+    pattern: &dyn tessera::pattern::Pattern,
+    mesh: &mut Mesh,
+) -> Result<(), tessera::Error> {
+    let mut layout = tessera::engine::layout::Layout::default();
+    let options = tessera::engine::EngineOptions { corner_params: true, ..Default::default() };
+    layout.build(set, plan, pattern, &options)?;
+    mesh.corner_params = Some(tessera::engine::corner_params(set, plan, pattern, &layout));
+    Ok(())
 }
 
 /// The output room a frame planned on the GPU starts with (`tessellate_from_camera`):
@@ -123,11 +175,12 @@ pub fn tessellate(
     set: &SurfaceSet,
     plan: &Plan,
     pattern: &dyn tessera::pattern::Pattern,
-    strips: bool,
+    output: Output,
     repeat: u32,
     mesh: &mut Mesh,
     times: &mut Vec<f64>,
 ) -> Result<GpuRun, GpuError> {
+    let Output { strips, corner_params } = output;
     let ctx = GpuContext::new()?;
     let mut gpu = GpuTessellator::new(&ctx, set)?;
     gpu.prepare(&ctx, set, plan, pattern)?;
@@ -138,6 +191,9 @@ pub fn tessellate(
         run = frames(&ctx, &mut gpu, repeat, times)?;
     }
     *mesh = gpu.read_mesh(&ctx, set)?;
+    if corner_params {
+        add_corner_params(set, plan, pattern, mesh)?;
+    }
     Ok(run)
 }
 

@@ -127,14 +127,6 @@ pub fn run(a: MeshArgs) -> CliResult {
                 check.rounds, check.failing_patches
             );
         }
-        if let Some(out) =
-            a.output.as_ref().filter(|o| o.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")))
-        {
-            eprintln!(
-                "note: the GPU engine gives no per-corner patch parameters: {} has no patch_uv, so `tessera check --against` cannot measure its error (--engine cpu writes them)",
-                out.display()
-            );
-        }
     }
     // The numbering rule gives culled patches' corners (and their edges' normal variants)
     // vertices no triangle uses; what is written and counted holds only the used ones.
@@ -188,9 +180,6 @@ fn check_flags(a: &MeshArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if a.max_triangles == Some(0) {
         return Err("--max-triangles 0: use 1 or more".into());
-    }
-    if a.engine == EngineArg::Gpu && a.measure_error {
-        return Err("--engine gpu gives no corner parameters: leave out --measure-error".into());
     }
     if let Some(out) = &a.output {
         tessera::io::check_output_path(out)?;
@@ -256,10 +245,10 @@ fn draw_on_gpu(
     validate(scheme, &criterion, &options, set, Engine::Gpu).map_err(explain)?;
     let mut mesh = Mesh::default();
     let mut times = Vec::new();
+    let output = gpu::Output { strips: a.strips, corner_params: opts.corner_params };
     let from_camera = options.camera.zip(gpu::screen_criterion(set, scheme, &criterion, &options));
     if let Some((camera, screen)) = from_camera {
-        let run =
-            gpu::tessellate_from_camera(set, &camera, screen, a.strips, a.repeat, &mut mesh, &mut times)?;
+        let run = gpu::tessellate_from_camera(set, &camera, screen, output, a.repeat, &mut mesh, &mut times)?;
         let culled = run.culled;
         let gpu = Some((run, times));
         return Ok(Drawn {
@@ -280,7 +269,7 @@ fn draw_on_gpu(
     crate::announce_large_output(layout, &opts, a.output.as_deref());
     let (plan, pattern) =
         (tess.plan().expect("a frame was planned"), tess.pattern().expect("a frame was planned"));
-    let run = gpu::tessellate(set, plan, pattern, a.strips, a.repeat, &mut mesh, &mut times)?;
+    let run = gpu::tessellate(set, plan, pattern, output, a.repeat, &mut mesh, &mut times)?;
     let culled = plan.culled_count();
     let frames = vec![tess.timings()];
     Ok(Drawn {

@@ -158,16 +158,44 @@ fn small_inconsistencies_are_gone() {
     assert!(text(&out.stderr).contains("out of range"), "{}", text(&out.stderr));
 }
 
+/// A `.ply` from the GPU engine carries the per-corner patch parameters (`patch_uv`) the CPU
+/// engine writes, so `tessera check --against` measures its error as the CPU's: the same
+/// report, a CPU plan drawn on the GPU and a frame planned on the GPU from the camera.
 #[test]
-fn gpu_ply_output_says_it_has_no_corner_parameters() {
+fn gpu_ply_output_carries_the_cpus_corner_parameters() {
     let dir = scratch("gpu-ply");
     let input = data("patches/teapot.patches");
-    let out =
-        tessera(&["mesh", input.to_str().unwrap(), "--factor", "2", "--engine", "gpu", "-o", "g.ply"], &dir);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stderr).contains("g.ply has no patch_uv"), "{}", text(&out.stderr));
-    let check = tessera(&["check", "g.ply", "--against", input.to_str().unwrap()], &dir);
-    assert!(text(&check.stdout).contains("--engine cpu"), "{}", text(&check.stdout));
+    let input = input.to_str().unwrap();
+    let cases: [&[&str]; 2] =
+        [&["--factor", "2"], &["--scheme", "transition", "--pixel-error", "2", "--cull"]];
+    for case in cases {
+        let mut reports = Vec::new();
+        for engine in ["cpu", "gpu"] {
+            let out = tessera(&[&["mesh", input, "--engine", engine, "-o", "m.ply"], case].concat(), &dir);
+            assert!(out.status.success(), "{}", text(&out.stderr));
+            assert!(!text(&out.stderr).contains("patch_uv"), "{}", text(&out.stderr));
+            // (A culled frame fails the check's topology comparison, as it should: the same
+            // way on both engines.)
+            let check = tessera(&["check", "m.ply", "--against", input], &dir);
+            let report = format!("{:?}\n{}", check.status.code(), text(&check.stdout));
+            assert!(report.contains("max error"), "{report}");
+            reports.push(report);
+        }
+        // Equal but for the errors' last digits (the GPU's positions are its own f32
+        // evaluations, within 1e-5 of the diagonal of the CPU's).
+        let error = |r: &str, key: &str| -> f64 {
+            let line = r.lines().find(|l| l.starts_with(key)).unwrap();
+            line[key.len()..].trim().parse().unwrap()
+        };
+        fn rest(r: &str) -> Vec<&str> {
+            r.lines().filter(|l| !l.contains(" error ")).collect()
+        }
+        assert_eq!(rest(&reports[0]), rest(&reports[1]), "{case:?}");
+        for key in ["max error", "rms error"] {
+            let (c, g) = (error(&reports[0], key), error(&reports[1], key));
+            assert!(c > 0.0 && (g - c).abs() <= 1e-3 * c, "{case:?}: {key} {g} on the GPU, {c} on the CPU");
+        }
+    }
 }
 
 /// `tessera check --against CAGE` measures a tessellation of a subdivision cage against the

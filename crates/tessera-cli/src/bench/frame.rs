@@ -288,12 +288,24 @@ fn gpu_first_frames(ctx: &Ctx, scenes: &[Scene], repeats: usize) -> BenchResult<
         let (mut mesh, mut times) = (tessera::mesh::Mesh::default(), Vec::new());
         let (set, camera, repeat) = (&scene.set, &scene.cameras[0], repeats as u32);
         let run = match &frame {
-            GpuFrame::FromCamera(screen) => {
-                crate::gpu::tessellate_from_camera(set, camera, *screen, false, repeat, &mut mesh, &mut times)
-            }
-            GpuFrame::FromPlan(p) => {
-                crate::gpu::tessellate(set, &p.plan, &p.pattern, false, repeat, &mut mesh, &mut times)
-            }
+            GpuFrame::FromCamera(screen) => crate::gpu::tessellate_from_camera(
+                set,
+                camera,
+                *screen,
+                crate::gpu::Output::TRIANGLES,
+                repeat,
+                &mut mesh,
+                &mut times,
+            ),
+            GpuFrame::FromPlan(p) => crate::gpu::tessellate(
+                set,
+                &p.plan,
+                &p.pattern,
+                crate::gpu::Output::TRIANGLES,
+                repeat,
+                &mut mesh,
+                &mut times,
+            ),
         };
         // A frame this adapter cannot hold is said in the table's note, not fatal to the suite.
         let run = match run {

@@ -122,8 +122,15 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
             let plan = Plan::uniform(&set, factor)?;
             let mut mesh = Mesh::default();
             let mut times = Vec::new();
-            let gpu =
-                crate::gpu::tessellate(&set, &plan, &Uniform, false, runs as u32, &mut mesh, &mut times)?;
+            let gpu = crate::gpu::tessellate(
+                &set,
+                &plan,
+                &Uniform,
+                crate::gpu::Output::TRIANGLES,
+                runs as u32,
+                &mut mesh,
+                &mut times,
+            )?;
             let wall: Vec<f64> = times.iter().map(|s| s * 1e3).collect();
             let (total, p95) = median_p95(&wall);
             let (tri, vert) = (mesh.triangle_count(), mesh.vertex_count());

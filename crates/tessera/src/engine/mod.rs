@@ -862,6 +862,44 @@ fn strips_of(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, layout: &Layo
     Ok(out)
 }
 
+/// The per-corner patch parameters of this engine's output for `plan` under `pattern` (what
+/// [`EngineOptions::corner_params`] fills, value for value), without evaluating a point: for
+/// an engine whose triangles are this engine's index for index — the GPU engine's — so that
+/// its output gets the parameters from the same rule (each patch's pattern, the plan's edge
+/// sampling, the triangles a collapsed corner drops). Three per triangle, in triangle order.
+///
+/// Preconditions: `layout` is [`Layout::build`]'s for `plan` and `pattern` on `set`. Cost:
+/// each visible patch's pattern built once (no evaluation), parallel; the output's size.
+pub fn corner_params(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, layout: &Layout) -> Vec<[f32; 2]> {
+    let generation = next_generation();
+    let per_patch: Vec<Vec<[f32; 2]>> = (0..set.patches.len())
+        .into_par_iter()
+        .map(|p| {
+            if !plan.is_visible(p) {
+                return Vec::new();
+            }
+            with_scratch(generation, |scratch| {
+                let input = layout::pattern_input(set, plan, p);
+                let map = LocalMap { set, plan, layout, input, patch: p };
+                let mut table = std::mem::take(&mut scratch.param);
+                let local = scratch.pattern(pattern, &input);
+                map.param_table(local, &mut table);
+                let params = local
+                    .triangles
+                    .iter()
+                    .filter(|tri| !layout::degenerate_after_collapse(set, &input, p, tri))
+                    .flat_map(|tri| tri.map(|v| table[v as usize]))
+                    .collect();
+                scratch.param = table;
+                params
+            })
+        })
+        .collect();
+    let params: Vec<[f32; 2]> = per_patch.concat();
+    debug_assert_eq!(params.len(), 3 * layout.triangle_count());
+    params
+}
+
 /// Number of triangles the uniform pattern gives a domain at factor `n` (for reports).
 pub fn uniform_triangles(domain: Domain, n: u32) -> u64 {
     match domain {
@@ -946,6 +984,58 @@ mod tests {
                     assert_eq!(mesh.indices, indices, "lowest {lowest}, corner params {corner_params}");
                     assert_eq!(mesh.triangle_patch, patches);
                 }
+            }
+        }
+    }
+
+    /// [`corner_params`] (no evaluation, for the GPU engine's output) equals what the engine
+    /// writes with [`EngineOptions::corner_params`], bit for bit: collapsed corners (the
+    /// teapot), a PN mesh, a Catmull-Clark cage with corners pinched at a valence-2 vertex
+    /// (cut by the uniform pattern) and a Loop cage, uniform and transition plans with culled
+    /// patches, the hardware's fractional partitioning.
+    #[test]
+    fn corner_params_without_evaluation_equal_the_engines() {
+        use crate::io::{LoadOptions, SurfaceKind};
+        use crate::sampling::hardware::Partitioning;
+        use crate::scheme::{Criterion, PlanOptions, Scheme};
+        let cage = |name: &str, surface| {
+            let options = LoadOptions { surface, ..Default::default() };
+            crate::io::load(&crate::test_support::data(&format!("subdivision/{name}.obj")), options).unwrap()
+        };
+        let sets = [
+            teapot(),
+            cow(),
+            cage("catmark_val2_interior", SurfaceKind::CatmullClark),
+            cage("loop_xord_boundary", SurfaceKind::Loop),
+        ];
+        let options = EngineOptions { corner_params: true, ..Default::default() };
+        for set in &sets {
+            let mut plan = Plan::uniform(set, 1).unwrap();
+            for (e, s) in plan.segments.iter_mut().enumerate() {
+                *s = 1 + (e as u32 * 7) % 5;
+            }
+            plan.factors = plan.segments.iter().map(|&s| s as f32).collect();
+            for (p, (interior, visible)) in plan.interior.iter_mut().zip(&mut plan.visible).enumerate() {
+                *interior = [1 + p as u32 % 4, 1 + (p as u32 / 3) % 4];
+                *visible = u32::from(p % 7 != 3);
+            }
+            let uniform = Plan::uniform(set, 4).unwrap();
+            let fractional = Scheme::Hardware(Partitioning::FractionalOdd)
+                .plan(set, &Criterion::Factor(4.4), &PlanOptions::default())
+                .unwrap();
+            let cases: [(&Plan, &dyn Pattern); 3] =
+                [(&uniform, &Uniform), (&plan, &Transition), (&fractional.plan, &fractional.pattern)];
+            for (k, (plan, pattern)) in cases.into_iter().enumerate() {
+                let mesh = tessellate(set, plan, pattern, options).unwrap();
+                let mut layout = Layout::default();
+                layout.build(set, plan, pattern, &options).unwrap();
+                let params = corner_params(set, plan, pattern, &layout);
+                let want = mesh.corner_params.as_ref().unwrap();
+                assert_eq!(params.len(), want.len(), "case {k}");
+                assert!(
+                    params.iter().zip(want).all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)),
+                    "case {k}"
+                );
             }
         }
     }

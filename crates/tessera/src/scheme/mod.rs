@@ -256,6 +256,21 @@ impl Scheme {
         }
     }
 
+    /// The scheme's pattern where it depends on the scheme alone: all but ESC's (its
+    /// insertion grids come with the plan) and the warped SD-2's (its corner depths come from
+    /// the camera), which give None. For drawing or describing a plan made elsewhere (the GPU
+    /// engine's). Cost: O(1).
+    pub fn fixed_pattern(&self) -> Option<SchemePattern> {
+        Some(match *self {
+            Scheme::Uniform => SchemePattern::Uniform(Uniform),
+            Scheme::Transition => SchemePattern::Transition(Transition),
+            Scheme::SemiUniform { .. } => SchemePattern::SemiUniform(SemiUniform),
+            Scheme::Hardware(partitioning) => SchemePattern::Hardware(Hardware { partitioning }),
+            Scheme::Sd2 { warp: false } => SchemePattern::Sd2(Sd2::default()),
+            Scheme::Sd2 { warp: true } | Scheme::Esc { .. } => return None,
+        })
+    }
+
     /// Plans `set` under `criterion`. Checks everything a caller can get wrong first: the
     /// criterion ([`Scheme::accepts`]), the factor ranges ([`Error::FactorOutOfRange`]), the
     /// patch kinds ([`Error::PatchKindNotAccepted`]), the camera ([`Error::NeedsCamera`]).
@@ -308,13 +323,7 @@ impl Scheme {
         }
         let rule = accepted.edge_rule.expect("every scheme but ESC has an edge rule");
         let interior = accepted.interior_rule;
-        out.pattern = match self {
-            Scheme::Uniform => SchemePattern::Uniform(Uniform),
-            Scheme::Transition => SchemePattern::Transition(Transition),
-            Scheme::SemiUniform { .. } => SchemePattern::SemiUniform(SemiUniform),
-            Scheme::Hardware(p) => SchemePattern::Hardware(Hardware { partitioning: *p }),
-            Scheme::Sd2 { .. } | Scheme::Esc { .. } => unreachable!("planned above"),
-        };
+        out.pattern = self.fixed_pattern().expect("SD-2 and ESC are planned above");
         out.report = None;
         let cap = accepted.cap;
         let caps = prepared.caps(cap);
