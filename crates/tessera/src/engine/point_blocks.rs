@@ -135,6 +135,9 @@ pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
 impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// The Bézier triangle of degree `d` whose control point `b_ijk` is `b(i, j, k)`, and
     /// whose control points are `points` (any order: they set the frame). Cost: O(N).
+    /// Inlined: the grouped leaves (`tree_points`) make one a group, in their caller's
+    /// instructions.
+    #[inline(always)]
     pub(crate) fn from_net(points: &[DVec3], b: impl Fn(usize, usize, usize) -> DVec3) -> Self {
         let d = const { degree(N) };
         const { assert!(degree(M) + 1 == degree(N)) };

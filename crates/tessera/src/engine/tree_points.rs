@@ -61,6 +61,8 @@ pub(super) struct Found {
 pub(super) trait LeafTree {
     /// A Bézier leaf's net in its local frame, as [`LeafTree::block`] takes it.
     type Local;
+    /// Points per leaf of the view, on average, from which grouping pays ([`worth_grouping`]).
+    const MIN_DENSITY: f64;
     /// How many leaves the tree has.
     fn leaf_count(&self) -> usize;
     /// The share of the tree's domain the patch covers (a view of a quadrant: a quarter).
@@ -84,6 +86,12 @@ pub(super) trait LeafTree {
 
 impl LeafTree for PatchTree {
     type Local = LocalPatch;
+    /// Below it most groups would be single points, which pay for finding and grouping on
+    /// top of their f64 evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead.
+    /// Measured on one thread: grouping every list made `catmark_rook` at rate 16 (creases
+    /// isolate its faces six levels deep) 25–45 % slower; with this rule it is unchanged, and
+    /// `catmark_cube_creases0` at factor 64 (points dense next to its leaves) a third faster.
+    const MIN_DENSITY: f64 = 4.0;
 
     #[inline(always)]
     fn leaf_count(&self) -> usize {
@@ -144,6 +152,11 @@ impl LeafTree for PatchTree {
 
 impl LeafTree for TriangleTree {
     type Local = LocalQuartic;
+    /// Every list: Loop's f64 path has no look-ahead to lose, and finding a point's leaf is
+    /// its cost whichever way. An edge's inner samples (a few leaves along it, but fewer points
+    /// than the density rule asks of the whole tree) were a third of `loop_xord_interior`'s
+    /// vertex time at factor 32 before this.
+    const MIN_DENSITY: f64 = 0.0;
 
     #[inline(always)]
     fn leaf_count(&self) -> usize {
@@ -202,20 +215,12 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// Points per leaf of the view, on average, from which grouping pays. Below it most groups
-/// would be single points, which pay for finding and grouping on top of their f64
-/// evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead. Measured on one
-/// thread: grouping every list made `catmark_rook` at rate 16 (creases isolate its faces six
-/// levels deep) 25–45 % slower; with this rule it is unchanged, and `catmark_cube_creases0`
-/// at factor 64 (points dense next to its leaves) a third faster.
-const MIN_DENSITY: f64 = 4.0;
-
 /// Whether [`eval`] is the faster way to evaluate `points` points of `tree`: they are dense
-/// next to the leaves the view covers (estimated from the tree's leaf count and the view's
-/// share of the tree's domain). Cost: O(1).
+/// next to the leaves the view covers ([`LeafTree::MIN_DENSITY`], estimated from the tree's
+/// leaf count and the view's share of the tree's domain), and at least a group. Cost: O(1).
 #[inline(always)]
-pub(super) fn worth_grouping(tree: &impl LeafTree, points: usize) -> bool {
-    points as f64 >= MIN_DENSITY * tree.leaf_count() as f64 * tree.view_area()
+pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
+    points >= MIN_GROUP && points as f64 >= T::MIN_DENSITY * tree.leaf_count() as f64 * tree.view_area()
 }
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
