@@ -175,9 +175,19 @@ impl LeafTree for TriangleTree {
     }
 
     #[inline(always)]
+    fn prefetch_nodes(&self) {
+        TriangleTree::prefetch_nodes(self);
+    }
+
+    #[inline(always)]
+    fn prefetch_leaf(&self, leaf: usize, _st: DVec2) {
+        TriangleTree::prefetch_leaf(self, leaf);
+    }
+
+    #[inline(always)]
     fn local(&self, leaf: usize) -> Option<LocalQuartic> {
         match &self.leaves()[leaf].patch {
-            TriangleLeafPatch::Quartic(q) => Some(LocalQuartic::from_net(&q.points, |i, j, k| q.b(i, j, k))),
+            TriangleLeafPatch::Quartic(q) => Some(LocalQuartic::from_net(&q.points)),
             TriangleLeafPatch::Gregory(_) => None,
         }
     }
@@ -440,13 +450,7 @@ mod tests {
     /// triangles alike.
     #[test]
     fn loop_points_match_the_f64_evaluation_on_every_cage() {
-        let folder = crate::test_support::data("subdivision");
-        let mut cages: Vec<_> = std::fs::read_dir(&folder)
-            .unwrap_or_else(|e| panic!("{}: {e} (set TESSERA_DATA)", folder.display()))
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("loop_")))
-            .collect();
-        cages.sort();
+        let cages = crate::test_support::data_files("subdivision", &["loop_"]);
         let n = 24;
         let uvs: Vec<DVec2> = (0..=n)
             .flat_map(|j| (0..=n - j).map(move |i| DVec2::new(i as f64, j as f64) / n as f64))

@@ -214,6 +214,18 @@ impl TriangleTree {
         }
     }
 
+    /// Starts loading the quadtree's nodes (a hint, as [`super::PatchTree`]'s).
+    #[inline(always)]
+    pub(crate) fn prefetch_nodes(&self) {
+        super::patch_tree::prefetch_nodes(&self.nodes);
+    }
+
+    /// Starts loading leaf `leaf` (a hint).
+    #[inline(always)]
+    pub(crate) fn prefetch_leaf(&self, leaf: usize) {
+        super::patch_tree::prefetch_nodes(std::slice::from_ref(&self.leaves[leaf]));
+    }
+
     /// Position and first derivatives with respect to the patch's `uv`. Cost: a tree walk and
     /// one leaf's evaluation.
     pub fn derivatives(&self, uv: DVec2) -> SurfaceDerivatives {
