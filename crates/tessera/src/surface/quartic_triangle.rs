@@ -230,18 +230,6 @@ impl QuarticTriangle {
         QuarticTriangle { points }
     }
 
-    /// The same surface with `u` and `v` exchanged (`b'_ijk = b_ikj`).
-    pub fn swapped_uv(&self) -> QuarticTriangle {
-        let mut out = self.clone();
-        for i in 0..=4usize {
-            for j in 0..=4 - i {
-                let k = 4 - i - j;
-                out.points[Self::index(i, k, j)] = self.b(i, j, k);
-            }
-        }
-        out
-    }
-
     /// Position at `uv`. Cost: 15 control points.
     pub fn position(&self, uv: DVec2) -> DVec3 {
         let pw = powers(uv);
