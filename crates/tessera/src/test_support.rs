@@ -18,6 +18,21 @@ pub fn data(rel: &str) -> PathBuf {
     dir.join(rel)
 }
 
+/// The files of the shared data's folder `folder` whose names start with one of `prefixes`,
+/// sorted. Panics, naming the folder, where it cannot be read.
+pub fn data_files(folder: &str, prefixes: &[&str]) -> Vec<PathBuf> {
+    let dir = data(folder);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e} (set TESSERA_DATA)", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name().is_some_and(|n| prefixes.iter().any(|s| n.to_string_lossy().starts_with(s)))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
 /// Asserts that `result` is a parse error at `file:line` whose message names the file
 /// and contains `needle`.
 #[track_caller]

@@ -1,6 +1,6 @@
 //! A specialisation of *evaluation*: any list of parameters on one patch, evaluated
 //! [`LANES`] points at a time in f32, for bicubic patches (polynomial or rational), cubic
-//! Bézier triangles and PN triangles.
+//! and quartic Bézier triangles (a regular Loop patch is one quartic) and PN triangles.
 //!
 //! Where [`super::uniform_quads`] exploits a grid (a row reduced to a curve once), this
 //! evaluator takes parameters as a pattern or an edge sampling chose them — transition strips,
@@ -73,78 +73,157 @@ fn to_local(q: DVec3, origin: DVec3, scale: f64) -> [f32; 3] {
     ((q - origin) * (1.0 / scale)).as_vec3().to_array()
 }
 
-/// The exponents `(i, j, k)` of the cubic monomials `λ0^i λ1^j λ2^k`, in
-/// [`BezierTriangle::index`] order.
-const CUBIC: [(usize, usize, usize); 10] = [
-    (3, 0, 0),
-    (2, 1, 0),
-    (2, 0, 1),
-    (1, 2, 0),
-    (1, 1, 1),
-    (1, 0, 2),
-    (0, 3, 0),
-    (0, 2, 1),
-    (0, 1, 2),
-    (0, 0, 3),
-];
+/// The exponents `(i, j, k)`, `i + j + k = d`, of the `N = (d + 1)(d + 2) / 2` monomials
+/// `λ0^i λ1^j λ2^k` of degree `d`, in [`BezierTriangle::index`] order (`i`, then `j`,
+/// descending), which is also [`crate::surface::QuarticTriangle::index`]'s.
+const fn exponents<const N: usize>() -> [(usize, usize, usize); N] {
+    let d = degree(N);
+    let mut out = [(0, 0, 0); N];
+    let (mut m, mut i) = (0, d + 1);
+    while i > 0 {
+        i -= 1;
+        let mut j = d - i + 1;
+        while j > 0 {
+            j -= 1;
+            out[m] = (i, j, d - i - j);
+            m += 1;
+        }
+    }
+    out
+}
 
-/// The quadratic monomials, in the order of the derivative tables below.
-const QUADRATIC: [(usize, usize, usize); 6] =
-    [(2, 0, 0), (1, 1, 0), (1, 0, 1), (0, 2, 0), (0, 1, 1), (0, 0, 2)];
+/// The degree of a Bézier triangle with `n` control points.
+const fn degree(n: usize) -> usize {
+    let mut d = 0;
+    while (d + 1) * (d + 2) / 2 < n {
+        d += 1;
+    }
+    assert!((d + 1) * (d + 2) / 2 == n, "not a triangular number of points");
+    d
+}
 
 /// The PN normal field's monomials, in the order of [`crate::surface::PnTriangle::normals`]:
 /// `λ0², λ1², λ2², λ0λ1, λ1λ2, λ0λ2`.
 const PN_NORMAL: [(usize, usize, usize); 6] =
     [(2, 0, 0), (0, 2, 0), (0, 0, 2), (1, 1, 0), (0, 1, 1), (1, 0, 1)];
 
-fn factorial(n: usize) -> f64 {
-    [1.0, 1.0, 2.0, 6.0][n]
+const fn factorial(n: usize) -> f64 {
+    [1.0, 1.0, 2.0, 6.0, 24.0][n]
 }
 
-/// A cubic Bézier triangle in its local frame, with the multinomial coefficients folded into
-/// the control points so that each sum is over bare monomials.
-struct LocalTriangle {
+/// The storage index of `b_ijk` (`i + j + k = d`) in [`exponents`] order: the rule of
+/// [`BezierTriangle::index`] at any degree.
+const fn index(d: usize, i: usize, j: usize) -> usize {
+    (d - i) * (d - i + 1) / 2 + (d - i - j)
+}
+
+/// For each control point `b_ijk` of degree `d` in [`exponents`] order, where `b_ikj` stands:
+/// the net of the same surface with `u` and `v` exchanged, read through it.
+const fn swapped<const N: usize>() -> [usize; N] {
+    let (d, e) = (degree(N), exponents::<N>());
+    let mut out = [0; N];
+    let mut m = 0;
+    while m < N {
+        let (i, _, k) = e[m];
+        out[m] = index(d, i, k);
+        m += 1;
+    }
+    out
+}
+
+/// `d!/(i!j!k!)` of each control point of degree `d`, in [`exponents`] order.
+const fn multinomials<const N: usize>() -> [f64; N] {
+    let e = exponents::<N>();
+    let mut out = [0.0; N];
+    let mut m = 0;
+    while m < N {
+        let (i, j, k) = e[m];
+        out[m] = factorial(i + j + k) / (factorial(i) * factorial(j) * factorial(k));
+        m += 1;
+    }
+    out
+}
+
+/// The derivatives' control points of a Bézier triangle of degree `d` (`N` points): for each
+/// `(i, j, k)` of degree `d − 1` in [`exponents`] order, where `b_{i+1,j,k}`, `b_{i,j+1,k}`
+/// and `b_{i,j,k+1}` stand in the net, and `d · (d−1)!/(i!j!k!)`, so that
+/// `∂S/∂u = Σ c (b_{i,j+1,k} − b_{i+1,j,k}) λ0^i λ1^j λ2^k`, and `∂S/∂v` with `b_{i,j,k+1}`.
+const fn differences<const N: usize, const M: usize>() -> [(usize, usize, usize, f64); M] {
+    let d = degree(N);
+    assert!(degree(M) + 1 == d, "the derivatives' degree is one less");
+    let (e, c) = (exponents::<M>(), multinomials::<M>());
+    let mut out = [(0, 0, 0, 0.0); M];
+    let mut m = 0;
+    while m < M {
+        let (i, j, _) = e[m];
+        out[m] = (index(d, i + 1, j), index(d, i, j + 1), index(d, i, j), d as f64 * c[m]);
+        m += 1;
+    }
+    out
+}
+
+/// A Bézier triangle of degree `d` (`N` control points; `M` those of degree `d − 1`: cubic
+/// `<10, 6>`, quartic `<15, 10>`) in its local frame, with the multinomial coefficients folded
+/// into the control points so that each sum is over bare monomials.
+pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
     origin: [f32; 3],
     scale: f32,
-    /// `pos[c][m] = 3!/(i!j!k!) · b_ijk`, component `c`, `m` in [`CUBIC`] order.
-    pos: [[f32; 10]; 3],
-    /// `du[c][m] = 3 · 2!/(i!j!k!) · (b_{i,j+1,k} − b_{i+1,j,k})`, `m` in [`QUADRATIC`] order.
-    du: [[f32; 6]; 3],
+    /// `pos[c][m] = d!/(i!j!k!) · b_ijk`, component `c`, `m` in [`exponents`] order.
+    pos: [[f32; N]; 3],
+    /// `du[c][m] = d · (d−1)!/(i!j!k!) · (b_{i,j+1,k} − b_{i+1,j,k})`, `m` in [`exponents`]
+    /// order of degree `d − 1`.
+    du: [[f32; M]; 3],
     /// Likewise with `b_{i,j,k+1}`.
-    dv: [[f32; 6]; 3],
+    dv: [[f32; M]; 3],
     /// The PN normal field's coefficients `[c][m]` in [`PN_NORMAL`] order; None for a plain
     /// Bézier triangle (normal from the derivatives).
     pn: Option<[[f32; 6]; 3]>,
 }
 
-impl LocalTriangle {
-    fn new(t: &BezierTriangle, pn_normals: Option<&[DVec3; 6]>) -> LocalTriangle {
-        let (origin, scale) = local_frame(&t.points);
+/// A quartic Bézier triangle in its local frame: Loop's regular pieces.
+pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
+
+impl<const N: usize, const M: usize> LocalTriangle<N, M> {
+    /// The Bézier triangle of degree `d` with control points `net` in [`exponents`] order.
+    /// Cost: O(N), every index and coefficient a constant. Inlined: the grouped leaves
+    /// (`tree_points`) make one a group, in their caller's instructions, where it was a
+    /// quarter of `loop_xord_interior`'s vertex time at factor 16 with the indices and
+    /// coefficients computed.
+    #[inline(always)]
+    pub(crate) fn from_net(net: &[DVec3; N]) -> Self {
+        let (origin, scale) = local_frame(net);
         let inv = 1.0 / scale;
         let mut local = LocalTriangle {
             origin: origin.as_vec3().to_array(),
             scale: scale as f32,
-            pos: [[0.0; 10]; 3],
-            du: [[0.0; 6]; 3],
-            dv: [[0.0; 6]; 3],
+            pos: [[0.0; N]; 3],
+            du: [[0.0; M]; 3],
+            dv: [[0.0; M]; 3],
             pn: None,
         };
-        for (m, &(i, j, k)) in CUBIC.iter().enumerate() {
-            let c = 6.0 / (factorial(i) * factorial(j) * factorial(k));
-            let q = to_local(t.b(i, j, k), origin, scale).map(|x| x * c as f32);
+        let coefficients = const { multinomials::<N>() };
+        for (m, (&q, &c)) in net.iter().zip(&coefficients).enumerate() {
+            let q = to_local(q, origin, scale).map(|x| x * c as f32);
             (0..3).for_each(|a| local.pos[a][m] = q[a]);
         }
-        for (m, &(i, j, k)) in QUADRATIC.iter().enumerate() {
-            let c = 3.0 * 2.0 / (factorial(i) * factorial(j) * factorial(k)) * inv;
+        for (m, &(at, at_u, at_v, c)) in const { differences::<N, M>() }.iter().enumerate() {
+            let c = c * inv;
             // Differences in f64 before rounding: the derivative keeps its relative precision
             // where neighbouring control points nearly coincide.
-            let du = ((t.b(i, j + 1, k) - t.b(i + 1, j, k)) * c).as_vec3().to_array();
-            let dv = ((t.b(i, j, k + 1) - t.b(i + 1, j, k)) * c).as_vec3().to_array();
+            let du = ((net[at_u] - net[at]) * c).as_vec3().to_array();
+            let dv = ((net[at_v] - net[at]) * c).as_vec3().to_array();
             for a in 0..3 {
                 local.du[a][m] = du[a];
                 local.dv[a][m] = dv[a];
             }
         }
+        local
+    }
+}
+
+impl LocalTriangle {
+    fn new(t: &BezierTriangle, pn_normals: Option<&[DVec3; 6]>) -> LocalTriangle {
+        let mut local = LocalTriangle::from_net(&t.points);
         local.pn = pn_normals.map(|n| {
             let mut out = [[0.0; 6]; 3];
             for (m, n) in n.iter().enumerate() {
@@ -165,6 +244,8 @@ enum Local {
     Bicubic(u32),
     Rational(u32),
     Triangle(u32),
+    /// A regular Loop patch (one quartic piece).
+    Quartic(u32),
     /// A rational bicubic whose weights span more than f32 carries
     /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
     Generic,
@@ -176,6 +257,7 @@ enum FormRef<'a> {
     Bicubic(&'a LocalPatch),
     Rational(&'a LocalPatch<4>),
     Triangle(&'a LocalTriangle),
+    Quartic(&'a LocalQuartic),
 }
 
 /// A patch's local form while a set is prepared.
@@ -183,6 +265,7 @@ enum Form {
     Bicubic(LocalPatch),
     Rational(LocalPatch<4>),
     Triangle(LocalTriangle),
+    Quartic(LocalQuartic),
     Generic,
 }
 
@@ -200,6 +283,7 @@ pub(crate) struct PointBlocks {
     bicubics: Vec<LocalPatch>,
     rationals: Vec<LocalPatch<4>>,
     triangles: Vec<LocalTriangle>,
+    quartics: Vec<LocalQuartic>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -439,7 +523,7 @@ fn rational_block<const FMA: bool, const L: usize>(
 /// The monomials `λ0^i λ1^j λ2^k` of each lane for the exponents `table`.
 #[inline(always)]
 fn monomials<const L: usize, const M: usize>(
-    powers: &[[[f32; L]; 4]; 3],
+    powers: &[[[f32; L]; 5]; 3],
     table: &[(usize, usize, usize); M],
 ) -> [[f32; L]; M] {
     let mut out = [[0f32; L]; M];
@@ -469,29 +553,30 @@ fn combine<const FMA: bool, const L: usize, const M: usize>(
     out
 }
 
-/// A cubic Bézier or PN triangle at each lane's `(u, v)`.
+/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
 #[inline(always)]
-fn triangle_block<const FMA: bool, const L: usize>(
-    t: &LocalTriangle,
+pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
     u: &[f32; L],
     v: &[f32; L],
 ) -> Block<L> {
-    // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v).
-    let mut powers = [[[1f32; L]; 4]; 3];
+    // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v), up to the degree.
+    let d = const { degree(N) };
+    let mut powers = [[[1f32; L]; 5]; 3];
     for l in 0..L {
         let lambda = [1.0 - u[l] - v[l], u[l], v[l]];
         for a in 0..3 {
             let x = lambda[a];
-            powers[a][1][l] = x;
-            powers[a][2][l] = x * x;
-            powers[a][3][l] = x * x * x;
+            for e in 1..=d {
+                powers[a][e][l] = powers[a][e - 1][l] * x;
+            }
         }
     }
-    let mut pos = combine::<FMA, L, 10>(&t.pos, &monomials(&powers, &CUBIC));
+    let mut pos = combine::<FMA, L, N>(&t.pos, &monomials(&powers, &const { exponents::<N>() }));
     let (nrm, margin) = match &t.pn {
         None => {
-            let quadratic = monomials(&powers, &QUADRATIC);
-            cross_normals(&combine::<FMA, L, 6>(&t.du, &quadratic), &combine::<FMA, L, 6>(&t.dv, &quadratic))
+            let lower = monomials(&powers, &const { exponents::<M>() });
+            cross_normals(&combine::<FMA, L, M>(&t.du, &lower), &combine::<FMA, L, M>(&t.dv, &lower))
         }
         Some(field) => {
             let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
@@ -524,9 +609,18 @@ impl PointBlocks {
                 Patch::Bicubic(b) => LocalPatch::rational(b).map_or(Form::Generic, Form::Rational),
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
-                // Piecewise (isolated) subdivision patches take the generic evaluation, and
-                // Loop patches (the quartic kernels are not written yet).
-                Patch::Subdivision(_) | Patch::Loop(_) => Form::Generic,
+                // A regular Loop triangle is one quartic piece, in the patch's parameters.
+                Patch::Loop(t) => t.regular().map_or(Form::Generic, |q| {
+                    let net = if t.is_swapped() {
+                        const { swapped::<15>() }.map(|m| q.points[m])
+                    } else {
+                        q.points
+                    };
+                    Form::Quartic(LocalQuartic::from_net(&net))
+                }),
+                // Piecewise (isolated) patches take the generic evaluation, or their points
+                // grouped by leaf (`tree_points`).
+                Patch::Subdivision(_) => Form::Generic,
             })
             .collect::<Vec<_>>();
         let mut blocks = PointBlocks {
@@ -534,6 +628,7 @@ impl PointBlocks {
             bicubics: Vec::new(),
             rationals: Vec::new(),
             triangles: Vec::new(),
+            quartics: Vec::new(),
             all_bicubic: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
@@ -542,6 +637,7 @@ impl PointBlocks {
                 Form::Bicubic(b) => Local::Bicubic(push(&mut blocks.bicubics, b)),
                 Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
                 Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
+                Form::Quartic(t) => Local::Quartic(push(&mut blocks.quartics, t)),
                 Form::Generic => Local::Generic,
             };
             blocks.locals.push(local);
@@ -556,7 +652,7 @@ impl PointBlocks {
         match self.form(p)? {
             FormRef::Bicubic(local) => Some(GridPatch::Polynomial(local)),
             FormRef::Rational(local) => Some(GridPatch::Rational(local)),
-            FormRef::Triangle(_) => None,
+            FormRef::Triangle(_) | FormRef::Quartic(_) => None,
         }
     }
 
@@ -566,6 +662,7 @@ impl PointBlocks {
             Local::Bicubic(i) => FormRef::Bicubic(&self.bicubics[i as usize]),
             Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
             Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
+            Local::Quartic(i) => FormRef::Quartic(&self.quartics[i as usize]),
             Local::Generic => return None,
         })
     }
@@ -601,9 +698,16 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        if let (Local::Generic, Patch::Subdivision(tree)) = (&self.locals[p], &set.patches[p]) {
-            if super::tree_points::worth_grouping(tree, uvs.len()) {
-                return super::tree_points::eval::<FMA>(set, p, tree, uvs, out);
+        if let Local::Generic = self.locals[p] {
+            use super::tree_points::{eval as grouped, worth_grouping};
+            match &set.patches[p] {
+                Patch::Subdivision(tree) if worth_grouping(&**tree, uvs.len()) => {
+                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+                }
+                Patch::Loop(tree) if worth_grouping(&**tree, uvs.len()) => {
+                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+                }
+                _ => {}
             }
         }
         if matches!(self.locals[p], Local::Generic) {
@@ -651,7 +755,8 @@ impl PointBlocks {
             let block = match form {
                 FormRef::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
                 FormRef::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
-                FormRef::Triangle(t) => triangle_block::<FMA, L>(t, &u, &v),
+                FormRef::Triangle(t) => triangle_block::<FMA, L, 10, 6>(t, &u, &v),
+                FormRef::Quartic(t) => triangle_block::<FMA, L, 15, 10>(t, &u, &v),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 (*pos, *nrm) = block.lane_or_exact(l, set, p, uv[l]);
@@ -1025,30 +1130,33 @@ mod tests {
 
     /// Subdivision cages: the grouped leaf kernels (`tree_points`, for dense points) and the
     /// f64 path they fall back to, with both instruction sets, against the generic engine on
-    /// every cage of `subdivision/` — uniform at a factor where the isolated faces' points
-    /// are dense next to their leaves, and transition at a pixel error, whose factors mix
-    /// both paths. On the denser factor, the kernels must have made some normals.
+    /// every cage of `subdivision/`, Catmull-Clark's and Loop's (whose regular triangles take
+    /// the quartic kernel whole) — uniform at a factor where the isolated faces' points are
+    /// dense next to their leaves, and transition at a pixel error, whose factors mix both
+    /// paths. On the denser factor, the kernels must have made some normals.
     #[test]
     fn subdivision_cages_match_the_generic_engine() {
         use crate::engine::{EngineOptions, Layout};
         use crate::scheme::{Criterion, PlanOptions, Scheme};
-        let folder = crate::test_support::data("subdivision");
-        let mut cages: Vec<_> = std::fs::read_dir(&folder)
-            .unwrap_or_else(|e| panic!("{}: {e} (set TESSERA_DATA)", folder.display()))
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-            .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("catmark")))
-            .collect();
-        cages.sort();
-        assert!(cages.len() >= 30, "{cages:?}");
-        let (mut compared, mut grouped) = (0, 0);
+        let cages = crate::test_support::data_files("subdivision", &["catmark", "loop_"]);
+        let cages: Vec<_> = cages.into_iter().filter(|p| p.extension().is_some_and(|x| x == "obj")).collect();
+        assert!(cages.len() >= 40, "{cages:?}");
+        let (mut compared, mut grouped, mut loop_cages) = (0, 0, 0);
+        let piecewise = |p: &Patch| matches!(p, Patch::Subdivision(_) | Patch::Loop(_));
         for path in &cages {
             let mesh = crate::io::obj::read_obj(path).unwrap();
+            let is_loop = path.file_name().is_some_and(|n| n.to_string_lossy().starts_with("loop_"));
+            let built = if is_loop {
+                SurfaceSet::from_loop_cage(&mesh, path, Default::default())
+            } else {
+                SurfaceSet::from_subdivision_cage(&mesh, path, Default::default())
+            };
             // A few cages are refused (non-manifold ones; `tests/catmull_clark.rs` checks why).
-            let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, path, Default::default()) else {
+            let Ok(set) = built else {
                 continue;
             };
-            let trees = set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_)));
+            loop_cages += usize::from(is_loop);
+            let trees = set.patches.iter().any(piecewise);
             let (lo, hi) = set.bounds();
             let mut camera = crate::camera::Camera::framing(lo, hi, 1280, 720);
             camera.eye = camera.target + (camera.eye - camera.target) * 0.6;
@@ -1071,9 +1179,7 @@ mod tests {
                     );
                     if trees && matches!(scheme, Scheme::Uniform) {
                         // Isolated faces' normals from the kernels: some differ in their rounding.
-                        let from_trees = |k: usize| {
-                            matches!(set.patches[fast.vertex_patch[k] as usize], Patch::Subdivision(_))
-                        };
+                        let from_trees = |k: usize| piecewise(&set.patches[fast.vertex_patch[k] as usize]);
                         grouped += usize::from(
                             (0..fast.normals.len())
                                 .any(|k| from_trees(k) && fast.normals[k] != generic.normals[k]),
@@ -1083,9 +1189,10 @@ mod tests {
                 compared += 1;
             }
         }
-        assert!(compared >= 30 * 2, "only {compared} cage runs compared");
+        assert!(compared >= 40 * 2, "only {compared} cage runs compared");
+        assert!(loop_cages >= 10, "only {loop_cages} Loop cages");
         assert!(
-            grouped >= 20,
+            grouped >= 40,
             "the leaf kernels changed isolated faces' normals on only {grouped} cage runs"
         );
     }

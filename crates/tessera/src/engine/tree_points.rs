@@ -1,7 +1,8 @@
 //! A specialisation of *evaluation* for the piecewise patches of subdivision surfaces
-//! ([`PatchTree`]): a patch's points grouped by the leaf that holds them, and every group of
-//! a Bézier leaf evaluated as one bicubic in f32, [`LANES`] points at a time, by the same
-//! kernel as a whole bicubic patch ([`super::point_blocks`]).
+//! (Catmull-Clark's [`PatchTree`], Loop's [`TriangleTree`]: [`LeafTree`]): a patch's points
+//! grouped by the leaf that holds them, and every group of a Bézier leaf (bicubic, quartic
+//! triangle) evaluated in f32, [`LANES`] points at a time, by the same kernel as a whole
+//! bicubic patch or Bézier triangle ([`super::point_blocks`]).
 //!
 //! **Why by leaf.** Evaluated point by point in f64, a tree's point cost 60–100 ns on the
 //! machine this was written on (a regular face's about 5 ns), even where the leaves fit in
@@ -11,15 +12,20 @@
 //! its isolated faces share their leaf with three others or more, over half with fifteen
 //! others or more. Such a group pays once for moving its leaf's net to a local frame and
 //! rounding it to f32, then takes the bicubic kernel's price per point. A point alone in its
-//! leaf (a deep tree's, or an end cap's) keeps the f64 evaluation.
+//! leaf (a deep tree's), or in an end cap (a Gregory patch or triangle), keeps the f64
+//! evaluation. Loop's trees are the same story with quartic triangles for bicubics
+//! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame).
 //!
 //! **Same frame, same fallbacks.** The leaf's net is moved to the leaf's own local frame
 //! ([`super::point_blocks::local_frame`]), so f32 carries the leaf's detail at full relative
 //! precision however deep the leaf; the reliability rule of the normals
 //! ([`super::point_blocks::cross_normals`]) applies unchanged, a point failing it takes the f64
-//! evaluation. The normal of a leaf's derivatives is the patch's up to its sign: the view's
-//! derivatives are the leaf's scaled by a positive factor and turned by quarter turns (which
-//! keep their cross product), and exchanged where the view is transposed (which reverses it).
+//! evaluation (whose normal rule is the patch's own: [`crate::surface::subdivision_point`],
+//! [`crate::surface::triangle_point`]). The normal of a leaf's derivatives is the patch's up to
+//! its sign: the view's derivatives are the leaf's scaled by a positive factor and turned by
+//! quarter turns (which keep their cross product), a turned Loop leaf's both negated (which
+//! keeps it too), and exchanged where the view is transposed or the triangle swapped (which
+//! reverses it).
 //!
 //! **Watertight as before**: which patch evaluates a point and at which parameters is
 //! unchanged; only how its position and normal are rounded.
@@ -28,23 +34,178 @@ use std::cell::RefCell;
 
 use glam::DVec2;
 
-use super::point_blocks::{bicubic_block, LANES};
+use super::point_blocks::{bicubic_block, triangle_block, Block, LocalQuartic, LANES};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
-use crate::surface::{subdivision_point, SurfaceSet};
+use crate::surface::triangle_tree::TriangleLeafPatch;
+use crate::surface::{loop_point, subdivision_point, SurfacePoint, SurfaceSet, TriangleTree};
 
 /// The fewest points of one leaf evaluated as a group; fewer take the f64 evaluation, where
 /// moving the net to its frame would cost more than it saves.
 const MIN_GROUP: usize = 2;
 
-/// A point of the patch's list and where [`PatchTree::find`] put it.
+/// A point of the patch's list and where [`LeafTree::find`] put it.
 #[derive(Clone, Copy)]
-struct Found {
+pub(super) struct Found {
     leaf: u32,
     k: u32,
     st: DVec2,
+    /// The leaf's side where the tree's search gives it ([`PatchTree::find`]); else unused.
     size: f64,
+}
+
+/// A piecewise patch whose points [`eval`] groups by leaf: what differs between Catmull-Clark's
+/// trees and Loop's. Everything is inlined into [`eval`] (and so compiled for its caller's
+/// instructions).
+pub(super) trait LeafTree {
+    /// A Bézier leaf's net in its local frame, as [`LeafTree::block`] takes it.
+    type Local;
+    /// Points per leaf of the view, on average, from which grouping pays ([`worth_grouping`]).
+    const MIN_DENSITY: f64;
+    /// How many leaves the tree has.
+    fn leaf_count(&self) -> usize;
+    /// The share of the tree's domain the patch covers (a view of a quadrant: a quarter).
+    fn view_area(&self) -> f64;
+    /// The leaf of `uv` and `uv` in its parameters, as [`Found`] holds them (`k` unset).
+    fn find(&self, uv: DVec2) -> Found;
+    /// Starts loading the quadtree's nodes (a hint).
+    fn prefetch_nodes(&self) {}
+    /// Starts loading what evaluating `leaf` at `st` reads (a hint).
+    fn prefetch_leaf(&self, _leaf: usize, _st: DVec2) {}
+    /// Leaf `leaf`'s net in its local frame; None for an end cap (evaluated in f64).
+    fn local(&self, leaf: usize) -> Option<Self::Local>;
+    /// The leaf at each lane's parameters, its normal the leaf's own.
+    fn block<const FMA: bool, const L: usize>(local: &Self::Local, u: &[f32; L], v: &[f32; L]) -> Block<L>;
+    /// Whether the patch's normal is the opposite of its leaves' (module doc).
+    fn reverses_normal(&self) -> bool;
+    /// The point `f` in f64, as the generic evaluation of the patch at `uv` gives it.
+    /// With `FMA`, the CPU has AVX2 and FMA.
+    fn single<const FMA: bool>(&self, f: &Found, uv: DVec2) -> SurfacePoint;
+}
+
+impl LeafTree for PatchTree {
+    type Local = LocalPatch;
+    /// Below it most groups would be single points, which pay for finding and grouping on
+    /// top of their f64 evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead.
+    /// Measured on one thread: grouping every list made `catmark_rook` at rate 16 (creases
+    /// isolate its faces six levels deep) 25–45 % slower; with this rule it is unchanged, and
+    /// `catmark_cube_creases0` at factor 64 (points dense next to its leaves) a third faster.
+    const MIN_DENSITY: f64 = 4.0;
+
+    #[inline(always)]
+    fn leaf_count(&self) -> usize {
+        self.leaves().len()
+    }
+
+    #[inline(always)]
+    fn view_area(&self) -> f64 {
+        let (_, view) = self.view_square();
+        view * view
+    }
+
+    #[inline(always)]
+    fn find(&self, uv: DVec2) -> Found {
+        let (leaf, st, size) = PatchTree::find(self, uv);
+        Found { leaf: leaf as u32, k: 0, st, size }
+    }
+
+    #[inline(always)]
+    fn prefetch_nodes(&self) {
+        PatchTree::prefetch_nodes(self);
+    }
+
+    #[inline(always)]
+    fn prefetch_leaf(&self, leaf: usize, st: DVec2) {
+        PatchTree::prefetch_leaf(self, leaf, st);
+    }
+
+    #[inline(always)]
+    fn local(&self, leaf: usize) -> Option<LocalPatch> {
+        match &self.leaves()[leaf].patch {
+            LeafPatch::Bezier(net) => Some(LocalPatch::from_net(net)),
+            LeafPatch::Gregory(_) => None,
+        }
+    }
+
+    #[inline(always)]
+    fn block<const FMA: bool, const L: usize>(local: &LocalPatch, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+        bicubic_block::<FMA, L>(local, u, v)
+    }
+
+    #[inline(always)]
+    fn reverses_normal(&self) -> bool {
+        self.is_transposed()
+    }
+
+    #[inline(always)]
+    fn single<const FMA: bool>(&self, f: &Found, uv: DVec2) -> SurfacePoint {
+        #[cfg(target_arch = "x86_64")]
+        if FMA {
+            // SAFETY: `FMA` is only set for a CPU with AVX2 and FMA (the caller's precondition).
+            let d = unsafe { self.found_derivatives_avx(f.leaf as usize, f.st, f.size) };
+            return subdivision_point(self, uv, d);
+        }
+        subdivision_point(self, uv, self.found_derivatives(f.leaf as usize, f.st, f.size))
+    }
+}
+
+impl LeafTree for TriangleTree {
+    type Local = LocalQuartic;
+    /// Every list: Loop's f64 path has no look-ahead to lose, and finding a point's leaf is
+    /// its cost whichever way. An edge's inner samples (a few leaves along it, but fewer points
+    /// than the density rule asks of the whole tree) were a third of `loop_xord_interior`'s
+    /// vertex time at factor 32 before this.
+    const MIN_DENSITY: f64 = 0.0;
+
+    #[inline(always)]
+    fn leaf_count(&self) -> usize {
+        self.leaves().len()
+    }
+
+    #[inline(always)]
+    fn view_area(&self) -> f64 {
+        1.0
+    }
+
+    #[inline(always)]
+    fn find(&self, uv: DVec2) -> Found {
+        let (leaf, st) = TriangleTree::find(self, uv);
+        Found { leaf: leaf as u32, k: 0, st, size: 0.0 }
+    }
+
+    #[inline(always)]
+    fn prefetch_nodes(&self) {
+        TriangleTree::prefetch_nodes(self);
+    }
+
+    #[inline(always)]
+    fn prefetch_leaf(&self, leaf: usize, _st: DVec2) {
+        TriangleTree::prefetch_leaf(self, leaf);
+    }
+
+    #[inline(always)]
+    fn local(&self, leaf: usize) -> Option<LocalQuartic> {
+        match &self.leaves()[leaf].patch {
+            TriangleLeafPatch::Quartic(q) => Some(LocalQuartic::from_net(&q.points)),
+            TriangleLeafPatch::Gregory(_) => None,
+        }
+    }
+
+    #[inline(always)]
+    fn block<const FMA: bool, const L: usize>(local: &LocalQuartic, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+        triangle_block::<FMA, L, 15, 10>(local, u, v)
+    }
+
+    #[inline(always)]
+    fn reverses_normal(&self) -> bool {
+        self.is_swapped()
+    }
+
+    #[inline(always)]
+    fn single<const FMA: bool>(&self, f: &Found, uv: DVec2) -> SurfacePoint {
+        loop_point(self, uv, self.found_derivatives(f.leaf as usize, f.st))
+    }
 }
 
 /// A patch's points by leaf: the scratch of [`eval`], reused from patch to patch (a frame's
@@ -64,21 +225,12 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// Points per leaf of the view, on average, from which grouping pays. Below it most groups
-/// would be single points, which pay for finding and grouping on top of their f64
-/// evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead. Measured on one
-/// thread: grouping every list made `catmark_rook` at rate 16 (creases isolate its faces six
-/// levels deep) 25–45 % slower; with this rule it is unchanged, and `catmark_cube_creases0`
-/// at factor 64 (points dense next to its leaves) a third faster.
-const MIN_DENSITY: f64 = 4.0;
-
 /// Whether [`eval`] is the faster way to evaluate `points` points of `tree`: they are dense
-/// next to the leaves the view covers (estimated from the tree's leaf count and the view's
-/// share of the tree's square). Cost: O(1).
+/// next to the leaves the view covers ([`LeafTree::MIN_DENSITY`], estimated from the tree's
+/// leaf count and the view's share of the tree's domain), and at least a group. Cost: O(1).
 #[inline(always)]
-pub(super) fn worth_grouping(tree: &PatchTree, points: usize) -> bool {
-    let (_, view) = tree.view_square();
-    points as f64 >= MIN_DENSITY * tree.leaves().len() as f64 * view * view
+pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
+    points >= MIN_GROUP && points as f64 >= T::MIN_DENSITY * tree.leaf_count() as f64 * tree.view_area()
 }
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
@@ -89,10 +241,10 @@ pub(super) fn worth_grouping(tree: &PatchTree, points: usize) -> bool {
 /// price per point; per single point, the f64 evaluation. No allocation once the thread's
 /// scratch has grown.
 #[inline(always)]
-pub(super) fn eval<const FMA: bool>(
+pub(super) fn eval<const FMA: bool, T: LeafTree>(
     set: &SurfaceSet,
     p: usize,
-    tree: &PatchTree,
+    tree: &T,
     uvs: &[DVec2],
     mut out: VertexSlices<'_>,
 ) {
@@ -104,16 +256,15 @@ pub(super) fn eval<const FMA: bool>(
     tree.prefetch_nodes();
     let mut last = u32::MAX;
     for (k, &uv) in uvs.iter().enumerate() {
-        let (leaf, st, size) = tree.find(uv);
-        let leaf = leaf as u32;
-        if leaf != last {
-            tree.prefetch_leaf(leaf as usize, st);
-            last = leaf;
+        let f = Found { k: k as u32, ..tree.find(uv) };
+        if f.leaf != last {
+            tree.prefetch_leaf(f.leaf as usize, f.st);
+            last = f.leaf;
         }
-        found.push(Found { leaf, k: k as u32, st, size });
+        found.push(f);
     }
     grouped.clear();
-    let leaf_count = tree.leaves().len();
+    let leaf_count = tree.leaf_count();
     if found.len() < leaf_count {
         // Fewer points than leaves: a comparison sort, O(n log n), costs less than a pass
         // over every leaf's counter.
@@ -136,23 +287,18 @@ pub(super) fn eval<const FMA: bool>(
             *at += 1;
         }
     }
-    let flip = tree.is_transposed();
-    let leaves = tree.leaves();
+    let flip = tree.reverses_normal();
     for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
-        match &leaves[group[0].leaf as usize].patch {
-            LeafPatch::Bezier(net) if group.len() >= MIN_GROUP => {
-                let local = LocalPatch::from_net(net);
-                if group.len() <= LANES / 2 {
-                    blocks::<FMA, { LANES / 2 }>(set, p, &local, flip, group, uvs, &mut out);
-                } else {
-                    blocks::<FMA, LANES>(set, p, &local, flip, group, uvs, &mut out);
-                }
+        let local = if group.len() >= MIN_GROUP { tree.local(group[0].leaf as usize) } else { None };
+        match local {
+            Some(local) if group.len() <= LANES / 2 => {
+                blocks::<FMA, { LANES / 2 }, T>(set, p, &local, flip, group, uvs, &mut out);
             }
-            _ => {
+            Some(local) => blocks::<FMA, LANES, T>(set, p, &local, flip, group, uvs, &mut out),
+            None => {
                 for f in group {
                     let k = f.k as usize;
-                    let d = single::<FMA>(tree, f);
-                    let q = subdivision_point(tree, uvs[k], d);
+                    let q = tree.single::<FMA>(f, uvs[k]);
                     out.pos[k] = q.position.as_vec3().to_array();
                     out.nrm[k] = q.normal.as_vec3().to_array();
                 }
@@ -164,23 +310,12 @@ pub(super) fn eval<const FMA: bool>(
     out.patch.fill(p as u32);
 }
 
-/// One point's derivatives in f64, as [`PatchTree::derivatives`] gives them.
-#[inline(always)]
-fn single<const FMA: bool>(tree: &PatchTree, f: &Found) -> (glam::DVec3, glam::DVec3, glam::DVec3) {
-    #[cfg(target_arch = "x86_64")]
-    if FMA {
-        // SAFETY: `FMA` is only set for a CPU with AVX2 and FMA (the caller's precondition).
-        return unsafe { tree.found_derivatives_avx(f.leaf as usize, f.st, f.size) };
-    }
-    tree.found_derivatives(f.leaf as usize, f.st, f.size)
-}
-
 /// The points of `group` (one leaf, whose net is `local`) in blocks of `L` lanes.
 #[inline(always)]
-fn blocks<const FMA: bool, const L: usize>(
+fn blocks<const FMA: bool, const L: usize, T: LeafTree>(
     set: &SurfaceSet,
     p: usize,
-    local: &LocalPatch,
+    local: &T::Local,
     flip: bool,
     group: &[Found],
     uvs: &[DVec2],
@@ -195,7 +330,7 @@ fn blocks<const FMA: bool, const L: usize>(
             u[l] = st.x as f32;
             v[l] = st.y as f32;
         }
-        let block = bicubic_block::<FMA, L>(local, &u, &v);
+        let block = T::block::<FMA, L>(local, &u, &v);
         for (l, f) in chunk.iter().enumerate() {
             let k = f.k as usize;
             let (pos, nrm) = block.lane_or_exact(l, set, p, uvs[k]);
@@ -210,14 +345,70 @@ fn blocks<const FMA: bool, const L: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::point_blocks::has_avx2_fma;
+    use crate::engine::point_blocks::{has_avx2_fma, PointBlocks};
     use crate::surface::Patch;
     use glam::Vec3;
 
+    /// `eval(fma, out)` (patch `p` of `set` at `uvs`, with the AVX2 and FMA kernels or without;
+    /// only the builds the CPU has) against the generic f64 evaluation point by point:
+    /// positions within 1e-6 of `size`, normals within 1e-5 (the f32 kernels' promise),
+    /// parameters and patch ids exact. Returns how many normals the kernels made (they differ
+    /// from the f64 path's in their rounding).
+    fn assert_matches_f64(
+        what: &str,
+        set: &SurfaceSet,
+        p: usize,
+        uvs: &[DVec2],
+        size: f32,
+        eval: impl Fn(bool, VertexSlices<'_>),
+    ) -> usize {
+        let mut kernels = 0;
+        for fma in [false, true] {
+            if fma && !has_avx2_fma() {
+                continue;
+            }
+            let m = uvs.len();
+            let (mut pos, mut nrm, mut uv, mut patch) =
+                (vec![[0f32; 3]; m], vec![[0f32; 3]; m], vec![[0f32; 2]; m], vec![0u32; m]);
+            eval(fma, VertexSlices { pos: &mut pos, nrm: &mut nrm, uv: &mut uv, patch: &mut patch });
+            for (k, &at) in uvs.iter().enumerate() {
+                let q = set.patches[p].eval(at);
+                let what = format!("{what} fma {fma} at {at:?}");
+                let dp = (Vec3::from(pos[k]) - q.position.as_vec3()).length() / size;
+                let dn = (Vec3::from(nrm[k]) - q.normal.as_vec3()).length();
+                assert!(dp <= 1e-6, "{what}: position off by {dp:e} of the size");
+                assert!(dn <= 1e-5, "{what}: normal off by {dn:e}");
+                assert_eq!(uv[k], at.as_vec2().to_array(), "{what}");
+                assert_eq!(patch[k], p as u32, "{what}");
+                kernels += usize::from(nrm[k] != q.normal.as_vec3().to_array());
+            }
+        }
+        kernels
+    }
+
+    /// [`eval`] with the kernels `fma` says (the engine's two builds).
+    fn eval_either<T: LeafTree>(
+        fma: bool,
+        set: &SurfaceSet,
+        p: usize,
+        tree: &T,
+        uvs: &[DVec2],
+        out: VertexSlices<'_>,
+    ) {
+        if fma {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `assert_matches_f64` asks for these kernels only where the CPU has AVX2 and FMA.
+            unsafe {
+                eval_avx2_fma(set, p, tree, uvs, out)
+            };
+        } else {
+            eval::<false, T>(set, p, tree, uvs, out);
+        }
+    }
+
     /// Every view of an isolated face's tree (turned, transposed, a quarter) evaluated by
     /// [`eval`] at dense points — groups of every size, single points, end caps — against
-    /// the generic f64 evaluation point by point: positions within 1e-6 of the patch's size,
-    /// normals within 1e-5 (the f32 kernels' promise), parameters and patch ids exact.
+    /// the generic f64 evaluation point by point ([`assert_matches_f64`]).
     #[test]
     fn grouped_points_match_the_f64_evaluation_on_every_view() {
         let path = crate::test_support::data("subdivision/catmark_cube_creases0.obj");
@@ -244,37 +435,68 @@ mod tests {
         for (v, view) in views.iter().enumerate() {
             set.patches[p] = Patch::Subdivision(Box::new(view.clone()));
             assert!(worth_grouping(view, uvs.len()), "view {v}: dense enough to group");
-            for fma in [false, true] {
-                if fma && !has_avx2_fma() {
-                    continue;
-                }
-                let m = uvs.len();
-                let (mut pos, mut nrm, mut uv, mut patch) =
-                    (vec![[0f32; 3]; m], vec![[0f32; 3]; m], vec![[0f32; 2]; m], vec![0u32; m]);
-                let out = VertexSlices { pos: &mut pos, nrm: &mut nrm, uv: &mut uv, patch: &mut patch };
-                if fma {
-                    #[cfg(target_arch = "x86_64")]
-                    // SAFETY: the CPU has AVX2 and FMA (checked above).
-                    unsafe {
-                        eval_avx2_fma(&set, p, view, &uvs, out)
-                    };
-                } else {
-                    eval::<false>(&set, p, view, &uvs, out);
-                }
-                for (k, &at) in uvs.iter().enumerate() {
-                    let q = set.patches[p].eval(at);
-                    let what = format!("view {v} fma {fma} at {at:?}");
-                    let dp = (Vec3::from(pos[k]) - q.position.as_vec3()).length() / size;
-                    let dn = (Vec3::from(nrm[k]) - q.normal.as_vec3()).length();
-                    assert!(dp <= 1e-6, "{what}: position off by {dp:e} of the size");
-                    assert!(dn <= 1e-5, "{what}: normal off by {dn:e}");
-                    assert_eq!(uv[k], at.as_vec2().to_array(), "{what}");
-                    assert_eq!(patch[k], p as u32, "{what}");
-                    kernels += usize::from(nrm[k] != q.normal.as_vec3().to_array());
+            kernels += assert_matches_f64(&format!("view {v}"), &set, p, &uvs, size, |fma, out| {
+                eval_either(fma, &set, p, view, &uvs, out)
+            });
+        }
+        assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
+    }
+
+    /// Every Loop patch of every manifold `loop_*` cage, as built and swapped (the opposite
+    /// orientation), at dense points of its triangle: the trees through [`eval`] (quartic
+    /// leaves grouped, Gregory leaves and lone points in f64), the regular triangles through
+    /// [`PointBlocks`] as one quartic, against the generic f64 evaluation point by point
+    /// ([`assert_matches_f64`]). Most normals must come from the kernels, on trees and regular
+    /// triangles alike.
+    #[test]
+    fn loop_points_match_the_f64_evaluation_on_every_cage() {
+        let cages = crate::test_support::data_files("subdivision", &["loop_"]);
+        let n = 24;
+        let uvs: Vec<DVec2> = (0..=n)
+            .flat_map(|j| (0..=n - j).map(move |i| DVec2::new(i as f64, j as f64) / n as f64))
+            .collect();
+        let (mut cages_read, mut end_caps) = (0, 0);
+        // [trees, regular triangles]: points compared, normals from the kernels.
+        let (mut points, mut kernels) = ([0; 2], [0; 2]);
+        for path in &cages {
+            let mesh = crate::io::obj::read_obj(path).unwrap();
+            // The non-manifold cage is refused (`tests/loop_oracle.rs` checks why).
+            let Ok(built) = SurfaceSet::from_loop_cage(&mesh, path, Default::default()) else { continue };
+            cages_read += 1;
+            let (lo, hi) = built.bounds();
+            let size = lo.distance(hi) as f32;
+            let mut swapped = built.clone();
+            swapped.patches.iter_mut().for_each(|p| *p = p.flipped());
+            for (s, set) in [built, swapped].iter().enumerate() {
+                let blocks = [false, true].map(|fma| PointBlocks::for_set(set, fma));
+                for (p, patch) in set.patches.iter().enumerate() {
+                    let Patch::Loop(tree) = patch else { panic!("{}: a Loop cage's patch", path.display()) };
+                    let what = format!("{} patch {p} swapped {}", path.display(), s == 1);
+                    let regular = tree.regular().is_some();
+                    if !regular {
+                        end_caps += tree
+                            .leaves()
+                            .iter()
+                            .filter(|l| matches!(l.patch, TriangleLeafPatch::Gregory(_)))
+                            .count();
+                    }
+                    points[usize::from(regular)] += uvs.len();
+                    kernels[usize::from(regular)] +=
+                        assert_matches_f64(&what, set, p, &uvs, size, |fma, out| {
+                            if regular {
+                                blocks[usize::from(fma)].eval(set, p, &uvs, out)
+                            } else {
+                                eval_either(fma, set, p, &**tree, &uvs, out)
+                            }
+                        });
                 }
             }
         }
-        assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
+        assert!(cages_read >= 10, "only {cages_read} Loop cages read");
+        assert!(end_caps > 0, "no Gregory leaves among the trees");
+        for (kind, (k, n)) in ["trees", "regular triangles"].iter().zip(kernels.iter().zip(points)) {
+            assert!(*k * 2 > n, "{kind}: only {k} of {n} normals from the kernels");
+        }
     }
 
     /// [`eval`] compiled for AVX2 and FMA, as the engine calls it.
@@ -283,13 +505,13 @@ mod tests {
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn eval_avx2_fma(
+    unsafe fn eval_avx2_fma<T: LeafTree>(
         set: &SurfaceSet,
         p: usize,
-        tree: &PatchTree,
+        tree: &T,
         uvs: &[DVec2],
         out: VertexSlices<'_>,
     ) {
-        eval::<true>(set, p, tree, uvs, out)
+        eval::<true, T>(set, p, tree, uvs, out)
     }
 }

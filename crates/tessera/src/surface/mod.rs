@@ -91,7 +91,7 @@ impl Patch {
             Patch::BezierTriangle(p) => p.eval(uv),
             Patch::Pn(p) => p.eval(uv),
             Patch::Subdivision(t) => subdivision_point(t, uv, t.derivatives(uv)),
-            Patch::Loop(t) => loop_point(t, uv),
+            Patch::Loop(t) => loop_point(t, uv, t.derivatives(uv)),
         }
     }
 
@@ -211,10 +211,12 @@ pub(crate) fn subdivision_point(
     SurfacePoint { position, normal }
 }
 
-/// A Loop patch's point at `uv` ([`triangle_point`]; a piecewise patch offers no single
-/// mixed derivative, so a degenerate corner takes the nudged normal).
-fn loop_point(t: &TriangleTree, uv: DVec2) -> SurfacePoint {
-    triangle_point(t.derivatives(uv), uv, || DVec3::ZERO, |q| t.derivatives(q))
+/// A Loop patch's point at `uv` from its position and derivatives `d` there
+/// ([`triangle_point`]; a piecewise patch offers no single mixed derivative, so a degenerate
+/// corner takes the nudged normal).
+#[inline(always)]
+pub(crate) fn loop_point(t: &TriangleTree, uv: DVec2, d: SurfaceDerivatives) -> SurfacePoint {
+    triangle_point(d, uv, || DVec3::ZERO, |q| t.derivatives(q))
 }
 
 /// The point of a triangle patch at `uv` from its derivatives `d` there: the unit normal

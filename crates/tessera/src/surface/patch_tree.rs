@@ -595,9 +595,10 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
 /// point's walk reads several, one after the other, so a node not in the cache stalls the
 /// walk, where a tree's nodes together are a few kilobytes that stream in at once. Profiles
 /// of a cage larger than the cache showed the walks' node loads as the largest stalls; on
-/// `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 % faster.
+/// `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 % faster. Also Loop's
+/// trees' nodes and leaves ([`crate::surface::TriangleTree`]).
 #[inline(always)]
-fn prefetch_nodes(nodes: &[[Slot; 4]]) {
+pub(crate) fn prefetch_nodes<T>(nodes: &[T]) {
     #[cfg(target_arch = "x86_64")]
     {
         let bytes = std::mem::size_of_val(nodes).min(64 * NODE_LINES);

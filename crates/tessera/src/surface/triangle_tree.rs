@@ -248,10 +248,45 @@ impl TriangleTree {
         }
     }
 
+    /// The one quartic piece of a regular triangle (a tree of one leaf over the whole
+    /// triangle), in the leaf's own parameters: the patch's, exchanged where the tree
+    /// [`TriangleTree::is_swapped`]. None for a tree of several leaves or an end cap.
+    pub fn regular(&self) -> Option<&QuarticTriangle> {
+        match (&self.root, &*self.leaves) {
+            (TriangleSlot::Leaf(0), [leaf])
+                if !leaf.turned && leaf.origin == DVec2::ZERO && leaf.size == 1.0 =>
+            {
+                match &leaf.patch {
+                    TriangleLeafPatch::Quartic(q) => Some(q),
+                    TriangleLeafPatch::Gregory(_) => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// Starts loading the quadtree's nodes (a hint, as [`super::PatchTree`]'s).
+    #[inline(always)]
+    pub(crate) fn prefetch_nodes(&self) {
+        super::patch_tree::prefetch_nodes(&self.nodes);
+    }
+
+    /// Starts loading leaf `leaf` (a hint).
+    #[inline(always)]
+    pub(crate) fn prefetch_leaf(&self, leaf: usize) {
+        super::patch_tree::prefetch_nodes(std::slice::from_ref(&self.leaves[leaf]));
+    }
+
     /// Position and first derivatives with respect to the patch's `uv`. Cost: a tree walk and
     /// one leaf's evaluation.
     pub fn derivatives(&self, uv: DVec2) -> SurfaceDerivatives {
         let (leaf, st) = self.find(uv);
+        self.found_derivatives(leaf, st)
+    }
+
+    /// [`TriangleTree::derivatives`] of the point [`TriangleTree::find`] placed at `st` in
+    /// leaf `leaf`: the same values. Cost: one leaf's evaluation.
+    pub(crate) fn found_derivatives(&self, leaf: usize, st: DVec2) -> SurfaceDerivatives {
         let leaf = &self.leaves[leaf];
         let d = leaf.patch.derivatives(st);
         let scale = if leaf.turned { -1.0 / leaf.size } else { 1.0 / leaf.size };
