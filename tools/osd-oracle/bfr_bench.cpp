@@ -280,7 +280,7 @@ void tessellateFaces(const Bfr::RefinerSurfaceFactory<> &factory, const std::vec
 struct Args {
     int threads = 2, rate = 16, copies = 0, repeat = 5;
     bool useFloat = false;
-    std::string ratesPath, path;
+    std::string ratesPath, path, scheme;
 };
 
 template <typename REAL>
@@ -365,7 +365,8 @@ int run(const Cage &cage, const Topology &topo, const Args &args) {
                 "  --float      evaluate with Bfr::Surface<float> (default: double)\n"
                 "  --adaptive-rates FILE  per-face rates, one line per face of the\n"
                 "               replicated cage, instead of --rate\n"
-                "  scheme: loop if the file name starts with 'loop_', else catmark\n");
+                "  --scheme loop|catmark  the subdivision scheme (default: loop if the file\n"
+                "               name starts with 'loop_', else catmark)\n");
     std::exit(0);
 }
 
@@ -389,6 +390,12 @@ int main(int argc, char **argv) {
         else if (a == "--copies") args.copies = intArg(i, "--copies", 1, 1000000);
         else if (a == "--repeat") args.repeat = intArg(i, "--repeat", 1, 1000);
         else if (a == "--float") args.useFloat = true;
+        else if (a == "--scheme") {
+            if (i + 1 >= argc) badArgs("--scheme needs a value");
+            args.scheme = argv[++i];
+            if (args.scheme != "loop" && args.scheme != "catmark")
+                badArgs("--scheme must be loop or catmark, not '" + args.scheme + "'");
+        }
         else if (a == "--adaptive-rates") {
             if (i + 1 >= argc) badArgs("--adaptive-rates needs a value");
             args.ratesPath = argv[++i];
@@ -402,7 +409,8 @@ int main(int argc, char **argv) {
 
     std::string base = args.path.substr(
         args.path.find_last_of('/') == std::string::npos ? 0 : args.path.find_last_of('/') + 1);
-    Sdc::SchemeType scheme = base.rfind("loop_", 0) == 0 ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
+    bool loop = args.scheme.empty() ? base.rfind("loop_", 0) == 0 : args.scheme == "loop";
+    Sdc::SchemeType scheme = loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
 
     Far::SetErrorCallback(farError);
     Far::SetWarningCallback(farWarning);

@@ -246,21 +246,24 @@ fn tolerance_bounds_hold_on_every_cage() {
     tolerance_bounds_hold(false);
 }
 
-/// The GPU engine takes every Catmull-Clark cage: regular faces as bicubic patches, isolated
-/// faces as their trees of pieces (`tessera-gpu`'s `tree.wgsl`; its tests compare the frames
-/// with the CPU's). Loop cages are refused by name until the GPU evaluates their triangles.
+/// The GPU engine takes every subdivision cage: Catmull-Clark regular faces as bicubic
+/// patches, isolated faces as their trees of pieces, Loop triangles as their triangle trees
+/// (`tessera-gpu`'s `tree.wgsl`; its tests compare the frames with the CPU's).
 #[test]
-fn the_gpu_engine_takes_every_catmull_clark_cage_and_refuses_loop_cages() {
+fn the_gpu_engine_takes_catmull_clark_and_loop_cages() {
     let criterion = Criterion::Factor(4.0);
     let options = PlanOptions::default();
-    for cage in ["subdivision/catmark_torus.obj", "subdivision/catmark_cube.obj"] {
-        let set = load_cage(&common::model(cage), SurfaceKind::CatmullClark);
-        validate(Scheme::Uniform, &criterion, &options, &set, Engine::Gpu).unwrap();
+    let cages = [
+        ("subdivision/catmark_torus.obj", SurfaceKind::CatmullClark),
+        ("subdivision/catmark_cube.obj", SurfaceKind::CatmullClark),
+        ("subdivision/loop_cube.obj", SurfaceKind::Loop),
+    ];
+    for (cage, kind) in cages {
+        let set = load_cage(&common::model(cage), kind);
+        for engine in [Engine::Cpu, Engine::Gpu] {
+            validate(Scheme::Uniform, &criterion, &options, &set, engine).unwrap();
+        }
     }
-    let set = load_cage(&common::model("subdivision/loop_cube.obj"), SurfaceKind::Loop);
-    validate(Scheme::Uniform, &criterion, &options, &set, Engine::Cpu).unwrap();
-    let e = validate(Scheme::Uniform, &criterion, &options, &set, Engine::Gpu).unwrap_err();
-    assert!(matches!(e, Error::EngineNotSupported { .. }) && e.to_string().contains("Loop"), "{e}");
 }
 
 /// Bad cages are refused with the file, the line and the reason; never a panic.

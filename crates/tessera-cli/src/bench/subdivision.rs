@@ -1,8 +1,9 @@
 //! `subdivision`: Catmull-Clark and Loop cages against OpenSubdiv's Bfr, the reference —
 //! uniform tessellation at Bfr's rate 16 and adaptive tessellation at half a pixel, on cages
 //! copied past 50,000 faces (`catmark_torus`, all regular; `catmark_rook`, triangles and
-//! semi-sharp creases; `loop_xord_interior`, Loop with extraordinary vertices), per thread
-//! count.
+//! semi-sharp creases; `loop_xord_interior`, Loop with extraordinary vertices next to every
+//! face; `killeroo_cage`, pbrt's Loop control mesh of a scanned figure, mostly regular), per
+//! thread count.
 //!
 //! Bfr's figures come from `tools/osd-oracle/bfr_bench` (a C++ program linked against
 //! OpenSubdiv, built by `tools/osd-oracle/bfr_bench.sh`; tessera does not link OpenSubdiv),
@@ -25,25 +26,29 @@ use tessera::tessellator::{Tessellator, TessellatorOptions};
 struct Case {
     model: &'static str,
     copies: usize,
+    /// A Loop cage (else Catmull-Clark).
+    loop_: bool,
 }
 
 fn cases(quick: bool) -> Vec<Case> {
     if quick {
         return vec![
-            Case { model: "subdivision/catmark_torus.obj", copies: 16 },
-            Case { model: "subdivision/catmark_torus_creases0.obj", copies: 4 },
+            Case { model: "subdivision/catmark_torus.obj", copies: 16, loop_: false },
+            Case { model: "subdivision/catmark_torus_creases0.obj", copies: 4, loop_: false },
             // Triangles and a quad, so split into sub-faces, with creases.
-            Case { model: "subdivision/catmark_pyramid_creases0.obj", copies: 16 },
+            Case { model: "subdivision/catmark_pyramid_creases0.obj", copies: 16, loop_: false },
             // Loop, semi-sharp creases.
-            Case { model: "subdivision/loop_cube_creases0.obj", copies: 16 },
+            Case { model: "subdivision/loop_cube_creases0.obj", copies: 16, loop_: true },
         ];
     }
     vec![
         // 32 faces × 1,563 = 50,016 and 777 × 65 = 50,505: the issue's "≥ 50k faces".
-        Case { model: "subdivision/catmark_torus.obj", copies: 1563 },
-        Case { model: "subdivision/catmark_rook.obj", copies: 65 },
+        Case { model: "subdivision/catmark_torus.obj", copies: 1563, loop_: false },
+        Case { model: "subdivision/catmark_rook.obj", copies: 65, loop_: false },
         // Loop (issue 28): 69 triangles with extraordinary vertices × 725 = 50,025.
-        Case { model: "subdivision/loop_xord_interior.obj", copies: 725 },
+        Case { model: "subdivision/loop_xord_interior.obj", copies: 725, loop_: true },
+        // A real Loop cage (pbrt's `loopsubdiv` Killeroo): 8,316 triangles × 7 = 58,212.
+        Case { model: "meshes/killeroo_cage.obj", copies: 7, loop_: true },
     ]
 }
 
@@ -98,8 +103,7 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
         ctx.step(&format!("subdivision: loading {name} × {}", case.copies));
         let start = std::time::Instant::now();
         let mesh = tessera::scene::mesh_grid(&tessera::io::obj::read_obj(&path)?, case.copies);
-        // `loop_*` cages are Loop's, as Bfr's benchmark takes them by the file name.
-        let set = if name.starts_with("loop_") {
+        let set = if case.loop_ {
             SurfaceSet::from_loop_cage(&mesh, &path, CageOptions::default())?
         } else {
             SurfaceSet::from_subdivision_cage(&mesh, &path, CageOptions::default())?
@@ -136,6 +140,7 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
                         .map_err(|e| format!("{}: {e}", rates_file.display()))?;
                     bfr_args = vec!["--adaptive-rates".into(), rates_file.display().to_string()];
                 }
+                bfr_args.extend(["--scheme".into(), if case.loop_ { "loop" } else { "catmark" }.into()]);
                 let bfr_row = match &bfr {
                     Some(program) => Some(run_bfr(program, &path, case.copies, threads, runs, &bfr_args)?),
                     None => None,
