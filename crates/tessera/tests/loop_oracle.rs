@@ -3,7 +3,7 @@
 //! through `tools/osd-oracle` (`SCHEME_LOOP`, chosen by the file name), within 1e-6 of the
 //! cage's bounding-box diagonal. Bfr's parameters of a triangle are the patch's own.
 
-use common::osd::{cage_diagonal, run_oracle};
+use common::osd::{cage_diagonal, run_oracle, run_oracle_with};
 use tessera::io::obj::read_obj;
 use tessera::subdivision::CageOptions;
 use tessera::surface::{Orientation, SurfaceSet};
@@ -38,31 +38,7 @@ fn every_loop_face_agrees_with_bfr() {
             assert!(e.to_string().contains("non-manifold") && e.to_string().contains(":72:"), "{e}");
             continue;
         }
-        let set = SurfaceSet::from_loop_cage(&mesh, &path, options).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let patch_of: std::collections::HashMap<u32, usize> =
-            set.origins.iter().enumerate().map(|(p, o)| (o.face, p)).collect();
-        let diagonal = cage_diagonal(&mesh);
-        let mut worst = (0.0f64, String::new());
-        let mut points = 0;
-        for rate in 1..=8 {
-            let faces = run_oracle(&path, rate);
-            assert_eq!(faces.len(), mesh.faces.len(), "{name}");
-            for (f, face) in faces.iter().enumerate() {
-                assert_eq!(
-                    patch_of.contains_key(&(f as u32)),
-                    face.limit,
-                    "{name} face {f}: has a limit surface"
-                );
-                for &(uv, expected) in &face.points {
-                    let p = patch_of[&(f as u32)];
-                    let d = (set.patches[p].position(uv) - expected).length() / diagonal;
-                    if d > worst.0 {
-                        worst = (d, format!("face {f} rate {rate} at {uv}"));
-                    }
-                    points += 1;
-                }
-            }
-        }
+        let (worst, points) = compare_with_bfr(&path, 1..=8);
         compared += 1;
         if worst.0 > worst_overall.0 {
             worst_overall = (worst.0, format!("{name} {}", worst.1));
@@ -73,6 +49,55 @@ fn every_loop_face_agrees_with_bfr() {
     eprintln!("worst of all: {:.3e} of the diagonal, {}", worst_overall.0, worst_overall.1);
     assert!(compared >= 11, "only {compared} Loop cages compared");
     assert!(worst_overall.0 < 1e-6, "worst {:.3e} at {}", worst_overall.0, worst_overall.1);
+}
+
+/// The largest distance (relative to the cage's diagonal) from tessera's limit point to Bfr's
+/// over every face of the cage at `path` at each uniform rate of `rates`, where, and how many
+/// points were compared. Asserts that the same faces have a limit surface.
+fn compare_with_bfr(path: &std::path::Path, rates: std::ops::RangeInclusive<u32>) -> ((f64, String), usize) {
+    let name = path.file_name().unwrap().to_string_lossy().into_owned();
+    let mesh = read_obj(path).unwrap();
+    let options = CageOptions { orientation: Orientation::AsGiven, ..Default::default() };
+    let set = SurfaceSet::from_loop_cage(&mesh, path, options).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let patch_of: std::collections::HashMap<u32, usize> =
+        set.origins.iter().enumerate().map(|(p, o)| (o.face, p)).collect();
+    let diagonal = cage_diagonal(&mesh);
+    let mut worst = (0.0f64, String::new());
+    let mut points = 0;
+    for rate in rates {
+        let faces = run_oracle_with(path, rate, &["--scheme", "loop"]);
+        assert_eq!(faces.len(), mesh.faces.len(), "{name}");
+        for (f, face) in faces.iter().enumerate() {
+            assert_eq!(
+                patch_of.contains_key(&(f as u32)),
+                face.limit,
+                "{name} face {f}: has a limit surface"
+            );
+            for &(uv, expected) in &face.points {
+                let p = patch_of[&(f as u32)];
+                let d = (set.patches[p].position(uv) - expected).length() / diagonal;
+                if d > worst.0 {
+                    worst = (d, format!("face {f} rate {rate} at {uv}"));
+                }
+                points += 1;
+            }
+        }
+    }
+    (worst, points)
+}
+
+/// A real Loop cage, not made to test a feature: pbrt's `loopsubdiv` Killeroo control mesh
+/// (8,316 triangles, open, nine pieces), every face at rates 1, 2 and 5.
+#[test]
+fn a_real_loop_cage_agrees_with_bfr() {
+    let path = tessera::test_support::data("meshes/killeroo_cage.obj");
+    let (worst, points) = compare_with_bfr(&path, 1..=2);
+    let (worst5, points5) = compare_with_bfr(&path, 5..=5);
+    let worst = if worst5.0 > worst.0 { worst5 } else { worst };
+    eprintln!("killeroo_cage: {} points, worst {:.2e} {}", points + points5, worst.0, worst.1);
+    // Every face has a limit surface: 3 + 6 + 21 points each.
+    assert_eq!(points + points5, 8316 * 30);
+    assert!(worst.0 < 1e-6, "worst {:.3e} at {}", worst.0, worst.1);
 }
 
 /// tessera's output itself, in f32: the uniform tessellation at factor N of every manifold

@@ -47,7 +47,14 @@ pub fn oracle_version() -> [u32; 3] {
 }
 
 pub fn run_oracle(cage: &Path, rate: u32) -> Vec<OracleFace> {
-    let out = Command::new(oracle()).arg(cage).arg(rate.to_string()).output().expect("run the oracle");
+    run_oracle_with(cage, rate, &[])
+}
+
+/// [`run_oracle`] with the oracle's options `args` (e.g. `["--scheme", "loop"]` for a Loop
+/// cage whose name does not start with `loop_`).
+pub fn run_oracle_with(cage: &Path, rate: u32, args: &[&str]) -> Vec<OracleFace> {
+    let out =
+        Command::new(oracle()).args(args).arg(cage).arg(rate.to_string()).output().expect("run the oracle");
     assert!(
         out.status.success(),
         "oracle failed on {}: {}",
