@@ -260,7 +260,14 @@ fn loop_derivatives(p: u32, uv_in: vec2<f32>) -> Derivatives {
     let leaf_turned = (kind & 2u) != 0u;
     var st = (uv - leaf.xy) / leaf.z;
     if (leaf_turned) { st = (leaf.xy + vec2<f32>(leaf.z) - uv) / leaf.z; }
-    let d = quartic_derivatives(loop_leaf_net(at + 1u, (kind & 1u) != 0u, st), st);
+    // The net moved to its first point: the derivatives are differences of the net's points,
+    // which lose the bits the net's distance from the origin takes (a degenerate corner's
+    // normal, a small step inside, needs them), and the position gets the point back.
+    var net = loop_leaf_net(at + 1u, (kind & 1u) != 0u, st);
+    let origin = net[0];
+    for (var k = 0u; k < 15u; k = k + 1u) { net[k] = net[k] - origin; }
+    var d = quartic_derivatives(net, st);
+    d.position = d.position + origin;
     let scale = select(1.0, -1.0, leaf_turned) / leaf.z;
     if (swapped) { return Derivatives(d.position, d.dv * scale, d.du * scale); }
     return Derivatives(d.position, d.du * scale, d.dv * scale);

@@ -163,7 +163,21 @@ pub fn assert_gpu_equals_cpu_after_record(
     }
     for (v, (g, w)) in got.normals.iter().zip(&want.normals).enumerate() {
         let dot = g[0] * w[0] + g[1] * w[1] + g[2] * w[2];
-        assert!(dot > 0.99, "{name}: normal {v} is {g:?}, the CPU's {w:?}");
+        // Where the surface's first derivatives are parallel (a Loop boundary vertex of one
+        // triangle: its two edges leave along one tangent), the normal is a limit: the CPU
+        // takes it 1e-6 inside in f64, the GPU in f32 a step of 1e-4 or more inside, within
+        // about 20° of it (measured up to 19.4° on pbrt's Killeroo cage).
+        let degenerate = || {
+            let p = want.vertex_patch[v] as usize;
+            let uv = glam::DVec2::new(want.uvs[v][0] as f64, want.uvs[v][1] as f64);
+            let d = set.patches[p].derivatives(uv);
+            let scale = d.du.length_squared().max(d.dv.length_squared());
+            d.du.cross(d.dv).length_squared() <= 1e-20 * scale * scale
+        };
+        assert!(
+            dot > 0.99 || (dot > 0.94 && degenerate()),
+            "{name}: normal {v} is {g:?}, the CPU's {w:?}"
+        );
     }
     assert_eq!(got.vertex_patch, want.vertex_patch, "{name}: vertex patches");
     assert_eq!(got.triangle_patch, want.triangle_patch, "{name}: triangle patches");
