@@ -174,10 +174,7 @@ pub fn assert_gpu_equals_cpu_after_record(
             let scale = d.du.length_squared().max(d.dv.length_squared());
             d.du.cross(d.dv).length_squared() <= 1e-20 * scale * scale
         };
-        assert!(
-            dot > 0.99 || (dot > 0.94 && degenerate()),
-            "{name}: normal {v} is {g:?}, the CPU's {w:?}"
-        );
+        assert!(dot > 0.99 || (dot > 0.94 && degenerate()), "{name}: normal {v} is {g:?}, the CPU's {w:?}");
     }
     assert_eq!(got.vertex_patch, want.vertex_patch, "{name}: vertex patches");
     assert_eq!(got.triangle_patch, want.triangle_patch, "{name}: triangle patches");
