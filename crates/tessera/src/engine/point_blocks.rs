@@ -27,7 +27,7 @@
 
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
-use crate::surface::{BezierTriangle, Patch, SurfacePoint, SurfaceSet};
+use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -162,6 +162,44 @@ const fn differences<const N: usize, const M: usize>() -> [(usize, usize, usize,
     out
 }
 
+/// Where a lone control point `at` of a Bézier triangle of degree `d` (`N` points) enters
+/// the derivatives: for each monomial `m` of degree `d − 1` ([`exponents`] order) that it
+/// enters, `(m, cu, cv)` with `∂S/∂u = Σ cu · λ^m` and `∂S/∂v = Σ cv · λ^m` for that point at
+/// 1 and the others at 0 ([`differences`] read backwards). An interior point enters three
+/// monomials, which the precondition asks.
+const fn point_differences<const N: usize, const M: usize>(at: usize) -> [(usize, f64, f64); 3] {
+    let table = differences::<N, M>();
+    let mut out = [(0, 0.0, 0.0); 3];
+    let (mut m, mut n) = (0, 0);
+    while m < M {
+        let (base, at_u, at_v, c) = table[m];
+        let minus = if base == at { c } else { 0.0 };
+        let cu = if at_u == at { c } else { 0.0 } - minus;
+        let cv = if at_v == at { c } else { 0.0 } - minus;
+        if cu != 0.0 || cv != 0.0 {
+            out[n] = (m, cu, cv);
+            n += 1;
+        }
+        m += 1;
+    }
+    assert!(n == 3, "an interior point enters three monomials");
+    out
+}
+
+/// Per corner of a Gregory triangle ([`GregoryTriangle::INTERIOR`]): where its interior point
+/// stands in the quartic net, its multinomial `4!/(i!j!k!)`, and its [`point_differences`].
+const fn gregory_interior() -> [(usize, f64, [(usize, f64, f64); 3]); 3] {
+    let mut out = [(0, 0.0, [(0, 0.0, 0.0); 3]); 3];
+    let mut c = 0;
+    while c < 3 {
+        let (_, _, (i, j, _)) = GregoryTriangle::INTERIOR[c];
+        let at = index(4, i, j);
+        out[c] = (at, multinomials::<15>()[at], point_differences::<15, 10>(at));
+        c += 1;
+    }
+    out
+}
+
 /// A Bézier triangle of degree `d` (`N` control points; `M` those of degree `d − 1`: cubic
 /// `<10, 6>`, quartic `<15, 10>`) in its local frame, with the multinomial coefficients folded
 /// into the control points so that each sum is over bare monomials.
@@ -183,6 +221,30 @@ pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
 /// A quartic Bézier triangle in its local frame: Loop's regular pieces.
 pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
 
+/// A Gregory triangle (Loop's end caps, [`GregoryTriangle`]) in its local frame, the frame
+/// of all its 18 points: the quartic net with each interior point its corner's `Fp`, and each
+/// corner's `Fm − Fp`. The blended net of a lane is that quartic plus `g · (Fm − Fp)` at each
+/// interior point, `g` the lane's weight of `Fm` ([`GregoryTriangle::blend_weights_of`]); the
+/// kernel is linear in the net, so it adds each interior point's basis (and its derivatives,
+/// the blend held fixed as OpenSubdiv holds it) times that, per lane ([`gregory_block`]).
+pub(crate) struct LocalGregory {
+    net: LocalQuartic,
+    /// `(Fm − Fp) / scale` of each corner, rounded to f32: `[corner][component]`.
+    spread: [[f32; 3]; 3],
+}
+
+impl LocalGregory {
+    /// Cost: O(18), like [`LocalTriangle::from_net`].
+    #[inline(always)]
+    pub(crate) fn new(g: &GregoryTriangle) -> Self {
+        let (origin, scale) = local_frame(&g.points);
+        let net = LocalQuartic::in_frame(&g.blended_with([(1.0, 0.0); 3]).points, (origin, scale));
+        let spread = GregoryTriangle::INTERIOR
+            .map(|(fp, fm, _)| ((g.points[fm] - g.points[fp]) * (1.0 / scale)).as_vec3().to_array());
+        LocalGregory { net, spread }
+    }
+}
+
 impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// The Bézier triangle of degree `d` with control points `net` in [`exponents`] order.
     /// Cost: O(N), every index and coefficient a constant. Inlined: the grouped leaves
@@ -191,7 +253,13 @@ impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// coefficients computed.
     #[inline(always)]
     pub(crate) fn from_net(net: &[DVec3; N]) -> Self {
-        let (origin, scale) = local_frame(net);
+        Self::in_frame(net, local_frame(net))
+    }
+
+    /// [`LocalTriangle::from_net`] in the frame `(origin, scale)` ([`local_frame`] of the net,
+    /// or of points around it).
+    #[inline(always)]
+    fn in_frame(net: &[DVec3; N], (origin, scale): (DVec3, f64)) -> Self {
         let inv = 1.0 / scale;
         let mut local = LocalTriangle {
             origin: origin.as_vec3().to_array(),
@@ -553,15 +621,9 @@ fn combine<const FMA: bool, const L: usize, const M: usize>(
     out
 }
 
-/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
+/// `powers[a][e][l] = λa^e` of lane `l`, `λ = (1 − u − v, u, v)`, for `e` up to `d` (≤ 4).
 #[inline(always)]
-pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
-    t: &LocalTriangle<N, M>,
-    u: &[f32; L],
-    v: &[f32; L],
-) -> Block<L> {
-    // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v), up to the degree.
-    let d = const { degree(N) };
+fn lambda_powers<const L: usize>(d: usize, u: &[f32; L], v: &[f32; L]) -> [[[f32; L]; 5]; 3] {
     let mut powers = [[[1f32; L]; 5]; 3];
     for l in 0..L {
         let lambda = [1.0 - u[l] - v[l], u[l], v[l]];
@@ -572,11 +634,77 @@ pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, co
             }
         }
     }
+    powers
+}
+
+/// A Bézier triangle's `∂S/∂u` and `∂S/∂v` (local frame) of each lane, from its
+/// [`lambda_powers`].
+#[inline(always)]
+fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
+    powers: &[[[f32; L]; 5]; 3],
+) -> [[[f32; L]; 3]; 2] {
+    let lower = monomials(powers, &const { exponents::<M>() });
+    [combine::<FMA, L, M>(&t.du, &lower), combine::<FMA, L, M>(&t.dv, &lower)]
+}
+
+/// A Gregory triangle at each lane's `(u, v)` ([`LocalGregory`]): the quartic kernel's sums
+/// of the net with the `Fp`s, plus each corner's interior basis times the lane's blend
+/// weight of `Fm` times `Fm − Fp`; normal and reliability as every triangle's.
+// Index loops over lanes (they vectorize).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
+    g: &LocalGregory,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let powers = lambda_powers::<L>(4, u, v);
+    let basis = monomials(&powers, &const { exponents::<15>() });
+    let mut pos = combine::<FMA, L, 15>(&g.net.pos, &basis);
+    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10>(&g.net, &powers);
+    let lower = monomials(&powers, &const { exponents::<10>() });
+    let mut weights = [[0f32; L]; 3];
+    for l in 0..L {
+        let w = GregoryTriangle::blend_weights_of(u[l], v[l]);
+        (0..3).for_each(|c| weights[c][l] = w[c].1);
+    }
+    for (c, &(at, coefficient, enters)) in const { gregory_interior() }.iter().enumerate() {
+        for l in 0..L {
+            let g_l = weights[c][l];
+            let b = coefficient as f32 * basis[at][l] * g_l;
+            let (mut bu, mut bv) = (0f32, 0f32);
+            for &(m, cu, cv) in &enters {
+                bu = madd::<FMA>(cu as f32, lower[m][l], bu);
+                bv = madd::<FMA>(cv as f32, lower[m][l], bv);
+            }
+            let (bu, bv) = (bu * g_l, bv * g_l);
+            for a in 0..3 {
+                let d = g.spread[c][a];
+                pos[a][l] = madd::<FMA>(b, d, pos[a][l]);
+                su[a][l] = madd::<FMA>(bu, d, su[a][l]);
+                sv[a][l] = madd::<FMA>(bv, d, sv[a][l]);
+            }
+        }
+    }
+    let (nrm, margin) = cross_normals(&su, &sv);
+    to_model::<FMA, L>(&mut pos, &g.net.origin, g.net.scale);
+    Block { pos, nrm, margin }
+}
+
+/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
+#[inline(always)]
+pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let powers = lambda_powers::<L>(const { degree(N) }, u, v);
     let mut pos = combine::<FMA, L, N>(&t.pos, &monomials(&powers, &const { exponents::<N>() }));
     let (nrm, margin) = match &t.pn {
         None => {
-            let lower = monomials(&powers, &const { exponents::<M>() });
-            cross_normals(&combine::<FMA, L, M>(&t.du, &lower), &combine::<FMA, L, M>(&t.dv, &lower))
+            let [su, sv] = derivative_sums::<FMA, L, N, M>(t, &powers);
+            cross_normals(&su, &sv)
         }
         Some(field) => {
             let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
