@@ -25,6 +25,7 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
+use super::tree_points::{loop_leaves, LoopLeaf};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
@@ -162,12 +163,16 @@ const fn differences<const N: usize, const M: usize>() -> [(usize, usize, usize,
     out
 }
 
+/// `(m, cu, cv)` for each monomial of the derivatives that an interior point enters
+/// ([`point_differences`]).
+type PointDifferences = [(usize, f64, f64); 3];
+
 /// Where a lone control point `at` of a Bézier triangle of degree `d` (`N` points) enters
 /// the derivatives: for each monomial `m` of degree `d − 1` ([`exponents`] order) that it
 /// enters, `(m, cu, cv)` with `∂S/∂u = Σ cu · λ^m` and `∂S/∂v = Σ cv · λ^m` for that point at
 /// 1 and the others at 0 ([`differences`] read backwards). An interior point enters three
 /// monomials, which the precondition asks.
-const fn point_differences<const N: usize, const M: usize>(at: usize) -> [(usize, f64, f64); 3] {
+const fn point_differences<const N: usize, const M: usize>(at: usize) -> PointDifferences {
     let table = differences::<N, M>();
     let mut out = [(0, 0.0, 0.0); 3];
     let (mut m, mut n) = (0, 0);
@@ -188,7 +193,7 @@ const fn point_differences<const N: usize, const M: usize>(at: usize) -> [(usize
 
 /// Per corner of a Gregory triangle ([`GregoryTriangle::INTERIOR`]): where its interior point
 /// stands in the quartic net, its multinomial `4!/(i!j!k!)`, and its [`point_differences`].
-const fn gregory_interior() -> [(usize, f64, [(usize, f64, f64); 3]); 3] {
+const fn gregory_interior() -> [(usize, f64, PointDifferences); 3] {
     let mut out = [(0, 0.0, [(0, 0.0, 0.0); 3]); 3];
     let mut c = 0;
     while c < 3 {
@@ -314,6 +319,8 @@ enum Local {
     Triangle(u32),
     /// A regular Loop patch (one quartic piece).
     Quartic(u32),
+    /// An irregular Loop patch: its tree's leaves start there in [`PointBlocks`]' `loop_leaves`.
+    LoopTree(u32),
     /// A rational bicubic whose weights span more than f32 carries
     /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
     Generic,
@@ -334,6 +341,7 @@ enum Form {
     Rational(LocalPatch<4>),
     Triangle(LocalTriangle),
     Quartic(LocalQuartic),
+    LoopTree(Vec<LoopLeaf>),
     Generic,
 }
 
@@ -352,6 +360,10 @@ pub(crate) struct PointBlocks {
     rationals: Vec<LocalPatch<4>>,
     triangles: Vec<LocalTriangle>,
     quartics: Vec<LocalQuartic>,
+    /// Every leaf of each irregular Loop patch's tree, in its local frame, the trees in patch
+    /// order: made once per set rather than once for every list of points that reaches a leaf
+    /// (the interior's, each owned edge's).
+    loop_leaves: Vec<LoopLeaf>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -738,14 +750,17 @@ impl PointBlocks {
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
-                Patch::Loop(t) => t.regular().map_or(Form::Generic, |q| {
-                    let net = if t.is_swapped() {
-                        const { swapped::<15>() }.map(|m| q.points[m])
-                    } else {
-                        q.points
-                    };
-                    Form::Quartic(LocalQuartic::from_net(&net))
-                }),
+                Patch::Loop(t) => t.regular().map_or_else(
+                    || Form::LoopTree(loop_leaves(t)),
+                    |q| {
+                        let net = if t.is_swapped() {
+                            const { swapped::<15>() }.map(|m| q.points[m])
+                        } else {
+                            q.points
+                        };
+                        Form::Quartic(LocalQuartic::from_net(&net))
+                    },
+                ),
                 // Piecewise (isolated) patches take the generic evaluation, or their points
                 // grouped by leaf (`tree_points`).
                 Patch::Subdivision(_) => Form::Generic,
@@ -757,6 +772,7 @@ impl PointBlocks {
             rationals: Vec::new(),
             triangles: Vec::new(),
             quartics: Vec::new(),
+            loop_leaves: Vec::new(),
             all_bicubic: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
@@ -766,6 +782,11 @@ impl PointBlocks {
                 Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
                 Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
                 Form::Quartic(t) => Local::Quartic(push(&mut blocks.quartics, t)),
+                Form::LoopTree(leaves) => {
+                    let first = blocks.loop_leaves.len() as u32;
+                    blocks.loop_leaves.extend(leaves);
+                    Local::LoopTree(first)
+                }
                 Form::Generic => Local::Generic,
             };
             blocks.locals.push(local);
@@ -791,7 +812,7 @@ impl PointBlocks {
             Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
             Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
             Local::Quartic(i) => FormRef::Quartic(&self.quartics[i as usize]),
-            Local::Generic => return None,
+            Local::LoopTree(_) | Local::Generic => return None,
         })
     }
 
@@ -826,19 +847,21 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        if let Local::Generic = self.locals[p] {
+        if let Local::Generic | Local::LoopTree(_) = self.locals[p] {
             use super::tree_points::{eval as grouped, worth_grouping};
-            match &set.patches[p] {
-                Patch::Subdivision(tree) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+            match (&set.patches[p], self.locals[p]) {
+                (Patch::Subdivision(tree), _) if worth_grouping(&**tree, uvs.len()) => {
+                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
                 }
-                Patch::Loop(tree) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+                (Patch::Loop(tree), Local::LoopTree(first)) if worth_grouping(&**tree, uvs.len()) => {
+                    let first = first as usize;
+                    let leaves = &self.loop_leaves[first..first + tree.leaves().len()];
+                    return grouped::<FMA, _>(set, p, &**tree, Some(leaves), uvs, out);
                 }
                 _ => {}
             }
         }
-        if matches!(self.locals[p], Local::Generic) {
+        if matches!(self.locals[p], Local::Generic | Local::LoopTree(_)) {
             // In f64 as the generic evaluation, compiled here for the wider instructions
             // (Rust never fuses a multiply and an add by itself, so the values are the same).
             let mut out = out;

@@ -161,6 +161,12 @@ pub(super) enum LoopLeaf {
     Gregory(LocalGregory),
 }
 
+/// Every leaf of `tree` in its local frame ([`LeafTree::local`]), in leaf order: what
+/// [`super::point_blocks::PointBlocks`] keeps per set for [`eval`]. Cost: O(leaves).
+pub(super) fn loop_leaves(tree: &TriangleTree) -> Vec<LoopLeaf> {
+    (0..tree.leaves().len()).map(|l| tree.local(l).expect("every Loop leaf has a local form")).collect()
+}
+
 impl LeafTree for TriangleTree {
     type Local = LoopLeaf;
     /// Every list: Loop's f64 path has no look-ahead to lose, and finding a point's leaf is
@@ -254,17 +260,19 @@ pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
 }
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
-/// [`VertexSlices::put`] does point by point. Preconditions: `set.patches[p]` is `tree`;
-/// `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2 and FMA. Cost: a leaf
-/// lookup per point and a sort of the points by leaf (O(n + leaves), or O(n log n) for fewer
-/// points than leaves); per group, moving its net to f32 once and the bicubic kernel's
-/// price per point; per single point, the f64 evaluation. No allocation once the thread's
-/// scratch has grown.
+/// [`VertexSlices::put`] does point by point, the leaves' local forms taken from `locals`
+/// where given (per leaf, in leaf order), else made for each group. Preconditions:
+/// `set.patches[p]` is `tree`; `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2
+/// and FMA. Cost: a leaf lookup per point and a sort of the points by leaf (O(n + leaves), or
+/// O(n log n) for fewer points than leaves); per group, moving its net to f32 once (unless
+/// `locals` holds it) and the kernel's price per point; per single point, the f64 evaluation.
+/// No allocation once the thread's scratch has grown.
 #[inline(always)]
 pub(super) fn eval<const FMA: bool, T: LeafTree>(
     set: &SurfaceSet,
     p: usize,
     tree: &T,
+    locals: Option<&[T::Local]>,
     uvs: &[DVec2],
     mut out: VertexSlices<'_>,
 ) {
@@ -309,12 +317,21 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     }
     let flip = tree.reverses_normal();
     for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
-        let local = if group.len() >= T::MIN_GROUP { tree.local(group[0].leaf as usize) } else { None };
+        let leaf = group[0].leaf as usize;
+        let made;
+        let local = match locals {
+            _ if group.len() < T::MIN_GROUP => None,
+            Some(locals) => Some(&locals[leaf]),
+            None => {
+                made = tree.local(leaf);
+                made.as_ref()
+            }
+        };
         match local {
             Some(local) if group.len() <= LANES / 2 => {
-                blocks::<FMA, { LANES / 2 }, T>(set, p, &local, flip, group, uvs, &mut out);
+                blocks::<FMA, { LANES / 2 }, T>(set, p, local, flip, group, uvs, &mut out);
             }
-            Some(local) => blocks::<FMA, LANES, T>(set, p, &local, flip, group, uvs, &mut out),
+            Some(local) => blocks::<FMA, LANES, T>(set, p, local, flip, group, uvs, &mut out),
             None => {
                 for f in group {
                     let k = f.k as usize;
@@ -422,7 +439,7 @@ mod tests {
                 eval_avx2_fma(set, p, tree, uvs, out)
             };
         } else {
-            eval::<false, T>(set, p, tree, uvs, out);
+            eval::<false, T>(set, p, tree, None, uvs, out);
         }
     }
 
@@ -464,9 +481,9 @@ mod tests {
     }
 
     /// Every Loop patch of every manifold `loop_*` cage, as built and swapped (the opposite
-    /// orientation), at dense points of its triangle: the trees through [`eval`] (quartic and
-    /// Gregory leaves grouped, lone points in f64), the regular triangles through
-    /// [`PointBlocks`] as one quartic, against the generic f64 evaluation point by point
+    /// orientation), at dense points of its triangle, through [`PointBlocks`] as the engine
+    /// calls it: the trees through [`eval`] with the set's leaf forms (quartic and Gregory
+    /// leaves grouped, lone points in f64), the regular triangles as one quartic, against the generic f64 evaluation point by point
     /// ([`assert_matches_f64`]). Most normals must come from the kernels, on trees and regular
     /// triangles alike, and on the Gregory leaves' points of the trees too.
     #[test]
@@ -503,11 +520,7 @@ mod tests {
                             .count();
                     }
                     let made = assert_matches_f64(&what, set, p, &uvs, size, |fma, out| {
-                        if regular {
-                            blocks[usize::from(fma)].eval(set, p, &uvs, out)
-                        } else {
-                            eval_either(fma, set, p, &**tree, &uvs, out)
-                        }
+                        blocks[usize::from(fma)].eval(set, p, &uvs, out)
                     });
                     points[usize::from(regular)] += uvs.len();
                     kernels[usize::from(regular)] += made.iter().sum::<usize>();
@@ -527,7 +540,7 @@ mod tests {
         assert!(end_caps > 0, "no Gregory leaves among the trees");
         let kinds = ["trees", "regular triangles", "the trees' Gregory leaves"];
         for (kind, (k, n)) in kinds.iter().zip(kernels.iter().zip(points)) {
-            eprintln!("{kind}: {k} of {n} normals from the kernels");
+            eprintln!("{kind}: {n} points, {k} normals from the kernels (both builds)");
             assert!(*k * 2 > n, "{kind}: only {k} of {n} normals from the kernels");
         }
     }
@@ -545,6 +558,6 @@ mod tests {
         uvs: &[DVec2],
         out: VertexSlices<'_>,
     ) {
-        eval::<true, T>(set, p, tree, uvs, out)
+        eval::<true, T>(set, p, tree, None, uvs, out)
     }
 }
