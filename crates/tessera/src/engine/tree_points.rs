@@ -63,8 +63,9 @@ pub(super) trait LeafTree {
     type Local;
     /// Points per leaf of the view, on average, from which grouping pays ([`worth_grouping`]).
     const MIN_DENSITY: f64;
-    /// The fewest points of one leaf evaluated as a group; fewer take the f64 evaluation,
-    /// where moving the net to its frame would cost more than it saves.
+    /// The fewest points of one leaf evaluated as a group where [`eval`] makes the leaf's
+    /// form; fewer take the f64 evaluation, where moving the net to its frame would cost more
+    /// than it saves.
     const MIN_GROUP: usize;
     /// How many leaves the tree has.
     fn leaf_count(&self) -> usize;
@@ -320,8 +321,9 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
         let leaf = group[0].leaf as usize;
         let made;
         let local = match locals {
-            _ if group.len() < T::MIN_GROUP => None,
+            // A leaf's form already made: the kernel costs a lone point less than f64 does.
             Some(locals) => Some(&locals[leaf]),
+            _ if group.len() < T::MIN_GROUP => None,
             None => {
                 made = tree.local(leaf);
                 made.as_ref()
