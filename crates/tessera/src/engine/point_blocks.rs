@@ -1,6 +1,7 @@
 //! A specialisation of *evaluation*: any list of parameters on one patch, evaluated
 //! [`LANES`] points at a time in f32, for bicubic patches (polynomial or rational), cubic
-//! and quartic Bézier triangles (a regular Loop patch is one quartic) and PN triangles.
+//! and quartic Bézier triangles (a regular Loop patch is one quartic), Gregory triangles (Loop's
+//! end caps, for `tree_points`) and PN triangles.
 //!
 //! Where [`super::uniform_quads`] exploits a grid (a row reduced to a curve once), this
 //! evaluator takes parameters as a pattern or an edge sampling chose them — transition strips,
@@ -25,9 +26,10 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
+use super::tree_points::{loop_leaves, LoopLeaf};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
-use crate::surface::{BezierTriangle, Patch, SurfacePoint, SurfaceSet};
+use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -162,6 +164,48 @@ const fn differences<const N: usize, const M: usize>() -> [(usize, usize, usize,
     out
 }
 
+/// `(m, cu, cv)` for each monomial of the derivatives that an interior point enters
+/// ([`point_differences`]).
+type PointDifferences = [(usize, f64, f64); 3];
+
+/// Where a lone control point `at` of a Bézier triangle of degree `d` (`N` points) enters
+/// the derivatives: for each monomial `m` of degree `d − 1` ([`exponents`] order) that it
+/// enters, `(m, cu, cv)` with `∂S/∂u = Σ cu · λ^m` and `∂S/∂v = Σ cv · λ^m` for that point at
+/// 1 and the others at 0 ([`differences`] read backwards). An interior point enters three
+/// monomials, which the precondition asks.
+const fn point_differences<const N: usize, const M: usize>(at: usize) -> PointDifferences {
+    let table = differences::<N, M>();
+    let mut out = [(0, 0.0, 0.0); 3];
+    let (mut m, mut n) = (0, 0);
+    while m < M {
+        let (base, at_u, at_v, c) = table[m];
+        let minus = if base == at { c } else { 0.0 };
+        let cu = if at_u == at { c } else { 0.0 } - minus;
+        let cv = if at_v == at { c } else { 0.0 } - minus;
+        if cu != 0.0 || cv != 0.0 {
+            out[n] = (m, cu, cv);
+            n += 1;
+        }
+        m += 1;
+    }
+    assert!(n == 3, "an interior point enters three monomials");
+    out
+}
+
+/// Per corner of a Gregory triangle ([`GregoryTriangle::INTERIOR`]): where its interior point
+/// stands in the quartic net, its multinomial `4!/(i!j!k!)`, and its [`point_differences`].
+const fn gregory_interior() -> [(usize, f64, PointDifferences); 3] {
+    let mut out = [(0, 0.0, [(0, 0.0, 0.0); 3]); 3];
+    let mut c = 0;
+    while c < 3 {
+        let (_, _, (i, j, _)) = GregoryTriangle::INTERIOR[c];
+        let at = index(4, i, j);
+        out[c] = (at, multinomials::<15>()[at], point_differences::<15, 10>(at));
+        c += 1;
+    }
+    out
+}
+
 /// A Bézier triangle of degree `d` (`N` control points; `M` those of degree `d − 1`: cubic
 /// `<10, 6>`, quartic `<15, 10>`) in its local frame, with the multinomial coefficients folded
 /// into the control points so that each sum is over bare monomials.
@@ -183,6 +227,30 @@ pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
 /// A quartic Bézier triangle in its local frame: Loop's regular pieces.
 pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
 
+/// A Gregory triangle (Loop's end caps, [`GregoryTriangle`]) in its local frame, the frame
+/// of all its 18 points: the quartic net with each interior point its corner's `Fp`, and each
+/// corner's `Fm − Fp`. The blended net of a lane is that quartic plus `g · (Fm − Fp)` at each
+/// interior point, `g` the lane's weight of `Fm` ([`GregoryTriangle::blend_weights_of`]); the
+/// kernel is linear in the net, so it adds each interior point's basis (and its derivatives,
+/// the blend held fixed as OpenSubdiv holds it) times that, per lane ([`gregory_block`]).
+pub(crate) struct LocalGregory {
+    net: LocalQuartic,
+    /// `(Fm − Fp) / scale` of each corner, rounded to f32: `[corner][component]`.
+    spread: [[f32; 3]; 3],
+}
+
+impl LocalGregory {
+    /// Cost: O(18), like [`LocalTriangle::from_net`].
+    #[inline(always)]
+    pub(crate) fn new(g: &GregoryTriangle) -> Self {
+        let (origin, scale) = local_frame(&g.points);
+        let net = LocalQuartic::in_frame(&g.blended_with([(1.0, 0.0); 3]).points, (origin, scale));
+        let spread = GregoryTriangle::INTERIOR
+            .map(|(fp, fm, _)| ((g.points[fm] - g.points[fp]) * (1.0 / scale)).as_vec3().to_array());
+        LocalGregory { net, spread }
+    }
+}
+
 impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// The Bézier triangle of degree `d` with control points `net` in [`exponents`] order.
     /// Cost: O(N), every index and coefficient a constant. Inlined: the grouped leaves
@@ -191,7 +259,13 @@ impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// coefficients computed.
     #[inline(always)]
     pub(crate) fn from_net(net: &[DVec3; N]) -> Self {
-        let (origin, scale) = local_frame(net);
+        Self::in_frame(net, local_frame(net))
+    }
+
+    /// [`LocalTriangle::from_net`] in the frame `(origin, scale)` ([`local_frame`] of the net,
+    /// or of points around it).
+    #[inline(always)]
+    fn in_frame(net: &[DVec3; N], (origin, scale): (DVec3, f64)) -> Self {
         let inv = 1.0 / scale;
         let mut local = LocalTriangle {
             origin: origin.as_vec3().to_array(),
@@ -246,6 +320,8 @@ enum Local {
     Triangle(u32),
     /// A regular Loop patch (one quartic piece).
     Quartic(u32),
+    /// An irregular Loop patch: its tree's leaves start there in [`PointBlocks`]' `loop_leaves`.
+    LoopTree(u32),
     /// A rational bicubic whose weights span more than f32 carries
     /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
     Generic,
@@ -266,6 +342,7 @@ enum Form {
     Rational(LocalPatch<4>),
     Triangle(LocalTriangle),
     Quartic(LocalQuartic),
+    LoopTree(Vec<LoopLeaf>),
     Generic,
 }
 
@@ -277,13 +354,18 @@ pub(crate) enum GridPatch<'a> {
 }
 
 /// Every patch of a set in its local frame, made once per set: a table of eight bytes a
-/// patch and each kind's forms in patch order. Cost: O(P) to build, 200–400 bytes a patch.
+/// patch and each kind's forms in patch order. Cost: O(P) to build, 200–400 bytes a patch
+/// (an isolated Loop patch: 548 bytes a leaf of its tree).
 pub(crate) struct PointBlocks {
     locals: Vec<Local>,
     bicubics: Vec<LocalPatch>,
     rationals: Vec<LocalPatch<4>>,
     triangles: Vec<LocalTriangle>,
     quartics: Vec<LocalQuartic>,
+    /// Every leaf of each irregular Loop patch's tree, in its local frame, the trees in patch
+    /// order: made once per set rather than once for every list of points that reaches a leaf
+    /// (the interior's, each owned edge's).
+    loop_leaves: Vec<LoopLeaf>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -553,15 +635,9 @@ fn combine<const FMA: bool, const L: usize, const M: usize>(
     out
 }
 
-/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
+/// `powers[a][e][l] = λa^e` of lane `l`, `λ = (1 − u − v, u, v)`, for `e` up to `d` (≤ 4).
 #[inline(always)]
-pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
-    t: &LocalTriangle<N, M>,
-    u: &[f32; L],
-    v: &[f32; L],
-) -> Block<L> {
-    // powers[a][e][l] = λa^e of lane l, λ = (1 − u − v, u, v), up to the degree.
-    let d = const { degree(N) };
+fn lambda_powers<const L: usize>(d: usize, u: &[f32; L], v: &[f32; L]) -> [[[f32; L]; 5]; 3] {
     let mut powers = [[[1f32; L]; 5]; 3];
     for l in 0..L {
         let lambda = [1.0 - u[l] - v[l], u[l], v[l]];
@@ -572,11 +648,77 @@ pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, co
             }
         }
     }
+    powers
+}
+
+/// A Bézier triangle's `∂S/∂u` and `∂S/∂v` (local frame) of each lane, from its
+/// [`lambda_powers`].
+#[inline(always)]
+fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
+    powers: &[[[f32; L]; 5]; 3],
+) -> [[[f32; L]; 3]; 2] {
+    let lower = monomials(powers, &const { exponents::<M>() });
+    [combine::<FMA, L, M>(&t.du, &lower), combine::<FMA, L, M>(&t.dv, &lower)]
+}
+
+/// A Gregory triangle at each lane's `(u, v)` ([`LocalGregory`]): the quartic kernel's sums
+/// of the net with the `Fp`s, plus each corner's interior basis times the lane's blend
+/// weight of `Fm` times `Fm − Fp`; normal and reliability as every triangle's.
+// Index loops over lanes (they vectorize).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
+    g: &LocalGregory,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let powers = lambda_powers::<L>(4, u, v);
+    let basis = monomials(&powers, &const { exponents::<15>() });
+    let mut pos = combine::<FMA, L, 15>(&g.net.pos, &basis);
+    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10>(&g.net, &powers);
+    let lower = monomials(&powers, &const { exponents::<10>() });
+    let mut weights = [[0f32; L]; 3];
+    for l in 0..L {
+        let w = GregoryTriangle::blend_weights_of(u[l], v[l]);
+        (0..3).for_each(|c| weights[c][l] = w[c].1);
+    }
+    for (c, &(at, coefficient, enters)) in const { gregory_interior() }.iter().enumerate() {
+        for l in 0..L {
+            let g_l = weights[c][l];
+            let b = coefficient as f32 * basis[at][l] * g_l;
+            let (mut bu, mut bv) = (0f32, 0f32);
+            for &(m, cu, cv) in &enters {
+                bu = madd::<FMA>(cu as f32, lower[m][l], bu);
+                bv = madd::<FMA>(cv as f32, lower[m][l], bv);
+            }
+            let (bu, bv) = (bu * g_l, bv * g_l);
+            for a in 0..3 {
+                let d = g.spread[c][a];
+                pos[a][l] = madd::<FMA>(b, d, pos[a][l]);
+                su[a][l] = madd::<FMA>(bu, d, su[a][l]);
+                sv[a][l] = madd::<FMA>(bv, d, sv[a][l]);
+            }
+        }
+    }
+    let (nrm, margin) = cross_normals(&su, &sv);
+    to_model::<FMA, L>(&mut pos, &g.net.origin, g.net.scale);
+    Block { pos, nrm, margin }
+}
+
+/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
+#[inline(always)]
+pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let powers = lambda_powers::<L>(const { degree(N) }, u, v);
     let mut pos = combine::<FMA, L, N>(&t.pos, &monomials(&powers, &const { exponents::<N>() }));
     let (nrm, margin) = match &t.pn {
         None => {
-            let lower = monomials(&powers, &const { exponents::<M>() });
-            cross_normals(&combine::<FMA, L, M>(&t.du, &lower), &combine::<FMA, L, M>(&t.dv, &lower))
+            let [su, sv] = derivative_sums::<FMA, L, N, M>(t, &powers);
+            cross_normals(&su, &sv)
         }
         Some(field) => {
             let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
@@ -610,14 +752,17 @@ impl PointBlocks {
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
-                Patch::Loop(t) => t.regular().map_or(Form::Generic, |q| {
-                    let net = if t.is_swapped() {
-                        const { swapped::<15>() }.map(|m| q.points[m])
-                    } else {
-                        q.points
-                    };
-                    Form::Quartic(LocalQuartic::from_net(&net))
-                }),
+                Patch::Loop(t) => t.regular().map_or_else(
+                    || Form::LoopTree(loop_leaves(t)),
+                    |q| {
+                        let net = if t.is_swapped() {
+                            const { swapped::<15>() }.map(|m| q.points[m])
+                        } else {
+                            q.points
+                        };
+                        Form::Quartic(LocalQuartic::from_net(&net))
+                    },
+                ),
                 // Piecewise (isolated) patches take the generic evaluation, or their points
                 // grouped by leaf (`tree_points`).
                 Patch::Subdivision(_) => Form::Generic,
@@ -629,6 +774,7 @@ impl PointBlocks {
             rationals: Vec::new(),
             triangles: Vec::new(),
             quartics: Vec::new(),
+            loop_leaves: Vec::new(),
             all_bicubic: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
@@ -638,6 +784,11 @@ impl PointBlocks {
                 Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
                 Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
                 Form::Quartic(t) => Local::Quartic(push(&mut blocks.quartics, t)),
+                Form::LoopTree(leaves) => {
+                    let first = blocks.loop_leaves.len() as u32;
+                    blocks.loop_leaves.extend(leaves);
+                    Local::LoopTree(first)
+                }
                 Form::Generic => Local::Generic,
             };
             blocks.locals.push(local);
@@ -663,7 +814,7 @@ impl PointBlocks {
             Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
             Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
             Local::Quartic(i) => FormRef::Quartic(&self.quartics[i as usize]),
-            Local::Generic => return None,
+            Local::LoopTree(_) | Local::Generic => return None,
         })
     }
 
@@ -698,19 +849,21 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        if let Local::Generic = self.locals[p] {
+        if let Local::Generic | Local::LoopTree(_) = self.locals[p] {
             use super::tree_points::{eval as grouped, worth_grouping};
-            match &set.patches[p] {
-                Patch::Subdivision(tree) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+            match (&set.patches[p], self.locals[p]) {
+                (Patch::Subdivision(tree), _) if worth_grouping(&**tree, uvs.len()) => {
+                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
                 }
-                Patch::Loop(tree) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, uvs, out);
+                (Patch::Loop(tree), Local::LoopTree(first)) if worth_grouping(&**tree, uvs.len()) => {
+                    let first = first as usize;
+                    let leaves = &self.loop_leaves[first..first + tree.leaves().len()];
+                    return grouped::<FMA, _>(set, p, &**tree, Some(leaves), uvs, out);
                 }
                 _ => {}
             }
         }
-        if matches!(self.locals[p], Local::Generic) {
+        if matches!(self.locals[p], Local::Generic | Local::LoopTree(_)) {
             // In f64 as the generic evaluation, compiled here for the wider instructions
             // (Rust never fuses a multiply and an add by itself, so the values are the same).
             let mut out = out;

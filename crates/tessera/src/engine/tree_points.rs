@@ -12,9 +12,11 @@
 //! its isolated faces share their leaf with three others or more, over half with fifteen
 //! others or more. Such a group pays once for moving its leaf's net to a local frame and
 //! rounding it to f32, then takes the bicubic kernel's price per point. A point alone in its
-//! leaf (a deep tree's), or in an end cap (a Gregory patch or triangle), keeps the f64
+//! leaf (a deep tree's), or in a Catmull-Clark end cap (a Gregory patch), keeps the f64
 //! evaluation. Loop's trees are the same story with quartic triangles for bicubics
-//! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame).
+//! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame), and their
+//! end caps, Gregory triangles, take the quartic kernel too, with each lane's blend of the
+//! face points added ([`super::point_blocks::gregory_block`]).
 //!
 //! **Same frame, same fallbacks.** The leaf's net is moved to the leaf's own local frame
 //! ([`super::point_blocks::local_frame`]), so f32 carries the leaf's detail at full relative
@@ -34,16 +36,14 @@ use std::cell::RefCell;
 
 use glam::DVec2;
 
-use super::point_blocks::{bicubic_block, triangle_block, Block, LocalQuartic, LANES};
+use super::point_blocks::{
+    bicubic_block, gregory_block, triangle_block, Block, LocalGregory, LocalQuartic, LANES,
+};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
 use crate::surface::triangle_tree::TriangleLeafPatch;
 use crate::surface::{loop_point, subdivision_point, SurfacePoint, SurfaceSet, TriangleTree};
-
-/// The fewest points of one leaf evaluated as a group; fewer take the f64 evaluation, where
-/// moving the net to its frame would cost more than it saves.
-const MIN_GROUP: usize = 2;
 
 /// A point of the patch's list and where [`LeafTree::find`] put it.
 #[derive(Clone, Copy)]
@@ -63,6 +63,10 @@ pub(super) trait LeafTree {
     type Local;
     /// Points per leaf of the view, on average, from which grouping pays ([`worth_grouping`]).
     const MIN_DENSITY: f64;
+    /// The fewest points of one leaf evaluated as a group where [`eval`] makes the leaf's
+    /// form; fewer take the f64 evaluation, where moving the net to its frame would cost more
+    /// than it saves.
+    const MIN_GROUP: usize;
     /// How many leaves the tree has.
     fn leaf_count(&self) -> usize;
     /// The share of the tree's domain the patch covers (a view of a quadrant: a quarter).
@@ -73,7 +77,8 @@ pub(super) trait LeafTree {
     fn prefetch_nodes(&self) {}
     /// Starts loading what evaluating `leaf` at `st` reads (a hint).
     fn prefetch_leaf(&self, _leaf: usize, _st: DVec2) {}
-    /// Leaf `leaf`'s net in its local frame; None for an end cap (evaluated in f64).
+    /// Leaf `leaf`'s net in its local frame; None for an end cap without an f32 kernel (a
+    /// Catmull-Clark Gregory patch, evaluated in f64).
     fn local(&self, leaf: usize) -> Option<Self::Local>;
     /// The leaf at each lane's parameters, its normal the leaf's own.
     fn block<const FMA: bool, const L: usize>(local: &Self::Local, u: &[f32; L], v: &[f32; L]) -> Block<L>;
@@ -92,6 +97,7 @@ impl LeafTree for PatchTree {
     /// isolate its faces six levels deep) 25–45 % slower; with this rule it is unchanged, and
     /// `catmark_cube_creases0` at factor 64 (points dense next to its leaves) a third faster.
     const MIN_DENSITY: f64 = 4.0;
+    const MIN_GROUP: usize = 2;
 
     #[inline(always)]
     fn leaf_count(&self) -> usize {
@@ -150,13 +156,31 @@ impl LeafTree for PatchTree {
     }
 }
 
+/// A Loop leaf in its local frame: a quartic piece or a Gregory end cap.
+pub(super) enum LoopLeaf {
+    Quartic(LocalQuartic),
+    Gregory(LocalGregory),
+}
+
+/// Every leaf of `tree` in its local frame ([`LeafTree::local`]), in leaf order: what
+/// [`super::point_blocks::PointBlocks`] keeps per set for [`eval`]. Cost: O(leaves).
+pub(super) fn loop_leaves(tree: &TriangleTree) -> Vec<LoopLeaf> {
+    (0..tree.leaves().len()).map(|l| tree.local(l).expect("every Loop leaf has a local form")).collect()
+}
+
 impl LeafTree for TriangleTree {
-    type Local = LocalQuartic;
+    type Local = LoopLeaf;
     /// Every list: Loop's f64 path has no look-ahead to lose, and finding a point's leaf is
     /// its cost whichever way. An edge's inner samples (a few leaves along it, but fewer points
     /// than the density rule asks of the whole tree) were a third of `loop_xord_interior`'s
     /// vertex time at factor 32 before this.
     const MIN_DENSITY: f64 = 0.0;
+    /// Timed one leaf at a time (`loop_xord_interior`'s leaves, optimized test build, no
+    /// AVX2): moving a quartic leaf's net to its frame took about 115 ns, a Gregory leaf's
+    /// 165, a block of 4 lanes 60 and 80 ns, against 80 and 113 ns a point in f64, so a
+    /// group of two costs more in f32 (175 against 160 ns, 245 against 225) and one of three
+    /// less.
+    const MIN_GROUP: usize = 3;
 
     #[inline(always)]
     fn leaf_count(&self) -> usize {
@@ -185,16 +209,19 @@ impl LeafTree for TriangleTree {
     }
 
     #[inline(always)]
-    fn local(&self, leaf: usize) -> Option<LocalQuartic> {
-        match &self.leaves()[leaf].patch {
-            TriangleLeafPatch::Quartic(q) => Some(LocalQuartic::from_net(&q.points)),
-            TriangleLeafPatch::Gregory(_) => None,
-        }
+    fn local(&self, leaf: usize) -> Option<LoopLeaf> {
+        Some(match &self.leaves()[leaf].patch {
+            TriangleLeafPatch::Quartic(q) => LoopLeaf::Quartic(LocalQuartic::from_net(&q.points)),
+            TriangleLeafPatch::Gregory(g) => LoopLeaf::Gregory(LocalGregory::new(g)),
+        })
     }
 
     #[inline(always)]
-    fn block<const FMA: bool, const L: usize>(local: &LocalQuartic, u: &[f32; L], v: &[f32; L]) -> Block<L> {
-        triangle_block::<FMA, L, 15, 10>(local, u, v)
+    fn block<const FMA: bool, const L: usize>(local: &LoopLeaf, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+        match local {
+            LoopLeaf::Quartic(q) => triangle_block::<FMA, L, 15, 10>(q, u, v),
+            LoopLeaf::Gregory(g) => gregory_block::<FMA, L>(g, u, v),
+        }
     }
 
     #[inline(always)]
@@ -230,21 +257,23 @@ thread_local! {
 /// leaf count and the view's share of the tree's domain), and at least a group. Cost: O(1).
 #[inline(always)]
 pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
-    points >= MIN_GROUP && points as f64 >= T::MIN_DENSITY * tree.leaf_count() as f64 * tree.view_area()
+    points >= T::MIN_GROUP && points as f64 >= T::MIN_DENSITY * tree.leaf_count() as f64 * tree.view_area()
 }
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
-/// [`VertexSlices::put`] does point by point. Preconditions: `set.patches[p]` is `tree`;
-/// `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2 and FMA. Cost: a leaf
-/// lookup per point and a sort of the points by leaf (O(n + leaves), or O(n log n) for fewer
-/// points than leaves); per group, moving its net to f32 once and the bicubic kernel's
-/// price per point; per single point, the f64 evaluation. No allocation once the thread's
-/// scratch has grown.
+/// [`VertexSlices::put`] does point by point, the leaves' local forms taken from `locals`
+/// where given (per leaf, in leaf order), else made for each group. Preconditions:
+/// `set.patches[p]` is `tree`; `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2
+/// and FMA. Cost: a leaf lookup per point and a sort of the points by leaf (O(n + leaves), or
+/// O(n log n) for fewer points than leaves); per group, moving its net to f32 once (unless
+/// `locals` holds it) and the kernel's price per point; per single point, the f64 evaluation.
+/// No allocation once the thread's scratch has grown.
 #[inline(always)]
 pub(super) fn eval<const FMA: bool, T: LeafTree>(
     set: &SurfaceSet,
     p: usize,
     tree: &T,
+    locals: Option<&[T::Local]>,
     uvs: &[DVec2],
     mut out: VertexSlices<'_>,
 ) {
@@ -289,12 +318,22 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     }
     let flip = tree.reverses_normal();
     for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
-        let local = if group.len() >= MIN_GROUP { tree.local(group[0].leaf as usize) } else { None };
+        let leaf = group[0].leaf as usize;
+        let made;
+        let local = match locals {
+            // A leaf's form already made: the kernel costs a lone point less than f64 does.
+            Some(locals) => Some(&locals[leaf]),
+            _ if group.len() < T::MIN_GROUP => None,
+            None => {
+                made = tree.local(leaf);
+                made.as_ref()
+            }
+        };
         match local {
             Some(local) if group.len() <= LANES / 2 => {
-                blocks::<FMA, { LANES / 2 }, T>(set, p, &local, flip, group, uvs, &mut out);
+                blocks::<FMA, { LANES / 2 }, T>(set, p, local, flip, group, uvs, &mut out);
             }
-            Some(local) => blocks::<FMA, LANES, T>(set, p, &local, flip, group, uvs, &mut out),
+            Some(local) => blocks::<FMA, LANES, T>(set, p, local, flip, group, uvs, &mut out),
             None => {
                 for f in group {
                     let k = f.k as usize;
@@ -352,8 +391,8 @@ mod tests {
     /// `eval(fma, out)` (patch `p` of `set` at `uvs`, with the AVX2 and FMA kernels or without;
     /// only the builds the CPU has) against the generic f64 evaluation point by point:
     /// positions within 1e-6 of `size`, normals within 1e-5 (the f32 kernels' promise),
-    /// parameters and patch ids exact. Returns how many normals the kernels made (they differ
-    /// from the f64 path's in their rounding).
+    /// parameters and patch ids exact. Returns, per point, how many of the builds made its
+    /// normal in the kernels (it differs from the f64 path's in its rounding).
     fn assert_matches_f64(
         what: &str,
         set: &SurfaceSet,
@@ -361,8 +400,8 @@ mod tests {
         uvs: &[DVec2],
         size: f32,
         eval: impl Fn(bool, VertexSlices<'_>),
-    ) -> usize {
-        let mut kernels = 0;
+    ) -> Vec<usize> {
+        let mut kernels = vec![0; uvs.len()];
         for fma in [false, true] {
             if fma && !has_avx2_fma() {
                 continue;
@@ -380,7 +419,7 @@ mod tests {
                 assert!(dn <= 1e-5, "{what}: normal off by {dn:e}");
                 assert_eq!(uv[k], at.as_vec2().to_array(), "{what}");
                 assert_eq!(patch[k], p as u32, "{what}");
-                kernels += usize::from(nrm[k] != q.normal.as_vec3().to_array());
+                kernels[k] += usize::from(nrm[k] != q.normal.as_vec3().to_array());
             }
         }
         kernels
@@ -402,7 +441,7 @@ mod tests {
                 eval_avx2_fma(set, p, tree, uvs, out)
             };
         } else {
-            eval::<false, T>(set, p, tree, uvs, out);
+            eval::<false, T>(set, p, tree, None, uvs, out);
         }
     }
 
@@ -435,19 +474,20 @@ mod tests {
         for (v, view) in views.iter().enumerate() {
             set.patches[p] = Patch::Subdivision(Box::new(view.clone()));
             assert!(worth_grouping(view, uvs.len()), "view {v}: dense enough to group");
-            kernels += assert_matches_f64(&format!("view {v}"), &set, p, &uvs, size, |fma, out| {
+            let made = assert_matches_f64(&format!("view {v}"), &set, p, &uvs, size, |fma, out| {
                 eval_either(fma, &set, p, view, &uvs, out)
             });
+            kernels += made.iter().sum::<usize>();
         }
         assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
     }
 
     /// Every Loop patch of every manifold `loop_*` cage, as built and swapped (the opposite
-    /// orientation), at dense points of its triangle: the trees through [`eval`] (quartic
-    /// leaves grouped, Gregory leaves and lone points in f64), the regular triangles through
-    /// [`PointBlocks`] as one quartic, against the generic f64 evaluation point by point
+    /// orientation), at dense points of its triangle, through [`PointBlocks`] as the engine
+    /// calls it: the trees through [`eval`] with the set's leaf forms (quartic and Gregory
+    /// leaves grouped, lone points in f64), the regular triangles as one quartic, against the generic f64 evaluation point by point
     /// ([`assert_matches_f64`]). Most normals must come from the kernels, on trees and regular
-    /// triangles alike.
+    /// triangles alike, and on the Gregory leaves' points of the trees too.
     #[test]
     fn loop_points_match_the_f64_evaluation_on_every_cage() {
         let cages = crate::test_support::data_files("subdivision", &["loop_"]);
@@ -456,8 +496,9 @@ mod tests {
             .flat_map(|j| (0..=n - j).map(move |i| DVec2::new(i as f64, j as f64) / n as f64))
             .collect();
         let (mut cages_read, mut end_caps) = (0, 0);
-        // [trees, regular triangles]: points compared, normals from the kernels.
-        let (mut points, mut kernels) = ([0; 2], [0; 2]);
+        // [trees, regular triangles, the trees' Gregory leaves]: points compared, normals from
+        // the kernels (of both builds, where the CPU has them).
+        let (mut points, mut kernels) = ([0; 3], [0; 3]);
         for path in &cages {
             let mesh = crate::io::obj::read_obj(path).unwrap();
             // The non-manifold cage is refused (`tests/loop_oracle.rs` checks why).
@@ -480,21 +521,28 @@ mod tests {
                             .filter(|l| matches!(l.patch, TriangleLeafPatch::Gregory(_)))
                             .count();
                     }
+                    let made = assert_matches_f64(&what, set, p, &uvs, size, |fma, out| {
+                        blocks[usize::from(fma)].eval(set, p, &uvs, out)
+                    });
                     points[usize::from(regular)] += uvs.len();
-                    kernels[usize::from(regular)] +=
-                        assert_matches_f64(&what, set, p, &uvs, size, |fma, out| {
-                            if regular {
-                                blocks[usize::from(fma)].eval(set, p, &uvs, out)
-                            } else {
-                                eval_either(fma, set, p, &**tree, &uvs, out)
+                    kernels[usize::from(regular)] += made.iter().sum::<usize>();
+                    if !regular {
+                        for (&uv, made) in uvs.iter().zip(&made) {
+                            let (leaf, _) = tree.find(uv);
+                            if matches!(tree.leaves()[leaf].patch, TriangleLeafPatch::Gregory(_)) {
+                                points[2] += 1;
+                                kernels[2] += made;
                             }
-                        });
+                        }
+                    }
                 }
             }
         }
         assert!(cages_read >= 10, "only {cages_read} Loop cages read");
         assert!(end_caps > 0, "no Gregory leaves among the trees");
-        for (kind, (k, n)) in ["trees", "regular triangles"].iter().zip(kernels.iter().zip(points)) {
+        let kinds = ["trees", "regular triangles", "the trees' Gregory leaves"];
+        for (kind, (k, n)) in kinds.iter().zip(kernels.iter().zip(points)) {
+            eprintln!("{kind}: {n} points, {k} normals from the kernels (both builds)");
             assert!(*k * 2 > n, "{kind}: only {k} of {n} normals from the kernels");
         }
     }
@@ -512,6 +560,6 @@ mod tests {
         uvs: &[DVec2],
         out: VertexSlices<'_>,
     ) {
-        eval::<true, T>(set, p, tree, uvs, out)
+        eval::<true, T>(set, p, tree, None, uvs, out)
     }
 }

@@ -14,6 +14,7 @@
 
 use super::{triangle_point, QuarticTriangle, SurfaceDerivatives, SurfacePoint};
 use glam::{DVec2, DVec3};
+use std::ops::{Add, Div, Sub};
 
 /// A quartic Gregory triangle in OpenSubdiv's `GREGORY_TRIANGLE` point order: per corner
 /// `c = 0, 1, 2` five points `5c..5c+5` — the corner point `P`, the edge point `Ep` towards
@@ -62,15 +63,32 @@ impl GregoryTriangle {
     /// as OpenSubdiv computes them (same operations, same 0/0 rule), so that the blended net
     /// matches its basis to rounding.
     pub fn blend_weights(uv: DVec2) -> [(f64, f64); 3] {
-        let (u, v) = (uv.x, uv.y);
-        let w = 1.0 - u - v;
-        let pair = |a: f64, b: f64| if a + b > 0.0 { (a / (a + b), b / (a + b)) } else { (1.0, 0.0) };
+        Self::blend_weights_of(uv.x, uv.y)
+    }
+
+    /// [`GregoryTriangle::blend_weights`] at `(u, v)` in any float type (the f32 kernel's
+    /// lanes take it too): the one home of the blend and its 0/0 rule.
+    #[inline(always)]
+    pub(crate) fn blend_weights_of<T>(u: T, v: T) -> [(T, T); 3]
+    where
+        T: Copy + PartialOrd + From<u8> + Add<Output = T> + Sub<Output = T> + Div<Output = T>,
+    {
+        let (zero, one) = (T::from(0), T::from(1));
+        let w = one - u - v;
+        let pair = |a: T, b: T| if a + b > zero { (a / (a + b), b / (a + b)) } else { (one, zero) };
         [pair(u, v), pair(v, w), pair(w, u)]
     }
 
     /// The quartic Bézier triangle that the patch is at `uv`: the fixed points in place and
     /// each interior point the blend of its face points at `uv`. Cost: 18 points.
     pub fn blended(&self, uv: DVec2) -> QuarticTriangle {
+        self.blended_with(Self::blend_weights(uv))
+    }
+
+    /// The quartic Bézier triangle with the fixed points in place and each corner's interior
+    /// point `weights[c].0 · Fp + weights[c].1 · Fm` (weights as
+    /// [`GregoryTriangle::blend_weights`] gives them). Cost: 18 points.
+    pub(crate) fn blended_with(&self, weights: [(f64, f64); 3]) -> QuarticTriangle {
         let p = &self.points;
         let mut points = [DVec3::ZERO; 15];
         for (g, at) in BEZIER_OF_GREGORY.iter().enumerate() {
@@ -78,12 +96,16 @@ impl GregoryTriangle {
                 points[QuarticTriangle::index(i, j, k)] = p[g];
             }
         }
-        let [g0, g1, g2] = Self::blend_weights(uv);
-        points[QuarticTriangle::index(2, 1, 1)] = p[3] * g0.0 + p[4] * g0.1;
-        points[QuarticTriangle::index(1, 2, 1)] = p[8] * g1.0 + p[9] * g1.1;
-        points[QuarticTriangle::index(1, 1, 2)] = p[13] * g2.0 + p[14] * g2.1;
+        for (&(fp, fm, (i, j, k)), (a, b)) in Self::INTERIOR.iter().zip(weights) {
+            points[QuarticTriangle::index(i, j, k)] = p[fp] * a + p[fm] * b;
+        }
         QuarticTriangle { points }
     }
+
+    /// Per corner `c`: its face points `(Fp, Fm)` and where their blend stands in the quartic
+    /// net, `(i, j, k)` (`b211`, `b121`, `b112`).
+    pub(crate) const INTERIOR: [(usize, usize, (usize, usize, usize)); 3] =
+        [(3, 4, (2, 1, 1)), (8, 9, (1, 2, 1)), (13, 14, (1, 1, 2))];
 
     /// Position at `uv` (the blended net's). Cost: one [`GregoryTriangle::blended`] and one
     /// quartic evaluation.
