@@ -168,7 +168,7 @@ fn pack_trees(set: &SurfaceSet, trees: &[usize], packed: &mut PackedSet) {
             let block = packed.control_points.len() as u32;
             packed.tree_blocks.push((p, block));
             let (root, nodes) = tree.quadtree();
-            let leaf_at = leaf_offsets(&set.patches[p]);
+            let leaf_at = offsets(nodes.len(), tree.leaf_point_counts());
             let slot = |s: u32| {
                 if s & LEAF_SLOT != 0 {
                     LEAF_SLOT | leaf_at[(s & !LEAF_SLOT) as usize].0
@@ -216,6 +216,14 @@ impl<'a> PackedTree<'a> {
         }
     }
 
+    /// How many points each leaf has, leaf by leaf.
+    fn leaf_point_counts(&self) -> Vec<usize> {
+        match self {
+            PackedTree::CatmullClark(t) => t.leaves().iter().map(|l| l.patch.points().len()).collect(),
+            PackedTree::Loop(t) => t.leaves().iter().map(|l| l.patch.points().len()).collect(),
+        }
+    }
+
     /// Each leaf's record and points ([`pack_trees`]).
     fn push_leaves(&self, out: &mut Vec<[f32; 4]>) {
         use tessera::surface::patch_tree::LeafPatch;
@@ -253,16 +261,14 @@ impl<'a> PackedTree<'a> {
 
 /// Where each leaf of `patch`'s tree (a Catmull-Clark or Loop patch) starts in its block
 /// ([`pack_trees`]), after the header and the nodes, and how many points follow its record.
-/// Cost: O(leaves).
+/// Cost: O(nodes + leaves).
 pub(crate) fn leaf_offsets(patch: &Patch) -> Vec<(u32, u32)> {
-    let (nodes, points): (usize, Vec<usize>) = match PackedTree::of(patch) {
-        PackedTree::CatmullClark(t) => {
-            (t.quadtree().1.len(), t.leaves().iter().map(|l| l.patch.points().len()).collect())
-        }
-        PackedTree::Loop(t) => {
-            (t.quadtree().1.len(), t.leaves().iter().map(|l| l.patch.points().len()).collect())
-        }
-    };
+    let tree = PackedTree::of(patch);
+    offsets(tree.quadtree().1.len(), tree.leaf_point_counts())
+}
+
+/// [`leaf_offsets`] of a tree of `nodes` nodes whose leaves have `points` points each.
+fn offsets(nodes: usize, points: Vec<usize>) -> Vec<(u32, u32)> {
     let mut at = 1 + nodes as u32;
     points
         .into_iter()
