@@ -124,6 +124,31 @@ pub struct CriterionArgs {
     /// closed mesh.
     #[arg(long)]
     pub cull: bool,
+    /// The guaranteed bound --tolerance and --pixel-error plan with: `hessian`, one
+    /// second-derivative bound per patch; `taylor`, also the second derivatives where each
+    /// triangle is with a third-derivative remainder (fewer triangles for the same guarantee
+    /// on Bézier patches and PN triangles; planned on the CPU).
+    #[arg(long, value_enum, default_value = "hessian")]
+    pub bound: BoundArg,
+}
+
+/// The guaranteed bound of the error-bounded criteria (`--bound`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BoundArg {
+    /// One second-derivative bound per patch (the GPU engine plans with it too).
+    Hessian,
+    /// The smaller of that and the Taylor bound at each triangle.
+    Taylor,
+}
+
+impl BoundArg {
+    /// The library's bound.
+    pub fn bound(self) -> tessera::scheme::ErrorBound {
+        match self {
+            BoundArg::Hessian => tessera::scheme::ErrorBound::Hessian,
+            BoundArg::Taylor => tessera::scheme::ErrorBound::Taylor,
+        }
+    }
 }
 
 /// Which engine tessellates (`--engine`).
@@ -289,6 +314,7 @@ pub fn choose(
         cull: args.cull,
         max_factor: args.max_factor,
         max_triangles,
+        bound: args.bound.bound(),
     };
     let mut description = format!("{}, {text}", scheme.name());
     match scheme {

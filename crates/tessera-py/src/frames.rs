@@ -167,7 +167,13 @@ fn choose(
     };
     let scheme = named.unwrap_or_else(|| Scheme::default_for(&criterion));
     let camera = camera.unwrap_or_else(|| default_camera(set, (1280, 720)));
-    let plan = PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles };
+    let plan = PlanOptions {
+        camera: Some(camera),
+        cull: r.cull,
+        max_factor: r.max_factor,
+        max_triangles,
+        ..PlanOptions::default()
+    };
     Ok(Chosen { scheme, criterion, plan, tolerance: tolerance_value })
 }
 

@@ -131,7 +131,13 @@ impl Model {
                 (Scheme::Esc { max_level: 6 }, Criterion::Esc { threshold, level: Some(level as u32) }, 64)
             }
         };
-        let options = PlanOptions { camera: Some(self.camera), cull: false, max_factor, max_triangles };
+        let options = PlanOptions {
+            camera: Some(self.camera),
+            cull: false,
+            max_factor,
+            max_triangles,
+            ..Default::default()
+        };
         let too_large = |e: &tessera::Error| matches!(e, tessera::Error::OutputTooLarge { .. });
         let planned = match scheme.plan(&self.set, &criterion, &options) {
             Ok(p) => p,

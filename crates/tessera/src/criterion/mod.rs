@@ -15,6 +15,7 @@ pub mod esc;
 pub mod resolve;
 pub mod screen;
 pub mod sd2;
+pub mod taylor;
 pub mod tolerance;
 pub mod view;
 
@@ -25,6 +26,23 @@ use esc::Threshold;
 use view::ViewCriterion;
 
 pub use crate::sampling::MAX_FACTOR;
+
+/// Which guaranteed bound the error-bounded criteria (a tolerance, a pixel error) plan with.
+/// Both are proven upper bounds of the linear interpolation error; they differ in slack and
+/// cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ErrorBound {
+    /// One second-derivative bound per patch ([`bounds`]): O(1) a grid, and what the GPU
+    /// engine's own plans compute.
+    #[default]
+    Hessian,
+    /// The smaller of that and the Taylor bound ([`taylor`]): the second derivatives where each
+    /// triangle is, plus a third-derivative remainder. Fewer triangles for the same guarantee
+    /// on polynomial bicubics, Bézier and PN triangles (the other kinds keep the first); one
+    /// evaluation a grid cell in the check. The CPU plans it; the GPU engine draws such plans
+    /// but does not yet plan them itself.
+    Taylor,
+}
 
 /// What decides the factors.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,6 +98,7 @@ pub struct Prepared {
     pub curves: Vec<[f64; 4]>,
     views: std::sync::OnceLock<Vec<screen::PatchView>>,
     triangle_errors: std::sync::OnceLock<Vec<bounds::TriangleErrors>>,
+    taylor: std::sync::OnceLock<Vec<taylor::TaylorBound>>,
     vertex_data: std::sync::OnceLock<Vec<(glam::DVec3, glam::DVec3)>>,
     edge_midpoints: std::sync::OnceLock<Vec<[(glam::DVec3, glam::DVec3); 2]>>,
 }
@@ -98,6 +117,7 @@ impl Prepared {
             hessians,
             views: Default::default(),
             triangle_errors: Default::default(),
+            taylor: Default::default(),
             vertex_data: Default::default(),
             edge_midpoints: Default::default(),
         }
@@ -107,6 +127,15 @@ impl Prepared {
     /// criteria). Cost: that of `new`.
     pub fn for_criterion(set: &SurfaceSet, criterion: &Criterion) -> Prepared {
         Prepared::new(set, criterion.needs_bounds())
+    }
+
+    /// Every patch's [`taylor::TaylorBound`] ([`taylor::TaylorBound::NONE`] for the kinds it
+    /// does not cover), computed on the first call and kept, for plans asked for
+    /// [`ErrorBound::Taylor`]. Preconditions: `set` is the set this was prepared for. Cost:
+    /// the first call O(P), parallel, about 650 bytes a patch; later calls nothing.
+    pub fn taylor_bounds(&self, set: &SurfaceSet) -> &[taylor::TaylorBound] {
+        use rayon::prelude::*;
+        self.taylor.get_or_init(|| set.patches.par_iter().map(taylor::TaylorBound::of).collect())
     }
 
     /// Every patch's [`bounds::TriangleErrors`] (what the a-posteriori check's triangle bound

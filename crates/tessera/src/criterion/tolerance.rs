@@ -9,6 +9,7 @@
 
 use super::bounds::{self, HessianBound, TriangleErrors};
 use super::resolve::{self, EdgeRule, InteriorRule};
+use super::taylor::TaylorBound;
 use super::{Plan, Prepared};
 use crate::error::{Error, Result};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
@@ -147,20 +148,28 @@ fn built_pattern_bound(
 /// The bound of the pattern `built` over its local-vertex parameters `params`
 /// ([`crate::pattern::cache::local_params`]): the largest triangle error.
 fn params_bound(errors: &TriangleErrors, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
-    triangles_bound(errors, &built.triangles, params, 0.0)
+    triangles_bound(errors, None, &built.triangles, params, 0.0)
 }
 
-/// The largest triangle error of `triangles` over `params`, and `at_least`.
+/// The largest triangle error of `triangles` over `params`, and `at_least`: each triangle's
+/// the smaller of its second-derivative bound and, where there is one, its Taylor bound
+/// (both are valid).
 fn triangles_bound(
     errors: &TriangleErrors,
+    taylor: Option<&TaylorBound>,
     triangles: &[[u32; 3]],
     params: &[glam::DVec2],
     at_least: f64,
 ) -> f64 {
-    // The running largest error skips what cannot raise it ([`TriangleErrors::exceeds`]).
-    triangles
-        .iter()
-        .fold(at_least, |most, t| errors.exceeds(t.map(|l| params[l as usize]), most).unwrap_or(most))
+    // The running largest error skips what cannot raise it ([`TriangleErrors::exceeds`]);
+    // the Taylor bound, dearer, is computed only for a triangle that would raise it.
+    triangles.iter().fold(at_least, |most, t| {
+        let t = t.map(|l| params[l as usize]);
+        match errors.exceeds(t, most) {
+            None => most,
+            Some(e) => most.max(taylor.map_or(e, |taylor| e.min(taylor.triangle_error(t)))),
+        }
+    })
 }
 
 /// [`params_bound`] of a pattern whose first triangles are core cells
@@ -168,6 +177,7 @@ fn triangles_bound(
 /// one.
 fn core_params_bound(
     errors: &TriangleErrors,
+    taylor: Option<(&TaylorBound, Domain)>,
     core: Option<([u32; 2], u32)>,
     built: &LocalTessellation,
     params: &[glam::DVec2],
@@ -175,18 +185,93 @@ fn core_params_bound(
     match core {
         Some((cells, count)) if count > 0 && count as usize <= built.triangles.len() => {
             let rest = &built.triangles[count as usize..];
-            triangles_bound(errors, rest, params, grid_bound(errors, cells))
+            triangles_bound(errors, taylor.map(|t| t.0), rest, params, grid_bound(errors, taylor, cells))
         }
-        _ => params_bound(errors, built, params),
+        _ => triangles_bound(errors, taylor.map(|t| t.0), &built.triangles, params, 0.0),
     }
 }
 
 /// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
-/// ([`Pattern::grid_cells`]): that of one of them, `(0, 0), (1/nu, 0), (0, 1/nv)`. Every
-/// such triangle has the same bound (it depends only on the differences of the corners), so
-/// no pattern is built. Cost: O(1).
-fn grid_bound(m: &TriangleErrors, [nu, nv]: [u32; 2]) -> f64 {
-    m.cell_error(1.0 / nu as f64, 1.0 / nv as f64)
+/// ([`Pattern::grid_cells`]): the second-derivative bound of one of them,
+/// `(0, 0), (1/nu, 0), (0, 1/nv)` (every such triangle has the same, as it depends only on
+/// the differences of the corners), or, where the patch has a Taylor bound and it is smaller,
+/// the largest Taylor bound of the grid's cells (a core grid's cells are among them). No
+/// pattern is built. Cost: O(1), or one evaluation a cell with a Taylor bound.
+fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, nv]: [u32; 2]) -> f64 {
+    let hessian = m.cell_error(1.0 / nu as f64, 1.0 / nv as f64);
+    match taylor {
+        Some((t, domain)) => hessian.min(t.grid_error(domain == Domain::Tri, [nu, nv])),
+        None => hessian,
+    }
+}
+
+/// The grid with the fewest cells near `start` (the second-derivative bound's, which the
+/// Taylor bound may not meet on coarse grids) whose Taylor bound meets `eps`. The
+/// second-derivative bound's grid, scaled by the square root of the Taylor bound's slack there
+/// (errors shrink like `h²`), gives a first grid `(nu1, nv1)` that meets it; then a staircase
+/// walk over the column counts from `nu1/2` to `2·nu1`, each with the fewest rows that meet
+/// it (rows only shrink as columns grow), keeps the grid with the fewest cells. `start`
+/// itself where the Taylor bound does not meet `eps` there. A proposal only: the a-posteriori
+/// check verifies the built pattern. Cost: about `2·nu1 + nv1` grid bounds of one
+/// evaluation a cell.
+fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) {
+    let fits = |nu: u32, nv: u32| t.grid_error(false, [nu, nv]) <= eps;
+    let (nu0, nv0) = start;
+    let at_start = t.grid_error(false, [nu0, nv0]);
+    if at_start > eps {
+        return start;
+    }
+    let mut scale = (at_start / eps).sqrt();
+    let (nu1, nv1) = loop {
+        let n = |n0: u32| ((n0 as f64 * scale).ceil() as u32).clamp(1, n0);
+        let (nu, nv) = (n(nu0), n(nv0));
+        if (nu, nv) == start || fits(nu, nv) {
+            break (nu, nv);
+        }
+        scale *= 1.05;
+    };
+    let cells = |g: (u32, u32)| g.0 as u64 * g.1 as u64;
+    let mut best = (nu1, nv1);
+    // The rows the walk's first column count needs: at most what beats the best (none where
+    // even those do not meet the bound there).
+    let first = (nu1 / 2).max(1);
+    let mut rows = (cells(best) / first as u64).min(u32::MAX as u64) as u32;
+    for nu in first..=nu1.saturating_mul(2) {
+        if nu as u64 >= cells(best) {
+            break; // one row of this many columns is no fewer cells
+        }
+        rows = rows.min((cells(best) / nu as u64) as u32);
+        if rows == 0 || !fits(nu, rows) {
+            continue;
+        }
+        while rows > 1 && fits(nu, rows - 1) {
+            rows -= 1;
+        }
+        if cells((nu, rows)) < cells(best) {
+            best = (nu, rows);
+        }
+    }
+    best
+}
+
+/// The smallest uniform factor up to `start` whose `n × n` grid's Taylor bound meets `eps`
+/// (bisection: the bound shrinks as `n` grows), `start` where none smaller does. A proposal
+/// only, as [`taylor_quad_grid`]'s. Cost: about `log₂ start` grid bounds.
+fn taylor_uniform_factor(t: &TaylorBound, domain: Domain, start: f64, eps: f64) -> f64 {
+    let fits = |n: u32| t.grid_error(domain == Domain::Tri, [n, n]) <= eps;
+    let (mut lo, mut hi) = (1u32, start.max(1.0) as u32);
+    if !fits(hi) {
+        return start;
+    }
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if fits(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    hi as f64
 }
 
 /// Minimum segments for edges whose samples could otherwise coincide with another edge's:
@@ -287,7 +372,8 @@ pub(crate) struct Scratch {
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
 /// for `pattern` with the scheme's `rule` and `interior` rule, factors capped at `max_factor`
 /// (a power of two for [`EdgeRule::PowerOfTwo`]), for an output of at most `max_triangles`,
-/// into `plan` (its buffers reused). [`crate::scheme::Scheme::plan`] is the public door: it
+/// into `plan` (its buffers reused). With `taylor` (one per patch, [`TaylorBound::of`]) every
+/// proposal and check also takes the Taylor bound, and a triangle's bound is the smaller. [`crate::scheme::Scheme::plan`] is the public door: it
 /// pairs the pattern with its rules.
 ///
 /// Before each round of a-posteriori checks (which build patterns), the output the current
@@ -307,6 +393,7 @@ pub(crate) fn plan_limited(
     pattern: &dyn Pattern,
     max_factor: u32,
     max_triangles: u64,
+    taylor: Option<&[TaylorBound]>,
     scratch: &mut Scratch,
     plan: &mut Plan,
 ) -> Result<BoundReport> {
@@ -355,13 +442,21 @@ pub(crate) fn plan_limited(
         let Some(e) = eps[p] else { return };
         let domain = set.topology.patch_domains[p];
         let m = &hessians[p];
+        let taylor = taylor.map(|t| &t[p]).filter(|t| t.is_some());
         match (interior, domain) {
             (InteriorRule::Core, Domain::Quad) => {
-                let (nu, nv) = quad_grid(m, e, cap).unwrap_or((cap, cap));
+                let mut grid = quad_grid(m, e, cap).unwrap_or((cap, cap));
+                if let Some(t) = taylor {
+                    grid = taylor_quad_grid(t, grid, e);
+                }
+                let (nu, nv) = grid;
                 *out = [nu as f64, nv as f64, nu as f64, nv as f64];
             }
             _ => {
-                let n = uniform_factor(m, e);
+                let mut n = uniform_factor(m, e);
+                if let Some(t) = taylor {
+                    n = taylor_uniform_factor(t, domain, n.min(cap as f64), e);
+                }
                 out[..domain.corner_count()].fill(n);
             }
         }
@@ -388,7 +483,7 @@ pub(crate) fn plan_limited(
     which.clear();
     which.extend(0..patches);
     let mut check = |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>| {
-        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors };
+        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors, taylor };
         check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, patterns, out)
     };
     check(&plan.segments, proposals, which, results);
@@ -575,6 +670,7 @@ struct CheckInputs<'a> {
     cap: u32,
     minimum: &'a [[u32; 2]],
     errors: &'a [TriangleErrors],
+    taylor: Option<&'a [TaylorBound]>,
 }
 
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
@@ -594,7 +690,7 @@ fn check_patches(
     patterns: &mut crate::pattern::cache::PatternCache,
     out: &mut Vec<Check>,
 ) {
-    let CheckInputs { set, eps, layout, cap, minimum, errors } = *inputs;
+    let CheckInputs { set, eps, layout, cap, minimum, errors, taylor } = *inputs;
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
     // The engine's input, collapsed edges included, so the bound is that of the output.
@@ -689,18 +785,19 @@ fn check_patches(
                 }
                 let cached = patterns.params(i).filter(|_| interior == first);
                 let grid = limit.pattern.grid_cells(&input);
+                let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
                 let bound = match (grid, cached) {
-                    // A pure grid (no strips): one cell's triangle bounds them all, no build.
-                    (Some(cells), _) => grid_bound(&errors[p], cells),
+                    // A pure grid (no strips): bounded from its cells, no build.
+                    (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
                     (None, Some((_, built, params))) => {
-                        core_params_bound(&errors[p], limit.pattern.core_cells(&input), built, params)
+                        core_params_bound(&errors[p], taylor, limit.pattern.core_cells(&input), built, params)
                     }
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
                     (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
                         let slot = recent.get(generation, limit.pattern, &input, true);
                         let (built, params) = (&slot.local, &slot.params[..]);
-                        core_params_bound(&errors[p], limit.pattern.core_cells(&input), built, params)
+                        core_params_bound(&errors[p], taylor, limit.pattern.core_cells(&input), built, params)
                     }),
                 };
                 if bound <= e * (1.0 + 1e-9) {

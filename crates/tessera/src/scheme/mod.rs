@@ -83,15 +83,23 @@ pub struct PlanOptions {
     /// Largest output the error-bounded criteria may build while they check their bounds;
     /// beyond it they refuse with [`Error::OutputTooLarge`].
     pub max_triangles: u64,
+    /// The guaranteed bound the error-bounded criteria plan with ([`ErrorBound`]).
+    pub bound: ErrorBound,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        PlanOptions { camera: None, cull: false, max_factor: 64, max_triangles: u64::MAX }
+        PlanOptions {
+            camera: None,
+            cull: false,
+            max_factor: 64,
+            max_triangles: u64::MAX,
+            bound: ErrorBound::Hessian,
+        }
     }
 }
 
-pub use crate::criterion::{Criterion, Prepared};
+pub use crate::criterion::{Criterion, ErrorBound, Prepared};
 
 /// A plan, the pattern that draws it, and the guarantee report where the criterion has one.
 #[derive(Debug, Clone)]
@@ -400,6 +408,7 @@ impl Scheme {
                     &out.pattern,
                     cap as u32,
                     options.max_triangles,
+                    (options.bound == ErrorBound::Taylor).then(|| prepared.taylor_bounds(set)),
                     &mut scratch.tolerance,
                     &mut out.plan,
                 )?;

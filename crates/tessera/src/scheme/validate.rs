@@ -343,6 +343,13 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     options.max_factor
                 ));
             }
+            if checked && options.bound == crate::criterion::ErrorBound::Taylor {
+                return refuse(
+                    "the Taylor bound planned on the GPU (its check computes the second-derivative \
+                     bound; plan this frame on the CPU)"
+                        .into(),
+                );
+            }
             Ok(())
         }
     }
@@ -398,6 +405,14 @@ mod tests {
             Engine::GpuFromCamera
         )));
         v(Scheme::Uniform, Criterion::PixelError(0.5), &high_cap, Engine::GpuFromCamera).unwrap();
+        let taylor = PlanOptions { bound: crate::criterion::ErrorBound::Taylor, ..culled };
+        assert!(engine_refused(v(
+            Scheme::Transition,
+            Criterion::PixelError(0.5),
+            &taylor,
+            Engine::GpuFromCamera
+        )));
+        v(Scheme::Transition, Criterion::PixelError(0.5), &taylor, Engine::Gpu).unwrap();
         // The request's own errors come first, the same for every engine.
         for engine in [Engine::Cpu, Engine::Gpu, Engine::GpuFromCamera] {
             assert!(matches!(

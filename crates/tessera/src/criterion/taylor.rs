@@ -1,0 +1,321 @@
+//! The Taylor bound: a triangle's linear-interpolation error from the patch's second
+//! derivatives *at* the triangle, plus a bound on its third derivatives.
+//!
+//! [`super::bounds`] bounds the error over a triangle by the largest second derivative
+//! anywhere on the patch, each of `S_uu`, `S_uv`, `S_vv` in norm on its own. That is three
+//! sources of slack: the largest derivative is not where most triangles are; `S_uu`, `S_uv`
+//! and `S_vv` reach their largest norms at different places; and a cell's error along its
+//! diagonal, `|S_uu·hu² ∓ 2·S_uv·hu·hv + S_vv·hv²|/8`, is a norm of a sum, not a sum of norms.
+//! This bound keeps the vectors together and takes them where the triangle is.
+//!
+//! **What is proven.** Let `T` be a parameter triangle with corners `c_0, c_1, c_2`, `L` the
+//! linear interpolant of `S` at them, `g` a point of the convex region where the bounds below
+//! hold with `T` inside it, and `H = D²S(g)` (the vectors `A = S_uu(g)`, `B = S_uv(g)`,
+//! `C = S_vv(g)`). Taylor's theorem with the integral remainder gives
+//! `S(x) = S(g) + DS(g)(x − g) + ½·H[x − g]² + R(x)` with
+//! `|R(x)| ≤ f₃(x − g)/6`, `f₃(δ) = t₀|δu|³ + 3t₁|δu|²|δv| + 3t₂|δu||δv|² + t₃|δv|³`, where
+//! `t₀..t₃` bound `|S_uuu|, |S_uuv|, |S_uvv|, |S_vvv|` on the region (the segment from `g` to
+//! `x` stays in it). Linear interpolation reproduces the affine part, so
+//! `S − L = (Q − L_Q) + (R − L_R)` with `Q = ½·H[x − g]²`:
+//! - `Q − L_Q` is a quadratic vanishing at the corners; such a quadratic is fixed by its
+//!   values at the edge midpoints, and along edge `i` (opposite corner `i`, vector `e_i`) it is
+//!   the chord error of a parabola: `−(e_iᵀ H e_i)/8 · 4λ_jλ_k`. So
+//!   `Q − L_Q = −Σ m_i φ_i` with `m_i = e_iᵀ H e_i / 8` (vectors) and `φ_i = 4λ_jλ_k ≥ 0`,
+//!   and `|Q − L_Q| ≤ Σ |m_i| φ_i ≤ max over T of Σ |m_i| φ_i` ([`bubble_max`], in closed form).
+//!   On the edges this is exact; inside it is exact when the `m_i` are parallel.
+//! - `|R(x) − L_R(x)| ≤ |R(x)| + Σ λ_k |R(c_k)| ≤ f₃(Δ)/3`, with `Δ` the largest `|δu|`,
+//!   `|δv|` from `g` to a corner (`f₃` grows with each, and `T` lies in that box about `g`).
+//!
+//! So `|S − L| ≤ bubble_max(|m_0|, |m_1|, |m_2|) + f₃(Δ)/3` on `T`. As triangles shrink the
+//! remainder vanishes like `h³` against the `h²` of the rest, and the bound tends to the exact
+//! error of the triangle where the `m_i` are parallel (the usual case: the normal components
+//! dominate). It assumes nothing beyond the bounds `t_k` on the region, which come from the
+//! control net (the convex-hull property of the third derivatives' Bézier forms).
+//!
+//! **Which patches.** Polynomial bicubics (`S_uu`, `S_uv`, `S_vv` are Bézier patches of
+//! degrees (1,3), (2,2), (3,1); the third derivatives of degrees (0,3), (1,2), (2,1), (3,0)),
+//! cubic Bézier triangles and PN triangles (second derivatives linear, third constant: the
+//! bound is exact up to the triangle inequality inside). Rational bicubics and subdivision
+//! patches have none ([`TaylorBound::of`] gives [`TaylorBound::NONE`]), and keep the
+//! second-derivative bound alone. Every caller takes the smaller of the two, each valid.
+
+use crate::surface::{BezierTriangle, Patch, RationalBicubic};
+use glam::{DVec2, DVec3};
+
+/// One patch's Taylor bound: the field of its second derivatives and bounds on its third.
+/// Cost of an error query: one evaluation of the second derivatives (25 Bernstein terms for
+/// a bicubic, 9 for a triangle) and a 3 × 3 closed form.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TaylorBound {
+    field: SecondDerivatives,
+    /// Bounds on `|S_uuu|`, `|S_uuv|`, `|S_uvv|`, `|S_vvv|` over the domain.
+    third: [f64; 4],
+}
+
+// The variants differ in size (600 bytes against 216), but a set's bounds live in one
+// vector, read per triangle: boxing the large one would add an allocation a patch and a
+// pointer chase a query to save memory only on triangle meshes.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SecondDerivatives {
+    /// No Taylor bound for this patch kind: every error is infinite.
+    None,
+    /// Bézier nets of `S_uu` (2 × 4, `[i][j]` with `i` along u), `S_uv` (3 × 3), `S_vv` (4 × 2).
+    Bicubic { uu: [[DVec3; 4]; 2], uv: [[DVec3; 3]; 3], vv: [[DVec3; 2]; 4] },
+    /// `[S_uu, S_uv, S_vv]` at the corners `(0,0)`, `(1,0)`, `(0,1)`; linear in between.
+    Triangle { corners: [[DVec3; 3]; 3] },
+}
+
+impl TaylorBound {
+    /// No bound: [`TaylorBound::triangle_error`] is infinite.
+    pub const NONE: TaylorBound = TaylorBound { field: SecondDerivatives::None, third: [0.0; 4] };
+
+    /// The bound of `patch`, or [`TaylorBound::NONE`] for the kinds it does not cover
+    /// (rational bicubics, subdivision patches). Cost: O(control points).
+    pub fn of(patch: &Patch) -> TaylorBound {
+        match patch {
+            Patch::Bicubic(b) if b.is_polynomial() => bicubic(b),
+            Patch::BezierTriangle(t) => triangle(t),
+            Patch::Pn(pn) => triangle(&pn.geometry),
+            _ => TaylorBound::NONE,
+        }
+    }
+
+    /// Whether this bound covers its patch (else every error is infinite).
+    pub fn is_some(&self) -> bool {
+        !matches!(self.field, SecondDerivatives::None)
+    }
+
+    /// `[S_uu, S_uv, S_vv]` at `x`. Preconditions: `x` in the patch's domain.
+    pub fn second_derivatives(&self, x: DVec2) -> [DVec3; 3] {
+        match &self.field {
+            SecondDerivatives::None => [DVec3::ZERO; 3],
+            SecondDerivatives::Bicubic { uu, uv, vv } => [net_at(uu, x), net_at(uv, x), net_at(vv, x)],
+            SecondDerivatives::Triangle { corners } => {
+                let l = [1.0 - x.x - x.y, x.x, x.y];
+                std::array::from_fn(|k| corners[0][k] * l[0] + corners[1][k] * l[1] + corners[2][k] * l[2])
+            }
+        }
+    }
+
+    /// `f₃(Δ)/3`: the remainder's share of the bound over a triangle within `delta` of its
+    /// expansion point (per parameter).
+    fn remainder(&self, delta: DVec2) -> f64 {
+        let (a, b) = (delta.x.abs(), delta.y.abs());
+        let [t0, t1, t2, t3] = self.third;
+        (t0 * a * a * a + 3.0 * t1 * a * a * b + 3.0 * t2 * a * b * b + t3 * b * b * b) / 3.0
+    }
+
+    /// Guaranteed bound on `|S − L|` over the parameter triangle `t` (module doc), expanded
+    /// about its centroid. Infinite for [`TaylorBound::NONE`]. Preconditions: `t` in the
+    /// patch's domain. Cost: one evaluation of the second derivatives.
+    pub fn triangle_error(&self, t: [DVec2; 3]) -> f64 {
+        if !self.is_some() {
+            return f64::INFINITY;
+        }
+        let g = (t[0] + t[1] + t[2]) / 3.0;
+        let [a, b, c] = self.second_derivatives(g);
+        let m = |i: usize| {
+            let e = t[(i + 2) % 3] - t[(i + 1) % 3];
+            (a * (e.x * e.x) + b * (2.0 * e.x * e.y) + c * (e.y * e.y)).length() / 8.0
+        };
+        let delta = t.iter().fold(DVec2::ZERO, |d, p| d.max((*p - g).abs()));
+        bubble_max([m(0), m(1), m(2)]) + self.remainder(delta)
+    }
+
+    /// The bound over both halves of the grid cell of sides `hu`, `hv` centred at `centre`,
+    /// whichever diagonal splits it: one evaluation, at the centre, serves both triangles and
+    /// both diagonals. Cost: one evaluation of the second derivatives.
+    pub fn cell_error(&self, centre: DVec2, hu: f64, hv: f64) -> f64 {
+        if !self.is_some() {
+            return f64::INFINITY;
+        }
+        let [a, b, c] = self.second_derivatives(centre);
+        let (a, b, c) = (a * (hu * hu), b * (2.0 * hu * hv), c * (hv * hv));
+        let (legs_u, legs_v) = (a.length() / 8.0, c.length() / 8.0);
+        let diagonal = ((a + c - b).length().max((a + c + b).length())) / 8.0;
+        bubble_max([diagonal, legs_u, legs_v]) + self.remainder(DVec2::new(hu, hv) / 2.0)
+    }
+
+    /// The bound over every triangle of the `nu × nv` grid of the unit square, whichever way
+    /// its cells are split; on a triangle domain, over the cells that meet the triangle
+    /// (`i + j < nu` for `nu = nv`). Cost: one evaluation per cell.
+    pub fn grid_error(&self, triangle_domain: bool, [nu, nv]: [u32; 2]) -> f64 {
+        if !self.is_some() {
+            return f64::INFINITY;
+        }
+        let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+        let mut worst = 0.0f64;
+        for i in 0..nu {
+            for j in 0..nv {
+                if triangle_domain && (i as u64 * nv as u64 + j as u64 * nu as u64) >= nu as u64 * nv as u64 {
+                    continue; // the cell lies beyond the diagonal u + v = 1
+                }
+                let centre = DVec2::new((i as f64 + 0.5) * hu, (j as f64 + 0.5) * hv);
+                worst = worst.max(self.cell_error(centre, hu, hv));
+            }
+        }
+        worst
+    }
+}
+
+/// The largest value over a triangle of `Σ a_i·4λ_jλ_k` (`a_i ≥ 0`, `{i, j, k} = {0, 1, 2}`):
+/// on the edges `max a_i` (at a midpoint); inside, the critical point of the quadratic, which
+/// Lagrange's condition puts at `λ_i ∝ a_i·(a_0 + a_1 + a_2 − 2a_i)` and which lies inside
+/// only when every factor is positive. The maximum over the triangle is the larger of the
+/// two. Cost: O(1).
+pub fn bubble_max(a: [f64; 3]) -> f64 {
+    let edges = a[0].max(a[1]).max(a[2]);
+    let s = a[0] + a[1] + a[2];
+    let l = a.map(|ai| ai * (s - 2.0 * ai));
+    let total = l[0] + l[1] + l[2];
+    if l.iter().all(|&x| x > 0.0) && total > 0.0 {
+        let l = l.map(|x| x / total);
+        let inside = 4.0 * (a[0] * l[1] * l[2] + a[1] * l[2] * l[0] + a[2] * l[0] * l[1]);
+        edges.max(inside)
+    } else {
+        edges
+    }
+}
+
+/// Bernstein weights of degree `n ≤ 3` at `t`.
+fn bernstein(n: usize, t: f64) -> [f64; 4] {
+    let s = 1.0 - t;
+    match n {
+        0 => [1.0, 0.0, 0.0, 0.0],
+        1 => [s, t, 0.0, 0.0],
+        2 => [s * s, 2.0 * s * t, t * t, 0.0],
+        _ => [s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t],
+    }
+}
+
+/// A tensor Bézier patch with `M × N` points (`net[i][j]`, `i` along u) at `x`.
+fn net_at<const M: usize, const N: usize>(net: &[[DVec3; N]; M], x: DVec2) -> DVec3 {
+    let (bu, bv) = (bernstein(M - 1, x.x), bernstein(N - 1, x.y));
+    let mut out = DVec3::ZERO;
+    for (i, row) in net.iter().enumerate() {
+        let mut r = DVec3::ZERO;
+        for (j, p) in row.iter().enumerate() {
+            r += *p * bv[j];
+        }
+        out += r * bu[i];
+    }
+    out
+}
+
+fn max_norm<'a>(it: impl IntoIterator<Item = &'a DVec3>) -> f64 {
+    it.into_iter().map(|v| v.length()).fold(0.0, f64::max)
+}
+
+/// A polynomial bicubic's second-derivative nets (`6·Δ²_u b`, `9·ΔuΔv b`, `6·Δ²_v b`) and
+/// third-derivative bounds: `S_uuu = 6 Σ Δ³_u b·B³(v)`, `S_uuv = 18 Σ Δ²_uΔ_v b·B¹(u)B²(v)`,
+/// and their mirrors, each at most its largest coefficient.
+fn bicubic(p: &RationalBicubic) -> TaylorBound {
+    let b = |i: usize, j: usize| p.points[4 * i + j];
+    let du = |i: usize, j: usize| b(i + 1, j) - b(i, j);
+    let duu = |i: usize, j: usize| du(i + 1, j) - du(i, j);
+    let duv = |i: usize, j: usize| du(i, j + 1) - du(i, j);
+    let dvv = |i: usize, j: usize| b(i, j + 2) - 2.0 * b(i, j + 1) + b(i, j);
+    let uu: [[DVec3; 4]; 2] = std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j) * 6.0));
+    let uv: [[DVec3; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| duv(i, j) * 9.0));
+    let vv: [[DVec3; 2]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| dvv(i, j) * 6.0));
+    let uuu: Vec<DVec3> = (0..4).map(|j| (duu(1, j) - duu(0, j)) * 6.0).collect();
+    let uuv: Vec<DVec3> =
+        (0..2).flat_map(|i| (0..3).map(move |j| (duu(i, j + 1) - duu(i, j)) * 18.0)).collect();
+    let uvv: Vec<DVec3> =
+        (0..3).flat_map(|i| (0..2).map(move |j| (dvv(i + 1, j) - dvv(i, j)) * 18.0)).collect();
+    let vvv: Vec<DVec3> = (0..4).map(|i| (dvv(i, 1) - dvv(i, 0)) * 6.0).collect();
+    TaylorBound {
+        field: SecondDerivatives::Bicubic { uu, uv, vv },
+        third: [max_norm(&uuu), max_norm(&uuv), max_norm(&uvv), max_norm(&vvv)],
+    }
+}
+
+/// A cubic Bézier triangle's second derivatives at its corners and its (constant) third
+/// derivatives. With `b(i, j, k)` (`i` the exponent of `λ0 = 1 − u − v`, `j` of `u`, `k` of
+/// `v`), `∂/∂u` is the difference `E_j − E_i` and `∂/∂v` is `E_k − E_i`: so
+/// `S_uu = 6 Σ (E_j − E_i)² b · B¹` and `S_uuu = 6 (E_j − E_i)³ b_000`, and so on.
+fn triangle(t: &BezierTriangle) -> TaylorBound {
+    let b = |i: usize, j: usize, k: usize| t.b(i, j, k);
+    // The difference operators applied at base (i, j, k) of degree 3 − order.
+    let d_uu = |i, j, k| b(i, j + 2, k) - 2.0 * b(i + 1, j + 1, k) + b(i + 2, j, k);
+    let d_uv = |i, j, k| b(i, j + 1, k + 1) - b(i + 1, j, k + 1) - b(i + 1, j + 1, k) + b(i + 2, j, k);
+    let d_vv = |i, j, k| b(i, j, k + 2) - 2.0 * b(i + 1, j, k + 1) + b(i + 2, j, k);
+    let corners = [(1, 0, 0), (0, 1, 0), (0, 0, 1)]
+        .map(|(i, j, k)| [d_uu(i, j, k), d_uv(i, j, k), d_vv(i, j, k)].map(|d| d * 6.0));
+    // Third differences: one more (E_j − E_i) or (E_k − E_i) on the second ones.
+    let uuu = d_uu(0, 1, 0) - d_uu(1, 0, 0);
+    let uuv = d_uu(0, 0, 1) - d_uu(1, 0, 0);
+    let uvv = d_vv(0, 1, 0) - d_vv(1, 0, 0);
+    let vvv = d_vv(0, 0, 1) - d_vv(1, 0, 0);
+    TaylorBound {
+        field: SecondDerivatives::Triangle { corners },
+        third: [uuu, uuv, uvv, vvv].map(|d| 6.0 * d.length()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::Lcg;
+
+    fn second_by_differences(p: &Patch, x: DVec2) -> [DVec3; 3] {
+        let h = 1e-4;
+        let f = |dx: f64, dy: f64| p.position(x + DVec2::new(dx, dy));
+        [
+            (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
+            (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
+            (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
+        ]
+    }
+
+    fn random_net(rng: &mut Lcg) -> Vec<DVec3> {
+        (0..16).map(|_| DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - DVec3::ONE).collect()
+    }
+
+    /// The second-derivative fields equal the surfaces' own, measured by central differences.
+    #[test]
+    fn second_derivatives_are_the_surfaces() {
+        let mut rng = Lcg(3);
+        for _ in 0..20 {
+            let net = random_net(&mut rng);
+            let bicubic = Patch::Bicubic(RationalBicubic::polynomial(std::array::from_fn(|k| net[k])));
+            let tri = Patch::BezierTriangle(BezierTriangle { points: std::array::from_fn(|k| net[k]) });
+            for p in [bicubic, tri] {
+                let taylor = TaylorBound::of(&p);
+                for _ in 0..20 {
+                    let x = DVec2::new(0.1 + 0.4 * rng.unit(), 0.1 + 0.4 * rng.unit());
+                    let (got, want) = (taylor.second_derivatives(x), second_by_differences(&p, x));
+                    for k in 0..3 {
+                        assert!(
+                            got[k].distance(want[k]) < 1e-5 * (1.0 + want[k].length()),
+                            "{k}: {got:?} {want:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bubble_max_is_the_maximum_over_the_triangle() {
+        let mut rng = Lcg(11);
+        for _ in 0..500 {
+            let a = [rng.unit(), rng.unit(), rng.unit()].map(|x| if x < 0.1 { 0.0 } else { x });
+            let mut sampled = 0.0f64;
+            let n = 200;
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let (l0, l1) = (i as f64 / n as f64, j as f64 / n as f64);
+                    let l2 = 1.0 - l0 - l1;
+                    sampled = sampled.max(4.0 * (a[0] * l1 * l2 + a[1] * l2 * l0 + a[2] * l0 * l1));
+                }
+            }
+            let exact = bubble_max(a);
+            assert!(
+                exact >= sampled - 1e-12 && exact <= sampled * (1.0 + 1e-3) + 1e-12,
+                "{a:?}: {exact} vs {sampled}"
+            );
+        }
+    }
+}

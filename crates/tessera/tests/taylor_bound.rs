@@ -1,0 +1,114 @@
+//! The Taylor bound ([`tessera::criterion::taylor`]) is an upper bound: on every patch and
+//! mesh model, for random parameter triangles of every size and shape and for whole grids,
+//! the error measured densely (the linear interpolant against the surface at 300–1,300
+//! points a triangle) never exceeds it; and it is tight where triangles are small.
+
+mod common;
+
+use glam::DVec2;
+use tessera::criterion::taylor::TaylorBound;
+use tessera::surface::{Domain, Patch};
+use tessera::test_support::Lcg;
+
+/// Largest `|S − L|` over the triangle `t` at the points of an order-`order` barycentric grid.
+fn measured(patch: &Patch, t: [DVec2; 3], order: u32) -> f64 {
+    let x = t.map(|q| patch.position(q));
+    let mut worst = 0.0f64;
+    for i in 0..=order {
+        for j in 0..=order - i {
+            let (a, b) = (i as f64 / order as f64, j as f64 / order as f64);
+            let c = 1.0 - a - b;
+            let q = t[0] * a + t[1] * b + t[2] * c;
+            worst = worst.max((x[0] * a + x[1] * b + x[2] * c).distance(patch.position(q)));
+        }
+    }
+    worst
+}
+
+fn inside(domain: Domain, q: DVec2) -> bool {
+    let slack = 1e-12; // grid points computed as i·h may pass 1 in the last bit
+    q.min_element() >= 0.0
+        && q.max_element() <= 1.0 + slack
+        && (domain == Domain::Quad || q.x + q.y <= 1.0 + slack)
+}
+
+/// A random triangle of the domain about `size` across (corners inside the domain).
+fn random_triangle(rng: &mut Lcg, domain: Domain, size: f64) -> [DVec2; 3] {
+    loop {
+        let c = DVec2::new(rng.unit(), rng.unit());
+        let t = [0, 1, 2].map(|_| c + (DVec2::new(rng.unit(), rng.unit()) - 0.5) * size);
+        if t.iter().all(|&q| inside(domain, q)) {
+            return t;
+        }
+    }
+}
+
+#[test]
+fn the_taylor_bound_holds_on_every_model() {
+    let mut rng = Lcg(2027);
+    let mut small_ratios = Vec::new();
+    for path in common::all_surface_models() {
+        let set = common::load(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        // Every patch of a small model, about 60 of a large one.
+        let step = (set.patches.len() / 60).max(1);
+        let mut covered = 0;
+        for patch in set.patches.iter().step_by(step) {
+            let taylor = TaylorBound::of(patch);
+            if !taylor.is_some() {
+                continue;
+            }
+            covered += 1;
+            let domain = patch.domain();
+            for size in [1.0, 0.4, 0.1, 0.02] {
+                let t = random_triangle(&mut rng, domain, size);
+                let bound = taylor.triangle_error(t);
+                let error = measured(patch, t, 24);
+                assert!(
+                    error <= bound * (1.0 + 1e-9) + 1e-15,
+                    "{name}: {t:?} measured {error:e} > bound {bound:e}"
+                );
+                if size <= 0.02 && bound > 0.0 {
+                    small_ratios.push(error / bound);
+                }
+            }
+            // A whole grid, each cell split either way.
+            let n = [1 + rng.below(6) as u32, 1 + rng.below(6) as u32];
+            let n = if domain == Domain::Tri { [n[0], n[0]] } else { n };
+            let bound = taylor.grid_error(domain == Domain::Tri, n);
+            let (hu, hv) = (1.0 / n[0] as f64, 1.0 / n[1] as f64);
+            let mut error = 0.0f64;
+            for i in 0..n[0] {
+                for j in 0..n[1] {
+                    let o = DVec2::new(i as f64 * hu, j as f64 * hv);
+                    let [a, b, c, d] =
+                        [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
+                    for t in [[a, b, c], [b, d, c], [a, b, d], [a, d, c]] {
+                        if t.iter().all(|&q| inside(domain, q)) {
+                            error = error.max(measured(patch, t, 12));
+                        }
+                    }
+                }
+            }
+            assert!(
+                error <= bound * (1.0 + 1e-9) + 1e-15,
+                "{name}: grid {n:?} measured {error:e} > bound {bound:e}"
+            );
+        }
+        assert!(covered > 0, "{name}: no patch with a Taylor bound");
+        println!("{name}: {covered} patches");
+    }
+    // Small triangles: the remainder is small, so the bound is near the truth (the triangle
+    // inequality inside a triangle, and the order-24 sampling, are the rest of the slack).
+    small_ratios.sort_by(f64::total_cmp);
+    let median = small_ratios[small_ratios.len() / 2];
+    let tenth = small_ratios[small_ratios.len() / 10];
+    println!(
+        "{} small triangles: measured / bound median {median:.3}, 10th percentile {tenth:.3}",
+        small_ratios.len()
+    );
+    assert!(
+        median >= 0.8 && tenth >= 0.5,
+        "measured / bound on small triangles: median {median}, 10th percentile {tenth}"
+    );
+}
