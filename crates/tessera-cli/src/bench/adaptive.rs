@@ -20,7 +20,7 @@ use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::{tessellate, EngineOptions};
 use tessera::pattern::hardware::Partitioning;
-use tessera::scheme::{Criterion, PlanOptions, Scheme};
+use tessera::scheme::{Criterion, ErrorBound, PlanOptions, Scheme};
 use tessera::surface::{Domain, SurfaceSet};
 use tessera::verify;
 
@@ -29,8 +29,8 @@ use tessera::verify;
 enum Knob {
     /// Uniform factor `n = s`.
     Uniform,
-    /// Tolerance `diagonal · 10^-s` (error-bounded schemes).
-    Tolerance(Scheme),
+    /// Tolerance `diagonal · 10^-s` (error-bounded schemes), planned with a bound.
+    Tolerance(Scheme, ErrorBound),
     /// Distance level function with `f_max = s` (schemes without a bound).
     Distance(Scheme),
     /// ESC at level `L = ⌊s / 10⌋` with `ρ = diagonal · 10^-(s mod 10)`: two knobs in one
@@ -38,11 +38,14 @@ enum Knob {
     Esc,
 }
 
-const SCHEMES: [(&str, Knob); 6] = [
+/// Semi-uniform at level 8 (factors up to 256), as the tests, so the cap rarely stops a bound.
+const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 8 };
+
+const SCHEMES: [(&str, Knob); 7] = [
     ("uniform", Knob::Uniform),
-    ("transition", Knob::Tolerance(Scheme::Transition)),
-    // Level 8 (factors up to 256), as the tests, so the cap rarely stops a bound.
-    ("semi-uniform", Knob::Tolerance(Scheme::SemiUniform { max_level: 8 })),
+    ("transition", Knob::Tolerance(Scheme::Transition, ErrorBound::Hessian)),
+    ("transition, taylor", Knob::Tolerance(Scheme::Transition, ErrorBound::Taylor)),
+    ("semi-uniform", Knob::Tolerance(SEMI_UNIFORM, ErrorBound::Hessian)),
     ("sd2", Knob::Distance(Scheme::Sd2 { warp: false })),
     ("fractional-odd", Knob::Distance(Scheme::Hardware(Partitioning::FractionalOdd))),
     ("esc", Knob::Esc),
@@ -54,6 +57,8 @@ struct Point {
     s: f64,
     triangles: usize,
     error: f64,
+    /// The certified bound, for the error-bounded schemes.
+    bound: Option<f64>,
 }
 
 struct Sizes {
@@ -118,9 +123,13 @@ impl Model {
     /// Tessellates with knob value `s` and measures the max error; None when the output
     /// would exceed `max_triangles`.
     fn measure(&self, knob: Knob, s: f64, max_triangles: u64) -> BenchResult<Option<Point>> {
+        let mut bound = ErrorBound::Hessian;
         let (scheme, criterion, max_factor) = match knob {
             Knob::Uniform => (Scheme::Uniform, Criterion::Factor(s.round().max(1.0)), 64),
-            Knob::Tolerance(scheme) => (scheme, Criterion::Tolerance(self.diagonal * 10f64.powf(-s)), 4096),
+            Knob::Tolerance(scheme, b) => {
+                bound = b;
+                (scheme, Criterion::Tolerance(self.diagonal * 10f64.powf(-s)), 4096)
+            }
             Knob::Distance(scheme) => {
                 let criterion = ViewCriterion::Distance(Mapping::Linear);
                 (scheme, Criterion::View { criterion, fmin: (s / 2.0).max(1.0), fmax: s }, 64)
@@ -131,13 +140,8 @@ impl Model {
                 (Scheme::Esc { max_level: 6 }, Criterion::Esc { threshold, level: Some(level as u32) }, 64)
             }
         };
-        let options = PlanOptions {
-            camera: Some(self.camera),
-            cull: false,
-            max_factor,
-            max_triangles,
-            ..Default::default()
-        };
+        let options =
+            PlanOptions { camera: Some(self.camera), cull: false, max_factor, max_triangles, bound };
         let too_large = |e: &tessera::Error| matches!(e, tessera::Error::OutputTooLarge { .. });
         let planned = match scheme.plan(&self.set, &criterion, &options) {
             Ok(p) => p,
@@ -152,7 +156,8 @@ impl Model {
             Err(e) => return Err(e.into()),
         };
         let error = verify::approximation_error(&mesh, &self.set, 5)?.max;
-        Ok(Some(Point { s, triangles: mesh.triangle_count(), error }))
+        let bound = planned.report.map(|r| r.worst_bound);
+        Ok(Some(Point { s, triangles: mesh.triangle_count(), error, bound }))
     }
 }
 
@@ -266,6 +271,19 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         "adaptive: triangles at equal measured max error, % of uniform's",
         &columns,
     );
+    let mut tightness = Table::new(
+        "adaptive_bounds",
+        "adaptive: measured max error against the certified bound, per model, scheme and bound",
+        &[
+            "model",
+            "scheme",
+            "tolerance / diagonal",
+            "triangles",
+            "measured / diagonal",
+            "certified / diagonal",
+            "measured / certified",
+        ],
+    );
     let threads = *ctx.threads.iter().max().unwrap_or(&1);
     for rel in models {
         let set = scenes::load(ctx, rel)?;
@@ -287,7 +305,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
             }
             let grid: Vec<f64> = match knob {
                 Knob::Uniform => sz.factor_grid.iter().map(|&f| f as f64).collect(),
-                Knob::Tolerance(_) => sz.tolerance_grid.clone(),
+                Knob::Tolerance(..) => sz.tolerance_grid.clone(),
                 Knob::Distance(_) => sz.distance_grid.iter().map(|&f| f as f64).collect(),
                 Knob::Esc => {
                     (1..=6).flat_map(|l| sz.esc_grid.iter().map(move |r| 10.0 * l as f64 + r)).collect()
@@ -312,10 +330,25 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
             })??;
             let knob_name = match knob {
                 Knob::Uniform => "factor",
-                Knob::Tolerance(_) => "-log10(tolerance / diagonal)",
+                Knob::Tolerance(..) => "-log10(tolerance / diagonal)",
                 Knob::Distance(_) => "f_max (distance, f_min = f_max/2)",
                 Knob::Esc => "10 L - log10(rho / diagonal)",
             };
+            if let Knob::Tolerance(..) = knob {
+                // The grid's points at 1 %, 0.1 % and 0.01 % of the diagonal.
+                for p in points.iter().filter(|p| [2.0, 3.0, 4.0].contains(&p.s)) {
+                    let Some(bound) = p.bound else { continue };
+                    tightness.row(vec![
+                        model.name.clone().into(),
+                        name.into(),
+                        format!("{:e}", 10f64.powf(-p.s)).into(),
+                        p.triangles.into(),
+                        num(p.error / model.diagonal, 7),
+                        num(bound / model.diagonal, 7),
+                        num(p.error / bound, 3),
+                    ]);
+                }
+            }
             for p in &points {
                 curves.row(vec![
                     model.name.clone().into(),
@@ -397,7 +430,14 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
          f_max/2, no error bound); ESC: levels 1–6 × a grid of ρ. Errors: tessera::verify::approximation_error, order 5.",
         sz.bisections, sz.max_triangles
     ));
-    Ok(vec![ratio, equal, curves])
+    tightness.note(
+        "Each error-bounded scheme at tolerances of 1 %, 0.1 % and 0.01 % of the diagonal (the points of its knob grid; \
+         the quick run has no 0.01 %): the measured max error (order 5, as above) and the plan's certified bound \
+         (BoundReport::worst_bound, the largest over the patches). \"transition, taylor\" plans with ErrorBound::Taylor \
+         (tessera mesh --bound taylor), the others with the second-derivative bound."
+            .to_string(),
+    );
+    Ok(vec![ratio, tightness, equal, curves])
 }
 
 #[cfg(test)]
