@@ -297,5 +297,38 @@ fn the_taylor_bound_cuts_triangles_at_the_same_guarantee() {
                 counts[0]
             );
         }
+        // The same at 0.5 px from three cameras: the framing one and two more around the model.
+        let (lo, hi) = set.bounds();
+        let framing = Camera::framing(lo, hi, 1280, 720);
+        let (centre, d) = ((lo + hi) / 2.0, lo.distance(hi));
+        for eye in [None, Some(DVec3::new(1.5, 1.0, 2.0)), Some(DVec3::new(-1.0, 2.5, 0.5))] {
+            let camera = match eye {
+                None => framing,
+                Some(dir) => {
+                    let e = centre + dir * d;
+                    Camera::parse(&format!("eye={},{},{}", e.x, e.y, e.z), &framing).unwrap()
+                }
+            };
+            let mut counts = [0usize; 2];
+            for (k, bound) in [ErrorBound::Hessian, ErrorBound::Taylor].into_iter().enumerate() {
+                let (plan, pattern, _) = plan_with(
+                    &set,
+                    Scheme::Transition,
+                    Criterion::PixelError(0.5),
+                    Some(camera),
+                    false,
+                    bound,
+                );
+                let mesh = run(&set, &plan, &pattern);
+                counts[k] = mesh.triangle_count();
+                let px = projected_error(&mesh, &set, &camera);
+                assert!(px <= 0.5, "{rel} {eye:?} {bound:?}: {px} px");
+            }
+            println!(
+                "{rel} 0.5 px from {eye:?}: {} triangles with the Taylor bound, {} without",
+                counts[1], counts[0]
+            );
+            assert!(counts[1] as f64 <= 0.8 * counts[0] as f64, "{rel} 0.5 px from {eye:?}: {counts:?}");
+        }
     }
 }
