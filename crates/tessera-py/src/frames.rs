@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use tessera::criterion::esc::Threshold;
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::engine::EngineOptions;
-use tessera::scheme::{Criterion, PlanOptions, Scheme};
+use tessera::scheme::{Criterion, ErrorBound, PlanOptions, Scheme};
 use tessera::tessellator::{Tessellator as Inner, TessellatorOptions};
 
 /// Every scheme name `scheme=` takes, in the command line's order.
@@ -58,6 +58,8 @@ struct Request<'a, 'py> {
     threshold: Option<f64>,
     /// SD-2's reverse projection.
     warp: bool,
+    /// The guaranteed bound of `tolerance` and `pixel_error`: "hessian" or "taylor".
+    bound: &'a str,
 }
 
 /// Maps the keyword arguments to the library's request; every rule it applies is the
@@ -167,13 +169,12 @@ fn choose(
     };
     let scheme = named.unwrap_or_else(|| Scheme::default_for(&criterion));
     let camera = camera.unwrap_or_else(|| default_camera(set, (1280, 720)));
-    let plan = PlanOptions {
-        camera: Some(camera),
-        cull: r.cull,
-        max_factor: r.max_factor,
-        max_triangles,
-        ..PlanOptions::default()
+    let bound = match r.bound {
+        "hessian" => ErrorBound::Hessian,
+        "taylor" => ErrorBound::Taylor,
+        other => return Err(parameter_error(py, format!("bound={other:?}: use \"hessian\" or \"taylor\""))),
     };
+    let plan = PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles, bound };
     Ok(Chosen { scheme, criterion, plan, tolerance: tolerance_value })
 }
 
@@ -205,7 +206,7 @@ impl Tessellator {
     /// Prepares `set` (error bounds, topology minimums) for the scheme and the criterion;
     /// see `tessera.Tessellator` for the arguments. Refuses what the library refuses.
     #[new]
-    #[pyo3(signature = (set, *, scheme = None, factor = None, tolerance = None, pixel_error = None, distance = None, silhouette = None, silhouette_mode = None, mapping = "linear", camera = None, cull = false, max_factor = 64, max_level = None, level = None, quality = None, threshold = None, warp = false, strips = false, corner_params = false, max_triangles = None))]
+    #[pyo3(signature = (set, *, scheme = None, factor = None, tolerance = None, pixel_error = None, distance = None, silhouette = None, silhouette_mode = None, mapping = "linear", camera = None, cull = false, max_factor = 64, max_level = None, level = None, quality = None, threshold = None, warp = false, bound = "hessian", strips = false, corner_params = false, max_triangles = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -226,6 +227,7 @@ impl Tessellator {
         quality: Option<&str>,
         threshold: Option<f64>,
         warp: bool,
+        bound: &str,
         strips: bool,
         corner_params: bool,
         max_triangles: Option<u64>,
@@ -252,6 +254,7 @@ impl Tessellator {
             quality,
             threshold,
             warp,
+            bound,
         };
         let camera = camera.map(|c| c.camera);
         let chosen = choose(py, &set, &request, camera, engine.max_triangles.unwrap_or(u64::MAX))?;

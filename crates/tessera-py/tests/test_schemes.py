@@ -101,3 +101,13 @@ def canonical(t):
     t = tuple(t)
     k = t.index(min(t))
     return t[k:] + t[:k]
+
+
+def test_the_taylor_bound_keeps_the_guarantee_with_fewer_triangles(data):
+    s = tessera.load(data / "patches" / "teapot.patches")
+    hessian = tessera.tessellate(s, tolerance="0.1%", corner_params=True)
+    taylor = tessera.tessellate(s, tolerance="0.1%", bound="taylor", corner_params=True)
+    assert hessian.report["bound_met"] and taylor.report["bound_met"]
+    assert taylor.triangle_count <= 0.8 * hessian.triangle_count
+    with pytest.raises(tessera.ParameterError, match="bound="):
+        tessera.tessellate(s, tolerance="0.1%", bound="exact")

@@ -88,6 +88,7 @@ class Tessellator:
         quality: Optional[str] = None,
         threshold: Optional[float] = None,
         warp: bool = False,
+        bound: str = "hessian",
         strips: bool = False,
         corner_params: bool = False,
         max_triangles: Optional[int] = None,
