@@ -225,6 +225,27 @@ fn tolerance_is_met_and_the_cap_is_reported() {
     );
 }
 
+/// `--bound taylor` keeps the guarantee, measured, with at most 80 % of the default bound's
+/// triangles on spot's PN triangles; an unknown bound is refused by name.
+#[test]
+fn the_taylor_bound_is_met_with_fewer_triangles() {
+    let dir = scratch("taylor");
+    let spot = data("meshes/spot.obj");
+    let s = spot.to_str().unwrap();
+    let run = |bound: &str| {
+        stats(&["mesh", s, "--tolerance", "0.1%", "--bound", bound, "--stats", "--measure-error"], &dir).0
+    };
+    let (hessian, taylor) = (run("hessian"), run("taylor"));
+    for v in [&hessian, &taylor] {
+        assert_eq!(v["bound_met"], true, "{v}");
+        assert!(v["max_error"].as_f64().unwrap() <= v["guaranteed_bound"].as_f64().unwrap(), "{v}");
+    }
+    let count = |v: &serde_json::Value| v["triangles"].as_u64().unwrap();
+    assert!(count(&taylor) * 10 <= count(&hessian) * 8, "{} against {}", count(&taylor), count(&hessian));
+    let out = tessera(&["mesh", s, "--bound", "exact", "--tolerance", "0.1%"], &dir);
+    assert!(!out.status.success() && text(&out.stderr).contains("--bound"), "{}", text(&out.stderr));
+}
+
 #[test]
 fn pixel_error_keeps_closed_inputs_closed_unless_asked_to_cull() {
     let dir = scratch("pixels");

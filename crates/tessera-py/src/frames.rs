@@ -174,7 +174,8 @@ fn choose(
         "taylor" => ErrorBound::Taylor,
         other => return Err(parameter_error(py, format!("bound={other:?}: use \"hessian\" or \"taylor\""))),
     };
-    let plan = PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles, bound };
+    let plan =
+        PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles, bound };
     Ok(Chosen { scheme, criterion, plan, tolerance: tolerance_value })
 }
 
