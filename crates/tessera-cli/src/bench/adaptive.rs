@@ -44,7 +44,7 @@ const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 8 };
 const SCHEMES: [(&str, Knob); 7] = [
     ("uniform", Knob::Uniform),
     ("transition", Knob::Tolerance(Scheme::Transition, ErrorBound::Hessian)),
-    ("transition, taylor", Knob::Tolerance(Scheme::Transition, ErrorBound::Taylor)),
+    ("transition-taylor", Knob::Tolerance(Scheme::Transition, ErrorBound::Taylor)),
     ("semi-uniform", Knob::Tolerance(SEMI_UNIFORM, ErrorBound::Hessian)),
     ("sd2", Knob::Distance(Scheme::Sd2 { warp: false })),
     ("fractional-odd", Knob::Distance(Scheme::Hardware(Partitioning::FractionalOdd))),
@@ -433,7 +433,7 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
     tightness.note(
         "Each error-bounded scheme at tolerances of 1 %, 0.1 % and 0.01 % of the diagonal (the points of its knob grid; \
          the quick run has no 0.01 %): the measured max error (order 5, as above) and the plan's certified bound \
-         (BoundReport::worst_bound, the largest over the patches). \"transition, taylor\" plans with ErrorBound::Taylor \
+         (BoundReport::worst_bound, the largest over the patches). \"transition-taylor\" plans with ErrorBound::Taylor \
          (tessera mesh --bound taylor), the others with the second-derivative bound."
             .to_string(),
     );

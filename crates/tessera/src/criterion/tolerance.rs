@@ -205,6 +205,12 @@ fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, n
     }
 }
 
+/// The largest grid (in cells) a Taylor proposal searches below: each step of the search
+/// bounds a whole grid, so an absurd tolerance (grids of thousands of cells a side) keeps the
+/// second-derivative bound's proposal, and only the check, which bounds each pattern once
+/// after the output budget admitted it, takes the Taylor bound there.
+const TAYLOR_SEARCH_CELLS: u64 = 1 << 16;
+
 /// The grid with the fewest cells near `start` (the second-derivative bound's, which the
 /// Taylor bound may not meet on coarse grids) whose Taylor bound meets `eps`. The
 /// second-derivative bound's grid, scaled by the square root of the Taylor bound's slack there
@@ -217,6 +223,9 @@ fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, n
 fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) {
     let fits = |nu: u32, nv: u32| t.grid_error(false, [nu, nv]) <= eps;
     let (nu0, nv0) = start;
+    if nu0 as u64 * nv0 as u64 > TAYLOR_SEARCH_CELLS {
+        return start;
+    }
     let at_start = t.grid_error(false, [nu0, nv0]);
     if at_start > eps {
         return start;
@@ -260,6 +269,9 @@ fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) 
 fn taylor_uniform_factor(t: &TaylorBound, domain: Domain, start: f64, eps: f64) -> f64 {
     let fits = |n: u32| t.grid_error(domain == Domain::Tri, [n, n]) <= eps;
     let (mut lo, mut hi) = (1u32, start.max(1.0) as u32);
+    if hi as u64 * hi as u64 > TAYLOR_SEARCH_CELLS {
+        return start;
+    }
     if !fits(hi) {
         return start;
     }
