@@ -56,16 +56,20 @@ fn diagonal(set: &SurfaceSet) -> f64 {
 
 #[test]
 fn tolerance_bounds_hold_on_the_fast_models() {
-    tolerance_bounds_hold(&common::fast_models());
+    tolerance_bounds_hold(&common::fast_models(), true);
 }
 
 #[test]
 #[ignore = "slow tier (every model): scripts/test runs it"]
 fn tolerance_bounds_hold_on_every_model() {
-    tolerance_bounds_hold(&common::all_surface_models());
+    tolerance_bounds_hold(&common::all_surface_models(), false);
 }
 
-fn tolerance_bounds_hold(models: &[std::path::PathBuf]) {
+/// Every scheme at 1 %, 0.1 % (transition also 0.01 %) of the diagonal, with both bounds; with
+/// `every_taylor` false the Taylor bound only for transition at 1 % and 0.1 % (its planning
+/// at 0.01 % on the large meshes takes seconds; the fast models and `taylor_bound.rs` cover
+/// the rest).
+fn tolerance_bounds_hold(models: &[std::path::PathBuf], every_taylor: bool) {
     for path in models {
         let set = common::load(path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -77,6 +81,12 @@ fn tolerance_bounds_hold(models: &[std::path::PathBuf]) {
             {
                 if scheme != Scheme::Transition && share < 1e-3 {
                     continue; // uniform and dyadic outputs at 0.01% are large; 1% and 0.1% cover them
+                }
+                if bound == ErrorBound::Taylor
+                    && !every_taylor
+                    && (scheme != Scheme::Transition || share < 1e-3)
+                {
+                    continue;
                 }
                 let (plan, pattern, report) =
                     plan_with(&set, scheme, Criterion::Tolerance(eps), None, false, bound);
