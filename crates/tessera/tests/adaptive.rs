@@ -159,16 +159,18 @@ fn projected_error(mesh: &Mesh, set: &SurfaceSet, camera: &Camera) -> f64 {
 /// error of visible patches stays under the requested pixels.
 #[test]
 fn screen_space_bounds_hold_for_random_cameras_on_the_fast_models() {
-    screen_space_bounds_hold(&common::fast_models(), 12);
+    screen_space_bounds_hold(&common::fast_models(), 12, 0.5);
 }
 
 #[test]
 #[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
 fn screen_space_bounds_hold_for_random_cameras_on_every_model() {
-    screen_space_bounds_hold(&common::all_surface_models(), 20);
+    screen_space_bounds_hold(&common::all_surface_models(), 20, 0.2);
 }
 
-fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32) {
+/// `cases` seeded cameras per model; a camera plans with the Taylor bound with probability
+/// `taylor` (its planning is the slower on the large meshes).
+fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32, taylor: f64) {
     for path in models {
         let set = common::load(path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -180,7 +182,12 @@ fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32) {
         );
         runner
             .run(
-                &(common::random_camera(&set), any::<bool>(), any::<bool>(), any::<bool>()),
+                &(
+                    common::random_camera(&set),
+                    any::<bool>(),
+                    any::<bool>(),
+                    proptest::bool::weighted(taylor),
+                ),
                 |((camera, px), cull, dyadic, taylor)| {
                     // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic),
                     // and both bounds.
