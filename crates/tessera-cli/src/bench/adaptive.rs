@@ -123,11 +123,13 @@ impl Model {
     /// Tessellates with knob value `s` and measures the max error; None when the output
     /// would exceed `max_triangles`.
     fn measure(&self, knob: Knob, s: f64, max_triangles: u64) -> BenchResult<Option<Point>> {
-        let mut bound = ErrorBound::Hessian;
+        let bound = match knob {
+            Knob::Tolerance(_, bound) => bound,
+            _ => ErrorBound::Hessian,
+        };
         let (scheme, criterion, max_factor) = match knob {
             Knob::Uniform => (Scheme::Uniform, Criterion::Factor(s.round().max(1.0)), 64),
-            Knob::Tolerance(scheme, b) => {
-                bound = b;
+            Knob::Tolerance(scheme, _) => {
                 (scheme, Criterion::Tolerance(self.diagonal * 10f64.powf(-s)), 4096)
             }
             Knob::Distance(scheme) => {

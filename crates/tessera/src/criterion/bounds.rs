@@ -162,7 +162,8 @@ pub fn enclosing_radius(t: [DVec2; 3]) -> f64 {
     (a * b * c).sqrt() / (2.0 * area2)
 }
 
-fn max_norm(it: impl Iterator<Item = DVec3>) -> f64 {
+/// The largest norm of `it`'s vectors (0 for none): a Bézier form's bound by its points.
+pub(crate) fn max_norm(it: impl Iterator<Item = DVec3>) -> f64 {
     it.map(|v| v.length()).fold(0.0, f64::max)
 }
 

@@ -39,6 +39,7 @@
 //! patches have none ([`TaylorBound::of`] gives [`TaylorBound::NONE`]), and keep the
 //! second-derivative bound alone. Every caller takes the smaller of the two, each valid.
 
+use super::bounds::max_norm;
 use crate::surface::{BezierTriangle, Patch, RationalBicubic};
 use glam::{DVec2, DVec3};
 
@@ -113,9 +114,7 @@ impl TaylorBound {
         match &self.field {
             SecondDerivatives::None => DVec3::ZERO,
             SecondDerivatives::Bicubic { points, .. } => net_at(points, x),
-            SecondDerivatives::Triangle { net, .. } => {
-                sub_net(net, [DVec3::new(1.0 - x.x - x.y, x.x, x.y); 3])[0]
-            }
+            SecondDerivatives::Triangle { net, .. } => BezierTriangle { points: *net }.position(x),
         }
     }
 
@@ -202,11 +201,11 @@ impl TaylorBound {
         debug_assert!(!triangle_domain || nu == nv, "a triangle's grids are n × n");
         let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
         let mut worst = 0.0f64;
+        let full = nu as u64 * nv as u64;
         for i in 0..nu {
             for j in 0..nv {
-                // `(i + di)/nu + (j + dj)/nv` against 1, in integers.
+                // `(i + di)/nu + (j + dj)/nv` against `full / full = 1`, in integers.
                 let beyond = |di: u64, dj: u64| (i as u64 + di) * nv as u64 + (j as u64 + dj) * nu as u64;
-                let full = nu as u64 * nv as u64;
                 if triangle_domain && beyond(0, 0) >= full {
                     continue; // the cell lies beyond the diagonal
                 }
@@ -276,8 +275,8 @@ const SPLIT_WHEN: f64 = 0.25;
 pub fn cubic_error_hull(net: &[DVec3; 10], t: [DVec2; 3]) -> f64 {
     let bary = |x: DVec2| DVec3::new(1.0 - x.x - x.y, x.x, x.y);
     let m = [(t[1] + t[2]) / 2.0, (t[2] + t[0]) / 2.0, (t[0] + t[1]) / 2.0];
-    let corner_net = sub_net(net, t.map(bary));
-    let at = [(3, 0), (0, 3), (0, 0)].map(|(i, j)| corner_net[BezierTriangle::index(i, j, 3 - i - j)]);
+    let surface = BezierTriangle { points: *net };
+    let at = t.map(|x| surface.position(x));
     // L is affine: at a midpoint, the mean of its ends.
     let l_mid = [(at[1] + at[2]) / 2.0, (at[2] + at[0]) / 2.0, (at[0] + at[1]) / 2.0];
     let subs = [
@@ -381,10 +380,6 @@ fn net_at<const M: usize, const N: usize>(net: &[[DVec3; N]; M], x: DVec2) -> DV
     out
 }
 
-fn max_norm<'a>(it: impl IntoIterator<Item = &'a DVec3>) -> f64 {
-    it.into_iter().map(|v| v.length()).fold(0.0, f64::max)
-}
-
 /// A polynomial bicubic's second-derivative nets (`6·Δ²_u b`, `9·ΔuΔv b`, `6·Δ²_v b`) and
 /// third-derivative bounds: `S_uuu = 6 Σ Δ³_u b·B³(v)`, `S_uuv = 18 Σ Δ²_uΔ_v b·B¹(u)B²(v)`,
 /// and their mirrors, each at most its largest coefficient.
@@ -397,12 +392,10 @@ fn bicubic(p: &RationalBicubic) -> TaylorBound {
     let uu: [[DVec3; 4]; 2] = std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j) * 6.0));
     let uv: [[DVec3; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| duv(i, j) * 9.0));
     let vv: [[DVec3; 2]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| dvv(i, j) * 6.0));
-    let uuu: Vec<DVec3> = (0..4).map(|j| (duu(1, j) - duu(0, j)) * 6.0).collect();
-    let uuv: Vec<DVec3> =
-        (0..2).flat_map(|i| (0..3).map(move |j| (duu(i, j + 1) - duu(i, j)) * 18.0)).collect();
-    let uvv: Vec<DVec3> =
-        (0..3).flat_map(|i| (0..2).map(move |j| (dvv(i + 1, j) - dvv(i, j)) * 18.0)).collect();
-    let vvv: Vec<DVec3> = (0..4).map(|i| (dvv(i, 1) - dvv(i, 0)) * 6.0).collect();
+    let uuu = max_norm((0..4).map(|j| (duu(1, j) - duu(0, j)) * 6.0));
+    let uuv = max_norm((0..2).flat_map(|i| (0..3).map(move |j| (duu(i, j + 1) - duu(i, j)) * 18.0)));
+    let uvv = max_norm((0..3).flat_map(|i| (0..2).map(move |j| (dvv(i + 1, j) - dvv(i, j)) * 18.0)));
+    let vvv = max_norm((0..4).map(|i| (dvv(i, 1) - dvv(i, 0)) * 6.0));
     TaylorBound {
         field: SecondDerivatives::Bicubic {
             uu,
@@ -410,7 +403,7 @@ fn bicubic(p: &RationalBicubic) -> TaylorBound {
             vv,
             points: std::array::from_fn(|i| std::array::from_fn(|j| b(i, j))),
         },
-        third: [max_norm(&uuu), max_norm(&uuv), max_norm(&uvv), max_norm(&vvv)],
+        third: [uuu, uuv, uvv, vvv],
     }
 }
 
