@@ -65,10 +65,12 @@ fn tolerance_bounds_hold_on_every_model() {
     tolerance_bounds_hold(&common::all_surface_models(), false);
 }
 
-/// Every scheme at 1 %, 0.1 % (transition also 0.01 %) of the diagonal, with both bounds; with
-/// `every_taylor` false the Taylor bound only for transition at 1 % and 0.1 % (its planning
-/// at 0.01 % on the large meshes takes seconds; the fast models and `taylor_bound.rs` cover
-/// the rest).
+/// Every scheme at 1 %, 0.1 % (transition also 0.01 %) of the diagonal, with both bounds, the
+/// measured error within the certified bound and, for transition with the Taylor bound, at
+/// least 0.8 of it; with `every_taylor` false the Taylor bound only for transition at 1 % and
+/// 0.1 % (measuring every large mesh again at 0.01 % would add a minute of CI;
+/// `the_taylor_bound_cuts_triangles_at_the_same_guarantee`, `taylor_bound.rs` and `tessera
+/// bench --suite adaptive` cover the rest).
 fn tolerance_bounds_hold(models: &[std::path::PathBuf], every_taylor: bool) {
     for path in models {
         let set = common::load(path).unwrap();
@@ -100,6 +102,20 @@ fn tolerance_bounds_hold(models: &[std::path::PathBuf], every_taylor: bool) {
                     err.max,
                     report.worst_bound
                 );
+                if (scheme, bound) == (Scheme::Transition, ErrorBound::Taylor) {
+                    // The certified bound within 1.25× of the truth. Order 5 samples 15 points
+                    // inside a triangle; at 1 % a PN mesh's triangles are whole patches, whose
+                    // largest error can lie between them: those are measured again, denser.
+                    let mut measured = err.max;
+                    if measured < 0.8 * report.worst_bound {
+                        measured = measured.max(verify::approximation_error(&mesh, &set, 16).unwrap().max);
+                    }
+                    assert!(
+                        measured >= 0.8 * report.worst_bound,
+                        "{name} {share}: measured {measured:.3e} < 0.8 × bound {:.3e}",
+                        report.worst_bound
+                    );
+                }
                 common::expect_topology(&set, &plan, &mesh, &name);
             }
         }
@@ -270,10 +286,11 @@ fn adaptive_beats_uniform_at_equal_measured_error() {
     }
 }
 
-/// Issue 27's bound: on the three patch models and spot's PN triangles at 0.1 % and 0.01 % of
-/// the diagonal, transition planned with the Taylor bound needs at most 80 % of the triangles
-/// the second-derivative bound needs for the same guarantee, and its certified bound sits
-/// within 1.25× of the measured error (measured ≥ 0.8 × bound) without ever being exceeded.
+/// Issue 27's bound: on the three patch models and spot's PN triangles at 1 %, 0.1 % and
+/// 0.01 % of the diagonal, transition planned with the Taylor bound has its certified bound
+/// within 1.25× of the measured error (measured ≥ 0.8 × bound) without it ever being
+/// exceeded, and at 0.1 % and 0.01 % needs at most 80 % of the triangles the
+/// second-derivative bound needs for the same guarantee.
 #[test]
 fn the_taylor_bound_cuts_triangles_at_the_same_guarantee() {
     let models = [
@@ -284,7 +301,7 @@ fn the_taylor_bound_cuts_triangles_at_the_same_guarantee() {
     ];
     for rel in models {
         let set = common::load(&common::model(rel)).unwrap();
-        for share in [1e-3, 1e-4] {
+        for share in [1e-2, 1e-3, 1e-4] {
             let eps = share * diagonal(&set);
             let mut counts = [0usize; 2];
             for (k, bound) in [ErrorBound::Hessian, ErrorBound::Taylor].into_iter().enumerate() {
@@ -307,8 +324,9 @@ fn the_taylor_bound_cuts_triangles_at_the_same_guarantee() {
                     );
                 }
             }
+            // At 1 % spot's patches are single triangles with either bound: no fewer there.
             assert!(
-                counts[1] as f64 <= 0.8 * counts[0] as f64,
+                share > 1e-3 || counts[1] as f64 <= 0.8 * counts[0] as f64,
                 "{rel} {share}: {} triangles with the Taylor bound, {} without",
                 counts[1],
                 counts[0]

@@ -32,6 +32,21 @@
 //! dominate). It assumes nothing beyond the bounds `t_k` on the region, which come from the
 //! control net (the convex-hull property of the third derivatives' Bézier forms).
 //!
+//! **Refinement.** On coarse triangles the remainder, taken with the patch's largest third
+//! derivatives, dominates; two refinements bound them closer, and every query takes the
+//! smallest valid bound:
+//! - a cubic triangle's error `S − L` is itself a cubic: its Bézier control points over four
+//!   midpoint sub-triangles bound it (convex hull, [`cubic_error_hull`]);
+//! - a bicubic's triangle is cut into the `n²` leaves of its `n`-lattice
+//!   ([`TaylorBound::split_error`]): on each leaf `S − L` is the leaf's own interpolation error
+//!   (its Taylor bound, `1/n²` of the whole's) plus an affine function, bounded by the exact
+//!   `|S − L|` at the leaf's corners. So the bound is the error sampled on the lattice plus a
+//!   small margin, and tends to the truth as `n` grows.
+//!
+//! Refining costs about twenty evaluations, so a walk refines only a triangle whose plain
+//! bound could change its answer ([`TaylorBound::grid_fits`]: above the tolerance; a
+//! pattern's largest bound: above the largest so far).
+//!
 //! **Which patches.** Polynomial bicubics (`S_uu`, `S_uv`, `S_vv` are Bézier patches of
 //! degrees (1,3), (2,2), (3,1); the third derivatives of degrees (0,3), (1,2), (2,1), (3,0)),
 //! cubic Bézier triangles and PN triangles (second derivatives linear, third constant: the
@@ -119,43 +134,74 @@ impl TaylorBound {
     }
 
     /// Guaranteed bound on `|S − L|` over the parameter triangle `t` (module doc), expanded
-    /// about its centroid; on a large triangle, where the remainder weighs, also
-    /// [`cubic_error_hull`] for a cubic and [`TaylorBound::split_error`] for a bicubic, the
-    /// smaller. Infinite for [`TaylorBound::NONE`]. Preconditions: `t` in the patch's domain.
-    /// Cost: one evaluation of the second derivatives; on large triangles about ten more.
+    /// about its centroid, and the smaller of that and a refined bound:
+    /// [`cubic_error_hull`] for a cubic, [`TaylorBound::split_error`] for a bicubic.
+    /// Infinite for [`TaylorBound::NONE`]. Preconditions: `t` in the patch's domain.
+    /// Cost: one evaluation of the second derivatives and the refinement's (about twenty).
     pub fn triangle_error(&self, t: [DVec2; 3]) -> f64 {
+        self.triangle_error_above(t, 0.0)
+    }
+
+    /// [`TaylorBound::triangle_error`] where only a value above `floor` matters: a triangle
+    /// whose plain Taylor bound is at most `floor` keeps it, without the dearer refinement
+    /// (which could only lower it), so `max(floor, ·)` of the two is the same. This is what
+    /// makes the refinements affordable: a pattern's check refines only the triangles that
+    /// could raise its largest bound, a proposal's test only those above the tolerance.
+    pub(crate) fn triangle_error_above(&self, t: [DVec2; 3], floor: f64) -> f64 {
         let (quadratic, remainder) = self.taylor_parts(t);
+        if quadratic + remainder <= floor {
+            return quadratic + remainder;
+        }
         match &self.field {
             // The error's own control points are tight on a cubic's large triangles.
-            SecondDerivatives::Triangle { net, .. } if remainder > HULL_WHEN * quadratic => {
-                (quadratic + remainder).min(cubic_error_hull(net, t))
-            }
-            SecondDerivatives::Bicubic { .. } if remainder > SPLIT_WHEN * quadratic => {
-                (quadratic + remainder).min(self.split_error(t))
-            }
-            _ => quadratic + remainder,
+            SecondDerivatives::Triangle { net, .. } => (quadratic + remainder).min(cubic_error_hull(net, t)),
+            SecondDerivatives::Bicubic { .. } => (quadratic + remainder).min(self.split_error(t)),
+            SecondDerivatives::None => quadratic + remainder,
         }
     }
 
-    /// The bound over `t` from its four midpoint sub-triangles `T'`: on each,
-    /// `S − L = (S − L_T') + (L_T' − L)`, the first bounded by the Taylor bound of `T'` (its
-    /// remainder an eighth of `t`'s), the second affine, so at most its largest value at `T'`'s
-    /// corners, which is `|S − L|` there: zero at `t`'s corners, evaluated at its edge
-    /// midpoints. For a quadratic this is exact where the `m_i` are parallel (the middle
-    /// sub-triangle gives `m/3 + m`, the peak `4m/3`). Cost: four Taylor bounds, six
-    /// positions.
+    /// The bound over `t` from the `n²` leaves of its `n`-lattice (`n` = [`SPLIT_LATTICE`]):
+    /// on a leaf `T'`, `S − L = (S − L_T') + (L_T' − L)`, the first bounded by the Taylor
+    /// bound of `T'` (its quadratic part `1/n²` of `t`'s, its remainder `1/n³`), the second
+    /// affine, so at most its largest value at `T'`'s corners, which is `|S − L|` there,
+    /// evaluated at the lattice points (zero at `t`'s corners). The bound is the sampled
+    /// error at the lattice plus at most a leaf's own bound, so it tends to the true error as
+    /// `n` grows. Splitting a leaf again would be looser: its corner terms would be measured
+    /// against the leaf's interpolant and added to `t`'s. Cost: `n²` Taylor bounds and
+    /// `(n + 1)(n + 2)/2` positions.
     pub fn split_error(&self, t: [DVec2; 3]) -> f64 {
+        const N: usize = SPLIT_LATTICE;
         let at = t.map(|x| self.position(x));
-        let m = [(t[1] + t[2]) / 2.0, (t[2] + t[0]) / 2.0, (t[0] + t[1]) / 2.0];
-        let e = [0, 1, 2].map(|i| (self.position(m[i]) - (at[(i + 1) % 3] + at[(i + 2) % 3]) / 2.0).length());
-        let part = |sub: [DVec2; 3], corner: f64| {
-            let (quadratic, remainder) = self.taylor_parts(sub);
-            quadratic + remainder + corner
+        // |S − L| at lattice point (i, j): barycentric (N − i − j, i, j)/N.
+        let mut error = [[0.0f64; N + 1]; N + 1];
+        let point = |i: usize, j: usize| {
+            let (a, b) = (i as f64 / N as f64, j as f64 / N as f64);
+            t[0] * (1.0 - a - b) + t[1] * a + t[2] * b
         };
-        part([t[0], m[2], m[1]], e[2].max(e[1]))
-            .max(part([m[2], t[1], m[0]], e[2].max(e[0])))
-            .max(part([m[1], m[0], t[2]], e[1].max(e[0])))
-            .max(part(m, e[0].max(e[1]).max(e[2])))
+        for (i, row) in error.iter_mut().enumerate() {
+            for (j, e) in row.iter_mut().enumerate().take(N + 1 - i) {
+                let corner = (i == 0 && j == 0) || i == N || j == N;
+                if !corner {
+                    let (a, b) = (i as f64 / N as f64, j as f64 / N as f64);
+                    let linear = at[0] * (1.0 - a - b) + at[1] * a + at[2] * b;
+                    *e = (self.position(point(i, j)) - linear).length();
+                }
+            }
+        }
+        let leaf = |c: [(usize, usize); 3]| {
+            let (quadratic, remainder) = self.taylor_parts(c.map(|(i, j)| point(i, j)));
+            quadratic + remainder + c.iter().map(|&(i, j)| error[i][j]).fold(0.0, f64::max)
+        };
+        let mut worst = 0.0f64;
+        for i in 0..N {
+            for j in 0..N - i {
+                worst = worst.max(leaf([(i, j), (i + 1, j), (i, j + 1)]));
+                if i + j + 1 < N {
+                    worst = worst.max(leaf([(i + 1, j), (i + 1, j + 1), (i, j + 1)]));
+                }
+            }
+        }
+        worst
     }
 
     /// The quadratic part and the remainder of the Taylor bound over `t` about its centroid
@@ -188,19 +234,98 @@ impl TaylorBound {
         bubble_max([diagonal, legs_u, legs_v]) + self.remainder(DVec2::new(hu, hv) / 2.0)
     }
 
+    /// [`TaylorBound::split_error`] of each of the four halves a grid cell can have (either
+    /// diagonal), from one `n × n` lattice of sub-cells (`n` = [`SPLIT_LATTICE`]) shared by
+    /// all four: a half's leaves are halves of the sub-cells it meets, each bounded by the
+    /// sub-cell's [`TaylorBound::cell_error`] plus the largest `|S − L_half|` at the leaf's
+    /// corners, which are the sub-cell's corners inside the half. Cost: `(n + 1)²`
+    /// positions and `n²` evaluations of the second derivatives, against four times
+    /// [`TaylorBound::split_error`]'s.
+    fn cell_split_error(&self, origin: DVec2, hu: f64, hv: f64) -> f64 {
+        const N: usize = SPLIT_LATTICE;
+        let point = |i: usize, j: usize| origin + DVec2::new(hu * i as f64, hv * j as f64) / N as f64;
+        let mut at = [[DVec3::ZERO; N + 1]; N + 1];
+        for (i, row) in at.iter_mut().enumerate() {
+            for (j, p) in row.iter_mut().enumerate() {
+                *p = self.position(point(i, j));
+            }
+        }
+        let mut sub = [[0.0f64; N]; N];
+        for (i, row) in sub.iter_mut().enumerate() {
+            for (j, e) in row.iter_mut().enumerate() {
+                *e = self.cell_error(
+                    point(i, j) + DVec2::new(hu, hv) / (2 * N) as f64,
+                    hu / N as f64,
+                    hv / N as f64,
+                );
+            }
+        }
+        let (a, b, c, d) = (at[0][0], at[N][0], at[0][N], at[N][N]);
+        // Each half in the lattice's integer coordinates: whether (i, j) lies in it, and its
+        // linear interpolant there (x = i/n, y = j/n).
+        type Half = (fn(usize, usize) -> bool, fn([DVec3; 4], f64, f64) -> DVec3);
+        let halves: [Half; 4] = [
+            (|i, j| i + j <= N, |[a, b, c, _], x, y| a * (1.0 - x - y) + b * x + c * y),
+            (|i, j| i + j >= N, |[_, b, c, d], x, y| b * (1.0 - y) + c * (1.0 - x) + d * (x + y - 1.0)),
+            (|i, j| i >= j, |[a, b, _, d], x, y| a * (1.0 - x) + b * (x - y) + d * y),
+            (|i, j| j >= i, |[a, _, c, d], x, y| a * (1.0 - y) + c * (y - x) + d * x),
+        ];
+        let mut worst = 0.0f64;
+        for (inside, linear) in halves {
+            let mut error = [[0.0f64; N + 1]; N + 1];
+            for (i, row) in error.iter_mut().enumerate() {
+                for (j, e) in row.iter_mut().enumerate() {
+                    if inside(i, j) {
+                        let l = linear([a, b, c, d], i as f64 / N as f64, j as f64 / N as f64);
+                        *e = (at[i][j] - l).length();
+                    }
+                }
+            }
+            for (i, row) in sub.iter().enumerate() {
+                for (j, own) in row.iter().enumerate() {
+                    let corners = [(i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1)];
+                    let (count, corner) = corners
+                        .into_iter()
+                        .filter(|&(ci, cj)| inside(ci, cj))
+                        .fold((0, 0.0f64), |(n, e), (ci, cj)| (n + 1, e.max(error[ci][cj])));
+                    // A sub-cell meets the half in a leaf where three of its corners lie in
+                    // it (the half's sides run along sub-cell sides and diagonals); with
+                    // fewer, in a side or a point that its neighbours' leaves hold.
+                    if count >= 3 {
+                        worst = worst.max(own + corner);
+                    }
+                }
+            }
+        }
+        worst
+    }
+
     /// The bound over every triangle of the `nu × nv` grid of the unit square, whichever way
     /// its cells are split. On a triangle domain (`nu = nv = n`) the grid is the barycentric
     /// lattice the patterns build (`pattern::uniform::grid`, the transition pattern's core):
     /// cells split along `u + v = const`, the cells on the diagonal `u + v = 1` keeping their
-    /// lower half. Cost: one evaluation per cell (two per triangle-domain cell, with hulls on
-    /// coarse cubic triangles).
-    pub fn grid_error(&self, triangle_domain: bool, [nu, nv]: [u32; 2]) -> f64 {
+    /// lower half. Cost: one evaluation per cell (two per triangle-domain cell), and a
+    /// refinement for each cell that raises the largest bound so far.
+    pub fn grid_error(&self, triangle_domain: bool, n: [u32; 2]) -> f64 {
+        self.grid_error_above(triangle_domain, n, 0.0, f64::INFINITY)
+    }
+
+    /// Whether [`TaylorBound::grid_error`] is at most `eps`, cheaper: only cells whose plain
+    /// bound exceeds `eps` are refined, and the walk stops at the first that still does.
+    pub fn grid_fits(&self, triangle_domain: bool, n: [u32; 2], eps: f64) -> bool {
+        self.grid_error_above(triangle_domain, n, eps, eps) <= eps
+    }
+
+    /// `max(floor, grid_error)`, refining (hull, split) only the cells whose plain bound
+    /// exceeds the largest so far, and returning early, with some value above `stop`, once
+    /// the largest exceeds it.
+    fn grid_error_above(&self, triangle_domain: bool, [nu, nv]: [u32; 2], floor: f64, stop: f64) -> f64 {
         if !self.is_some() {
             return f64::INFINITY;
         }
         debug_assert!(!triangle_domain || nu == nv, "a triangle's grids are n × n");
         let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
-        let mut worst = 0.0f64;
+        let mut worst = floor;
         let full = nu as u64 * nv as u64;
         for i in 0..nu {
             for j in 0..nv {
@@ -214,20 +339,22 @@ impl TaylorBound {
                     [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
                 let error = if !triangle_domain {
                     let cell = self.cell_error((a + d) / 2.0, hu, hv);
-                    if self.remainder(DVec2::new(hu, hv) / 2.0) > SPLIT_WHEN * cell {
-                        // A coarse cell: each of its four possible halves split.
-                        let halves = [[a, b, c], [b, d, c], [a, b, d], [a, d, c]];
-                        cell.min(halves.iter().map(|t| self.split_error(*t)).fold(0.0, f64::max))
+                    if cell > worst {
+                        cell.min(self.cell_split_error(o, hu, hv))
                     } else {
                         cell
                     }
                 } else if beyond(1, 1) > full {
                     // On the diagonal: the lower half alone.
-                    self.triangle_error([a, b, c])
+                    self.triangle_error_above([a, b, c], worst)
                 } else {
-                    self.triangle_error([a, b, c]).max(self.triangle_error([b, d, c]))
+                    let lower = self.triangle_error_above([a, b, c], worst);
+                    lower.max(self.triangle_error_above([b, d, c], worst.max(lower)))
                 };
                 worst = worst.max(error);
+                if worst > stop {
+                    return worst;
+                }
             }
         }
         worst
@@ -253,16 +380,8 @@ pub fn bubble_max(a: [f64; 3]) -> f64 {
     }
 }
 
-/// Where the remainder exceeds this share of the quadratic part, a cubic triangle's error is
-/// also bounded by its control points ([`cubic_error_hull`]): on small triangles the
-/// remainder is negligible and the hull would not win.
-const HULL_WHEN: f64 = 0.05;
-
-/// Where the remainder exceeds this share of the quadratic part, a bicubic's triangle is also
-/// bounded by splitting it ([`TaylorBound::split_error`]). Split only on coarse triangles:
-/// it costs ten evaluations, and below this share it changed no plan of the patch models
-/// (measured at 1 %, 0.1 % and 0.01 % of the diagonal and 0.5 px from three cameras).
-const SPLIT_WHEN: f64 = 0.25;
+/// The lattice of [`TaylorBound::split_error`]: `n` parts a side, `n²` leaves.
+const SPLIT_LATTICE: usize = 4;
 
 /// A bound on `|S − L|` over the parameter triangle `t` of the cubic Bézier triangle with
 /// points `net`, `L` the linear interpolant at `t`'s corners: `S − L` is a cubic vanishing at

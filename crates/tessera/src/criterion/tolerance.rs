@@ -167,7 +167,7 @@ fn triangles_bound(
         let t = t.map(|l| params[l as usize]);
         match errors.exceeds(t, most) {
             None => most,
-            Some(e) => most.max(taylor.map_or(e, |taylor| e.min(taylor.triangle_error(t)))),
+            Some(e) => most.max(taylor.map_or(e, |taylor| e.min(taylor.triangle_error_above(t, most)))),
         }
     })
 }
@@ -221,7 +221,7 @@ const TAYLOR_SEARCH_CELLS: u64 = 1 << 16;
 /// check verifies the built pattern. Cost: about `2·nu1 + nv1` grid bounds of one
 /// evaluation a cell.
 fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) {
-    let fits = |nu: u32, nv: u32| t.grid_error(false, [nu, nv]) <= eps;
+    let fits = |nu: u32, nv: u32| t.grid_fits(false, [nu, nv], eps);
     let (nu0, nv0) = start;
     if nu0 as u64 * nv0 as u64 > TAYLOR_SEARCH_CELLS {
         return start;
@@ -267,7 +267,7 @@ fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) 
 /// (bisection: the bound shrinks as `n` grows), `start` where none smaller does. A proposal
 /// only, as [`taylor_quad_grid`]'s. Cost: about `log₂ start` grid bounds.
 fn taylor_uniform_factor(t: &TaylorBound, domain: Domain, start: f64, eps: f64) -> f64 {
-    let fits = |n: u32| t.grid_error(domain == Domain::Tri, [n, n]) <= eps;
+    let fits = |n: u32| t.grid_fits(domain == Domain::Tri, [n, n], eps);
     let (mut lo, mut hi) = (1u32, start.max(1.0) as u32);
     if hi as u64 * hi as u64 > TAYLOR_SEARCH_CELLS {
         return start;
