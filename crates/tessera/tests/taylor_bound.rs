@@ -141,3 +141,122 @@ fn the_taylor_bound_holds_on_every_model() {
         );
     }
 }
+
+/// Catmull-Clark patch trees: a triangle or grid cell inside one Bézier leaf takes the leaf's
+/// bound, in the leaf's parameters, whatever the patch's turn, transposition or quadrant;
+/// across leaves or on an end cap there is none (infinite). Measured as above, on cages with
+/// extraordinary vertices, creases, n-gons and end caps.
+#[test]
+fn the_taylor_bound_holds_on_catmull_clark_trees() {
+    let mut rng = Lcg(2028);
+    let cages = [
+        "catmark_pole8.obj",
+        "catmark_torus_creases0.obj",
+        "catmark_nonquads.obj",
+        "catmark_xord_interior.obj",
+        "catmark_cube_creases1.obj",
+        "catmark_gregory_test3.obj",
+        "catmark_rook.obj",
+    ];
+    let mut finite = 0;
+    let mut ratios = Vec::new();
+    // Small triangles tried on patches without end caps, and those a leaf bounded: nearly
+    // all, since the leaves are at least 1/64 of a side (isolation level 6).
+    let (mut small, mut small_finite) = (0, 0);
+    for cage in cages {
+        let path = common::model(&format!("subdivision/{cage}"));
+        let options = tessera::io::LoadOptions {
+            surface: tessera::io::SurfaceKind::CatmullClark,
+            ..Default::default()
+        };
+        let set = tessera::io::load(&path, options).unwrap();
+        let trees = set.patches.iter().filter(|p| matches!(p, Patch::Subdivision(_)));
+        let mut covered = 0;
+        for patch in trees {
+            let Patch::Subdivision(tree) = patch else { unreachable!() };
+            let capped = tree
+                .leaves()
+                .iter()
+                .any(|l| matches!(l.patch, tessera::surface::patch_tree::LeafPatch::Gregory(_)));
+            let taylor = TaylorBound::of(patch);
+            assert!(taylor.is_some(), "{cage}: a tree has a Taylor bound");
+            covered += 1;
+            for size in [0.5, 0.1, 0.02, 0.005] {
+                for _ in 0..4 {
+                    let t = random_triangle(&mut rng, Domain::Quad, size);
+                    let bound = taylor.triangle_error(t);
+                    if size == 0.005 && !capped {
+                        small += 1;
+                        small_finite += usize::from(bound.is_finite());
+                    }
+                    if !bound.is_finite() {
+                        continue; // across leaves or on an end cap
+                    }
+                    finite += 1;
+                    let error = measured(patch, t, 16);
+                    assert!(
+                        error <= bound * (1.0 + 1e-9) + 1e-15,
+                        "{cage}: {t:?} measured {error:e} > bound {bound:e}"
+                    );
+                    if size <= 0.02 && bound > 0.0 {
+                        ratios.push(error / bound);
+                    }
+                    // The leaf's second derivatives, taken to the patch's parameters, are the
+                    // patch's (central differences, where the stencil's box lies in the leaf).
+                    let x = (t[0] + t[1] + t[2]) / 3.0;
+                    let h = 1e-4;
+                    let (lo, hi) = (x - DVec2::splat(h), x + DVec2::splat(h));
+                    let in_leaf = |t: [DVec2; 3]| taylor.triangle_error(t).is_finite();
+                    let box_in_leaf = in_leaf([lo, DVec2::new(hi.x, lo.y), DVec2::new(lo.x, hi.y)])
+                        && in_leaf([DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)]);
+                    if box_in_leaf && size <= 0.1 {
+                        let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
+                        let want = [
+                            (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
+                            (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
+                            (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
+                        ];
+                        let got = taylor.second_derivatives(x);
+                        let scale = want.iter().map(|w| w.length()).fold(1.0, f64::max);
+                        for k in 0..3 {
+                            assert!(
+                                got[k].distance(want[k]) < 1e-4 * scale,
+                                "{cage} at {x}: {k}: {got:?} {want:?}"
+                            );
+                        }
+                    }
+                }
+            }
+            let n = [1 + rng.below(12) as u32, 1 + rng.below(12) as u32];
+            let bound = taylor.grid_error(false, n);
+            if bound.is_finite() {
+                let (hu, hv) = (1.0 / n[0] as f64, 1.0 / n[1] as f64);
+                let mut error = 0.0f64;
+                for i in 0..n[0] {
+                    for j in 0..n[1] {
+                        let o = DVec2::new(i as f64 * hu, j as f64 * hv);
+                        let [a, b, c, d] =
+                            [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
+                        for t in [[a, b, c], [b, d, c], [a, b, d], [a, d, c]] {
+                            error = error.max(measured(patch, t, 8));
+                        }
+                    }
+                }
+                assert!(
+                    error <= bound * (1.0 + 1e-9) + 1e-15,
+                    "{cage}: grid {n:?} measured {error:e} > bound {bound:e}"
+                );
+            }
+        }
+        assert!(covered > 0, "{cage}: no patch tree");
+    }
+    ratios.sort_by(f64::total_cmp);
+    let median = ratios[ratios.len() / 2];
+    println!("{finite} triangles inside one leaf; small ones: measured / bound median {median:.3}");
+    assert!(finite >= 100, "only {finite} random triangles fell inside one leaf");
+    println!(
+        "{small_finite} of {small} triangles 0.005 across on trees without end caps bounded by one leaf"
+    );
+    assert!(small_finite * 10 >= small * 7, "{small_finite} of {small} small triangles inside one leaf");
+    assert!(median >= 0.8, "measured / bound on small triangles inside leaves: median {median}");
+}

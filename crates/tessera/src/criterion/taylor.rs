@@ -44,24 +44,30 @@
 //!   small margin, and tends to the truth as `n` grows.
 //!
 //! Refining costs about twenty evaluations, so a walk refines only a triangle whose plain
-//! bound could change its answer ([`TaylorBound::grid_fits`]: above the tolerance; a
+//! bound could change its answer (`grid_fits`: above the tolerance; a
 //! pattern's largest bound: above the largest so far).
 //!
 //! **Which patches.** Polynomial bicubics (`S_uu`, `S_uv`, `S_vv` are Bézier patches of
 //! degrees (1,3), (2,2), (3,1); the third derivatives of degrees (0,3), (1,2), (2,1), (3,0)),
 //! cubic Bézier triangles and PN triangles (second derivatives linear, third constant: the
-//! bound is exact up to the triangle inequality inside). Rational bicubics and subdivision
-//! patches have none ([`TaylorBound::of`] gives [`TaylorBound::NONE`]), and keep the
-//! second-derivative bound alone. Every caller takes the smaller of the two, each valid.
+//! bound is exact up to the triangle inequality inside), and Catmull-Clark patch trees
+//! through their Bézier leaves: a triangle or cell inside one leaf takes that leaf's bound
+//! (linear interpolation's error does not change under the affine map to the leaf's
+//! parameters); one across leaves or on a Gregory end cap has none, since the surface is
+//! only piecewise smooth there. Rational bicubics and Loop patches have none
+//! ([`TaylorBound::of`] gives [`TaylorBound::NONE`]). Every caller takes the smaller of
+//! this bound and the second-derivative bound, each valid, triangle by triangle (a grid:
+//! cell by cell, [`TaylorBound::grid_error_within`]).
 
 use super::bounds::max_norm;
-use crate::surface::{BezierTriangle, Patch, RationalBicubic};
+use crate::surface::patch_tree::{LeafPatch, PatchTree};
+use crate::surface::{BezierTriangle, Patch};
 use glam::{DVec2, DVec3};
 
 /// One patch's Taylor bound: the field of its second derivatives and bounds on its third.
 /// Cost of an error query: one evaluation of the second derivatives (25 Bernstein terms for
 /// a bicubic, 9 for a triangle) and a 3 × 3 closed form.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TaylorBound {
     field: SecondDerivatives,
     /// Bounds on `|S_uuu|`, `|S_uuv|`, `|S_uvv|`, `|S_vvv|` over the domain.
@@ -72,7 +78,7 @@ pub struct TaylorBound {
 // vector, read per triangle: boxing the large one would add an allocation a patch and a
 // pointer chase a query to save memory only on triangle meshes.
 #[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 enum SecondDerivatives {
     /// No Taylor bound for this patch kind: every error is infinite.
     None,
@@ -82,6 +88,13 @@ enum SecondDerivatives {
     /// `[S_uu, S_uv, S_vv]` at the corners `(0,0)`, `(1,0)`, `(0,1)`, linear in between, and
     /// the cubic's own control points (for [`cubic_error_hull`]).
     Triangle { corners: [[DVec3; 3]; 3], net: [DVec3; 10] },
+    /// A Catmull-Clark patch tree and each of its leaves' bounds in the leaf's own
+    /// parameters (a Bézier leaf's as a bicubic's; a Gregory end cap has none). A query is
+    /// answered by the one Bézier leaf that holds all its points (the error of linear
+    /// interpolation does not depend on an affine change of parameters), else it is infinite
+    /// and the caller's second-derivative bound answers: the surface is only piecewise
+    /// smooth across leaves, where one expansion point would not do.
+    Tree { tree: PatchTree, leaves: std::sync::Arc<[TaylorBound]> },
 }
 
 impl TaylorBound {
@@ -89,14 +102,53 @@ impl TaylorBound {
     pub const NONE: TaylorBound = TaylorBound { field: SecondDerivatives::None, third: [0.0; 4] };
 
     /// The bound of `patch`, or [`TaylorBound::NONE`] for the kinds it does not cover
-    /// (rational bicubics, subdivision patches). Cost: O(control points).
+    /// (rational bicubics, Loop patches). Cost: O(control points).
     pub fn of(patch: &Patch) -> TaylorBound {
         match patch {
-            Patch::Bicubic(b) if b.is_polynomial() => bicubic(b),
+            Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
             Patch::BezierTriangle(t) => triangle(t),
             Patch::Pn(pn) => triangle(&pn.geometry),
+            Patch::Subdivision(tree) => {
+                let leaves = tree
+                    .leaves()
+                    .iter()
+                    .map(|leaf| match &leaf.patch {
+                        LeafPatch::Bezier(points) => bicubic(points),
+                        LeafPatch::Gregory(_) => TaylorBound::NONE,
+                    })
+                    .collect();
+                TaylorBound {
+                    field: SecondDerivatives::Tree { tree: (**tree).clone(), leaves },
+                    third: [0.0; 4],
+                }
+            }
             _ => TaylorBound::NONE,
         }
+    }
+
+    /// For a tree: the Bézier leaf whose closed square holds all of `points` (patch
+    /// parameters), with the points in that leaf's own parameters; None where no one leaf
+    /// with a bound does.
+    fn leaf_of<const K: usize>(&self, points: [DVec2; K]) -> Option<(&TaylorBound, [DVec2; K])> {
+        let SecondDerivatives::Tree { tree, leaves } = &self.field else { return None };
+        let centre = points.iter().fold(DVec2::ZERO, |a, &p| a + p) / K as f64;
+        let (i, _, _) = tree.find(centre);
+        let leaf = &tree.leaves()[i];
+        let local = points.map(|p| (tree.tree_uv(p) - leaf.origin) / leaf.size);
+        let inside = local.iter().all(|q| q.min_element() >= 0.0 && q.max_element() <= 1.0);
+        (inside && leaves[i].is_some()).then_some((&leaves[i], local))
+    }
+
+    /// For a tree: the leaf holding the axis-aligned cell `origin + [0, hu] × [0, hv]` and
+    /// the cell in its parameters (origin and sides: a turned or transposed view turns the
+    /// cell, which stays axis-aligned).
+    fn leaf_cell(&self, origin: DVec2, hu: f64, hv: f64) -> Option<(&TaylorBound, DVec2, f64, f64)> {
+        let corners =
+            [origin, origin + DVec2::new(hu, 0.0), origin + DVec2::new(0.0, hv), origin + DVec2::new(hu, hv)];
+        let (leaf, local) = self.leaf_of(corners)?;
+        let lo = local.iter().fold(DVec2::splat(f64::INFINITY), |a, &q| a.min(q));
+        let hi = local.iter().fold(DVec2::splat(f64::NEG_INFINITY), |a, &q| a.max(q));
+        Some((leaf, lo, hi.x - lo.x, hi.y - lo.y))
     }
 
     /// Whether this bound covers its patch (else every error is infinite).
@@ -104,10 +156,23 @@ impl TaylorBound {
         !matches!(self.field, SecondDerivatives::None)
     }
 
-    /// `[S_uu, S_uv, S_vv]` at `x`. Preconditions: `x` in the patch's domain.
+    /// `[S_uu, S_uv, S_vv]` at `x` (a tree: of the leaf holding `x`, zero on an end cap).
+    /// Preconditions: `x` in the patch's domain.
     pub fn second_derivatives(&self, x: DVec2) -> [DVec3; 3] {
         match &self.field {
             SecondDerivatives::None => [DVec3::ZERO; 3],
+            SecondDerivatives::Tree { tree, leaves } => {
+                let (i, st, _) = tree.find(x);
+                // The chain rule through the affine map to the leaf's parameters, whose
+                // linear part takes the patch's unit steps to `ju`, `jv`.
+                let size = tree.leaves()[i].size;
+                let step = |d: DVec2| (tree.tree_uv(d) - tree.tree_uv(DVec2::ZERO)) / size;
+                let (ju, jv) = (step(DVec2::X), step(DVec2::Y));
+                let [uu, uv, vv] = leaves[i].second_derivatives(st);
+                let h =
+                    |a: DVec2, b: DVec2| uu * (a.x * b.x) + uv * (a.x * b.y + a.y * b.x) + vv * (a.y * b.y);
+                [h(ju, ju), h(ju, jv), h(jv, jv)]
+            }
             SecondDerivatives::Bicubic { uu, uv, vv, .. } => [net_at(uu, x), net_at(uv, x), net_at(vv, x)],
             SecondDerivatives::Triangle { corners, .. } => {
                 let l = [1.0 - x.x - x.y, x.x, x.y];
@@ -127,7 +192,7 @@ impl TaylorBound {
     /// The surface point at `x` (for [`TaylorBound::split_error`]).
     fn position(&self, x: DVec2) -> DVec3 {
         match &self.field {
-            SecondDerivatives::None => DVec3::ZERO,
+            SecondDerivatives::None | SecondDerivatives::Tree { .. } => DVec3::ZERO,
             SecondDerivatives::Bicubic { points, .. } => net_at(points, x),
             SecondDerivatives::Triangle { net, .. } => BezierTriangle { points: *net }.position(x),
         }
@@ -148,6 +213,9 @@ impl TaylorBound {
     /// makes the refinements affordable: a pattern's check refines only the triangles that
     /// could raise its largest bound, a proposal's test only those above the tolerance.
     pub(crate) fn triangle_error_above(&self, t: [DVec2; 3], floor: f64) -> f64 {
+        if let SecondDerivatives::Tree { .. } = self.field {
+            return self.leaf_of(t).map_or(f64::INFINITY, |(leaf, t)| leaf.triangle_error_above(t, floor));
+        }
         let (quadratic, remainder) = self.taylor_parts(t);
         if quadratic + remainder <= floor {
             return quadratic + remainder;
@@ -156,7 +224,7 @@ impl TaylorBound {
             // The error's own control points are tight on a cubic's large triangles.
             SecondDerivatives::Triangle { net, .. } => (quadratic + remainder).min(cubic_error_hull(net, t)),
             SecondDerivatives::Bicubic { .. } => (quadratic + remainder).min(self.split_error(t)),
-            SecondDerivatives::None => quadratic + remainder,
+            SecondDerivatives::None | SecondDerivatives::Tree { .. } => quadratic + remainder,
         }
     }
 
@@ -170,6 +238,9 @@ impl TaylorBound {
     /// against the leaf's interpolant and added to `t`'s. Cost: `n²` Taylor bounds and
     /// `(n + 1)(n + 2)/2` positions.
     pub fn split_error(&self, t: [DVec2; 3]) -> f64 {
+        if let SecondDerivatives::Tree { .. } = self.field {
+            return self.leaf_of(t).map_or(f64::INFINITY, |(leaf, t)| leaf.split_error(t));
+        }
         const N: usize = SPLIT_LATTICE;
         let at = t.map(|x| self.position(x));
         // |S − L| at lattice point (i, j): barycentric (N − i − j, i, j)/N.
@@ -207,7 +278,8 @@ impl TaylorBound {
     /// The quadratic part and the remainder of the Taylor bound over `t` about its centroid
     /// (module doc); infinite for [`TaylorBound::NONE`].
     fn taylor_parts(&self, t: [DVec2; 3]) -> (f64, f64) {
-        if !self.is_some() {
+        // A tree's leaves answer for it (they hold the third-derivative bounds).
+        if matches!(self.field, SecondDerivatives::None | SecondDerivatives::Tree { .. }) {
             return (f64::INFINITY, 0.0);
         }
         let g = (t[0] + t[1] + t[2]) / 3.0;
@@ -224,8 +296,16 @@ impl TaylorBound {
     /// whichever diagonal splits it: one evaluation, at the centre, serves both triangles and
     /// both diagonals. Cost: one evaluation of the second derivatives.
     pub fn cell_error(&self, centre: DVec2, hu: f64, hv: f64) -> f64 {
-        if !self.is_some() {
-            return f64::INFINITY;
+        match self.field {
+            SecondDerivatives::None => return f64::INFINITY,
+            SecondDerivatives::Tree { .. } => {
+                return self
+                    .leaf_cell(centre - DVec2::new(hu, hv) / 2.0, hu, hv)
+                    .map_or(f64::INFINITY, |(leaf, o, hu, hv)| {
+                        leaf.cell_error(o + DVec2::new(hu, hv) / 2.0, hu, hv)
+                    });
+            }
+            _ => {}
         }
         let [a, b, c] = self.second_derivatives(centre);
         let (a, b, c) = (a * (hu * hu), b * (2.0 * hu * hv), c * (hv * hv));
@@ -242,6 +322,11 @@ impl TaylorBound {
     /// positions and `n²` evaluations of the second derivatives, against four times
     /// [`TaylorBound::split_error`]'s.
     fn cell_split_error(&self, origin: DVec2, hu: f64, hv: f64) -> f64 {
+        if let SecondDerivatives::Tree { .. } = self.field {
+            return self
+                .leaf_cell(origin, hu, hv)
+                .map_or(f64::INFINITY, |(leaf, o, hu, hv)| leaf.cell_split_error(o, hu, hv));
+        }
         const N: usize = SPLIT_LATTICE;
         let point = |i: usize, j: usize| origin + DVec2::new(hu * i as f64, hv * j as f64) / N as f64;
         let mut at = [[DVec3::ZERO; N + 1]; N + 1];
@@ -307,21 +392,36 @@ impl TaylorBound {
     /// lower half. Cost: one evaluation per cell (two per triangle-domain cell), and a
     /// refinement for each cell that raises the largest bound so far.
     pub fn grid_error(&self, triangle_domain: bool, n: [u32; 2]) -> f64 {
-        self.grid_error_above(triangle_domain, n, 0.0, f64::INFINITY)
+        self.grid_error_above(triangle_domain, n, 0.0, f64::INFINITY, f64::INFINITY)
     }
 
-    /// Whether [`TaylorBound::grid_error`] is at most `eps`, cheaper: only cells whose plain
-    /// bound exceeds `eps` are refined, and the walk stops at the first that still does.
-    pub fn grid_fits(&self, triangle_domain: bool, n: [u32; 2], eps: f64) -> bool {
-        self.grid_error_above(triangle_domain, n, eps, eps) <= eps
+    /// [`TaylorBound::grid_error`] with each cell's bound at most `cap` (another valid bound
+    /// of every cell, the second-derivative bound's): where a tree's cell straddles leaves,
+    /// the cap answers for that cell alone.
+    pub(crate) fn grid_error_within(&self, triangle_domain: bool, n: [u32; 2], cap: f64) -> f64 {
+        self.grid_error_above(triangle_domain, n, 0.0, f64::INFINITY, cap)
     }
 
-    /// `max(floor, grid_error)`, refining (hull, split) only the cells whose plain bound
-    /// exceeds the largest so far, and returning early, with some value above `stop`, once
-    /// the largest exceeds it.
-    fn grid_error_above(&self, triangle_domain: bool, [nu, nv]: [u32; 2], floor: f64, stop: f64) -> f64 {
+    /// Whether [`TaylorBound::grid_error_within`] `cap` is at most `eps`, cheaper: only cells
+    /// whose plain bound exceeds `eps` are refined, and the walk stops at the first that
+    /// still does.
+    pub(crate) fn grid_fits(&self, triangle_domain: bool, n: [u32; 2], eps: f64, cap: f64) -> bool {
+        self.grid_error_above(triangle_domain, n, eps, eps, cap) <= eps
+    }
+
+    /// `max(floor, grid_error_within(cap))`, refining (hull, split) only the cells whose
+    /// plain bound exceeds the largest so far, and returning early, with some value above
+    /// `stop`, once the largest exceeds it.
+    fn grid_error_above(
+        &self,
+        triangle_domain: bool,
+        [nu, nv]: [u32; 2],
+        floor: f64,
+        stop: f64,
+        cap: f64,
+    ) -> f64 {
         if !self.is_some() {
-            return f64::INFINITY;
+            return floor.max(cap);
         }
         debug_assert!(!triangle_domain || nu == nv, "a triangle's grids are n × n");
         let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
@@ -338,7 +438,7 @@ impl TaylorBound {
                 let [a, b, c, d] =
                     [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
                 let error = if !triangle_domain {
-                    let cell = self.cell_error((a + d) / 2.0, hu, hv);
+                    let cell = self.cell_error((a + d) / 2.0, hu, hv).min(cap);
                     if cell > worst {
                         cell.min(self.cell_split_error(o, hu, hv))
                     } else {
@@ -346,10 +446,10 @@ impl TaylorBound {
                     }
                 } else if beyond(1, 1) > full {
                     // On the diagonal: the lower half alone.
-                    self.triangle_error_above([a, b, c], worst)
+                    self.triangle_error_above([a, b, c], worst).min(cap)
                 } else {
-                    let lower = self.triangle_error_above([a, b, c], worst);
-                    lower.max(self.triangle_error_above([b, d, c], worst.max(lower)))
+                    let lower = self.triangle_error_above([a, b, c], worst).min(cap);
+                    lower.max(self.triangle_error_above([b, d, c], worst.max(lower)).min(cap))
                 };
                 worst = worst.max(error);
                 if worst > stop {
@@ -502,8 +602,8 @@ fn net_at<const M: usize, const N: usize>(net: &[[DVec3; N]; M], x: DVec2) -> DV
 /// A polynomial bicubic's second-derivative nets (`6·Δ²_u b`, `9·ΔuΔv b`, `6·Δ²_v b`) and
 /// third-derivative bounds: `S_uuu = 6 Σ Δ³_u b·B³(v)`, `S_uuv = 18 Σ Δ²_uΔ_v b·B¹(u)B²(v)`,
 /// and their mirrors, each at most its largest coefficient.
-fn bicubic(p: &RationalBicubic) -> TaylorBound {
-    let b = |i: usize, j: usize| p.points[4 * i + j];
+fn bicubic(points: &[DVec3; 16]) -> TaylorBound {
+    let b = |i: usize, j: usize| points[4 * i + j];
     let du = |i: usize, j: usize| b(i + 1, j) - b(i, j);
     let duu = |i: usize, j: usize| du(i + 1, j) - du(i, j);
     let duv = |i: usize, j: usize| du(i, j + 1) - du(i, j);
@@ -552,6 +652,7 @@ fn triangle(t: &BezierTriangle) -> TaylorBound {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::surface::RationalBicubic;
     use crate::test_support::Lcg;
 
     fn second_by_differences(p: &Patch, x: DVec2) -> [DVec3; 3] {

@@ -194,13 +194,13 @@ fn core_params_bound(
 /// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
 /// ([`Pattern::grid_cells`]): the second-derivative bound of one of them,
 /// `(0, 0), (1/nu, 0), (0, 1/nv)` (every such triangle has the same, as it depends only on
-/// the differences of the corners), or, where the patch has a Taylor bound and it is smaller,
-/// the largest Taylor bound of the grid's cells (a core grid's cells are among them). No
+/// the differences of the corners), or, where the patch has a Taylor bound, the largest over
+/// the grid's cells of the smaller of the two (a core grid's cells are among them). No
 /// pattern is built. Cost: O(1), or one evaluation a cell with a Taylor bound.
 fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, nv]: [u32; 2]) -> f64 {
     let hessian = m.cell_error(1.0 / nu as f64, 1.0 / nv as f64);
     match taylor {
-        Some((t, domain)) => hessian.min(t.grid_error(domain == Domain::Tri, [nu, nv])),
+        Some((t, domain)) => t.grid_error_within(domain == Domain::Tri, [nu, nv], hessian),
         None => hessian,
     }
 }
@@ -212,7 +212,8 @@ fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, n
 const TAYLOR_SEARCH_CELLS: u64 = 1 << 16;
 
 /// The grid with the fewest cells near `start` (the second-derivative bound's, which the
-/// Taylor bound may not meet on coarse grids) whose Taylor bound meets `eps`. The
+/// Taylor bound may not meet on coarse grids) whose bound meets `eps` (cell by cell the
+/// smaller of the Taylor bound and `m`'s, as [`grid_bound`]). The
 /// second-derivative bound's grid, scaled by the square root of the Taylor bound's slack there
 /// (errors shrink like `h²`), gives a first grid `(nu1, nv1)` that meets it; then a staircase
 /// walk over the column counts from `nu1/2` to `2·nu1`, each with the fewest rows that meet
@@ -220,13 +221,13 @@ const TAYLOR_SEARCH_CELLS: u64 = 1 << 16;
 /// itself where the Taylor bound does not meet `eps` there. A proposal only: the a-posteriori
 /// check verifies the built pattern. Cost: about `2·nu1 + nv1` grid bounds of one
 /// evaluation a cell.
-fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) {
-    let fits = |nu: u32, nv: u32| t.grid_fits(false, [nu, nv], eps);
+fn taylor_quad_grid(t: &TaylorBound, m: &TriangleErrors, start: (u32, u32), eps: f64) -> (u32, u32) {
+    let fits = |nu: u32, nv: u32| t.grid_fits(false, [nu, nv], eps, grid_bound(m, None, [nu, nv]));
     let (nu0, nv0) = start;
     if nu0 as u64 * nv0 as u64 > TAYLOR_SEARCH_CELLS {
         return start;
     }
-    let at_start = t.grid_error(false, [nu0, nv0]);
+    let at_start = grid_bound(m, Some((t, Domain::Quad)), [nu0, nv0]);
     if at_start > eps {
         return start;
     }
@@ -266,8 +267,8 @@ fn taylor_quad_grid(t: &TaylorBound, start: (u32, u32), eps: f64) -> (u32, u32) 
 /// The smallest uniform factor up to `start` whose `n × n` grid's Taylor bound meets `eps`
 /// (bisection: the bound shrinks as `n` grows), `start` where none smaller does. A proposal
 /// only, as [`taylor_quad_grid`]'s. Cost: about `log₂ start` grid bounds.
-fn taylor_uniform_factor(t: &TaylorBound, domain: Domain, start: f64, eps: f64) -> f64 {
-    let fits = |n: u32| t.grid_fits(domain == Domain::Tri, [n, n], eps);
+fn taylor_uniform_factor(t: &TaylorBound, m: &TriangleErrors, domain: Domain, start: f64, eps: f64) -> f64 {
+    let fits = |n: u32| t.grid_fits(domain == Domain::Tri, [n, n], eps, grid_bound(m, None, [n, n]));
     let (mut lo, mut hi) = (1u32, start.max(1.0) as u32);
     if hi as u64 * hi as u64 > TAYLOR_SEARCH_CELLS {
         return start;
@@ -459,7 +460,7 @@ pub(crate) fn plan_limited(
             (InteriorRule::Core, Domain::Quad) => {
                 let mut grid = quad_grid(m, e, cap).unwrap_or((cap, cap));
                 if let Some(t) = taylor {
-                    grid = taylor_quad_grid(t, grid, e);
+                    grid = taylor_quad_grid(t, &m.triangle_errors(), grid, e);
                 }
                 let (nu, nv) = grid;
                 *out = [nu as f64, nv as f64, nu as f64, nv as f64];
@@ -467,7 +468,7 @@ pub(crate) fn plan_limited(
             _ => {
                 let mut n = uniform_factor(m, e);
                 if let Some(t) = taylor {
-                    n = taylor_uniform_factor(t, domain, n.min(cap as f64), e);
+                    n = taylor_uniform_factor(t, &m.triangle_errors(), domain, n.min(cap as f64), e);
                 }
                 out[..domain.corner_count()].fill(n);
             }

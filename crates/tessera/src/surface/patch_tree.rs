@@ -287,9 +287,7 @@ impl PatchTree {
     /// here and a caller can start loading it before it is needed
     /// ([`PatchTree::derivatives_each`]).
     pub(crate) fn find(&self, uv: DVec2) -> (usize, DVec2, f64) {
-        let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
-        let uv = rotate(uv, self.rotation);
-        let uv = self.view_origin + uv * self.view_size;
+        let uv = self.tree_uv(uv);
         let mut slot = self.data.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
         loop {
@@ -315,6 +313,13 @@ impl PatchTree {
                 }
             }
         }
+    }
+
+    /// The tree's parameters of this view's point `uv` (an affine map: transposition,
+    /// rotation, then the view's square).
+    pub(crate) fn tree_uv(&self, uv: DVec2) -> DVec2 {
+        let uv = if self.transposed { DVec2::new(uv.y, uv.x) } else { uv };
+        self.view_origin + rotate(uv, self.rotation) * self.view_size
     }
 
     /// The surface point at `uv` ∈ `[0,1]²`. Cost: O(depth) and one patch evaluation.
