@@ -213,9 +213,12 @@ fn tolerance_bounds_hold(fast: bool) {
         let prepared = Prepared::new(&set, true);
         for (k, share) in [1e-2, 1e-3, 1e-4].into_iter().enumerate() {
             let eps = share * lo.distance(hi);
-            // Both bounds, alternating by cage and tolerance: the Taylor bound answers inside
-            // one Bézier leaf of a tree, the second-derivative bound elsewhere.
-            let bound = [ErrorBound::Hessian, ErrorBound::Taylor][(name.len() / 2 + k) % 2];
+            // Both bounds, alternating by cage and tolerance (the Taylor bound: a Bézier leaf's
+            // Taylor bound inside one leaf of a tree, the sampled refinement elsewhere; at
+            // 0.01 % only on the fast tier's cages, as its planning samples millions of
+            // cells on the large ones).
+            let taylor = (name.len() / 2 + k) % 2 == 1 && (fast || share > 1e-4);
+            let bound = if taylor { ErrorBound::Taylor } else { ErrorBound::Hessian };
             let scheme = if share < 1e-3 {
                 Scheme::Transition
             } else {

@@ -85,7 +85,7 @@ impl HessianBound {
 /// [`HessianBound::triangle_error`] for one bound and many triangles: the scalings and their
 /// eigenvalues computed once ([`HessianBound::triangle_errors`]). Gives the same bits as
 /// `triangle_error`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriangleErrors {
     bound: HessianBound,
     scales: [DVec2; 3],

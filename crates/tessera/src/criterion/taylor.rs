@@ -53,13 +53,17 @@
 //! bound is exact up to the triangle inequality inside), and Catmull-Clark patch trees
 //! through their Bézier leaves: a triangle or cell inside one leaf takes that leaf's bound
 //! (linear interpolation's error does not change under the affine map to the leaf's
-//! parameters); one across leaves or on a Gregory end cap has none, since the surface is
-//! only piecewise smooth there. Rational bicubics and Loop patches have none
-//! ([`TaylorBound::of`] gives [`TaylorBound::NONE`]). Every caller takes the smaller of
-//! this bound and the second-derivative bound, each valid, triangle by triangle (a grid:
-//! cell by cell, [`TaylorBound::grid_error_within`]).
+//! parameters). Everything else — rational bicubics, Loop patches, a tree's triangles across
+//! leaves (the surface is only piecewise smooth there) or on Gregory end caps — takes the
+//! *sampled* bound: the lattice refinement with the patch's second-derivative bound in place
+//! of the expansion, so the sampled error plus `1/n²` of that bound. It is as valid as the
+//! second-derivative bound and only as tight as its margin allows: where that bound is
+//! loose (a Loop patch's covers its Gregory triangles) it gains about tenfold and stays
+//! loose. Every caller takes the smaller of this bound and the second-derivative bound,
+//! each valid, triangle by triangle (a grid: cell by cell,
+//! `grid_error_within`).
 
-use super::bounds::max_norm;
+use super::bounds::{hessian, max_norm, TriangleErrors};
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
 use crate::surface::{BezierTriangle, Patch};
 use glam::{DVec2, DVec3};
@@ -91,19 +95,30 @@ enum SecondDerivatives {
     /// A Catmull-Clark patch tree and each of its leaves' bounds in the leaf's own
     /// parameters (a Bézier leaf's as a bicubic's; a Gregory end cap has none). A query is
     /// answered by the one Bézier leaf that holds all its points (the error of linear
-    /// interpolation does not depend on an affine change of parameters), else it is infinite
-    /// and the caller's second-derivative bound answers: the surface is only piecewise
-    /// smooth across leaves, where one expansion point would not do.
-    Tree { tree: PatchTree, leaves: std::sync::Arc<[TaylorBound]> },
+    /// interpolation does not depend on an affine change of parameters), else by `whole`,
+    /// the tree's [`SecondDerivatives::Sampled`] bound: the surface is only piecewise smooth
+    /// across leaves, where one expansion point would not do.
+    Tree { tree: PatchTree, leaves: std::sync::Arc<[TaylorBound]>, whole: Box<TaylorBound> },
+    /// Any other patch (a rational bicubic, a Loop patch, a whole Catmull-Clark tree): the
+    /// patch's second-derivative bound `m` (valid over any triangle of its domain) takes the
+    /// place of the Taylor expansion, and the lattice refinement
+    /// ([`TaylorBound::split_error`]) samples the patch's own points: the sampled error plus
+    /// `1/n²` of the second-derivative bound.
+    Sampled { patch: Patch, m: TriangleErrors },
 }
 
 impl TaylorBound {
     /// No bound: [`TaylorBound::triangle_error`] is infinite.
     pub const NONE: TaylorBound = TaylorBound { field: SecondDerivatives::None, third: [0.0; 4] };
 
-    /// The bound of `patch`, or [`TaylorBound::NONE`] for the kinds it does not cover
-    /// (rational bicubics, Loop patches). Cost: O(control points).
+    /// The bound of `patch`: a Taylor expansion for the polynomial kinds (and a
+    /// Catmull-Clark tree's Bézier leaves), the sampled refinement of the second-derivative
+    /// bound for the others. Cost: O(control points).
     pub fn of(patch: &Patch) -> TaylorBound {
+        let sampled = |patch: &Patch| TaylorBound {
+            field: SecondDerivatives::Sampled { patch: patch.clone(), m: hessian(patch).triangle_errors() },
+            third: [0.0; 4],
+        };
         match patch {
             Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
             Patch::BezierTriangle(t) => triangle(t),
@@ -117,12 +132,13 @@ impl TaylorBound {
                         LeafPatch::Gregory(_) => TaylorBound::NONE,
                     })
                     .collect();
+                let whole = Box::new(sampled(patch));
                 TaylorBound {
-                    field: SecondDerivatives::Tree { tree: (**tree).clone(), leaves },
+                    field: SecondDerivatives::Tree { tree: (**tree).clone(), leaves, whole },
                     third: [0.0; 4],
                 }
             }
-            _ => TaylorBound::NONE,
+            _ => sampled(patch),
         }
     }
 
@@ -130,7 +146,7 @@ impl TaylorBound {
     /// parameters), with the points in that leaf's own parameters; None where no one leaf
     /// with a bound does.
     fn leaf_of<const K: usize>(&self, points: [DVec2; K]) -> Option<(&TaylorBound, [DVec2; K])> {
-        let SecondDerivatives::Tree { tree, leaves } = &self.field else { return None };
+        let SecondDerivatives::Tree { tree, leaves, .. } = &self.field else { return None };
         let centre = points.iter().fold(DVec2::ZERO, |a, &p| a + p) / K as f64;
         let (i, _, _) = tree.find(centre);
         let leaf = &tree.leaves()[i];
@@ -156,12 +172,20 @@ impl TaylorBound {
         !matches!(self.field, SecondDerivatives::None)
     }
 
+    /// Whether a query may sample the patch (a tree, or the sampled refinement): each
+    /// refined cell then costs tens of evaluations, so a proposal searches fewer grids
+    /// (`tolerance::taylor_quad_grid`).
+    pub(crate) fn samples(&self) -> bool {
+        matches!(self.field, SecondDerivatives::Tree { .. } | SecondDerivatives::Sampled { .. })
+    }
+
     /// `[S_uu, S_uv, S_vv]` at `x` (a tree: of the leaf holding `x`, zero on an end cap).
     /// Preconditions: `x` in the patch's domain.
     pub fn second_derivatives(&self, x: DVec2) -> [DVec3; 3] {
         match &self.field {
             SecondDerivatives::None => [DVec3::ZERO; 3],
-            SecondDerivatives::Tree { tree, leaves } => {
+            SecondDerivatives::Sampled { .. } => [DVec3::ZERO; 3],
+            SecondDerivatives::Tree { tree, leaves, .. } => {
                 let (i, st, _) = tree.find(x);
                 // The chain rule through the affine map to the leaf's parameters, whose
                 // linear part takes the patch's unit steps to `ju`, `jv`.
@@ -193,6 +217,7 @@ impl TaylorBound {
     fn position(&self, x: DVec2) -> DVec3 {
         match &self.field {
             SecondDerivatives::None | SecondDerivatives::Tree { .. } => DVec3::ZERO,
+            SecondDerivatives::Sampled { patch, .. } => patch.position(x),
             SecondDerivatives::Bicubic { points, .. } => net_at(points, x),
             SecondDerivatives::Triangle { net, .. } => BezierTriangle { points: *net }.position(x),
         }
@@ -213,8 +238,11 @@ impl TaylorBound {
     /// makes the refinements affordable: a pattern's check refines only the triangles that
     /// could raise its largest bound, a proposal's test only those above the tolerance.
     pub(crate) fn triangle_error_above(&self, t: [DVec2; 3], floor: f64) -> f64 {
-        if let SecondDerivatives::Tree { .. } = self.field {
-            return self.leaf_of(t).map_or(f64::INFINITY, |(leaf, t)| leaf.triangle_error_above(t, floor));
+        if let SecondDerivatives::Tree { whole, .. } = &self.field {
+            return match self.leaf_of(t) {
+                Some((leaf, t)) => leaf.triangle_error_above(t, floor),
+                None => whole.triangle_error_above(t, floor),
+            };
         }
         let (quadratic, remainder) = self.taylor_parts(t);
         if quadratic + remainder <= floor {
@@ -223,7 +251,9 @@ impl TaylorBound {
         match &self.field {
             // The error's own control points are tight on a cubic's large triangles.
             SecondDerivatives::Triangle { net, .. } => (quadratic + remainder).min(cubic_error_hull(net, t)),
-            SecondDerivatives::Bicubic { .. } => (quadratic + remainder).min(self.split_error(t)),
+            SecondDerivatives::Bicubic { .. } | SecondDerivatives::Sampled { .. } => {
+                (quadratic + remainder).min(self.split_error(t))
+            }
             SecondDerivatives::None | SecondDerivatives::Tree { .. } => quadratic + remainder,
         }
     }
@@ -238,8 +268,11 @@ impl TaylorBound {
     /// against the leaf's interpolant and added to `t`'s. Cost: `n²` Taylor bounds and
     /// `(n + 1)(n + 2)/2` positions.
     pub fn split_error(&self, t: [DVec2; 3]) -> f64 {
-        if let SecondDerivatives::Tree { .. } = self.field {
-            return self.leaf_of(t).map_or(f64::INFINITY, |(leaf, t)| leaf.split_error(t));
+        if let SecondDerivatives::Tree { whole, .. } = &self.field {
+            return match self.leaf_of(t) {
+                Some((leaf, t)) => leaf.split_error(t),
+                None => whole.split_error(t),
+            };
         }
         const N: usize = SPLIT_LATTICE;
         let at = t.map(|x| self.position(x));
@@ -278,9 +311,11 @@ impl TaylorBound {
     /// The quadratic part and the remainder of the Taylor bound over `t` about its centroid
     /// (module doc); infinite for [`TaylorBound::NONE`].
     fn taylor_parts(&self, t: [DVec2; 3]) -> (f64, f64) {
-        // A tree's leaves answer for it (they hold the third-derivative bounds).
-        if matches!(self.field, SecondDerivatives::None | SecondDerivatives::Tree { .. }) {
-            return (f64::INFINITY, 0.0);
+        match &self.field {
+            // A tree's leaves answer for it (they hold the third-derivative bounds).
+            SecondDerivatives::None | SecondDerivatives::Tree { .. } => return (f64::INFINITY, 0.0),
+            SecondDerivatives::Sampled { m, .. } => return (m.error(t), 0.0),
+            _ => {}
         }
         let g = (t[0] + t[1] + t[2]) / 3.0;
         let [a, b, c] = self.second_derivatives(g);
@@ -296,15 +331,16 @@ impl TaylorBound {
     /// whichever diagonal splits it: one evaluation, at the centre, serves both triangles and
     /// both diagonals. Cost: one evaluation of the second derivatives.
     pub fn cell_error(&self, centre: DVec2, hu: f64, hv: f64) -> f64 {
-        match self.field {
+        match &self.field {
             SecondDerivatives::None => return f64::INFINITY,
-            SecondDerivatives::Tree { .. } => {
-                return self
-                    .leaf_cell(centre - DVec2::new(hu, hv) / 2.0, hu, hv)
-                    .map_or(f64::INFINITY, |(leaf, o, hu, hv)| {
-                        leaf.cell_error(o + DVec2::new(hu, hv) / 2.0, hu, hv)
-                    });
+            SecondDerivatives::Tree { whole, .. } => {
+                return match self.leaf_cell(centre - DVec2::new(hu, hv) / 2.0, hu, hv) {
+                    Some((leaf, o, hu, hv)) => leaf.cell_error(o + DVec2::new(hu, hv) / 2.0, hu, hv),
+                    None => whole.cell_error(centre, hu, hv),
+                };
             }
+            // Every cell of a size has the same second-derivative bound, either diagonal.
+            SecondDerivatives::Sampled { m, .. } => return m.cell_error(hu, hv),
             _ => {}
         }
         let [a, b, c] = self.second_derivatives(centre);
@@ -322,10 +358,11 @@ impl TaylorBound {
     /// positions and `n²` evaluations of the second derivatives, against four times
     /// [`TaylorBound::split_error`]'s.
     fn cell_split_error(&self, origin: DVec2, hu: f64, hv: f64) -> f64 {
-        if let SecondDerivatives::Tree { .. } = self.field {
-            return self
-                .leaf_cell(origin, hu, hv)
-                .map_or(f64::INFINITY, |(leaf, o, hu, hv)| leaf.cell_split_error(o, hu, hv));
+        if let SecondDerivatives::Tree { whole, .. } = &self.field {
+            return match self.leaf_cell(origin, hu, hv) {
+                Some((leaf, o, hu, hv)) => leaf.cell_split_error(o, hu, hv),
+                None => whole.cell_split_error(origin, hu, hv),
+            };
         }
         const N: usize = SPLIT_LATTICE;
         let point = |i: usize, j: usize| origin + DVec2::new(hu * i as f64, hv * j as f64) / N as f64;
@@ -335,8 +372,14 @@ impl TaylorBound {
                 *p = self.position(point(i, j));
             }
         }
+        // A sampled bound's sub-cells all have the same bound: a half's is then that plus the
+        // largest error at its lattice points (each a leaf corner inside it).
+        let uniform = match &self.field {
+            SecondDerivatives::Sampled { m, .. } => Some(m.cell_error(hu / N as f64, hv / N as f64)),
+            _ => None,
+        };
         let mut sub = [[0.0f64; N]; N];
-        for (i, row) in sub.iter_mut().enumerate() {
+        for (i, row) in sub.iter_mut().enumerate().filter(|_| uniform.is_none()) {
             for (j, e) in row.iter_mut().enumerate() {
                 *e = self.cell_error(
                     point(i, j) + DVec2::new(hu, hv) / (2 * N) as f64,
@@ -365,6 +408,10 @@ impl TaylorBound {
                         *e = (at[i][j] - l).length();
                     }
                 }
+            }
+            if let Some(sub) = uniform {
+                worst = worst.max(sub + error.as_flattened().iter().fold(0.0f64, |a, &e| a.max(e)));
+                continue;
             }
             for (i, row) in sub.iter().enumerate() {
                 for (j, own) in row.iter().enumerate() {
@@ -667,6 +714,44 @@ mod tests {
 
     fn random_net(rng: &mut Lcg) -> Vec<DVec3> {
         (0..16).map(|_| DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - DVec3::ONE).collect()
+    }
+
+    /// A tree answers a triangle from the one Bézier leaf that holds it, in that leaf's
+    /// parameters: small triangles of trees without end caps nearly all find theirs (their
+    /// leaves are at least 1/64 across), and the leaf's bound then equals the one computed
+    /// from the leaf's own triangle.
+    #[test]
+    fn a_tree_answers_from_the_leaf_that_holds_the_triangle() {
+        let mut rng = Lcg(11);
+        let (mut tried, mut found) = (0, 0);
+        // Whole quads, turned sub-faces of n-gons and quadrants of quads with creases.
+        let cages = ["catmark_torus_creases0.obj", "catmark_nonquads.obj", "catmark_tent_creases0.obj"];
+        let sets = cages.map(|cage| {
+            let path = crate::test_support::data(&format!("subdivision/{cage}"));
+            let surface = crate::io::SurfaceKind::CatmullClark;
+            crate::io::load(&path, crate::io::LoadOptions { surface, ..Default::default() }).unwrap()
+        });
+        for patch in sets.iter().flat_map(|set| &set.patches) {
+            let Patch::Subdivision(tree) = patch else { continue };
+            if tree.leaves().iter().any(|l| matches!(l.patch, LeafPatch::Gregory(_))) {
+                continue;
+            }
+            let bound = TaylorBound::of(patch);
+            for _ in 0..20 {
+                let c = DVec2::new(0.01 + 0.98 * rng.unit(), 0.01 + 0.98 * rng.unit());
+                let t = [c, c + DVec2::new(0.004, 0.0), c + DVec2::new(0.0, 0.004)];
+                tried += 1;
+                let Some((leaf, local)) = bound.leaf_of(t) else { continue };
+                found += 1;
+                // The leaf's point at the local parameters is the patch's at the corner.
+                for (q, l) in t.iter().zip(local) {
+                    assert!(l.min_element() >= 0.0 && l.max_element() <= 1.0);
+                    assert!(leaf.position(l).distance(patch.position(*q)) < 1e-12, "{q} → {l}");
+                }
+                assert_eq!(bound.triangle_error(t), leaf.triangle_error(local));
+            }
+        }
+        assert!(tried > 0 && found * 10 >= tried * 9, "{found} of {tried} small triangles inside one leaf");
     }
 
     /// The second-derivative fields equal the surfaces' own, measured by central differences.

@@ -240,6 +240,10 @@ fn taylor_quad_grid(t: &TaylorBound, m: &TriangleErrors, start: (u32, u32), eps:
         }
         scale *= 1.05;
     };
+    if t.samples() {
+        // Every grid a walk meets would be sampled whole: the scaled grid alone.
+        return (nu1, nv1);
+    }
     let cells = |g: (u32, u32)| g.0 as u64 * g.1 as u64;
     let mut best = (nu1, nv1);
     // The rows the walk's first column count needs: at most what beats the best (none where
