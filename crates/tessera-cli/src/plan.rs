@@ -126,8 +126,9 @@ pub struct CriterionArgs {
     pub cull: bool,
     /// The guaranteed bound --tolerance and --pixel-error plan with: `hessian`, one
     /// second-derivative bound per patch; `taylor`, also the second derivatives where each
-    /// triangle is with a third-derivative remainder (fewer triangles for the same guarantee
-    /// on Bézier patches and PN triangles; planned on the CPU).
+    /// triangle is with a third-derivative remainder, and the error sampled on coarse
+    /// triangles (fewer triangles for the same guarantee on every surface kind; planned on
+    /// the CPU, more slowly).
     #[arg(long, value_enum, default_value = "hessian")]
     pub bound: BoundArg,
 }

@@ -124,8 +124,9 @@ fn tolerance_bounds_hold(models: &[std::path::PathBuf], every_taylor: bool) {
 
 /// Rational models (the teapot and the torus with weights a function of position,
 /// [`tessera::scene::position_weights`], so shared curves keep theirs): the rational bound
-/// (derivatives of the numerator and the weight over the smallest weight) holds when measured
-/// on the output of the f32 rational kernels, and the output has the input's topology.
+/// (derivatives of the numerator and the weight over the smallest weight), and with the
+/// Taylor option its sampled refinement, hold when measured on the output of the f32 rational
+/// kernels, the refinement with fewer triangles; the output has the input's topology.
 #[test]
 fn tolerance_bounds_hold_on_rational_models() {
     for rel in ["patches/teapot.patches", "bench/torus_64x32.patches"] {
@@ -134,14 +135,32 @@ fn tolerance_bounds_hold_on_rational_models() {
         let name = format!("{rel} rational");
         for share in [1e-2, 1e-3] {
             let eps = share * diagonal(&set);
+            let mut triangles = [0; 2];
             for scheme in [Scheme::Transition, Scheme::Uniform] {
-                let (plan, pattern, report) = plan(&set, scheme, Criterion::Tolerance(eps), None, false);
-                assert_eq!(report.capped_patches, 0, "{name}");
-                let mesh = run(&set, &plan, &pattern);
-                let err = verify::approximation_error(&mesh, &set, 5).unwrap();
-                assert!(err.max <= eps, "{name} {scheme:?} {share}: measured {:.3e} > {eps:.3e}", err.max);
-                common::expect_topology(&set, &plan, &mesh, &name);
+                // Both bounds: the Taylor option samples rational patches (the sampled bound).
+                for (k, bound) in [ErrorBound::Hessian, ErrorBound::Taylor].into_iter().enumerate() {
+                    let (plan, pattern, report) =
+                        plan_with(&set, scheme, Criterion::Tolerance(eps), None, false, bound);
+                    assert_eq!(report.capped_patches, 0, "{name}");
+                    let mesh = run(&set, &plan, &pattern);
+                    let err = verify::approximation_error(&mesh, &set, 5).unwrap();
+                    assert!(
+                        err.max <= report.worst_bound && report.worst_bound <= eps * (1.0 + 1e-9),
+                        "{name} {scheme:?} {bound:?} {share}: measured {:.3e}, bound {:.3e}, {eps:.3e}",
+                        err.max,
+                        report.worst_bound
+                    );
+                    common::expect_topology(&set, &plan, &mesh, &name);
+                    if scheme == Scheme::Transition {
+                        triangles[k] = mesh.triangle_count();
+                    }
+                }
             }
+            println!(
+                "{name} {share}: transition {} triangles, {} with the Taylor option",
+                triangles[0], triangles[1]
+            );
+            assert!(triangles[1] < triangles[0], "{name} {share}: {triangles:?}");
         }
     }
 }

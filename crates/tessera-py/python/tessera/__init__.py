@@ -190,9 +190,9 @@ class Tessellator:
         warp: SD-2's reverse projection.
         bound: the guaranteed bound ``tolerance`` and ``pixel_error`` plan with: ``"hessian"``
             (default; one second-derivative bound per patch, cheap to plan) or ``"taylor"``
-            (the second derivatives where each triangle is, with a third-derivative remainder:
-            fewer triangles for the same guarantee on Bézier patches and PN triangles, slower
-            to plan).
+            (the second derivatives where each triangle is, with a third-derivative remainder,
+            and the error sampled on coarse triangles: fewer triangles for the same guarantee
+            on every surface kind, slower to plan).
         strips: also make triangle strips (``sd2``, ``esc``).
         corner_params: also give each triangle corner's patch parameters.
         max_triangles: refuse larger outputs (default: what 3/4 of the available memory holds).

@@ -37,10 +37,11 @@ pub enum ErrorBound {
     #[default]
     Hessian,
     /// The smaller of that and the Taylor bound ([`taylor`]): the second derivatives where each
-    /// triangle is, plus a third-derivative remainder. Fewer triangles for the same guarantee
-    /// on polynomial bicubics, Bézier and PN triangles (the other kinds keep the first); one
-    /// evaluation a grid cell in the check. The CPU plans it; the GPU engine draws such plans
-    /// but does not yet plan them itself.
+    /// triangle is, plus a third-derivative remainder, and on coarse triangles the error
+    /// sampled on a lattice (for the kinds without a Taylor expansion, with the first bound
+    /// as its margin). Fewer triangles for the same guarantee on every surface kind; about
+    /// one evaluation a grid cell in the check, tens where it refines. The CPU plans it; the
+    /// GPU engine draws such plans but does not yet plan them itself.
     Taylor,
 }
 
@@ -129,10 +130,10 @@ impl Prepared {
         Prepared::new(set, criterion.needs_bounds())
     }
 
-    /// Every patch's [`taylor::TaylorBound`] ([`taylor::TaylorBound::NONE`] for the kinds it
-    /// does not cover), computed on the first call and kept, for plans asked for
-    /// [`ErrorBound::Taylor`]. Preconditions: `set` is the set this was prepared for. Cost:
-    /// the first call O(P), parallel, about 650 bytes a patch; later calls nothing.
+    /// Every patch's [`taylor::TaylorBound`], computed on the first call and kept, for plans
+    /// asked for [`ErrorBound::Taylor`]. Preconditions: `set` is the set this was prepared
+    /// for. Cost: the first call O(P) (a tree's: O(leaves)), parallel, about 700 bytes a
+    /// patch (a tree: about as much a leaf); later calls nothing.
     pub fn taylor_bounds(&self, set: &SurfaceSet) -> &[taylor::TaylorBound] {
         use rayon::prelude::*;
         self.taylor.get_or_init(|| set.patches.par_iter().map(taylor::TaylorBound::of).collect())
