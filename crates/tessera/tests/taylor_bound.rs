@@ -46,6 +46,30 @@ fn random_triangle(rng: &mut Lcg, domain: Domain, size: f64) -> [DVec2; 3] {
     }
 }
 
+/// Largest [`measured`] error over every triangle of the `nu × nv` grid of the domain: a
+/// quad's cells split either way, a triangle's the lattice's way (the halves inside it).
+fn measured_grid(patch: &Patch, domain: Domain, [nu, nv]: [u32; 2], order: u32) -> f64 {
+    let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+    let mut error = 0.0f64;
+    for i in 0..nu {
+        for j in 0..nv {
+            let o = DVec2::new(i as f64 * hu, j as f64 * hv);
+            let [a, b, c, d] = [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
+            let halves = if domain == Domain::Quad {
+                &[[a, b, c], [b, d, c], [a, b, d], [a, d, c]][..]
+            } else {
+                &[[a, b, c], [b, d, c]][..]
+            };
+            for &t in halves {
+                if t.iter().all(|&q| inside(domain, q)) {
+                    error = error.max(measured(patch, t, order));
+                }
+            }
+        }
+    }
+    error
+}
+
 #[test]
 fn the_taylor_bound_holds_on_every_model() {
     let mut rng = Lcg(2027);
@@ -84,25 +108,7 @@ fn the_taylor_bound_holds_on_every_model() {
             let n = [1 + rng.below(6) as u32, 1 + rng.below(6) as u32];
             let n = if domain == Domain::Tri { [n[0], n[0]] } else { n };
             let bound = taylor.grid_error(domain == Domain::Tri, n);
-            let (hu, hv) = (1.0 / n[0] as f64, 1.0 / n[1] as f64);
-            let mut error = 0.0f64;
-            for i in 0..n[0] {
-                for j in 0..n[1] {
-                    let o = DVec2::new(i as f64 * hu, j as f64 * hv);
-                    let [a, b, c, d] =
-                        [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
-                    let halves = if domain == Domain::Quad {
-                        &[[a, b, c], [b, d, c], [a, b, d], [a, d, c]][..]
-                    } else {
-                        &[[a, b, c], [b, d, c]][..]
-                    };
-                    for &t in halves {
-                        if t.iter().all(|&q| inside(domain, q)) {
-                            error = error.max(measured(patch, t, 12));
-                        }
-                    }
-                }
-            }
+            let error = measured_grid(patch, domain, n, 12);
             assert!(
                 error <= bound * (1.0 + 1e-9) + 1e-15,
                 "{name}: grid {n:?} measured {error:e} > bound {bound:e}"
@@ -217,18 +223,7 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
             }
             let n = [1 + rng.below(12) as u32, 1 + rng.below(12) as u32];
             let bound = taylor.grid_error(false, n);
-            let (hu, hv) = (1.0 / n[0] as f64, 1.0 / n[1] as f64);
-            let mut error = 0.0f64;
-            for i in 0..n[0] {
-                for j in 0..n[1] {
-                    let o = DVec2::new(i as f64 * hu, j as f64 * hv);
-                    let [a, b, c, d] =
-                        [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
-                    for t in [[a, b, c], [b, d, c], [a, b, d], [a, d, c]] {
-                        error = error.max(measured(patch, t, 8));
-                    }
-                }
-            }
+            let error = measured_grid(patch, Domain::Quad, n, 8);
             assert!(
                 error <= bound * (1.0 + 1e-9) + 1e-15,
                 "{cage}: grid {n:?} measured {error:e} > bound {bound:e}"
@@ -296,25 +291,7 @@ fn the_sampled_bound_holds_on_rational_and_loop_patches() {
             }
             let n = 1 + rng.below(5) as u32;
             let bound = taylor.grid_error(domain == Domain::Tri, [n, n]);
-            let h = 1.0 / n as f64;
-            let mut error = 0.0f64;
-            for i in 0..n {
-                for j in 0..n {
-                    let o = DVec2::new(i as f64 * h, j as f64 * h);
-                    let [a, b, c, d] =
-                        [o, o + DVec2::new(h, 0.0), o + DVec2::new(0.0, h), o + DVec2::new(h, h)];
-                    let halves = if domain == Domain::Quad {
-                        &[[a, b, c], [b, d, c], [a, b, d], [a, d, c]][..]
-                    } else {
-                        &[[a, b, c], [b, d, c]][..]
-                    };
-                    for &t in halves {
-                        if t.iter().all(|&q| inside(domain, q)) {
-                            error = error.max(measured(patch, t, 8));
-                        }
-                    }
-                }
-            }
+            let error = measured_grid(patch, domain, [n, n], 8);
             assert!(
                 error <= bound * (1.0 + 1e-9) + 1e-13,
                 "{name}: grid {n} measured {error:e} > bound {bound:e}"
