@@ -261,7 +261,7 @@ impl TaylorBound {
         }
     }
 
-    /// The bound over `t` from the `n²` leaves of its `n`-lattice (`n` = [`SPLIT_LATTICE`]):
+    /// The bound over `t` from the `n²` leaves of its `n`-lattice (`n` = 4):
     /// on a leaf `T'`, `S − L = (S − L_T') + (L_T' − L)`, the first bounded by the Taylor
     /// bound of `T'` (its quadratic part `1/n²` of `t`'s, its remainder `1/n³`), the second
     /// affine, so at most its largest value at `T'`'s corners, which is `|S − L|` there,
