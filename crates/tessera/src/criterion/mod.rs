@@ -136,7 +136,15 @@ impl Prepared {
     /// patch (a tree: about as much a leaf); later calls nothing.
     pub fn taylor_bounds(&self, set: &SurfaceSet) -> &[taylor::TaylorBound] {
         use rayon::prelude::*;
-        self.taylor.get_or_init(|| set.patches.par_iter().map(taylor::TaylorBound::of).collect())
+        let errors = self.triangle_errors();
+        self.taylor.get_or_init(|| {
+            let errors = |p: usize| errors.get(p).filter(|_| errors.len() == set.patches.len());
+            set.patches
+                .par_iter()
+                .enumerate()
+                .map(|(p, patch)| taylor::TaylorBound::with_errors(patch, errors(p)))
+                .collect()
+        })
     }
 
     /// Every patch's [`bounds::TriangleErrors`] (what the a-posteriori check's triangle bound

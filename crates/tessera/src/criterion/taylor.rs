@@ -115,8 +115,18 @@ impl TaylorBound {
     /// Catmull-Clark tree's Bézier leaves), the sampled refinement of the second-derivative
     /// bound for the others. Cost: O(control points).
     pub fn of(patch: &Patch) -> TaylorBound {
+        TaylorBound::with_errors(patch, None)
+    }
+
+    /// [`TaylorBound::of`] with the patch's second-derivative bound already at hand
+    /// (`errors`, [`crate::criterion::Prepared::triangle_errors`]), which the sampled bound
+    /// takes as its margin; None computes it where it is needed.
+    pub(crate) fn with_errors(patch: &Patch, errors: Option<&TriangleErrors>) -> TaylorBound {
         let sampled = |patch: &Patch| TaylorBound {
-            field: SecondDerivatives::Sampled { patch: patch.clone(), m: hessian(patch).triangle_errors() },
+            field: SecondDerivatives::Sampled {
+                patch: patch.clone(),
+                m: errors.copied().unwrap_or_else(|| hessian(patch).triangle_errors()),
+            },
             third: [0.0; 4],
         };
         match patch {
@@ -179,8 +189,9 @@ impl TaylorBound {
         matches!(self.field, SecondDerivatives::Tree { .. } | SecondDerivatives::Sampled { .. })
     }
 
-    /// `[S_uu, S_uv, S_vv]` at `x` (a tree: of the leaf holding `x`, zero on an end cap).
-    /// Preconditions: `x` in the patch's domain.
+    /// `[S_uu, S_uv, S_vv]` at `x` (a tree: of the leaf holding `x`, zero on an end cap;
+    /// zero for the sampled bound, which has no expansion). Preconditions: `x` in the
+    /// patch's domain.
     pub fn second_derivatives(&self, x: DVec2) -> [DVec3; 3] {
         match &self.field {
             SecondDerivatives::None => [DVec3::ZERO; 3],
@@ -281,17 +292,20 @@ impl TaylorBound {
         let at = t.map(|x| self.position(x));
         // |S − L| at lattice point (i, j): barycentric (N − i − j, i, j)/N.
         let mut error = [[0.0f64; N + 1]; N + 1];
-        let point = |i: usize, j: usize| {
+        let weights = |i: usize, j: usize| {
             let (a, b) = (i as f64 / N as f64, j as f64 / N as f64);
-            t[0] * (1.0 - a - b) + t[1] * a + t[2] * b
+            [1.0 - a - b, a, b]
+        };
+        let point = |i: usize, j: usize| {
+            let [w0, w1, w2] = weights(i, j);
+            t[0] * w0 + t[1] * w1 + t[2] * w2
         };
         for (i, row) in error.iter_mut().enumerate() {
             for (j, e) in row.iter_mut().enumerate().take(N + 1 - i) {
                 let corner = (i == 0 && j == 0) || i == N || j == N;
                 if !corner {
-                    let (a, b) = (i as f64 / N as f64, j as f64 / N as f64);
-                    let linear = at[0] * (1.0 - a - b) + at[1] * a + at[2] * b;
-                    *e = (self.position(point(i, j)) - linear).length();
+                    let [w0, w1, w2] = weights(i, j);
+                    *e = (self.position(point(i, j)) - (at[0] * w0 + at[1] * w1 + at[2] * w2)).length();
                 }
             }
         }

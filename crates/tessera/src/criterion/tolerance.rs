@@ -220,7 +220,9 @@ const TAYLOR_SEARCH_CELLS: u64 = 1 << 16;
 /// it (rows only shrink as columns grow), keeps the grid with the fewest cells. `start`
 /// itself where the Taylor bound does not meet `eps` there. A proposal only: the a-posteriori
 /// check verifies the built pattern. Cost: about `2·nu1 + nv1` grid bounds of one
-/// evaluation a cell.
+/// evaluation a cell; for a bound that samples its patch ([`TaylorBound::samples`]: a tree,
+/// the sampled bound), whose every tested grid would be sampled whole, the scaled grid
+/// alone, a few grid bounds.
 fn taylor_quad_grid(t: &TaylorBound, m: &TriangleErrors, start: (u32, u32), eps: f64) -> (u32, u32) {
     let fits = |nu: u32, nv: u32| t.grid_fits(false, [nu, nv], eps, grid_bound(m, None, [nu, nv]));
     let (nu0, nv0) = start;
@@ -464,7 +466,7 @@ pub(crate) fn plan_limited(
             (InteriorRule::Core, Domain::Quad) => {
                 let mut grid = quad_grid(m, e, cap).unwrap_or((cap, cap));
                 if let Some(t) = taylor {
-                    grid = taylor_quad_grid(t, &m.triangle_errors(), grid, e);
+                    grid = taylor_quad_grid(t, &errors[p], grid, e);
                 }
                 let (nu, nv) = grid;
                 *out = [nu as f64, nv as f64, nu as f64, nv as f64];
@@ -472,7 +474,7 @@ pub(crate) fn plan_limited(
             _ => {
                 let mut n = uniform_factor(m, e);
                 if let Some(t) = taylor {
-                    n = taylor_uniform_factor(t, &m.triangle_errors(), domain, n.min(cap as f64), e);
+                    n = taylor_uniform_factor(t, &errors[p], domain, n.min(cap as f64), e);
                 }
                 out[..domain.corner_count()].fill(n);
             }
