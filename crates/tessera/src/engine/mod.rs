@@ -522,7 +522,18 @@ impl Writer<'_> {
             return;
         }
         // Most edges of a distant view have no inner sample: skipped without a split.
-        for e in edges.filter(|&e| offsets[e + 1] > offsets[e]) {
+        let mut edges = edges;
+        while let Some(e) = edges.next() {
+            if offsets[e + 1] == offsets[e] {
+                continue;
+            }
+            if let Some(end) = self.owner_run(e, edges.end) {
+                // Edges `e..end` share their owner and lie one after the other in the output.
+                let part = out.take_front((offsets[end] - offsets[e]) as usize);
+                self.edge_run(e..end, part);
+                edges.start = end;
+                continue;
+            }
             let part = out.take_front((offsets[e + 1] - offsets[e]) as usize);
             match self.fast {
                 Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
@@ -535,6 +546,53 @@ impl Writer<'_> {
                 }),
             }
         }
+    }
+
+    /// The end of the run of edges from `e` (before `end`) that [`Writer::edge_run`]
+    /// evaluates in one call: edges owned by one patch whose form [`point_blocks`] evaluates in
+    /// blocks, each with one normal variant and not on the grid kernels. None for a run of one
+    /// edge (or none): the edge takes the usual path.
+    ///
+    /// Why: edges are numbered by owner ([`crate::topology::Topology::first_owned_edge`]), so
+    /// a patch's edges are neighbours in the output, and a coarse frame (a mesh's PN triangles
+    /// at half a pixel) has mostly one or two inner samples an edge: one evaluation call per
+    /// edge spent most of its block's lanes on padding and its setup on a point or two. Each
+    /// lane is evaluated alone, so a point's bits do not depend on its neighbours in a block.
+    fn owner_run(&self, e: usize, end: usize) -> Option<usize> {
+        let f = self.fast?;
+        let topo = &self.set.topology;
+        let single = |e: usize| topo.edges[e].variants == 1 && !f.covers_edge(self.plan, e);
+        if f.triangles().active() || !single(e) {
+            return None;
+        }
+        let owner = topo.edge_uses(e)[0].patch;
+        if !f.points().evaluates_in_blocks(owner as usize) {
+            return None;
+        }
+        let run = (e + 1..end).take_while(|&x| topo.edge_uses(x)[0].patch == owner && single(x)).count();
+        (run > 0).then_some(e + 1 + run)
+    }
+
+    /// The inner samples of `edges`, a run of [`Writer::owner_run`], evaluated in one call
+    /// on their owner into `out` (their samples, one edge after the other).
+    fn edge_run(&self, edges: std::ops::Range<usize>, out: VertexSlices<'_>) {
+        let (set, plan) = (self.set, self.plan);
+        let topo = &set.topology;
+        let owner = topo.edge_uses(edges.start)[0].patch as usize;
+        let d = topo.patch_domains[owner];
+        with_scratch(self.generation, |scratch| {
+            let uvs = &mut scratch.edge_params;
+            uvs.clear();
+            for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
+                let u = topo.edge_uses(e)[0];
+                uvs.extend((1..plan.segments(e)).map(|k| {
+                    let t = plan.param(e, k);
+                    d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
+                }));
+            }
+            let points = self.fast.expect("owner_run checked the evaluator").points();
+            points.eval(set, owner, uvs, out);
+        });
     }
 
     /// Pass `pass` of the interiors and triangles of `patches`, split like [`Writer::edges`].

@@ -818,6 +818,13 @@ impl PointBlocks {
         })
     }
 
+    /// Whether patch `p` is evaluated in blocks of lanes, each lane on its own (so a point's
+    /// value does not depend on the points evaluated with it): every form but the generic
+    /// evaluation and the subdivision trees, whose points are grouped by leaf.
+    pub(crate) fn evaluates_in_blocks(&self, p: usize) -> bool {
+        self.form(p).is_some()
+    }
+
     /// Whether every patch is a bicubic with a local form, polynomial or rational (the grid
     /// evaluator's precondition).
     pub(crate) fn all_bicubic(&self) -> bool {
