@@ -65,6 +65,82 @@ fn round_factor(x: f64) -> u32 {
     t.saturating_add(u32::from(x - t as f64 >= 0.5))
 }
 
+/// Edge `e`'s segments and factor: the maximum of its uses' proposals, capped, raised to
+/// the edge's minimum and rounded by `rule` — the one rule [`edges`] and [`update_edges`]
+/// apply. Cost: O(uses of `e`).
+#[inline]
+fn edge(set: &SurfaceSet, proposals: &[Proposals], rule: EdgeRule, caps: &Caps<'_>, e: usize) -> (u32, f32) {
+    let cap = caps.max_factor.max(1.0);
+    let wanted = set
+        .topology
+        .edge_uses(e)
+        .iter()
+        .map(|u| proposals[u.patch as usize][u.local as usize])
+        .fold(0.0, f64::max)
+        .min(cap);
+    let minimum = caps.minimum_segments[e].max(1);
+    match rule {
+        EdgeRule::Integer => {
+            let s = round_factor(wanted).max(minimum);
+            (s, s as f32)
+        }
+        EdgeRule::PowerOfTwo => {
+            // Level ⌈log2 f⌉, with a margin for factors that are powers of two up to
+            // rounding (the view criteria interpolate levels, not factors).
+            let level = (wanted.max(1.0).log2() - 1e-9).ceil().max(0.0) as u32;
+            let s = (1u32 << level.min(31)).max(minimum).next_power_of_two().min(cap as u32);
+            (s, s as f32)
+        }
+        EdgeRule::Fractional(spacing) => {
+            let f = wanted.max(minimum as f64);
+            let f = match spacing {
+                Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
+                Spacing::Symmetric => f,
+            };
+            // Segments follow from the stored f32 factor, the one every engine reads.
+            let f = f as f32;
+            (spacing_segments(f as f64, spacing), f)
+        }
+    }
+}
+
+/// [`edges`] again after the proposals of `patches` changed (and no other's), for a rule
+/// other than [`InteriorRule::Global`]: only their edges are resolved again, and those whose
+/// segments or factor changed are appended to `changed` (as `(edge, segments, factor)`, each
+/// edge once, in edge order) while `segments` and `factors` are left as they were. Applying
+/// them gives what [`edges`] gives from the new proposals, as no other edge reads a changed
+/// proposal. Cost: O(edges of `patches`), sequential.
+pub fn update_edges(
+    set: &SurfaceSet,
+    proposals: &[Proposals],
+    rule: EdgeRule,
+    caps: &Caps<'_>,
+    patches: &[usize],
+    (segments, factors): (&[u32], &[f32]),
+    changed: &mut Vec<(u32, u32, f32)>,
+) {
+    let topo = &set.topology;
+    let first = changed.len();
+    for &p in patches {
+        for pe in &topo.patch_edges[p][..topo.patch_domains[p].corner_count()] {
+            let e = pe.edge as usize;
+            let (s, f) = edge(set, proposals, rule, caps, e);
+            if s != segments[e] || f.to_bits() != factors[e].to_bits() {
+                changed.push((e as u32, s, f));
+            }
+        }
+    }
+    changed[first..].sort_unstable_by_key(|c| c.0);
+    let mut kept = first;
+    for i in first..changed.len() {
+        if kept == first || changed[kept - 1].0 != changed[i].0 {
+            changed[kept] = changed[i];
+            kept += 1;
+        }
+    }
+    changed.truncate(kept);
+}
+
 /// Resolves per-use proposals into per-edge segments and factors (written into `segments`
 /// and `factors`, cleared first). Cost: O(E) plus the edge uses, parallel.
 pub fn edges(
@@ -83,42 +159,13 @@ pub fn edges(
     segments.resize(edges, 0);
     factors.clear();
     factors.resize(edges, 0.0);
-    let cap = caps.max_factor.max(1.0);
     // Every edge on its own: parallel, in blocks large enough to outweigh the scheduling.
-    segments.par_iter_mut().zip(factors.par_iter_mut()).enumerate().with_min_len(1024).for_each(
-        |(e, (s, f))| {
-            let wanted = topo
-                .edge_uses(e)
-                .iter()
-                .map(|u| proposals[u.patch as usize][u.local as usize])
-                .fold(0.0, f64::max)
-                .min(cap);
-            let minimum = caps.minimum_segments[e].max(1);
-            (*s, *f) = match rule {
-                EdgeRule::Integer => {
-                    let s = round_factor(wanted).max(minimum);
-                    (s, s as f32)
-                }
-                EdgeRule::PowerOfTwo => {
-                    // Level ⌈log2 f⌉, with a margin for factors that are powers of two up to
-                    // rounding (the view criteria interpolate levels, not factors).
-                    let level = (wanted.max(1.0).log2() - 1e-9).ceil().max(0.0) as u32;
-                    let s = (1u32 << level.min(31)).max(minimum).next_power_of_two().min(cap as u32);
-                    (s, s as f32)
-                }
-                EdgeRule::Fractional(spacing) => {
-                    let f = wanted.max(minimum as f64);
-                    let f = match spacing {
-                        Spacing::Hardware(p) => settled_factor(p.hull_factor(f), p, OUTPUT_GAP),
-                        Spacing::Symmetric => f,
-                    };
-                    // Segments follow from the stored f32 factor, the one every engine reads.
-                    let f = f as f32;
-                    (spacing_segments(f as f64, spacing), f)
-                }
-            };
-        },
-    );
+    segments
+        .par_iter_mut()
+        .zip(factors.par_iter_mut())
+        .enumerate()
+        .with_min_len(1024)
+        .for_each(|(e, (s, f))| (*s, *f) = edge(set, proposals, rule, caps, e));
     if interior == InteriorRule::Global {
         let n = segments
             .iter()
