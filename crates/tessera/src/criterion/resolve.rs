@@ -310,6 +310,53 @@ mod tests {
         assert_eq!((s[shared], f[shared]), (spacing_segments(2.5, odd), 2.5));
     }
 
+    /// Raising some patches' proposals and resolving only their edges again
+    /// (`update_edges`, as a round of the a-posteriori check does) gives, once applied, what
+    /// resolving every edge gives, under every edge rule; and it lists only edges that changed.
+    #[test]
+    fn updating_the_raised_patches_edges_equals_resolving_every_edge() {
+        let path = crate::test_support::data("meshes/cow.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        let set = SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap();
+        let (edge_count, patch_count) = (set.topology.edges.len(), set.patches.len());
+        let mut rng = crate::test_support::Lcg(5);
+        let minimum: Vec<u32> = (0..edge_count).map(|_| 1 + (rng.below(4) == 0) as u32 * 2).collect();
+        let minimum_interior = vec![[1, 1]; patch_count];
+        let caps = Caps { max_factor: 24.0, minimum_segments: &minimum, minimum_interior: &minimum_interior };
+        let odd = Spacing::Hardware(crate::sampling::Partitioning::FractionalOdd);
+        let rules = [EdgeRule::Integer, EdgeRule::PowerOfTwo, EdgeRule::Fractional(odd)];
+        let mut changed_edges = 0;
+        for (round, rule) in rules.into_iter().cycle().take(12).enumerate() {
+            let mut proposals: Vec<Proposals> =
+                (0..patch_count).map(|_| std::array::from_fn(|_| 1.0 + 12.0 * rng.unit())).collect();
+            let (mut segments, mut factors) = (Vec::new(), Vec::new());
+            edges(&set, &proposals, rule, InteriorRule::MaxEdge, &caps, &mut segments, &mut factors);
+            let raised: Vec<usize> =
+                (0..patch_count).filter(|_| rng.below(10 + 40 * (round % 2)) == 0).collect();
+            for &p in &raised {
+                proposals[p] = proposals[p].map(|v| (v * (1.2 + 3.0 * rng.unit())).ceil().min(24.0));
+            }
+            let mut changed = Vec::new();
+            update_edges(&set, &proposals, rule, &caps, &raised, (&segments, &factors), &mut changed);
+            let (mut expected_s, mut expected_f) = (Vec::new(), Vec::new());
+            edges(&set, &proposals, rule, InteriorRule::MaxEdge, &caps, &mut expected_s, &mut expected_f);
+            assert!(changed.windows(2).all(|w| w[0].0 < w[1].0), "each edge once, in order");
+            for &(e, s, f) in &changed {
+                let e = e as usize;
+                assert!(s != segments[e] || f != factors[e], "edge {e} is listed but did not change");
+                (segments[e], factors[e]) = (s, f);
+            }
+            changed_edges += changed.len();
+            assert_eq!(segments, expected_s, "{rule:?}");
+            assert_eq!(
+                factors.iter().map(|f| f.to_bits()).collect::<Vec<_>>(),
+                expected_f.iter().map(|f| f.to_bits()).collect::<Vec<_>>(),
+                "{rule:?}"
+            );
+        }
+        assert!(changed_edges > 1000, "the raises change edges: {changed_edges}");
+    }
+
     #[test]
     fn the_global_rule_gives_every_edge_the_largest() {
         let set = pair();

@@ -553,7 +553,7 @@ impl Writer<'_> {
     /// blocks, each with one normal variant and not on the grid kernels. None for a run of one
     /// edge (or none): the edge takes the usual path.
     ///
-    /// Why: edges are numbered by owner ([`crate::topology::Topology::first_owned_edge`]), so
+    /// Why: `Topology::build` numbers edges as their owners first meet them, patch by patch, so
     /// a patch's edges are neighbours in the output, and a coarse frame (a mesh's PN triangles
     /// at half a pixel) has mostly one or two inner samples an edge: one evaluation call per
     /// edge spent most of its block's lanes on padding and its setup on a point or two. Each
