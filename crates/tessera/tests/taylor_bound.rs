@@ -243,8 +243,8 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
 
 /// The sampled refinement of the second-derivative bound, for the kinds without a Taylor
 /// expansion: rational bicubics (the teapot and the torus with weights that vary with
-/// position) and Loop patches (regular box-spline triangles, isolated ones with Gregory
-/// triangles). Measured as above (flat patches, whose bound is 0, measure rounding: 1e-13).
+/// position) and isolated Loop patches (trees of quartic leaves and Gregory triangles).
+/// Measured as above (flat patches, whose bound is 0, measure rounding: 1e-13).
 #[test]
 fn the_sampled_bound_holds_on_rational_and_loop_patches() {
     let mut rng = Lcg(2029);
@@ -267,8 +267,11 @@ fn the_sampled_bound_holds_on_rational_and_loop_patches() {
     }
     let (mut ratios, mut hessian_ratios) = (Vec::new(), Vec::new());
     for (name, set) in sets {
-        let step = (set.patches.len() / 40).max(1);
-        for patch in set.patches.iter().step_by(step) {
+        // A regular Loop patch has its own expansion (the next test).
+        let sampled: Vec<&Patch> =
+            set.patches.iter().filter(|p| !matches!(p, Patch::Loop(t) if t.regular().is_some())).collect();
+        let step = (sampled.len() / 40).max(1);
+        for &patch in sampled.iter().step_by(step) {
             let taylor = TaylorBound::of(patch);
             let hessian = tessera::criterion::bounds::hessian(patch);
             let domain = patch.domain();
@@ -307,4 +310,87 @@ fn the_sampled_bound_holds_on_rational_and_loop_patches() {
     // These kinds' second-derivative bounds are loose (a Loop patch's covers its Gregory
     // triangles), and the refinement keeps 1/16 of it as its margin: it gains, not all.
     assert!(refined >= 4.0 * plain, "measured / bound: refined {refined}, plain {plain}");
+}
+
+/// Regular Loop patches (one quartic box-spline piece, in the patch's parameters whether or
+/// not its tree is swapped) take a Taylor expansion of their own: measured as above, on the
+/// Loop cages, it holds, its second derivatives are the patch's, and on small triangles it is
+/// tight (the sampled bound they had kept 1/16 of a loose second-derivative bound).
+#[test]
+fn the_taylor_bound_holds_on_regular_loop_patches() {
+    let mut rng = Lcg(2030);
+    let (mut ratios, mut sampled_ratios) = (Vec::new(), Vec::new());
+    let (mut swapped, mut cages) = (0, 0);
+    let mut files = tessera::test_support::data_files("subdivision", &["loop_"]);
+    files.push(common::model("meshes/killeroo_cage.obj"));
+    for path in files {
+        let cage = path.file_name().unwrap().to_string_lossy().into_owned();
+        let options = LoadOptions { surface: SurfaceKind::Loop, ..Default::default() };
+        // (A non-manifold cage is refused: nothing to bound.)
+        let Ok(set) = tessera::io::load(&path, options) else { continue };
+        let regular: Vec<&Patch> =
+            set.patches.iter().filter(|p| matches!(p, Patch::Loop(t) if t.regular().is_some())).collect();
+        cages += usize::from(!regular.is_empty());
+        let step = (regular.len() / 30).max(1);
+        // Each patch as it is and flipped (its tree swapped: `u` and `v` exchanged).
+        let patches = regular.iter().step_by(step).flat_map(|&p| [p.clone(), p.flipped()]);
+        for patch in patches {
+            let patch = &patch;
+            let Patch::Loop(tree) = patch else { unreachable!() };
+            swapped += usize::from(tree.is_swapped());
+            let taylor = TaylorBound::of(patch);
+            // Sampled as the kinds without an expansion are: the comparison below.
+            let hessian = tessera::criterion::bounds::hessian(patch);
+            for size in [1.0, 0.3, 0.05, 0.01] {
+                let t = random_triangle(&mut rng, Domain::Tri, size);
+                let bound = taylor.triangle_error(t);
+                let error = measured(patch, t, 16);
+                assert!(
+                    error <= bound * (1.0 + 1e-9) + 1e-13,
+                    "{cage}: {t:?} measured {error:e} > bound {bound:e}"
+                );
+                if size <= 0.05 && bound > 0.0 {
+                    ratios.push(error / bound);
+                    sampled_ratios.push(error / hessian.triangle_error(t));
+                }
+                let x = (t[0] + t[1] + t[2]) / 3.0;
+                let h = 1e-4;
+                if x.min_element() > 2.0 * h && x.x + x.y < 1.0 - 4.0 * h {
+                    let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
+                    let want = [
+                        (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
+                        (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
+                        (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
+                    ];
+                    let got = taylor.second_derivatives(x);
+                    let scale = want.iter().map(|w| w.length()).fold(1.0, f64::max);
+                    for k in 0..3 {
+                        assert!(
+                            got[k].distance(want[k]) < 1e-4 * scale,
+                            "{cage} at {x}: {k}: {got:?} {want:?}"
+                        );
+                    }
+                }
+            }
+            let n = 1 + rng.below(6) as u32;
+            let bound = taylor.grid_error(true, [n, n]);
+            let error = measured_grid(patch, Domain::Tri, [n, n], 8);
+            assert!(
+                error <= bound * (1.0 + 1e-9) + 1e-13,
+                "{cage}: grid {n} measured {error:e} > bound {bound:e}"
+            );
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (taylor, hessian) = (median(ratios), median(sampled_ratios));
+    println!(
+        "regular Loop patches of {cages} cages: measured / bound median {taylor:.3} \
+         (second-derivative bound {hessian:.3}); {swapped} swapped"
+    );
+    assert!(cages >= 3, "only {cages} Loop cages with regular patches");
+    assert!(swapped > 0, "no swapped tree among the regular patches");
+    assert!(taylor >= 0.8, "measured / bound on small triangles: median {taylor}");
 }

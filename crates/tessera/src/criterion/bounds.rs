@@ -487,6 +487,13 @@ pub fn curve_second_derivative(points: [DVec3; 4], weights: [f64; 4]) -> f64 {
     (d2 + 2.0 * g * w1 + r * w2) / wmin
 }
 
+/// Bound on the second derivative of a quartic curve (a regular Loop patch's boundary,
+/// [`crate::surface::QuarticTriangle::edge_points`]) from its five control points: its second
+/// derivative is the quadratic Bézier curve `12 Σ Δ²p · B²`, inside the hull of its points.
+pub fn quartic_curve_second_derivative(points: [DVec3; 5]) -> f64 {
+    12.0 * max_norm((0..3).map(|i| points[i + 2] - 2.0 * points[i + 1] + points[i]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

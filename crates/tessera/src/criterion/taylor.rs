@@ -50,10 +50,12 @@
 //! **Which patches.** Polynomial bicubics (`S_uu`, `S_uv`, `S_vv` are Bézier patches of
 //! degrees (1,3), (2,2), (3,1); the third derivatives of degrees (0,3), (1,2), (2,1), (3,0)),
 //! cubic Bézier triangles and PN triangles (second derivatives linear, third constant: the
-//! bound is exact up to the triangle inequality inside), and Catmull-Clark patch trees
+//! bound is exact up to the triangle inequality inside), regular Loop patches (one quartic
+//! piece: second derivatives quadratic, third linear, refined by the lattice split as a
+//! bicubic is), and Catmull-Clark patch trees
 //! through their Bézier leaves: a triangle or cell inside one leaf takes that leaf's bound
 //! (linear interpolation's error does not change under the affine map to the leaf's
-//! parameters). Everything else — rational bicubics, Loop patches, a tree's triangles across
+//! parameters). Everything else — rational bicubics, isolated Loop patches, a tree's triangles across
 //! leaves (the surface is only piecewise smooth there) or on Gregory end caps — takes the
 //! *sampled* bound: the lattice refinement with the patch's second-derivative bound in place
 //! of the expansion, so the sampled error plus `1/n²` of that bound. It is as valid as the
@@ -65,7 +67,7 @@
 
 use super::bounds::{hessian, max_norm, TriangleErrors};
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
-use crate::surface::{BezierTriangle, Patch};
+use crate::surface::{BezierTriangle, Patch, QuarticTriangle};
 use glam::{DVec2, DVec3};
 
 /// One patch's Taylor bound: the field of its second derivatives and bounds on its third.
@@ -92,6 +94,10 @@ enum SecondDerivatives {
     /// `[S_uu, S_uv, S_vv]` at the corners `(0,0)`, `(1,0)`, `(0,1)`, linear in between, and
     /// the cubic's own control points (for [`cubic_error_hull`]).
     Triangle { corners: [[DVec3; 3]; 3], net: [DVec3; 10] },
+    /// A quartic Bézier triangle in the patch's parameters (a regular Loop patch: one box
+    /// spline piece): `S_uu`, `S_uv`, `S_vv` are quadratic triangles, the third derivatives
+    /// linear ones.
+    Quartic { net: QuarticTriangle },
     /// A Catmull-Clark patch tree and each of its leaves' bounds in the leaf's own
     /// parameters (a Bézier leaf's as a bicubic's; a Gregory end cap has none). A query is
     /// answered by the one Bézier leaf that holds all its points (the error of linear
@@ -133,6 +139,12 @@ impl TaylorBound {
             Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
             Patch::BezierTriangle(t) => triangle(t),
             Patch::Pn(pn) => triangle(&pn.geometry),
+            // A regular Loop patch is one quartic piece; the others are piecewise (isolated
+            // leaves, Gregory triangles) and sampled.
+            Patch::Loop(tree) => match tree.regular_net() {
+                Some(q) => quartic(&q),
+                None => sampled(patch),
+            },
             Patch::Subdivision(tree) => {
                 let leaves = tree
                     .leaves()
@@ -213,6 +225,10 @@ impl TaylorBound {
                 let l = [1.0 - x.x - x.y, x.x, x.y];
                 std::array::from_fn(|k| corners[0][k] * l[0] + corners[1][k] * l[1] + corners[2][k] * l[2])
             }
+            SecondDerivatives::Quartic { net } => {
+                let (uu, uv, vv) = net.second_derivatives(x);
+                [uu, uv, vv]
+            }
         }
     }
 
@@ -231,6 +247,7 @@ impl TaylorBound {
             SecondDerivatives::Sampled { patch, .. } => patch.position(x),
             SecondDerivatives::Bicubic { points, .. } => net_at(points, x),
             SecondDerivatives::Triangle { net, .. } => BezierTriangle { points: *net }.position(x),
+            SecondDerivatives::Quartic { net } => net.position(x),
         }
     }
 
@@ -265,9 +282,9 @@ impl TaylorBound {
             SecondDerivatives::Triangle { net, .. } if remainder > HULL_WHEN * quadratic => {
                 (quadratic + remainder).min(cubic_error_hull(net, t))
             }
-            SecondDerivatives::Bicubic { .. } | SecondDerivatives::Sampled { .. } => {
-                (quadratic + remainder).min(self.split_error(t))
-            }
+            SecondDerivatives::Bicubic { .. }
+            | SecondDerivatives::Quartic { .. }
+            | SecondDerivatives::Sampled { .. } => (quadratic + remainder).min(self.split_error(t)),
             _ => quadratic + remainder,
         }
     }
@@ -730,6 +747,27 @@ fn triangle(t: &BezierTriangle) -> TaylorBound {
         field: SecondDerivatives::Triangle { corners, net: t.points },
         third: [uuu, uuv, uvv, vvv].map(|d| 6.0 * d.length()),
     }
+}
+
+/// A quartic Bézier triangle's bound: its second derivatives are the quadratic triangles
+/// `12 Σ Δ² b · B²` ([`QuarticTriangle::second_derivatives`]); its third derivatives the
+/// linear ones `24 Σ Δ³ b · B¹`, whose largest control vector bounds each (convex hull), the
+/// third differences being one more `E_j − E_i` (along u) or `E_k − E_i` (along v) on the
+/// second ones, as for the cubic ([`triangle`]).
+fn quartic(q: &QuarticTriangle) -> TaylorBound {
+    let b = |i: usize, j: usize, k: usize| q.b(i, j, k);
+    // The second differences at base (i, j, k), i + j + k = 2.
+    let d_uu = |i, j, k| b(i, j + 2, k) - 2.0 * b(i + 1, j + 1, k) + b(i + 2, j, k);
+    let d_vv = |i, j, k| b(i, j, k + 2) - 2.0 * b(i + 1, j, k + 1) + b(i + 2, j, k);
+    let linear = [(1, 0, 0), (0, 1, 0), (0, 0, 1)];
+    let third = |f: &dyn Fn(usize, usize, usize) -> DVec3| {
+        24.0 * max_norm(linear.iter().map(|&(i, j, k)| f(i, j, k)))
+    };
+    let uuu = third(&|i, j, k| d_uu(i, j + 1, k) - d_uu(i + 1, j, k));
+    let uuv = third(&|i, j, k| d_uu(i, j, k + 1) - d_uu(i + 1, j, k));
+    let uvv = third(&|i, j, k| d_vv(i, j + 1, k) - d_vv(i + 1, j, k));
+    let vvv = third(&|i, j, k| d_vv(i, j, k + 1) - d_vv(i + 1, j, k));
+    TaylorBound { field: SecondDerivatives::Quartic { net: q.clone() }, third: [uuu, uuv, uvv, vvv] }
 }
 
 #[cfg(test)]

@@ -119,20 +119,6 @@ const fn index(d: usize, i: usize, j: usize) -> usize {
     (d - i) * (d - i + 1) / 2 + (d - i - j)
 }
 
-/// For each control point `b_ijk` of degree `d` in [`exponents`] order, where `b_ikj` stands:
-/// the net of the same surface with `u` and `v` exchanged, read through it.
-const fn swapped<const N: usize>() -> [usize; N] {
-    let (d, e) = (degree(N), exponents::<N>());
-    let mut out = [0; N];
-    let mut m = 0;
-    while m < N {
-        let (i, _, k) = e[m];
-        out[m] = index(d, i, k);
-        m += 1;
-    }
-    out
-}
-
 /// `d!/(i!j!k!)` of each control point of degree `d`, in [`exponents`] order.
 const fn multinomials<const N: usize>() -> [f64; N] {
     let e = exponents::<N>();
@@ -752,16 +738,9 @@ impl PointBlocks {
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
-                Patch::Loop(t) => t.regular().map_or_else(
+                Patch::Loop(t) => t.regular_net().map_or_else(
                     || Form::LoopTree(loop_leaves(t)),
-                    |q| {
-                        let net = if t.is_swapped() {
-                            const { swapped::<15>() }.map(|m| q.points[m])
-                        } else {
-                            q.points
-                        };
-                        Form::Quartic(LocalQuartic::from_net(&net))
-                    },
+                    |q| Form::Quartic(LocalQuartic::from_net(&q.points)),
                 ),
                 // Piecewise (isolated) patches take the generic evaluation, or their points
                 // grouped by leaf (`tree_points`).

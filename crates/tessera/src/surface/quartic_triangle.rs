@@ -166,6 +166,29 @@ impl QuarticTriangle {
         self.points[Self::index(i, j, k)]
     }
 
+    /// The same surface with `u` and `v` exchanged (`b_ijk ↔ b_ikj`): the opposite
+    /// orientation. Cost: 15 copies.
+    pub fn swapped_uv(&self) -> Self {
+        let mut out = self.clone();
+        for i in 0..=4usize {
+            for j in 0..=4 - i {
+                out.points[Self::index(i, 4 - i - j, j)] = self.b(i, j, 4 - i - j);
+            }
+        }
+        out
+    }
+
+    /// The five control points of boundary curve `e` (from corner `e` to corner `e + 1`,
+    /// corners `(0, 0)`, `(1, 0)`, `(0, 1)`): a quartic Bézier curve in the edge's own
+    /// parameter. Cost: 5 copies.
+    pub fn edge_points(&self, e: usize) -> [DVec3; 5] {
+        std::array::from_fn(|t| match e {
+            0 => self.b(4 - t, t, 0),
+            1 => self.b(0, 4 - t, t),
+            _ => self.b(t, 0, 4 - t),
+        })
+    }
+
     /// The quartic Bézier form of OpenSubdiv's regular Loop patch with the 12 box-spline
     /// points `points` in OpenSubdiv's order (module docs) and no boundary: the same
     /// polynomial, so it evaluates as `EvalBasisBoxSplineTri`'s weights do, to rounding.
@@ -350,6 +373,54 @@ pub(crate) mod tests {
         std::array::from_fn(|_| {
             DVec3::new(rng.unit53(), rng.unit53(), rng.unit53()) * 2.0 - DVec3::ONE + offset
         })
+    }
+
+    /// `swapped_uv` is the same surface with `u` and `v` exchanged; `edge_points(e)` are the
+    /// control points of the boundary curve from corner `e` to corner `e + 1` (the curve they
+    /// define is the surface there); and the quartic curve bound holds along each edge
+    /// (second differences of the surface there, `|C''(t)|`, never above it).
+    #[test]
+    fn swapped_nets_and_edge_curves_are_the_surfaces() {
+        let mut rng = Lcg(31);
+        let corners = [DVec2::ZERO, DVec2::X, DVec2::Y];
+        for _ in 0..200 {
+            let q = QuarticTriangle { points: random_points::<15>(&mut rng, DVec3::ZERO) };
+            let s = q.swapped_uv();
+            for _ in 0..10 {
+                let (u, v) = (rng.unit53(), rng.unit53());
+                let uv = if u + v <= 1.0 { DVec2::new(u, v) } else { DVec2::new(1.0 - u, 1.0 - v) };
+                assert!(s.position(uv).distance(q.position(DVec2::new(uv.y, uv.x))) < 1e-12);
+            }
+            assert_eq!(s.swapped_uv(), q);
+            for e in 0..3 {
+                let p = q.edge_points(e);
+                let bound = crate::criterion::bounds::quartic_curve_second_derivative(p);
+                let (a, b) = (corners[e], corners[(e + 1) % 3]);
+                let at = |t: f64| q.position(a + (b - a) * t);
+                for k in 0..=16 {
+                    let t = k as f64 / 16.0;
+                    // The curve of `p` in Bernstein form, against the surface on the edge.
+                    let s = 1.0 - t;
+                    let w = [
+                        s * s * s * s,
+                        4.0 * t * s * s * s,
+                        6.0 * t * t * s * s,
+                        4.0 * t * t * t * s,
+                        t * t * t * t,
+                    ];
+                    let curve = (0..5).fold(DVec3::ZERO, |c, i| c + p[i] * w[i]);
+                    assert!(curve.distance(at(t)) < 1e-12, "edge {e} at {t}");
+                    let h = 1e-3;
+                    if t > h && t < 1.0 - h {
+                        let second = (at(t + h) - 2.0 * at(t) + at(t - h)) / (h * h);
+                        assert!(
+                            second.length() <= bound * (1.0 + 1e-6) + 1e-6,
+                            "edge {e}: {second} > {bound}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     /// `Σ wᵢ Pᵢ`: how OpenSubdiv evaluates a patch from its basis weights.

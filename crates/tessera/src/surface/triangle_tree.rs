@@ -248,6 +248,12 @@ impl TriangleTree {
         }
     }
 
+    /// [`TriangleTree::regular`]'s piece in the patch's own parameters (exchanged back where
+    /// the tree is swapped): the quartic Bézier triangle that *is* the patch.
+    pub fn regular_net(&self) -> Option<QuarticTriangle> {
+        self.regular().map(|q| if self.swapped { q.swapped_uv() } else { q.clone() })
+    }
+
     /// The one quartic piece of a regular triangle (a tree of one leaf over the whole
     /// triangle), in the leaf's own parameters: the patch's, exchanged where the tree
     /// [`TriangleTree::is_swapped`]. None for a tree of several leaves or an end cap.
