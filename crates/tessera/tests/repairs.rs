@@ -158,3 +158,44 @@ fn degenerate_and_duplicate_faces_are_dropped_and_counted() {
     let err = SurfaceSet::pn_from_mesh(&flat, Path::new("<flat>"), BuildOptions::default()).unwrap_err();
     assert!(matches!(err, tessera::Error::Unsupported { .. }), "{err}");
 }
+
+/// Subdivision patches handed to `SurfaceSet::from_patches` (say, taken from a set loaded
+/// from a cage) have no one control net: they are welded by their limit surface's boundary
+/// points. Every patch is kept and none panics (the hull's eight points were once read as a
+/// net, past the end of the points); welded within a small distance, the neighbours find each
+/// other as the cage's own topology has them where both sides' pieces are exact (a creased
+/// cage's end caps agree with their neighbours only approximately: more edges there, never
+/// a non-manifold one).
+#[test]
+fn subdivision_patches_weld_by_their_boundary_points() {
+    use tessera::io::{LoadOptions, SurfaceKind};
+    for (cage, surface, same) in [
+        ("subdivision/catmark_torus.obj", SurfaceKind::CatmullClark, true),
+        ("subdivision/catmark_cube.obj", SurfaceKind::CatmullClark, true),
+        ("subdivision/catmark_torus_creases0.obj", SurfaceKind::CatmullClark, false),
+        ("subdivision/loop_xord_interior.obj", SurfaceKind::Loop, true),
+        ("subdivision/loop_triangle_edgecorner.obj", SurfaceKind::Loop, true),
+    ] {
+        let options = LoadOptions { surface, ..Default::default() };
+        let set = tessera::io::load(&common::model(cage), options).unwrap();
+        let (lo, hi) = set.bounds();
+        let weld = Weld::Within(1e-9 * (hi - lo).length());
+        let build = BuildOptions { weld, orientation: Orientation::AsGiven, ..Default::default() };
+        let rebuilt = SurfaceSet::from_patches(set.patches.clone(), build);
+        assert_eq!(rebuilt.patches.len(), set.patches.len(), "{cage}");
+        let (a, b) = (&set.topology.report, &rebuilt.topology.report);
+        let counts = |r: &tessera::topology::TopologyReport| (r.edges, r.boundary_edges, r.nonmanifold_edges);
+        if same {
+            assert_eq!(counts(b), counts(a), "{cage}");
+        } else {
+            assert!(
+                b.edges >= a.edges && b.nonmanifold_edges == 0,
+                "{cage}: {:?} against {:?}",
+                counts(b),
+                counts(a)
+            );
+        }
+        let exact = SurfaceSet::from_patches(set.patches.clone(), BuildOptions::default());
+        assert_eq!(exact.patches.len(), set.patches.len(), "{cage}");
+    }
+}

@@ -10,6 +10,7 @@ use glam::DVec2;
 use tessera::criterion::taylor::TaylorBound;
 use tessera::io::{LoadOptions, SurfaceKind};
 use tessera::surface::patch_tree::{Leaf, LeafPatch};
+use tessera::surface::triangle_tree::TriangleLeafPatch;
 use tessera::surface::{Domain, Patch, SurfaceSet};
 use tessera::test_support::Lcg;
 
@@ -243,10 +244,10 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
 
 /// The sampled refinement of the second-derivative bound, for the kinds without a Taylor
 /// expansion: rational bicubics (the teapot and the torus with weights that vary with
-/// position) and isolated Loop patches (trees of quartic leaves and Gregory triangles).
-/// Measured as above (flat patches, whose bound is 0, measure rounding: 1e-13).
+/// position). (A Loop tree's triangles across leaves and on Gregory triangles take it too:
+/// the next test.) Measured as above (flat patches, whose bound is 0, measure rounding: 1e-13).
 #[test]
-fn the_sampled_bound_holds_on_rational_and_loop_patches() {
+fn the_sampled_bound_holds_on_rational_patches() {
     let mut rng = Lcg(2029);
     let mut sets = Vec::new();
     for rel in ["patches/teapot.patches", "bench/torus_64x32.patches"] {
@@ -256,22 +257,10 @@ fn the_sampled_bound_holds_on_rational_and_loop_patches() {
             SurfaceSet::from_patch_file(&tessera::scene::position_weights(&file), Default::default()),
         ));
     }
-    for cage in
-        ["loop_pole8.obj", "loop_xord_interior.obj", "loop_cube_creases0.obj", "loop_triangle_edgecorner.obj"]
-    {
-        let options = LoadOptions { surface: SurfaceKind::Loop, ..Default::default() };
-        sets.push((
-            cage.to_string(),
-            tessera::io::load(&common::model(&format!("subdivision/{cage}")), options).unwrap(),
-        ));
-    }
     let (mut ratios, mut hessian_ratios) = (Vec::new(), Vec::new());
     for (name, set) in sets {
-        // A regular Loop patch has its own expansion (the next test).
-        let sampled: Vec<&Patch> =
-            set.patches.iter().filter(|p| !matches!(p, Patch::Loop(t) if t.regular().is_some())).collect();
-        let step = (sampled.len() / 40).max(1);
-        for &patch in sampled.iter().step_by(step) {
+        let step = (set.patches.len() / 40).max(1);
+        for patch in set.patches.iter().step_by(step) {
             let taylor = TaylorBound::of(patch);
             let hessian = tessera::criterion::bounds::hessian(patch);
             let domain = patch.domain();
@@ -307,20 +296,22 @@ fn the_sampled_bound_holds_on_rational_and_loop_patches() {
     };
     let (refined, plain) = (median(ratios), median(hessian_ratios));
     println!("measured / bound median {refined:.3}, with the second-derivative bound alone {plain:.3}");
-    // These kinds' second-derivative bounds are loose (a Loop patch's covers its Gregory
-    // triangles), and the refinement keeps 1/16 of it as its margin: it gains, not all.
+    // These kinds' second-derivative bounds are loose, and the refinement keeps 1/16 of it
+    // as its margin: it gains, not all.
     assert!(refined >= 4.0 * plain, "measured / bound: refined {refined}, plain {plain}");
 }
 
-/// Regular Loop patches (one quartic box-spline piece, in the patch's parameters whether or
-/// not its tree is swapped) take a Taylor expansion of their own: measured as above, on the
-/// Loop cages, it holds, its second derivatives are the patch's, and on small triangles it is
-/// tight (the sampled bound they had kept 1/16 of a loose second-derivative bound).
+/// Loop patches: a regular one (one quartic box-spline piece, in the patch's parameters
+/// whether or not its tree is swapped) takes its quartic's Taylor expansion; an isolated one
+/// answers a triangle from the quartic leaf that holds it, in that leaf's parameters, and
+/// anything else (across leaves, on a Gregory triangle) from the sampled bound. Measured as
+/// above on every Loop cage and the Killeroo cage, each patch as it is and flipped: the bound
+/// holds, its second derivatives are the patch's, and on small triangles it is tight.
 #[test]
-fn the_taylor_bound_holds_on_regular_loop_patches() {
+fn the_taylor_bound_holds_on_loop_patches() {
     let mut rng = Lcg(2030);
-    let (mut ratios, mut sampled_ratios) = (Vec::new(), Vec::new());
-    let (mut swapped, mut cages) = (0, 0);
+    let (mut regular_ratios, mut isolated_ratios, mut sampled_ratios) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut swapped, mut stencils) = (0, 0);
     let mut files = tessera::test_support::data_files("subdivision", &["loop_"]);
     files.push(common::model("meshes/killeroo_cage.obj"));
     for path in files {
@@ -328,18 +319,15 @@ fn the_taylor_bound_holds_on_regular_loop_patches() {
         let options = LoadOptions { surface: SurfaceKind::Loop, ..Default::default() };
         // (A non-manifold cage is refused: nothing to bound.)
         let Ok(set) = tessera::io::load(&path, options) else { continue };
-        let regular: Vec<&Patch> =
-            set.patches.iter().filter(|p| matches!(p, Patch::Loop(t) if t.regular().is_some())).collect();
-        cages += usize::from(!regular.is_empty());
-        let step = (regular.len() / 30).max(1);
+        let step = (set.patches.len() / 40).max(1);
         // Each patch as it is and flipped (its tree swapped: `u` and `v` exchanged).
-        let patches = regular.iter().step_by(step).flat_map(|&p| [p.clone(), p.flipped()]);
+        let patches = set.patches.iter().step_by(step).flat_map(|p| [p.clone(), p.flipped()]);
         for patch in patches {
             let patch = &patch;
-            let Patch::Loop(tree) = patch else { unreachable!() };
+            let Patch::Loop(tree) = patch else { continue };
+            let regular = tree.regular().is_some();
             swapped += usize::from(tree.is_swapped());
             let taylor = TaylorBound::of(patch);
-            // Sampled as the kinds without an expansion are: the comparison below.
             let hessian = tessera::criterion::bounds::hessian(patch);
             for size in [1.0, 0.3, 0.05, 0.01] {
                 let t = random_triangle(&mut rng, Domain::Tri, size);
@@ -349,13 +337,28 @@ fn the_taylor_bound_holds_on_regular_loop_patches() {
                     error <= bound * (1.0 + 1e-9) + 1e-13,
                     "{cage}: {t:?} measured {error:e} > bound {bound:e}"
                 );
-                if size <= 0.05 && bound > 0.0 {
+                // One quartic leaf holds the triangle (by the leaf of each corner).
+                let one_leaf = {
+                    let leaves = t.map(|q| tree.find(q).0);
+                    leaves.iter().all(|&l| l == leaves[0])
+                        && matches!(tree.leaves()[leaves[0]].patch, TriangleLeafPatch::Quartic(_))
+                };
+                if size <= 0.05 && bound > 0.0 && one_leaf {
+                    let ratios = if regular { &mut regular_ratios } else { &mut isolated_ratios };
                     ratios.push(error / bound);
                     sampled_ratios.push(error / hessian.triangle_error(t));
                 }
+                // The leaf's second derivatives, taken to the patch's parameters, are the
+                // patch's (central differences, where the stencil lies in one quartic leaf).
                 let x = (t[0] + t[1] + t[2]) / 3.0;
                 let h = 1e-4;
-                if x.min_element() > 2.0 * h && x.x + x.y < 1.0 - 4.0 * h {
+                let stencil = [-1.0, 0.0, 1.0].map(|a| [-1.0, 0.0, 1.0].map(|b| x + DVec2::new(a, b) * h));
+                let in_leaf =
+                    stencil.as_flattened().iter().all(|&q| {
+                        q.min_element() >= 0.0 && q.x + q.y <= 1.0 && tree.find(q).0 == tree.find(x).0
+                    }) && matches!(tree.leaves()[tree.find(x).0].patch, TriangleLeafPatch::Quartic(_));
+                if in_leaf && size <= 0.3 {
+                    stencils += 1;
                     let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
                     let want = [
                         (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
@@ -385,12 +388,65 @@ fn the_taylor_bound_holds_on_regular_loop_patches() {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    let (taylor, hessian) = (median(ratios), median(sampled_ratios));
+    let counts = (regular_ratios.len(), isolated_ratios.len());
+    let (regular, isolated, plain) =
+        (median(regular_ratios), median(isolated_ratios), median(sampled_ratios));
     println!(
-        "regular Loop patches of {cages} cages: measured / bound median {taylor:.3} \
-         (second-derivative bound {hessian:.3}); {swapped} swapped"
+        "small triangles in one quartic leaf ({counts:?} regular, isolated): measured / bound median \
+         {regular:.3} regular, {isolated:.3} isolated (second-derivative bound {plain:.3}); \
+         {swapped} swapped trees, {stencils} second-derivative checks"
     );
-    assert!(cages >= 3, "only {cages} Loop cages with regular patches");
-    assert!(swapped > 0, "no swapped tree among the regular patches");
-    assert!(taylor >= 0.8, "measured / bound on small triangles: median {taylor}");
+    assert!(swapped > 0 && stencils >= 100, "{swapped} swapped, {stencils} second-derivative checks");
+    assert!(regular >= 0.8 && isolated >= 0.8, "measured / bound: {regular} regular, {isolated} isolated");
+}
+
+/// The boundary curves' bounds the proposals read (`tolerance::curve_bounds`: a regular Loop
+/// patch's quartic edges, an isolated one's leaves along each edge) bound what they promise:
+/// a boundary curve cut into `n` equal parts is within `M/(8n²)` of its chords, measured at 33
+/// points a part, on every Loop patch of the Loop cages and the Killeroo cage, as it is and
+/// flipped.
+#[test]
+fn loop_boundary_curve_bounds_hold() {
+    let mut files = tessera::test_support::data_files("subdivision", &["loop_"]);
+    files.push(common::model("meshes/killeroo_cage.obj"));
+    let mut rng = Lcg(2031);
+    let (mut checked, mut ratios) = (0, Vec::new());
+    for path in files {
+        let options = LoadOptions { surface: SurfaceKind::Loop, ..Default::default() };
+        let Ok(set) = tessera::io::load(&path, options) else { continue };
+        let step = (set.patches.len() / 60).max(1);
+        let patches: Vec<Patch> =
+            set.patches.iter().step_by(step).flat_map(|p| [p.clone(), p.flipped()]).collect();
+        let flipped = SurfaceSet::from_patches(patches, Default::default());
+        let hessians: Vec<_> = flipped.patches.iter().map(tessera::criterion::bounds::hessian).collect();
+        let curves = tessera::criterion::tolerance::curve_bounds(&flipped, &hessians);
+        for (patch, m) in flipped.patches.iter().zip(&curves) {
+            for (e, &bound) in m.iter().enumerate().take(3) {
+                let n = 1 + rng.below(6) as u32;
+                let at = |t: f64| patch.position(Domain::Tri.edge_point(e, t));
+                let mut worst = 0.0f64;
+                for k in 0..n {
+                    let (t0, t1) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
+                    let (a, b) = (at(t0), at(t1));
+                    for j in 0..=32 {
+                        let s = j as f64 / 32.0;
+                        worst = worst.max(at(t0 + (t1 - t0) * s).distance(a * (1.0 - s) + b * s));
+                    }
+                }
+                let promised = bound / (8.0 * (n * n) as f64);
+                let name = path.display();
+                assert!(
+                    worst <= promised * (1.0 + 1e-9) + 1e-12,
+                    "{name}: edge {e}, {n} parts: {worst:e} > {promised:e}"
+                );
+                checked += 1;
+                if promised > 0.0 {
+                    ratios.push(worst / promised);
+                }
+            }
+        }
+    }
+    ratios.sort_by(f64::total_cmp);
+    println!("{checked} boundary curves; measured / promised median {:.3}", ratios[ratios.len() / 2]);
+    assert!(checked > 300, "only {checked} curves");
 }

@@ -431,6 +431,55 @@ pub fn loop_tree_hessian(t: &crate::surface::TriangleTree) -> HessianBound {
     m
 }
 
+/// Second-derivative bounds of an isolated Loop patch's three boundary curves (patch edges
+/// 0, 1, 2, each in its own parameter): the largest over the leaves with a side on the edge
+/// of the leaf's second derivative along it — a quartic leaf's by that side's five points
+/// ([`quartic_curve_second_derivative`]), a Gregory triangle's by its bound along the
+/// direction — times `1/h²` for a leaf of side `h`. [`loop_tree_hessian`] takes every leaf,
+/// the Gregory triangles at the patch's corners among them, for every edge. A turned leaf can
+/// only lie along the hypotenuse; a swapped tree's edges 0 and 2 are the patch's 2 and 0.
+/// Cost: O(leaves).
+pub fn loop_tree_curve_bounds(t: &crate::surface::TriangleTree) -> [f64; 3] {
+    use crate::surface::triangle_tree::TriangleLeafPatch;
+    let mut out = [0.0f64; 3];
+    for leaf in t.leaves() {
+        let (o, h) = (leaf.origin, leaf.size);
+        // The leaf's corners st = (0,0), (1,0), (0,1) in the tree's parameters.
+        let corners = if leaf.turned {
+            [o + glam::DVec2::splat(h), o + glam::DVec2::new(0.0, h), o + glam::DVec2::new(h, 0.0)]
+        } else {
+            [o, o + glam::DVec2::new(h, 0.0), o + glam::DVec2::new(0.0, h)]
+        };
+        let on = |e: usize, p: glam::DVec2| match e {
+            0 => p.y == 0.0,
+            1 => p.x + p.y == 1.0,
+            _ => p.x == 0.0,
+        };
+        for (e, bound) in out.iter_mut().enumerate() {
+            // The leaf's side on tree edge e: its local side `side` (corner `side` to `side + 1`).
+            let Some(side) = (0..3).find(|&c| on(e, corners[c]) && on(e, corners[(c + 1) % 3])) else {
+                continue;
+            };
+            let along = match &leaf.patch {
+                TriangleLeafPatch::Quartic(q) => quartic_curve_second_derivative(q.edge_points(side)),
+                TriangleLeafPatch::Gregory(g) => {
+                    let m = gregory_triangle_hessian(g);
+                    match side {
+                        0 => m.uu,
+                        1 => m.uu + 2.0 * m.uv + m.vv,
+                        _ => m.vv,
+                    }
+                }
+            };
+            *bound = bound.max(along / (h * h));
+        }
+    }
+    if t.is_swapped() {
+        out.swap(0, 2);
+    }
+    out
+}
+
 /// Second-derivative bounds of a Gregory triangle ([`crate::surface::GregoryTriangle`]).
 ///
 /// The patch is the quartic triangle `S⁻` whose three interior points are the corners' `Fm`,

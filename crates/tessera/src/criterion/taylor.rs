@@ -52,10 +52,10 @@
 //! cubic Bézier triangles and PN triangles (second derivatives linear, third constant: the
 //! bound is exact up to the triangle inequality inside), regular Loop patches (one quartic
 //! piece: second derivatives quadratic, third linear, refined by the lattice split as a
-//! bicubic is), and Catmull-Clark patch trees
-//! through their Bézier leaves: a triangle or cell inside one leaf takes that leaf's bound
-//! (linear interpolation's error does not change under the affine map to the leaf's
-//! parameters). Everything else — rational bicubics, isolated Loop patches, a tree's triangles across
+//! bicubic is), and the trees of Catmull-Clark and isolated Loop patches through their
+//! Bézier (bicubic, quartic) leaves: a triangle or cell inside one leaf takes that leaf's
+//! bound (linear interpolation's error does not change under the affine map to the leaf's
+//! parameters). Everything else — rational bicubics, a tree's triangles across
 //! leaves (the surface is only piecewise smooth there) or on Gregory end caps — takes the
 //! *sampled* bound: the lattice refinement with the patch's second-derivative bound in place
 //! of the expansion, so the sampled error plus `1/n²` of that bound. It is as valid as the
@@ -67,7 +67,8 @@
 
 use super::bounds::{hessian, max_norm, TriangleErrors};
 use crate::surface::patch_tree::{LeafPatch, PatchTree};
-use crate::surface::{BezierTriangle, Patch, QuarticTriangle};
+use crate::surface::triangle_tree::TriangleLeafPatch;
+use crate::surface::{BezierTriangle, Patch, QuarticTriangle, TriangleTree};
 use glam::{DVec2, DVec3};
 
 /// One patch's Taylor bound: the field of its second derivatives and bounds on its third.
@@ -98,19 +99,62 @@ enum SecondDerivatives {
     /// spline piece): `S_uu`, `S_uv`, `S_vv` are quadratic triangles, the third derivatives
     /// linear ones.
     Quartic { net: QuarticTriangle },
-    /// A Catmull-Clark patch tree and each of its leaves' bounds in the leaf's own
-    /// parameters (a Bézier leaf's as a bicubic's; a Gregory end cap has none). A query is
+    /// A Catmull-Clark patch tree or an isolated Loop patch's triangle tree, and each of its
+    /// leaves' bounds in the leaf's own parameters (a Bézier leaf's as a bicubic's, a
+    /// quartic leaf's as [`SecondDerivatives::Quartic`]; a Gregory end cap has none). A query is
     /// answered by the one Bézier leaf that holds all its points (the error of linear
     /// interpolation does not depend on an affine change of parameters), else by `whole`,
     /// the tree's [`SecondDerivatives::Sampled`] bound: the surface is only piecewise smooth
     /// across leaves, where one expansion point would not do.
-    Tree { tree: PatchTree, leaves: std::sync::Arc<[TaylorBound]>, whole: Box<TaylorBound> },
-    /// Any other patch (a rational bicubic, a Loop patch, a whole Catmull-Clark tree): the
+    Tree { tree: Pieces, leaves: std::sync::Arc<[TaylorBound]>, whole: Box<TaylorBound> },
+    /// Any other patch (a rational bicubic, a whole subdivision tree): the
     /// patch's second-derivative bound `m` (valid over any triangle of its domain) takes the
     /// place of the Taylor expansion, and the lattice refinement
     /// ([`TaylorBound::split_error`]) samples the patch's own points: the sampled error plus
     /// `1/n²` of the second-derivative bound.
     Sampled { patch: Patch, m: TriangleErrors },
+}
+
+/// The leaves of a piecewise patch, and where a point of the patch lies in them.
+#[derive(Debug, Clone, PartialEq)]
+enum Pieces {
+    /// A Catmull-Clark patch tree: square leaves.
+    Quad(PatchTree),
+    /// An isolated Loop patch: triangular leaves.
+    Tri(TriangleTree),
+}
+
+impl Pieces {
+    /// The leaf Bfr's search finds for `x` (patch parameters) and `x` in its parameters.
+    fn find(&self, x: DVec2) -> (usize, DVec2) {
+        match self {
+            Pieces::Quad(tree) => {
+                let (i, st, _) = tree.find(x);
+                (i, st)
+            }
+            Pieces::Tri(tree) => tree.find(x),
+        }
+    }
+
+    /// Patch parameters `x` in leaf `i`'s parameters, by the leaf's affine map.
+    fn leaf_params(&self, i: usize, x: DVec2) -> DVec2 {
+        match self {
+            Pieces::Quad(tree) => {
+                let leaf = &tree.leaves()[i];
+                (tree.tree_uv(x) - leaf.origin) / leaf.size
+            }
+            Pieces::Tri(tree) => tree.leaf_params(i, x),
+        }
+    }
+
+    /// Whether leaf parameters `st` lie in the leaf's closed domain (square or triangle).
+    fn in_leaf(&self, st: DVec2) -> bool {
+        st.min_element() >= 0.0
+            && match self {
+                Pieces::Quad(_) => st.max_element() <= 1.0,
+                Pieces::Tri(_) => st.x + st.y <= 1.0,
+            }
+    }
 }
 
 impl TaylorBound {
@@ -139,11 +183,25 @@ impl TaylorBound {
             Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
             Patch::BezierTriangle(t) => triangle(t),
             Patch::Pn(pn) => triangle(&pn.geometry),
-            // A regular Loop patch is one quartic piece; the others are piecewise (isolated
-            // leaves, Gregory triangles) and sampled.
+            // A regular Loop patch is one quartic piece; an isolated one a tree of quartic
+            // leaves and Gregory triangles, answered as a Catmull-Clark tree is.
             Patch::Loop(tree) => match tree.regular_net() {
                 Some(q) => quartic(&q),
-                None => sampled(patch),
+                None => {
+                    let leaves = tree
+                        .leaves()
+                        .iter()
+                        .map(|leaf| match &leaf.patch {
+                            TriangleLeafPatch::Quartic(q) => quartic(q),
+                            TriangleLeafPatch::Gregory(_) => TaylorBound::NONE,
+                        })
+                        .collect();
+                    let whole = Box::new(sampled(patch));
+                    TaylorBound {
+                        field: SecondDerivatives::Tree { tree: Pieces::Tri((**tree).clone()), leaves, whole },
+                        third: [0.0; 4],
+                    }
+                }
             },
             Patch::Subdivision(tree) => {
                 let leaves = tree
@@ -156,7 +214,7 @@ impl TaylorBound {
                     .collect();
                 let whole = Box::new(sampled(patch));
                 TaylorBound {
-                    field: SecondDerivatives::Tree { tree: (**tree).clone(), leaves, whole },
+                    field: SecondDerivatives::Tree { tree: Pieces::Quad((**tree).clone()), leaves, whole },
                     third: [0.0; 4],
                 }
             }
@@ -170,10 +228,9 @@ impl TaylorBound {
     fn leaf_of<const K: usize>(&self, points: [DVec2; K]) -> Option<(&TaylorBound, [DVec2; K])> {
         let SecondDerivatives::Tree { tree, leaves, .. } = &self.field else { return None };
         let centre = points.iter().fold(DVec2::ZERO, |a, &p| a + p) / K as f64;
-        let (i, _, _) = tree.find(centre);
-        let leaf = &tree.leaves()[i];
-        let local = points.map(|p| (tree.tree_uv(p) - leaf.origin) / leaf.size);
-        let inside = local.iter().all(|q| q.min_element() >= 0.0 && q.max_element() <= 1.0);
+        let (i, _) = tree.find(centre);
+        let local = points.map(|p| tree.leaf_params(i, p));
+        let inside = local.iter().all(|&q| tree.in_leaf(q));
         (inside && leaves[i].is_some()).then_some((&leaves[i], local))
     }
 
@@ -209,11 +266,10 @@ impl TaylorBound {
             SecondDerivatives::None => [DVec3::ZERO; 3],
             SecondDerivatives::Sampled { .. } => [DVec3::ZERO; 3],
             SecondDerivatives::Tree { tree, leaves, .. } => {
-                let (i, st, _) = tree.find(x);
+                let (i, st) = tree.find(x);
                 // The chain rule through the affine map to the leaf's parameters, whose
                 // linear part takes the patch's unit steps to `ju`, `jv`.
-                let size = tree.leaves()[i].size;
-                let step = |d: DVec2| (tree.tree_uv(d) - tree.tree_uv(DVec2::ZERO)) / size;
+                let step = |d: DVec2| tree.leaf_params(i, d) - tree.leaf_params(i, DVec2::ZERO);
                 let (ju, jv) = (step(DVec2::X), step(DVec2::Y));
                 let [uu, uv, vv] = leaves[i].second_derivatives(st);
                 let h =

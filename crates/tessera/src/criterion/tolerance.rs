@@ -586,7 +586,8 @@ pub(crate) fn plan_limited(
 /// The boundary curves' second-derivative bounds per patch and local edge
 /// ([`bounds::curve_second_derivative`]), view-independent: a curve needs `sqrt(M / 8ε)` segments on its own.
 /// A regular Loop patch's boundary is a quartic curve
-/// ([`bounds::quartic_curve_second_derivative`]). `hessians` are the patches' own bounds
+/// ([`bounds::quartic_curve_second_derivative`]), an isolated one's the sides of the leaves
+/// along it ([`bounds::loop_tree_curve_bounds`]). `hessians` are the patches' own bounds
 /// ([`bounds::hessian`], one per patch): a piecewise boundary (another subdivision patch's)
 /// is bounded by them, computed once rather than per edge.
 /// Cost: O(P).
@@ -601,6 +602,11 @@ pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]
                 Patch::Loop(tree) => tree.regular_net(),
                 _ => None,
             };
+            if let (Patch::Loop(tree), None) = (patch, &quartic) {
+                // An isolated Loop patch's boundary: the leaves along each edge.
+                let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
+                return [a, b, c, 0.0];
+            }
             for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
                 *o = match (edge_control_points(patch, l), &quartic) {
                     (Some((points, weights)), _) => bounds::curve_second_derivative(points, weights),

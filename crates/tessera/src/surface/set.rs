@@ -146,6 +146,32 @@ pub(crate) fn corner_and_edge_points(domain: Domain) -> (&'static [usize], &'sta
     }
 }
 
+/// The points [`SurfaceSet::from_patches`] welds for patch `p`, laid out as
+/// [`corner_and_edge_points`] reads them: a Bézier patch's own control points; for a
+/// subdivision patch (whose points are its pieces', not one net) a net of its limit surface's
+/// boundary points — the corners and each edge at a third and two thirds — with the centre
+/// elsewhere. Cost: none, or 10–16 evaluations.
+fn key_net(p: &Patch) -> std::borrow::Cow<'_, [DVec3]> {
+    match p {
+        Patch::Bicubic(_) | Patch::BezierTriangle(_) | Patch::Pn(_) => p.control_points().into(),
+        Patch::Subdivision(_) | Patch::Loop(_) => {
+            let d = p.domain();
+            let centre = p.position(match d {
+                Domain::Quad => DVec2::splat(0.5),
+                Domain::Tri => DVec2::splat(1.0 / 3.0),
+            });
+            let (_, edges) = corner_and_edge_points(d);
+            let mut net = vec![centre; if d == Domain::Quad { 16 } else { 10 }];
+            for (e, edge) in edges.iter().enumerate() {
+                for (k, &i) in edge.iter().enumerate() {
+                    net[i] = p.position(d.edge_point(e, k as f64 / 3.0));
+                }
+            }
+            net.into()
+        }
+    }
+}
+
 /// Signed volume enclosed by the patches relative to `centre`, from a coarse 4×4 sampling.
 fn signed_volume(patches: &[Patch], centre: DVec3) -> f64 {
     const N: usize = 4;
@@ -192,7 +218,10 @@ fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
 
 impl SurfaceSet {
     /// Builds a set from patches given by their control points; neighbours are found by
-    /// welding control points (`options.weld`), so they need not share indices.
+    /// welding control points (`options.weld`), so they need not share indices. Subdivision
+    /// patches have no one net: they are welded by their limit surface's boundary points (the
+    /// corners and the edges' thirds), so neighbours taken from one cage meet where those
+    /// evaluations weld; a cage's own topology is `io::load`'s (its edges, not welding).
     /// Preconditions: finite control points, positive weights. Cost: O(P) hashing.
     pub fn from_patches(mut patches: Vec<Patch>, options: BuildOptions) -> SurfaceSet {
         let mut repairs = Repairs::default();
@@ -212,19 +241,22 @@ impl SurfaceSet {
         // boundary-curve control points.
         let mut points = Vec::new();
         let mut weights = Vec::new();
-        for p in &patches {
-            points.extend_from_slice(p.control_points());
+        let nets: Vec<_> = patches.iter().map(key_net).collect();
+        for (p, net) in patches.iter().zip(&nets) {
+            points.extend_from_slice(net);
             match p {
                 Patch::Bicubic(b) => weights.extend_from_slice(&b.weights),
-                _ => weights.extend(std::iter::repeat_n(1.0, p.control_points().len())),
+                _ => weights.extend(std::iter::repeat_n(1.0, net.len())),
             }
         }
+        let counts: Vec<usize> = nets.iter().map(|n| n.len()).collect();
+        drop(nets);
         let mut welded = weld(&points, &weights, options.weld);
         if !matches!(options.weld, Weld::Off) {
             let mut base = 0;
-            let curves = patches.iter().flat_map(|p| {
+            let curves = patches.iter().zip(&counts).flat_map(|(p, &count)| {
                 let b = base;
-                base += p.control_points().len();
+                base += count;
                 corner_and_edge_points(p.domain()).1.iter().map(move |e| e.map(|c| b + c))
             });
             welded.merged += collapse_unresolved_curves(&points, curves, &mut welded.ids);
@@ -233,8 +265,7 @@ impl SurfaceSet {
         let mut keys = Vec::with_capacity(patches.len());
         let mut kept = Vec::with_capacity(patches.len());
         let mut base = 0;
-        for mut p in patches {
-            let count = p.control_points().len();
+        for (mut p, count) in patches.into_iter().zip(counts) {
             let ids = &welded.ids[base..base + count];
             base += count;
             if ids.iter().all(|&i| i == ids[0]) {

@@ -238,6 +238,13 @@ impl TriangleTree {
         (leaf, Self::leaf_st(&self.leaves[leaf], uv))
     }
 
+    /// Patch parameters `uv` in leaf `leaf`'s own parameters, by that leaf's affine map (also
+    /// for a point outside it): the tree's exchange, then the leaf's square and turn.
+    pub(crate) fn leaf_params(&self, leaf: usize, uv: DVec2) -> DVec2 {
+        let uv = if self.swapped { DVec2::new(uv.y, uv.x) } else { uv };
+        Self::leaf_st(&self.leaves[leaf], uv)
+    }
+
     /// `uv` (the tree's own, not swapped) in `leaf`'s parameters.
     #[inline]
     fn leaf_st(leaf: &TriangleLeaf, uv: DVec2) -> DVec2 {
