@@ -71,6 +71,22 @@ fn measured_grid(patch: &Patch, domain: Domain, [nu, nv]: [u32; 2], order: u32) 
     error
 }
 
+/// The bound's second derivatives at `x` are the patch's: central differences of step `h`
+/// (where the stencil lies in one smooth piece), to 1e-4 of their size.
+fn assert_second_derivatives(patch: &Patch, taylor: &TaylorBound, x: DVec2, h: f64, name: &str) {
+    let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
+    let want = [
+        (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
+        (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
+        (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
+    ];
+    let got = taylor.second_derivatives(x);
+    let scale = want.iter().map(|w| w.length()).fold(1.0, f64::max);
+    for k in 0..3 {
+        assert!(got[k].distance(want[k]) < 1e-4 * scale, "{name} at {x}: {k}: {got:?} {want:?}");
+    }
+}
+
 #[test]
 fn the_taylor_bound_holds_on_every_model() {
     let mut rng = Lcg(2027);
@@ -205,20 +221,7 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
                         && matches!(tree.locate(lo).0.patch, LeafPatch::Bezier(_));
                     if box_in_leaf && size <= 0.1 {
                         stencils += 1;
-                        let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
-                        let want = [
-                            (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
-                            (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
-                            (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
-                        ];
-                        let got = taylor.second_derivatives(x);
-                        let scale = want.iter().map(|w| w.length()).fold(1.0, f64::max);
-                        for k in 0..3 {
-                            assert!(
-                                got[k].distance(want[k]) < 1e-4 * scale,
-                                "{cage} at {x}: {k}: {got:?} {want:?}"
-                            );
-                        }
+                        assert_second_derivatives(patch, &taylor, x, h, cage);
                     }
                 }
             }
@@ -359,20 +362,7 @@ fn the_taylor_bound_holds_on_loop_patches() {
                     }) && matches!(tree.leaves()[tree.find(x).0].patch, TriangleLeafPatch::Quartic(_));
                 if in_leaf && size <= 0.3 {
                     stencils += 1;
-                    let f = |dx: f64, dy: f64| patch.position(x + DVec2::new(dx, dy));
-                    let want = [
-                        (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h),
-                        (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h),
-                        (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h),
-                    ];
-                    let got = taylor.second_derivatives(x);
-                    let scale = want.iter().map(|w| w.length()).fold(1.0, f64::max);
-                    for k in 0..3 {
-                        assert!(
-                            got[k].distance(want[k]) < 1e-4 * scale,
-                            "{cage} at {x}: {k}: {got:?} {want:?}"
-                        );
-                    }
+                    assert_second_derivatives(patch, &taylor, x, h, &cage);
                 }
             }
             let n = 1 + rng.below(6) as u32;

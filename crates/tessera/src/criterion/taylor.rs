@@ -188,38 +188,29 @@ impl TaylorBound {
             Patch::Loop(tree) => match tree.regular_net() {
                 Some(q) => quartic(&q),
                 None => {
-                    let leaves = tree
-                        .leaves()
-                        .iter()
-                        .map(|leaf| match &leaf.patch {
-                            TriangleLeafPatch::Quartic(q) => quartic(q),
-                            TriangleLeafPatch::Gregory(_) => TaylorBound::NONE,
-                        })
-                        .collect();
-                    let whole = Box::new(sampled(patch));
-                    TaylorBound {
-                        field: SecondDerivatives::Tree { tree: Pieces::Tri((**tree).clone()), leaves, whole },
-                        third: [0.0; 4],
-                    }
+                    let leaves = tree.leaves().iter().map(|leaf| match &leaf.patch {
+                        TriangleLeafPatch::Quartic(q) => quartic(q),
+                        TriangleLeafPatch::Gregory(_) => TaylorBound::NONE,
+                    });
+                    TaylorBound::tree(Pieces::Tri((**tree).clone()), leaves, sampled(patch))
                 }
             },
             Patch::Subdivision(tree) => {
-                let leaves = tree
-                    .leaves()
-                    .iter()
-                    .map(|leaf| match &leaf.patch {
-                        LeafPatch::Bezier(points) => bicubic(points),
-                        LeafPatch::Gregory(_) => TaylorBound::NONE,
-                    })
-                    .collect();
-                let whole = Box::new(sampled(patch));
-                TaylorBound {
-                    field: SecondDerivatives::Tree { tree: Pieces::Quad((**tree).clone()), leaves, whole },
-                    third: [0.0; 4],
-                }
+                let leaves = tree.leaves().iter().map(|leaf| match &leaf.patch {
+                    LeafPatch::Bezier(points) => bicubic(points),
+                    LeafPatch::Gregory(_) => TaylorBound::NONE,
+                });
+                TaylorBound::tree(Pieces::Quad((**tree).clone()), leaves, sampled(patch))
             }
             _ => sampled(patch),
         }
+    }
+
+    /// A piecewise patch's bound: its leaves' (in the leaves' order), `whole` where none
+    /// answers.
+    fn tree(pieces: Pieces, leaves: impl Iterator<Item = TaylorBound>, whole: TaylorBound) -> TaylorBound {
+        let (leaves, whole) = (leaves.collect(), Box::new(whole));
+        TaylorBound { field: SecondDerivatives::Tree { tree: pieces, leaves, whole }, third: [0.0; 4] }
     }
 
     /// For a tree: the Bézier leaf whose closed square holds all of `points` (patch
