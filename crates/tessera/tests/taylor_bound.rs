@@ -71,6 +71,40 @@ fn measured_grid(patch: &Patch, domain: Domain, [nu, nv]: [u32; 2], order: u32) 
     error
 }
 
+/// The bound over triangle `t` is at least the error [`measured`] finds at order `order` (up
+/// to `1e-9` of it and `floor`, the rounding of flat patches); returns both.
+fn assert_triangle_holds(
+    patch: &Patch,
+    taylor: &TaylorBound,
+    t: [DVec2; 3],
+    order: u32,
+    floor: f64,
+    name: &str,
+) -> (f64, f64) {
+    let bound = taylor.triangle_error(t);
+    let error = measured(patch, t, order);
+    assert!(error <= bound * (1.0 + 1e-9) + floor, "{name}: {t:?} measured {error:e} > bound {bound:e}");
+    (error, bound)
+}
+
+/// The bound over the whole `n` grid of `domain` is at least the error [`measured_grid`]
+/// finds at order `order` (up to `1e-9` of it and `floor`, the rounding of flat patches);
+/// returns both.
+fn assert_grid_holds(
+    patch: &Patch,
+    taylor: &TaylorBound,
+    domain: Domain,
+    n: [u32; 2],
+    order: u32,
+    floor: f64,
+    name: &str,
+) -> (f64, f64) {
+    let bound = taylor.grid_error(domain == Domain::Tri, n);
+    let error = measured_grid(patch, domain, n, order);
+    assert!(error <= bound * (1.0 + 1e-9) + floor, "{name}: grid {n:?} measured {error:e} > bound {bound:e}");
+    (error, bound)
+}
+
 /// The bound's second derivatives at `x` are the patch's: central differences of step `h`
 /// (where the stencil lies in one smooth piece), to 1e-4 of their size.
 fn assert_second_derivatives(patch: &Patch, taylor: &TaylorBound, x: DVec2, h: f64, name: &str) {
@@ -108,12 +142,7 @@ fn the_taylor_bound_holds_on_every_model() {
             let domain = patch.domain();
             for size in [1.0, 0.4, 0.1, 0.02] {
                 let t = random_triangle(&mut rng, domain, size);
-                let bound = taylor.triangle_error(t);
-                let error = measured(patch, t, 24);
-                assert!(
-                    error <= bound * (1.0 + 1e-9) + 1e-15,
-                    "{name}: {t:?} measured {error:e} > bound {bound:e}"
-                );
+                let (error, bound) = assert_triangle_holds(patch, &taylor, t, 24, 1e-15, &name);
                 if size <= 0.02 && bound > 0.0 {
                     small_ratios.push(error / bound);
                 }
@@ -124,12 +153,7 @@ fn the_taylor_bound_holds_on_every_model() {
             // A whole grid: a quad's cells split either way, a triangle's the lattice's way.
             let n = [1 + rng.below(6) as u32, 1 + rng.below(6) as u32];
             let n = if domain == Domain::Tri { [n[0], n[0]] } else { n };
-            let bound = taylor.grid_error(domain == Domain::Tri, n);
-            let error = measured_grid(patch, domain, n, 12);
-            assert!(
-                error <= bound * (1.0 + 1e-9) + 1e-15,
-                "{name}: grid {n:?} measured {error:e} > bound {bound:e}"
-            );
+            let (error, bound) = assert_grid_holds(patch, &taylor, domain, n, 12, 1e-15, &name);
             if bound > 0.0 {
                 coarse_ratios.push((domain, error / bound));
             }
@@ -199,12 +223,7 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
             for size in [0.5, 0.1, 0.02, 0.005] {
                 for _ in 0..4 {
                     let t = random_triangle(&mut rng, Domain::Quad, size);
-                    let bound = taylor.triangle_error(t);
-                    let error = measured(patch, t, 16);
-                    assert!(
-                        error <= bound * (1.0 + 1e-9) + 1e-15,
-                        "{cage}: {t:?} measured {error:e} > bound {bound:e}"
-                    );
+                    let (error, bound) = assert_triangle_holds(patch, &taylor, t, 16, 1e-15, cage);
                     if size <= 0.02 && bound > 0.0 {
                         ratios.push(error / bound);
                     }
@@ -226,12 +245,7 @@ fn the_taylor_bound_holds_on_catmull_clark_trees() {
                 }
             }
             let n = [1 + rng.below(12) as u32, 1 + rng.below(12) as u32];
-            let bound = taylor.grid_error(false, n);
-            let error = measured_grid(patch, Domain::Quad, n, 8);
-            assert!(
-                error <= bound * (1.0 + 1e-9) + 1e-15,
-                "{cage}: grid {n:?} measured {error:e} > bound {bound:e}"
-            );
+            assert_grid_holds(patch, &taylor, Domain::Quad, n, 8, 1e-15, cage);
         }
         assert!(covered > 0, "{cage}: no patch tree");
     }
@@ -269,12 +283,7 @@ fn the_sampled_bound_holds_on_rational_patches() {
             let domain = patch.domain();
             for size in [1.0, 0.3, 0.05] {
                 let t = random_triangle(&mut rng, domain, size);
-                let bound = taylor.triangle_error(t);
-                let error = measured(patch, t, 16);
-                assert!(
-                    error <= bound * (1.0 + 1e-9) + 1e-13,
-                    "{name}: {t:?} measured {error:e} > bound {bound:e}"
-                );
+                let (error, bound) = assert_triangle_holds(patch, &taylor, t, 16, 1e-13, &name);
                 assert!(
                     bound <= hessian.triangle_error(t) * (1.0 + 1e-12),
                     "{name}: never above the second-derivative bound"
@@ -285,12 +294,7 @@ fn the_sampled_bound_holds_on_rational_patches() {
                 }
             }
             let n = 1 + rng.below(5) as u32;
-            let bound = taylor.grid_error(domain == Domain::Tri, [n, n]);
-            let error = measured_grid(patch, domain, [n, n], 8);
-            assert!(
-                error <= bound * (1.0 + 1e-9) + 1e-13,
-                "{name}: grid {n} measured {error:e} > bound {bound:e}"
-            );
+            assert_grid_holds(patch, &taylor, domain, [n, n], 8, 1e-13, &name);
         }
     }
     let median = |mut v: Vec<f64>| {
@@ -334,12 +338,7 @@ fn the_taylor_bound_holds_on_loop_patches() {
             let hessian = tessera::criterion::bounds::hessian(patch);
             for size in [1.0, 0.3, 0.05, 0.01] {
                 let t = random_triangle(&mut rng, Domain::Tri, size);
-                let bound = taylor.triangle_error(t);
-                let error = measured(patch, t, 16);
-                assert!(
-                    error <= bound * (1.0 + 1e-9) + 1e-13,
-                    "{cage}: {t:?} measured {error:e} > bound {bound:e}"
-                );
+                let (error, bound) = assert_triangle_holds(patch, &taylor, t, 16, 1e-13, &cage);
                 // One quartic leaf holds the triangle (by the leaf of each corner).
                 let one_leaf = {
                     let leaves = t.map(|q| tree.find(q).0);
@@ -366,12 +365,7 @@ fn the_taylor_bound_holds_on_loop_patches() {
                 }
             }
             let n = 1 + rng.below(6) as u32;
-            let bound = taylor.grid_error(true, [n, n]);
-            let error = measured_grid(patch, Domain::Tri, [n, n], 8);
-            assert!(
-                error <= bound * (1.0 + 1e-9) + 1e-13,
-                "{cage}: grid {n} measured {error:e} > bound {bound:e}"
-            );
+            assert_grid_holds(patch, &taylor, Domain::Tri, [n, n], 8, 1e-13, &cage);
         }
     }
     let median = |mut v: Vec<f64>| {

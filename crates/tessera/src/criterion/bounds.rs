@@ -431,8 +431,9 @@ pub fn loop_tree_hessian(t: &crate::surface::TriangleTree) -> HessianBound {
     m
 }
 
-/// Second-derivative bounds of an isolated Loop patch's three boundary curves (patch edges
-/// 0, 1, 2, each in its own parameter): the largest over the leaves with a side on the edge
+/// Second-derivative bounds of a Loop patch's three boundary curves (patch edges 0, 1, 2,
+/// each in its own parameter; a regular patch is a tree of one leaf, the whole triangle,
+/// whose sides are its boundary): the largest over the leaves with a side on the edge
 /// of the leaf's second derivative along it — a quartic leaf's by that side's five points
 /// ([`quartic_curve_second_derivative`]), a Gregory triangle's by its bound along the
 /// direction — times `1/h²` for a leaf of side `h`. [`loop_tree_hessian`] takes every leaf,

@@ -585,11 +585,10 @@ pub(crate) fn plan_limited(
 
 /// The boundary curves' second-derivative bounds per patch and local edge
 /// ([`bounds::curve_second_derivative`]), view-independent: a curve needs `sqrt(M / 8ε)` segments on its own.
-/// A regular Loop patch's boundary is a quartic curve
-/// ([`bounds::quartic_curve_second_derivative`]), an isolated one's the sides of the leaves
-/// along it ([`bounds::loop_tree_curve_bounds`]). `hessians` are the patches' own bounds
-/// ([`bounds::hessian`], one per patch): a piecewise boundary (another subdivision patch's)
-/// is bounded by them, computed once rather than per edge.
+/// A Loop patch's boundary is the sides of its quartic leaves along it (a regular patch: one
+/// quartic curve; [`bounds::loop_tree_curve_bounds`]). `hessians` are the patches' own bounds
+/// ([`bounds::hessian`], one per patch): a Catmull-Clark patch's piecewise boundary is
+/// bounded by them, computed once rather than per edge.
 /// Cost: O(P).
 pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]> {
     debug_assert_eq!(hessians.len(), set.patches.len());
@@ -597,26 +596,20 @@ pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]
         .par_iter()
         .zip(hessians)
         .map(|(patch, h)| {
-            let mut out = [0.0; 4];
-            let quartic = match patch {
-                Patch::Loop(tree) => tree.regular_net(),
-                _ => None,
-            };
-            if let (Patch::Loop(tree), None) = (patch, &quartic) {
-                // An isolated Loop patch's boundary: the leaves along each edge.
+            if let Patch::Loop(tree) = patch {
+                // The quartic leaves (a regular patch's one) along each edge.
                 let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
                 return [a, b, c, 0.0];
             }
+            let mut out = [0.0; 4];
             for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
-                *o = match (edge_control_points(patch, l), &quartic) {
-                    (Some((points, weights)), _) => bounds::curve_second_derivative(points, weights),
-                    // A regular Loop patch's boundary is one quartic curve.
-                    (None, Some(q)) => bounds::quartic_curve_second_derivative(q.edge_points(l)),
+                *o = match edge_control_points(patch, l) {
+                    Some((points, weights)) => bounds::curve_second_derivative(points, weights),
                     // A piecewise boundary: the patch's own bound along the edge's direction
                     // bounds the curve's second derivative. A quad's edges 0 and 2 run along
                     // u; a triangle's edge 0 along u, edge 2 along v and edge 1 along
                     // (−1, 1), where |S_uu − 2 S_uv + S_vv| ≤ uu + 2 uv + vv.
-                    (None, None) => match (patch.domain(), l) {
+                    None => match (patch.domain(), l) {
                         (Domain::Quad, 0 | 2) | (Domain::Tri, 0) => h.uu,
                         (Domain::Tri, 1) => h.uu + 2.0 * h.uv + h.vv,
                         _ => h.vv,

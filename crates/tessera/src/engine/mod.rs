@@ -439,6 +439,15 @@ fn evaluate_corners(
     }
 }
 
+/// Appends the parameters, in the domain `d` of the patch of use `u`, of edge `e`'s inner
+/// samples `k = 1 .. segments − 1` in canonical order: where that patch evaluates them.
+fn push_edge_params(plan: &Plan, e: usize, d: Domain, u: &crate::topology::EdgeUse, uvs: &mut Vec<DVec2>) {
+    uvs.extend((1..plan.segments(e)).map(|k| {
+        let t = plan.param(e, k);
+        d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
+    }));
+}
+
 /// The inner samples of edge `e`, evaluated once per normal variant by a patch of that
 /// variant (in blocks where `points` is given); variants after the first copy the first's
 /// position bits. `uvs` is scratch.
@@ -458,10 +467,7 @@ fn write_edge(
         let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
         let d = topo.patch_domains[u.patch as usize];
         uvs.clear();
-        uvs.extend((1..=inner).map(|k| {
-            let t = plan.param(e, k as u32);
-            d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
-        }));
+        push_edge_params(plan, e, d, u, uvs);
         let r = variant * inner..(variant + 1) * inner;
         let mut part = VertexSlices {
             pos: &mut pos[r.clone()],
@@ -584,11 +590,7 @@ impl Writer<'_> {
             let uvs = &mut scratch.edge_params;
             uvs.clear();
             for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
-                let u = topo.edge_uses(e)[0];
-                uvs.extend((1..plan.segments(e)).map(|k| {
-                    let t = plan.param(e, k);
-                    d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
-                }));
+                push_edge_params(plan, e, d, &topo.edge_uses(e)[0], uvs);
             }
             let points = self.fast.expect("owner_run checked the evaluator").points();
             points.eval(set, owner, uvs, out);
