@@ -195,7 +195,7 @@ const fn gregory_interior() -> [(usize, f64, PointDifferences); 3] {
 /// A Bézier triangle of degree `d` (`N` control points; `M` those of degree `d − 1`: cubic
 /// `<10, 6>`, quartic `<15, 10>`) in its local frame, with the multinomial coefficients folded
 /// into the control points so that each sum is over bare monomials.
-pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
+pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6, F: NormalField = PnField> {
     origin: [f32; 3],
     scale: f32,
     /// `pos[c][m] = d!/(i!j!k!) · b_ijk`, component `c`, `m` in [`exponents`] order.
@@ -205,13 +205,39 @@ pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
     du: [[f32; M]; 3],
     /// Likewise with `b_{i,j,k+1}`.
     dv: [[f32; M]; 3],
-    /// The PN normal field's coefficients `[c][m]` in [`PN_NORMAL`] order; None for a plain
-    /// Bézier triangle (normal from the derivatives).
-    pn: Option<[[f32; 6]; 3]>,
+    /// The PN normal field, where the kind has one ([`NormalField`]).
+    pn: F,
 }
 
-/// A quartic Bézier triangle in its local frame: Loop's regular pieces.
-pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
+/// A quartic Bézier triangle in its local frame: Loop's regular pieces. No normal field:
+/// Loop's trees keep a form per leaf ([`PointBlocks`]), 76 bytes fewer each to stream.
+pub(crate) type LocalQuartic = LocalTriangle<15, 10, ()>;
+
+/// What a [`LocalTriangle`] holds of a PN normal field.
+pub(crate) trait NormalField: Default {
+    /// The field's coefficients `[c][m]` in [`PN_NORMAL`] order; None for a plain Bézier
+    /// triangle (normal from the derivatives).
+    fn field(&self) -> Option<&[[f32; 6]; 3]>;
+}
+
+/// A cubic triangle's field: PN triangles have one, Bézier triangles none (they share the
+/// form so that one vector holds both).
+pub(crate) type PnField = Option<[[f32; 6]; 3]>;
+
+impl NormalField for PnField {
+    #[inline(always)]
+    fn field(&self) -> Option<&[[f32; 6]; 3]> {
+        self.as_ref()
+    }
+}
+
+/// No field (quartic triangles).
+impl NormalField for () {
+    #[inline(always)]
+    fn field(&self) -> Option<&[[f32; 6]; 3]> {
+        None
+    }
+}
 
 /// A Gregory triangle (Loop's end caps, [`GregoryTriangle`]) in its local frame, the frame
 /// of all its 18 points: the quartic net with each interior point its corner's `Fp`, and each
@@ -237,7 +263,7 @@ impl LocalGregory {
     }
 }
 
-impl<const N: usize, const M: usize> LocalTriangle<N, M> {
+impl<const N: usize, const M: usize, F: NormalField> LocalTriangle<N, M, F> {
     /// The Bézier triangle of degree `d` with control points `net` in [`exponents`] order.
     /// Cost: O(N), every index and coefficient a constant. Inlined: the grouped leaves
     /// (`tree_points`) make one a group, in their caller's instructions, where it was a
@@ -259,7 +285,7 @@ impl<const N: usize, const M: usize> LocalTriangle<N, M> {
             pos: [[0.0; N]; 3],
             du: [[0.0; M]; 3],
             dv: [[0.0; M]; 3],
-            pn: None,
+            pn: F::default(),
         };
         let coefficients = const { multinomials::<N>() };
         for (m, (&q, &c)) in net.iter().zip(&coefficients).enumerate() {
@@ -341,7 +367,7 @@ pub(crate) enum GridPatch<'a> {
 
 /// Every patch of a set in its local frame, made once per set: a table of eight bytes a
 /// patch and each kind's forms in patch order. Cost: O(P) to build, 200–400 bytes a patch
-/// (an isolated Loop patch: 548 bytes a leaf of its tree).
+/// (an isolated Loop patch: 476 bytes a leaf of its tree).
 pub(crate) struct PointBlocks {
     locals: Vec<Local>,
     bicubics: Vec<LocalPatch>,
@@ -640,8 +666,8 @@ fn lambda_powers<const L: usize>(d: usize, u: &[f32; L], v: &[f32; L]) -> [[[f32
 /// A Bézier triangle's `∂S/∂u` and `∂S/∂v` (local frame) of each lane, from its
 /// [`lambda_powers`].
 #[inline(always)]
-fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize>(
-    t: &LocalTriangle<N, M>,
+fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize, F: NormalField>(
+    t: &LocalTriangle<N, M, F>,
     powers: &[[[f32; L]; 5]; 3],
 ) -> [[[f32; L]; 3]; 2] {
     let lower = monomials(powers, &const { exponents::<M>() });
@@ -662,7 +688,7 @@ pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
     let powers = lambda_powers::<L>(4, u, v);
     let basis = monomials(&powers, &const { exponents::<15>() });
     let mut pos = combine::<FMA, L, 15>(&g.net.pos, &basis);
-    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10>(&g.net, &powers);
+    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10, _>(&g.net, &powers);
     let lower = monomials(&powers, &const { exponents::<10>() });
     let mut weights = [[0f32; L]; 3];
     for l in 0..L {
@@ -694,16 +720,22 @@ pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
 
 /// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
 #[inline(always)]
-pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
-    t: &LocalTriangle<N, M>,
+pub(crate) fn triangle_block<
+    const FMA: bool,
+    const L: usize,
+    const N: usize,
+    const M: usize,
+    F: NormalField,
+>(
+    t: &LocalTriangle<N, M, F>,
     u: &[f32; L],
     v: &[f32; L],
 ) -> Block<L> {
     let powers = lambda_powers::<L>(const { degree(N) }, u, v);
     let mut pos = combine::<FMA, L, N>(&t.pos, &monomials(&powers, &const { exponents::<N>() }));
-    let (nrm, margin) = match &t.pn {
+    let (nrm, margin) = match t.pn.field() {
         None => {
-            let [su, sv] = derivative_sums::<FMA, L, N, M>(t, &powers);
+            let [su, sv] = derivative_sums::<FMA, L, N, M, _>(t, &powers);
             cross_normals(&su, &sv)
         }
         Some(field) => {
@@ -894,8 +926,8 @@ impl PointBlocks {
             let block = match form {
                 FormRef::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
                 FormRef::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
-                FormRef::Triangle(t) => triangle_block::<FMA, L, 10, 6>(t, &u, &v),
-                FormRef::Quartic(t) => triangle_block::<FMA, L, 15, 10>(t, &u, &v),
+                FormRef::Triangle(t) => triangle_block::<FMA, L, 10, 6, _>(t, &u, &v),
+                FormRef::Quartic(t) => triangle_block::<FMA, L, 15, 10, _>(t, &u, &v),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 (*pos, *nrm) = block.lane_or_exact(l, set, p, uv[l]);
