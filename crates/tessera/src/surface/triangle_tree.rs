@@ -234,7 +234,9 @@ impl TriangleTree {
 
     /// The leaf Bfr's search finds for `uv` (module doc: its quirk included), and `uv` in
     /// that leaf's own parameters. Points on a border between leaves go where Bfr's
-    /// comparisons send them. Cost: O(depth).
+    /// comparisons send them. Cost: O(depth). Inlined: a call per point took `loop_xord_interior`
+    /// × 725's vertex stage 7 % longer at factor 16.
+    #[inline(always)]
     pub fn find(&self, uv: DVec2) -> (usize, DVec2) {
         let uv = if self.swapped { DVec2::new(uv.y, uv.x) } else { uv };
         let (mut u, mut v) = (uv.x, uv.y);
