@@ -378,7 +378,7 @@ impl PatchTree {
         uvs: &[DVec2],
         mut each: impl FnMut(usize, (DVec3, DVec3, DVec3)),
     ) {
-        prefetch_nodes(&self.data.nodes);
+        prefetch_slice(&self.data.nodes);
         let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
         for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
             for (slot, &uv) in found.iter_mut().zip(chunk) {
@@ -428,7 +428,7 @@ impl PatchTree {
     /// Starts loading the quadtree's nodes (a hint, as in [`PatchTree::derivatives_each`]).
     #[inline(always)]
     pub(crate) fn prefetch_nodes(&self) {
-        prefetch_nodes(&self.data.nodes);
+        prefetch_slice(&self.data.nodes);
     }
 
     /// Position and derivatives with respect to the view's `uv` at `st` in `leaf`, whose
@@ -596,24 +596,25 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
     let _ = (leaf, st);
 }
 
-/// Starts loading a tree's quadtree nodes (up to [`NODE_LINES`] cache lines of them): every
-/// point's walk reads several, one after the other, so a node not in the cache stalls the
-/// walk, where a tree's nodes together are a few kilobytes that stream in at once. Profiles
-/// of a cage larger than the cache showed the walks' node loads as the largest stalls; on
-/// `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 % faster. Also Loop's
-/// trees' nodes and leaves ([`crate::surface::TriangleTree`]).
+/// Starts loading `items` (up to [`NODE_LINES`] cache lines of them). Made for a tree's
+/// quadtree nodes: every point's walk reads several, one after the other, so a node not in
+/// the cache stalls the walk, where a tree's nodes together are a few kilobytes that stream
+/// in at once. Profiles of a cage larger than the cache showed the walks' node loads as the
+/// largest stalls; on `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 %
+/// faster. Also Loop's trees' nodes, leaf frames and leaves ([`crate::surface::TriangleTree`])
+/// and the stored leaf forms a group of points reads (`engine::tree_points`).
 #[inline(always)]
-pub(crate) fn prefetch_nodes<T>(nodes: &[T]) {
+pub(crate) fn prefetch_slice<T>(items: &[T]) {
     #[cfg(target_arch = "x86_64")]
     {
-        let bytes = std::mem::size_of_val(nodes).min(64 * NODE_LINES);
-        let start = nodes.as_ptr().cast::<i8>();
+        let bytes = std::mem::size_of_val(items).min(64 * NODE_LINES);
+        let start = items.as_ptr().cast::<i8>();
         for offset in (0..bytes).step_by(64) {
             prefetch_line(start.wrapping_add(offset));
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = nodes;
+    let _ = items;
 }
 
 /// Asks for the cache line holding `at` (a hint: a prefetch never faults, whatever the
@@ -625,7 +626,7 @@ fn prefetch_line(at: *const i8) {
     unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at) }
 }
 
-/// The most node lines [`prefetch_nodes`] asks for (4 KiB: the nodes of a deep tree).
+/// The most lines [`prefetch_slice`] asks for (4 KiB: the nodes of a deep tree).
 const NODE_LINES: usize = 64;
 
 /// Where a Bézier leaf's net starts, in bytes from the leaf's address.

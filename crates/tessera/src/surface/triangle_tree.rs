@@ -319,14 +319,14 @@ impl TriangleTree {
     /// [`super::PatchTree`]'s nodes).
     #[inline(always)]
     pub(crate) fn prefetch_nodes(&self) {
-        super::patch_tree::prefetch_nodes(&self.nodes);
-        super::patch_tree::prefetch_nodes(&self.frames);
+        super::patch_tree::prefetch_slice(&self.nodes);
+        super::patch_tree::prefetch_slice(&self.frames);
     }
 
     /// Starts loading leaf `leaf` (a hint).
     #[inline(always)]
     pub(crate) fn prefetch_leaf(&self, leaf: usize) {
-        super::patch_tree::prefetch_nodes(std::slice::from_ref(&self.leaves[leaf]));
+        super::patch_tree::prefetch_slice(std::slice::from_ref(&self.leaves[leaf]));
     }
 
     /// Position and first derivatives with respect to the patch's `uv`. Cost: a tree walk and
