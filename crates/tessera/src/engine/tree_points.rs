@@ -41,7 +41,7 @@ use super::point_blocks::{
 };
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
-use crate::surface::patch_tree::{prefetch_slice, LeafPatch, PatchTree};
+use crate::surface::patch_tree::{prefetch_slice_to_l2, LeafPatch, PatchTree};
 use crate::surface::triangle_tree::TriangleLeafPatch;
 use crate::surface::{loop_point, subdivision_point, SurfacePoint, SurfaceSet, TriangleTree};
 
@@ -289,7 +289,7 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
         if f.leaf != last {
             // What the group will read: the leaf's stored form where given, else its net.
             match locals {
-                Some(locals) => prefetch_slice(std::slice::from_ref(&locals[f.leaf as usize])),
+                Some(locals) => prefetch_slice_to_l2(std::slice::from_ref(&locals[f.leaf as usize])),
                 None => tree.prefetch_leaf(f.leaf as usize, f.st),
             }
             last = f.leaf;

@@ -601,20 +601,42 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
 /// the cache stalls the walk, where a tree's nodes together are a few kilobytes that stream
 /// in at once. Profiles of a cage larger than the cache showed the walks' node loads as the
 /// largest stalls; on `rook × 16` (700 MB of leaves) at factor 8 this made the frame 8–10 %
-/// faster. Also Loop's trees' nodes, leaf frames and leaves ([`crate::surface::TriangleTree`])
-/// and the stored leaf forms a group of points reads (`engine::tree_points`).
+/// faster. Also Loop's trees' nodes, leaf frames and leaves ([`crate::surface::TriangleTree`]).
 #[inline(always)]
 pub(crate) fn prefetch_slice<T>(items: &[T]) {
     #[cfg(target_arch = "x86_64")]
-    {
-        let bytes = std::mem::size_of_val(items).min(64 * NODE_LINES);
-        let start = items.as_ptr().cast::<i8>();
-        for offset in (0..bytes).step_by(64) {
-            prefetch_line(start.wrapping_add(offset));
-        }
-    }
+    prefetch_lines::<{ std::arch::x86_64::_MM_HINT_T0 }, T>(items);
     #[cfg(not(target_arch = "x86_64"))]
     let _ = items;
+}
+
+/// [`prefetch_slice`] into the second-level cache only: for data asked for well before it is
+/// read, many lines at a time. The stored leaf forms a group of points reads
+/// (`engine::tree_points`: 476 bytes, 8 lines, a Loop leaf) are asked for as the leaf search
+/// meets them, a dozen forms a patch within a few hundred nanoseconds; into L1 those requests
+/// filled its miss buffers, and the search itself waited for them (a fifth of the vertex
+/// stage of `loop_xord_interior` × 200 in a profile without the kernels). Into L2 the search
+/// goes on, and a group finds its form one level down: the vertex stage 6–7 % faster at
+/// factor 16 and at half a pixel (one thread, measured alternating with the L1 hint).
+#[inline(always)]
+pub(crate) fn prefetch_slice_to_l2<T>(items: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    prefetch_lines::<{ std::arch::x86_64::_MM_HINT_T1 }, T>(items);
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = items;
+}
+
+/// The lines of `items` (up to [`NODE_LINES`]) asked for with the hint `HINT`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn prefetch_lines<const HINT: i32, T>(items: &[T]) {
+    let bytes = std::mem::size_of_val(items).min(64 * NODE_LINES);
+    let start = items.as_ptr().cast::<i8>();
+    for offset in (0..bytes).step_by(64) {
+        // SAFETY: a prefetch never faults, whatever the address, and changes nothing but the
+        // cache; nothing is read or written through the pointer.
+        unsafe { std::arch::x86_64::_mm_prefetch::<HINT>(start.wrapping_add(offset)) }
+    }
 }
 
 /// Asks for the cache line holding `at` (a hint: a prefetch never faults, whatever the
