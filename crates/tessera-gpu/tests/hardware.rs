@@ -164,6 +164,45 @@ fn hardware_plans_equal_the_cpu_engine_on_loop_cages() {
     }
 }
 
+/// Catmull-Clark cages (bicubic faces, trees of isolated faces, sub-faces of n-gons, holes,
+/// creases) and the corners pinched at a valence-2 vertex, which Direct3D's pattern never
+/// cuts across at corners 0 and 2 (`Hardware::cut_through_corners_0_and_2`), so the GPU draws
+/// them as the CPU does: every partitioning at its fixed factor, on random factors and from
+/// the camera.
+#[test]
+fn hardware_plans_equal_the_cpu_engine_on_catmull_clark_cages() {
+    let options =
+        tessera::io::LoadOptions { surface: tessera::io::SurfaceKind::CatmullClark, ..Default::default() };
+    let load_cage = |cage: &str| tessera::io::load(&data_dir().join(cage), options).unwrap();
+    let mut rng = Lcg(31);
+    let mut pinched = 0;
+    let cages = ["catmark_val2_interior", "catmark_nonquads", "catmark_hole_test1"]
+        .map(|c| format!("subdivision/{c}.obj"));
+    for cage in &cages {
+        let set = load_cage(cage);
+        pinched += set.topology.patch_pinched.iter().filter(|c| c.iter().any(|&x| x)).count();
+        let mut gpu = tessellator(&set);
+        for (i, p) in PARTITIONINGS.into_iter().enumerate() {
+            let plan = factor_plan(&set, p, real_factor(p));
+            let name = format!("{cage} {} factor {}", p.name(), real_factor(p));
+            assert_hardware_frame(&name, &set, &mut gpu, &plan);
+            for round in 0..2 {
+                let plan = random_plan(&set, p, if round == 0 { 3.0 } else { 9.0 }, &mut rng, i % 2 == 1);
+                assert_hardware_frame(
+                    &format!("{cage} {} random round {round}", p.name()),
+                    &set,
+                    &mut gpu,
+                    &plan,
+                );
+            }
+        }
+    }
+    assert!(pinched > 0, "no pinched corner among the cages");
+    // Planned on the GPU from the camera: every partitioning, silhouetteness and a factor.
+    let (_, counts) = hardware_from_the_camera(&cages[..1], load_cage, 8, 5, 1);
+    check_factor_counts(&counts);
+}
+
 #[test]
 fn hardware_plans_equal_the_cpu_engine_on_triangle_patches() {
     // PN triangles: the meshes under 40 kB (the blob, the knob, the non-manifold and the
@@ -404,6 +443,7 @@ const ROUNDING: f64 = 1e-5;
 /// output equals the CPU engine's for the plan the GPU drew, every `mesh_every`-th frame.
 fn hardware_from_the_camera(
     models: &[String],
+    load: impl Fn(&str) -> SurfaceSet,
     cameras_per_model: usize,
     seed: u64,
     mesh_every: usize,
@@ -533,7 +573,7 @@ fn hardware_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
             m.starts_with("patches/") || std::fs::metadata(data_dir().join(m)).unwrap().len() < 15_000
         })
         .collect();
-    let (_, counts) = hardware_from_the_camera(&models, 3, 3, 1);
+    let (_, counts) = hardware_from_the_camera(&models, load, 3, 3, 1);
     check_factor_counts(&counts);
 }
 
@@ -541,8 +581,8 @@ fn hardware_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
 #[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each (10 on the three meshes over 40,000 patches), every partitioning"]
 fn hardware_from_the_camera_on_every_model_20_cameras() {
     let (rest, large) = models_by_size();
-    let (mut sweep, mut counts) = hardware_from_the_camera(&rest, 20, 2026, 3);
-    let (more_sweep, more) = hardware_from_the_camera(&large, 10, 2026, 3);
+    let (mut sweep, mut counts) = hardware_from_the_camera(&rest, load, 20, 2026, 3);
+    let (more_sweep, more) = hardware_from_the_camera(&large, load, 10, 2026, 3);
     sweep.add(&more_sweep);
     counts.frames += more.frames;
     counts.edges += more.edges;

@@ -14,6 +14,7 @@ use crate::criterion::view::ViewCriterion;
 use crate::criterion::MAX_FACTOR;
 use crate::domain::Domain;
 use crate::error::{Error, Result};
+use crate::pattern::hardware::Hardware;
 use crate::pattern::semi_uniform::{SemiUniform, MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL};
 use crate::pattern::uniform::Uniform;
 use crate::pattern::Pattern;
@@ -91,6 +92,7 @@ pub fn validate(
         let grid = match scheme {
             Scheme::Uniform => Uniform.cut_through_corners_0_and_2(),
             Scheme::SemiUniform { .. } => SemiUniform.cut_through_corners_0_and_2(),
+            Scheme::Hardware(partitioning) => Hardware { partitioning }.cut_through_corners_0_and_2(),
             _ => false,
         };
         if let Some(p) = pinched_beyond_the_gpu(set, grid) {
@@ -241,8 +243,9 @@ pub fn pinched_beyond_the_gpu(set: &SurfaceSet, grid: bool) -> Option<usize> {
 /// What the GPU engine refuses for [`pinched_beyond_the_gpu`]'s patch `p`.
 pub fn pinched_on_gpu(p: usize) -> String {
     format!(
-        "patch {p}'s corner at an interior vertex of valence 2 with this scheme (the GPU's patterns \
-         do not cut such corners yet: use the uniform or semi-uniform scheme or the CPU engine)"
+        "patch {p}'s corner at an interior vertex of valence 2 with this scheme (the GPU's transition \
+         pattern does not cut such corners yet: use the uniform, semi-uniform or a hardware scheme, or \
+         the CPU engine)"
     )
 }
 

@@ -599,6 +599,19 @@ impl Pattern for Hardware {
         self.partitioning.name()
     }
 
+    /// Direct3D's quad pattern joins each ring of points to the next ring inside it, so every
+    /// triangle at a corner has a vertex on the first inner ring, which lies strictly inside
+    /// the domain (an inside factor of 1 beside a larger one makes it a segment across the
+    /// middle, still inside). Only where both inside factors are 1 is there no inner ring:
+    /// the quad is then two triangles, split along the diagonal from corner 0 to corner 2
+    /// (tessera's numbering). So a patch pinched at corners 0 and 2 needs no cut, and the
+    /// GPU, which does not run [`crate::pattern::cut_pinched_corners`], draws it as the CPU
+    /// does. Checked for every partitioning over every integer factor 1–8 on each edge and
+    /// thousands of real ones (`tests::corners_0_and_2_keep_a_vertex_off_their_edges`).
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        true
+    }
+
     /// O(rings).
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         let pre = self.processed(input);

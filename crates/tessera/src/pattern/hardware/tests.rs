@@ -244,3 +244,50 @@ fn pow2_hull_factors_are_powers_of_two() {
         assert_eq!(Partitioning::Pow2.hull_factor(f), want, "{f}");
     }
 }
+
+/// [`Hardware`]'s promise ([`Pattern::cut_through_corners_0_and_2`]): no triangle at corner
+/// 0 or 2 of a quad has all three vertices on the corner's two edges, so a patch pinched
+/// there needs no cut. Every partitioning, every integer factor 1–8 on each edge, and
+/// thousands of real ones (half of them small, where the inner ring degenerates). The same
+/// check at corners 1 and 3 must find the chord of the two-triangle quad, or it sees nothing.
+#[test]
+fn corners_0_and_2_keep_a_vertex_off_their_edges() {
+    let mut rng = Factors::new(9);
+    let mut out = LocalTessellation::default();
+    let mut chords_at_1_and_3 = 0;
+    for partitioning in ALL {
+        let pattern = Hardware { partitioning };
+        assert!(pattern.cut_through_corners_0_and_2());
+        let settle = |f: f64| settled_factor(partitioning.hull_factor(f), partitioning, OUTPUT_GAP);
+        let mut cases: Vec<[f64; 4]> = (0..8u32.pow(4))
+            .map(|code| std::array::from_fn(|e| 1.0 + ((code >> (3 * e)) % 8) as f64))
+            .collect();
+        for case in 0..3000 {
+            cases.push(std::array::from_fn(|_| {
+                if case % 2 == 0 {
+                    rng.factor(partitioning)
+                } else {
+                    1.0 + 3.0 * rng.next()
+                }
+            }));
+        }
+        for factors in cases {
+            let input = input(Domain::Quad, partitioning, factors.map(settle));
+            pattern.build(&input, &mut out);
+            for c in 0..4 {
+                let prev = (c + 3) % 4;
+                let on_edges: Vec<u32> = (0..=input.segments[c])
+                    .map(|k| input.boundary_vertex(c, k))
+                    .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
+                    .collect();
+                let chord = out.triangles.iter().any(|t| t.iter().all(|v| on_edges.contains(v)));
+                if c % 2 == 1 {
+                    chords_at_1_and_3 += usize::from(chord);
+                } else {
+                    assert!(!chord, "{partitioning:?} {input:?}: a triangle on corner {c}'s two edges");
+                }
+            }
+        }
+    }
+    assert!(chords_at_1_and_3 > 0, "no chord at corners 1 and 3: the check sees nothing");
+}
