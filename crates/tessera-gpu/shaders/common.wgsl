@@ -79,6 +79,7 @@ fn dispatch_grid(threads: u32) -> vec2<u32> {
 fn patch_edge(p: u32, e: u32) -> u32 { return patch_rows[p * PATCH_ROW + e]; }
 fn patch_edge_reversed(p: u32, e: u32) -> bool { return (patch_rows[p * PATCH_ROW + 4u + e] & 1u) != 0u; }
 fn patch_edge_collapsed(p: u32, e: u32) -> bool { return (patch_rows[p * PATCH_ROW + 4u + e] & 2u) != 0u; }
+fn patch_corner_pinched(p: u32, c: u32) -> bool { return (patch_rows[p * PATCH_ROW + 4u + c] & 4u) != 0u; }
 fn patch_edge_variant(p: u32, e: u32) -> u32 { return (patch_rows[p * PATCH_ROW + 4u + e] >> 8u) & 255u; }
 fn patch_corner_entry(p: u32, c: u32) -> u32 { return patch_rows[p * PATCH_ROW + 8u + c]; }
 fn patch_repeated_corner(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 1u) != 0u; }

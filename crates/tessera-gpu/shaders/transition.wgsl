@@ -20,10 +20,13 @@ struct QuadLayout {
     m: u32,
 }
 
-// One patch's pattern input: its local numbering (`local.wgsl`) and its core.
+// One patch's pattern input: its local numbering (`local.wgsl`), its core, and which of a
+// quad's corners 0 and 2 are pinched (bit c; `PatternInput::pinched`, the corners the
+// pattern reads: `transition` module doc, "Pinched corners").
 struct PatchInput {
     local: LocalNumbering,
     core: QuadLayout,
+    pinched: u32,
 }
 
 // `transition::strips_at_collapsed_edges` for N edges (3 or 4), updating in place as the
@@ -40,16 +43,17 @@ fn strips_at_collapsed(strip: u32, collapsed: u32, n: u32) -> u32 {
     return s;
 }
 
-// `QuadLayout::new`.
-fn quad_layout(s: vec4<u32>, interior_factors: vec2<u32>, c: u32) -> QuadLayout {
+// `QuadLayout::new`; `pinched` as `PatchInput`'s.
+fn quad_layout(s: vec4<u32>, interior_factors: vec2<u32>, c: u32, pinched: u32) -> QuadLayout {
     var nu = max(interior_factors.x, 1u);
     var nv = max(interior_factors.y, 1u);
+    let proper = select(0u, 1u, pinched != 0u);
     loop {
         var strip = select(0u, 1u, s.x != nu) | select(0u, 2u, s.y != nv) | select(0u, 4u, s.z != nu)
             | select(0u, 8u, s.w != nv);
         strip = strips_at_collapsed(strip, c, 4u);
-        let fan_u = (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u));
-        let fan_v = (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u));
+        let fan_u = (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u)) | proper;
+        let fan_v = (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u)) | proper;
         let need_u = bit(strip, 1u) + bit(strip, 3u) + fan_u;
         let need_v = bit(strip, 0u) + bit(strip, 2u) + fan_v;
         if (nu >= need_u && nv >= need_v) {
@@ -88,12 +92,14 @@ fn patch_input(p: u32) -> PatchInput {
 fn pattern_input(p: u32, interior_factors: vec2<u32>) -> PatchInput {
     let local = local_numbering(p);
     var core: QuadLayout;
+    var pinched = 0u;
     if (local.nc == 3u) {
         core = tri_layout(local.s, interior_factors.x, local.collapsed);
     } else {
-        core = quad_layout(local.s, interior_factors, local.collapsed);
+        pinched = select(0u, 1u, patch_corner_pinched(p, 0u)) | select(0u, 4u, patch_corner_pinched(p, 2u));
+        core = quad_layout(local.s, interior_factors, local.collapsed, pinched);
     }
-    return PatchInput(local, core);
+    return PatchInput(local, core, pinched);
 }
 
 // The pattern's core factors, read by the interior vertex pass: on a quad the interior grid
@@ -239,13 +245,18 @@ fn inner_local(input: PatchInput, e: u32, t: u32) -> u32 {
 const TIE_TOLERANCE: f32 = 1e-5;
 
 // `transition::walk`: the strip along edge e between its s outer segments and the m inner
-// ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification).
+// ones, Bresenham-like, with `lead` / `trail` virtual segments (the two-region modification),
+// its first or last step on the inner line where a pinched corner pins it
+// (`transition::pinned_ends`: a pinched corner 0 or 2 without a strip on its other edge).
 fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
     let l = input.core;
     let s = input.local.s[e];
     let m = inner_segments(input, e);
     let lead = bit(l.strips, (e + input.local.nc - 1u) % input.local.nc);
     let trail = bit(l.strips, (e + 1u) % input.local.nc);
+    // `pinched` marks corners 0 and 2 only (triangles: none).
+    let pin_start = bit(input.pinched, e) == 1u && lead == 0u;
+    let pin_end = bit(input.pinched, (e + 1u) % input.local.nc) == 1u && trail == 0u;
     let span = i32(m + lead + trail);
     let s32 = i32(s);
     var d = span - (2 * i32(lead) + 1) * s32;
@@ -261,6 +272,11 @@ fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
             advance_outer = true;
         } else if (i == s) {
             advance_outer = false;
+        } else if (pin_start && i == 0u && j == 0u) {
+            advance_outer = false;
+        } else if (pin_end && j + 1u == m) {
+            // The last inner step waits until the outer line is done.
+            advance_outer = true;
         } else if (d != 0) {
             advance_outer = d < 0;
         } else {

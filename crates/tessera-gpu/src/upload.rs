@@ -6,7 +6,8 @@
 //!
 //! - **patch row** ([`PATCH_ROW`] u32): `[0..4]` canonical edge of each local edge
 //!   (`patch_edges[p][e].edge`); `[4..8]` flags of each local edge: bit 0 reversed, bit 1 the
-//!   edge is collapsed, bits 8..16 the normal variant; `[8..12]` corner entry of each corner
+//!   edge is collapsed, bit 2 the corner it starts at is pinched
+//!   (`Topology::pinched_corners`), bits 8..16 the normal variant; `[8..12]` corner entry of each corner
 //!   (`patch_corner_entries`); `[12]` bit 0 [`tessera::engine::layout::has_repeated_corner`],
 //!   bit 1 a triangle domain, bit 2 a PN triangle (normals in the control-point slots), bit 3
 //!   a Catmull-Clark subdivision patch (a tree of pieces), bit 4 a Loop subdivision patch (a
@@ -70,11 +71,15 @@ impl PackedSet {
         for (p, patch) in set.patches.iter().enumerate() {
             let mut row = [0u32; PATCH_ROW as usize];
             let corners = patch.domain().corner_count();
+            let pinched = topo.pinched_corners(p);
             for e in 0..corners {
                 let pe = topo.patch_edges[p][e];
                 row[e] = pe.edge;
                 let collapsed = topo.edges[pe.edge as usize].collapsed;
-                row[4 + e] = pe.reversed as u32 | (collapsed as u32) << 1 | (pe.variant as u32) << 8;
+                row[4 + e] = pe.reversed as u32
+                    | (collapsed as u32) << 1
+                    | (pinched[e] as u32) << 2
+                    | (pe.variant as u32) << 8;
                 row[8 + e] = topo.patch_corner_entries[p][e];
             }
             let repeated = tessera::engine::layout::has_repeated_corner(set, p);

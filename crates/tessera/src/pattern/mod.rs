@@ -187,12 +187,13 @@ pub trait Pattern: Sync {
         None
     }
 
-    /// True when every triangle the pattern makes at a quad's corners 0 and 2 has a vertex off
-    /// the two edges there (cells of a grid cut from corner 0 to corner 2), so a patch
-    /// pinched at those corners needs no cut ([`cut_pinched_corners`] finds nothing to do):
-    /// an engine that does not run the cut (the GPU's, `scheme::pinched_beyond_the_gpu`)
-    /// still draws such a patch as the CPU does. False (the default) promises nothing.
-    /// Cost: O(1).
+    /// True when, at each of a quad's corners 0 and 2 that the input marks pinched, every
+    /// triangle [`Pattern::triangulate`] makes has a vertex off the corner's two edges (cells
+    /// of a grid cut from corner 0 to corner 2 do at any such corner; the transition pattern
+    /// reads the marks), so a patch pinched at those corners needs no cut
+    /// ([`cut_pinched_corners`] finds nothing to do): an engine that does not run the cut (the
+    /// GPU's, `scheme::pinched_beyond_the_gpu`) still draws such a patch as the CPU does.
+    /// False (the default) promises nothing. Cost: O(1).
     fn cut_through_corners_0_and_2(&self) -> bool {
         false
     }

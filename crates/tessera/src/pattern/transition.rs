@@ -70,6 +70,21 @@
 //! would also end such fans, but the criteria derive the core factors from the edges (the
 //! minimum per direction), so the core next to the point would lose its resolution.
 //!
+//! **Pinched corners.** At a corner pinched at an interior vertex of valence 2
+//! ([`PatternInput::pinched`]) the two edges are another patch's two edges too, so a triangle
+//! with all three vertices on them would be that patch's as well. On a quad, corners 0 and 2
+//! (where a subdivision cage's patches are turned to have them) never get one: the core's
+//! cell there is cut through the corner, as the uniform grid's are, and a strip along one of
+//! the two edges, with none along the other, has its inner line end on that other edge, so its
+//! walk takes its step on the inner line first there (a strip starting at the corner) or
+//! last (one ending there) — every triangle at the corner then has a vertex of the core line
+//! inside. For that, and so that no core line lies on an edge (a core of zero width along
+//! edge 0 would join corner 0 to corner 3 through strip 2), a quad pinched at corner 0 or 2
+//! keeps a core of at least one segment each way, raising its factors where needed as for
+//! collapsed edges. The engines that do not cut pinched corners after a pattern (the GPU's)
+//! then draw such patches as the CPU does; corners 1 and 3 are left to
+//! [`super::cut_pinched_corners`].
+//!
 //! The pattern assumes uniform edge samples (`t_k = k / segments`, `SamplingKind::Uniform`):
 //! its triangles have positive area for those positions.
 
@@ -133,6 +148,10 @@ impl QuadLayout {
             let c = input.collapsed;
             let fan_u = (strip[0] && c[0]) || (strip[2] && c[2]);
             let fan_v = (strip[1] && c[1]) || (strip[3] && c[3]);
+            // A pinched corner 0 or 2 keeps the core a segment wide each way (module doc,
+            // "Pinched corners").
+            let pinched = input.pinched[0] || input.pinched[2];
+            let (fan_u, fan_v) = (fan_u || pinched, fan_v || pinched);
             let need_u = u32::from(strip[1]) + u32::from(strip[3]) + u32::from(fan_u);
             let need_v = u32::from(strip[0]) + u32::from(strip[2]) + u32::from(fan_v);
             if nu >= need_u && nv >= need_v {
@@ -225,6 +244,7 @@ impl QuadLayout {
                 m,
                 lead,
                 trail,
+                pinned_ends(&self.strip, &input.pinched, e),
                 |k| (input.boundary_vertex(e, k), Domain::Quad.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
@@ -234,6 +254,15 @@ impl QuadLayout {
             );
         }
     }
+}
+
+/// Which ends of the strip on quad edge `e` a pinched corner pins (module doc, "Pinched
+/// corners"): `[start, end]`, the start at corner `e`, the end at corner `e + 1`. A corner
+/// pins a strip's end where it is corner 0 or 2, pinched, and the other edge there has no
+/// strip (so the strip's inner line ends on that edge). Cost: O(1).
+fn pinned_ends(strip: &[bool; 4], pinched: &[bool; 4], e: usize) -> [bool; 2] {
+    let (start, end) = (e, (e + 1) % 4);
+    [start % 2 == 0 && pinched[start] && !strip[(e + 3) % 4], end % 2 == 0 && pinched[end] && !strip[end]]
 }
 
 /// Gives a strip to every collapsed edge next to an edge with a strip (module doc, "Collapsed
@@ -347,6 +376,7 @@ impl TriLayout {
                 m,
                 lead,
                 trail,
+                [false; 2],
                 |k| (input.boundary_vertex(e, k), Domain::Tri.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
@@ -369,13 +399,16 @@ impl TriLayout {
 /// `d = (2i+1)·span − (2j'+1)·s`, `span = m + lead + trail`, `j' = j + lead`, the outer
 /// midpoint `(i+½)/s` comes first iff `d < 0`; `d` starts at `span − (2·lead+1)·s` (the
 /// difference of the two counts when `lead = 0`) and changes by `+2·span` or `−2·s`. Ties
-/// (`d = 0`) take the shorter diagonal. Emits `s + m` triangles, each with two vertices on
-/// one line and one on the other, so positive area. Cost: O(s + m).
+/// (`d = 0`) take the shorter diagonal. `pinned` (`[start, end]`, at most one, and then
+/// `m ≥ 1`) forces the first step, or the last, onto the inner line, whatever `d` says
+/// (module doc, "Pinched corners"); `d` moves as for any step. Emits `s + m` triangles, each
+/// with two vertices on one line and one on the other, so positive area. Cost: O(s + m).
 fn walk(
     s: u32,
     m: u32,
     lead: u32,
     trail: u32,
+    pinned: [bool; 2],
     outer: impl Fn(u32) -> (u32, DVec2),
     inner: impl Fn(u32) -> (u32, DVec2),
     tris: &mut Vec<[u32; 3]>,
@@ -393,6 +426,11 @@ fn walk(
             true
         } else if i == s {
             false
+        } else if pinned[0] && i == 0 && j == 0 {
+            false
+        } else if pinned[1] && j + 1 == m {
+            // The last inner step waits until the outer line is done.
+            true
         } else if d != 0 {
             d < 0
         } else {
@@ -438,6 +476,12 @@ impl Pattern for Transition {
         "transition"
     }
 
+    /// At a pinched corner 0 or 2 every triangle keeps a vertex off the corner's two edges
+    /// (module doc, "Pinched corners").
+    fn cut_through_corners_0_and_2(&self) -> bool {
+        true
+    }
+
     /// Interior vertex and triangle counts; O(1).
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
         match input.domain {
@@ -474,8 +518,9 @@ impl Pattern for Transition {
     /// The core's cells come first in [`Pattern::build`]: two triangles per cell of the core
     /// rectangle (quads), the `m²` triangles of the core triangle (triangles).
     fn core_cells(&self, input: &PatternInput) -> Option<([u32; 2], u32)> {
-        // A pinched corner's cut may reach into the core: no promise then.
-        if input.pinched.iter().any(|&p| p) {
+        // A pinched corner's cut may reach into the core: no promise then. Corners 0 and 2
+        // need no cut (module doc, "Pinched corners").
+        if input.pinched[1] || input.pinched[3] {
             return None;
         }
         match input.domain {
@@ -827,6 +872,56 @@ mod tests {
         assert!(unflagged_failures > 0, "the check cannot fail");
     }
 
+    /// "Pinched corners": with corner 0, corner 2 or both marked pinched, the pattern itself
+    /// keeps a vertex off the corner's two edges in every triangle there — no cut left for
+    /// `cut_pinched_corners` (`build` is `triangulate`) — and still tiles the domain with its
+    /// counts, over every quad input with edges and interiors of 1–6 segments. Without the
+    /// marks the same inputs have such triangles (or the test would see nothing).
+    #[test]
+    fn pinched_corners_0_and_2_keep_a_vertex_off_their_edges() {
+        let (mut chords_unmarked, mut raised) = (0, 0);
+        let (mut plain, mut built) = (LocalTessellation::default(), LocalTessellation::default());
+        for code in 0..6u32.pow(4) {
+            let segments: [u32; 4] = std::array::from_fn(|e| 1 + (code / 6u32.pow(e as u32)) % 6);
+            for interior in (1..=6).flat_map(|n| (1..=6).map(move |m| [n, m])) {
+                for pinched in
+                    [[true, false, false, false], [false, false, true, false], [true, false, true, false]]
+                {
+                    let unmarked = quad(segments, interior);
+                    let input = PatternInput { pinched, ..unmarked };
+                    let chord_at = |out: &LocalTessellation, c: usize| {
+                        let prev = (c + 3) % 4;
+                        let on_edges: Vec<u32> = (0..=input.segments[c])
+                            .map(|k| input.boundary_vertex(c, k))
+                            .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
+                            .collect();
+                        out.triangles.iter().any(|t| t.iter().all(|v| on_edges.contains(v)))
+                    };
+                    Transition.triangulate(&unmarked, &mut plain);
+                    chords_unmarked += (0..4).filter(|&c| pinched[c] && chord_at(&plain, c)).count();
+                    Transition.triangulate(&input, &mut built);
+                    for c in (0..4).filter(|&c| pinched[c]) {
+                        assert!(!chord_at(&built, c), "{input:?}: a triangle on corner {c}'s two edges");
+                    }
+                    assert_eq!(
+                        Transition.counts(&input),
+                        (built.interior.len() as u32, built.triangles.len() as u32),
+                        "{input:?}"
+                    );
+                    raised += usize::from(built.interior.len() != plain.interior.len());
+                    let mut cut = LocalTessellation::default();
+                    Transition.build(&input, &mut cut);
+                    assert_eq!(cut, built, "{input:?}: the cut found something left to do");
+                    let mut p = Vec::new();
+                    crate::pattern::cache::local_params(&input, &built, &mut p);
+                    crate::pattern::assert_tiles(&input, &built, &p, 0.0);
+                }
+            }
+        }
+        assert!(chords_unmarked > 1000, "only {chords_unmarked} unmarked chords: the test sees too little");
+        assert!(raised > 0, "no core factor raised for a pinned strip");
+    }
+
     #[test]
     fn walk_spreads_apexes_evenly() {
         // 2 outer segments against 6 inner: the outer triangles fall at inner points 1 and 4
@@ -834,7 +929,7 @@ mod tests {
         let mut tris = Vec::new();
         let outer = |i: u32| (100 + i, DVec2::new(i as f64 / 2.0, 0.0));
         let inner = |j: u32| (j, DVec2::new(j as f64 / 6.0, 1.0));
-        walk(2, 6, 0, 0, outer, inner, &mut tris);
+        walk(2, 6, 0, 0, [false; 2], outer, inner, &mut tris);
         let apexes: Vec<u32> = tris.iter().filter(|t| t[1] >= 100).map(|t| t[2]).collect();
         assert_eq!(apexes, vec![2, 4]);
         assert_eq!(tris.len(), 8);

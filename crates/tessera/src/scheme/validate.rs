@@ -16,6 +16,7 @@ use crate::domain::Domain;
 use crate::error::{Error, Result};
 use crate::pattern::hardware::Hardware;
 use crate::pattern::semi_uniform::{SemiUniform, MAX_LEVEL as SEMI_UNIFORM_MAX_LEVEL};
+use crate::pattern::transition::Transition;
 use crate::pattern::uniform::Uniform;
 use crate::pattern::Pattern;
 use crate::surface::{Patch, SurfaceSet};
@@ -89,13 +90,15 @@ pub fn validate(
     check_surface_kinds(scheme, set)?;
     check_engine(scheme, criterion, options, engine)?;
     if engine != Engine::Cpu {
-        let grid = match scheme {
+        let promised = match scheme {
             Scheme::Uniform => Uniform.cut_through_corners_0_and_2(),
+            Scheme::Transition => Transition.cut_through_corners_0_and_2(),
             Scheme::SemiUniform { .. } => SemiUniform.cut_through_corners_0_and_2(),
             Scheme::Hardware(partitioning) => Hardware { partitioning }.cut_through_corners_0_and_2(),
-            _ => false,
+            // SD-2 takes triangles and ESC no tree: neither meets a pinched corner.
+            Scheme::Sd2 { .. } | Scheme::Esc { .. } => false,
         };
-        if let Some(p) = pinched_beyond_the_gpu(set, grid) {
+        if let Some(p) = pinched_beyond_the_gpu(set, promised) {
             return Err(Error::EngineNotSupported { engine: engine.name(), what: pinched_on_gpu(p) });
         }
     }
@@ -232,20 +235,21 @@ fn check_request(scheme: Scheme, criterion: &Criterion, options: &PlanOptions) -
 
 /// The first patch whose pinched corner (an interior vertex of valence 2 of a Catmull-Clark
 /// cage, [`crate::topology::Topology::pinched_corners`]) the GPU's patterns would not cut:
-/// they do not run `pattern::cut_pinched_corners`, so only a pattern whose triangles are
-/// already cut through corners 0 and 2 (`grid`: `Pattern::cut_through_corners_0_and_2`;
-/// the cage's patches are turned to have their pinched corners there) draws such a patch as
-/// the CPU does. Cost: O(P) when the set has pinched corners, else O(1).
-pub fn pinched_beyond_the_gpu(set: &SurfaceSet, grid: bool) -> Option<usize> {
-    set.topology.patch_pinched.iter().position(|c| if grid { c[1] || c[3] } else { c.iter().any(|&x| x) })
+/// they do not run `pattern::cut_pinched_corners`, so only a pattern that needs no cut at
+/// corners 0 and 2 (`promised`: `Pattern::cut_through_corners_0_and_2`; the cage's patches
+/// are turned to have their pinched corners there) draws such a patch as the CPU does, and
+/// a patch pinched at corner 1 or 3 too (a face with such vertices at neighbouring corners)
+/// never. Cost: O(P) when the set has pinched corners, else O(1).
+pub fn pinched_beyond_the_gpu(set: &SurfaceSet, promised: bool) -> Option<usize> {
+    set.topology.patch_pinched.iter().position(|c| if promised { c[1] || c[3] } else { c.iter().any(|&x| x) })
 }
 
 /// What the GPU engine refuses for [`pinched_beyond_the_gpu`]'s patch `p`.
 pub fn pinched_on_gpu(p: usize) -> String {
     format!(
-        "patch {p}'s corner at an interior vertex of valence 2 with this scheme (the GPU's transition \
-         pattern does not cut such corners yet: use the uniform, semi-uniform or a hardware scheme, or \
-         the CPU engine)"
+        "patch {p} has corners at interior vertices of valence 2 next to each other (the GPU's \
+         patterns cut such a corner only at corners 0 and 2, where a face with one is turned to \
+         have it): use the CPU engine"
     )
 }
 
@@ -366,6 +370,39 @@ mod tests {
 
     fn quads() -> SurfaceSet {
         super::super::tests::flat()
+    }
+
+    /// A cage with an interior vertex of valence 2: every scheme that takes its patches goes to
+    /// the GPU (their patterns need no cut at corners 0 and 2, where its patches have the
+    /// vertex); a patch pinched at corner 1 or 3 as well is refused there by name, not on
+    /// the CPU.
+    #[test]
+    fn pinched_corners_go_to_the_gpu_at_corners_0_and_2_only() {
+        let path = crate::test_support::data("subdivision/catmark_val2_interior.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        let mut set = SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default()).unwrap();
+        let p = set.topology.patch_pinched.iter().position(|c| c.contains(&true)).expect("a pinched patch");
+        assert!(set.topology.patch_pinched.iter().all(|c| !c[1] && !c[3]), "turned to corners 0 and 2");
+        let o = PlanOptions::default();
+        let schemes = [
+            (Scheme::Uniform, Criterion::Factor(4.0)),
+            (Scheme::Transition, Criterion::Tolerance(0.01)),
+            (Scheme::SemiUniform { max_level: 5 }, Criterion::Factor(4.0)),
+            (Scheme::Hardware(Partitioning::FractionalOdd), Criterion::Factor(5.5)),
+        ];
+        for (scheme, criterion) in schemes {
+            validate(scheme, &criterion, &o, &set, Engine::Gpu).unwrap();
+        }
+        set.topology.patch_pinched[p][1] = true;
+        for (scheme, criterion) in schemes {
+            validate(scheme, &criterion, &o, &set, Engine::Cpu).unwrap();
+            let e = validate(scheme, &criterion, &o, &set, Engine::Gpu).unwrap_err();
+            assert!(matches!(e, Error::EngineNotSupported { .. }), "{e}");
+            assert!(
+                e.to_string().contains(&format!("patch {p} has corners at interior vertices of valence 2")),
+                "{e}"
+            );
+        }
     }
 
     #[test]
