@@ -237,14 +237,15 @@ impl QuadLayout {
         for e in (0..4).filter(|&e| self.strip[e]) {
             let s = input.segments[e];
             let m = self.inner_segments(e);
-            let lead = u32::from(self.strip[(e + 3) % 4]);
-            let trail = u32::from(self.strip[(e + 1) % 4]);
+            let ends = StripEnds {
+                lead: u32::from(self.strip[(e + 3) % 4]),
+                trail: u32::from(self.strip[(e + 1) % 4]),
+                pinned: pinned_ends(&self.strip, &input.pinched, e),
+            };
             walk(
                 s,
                 m,
-                lead,
-                trail,
-                pinned_ends(&self.strip, &input.pinched, e),
+                ends,
                 |k| (input.boundary_vertex(e, k), Domain::Quad.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
@@ -369,14 +370,15 @@ impl TriLayout {
         }
         for e in (0..3).filter(|&e| self.strip[e]) {
             let s = input.segments[e];
-            let lead = u32::from(self.strip[(e + 2) % 3]);
-            let trail = u32::from(self.strip[(e + 1) % 3]);
+            let ends = StripEnds {
+                lead: u32::from(self.strip[(e + 2) % 3]),
+                trail: u32::from(self.strip[(e + 1) % 3]),
+                pinned: [false; 2],
+            };
             walk(
                 s,
                 m,
-                lead,
-                trail,
-                [false; 2],
+                ends,
                 |k| (input.boundary_vertex(e, k), Domain::Tri.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
@@ -386,6 +388,16 @@ impl TriLayout {
             );
         }
     }
+}
+
+/// What a strip's walk ([`walk`]) needs to know of its two ends: the virtual segments that
+/// extend its inner line where the neighbouring edge has a strip too (`lead` at its start,
+/// `trail` at its end), and the ends a pinched corner pins ([`pinned_ends`]).
+#[derive(Debug, Clone, Copy)]
+struct StripEnds {
+    lead: u32,
+    trail: u32,
+    pinned: [bool; 2],
 }
 
 /// Triangulates the strip between an outer line of `s ≥ 1` segments (points `outer(0..=s)`)
@@ -406,9 +418,7 @@ impl TriLayout {
 fn walk(
     s: u32,
     m: u32,
-    lead: u32,
-    trail: u32,
-    pinned: [bool; 2],
+    StripEnds { lead, trail, pinned }: StripEnds,
     outer: impl Fn(u32) -> (u32, DVec2),
     inner: impl Fn(u32) -> (u32, DVec2),
     tris: &mut Vec<[u32; 3]>,
@@ -424,9 +434,7 @@ fn walk(
         // stays within a few times the counts (no overflow for any u32 counts).
         let advance_outer = if j == m {
             true
-        } else if i == s {
-            false
-        } else if pinned[0] && i == 0 && j == 0 {
+        } else if i == s || (pinned[0] && i == 0 && j == 0) {
             false
         } else if pinned[1] && j + 1 == m {
             // The last inner step waits until the outer line is done.
@@ -929,7 +937,7 @@ mod tests {
         let mut tris = Vec::new();
         let outer = |i: u32| (100 + i, DVec2::new(i as f64 / 2.0, 0.0));
         let inner = |j: u32| (j, DVec2::new(j as f64 / 6.0, 1.0));
-        walk(2, 6, 0, 0, [false; 2], outer, inner, &mut tris);
+        walk(2, 6, StripEnds { lead: 0, trail: 0, pinned: [false; 2] }, outer, inner, &mut tris);
         let apexes: Vec<u32> = tris.iter().filter(|t| t[1] >= 100).map(|t| t[2]).collect();
         assert_eq!(apexes, vec![2, 4]);
         assert_eq!(tris.len(), 8);
