@@ -249,13 +249,8 @@ pub fn cut_pinched_corners(input: &PatternInput, out: &mut LocalTessellation) {
         if !input.pinched[c] {
             continue;
         }
-        let prev = (c + 3) % 4;
-        let on_edges: Vec<u32> = (0..=input.segments[c])
-            .map(|k| input.boundary_vertex(c, k))
-            .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
-            .collect();
-        let shared = |t: &[u32; 3]| t.iter().all(|v| on_edges.contains(v));
-        if !out.triangles.iter().any(shared) {
+        let shared = on_corner_edges(input, c);
+        if !out.triangles.iter().any(&shared) {
             continue;
         }
         if positions.is_empty() {
@@ -277,11 +272,25 @@ pub fn cut_pinched_corners(input: &PatternInput, out: &mut LocalTessellation) {
         for w in waypoints {
             insert_edge(out, &positions, at, w);
             at = w;
-            if !out.triangles.iter().any(shared) {
+            if !out.triangles.iter().any(&shared) {
                 break;
             }
         }
     }
+}
+
+/// Whether a triangle (local indices) has all three vertices on the two edges at corner `c`
+/// (edges `c` and `c − 1`, their far corners included): what a pinched corner must not keep
+/// ([`cut_pinched_corners`]; [`Pattern::cut_through_corners_0_and_2`]'s promise). Cost:
+/// O(samples of the two edges) to make, and a call.
+pub(crate) fn on_corner_edges(input: &PatternInput, c: usize) -> impl Fn(&[u32; 3]) -> bool {
+    let nc = input.domain.corner_count();
+    let prev = (c + nc - 1) % nc;
+    let on_edges: Vec<u32> = (0..=input.segments[c])
+        .map(|k| input.boundary_vertex(c, k))
+        .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
+        .collect();
+    move |t| t.iter().all(|v| on_edges.contains(v))
 }
 
 /// Flips edges crossing the segment `c v` until the triangulation has the edge `c v`:

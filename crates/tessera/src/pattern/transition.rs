@@ -898,12 +898,7 @@ mod tests {
                     let unmarked = quad(segments, interior);
                     let input = PatternInput { pinched, ..unmarked };
                     let chord_at = |out: &LocalTessellation, c: usize| {
-                        let prev = (c + 3) % 4;
-                        let on_edges: Vec<u32> = (0..=input.segments[c])
-                            .map(|k| input.boundary_vertex(c, k))
-                            .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
-                            .collect();
-                        out.triangles.iter().any(|t| t.iter().all(|v| on_edges.contains(v)))
+                        out.triangles.iter().any(crate::pattern::on_corner_edges(&input, c))
                     };
                     Transition.triangulate(&unmarked, &mut plain);
                     chords_unmarked += (0..4).filter(|&c| pinched[c] && chord_at(&plain, c)).count();

@@ -275,12 +275,7 @@ fn corners_0_and_2_keep_a_vertex_off_their_edges() {
             let input = input(Domain::Quad, partitioning, factors.map(settle));
             pattern.build(&input, &mut out);
             for c in 0..4 {
-                let prev = (c + 3) % 4;
-                let on_edges: Vec<u32> = (0..=input.segments[c])
-                    .map(|k| input.boundary_vertex(c, k))
-                    .chain((0..=input.segments[prev]).map(|k| input.boundary_vertex(prev, k)))
-                    .collect();
-                let chord = out.triangles.iter().any(|t| t.iter().all(|v| on_edges.contains(v)));
+                let chord = out.triangles.iter().any(crate::pattern::on_corner_edges(&input, c));
                 if c % 2 == 1 {
                     chords_at_1_and_3 += usize::from(chord);
                 } else {
