@@ -757,9 +757,33 @@ pub(crate) fn triangle_block<
     Block { pos, nrm, margin }
 }
 
+/// The most memory [`PointBlocks`] gives the leaf forms of Loop's trees (1 GiB: 2.2 million
+/// leaves, an all-isolated cage of some 170,000 triangles). A set whose forms would take more
+/// keeps none: a group of points then makes its leaf's form, as Catmull-Clark's trees do
+/// ([`super::tree_points::eval`] without stored forms; one or two points of a leaf in f64), so
+/// the set costs its trees alone, and its vertex stage 1.6–1.8× more time (`loop_xord_interior`
+/// × 200, one thread, with this at 0). A constant, not a share of the memory available, so
+/// that a set's output does not depend on the machine.
+const LOOP_FORMS_BUDGET: usize = 1 << 30;
+
 impl PointBlocks {
     /// Every patch of `set` in its local frame. Cost: O(P), parallel.
     pub(crate) fn for_set(set: &SurfaceSet, avx2_fma: bool) -> PointBlocks {
+        Self::for_set_within(set, avx2_fma, LOOP_FORMS_BUDGET)
+    }
+
+    /// [`PointBlocks::for_set`] with `loop_budget` bytes for Loop's leaf forms
+    /// ([`LOOP_FORMS_BUDGET`]).
+    pub(super) fn for_set_within(set: &SurfaceSet, avx2_fma: bool, loop_budget: usize) -> PointBlocks {
+        let tree_leaves: usize = set
+            .patches
+            .iter()
+            .map(|p| match p {
+                Patch::Loop(t) if t.regular().is_none() => t.leaves().len(),
+                _ => 0,
+            })
+            .sum();
+        let store_loop_leaves = tree_leaves.saturating_mul(std::mem::size_of::<LoopLeaf>()) <= loop_budget;
         let forms = set
             .patches
             .par_iter()
@@ -770,10 +794,11 @@ impl PointBlocks {
                 Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
                 Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
-                Patch::Loop(t) => t.regular_net().map_or_else(
-                    || Form::LoopTree(loop_leaves(t)),
-                    |q| Form::Quartic(LocalQuartic::from_net(&q.points)),
-                ),
+                Patch::Loop(t) => match t.regular_net() {
+                    Some(q) => Form::Quartic(LocalQuartic::from_net(&q.points)),
+                    None if store_loop_leaves => Form::LoopTree(loop_leaves(t)),
+                    None => Form::Generic,
+                },
                 // Piecewise (isolated) patches take the generic evaluation, or their points
                 // grouped by leaf (`tree_points`).
                 Patch::Subdivision(_) => Form::Generic,
@@ -807,6 +832,12 @@ impl PointBlocks {
         blocks.all_bicubic =
             blocks.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
         blocks
+    }
+
+    /// How many Loop leaf forms the set keeps ([`LOOP_FORMS_BUDGET`]).
+    #[cfg(test)]
+    pub(super) fn stored_loop_leaves(&self) -> usize {
+        self.loop_leaves.len()
     }
 
     /// Patch `p`'s local bicubic form, where it is a bicubic that has one.
@@ -877,6 +908,10 @@ impl PointBlocks {
                     let first = first as usize;
                     let leaves = &self.loop_leaves[first..first + tree.leaves().len()];
                     return grouped::<FMA, _>(set, p, &**tree, Some(leaves), uvs, out);
+                }
+                // A set past the budget for stored forms (`LOOP_FORMS_BUDGET`).
+                (Patch::Loop(tree), Local::Generic) if worth_grouping(&**tree, uvs.len()) => {
+                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
                 }
                 _ => {}
             }

@@ -551,6 +551,40 @@ mod tests {
         }
     }
 
+    /// A Loop set past the budget for stored leaf forms (here a budget of 0) keeps none, and
+    /// its trees' points are grouped with each group's form made for it (one or two points of
+    /// a leaf in f64): still the f64 evaluation's points within the kernels' promise, most
+    /// normals from the kernels.
+    #[test]
+    fn loop_points_without_stored_forms_match_the_f64_evaluation() {
+        let path = crate::test_support::data("subdivision/loop_xord_interior.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        let set = SurfaceSet::from_loop_cage(&mesh, &path, Default::default()).unwrap();
+        let n = 24;
+        let uvs: Vec<DVec2> = (0..=n)
+            .flat_map(|j| (0..=n - j).map(move |i| DVec2::new(i as f64, j as f64) / n as f64))
+            .collect();
+        let (lo, hi) = set.bounds();
+        let size = lo.distance(hi) as f32;
+        let blocks = [false, true].map(|fma| PointBlocks::for_set_within(&set, fma, 0));
+        assert!(PointBlocks::for_set(&set, false).stored_loop_leaves() > 0, "forms kept within the budget");
+        let (mut points, mut kernels) = (0, 0);
+        for (p, patch) in set.patches.iter().enumerate() {
+            let Patch::Loop(tree) = patch else { panic!("a Loop cage's patch") };
+            if tree.regular().is_some() {
+                continue;
+            }
+            assert!(blocks.iter().all(|b| b.stored_loop_leaves() == 0), "a form stored past the budget");
+            let made = assert_matches_f64(&format!("patch {p}"), &set, p, &uvs, size, |fma, out| {
+                blocks[usize::from(fma)].eval(&set, p, &uvs, out)
+            });
+            points += uvs.len();
+            kernels += made.iter().sum::<usize>();
+        }
+        assert!(points > 0, "no tree among the patches");
+        assert!(kernels * 2 > points, "only {kernels} of {points} normals from the kernels");
+    }
+
     /// [`eval`] compiled for AVX2 and FMA, as the engine calls it.
     ///
     /// # Safety
