@@ -26,7 +26,7 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
-use super::tree_points::{loop_leaves, LoopLeaf};
+use super::tree_points::{loop_leaf, LoopLeaf};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
@@ -354,7 +354,9 @@ enum Form {
     Rational(LocalPatch<4>),
     Triangle(LocalTriangle),
     Quartic(LocalQuartic),
-    LoopTree(Vec<LoopLeaf>),
+    /// A Loop tree whose leaves' forms the set keeps (made after every patch's form, into
+    /// their place in [`PointBlocks`]' vector).
+    LoopTree,
     Generic,
 }
 
@@ -796,7 +798,7 @@ impl PointBlocks {
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
                 Patch::Loop(t) => match t.regular_net() {
                     Some(q) => Form::Quartic(LocalQuartic::from_net(&q.points)),
-                    None if store_loop_leaves => Form::LoopTree(loop_leaves(t)),
+                    None if store_loop_leaves => Form::LoopTree,
                     None => Form::Generic,
                 },
                 // Piecewise (isolated) patches take the generic evaluation, or their points
@@ -814,21 +816,36 @@ impl PointBlocks {
             all_bicubic: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
-        for form in forms {
+        // Each stored tree's first leaf and patch, in patch order.
+        let (mut trees, mut stored) = (Vec::new(), 0usize);
+        for (p, form) in forms.into_iter().enumerate() {
             let local = match form {
                 Form::Bicubic(b) => Local::Bicubic(push(&mut blocks.bicubics, b)),
                 Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
                 Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
                 Form::Quartic(t) => Local::Quartic(push(&mut blocks.quartics, t)),
-                Form::LoopTree(leaves) => {
-                    let first = blocks.loop_leaves.len() as u32;
-                    blocks.loop_leaves.extend(leaves);
+                Form::LoopTree => {
+                    let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
+                    trees.push((stored, p));
+                    let first = stored as u32;
+                    stored += tree.leaves().len();
                     Local::LoopTree(first)
                 }
                 Form::Generic => Local::Generic,
             };
             blocks.locals.push(local);
         }
+        // Made straight into place, leaf by leaf in parallel: per-patch vectors moved into this
+        // one held every form twice at the peak.
+        blocks.loop_leaves = (0..stored)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let (first, p) = trees[trees.partition_point(|&(first, _)| first <= i) - 1];
+                let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
+                loop_leaf(tree, i - first)
+            })
+            .collect();
         blocks.all_bicubic =
             blocks.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
         blocks

@@ -162,10 +162,10 @@ pub(super) enum LoopLeaf {
     Gregory(LocalGregory),
 }
 
-/// Every leaf of `tree` in its local frame ([`LeafTree::local`]), in leaf order: what
-/// [`super::point_blocks::PointBlocks`] keeps per set for [`eval`]. Cost: O(leaves).
-pub(super) fn loop_leaves(tree: &TriangleTree) -> Vec<LoopLeaf> {
-    (0..tree.leaves().len()).map(|l| tree.local(l).expect("every Loop leaf has a local form")).collect()
+/// Leaf `leaf` of `tree` in its local frame ([`LeafTree::local`]): what
+/// [`super::point_blocks::PointBlocks`] keeps per leaf of a set for [`eval`]. Cost: O(1).
+pub(super) fn loop_leaf(tree: &TriangleTree, leaf: usize) -> LoopLeaf {
+    tree.local(leaf).expect("every Loop leaf has a local form")
 }
 
 impl LeafTree for TriangleTree {
