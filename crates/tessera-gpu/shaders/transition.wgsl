@@ -52,10 +52,10 @@ fn quad_layout(s: vec4<u32>, interior_factors: vec2<u32>, c: u32, pinched: u32) 
         var strip = select(0u, 1u, s.x != nu) | select(0u, 2u, s.y != nv) | select(0u, 4u, s.z != nu)
             | select(0u, 8u, s.w != nv);
         strip = strips_at_collapsed(strip, c, 4u);
-        let fan_u = (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u)) | proper;
-        let fan_v = (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u)) | proper;
-        let need_u = bit(strip, 1u) + bit(strip, 3u) + fan_u;
-        let need_v = bit(strip, 0u) + bit(strip, 2u) + fan_v;
+        let keep_u = proper | (bit(strip, 0u) & bit(c, 0u)) | (bit(strip, 2u) & bit(c, 2u));
+        let keep_v = proper | (bit(strip, 1u) & bit(c, 1u)) | (bit(strip, 3u) & bit(c, 3u));
+        let need_u = bit(strip, 1u) + bit(strip, 3u) + keep_u;
+        let need_v = bit(strip, 0u) + bit(strip, 2u) + keep_v;
         if (nu >= need_u && nv >= need_v) {
             return QuadLayout(nu, nv, strip, bit(strip, 3u), nu - bit(strip, 1u), bit(strip, 0u), nv - bit(strip, 2u), 0u);
         }

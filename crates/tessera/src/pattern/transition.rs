@@ -138,22 +138,21 @@ impl QuadLayout {
         let s = input.segments;
         let mut nu = input.interior[0].max(1);
         let mut nv = input.interior[1].max(1);
+        // A pinched corner 0 or 2 keeps the core a segment wide each way (module doc,
+        // "Pinched corners").
+        let pinched = input.pinched[0] || input.pinched[2];
         // Raising a factor can create strips on the sides that matched the old one, which can
         // require raising the other factor; both only grow (to at most 3), so this ends.
         loop {
             let mut strip = [s[0] != nu, s[1] != nv, s[2] != nu, s[3] != nv];
             strips_at_collapsed_edges(&mut strip, &input.collapsed);
             // A strip on a collapsed edge needs a core side of at least one segment facing it
-            // (module doc, "Collapsed edges").
+            // (module doc, "Collapsed edges"); so does every side at a pinched corner.
             let c = input.collapsed;
-            let fan_u = (strip[0] && c[0]) || (strip[2] && c[2]);
-            let fan_v = (strip[1] && c[1]) || (strip[3] && c[3]);
-            // A pinched corner 0 or 2 keeps the core a segment wide each way (module doc,
-            // "Pinched corners").
-            let pinched = input.pinched[0] || input.pinched[2];
-            let (fan_u, fan_v) = (fan_u || pinched, fan_v || pinched);
-            let need_u = u32::from(strip[1]) + u32::from(strip[3]) + u32::from(fan_u);
-            let need_v = u32::from(strip[0]) + u32::from(strip[2]) + u32::from(fan_v);
+            let keep_u = pinched || (strip[0] && c[0]) || (strip[2] && c[2]);
+            let keep_v = pinched || (strip[1] && c[1]) || (strip[3] && c[3]);
+            let need_u = u32::from(strip[1]) + u32::from(strip[3]) + u32::from(keep_u);
+            let need_v = u32::from(strip[0]) + u32::from(strip[2]) + u32::from(keep_v);
             if nu >= need_u && nv >= need_v {
                 return QuadLayout {
                     nu,

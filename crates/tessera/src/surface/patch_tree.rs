@@ -581,7 +581,7 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
     #[cfg(target_arch = "x86_64")]
     {
         let start = (leaf as *const Leaf).cast::<i8>();
-        let line = |offset: usize| prefetch_line(start.wrapping_add(offset));
+        let line = |offset: usize| prefetch_at::<TO_L1>(start.wrapping_add(offset));
         line(0);
         let point = std::mem::size_of::<DVec3>();
         let rows = live(st.x);
@@ -604,10 +604,7 @@ fn prefetch(leaf: &Leaf, st: DVec2) {
 /// faster. Also Loop's trees' nodes, leaf frames and leaves ([`crate::surface::TriangleTree`]).
 #[inline(always)]
 pub(crate) fn prefetch_slice<T>(items: &[T]) {
-    #[cfg(target_arch = "x86_64")]
-    prefetch_lines::<{ std::arch::x86_64::_MM_HINT_T0 }, T>(items);
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = items;
+    prefetch_lines::<TO_L1, T>(items);
 }
 
 /// [`prefetch_slice`] into the second-level cache only: for data asked for well before it is
@@ -620,32 +617,38 @@ pub(crate) fn prefetch_slice<T>(items: &[T]) {
 /// factor 16 and at half a pixel (one thread, measured alternating with the L1 hint).
 #[inline(always)]
 pub(crate) fn prefetch_slice_to_l2<T>(items: &[T]) {
-    #[cfg(target_arch = "x86_64")]
-    prefetch_lines::<{ std::arch::x86_64::_MM_HINT_T1 }, T>(items);
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = items;
+    prefetch_lines::<TO_L2, T>(items);
 }
 
-/// The lines of `items` (up to [`NODE_LINES`]) asked for with the hint `HINT`.
+/// The cache levels a prefetch fills, numbered as `_mm_prefetch`'s hints: every level
+/// (`_MM_HINT_T0`), or the second level and below (`_MM_HINT_T1`).
+const TO_L1: i32 = 3;
+const TO_L2: i32 = 2;
 #[cfg(target_arch = "x86_64")]
+const _: () = assert!(TO_L1 == std::arch::x86_64::_MM_HINT_T0 && TO_L2 == std::arch::x86_64::_MM_HINT_T1);
+
+/// The lines of `items` (up to [`NODE_LINES`]) asked for with the hint `HINT`.
 #[inline(always)]
 fn prefetch_lines<const HINT: i32, T>(items: &[T]) {
     let bytes = std::mem::size_of_val(items).min(64 * NODE_LINES);
     let start = items.as_ptr().cast::<i8>();
     for offset in (0..bytes).step_by(64) {
-        // SAFETY: a prefetch never faults, whatever the address, and changes nothing but the
-        // cache; nothing is read or written through the pointer.
-        unsafe { std::arch::x86_64::_mm_prefetch::<HINT>(start.wrapping_add(offset)) }
+        prefetch_at::<HINT>(start.wrapping_add(offset));
     }
 }
 
-/// Asks for the cache line holding `at` (a hint: a prefetch never faults, whatever the
-/// address, and changes nothing but the cache).
-#[cfg(target_arch = "x86_64")]
+/// Asks for the cache line holding `at` with the hint `HINT` (a hint: a prefetch never
+/// faults, whatever the address, and changes nothing but the cache; elsewhere than x86-64,
+/// nothing).
 #[inline(always)]
-fn prefetch_line(at: *const i8) {
+fn prefetch_at<const HINT: i32>(at: *const i8) {
     // SAFETY: see above; nothing is read or written through `at`.
-    unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at) }
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<HINT>(at)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = at;
 }
 
 /// The most lines [`prefetch_slice`] asks for (4 KiB: the nodes of a deep tree).
