@@ -592,33 +592,33 @@ pub(crate) fn plan_limited(
 /// Cost: O(P).
 pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]> {
     debug_assert_eq!(hessians.len(), set.patches.len());
-    set.patches
-        .par_iter()
-        .zip(hessians)
-        .map(|(patch, h)| {
-            if let Patch::Loop(tree) = patch {
-                // The quartic leaves (a regular patch's one) along each edge.
-                let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
-                return [a, b, c, 0.0];
-            }
-            let mut out = [0.0; 4];
-            for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
-                *o = match edge_control_points(patch, l) {
-                    Some((points, weights)) => bounds::curve_second_derivative(points, weights),
-                    // A piecewise boundary: the patch's own bound along the edge's direction
-                    // bounds the curve's second derivative. A quad's edges 0 and 2 run along
-                    // u; a triangle's edge 0 along u, edge 2 along v and edge 1 along
-                    // (−1, 1), where |S_uu − 2 S_uv + S_vv| ≤ uu + 2 uv + vv.
-                    None => match (patch.domain(), l) {
-                        (Domain::Quad, 0 | 2) | (Domain::Tri, 0) => h.uu,
-                        (Domain::Tri, 1) => h.uu + 2.0 * h.uv + h.vv,
-                        _ => h.vv,
-                    },
-                };
-            }
-            out
-        })
-        .collect()
+    set.patches.par_iter().zip(hessians).map(|(patch, h)| patch_curve_bounds(patch, h)).collect()
+}
+
+/// [`curve_bounds`] of one patch, whose own bound is `h`. Cost: O(1) for a net, O(leaves)
+/// for a Loop tree.
+pub fn patch_curve_bounds(patch: &Patch, h: &HessianBound) -> [f64; 4] {
+    if let Patch::Loop(tree) = patch {
+        // The quartic leaves (a regular patch's one) along each edge.
+        let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
+        return [a, b, c, 0.0];
+    }
+    let mut out = [0.0; 4];
+    for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {
+        *o = match edge_control_points(patch, l) {
+            Some((points, weights)) => bounds::curve_second_derivative(points, weights),
+            // A piecewise boundary: the patch's own bound along the edge's direction
+            // bounds the curve's second derivative. A quad's edges 0 and 2 run along
+            // u; a triangle's edge 0 along u, edge 2 along v and edge 1 along
+            // (−1, 1), where |S_uu − 2 S_uv + S_vv| ≤ uu + 2 uv + vv.
+            None => match (patch.domain(), l) {
+                (Domain::Quad, 0 | 2) | (Domain::Tri, 0) => h.uu,
+                (Domain::Tri, 1) => h.uu + 2.0 * h.uv + h.vv,
+                _ => h.vv,
+            },
+        };
+    }
+    out
 }
 
 /// The output budget of [`plan_limited`]: the triangles of each patch's latest checked

@@ -21,6 +21,7 @@ pub mod loop_gregory;
 pub mod loop_isolation;
 pub mod loop_sdc;
 mod loop_surface;
+pub mod moving_bounds;
 pub mod sdc;
 pub mod stencils;
 

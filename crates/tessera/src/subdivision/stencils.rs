@@ -329,6 +329,24 @@ impl CageStencils {
             .collect())
     }
 
+    /// Patch `patch` (of face `origin`, as built with these stencils) with its points at
+    /// `points` instead, in [`CageStencils::point_ranges`]' order: a bicubic patch's 16, or
+    /// every leaf point of the tree it views. For bounding what a cage's motion does to a
+    /// patch ([`super::moving_bounds`]). Preconditions: `patch` is one of the set these
+    /// stencils checked, and `points` has its range's length. Cost: a copy of the tree.
+    pub(super) fn with_points(&self, patch: &Patch, origin: &PatchOrigin, points: &[DVec3]) -> Patch {
+        match (patch, &self.shapes[origin.face as usize]) {
+            (Patch::Bicubic(_), _) => {
+                Patch::Bicubic(RationalBicubic::polynomial(std::array::from_fn(|k| points[k])))
+            }
+            (Patch::Subdivision(tree), FaceShape::Isolated(trees)) => Patch::Subdivision(Box::new(
+                tree.with_tree_of(&trees[tree_index(origin)].with_leaf_points(points)),
+            )),
+            (Patch::Loop(tree), _) => Patch::Loop(Box::new(tree.with_leaf_points(points))),
+            _ => unreachable!("a patch these stencils checked"),
+        }
+    }
+
     /// Whether `set` has the patches these stencils were made for: the count, and each
     /// patch's kind and face as built.
     fn check_set(&self, set: &SurfaceSet) -> Result<()> {
