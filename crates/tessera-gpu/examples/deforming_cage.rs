@@ -3,9 +3,13 @@
 //! patches' control points on the GPU, and the same command buffer tessellates them.
 //!
 //! `cargo run --release -p tessera-gpu --example deforming_cage -- [CAGE.obj] [FRAMES]
-//! [FACTOR] [OUT_DIR] [catmull-clark|loop]` (defaults: `$TESSERA_DATA/subdivision/catmark_torus.obj`,
-//! 60 frames, factor 8, `frames/`, Catmull-Clark; a Loop cage is a triangle cage such as
-//! `subdivision/loop_xord_interior.obj`). The cage bends and breathes over the frames; each frame's mesh is
+//! [PIXELSpx|FACTOR] [OUT_DIR] [catmull-clark|loop]` (defaults: `$TESSERA_DATA/subdivision/catmark_torus.obj`,
+//! 60 frames, `0.5px`, `frames/`, Catmull-Clark; a Loop cage is a triangle cage such as
+//! `subdivision/loop_xord_interior.obj`). With a pixel error (`0.5px`) every frame is planned
+//! on the GPU from a camera framing the cage — culling, the transition scheme's edge factors
+//! and its a-posteriori check — on bounds that move with the cage
+//! (`GpuStencils::with_moving_bounds`); with a number, every frame is the uniform grid of that
+//! factor. The cage bends and breathes over the frames; each frame's mesh is
 //! read back and written as `OUT_DIR/cage_NNN.ply` (a headless app's stand-in for drawing
 //! it: the vertex and index buffers are the engine's own, as `tessera-render`'s examples
 //! draw them), and a line per frame gives the vertices uploaded and the GPU time of the
@@ -20,10 +24,23 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::DVec3;
+use tessera::camera::Camera;
 use tessera::criterion::Plan;
+use tessera::pattern::transition::Transition;
 use tessera::pattern::uniform::Uniform;
+use tessera::pattern::Pattern;
+use tessera::scheme::{Criterion, Prepared, Scheme};
 use tessera::subdivision::{CageOptions, CageStencils};
+use tessera_gpu::tessellator::ScreenCriterion;
 use tessera_gpu::{GpuContext, GpuStencils, GpuTessellator};
+
+/// How each frame is tessellated.
+enum Tessellation {
+    /// The uniform grid of this factor, planned once on the CPU.
+    Factor(u32),
+    /// The transition scheme at this pixel error, planned on the GPU every frame.
+    Pixels(f64),
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -31,7 +48,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::env::var_os("TESSERA_DATA").map_or_else(|| PathBuf::from("../shared/data"), PathBuf::from);
     let cage_path = args.get(1).map_or_else(|| data.join("subdivision/catmark_torus.obj"), PathBuf::from);
     let frames: usize = args.get(2).map_or(Ok(60), |s| s.parse())?;
-    let factor: u32 = args.get(3).map_or(Ok(8), |s| s.parse())?;
+    let tessellation = match args.get(3).map(String::as_str) {
+        None => Tessellation::Pixels(0.5),
+        Some(s) if s.ends_with("px") => Tessellation::Pixels(s.trim_end_matches("px").parse()?),
+        Some(s) => Tessellation::Factor(s.parse()?),
+    };
     let out = PathBuf::from(args.get(4).map_or("frames", String::as_str));
     let build = match args.get(5).map_or("catmull-clark", String::as_str) {
         "catmull-clark" => CageStencils::build,
@@ -54,12 +75,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ctx = GpuContext::new()?;
     println!("adapter: {} ({:?})", ctx.info.name, ctx.info.backend);
     let mut gpu = GpuTessellator::new(&ctx, &set)?;
-    let moving = GpuStencils::new(&ctx, &stencils, &set, &gpu)?;
-    // A uniform plan: it needs no per-patch bounds, which the stencil pass does not refresh.
-    let plan = Plan::uniform(&set, factor)?;
-    gpu.prepare(&ctx, &set, &plan, &Uniform)?;
-
     let (lo, hi) = set.bounds();
+    let (moving, pattern): (GpuStencils, &dyn Pattern) = match tessellation {
+        Tessellation::Factor(factor) => {
+            // A uniform plan needs no per-patch bounds: the stencil pass alone moves the cage.
+            let moving = GpuStencils::new(&ctx, &stencils, &set, &gpu)?;
+            gpu.prepare(&ctx, &set, &Plan::uniform(&set, factor)?, &Uniform)?;
+            (moving, &Uniform)
+        }
+        Tessellation::Pixels(pixels) => {
+            let prepared = Prepared::new(&set, true);
+            let moving =
+                GpuStencils::with_moving_bounds(&ctx, &stencils, &set, &mut gpu, &prepared, &mesh.positions)?;
+            // The rest cage's box grown by the breathing (15 %) and the bend.
+            let pad = (hi - lo) * 0.3;
+            let camera = Camera::framing(lo - pad, hi + pad, 1280, 1024);
+            let criterion = Criterion::PixelError(pixels);
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: 32, capacity: None };
+            gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
+            (moving, &Transition)
+        }
+    };
+
     let (centre, size) = ((lo + hi) * 0.5, (hi - lo).max_element());
     for frame in 0..frames {
         let t = frame as f64 / frames.max(1) as f64 * std::f64::consts::TAU;
@@ -72,6 +110,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ctx.queue.submit([encoder.finish()]);
         ctx.wait()?;
         let gpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        // A frame that needed more room than the output had drew nothing: grown, drawn again.
+        while gpu.grow_if_overflowed(&ctx)? {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            moving.record(&mut encoder);
+            gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+        }
         let drawn = gpu.read_mesh(&ctx, &set)?;
         let path = out.join(format!("cage_{frame:03}.ply"));
         tessera::io::write_mesh(&drawn, &path)?;
@@ -84,7 +129,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // The CPU's stencils give the same surface (a check a real loop would leave out).
         if frame == frames - 1 {
             stencils.apply(&positions, &mut set)?;
-            let cpu = tessera::engine::tessellate(&set, &plan, &Uniform, Default::default())?;
+            let plan = gpu.read_plan(&ctx)?;
+            let cpu = tessera::engine::tessellate(&set, &plan, pattern, Default::default())?;
             let worst = cpu
                 .positions
                 .iter()

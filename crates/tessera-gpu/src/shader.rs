@@ -18,6 +18,7 @@ pub mod sources {
     pub(crate) const COMMON: &str =
         concat!(include_str!("../shaders/threads.wgsl"), include_str!("../shaders/common.wgsl"));
     pub(crate) const STENCILS: &str = include_str!("../shaders/stencils.wgsl");
+    pub(crate) const MOVING_BOUNDS: &str = include_str!("../shaders/moving_bounds.wgsl");
     /// `bicubic.wgsl`: `bicubic_eval(p, uv)`, patch `p`'s position and normal as
     /// `tessera::surface::RationalBicubic::eval` computes them, from the `control_points`
     /// rows ([`crate::upload`]).

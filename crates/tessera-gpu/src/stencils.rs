@@ -8,21 +8,31 @@
 //! every leaf point of an isolated face's tree or a Loop triangle's where [`crate::upload`]
 //! packed it (each tree once, however many
 //! patches view it). `stencils.wgsl` applies them in f32 as `SparseRows::apply_row` does in
-//! f64. What the pass does not refresh: an isolated patch's 16 slots (the bounding box of its
-//! pieces, which culling reads) and the view passes' per-patch bounds (culling's boxes and
-//! normal cones, the screen criteria's second-derivative bounds), which
-//! [`GpuTessellator::new`] prepared from the set as it was. A deforming cage is therefore
-//! drawn from a plan that needs no bounds — a uniform factor or hardware factors planned on
-//! the CPU ([`GpuTessellator::prepare`]), without a culling camera — until those bounds are
-//! computed on the GPU too.
+//! f64.
+//!
+//! A cage planned from the camera (culling, a pixel error) also needs each patch's view
+//! bounds — its box and sphere, normal cone, second-derivative and boundary-curve bounds —
+//! for the moved surface. [`GpuStencils::with_moving_bounds`] keeps the rest cage's and, per
+//! patch, what each cage vertex's displacement can add to them
+//! ([`tessera::subdivision::moving_bounds`], where the rule is proven); a second pass,
+//! `moving_bounds.wgsl`, adds them up each frame from the same uploaded vertices (and
+//! rewrites an isolated patch's 16 slots, the box of its pieces that culling reads). The
+//! bounds are conservative and loosen as the cage moves away from its rest pose: the frame
+//! keeps its pixel-error guarantee with more triangles than a set rebuilt at the pose would
+//! get. Made with [`GpuStencils::new`], the bounds stay the rest cage's, so a deforming cage
+//! is then drawn from a plan that needs none (a uniform factor or hardware factors planned
+//! on the CPU, [`GpuTessellator::prepare`], without a culling camera).
 
 use glam::DVec3;
 
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::shader::{self, Binding};
+use crate::tessellator::PATCH_VIEW_ROW;
 use crate::upload::{storage_buffer, CONTROL_POINTS};
 use crate::GpuTessellator;
+use tessera::scheme::Prepared;
+use tessera::subdivision::moving_bounds::MovingBounds;
 use tessera::subdivision::CageStencils;
 use tessera::surface::{Patch, SurfaceSet};
 
@@ -42,6 +52,19 @@ pub struct GpuStencils {
     rows: u32,
     vertex_count: usize,
     positions: wgpu::Buffer,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    moving: Option<MovingPass>,
+}
+
+/// The view rows of a patch the moving-bounds pass keeps from the rest cage: cone, sphere,
+/// trigonometry, box (2), second-derivative bound, boundary curves.
+const REST_ROWS: u32 = 7;
+
+/// `moving_bounds.wgsl`, bound to a tessellator's view rows and control points.
+#[derive(Debug)]
+struct MovingPass {
+    patches: u32,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
 }
@@ -130,7 +153,115 @@ impl GpuStencils {
             positions,
             pipeline,
             bind_group,
+            moving: None,
         })
+    }
+
+    /// [`GpuStencils::new`], and every frame's view bounds moved with the cage (module doc):
+    /// `tessellator` can then plan from the camera ([`GpuTessellator::prepare_screen`] with a
+    /// pixel error and the uniform, transition or semi-uniform scheme, or culling alone) on
+    /// the moved cage. `rest` are the cage vertices `set` was built from and `prepared` its
+    /// bounds (`Prepared::new(set, true)`, the one given to `prepare_screen`); the rows are
+    /// uploaded now, so the first frame may come before any position is written.
+    ///
+    /// Errors: as [`GpuStencils::new`]; [`tessera::Error::InvalidParameter`] for `rest` of
+    /// another count or not finite; as [`GpuTessellator::prepare_screen`] for a `prepared`
+    /// without bounds. Later, `prepare_screen` refuses the criteria that read what the pass
+    /// does not move (silhouetteness, SD-2, ESC) with [`crate::GpuError::Unsupported`]. Cost:
+    /// [`MovingBounds::new`] (a bound per patch and neighbourhood vertex, parallel, once per
+    /// topology), an upload of 32 bytes a term and 112 a patch, one WGSL compilation.
+    pub fn with_moving_bounds(
+        ctx: &GpuContext,
+        stencils: &CageStencils,
+        set: &SurfaceSet,
+        tessellator: &mut GpuTessellator,
+        prepared: &Prepared,
+        rest: &[DVec3],
+    ) -> Result<GpuStencils> {
+        let mut out = Self::new(ctx, stencils, set, tessellator)?;
+        tessera::subdivision::stencils::check_positions(rest, out.vertex_count)?;
+        let bounds = MovingBounds::new(stencils, set)?;
+        let rows = tessellator.moving_view_rows(ctx, set, prepared)?;
+        let (per_patch, kept) = (PATCH_VIEW_ROW as usize, REST_ROWS as usize);
+        let mut rest_rows = Vec::with_capacity(kept * set.patches.len());
+        for (p, patch) in set.patches.iter().enumerate() {
+            let first = rest_rows.len();
+            rest_rows.extend_from_slice(&rows[per_patch * p..per_patch * p + kept]);
+            // Row 2's w (0 in the view rows) marks a tree, whose 16 slots hold its box.
+            rest_rows[first + 2][3] =
+                f32::from(u8::from(matches!(patch, Patch::Subdivision(_) | Patch::Loop(_))));
+        }
+        let terms: Vec<[f32; 4]> = bounds
+            .terms
+            .iter()
+            .flat_map(|t| [[t[0], t[1], t[2], t[3]], [t[4], t[5], t[6], t[7]]].map(|r| r.map(|x| x as f32)))
+            .collect();
+        let rest_cage: Vec<[f32; 4]> =
+            rest.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32, 1.0]).collect();
+        let device = &ctx.device;
+        let patches = set.patches.len() as u32;
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("moving bounds"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&uniform, 0, bytemuck::cast_slice(&[patches, 0, 0, 0]));
+        // Storage buffers may not be empty.
+        let nonempty = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+        let starts = storage_buffer(device, "moving bounds starts", &bounds.starts);
+        let vertices = storage_buffer(device, "moving bounds vertices", &nonempty(&bounds.vertices));
+        let terms = storage_buffer(
+            device,
+            "moving bounds terms",
+            &if terms.is_empty() { vec![[0f32; 4]; 2] } else { terms },
+        );
+        let rest_rows = storage_buffer(device, "moving bounds rest rows", &rest_rows);
+        let rest_cage = storage_buffer(device, "rest cage vertices", &rest_cage);
+        let layout = shader::layout(
+            device,
+            &[
+                Binding::Uniform,
+                Binding::Read,
+                Binding::Read,
+                Binding::Read,
+                Binding::Read,
+                Binding::Read,
+                Binding::Read,
+                Binding::Write,
+                Binding::Write,
+            ],
+        );
+        let module = shader::module(
+            device,
+            "moving bounds",
+            &[shader::sources::THREADS, shader::sources::MOVING_BOUNDS],
+            &[
+                ("REST_ROWS", REST_ROWS),
+                ("PATCH_VIEW_ROW", PATCH_VIEW_ROW),
+                ("CONTROL_POINTS", CONTROL_POINTS),
+            ],
+        );
+        let pipeline = shader::pipeline(device, &module, "apply_moving_bounds", &layout);
+        let bind_group = shader::bind(
+            device,
+            &layout,
+            &[
+                &uniform,
+                &starts,
+                &vertices,
+                &terms,
+                &rest_rows,
+                &rest_cage,
+                &out.positions,
+                tessellator.patch_views(),
+                tessellator.control_points(),
+            ],
+        );
+        // The moved positions start at the rest pose (the rows as uploaded).
+        out.write_positions(ctx, rest)?;
+        out.moving = Some(MovingPass { patches, pipeline, bind_group });
+        Ok(out)
     }
 
     /// Uploads the cage's vertex positions for the next [`GpuStencils::record`] (as f32).
@@ -159,5 +290,11 @@ impl GpuStencils {
         pass.set_bind_group(0, &self.bind_group, &[]);
         let (x, y) = shader::grid(self.rows.div_ceil(shader::WORKGROUP));
         pass.dispatch_workgroups(x, y, 1);
+        if let Some(moving) = &self.moving {
+            pass.set_pipeline(&moving.pipeline);
+            pass.set_bind_group(0, &moving.bind_group, &[]);
+            let (x, y) = shader::grid(moving.patches.div_ceil(shader::WORKGROUP));
+            pass.dispatch_workgroups(x, y, 1);
+        }
     }
 }

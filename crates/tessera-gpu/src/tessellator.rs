@@ -79,6 +79,7 @@ pub use screen::{ScreenCriterion, CHECK_MAX_FACTOR};
 pub use timer::PassTimer;
 
 pub(crate) use pipelines::Params;
+pub(crate) use screen::PATCH_VIEW_ROW;
 // For the contract test (`crate::contract`), which checks them against the WGSL.
 #[cfg(test)]
 pub(crate) use {

@@ -1111,6 +1111,176 @@ fn loop_cages_equal_the_cpu_engine_on_every_cage_20_cameras() {
     subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::Loop, &cages, &[3], 20);
 }
 
+/// `subdivision/{cage}.obj`, its set and its stencils: Catmull-Clark, or Loop with `loop_`.
+fn cage_with_stencils(
+    cage: &str,
+    loop_: bool,
+) -> (tessera::surface::PolygonMesh, SurfaceSet, tessera::subdivision::CageStencils) {
+    use tessera::subdivision::{CageOptions, CageStencils};
+    let path = data_dir().join(format!("subdivision/{cage}.obj"));
+    let mesh = tessera::io::obj::read_obj(&path).unwrap();
+    let build = if loop_ { CageStencils::build_loop } else { CageStencils::build };
+    let (set, stencils) = build(&mesh, &path, CageOptions::default()).unwrap();
+    (mesh, set, stencils)
+}
+
+/// A deforming cage planned from the camera on the GPU (`GpuStencils::with_moving_bounds`), for
+/// both schemes — regular, isolated, split into sub-faces, Loop. At the rest pose, after the
+/// moving-bounds pass, the GPU's pixel-error plan equals the CPU's index for index (the pass
+/// keeps the rest rows and a tree's culling box bit for bit). Moved, every patch the CPU draws
+/// for the moved set is drawn (no patch culled by a stale box), the GPU's plan keeps every
+/// drawn patch's bound, measured with the moved set's own bounds, under its tolerance from
+/// the moved surface's box (but the patches the GPU reports failing at the cap), and its
+/// output equals the CPU engine's with that plan on the moved set. The refusals: criteria
+/// that read rows the pass does not move.
+#[test]
+fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
+    use glam::DVec3;
+    use tessera::scheme::{Criterion, PlanOptions, Prepared, Scheme};
+    use tessera_gpu::GpuStencils;
+    let ctx = ctx();
+    let (pixels, cap) = (0.5, 32);
+    let mut moved_plans_differ = 0;
+    for (cage, loop_) in [
+        ("catmark_torus", false),
+        ("catmark_torus_creases0", false),
+        ("catmark_pyramid_creases0", false),
+        ("loop_xord_interior", true),
+    ] {
+        let (mesh, set, stencils) = cage_with_stencils(cage, loop_);
+        let prepared = Prepared::new(&set, true);
+        let mut gpu = tessellator(&set);
+        let on_gpu =
+            GpuStencils::with_moving_bounds(ctx, &stencils, &set, &mut gpu, &prepared, &mesh.positions)
+                .unwrap();
+        let record_stencils = || {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            on_gpu.record(&mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+        };
+        let (lo, hi) = set.bounds();
+        let size = lo.distance(hi);
+        for (c, camera) in cameras(&set, 3, 71).into_iter().enumerate() {
+            let name = format!("{cage} camera {c}");
+            // The rest pose through the pass: the CPU's plan, index for index.
+            on_gpu.write_positions(ctx, &mesh.positions).unwrap();
+            record_stencils();
+            let mut counts = SweepCounts::default();
+            let drawn = checked_frame(
+                Scheme::Transition,
+                &format!("{name} at rest"),
+                &set,
+                &prepared,
+                &mut gpu,
+                &camera,
+                pixels,
+                cap,
+                &mut counts,
+            );
+            assert_eq!(counts.check_ties + counts.cull_ties, 0, "{name} at rest: {counts:?}");
+            assert_gpu_equals_cpu_after_record(&format!("{name} at rest"), &set, &gpu, &drawn, &Transition);
+
+            // Moved: a twist about z and a jitter of up to 4 % of the size, per vertex and
+            // camera.
+            let moved: Vec<DVec3> = mesh
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let (s, co) = (0.4 * (p.z - lo.z) / (hi.z - lo.z)).sin_cos();
+                    let k = (i + 7 * c) as f64;
+                    let jitter =
+                        DVec3::new((1.7 * k).sin(), (2.3 * k).sin(), (3.1 * k).sin()) * (0.04 * size);
+                    DVec3::new(co * p.x - s * p.y, s * p.x + co * p.y, p.z) + jitter
+                })
+                .collect();
+            on_gpu.write_positions(ctx, &moved).unwrap();
+            record_stencils();
+            let screen = ScreenCriterion {
+                scheme: Scheme::Transition,
+                criterion: Criterion::PixelError(pixels),
+                max_factor: cap,
+                capacity: None,
+            };
+            screen_frame(&mut gpu, &set, &prepared, &camera, screen);
+            let report = gpu.read_screen_report(ctx).unwrap();
+            let plan = gpu.read_plan(ctx).unwrap();
+            moved_plans_differ += usize::from(plan.segments != drawn.segments);
+            let mut moved_set = set.clone();
+            stencils.apply(&moved, &mut moved_set).unwrap();
+            let moved_prepared = Prepared::new(&moved_set, true);
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let exact = Scheme::Transition
+                .plan_prepared(&moved_set, &moved_prepared, &Criterion::PixelError(pixels), &options)
+                .unwrap();
+            let views = moved_prepared.views(&moved_set);
+            let view = camera.view();
+            let mut scratch = tessera::pattern::LocalTessellation::default();
+            let mut missed = 0;
+            for (p, patch_view) in views.iter().enumerate() {
+                if !plan.is_visible(p) {
+                    assert!(!exact.plan.is_visible(p), "{name} moved: patch {p} is culled, the CPU draws it");
+                    continue;
+                }
+                let eps = patch_view.tolerance(&moved_set.patches[p], &view, pixels, false).unwrap();
+                let input = tessera::engine::layout::pattern_input(&moved_set, &plan, p);
+                let bound = tessera::criterion::tolerance::patch_bound(
+                    &moved_prepared.hessians[p],
+                    &input,
+                    &exact.pattern,
+                    &mut scratch,
+                );
+                missed += usize::from(bound > eps * (1.0 + 1e-4));
+            }
+            assert!(
+                missed <= report.failing_patches as usize,
+                "{name} moved: {missed} patches miss their bound, the GPU reports {} failing",
+                report.failing_patches
+            );
+            assert_gpu_equals_cpu_after_record(
+                &format!("{name} moved"),
+                &moved_set,
+                &gpu,
+                &plan,
+                &Transition,
+            );
+        }
+        if cage == "catmark_torus" {
+            // What the pass does not move is refused.
+            let camera = cameras(&set, 1, 5)[0];
+            for (scheme, criterion) in [
+                (
+                    Scheme::Sd2 { warp: false },
+                    Criterion::View {
+                        criterion: tessera::criterion::view::ViewCriterion::Distance(
+                            tessera::criterion::view::Mapping::Linear,
+                        ),
+                        fmin: 1.0,
+                        fmax: 8.0,
+                    },
+                ),
+                (
+                    Scheme::Transition,
+                    Criterion::View {
+                        criterion: tessera::criterion::view::ViewCriterion::Silhouetteness,
+                        fmin: 1.0,
+                        fmax: 8.0,
+                    },
+                ),
+            ] {
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
+                assert!(
+                    matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),
+                    "{e}"
+                );
+            }
+        }
+    }
+    assert!(moved_plans_differ > 0, "moving the cages never changed a plan");
+}
+
 /// A deforming Catmull-Clark or Loop cage on the GPU (`GpuStencils`): each frame uploads the moved
 /// cage vertices only, the stencil pass recomputes the control points and the isolated faces'
 /// pieces, and the frame equals the CPU engine's on the set the CPU's stencils give for the
@@ -1118,31 +1288,22 @@ fn loop_cages_equal_the_cpu_engine_on_every_cage_20_cameras() {
 #[test]
 fn stencils_deform_a_cage_on_the_gpu_as_on_the_cpu() {
     use glam::DVec3;
-    use tessera::subdivision::{CageOptions, CageStencils};
+    use tessera::subdivision::CageOptions;
     use tessera_gpu::GpuStencils;
     let ctx = ctx();
     // A regular cage (control points only), one with creases (isolated quads: their trees'
     // leaf points) and one split into sub-faces (an isolated quad's quarters view one tree).
     // Loop cages: every triangle a tree (one leaf where regular), creased, and with
     // extraordinary vertices inside and on the boundary.
-    type Build = fn(
-        &tessera::surface::PolygonMesh,
-        &std::path::Path,
-        CageOptions,
-    ) -> tessera::Result<(tessera::surface::SurfaceSet, CageStencils)>;
-    let catmull_clark: Build = CageStencils::build;
-    let loop_: Build = CageStencils::build_loop;
-    for (cage, build) in [
-        ("catmark_torus", catmull_clark),
-        ("catmark_torus_creases0", catmull_clark),
-        ("catmark_pyramid_creases0", catmull_clark),
-        ("loop_cube_creases0", loop_),
-        ("loop_xord_interior", loop_),
-        ("loop_xord_boundary", loop_),
+    for (cage, loop_) in [
+        ("catmark_torus", false),
+        ("catmark_torus_creases0", false),
+        ("catmark_pyramid_creases0", false),
+        ("loop_cube_creases0", true),
+        ("loop_xord_interior", true),
+        ("loop_xord_boundary", true),
     ] {
-        let path = data_dir().join(format!("subdivision/{cage}.obj"));
-        let mesh = tessera::io::obj::read_obj(&path).unwrap();
-        let (mut set, stencils) = build(&mesh, &path, CageOptions::default()).unwrap();
+        let (mesh, mut set, stencils) = cage_with_stencils(cage, loop_);
         let mut gpu = tessellator(&set);
         let on_gpu = GpuStencils::new(ctx, &stencils, &set, &gpu).unwrap();
         let plan = Plan::uniform(&set, 5).unwrap();

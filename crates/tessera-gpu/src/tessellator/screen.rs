@@ -29,7 +29,7 @@ pub(super) const ROUND_ARGS_BINDING: u32 = 5;
 pub const CHECK_MAX_FACTOR: u32 = tessera::scheme::GPU_CHECK_MAX_FACTOR;
 
 /// `vec4<f32>` per patch in the view passes' patch rows ([`patch_view_rows`]).
-pub(super) const PATCH_VIEW_ROW: u32 = 10;
+pub(crate) const PATCH_VIEW_ROW: u32 = 10;
 
 /// What [`GpuTessellator::prepare_screen`] plans on the GPU: `scheme` under `criterion`
 /// with `PlanOptions::max_factor = max_factor`.
@@ -149,6 +149,10 @@ pub(super) struct ViewBuffers {
     /// Whether the bounds and edge rows of [`GpuTessellator::prepare_screen`] are on the
     /// device.
     pub(super) bounds_uploaded: bool,
+    /// Whether a [`crate::GpuStencils`] moves the patches' bounds each frame
+    /// ([`GpuTessellator::moving_view_rows`]): the edge, vertex and ESC rows then stay the
+    /// rest cage's, so the criteria that read them are refused.
+    pub(super) moving: bool,
     /// The set's topology vertices (their rows follow the edges').
     pub(super) vertices: u32,
 }
@@ -193,6 +197,7 @@ impl ViewBuffers {
             round_args,
             rounds,
             bounds_uploaded: false,
+            moving: false,
             vertices,
         }
     }
@@ -327,6 +332,17 @@ impl GpuTessellator {
         criterion: ScreenCriterion,
     ) -> Result<()> {
         let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
+        let reads_rest_rows = matches!(criterion, Criterion::View { .. } | Criterion::Esc { .. })
+            || matches!(scheme, Scheme::Sd2 { .. } | Scheme::Esc { .. });
+        if self.view.moving && reads_rest_rows {
+            return Err(GpuError::Unsupported {
+                what: format!(
+                    "{scheme:?} with {criterion:?} on a moving cage (its moving bounds refresh the patches' \
+                     boxes and second-derivative bounds only; use a pixel error with the uniform, \
+                     transition or semi-uniform scheme)"
+                ),
+            });
+        }
         let screen = screen_of(set, camera, scheme, criterion, max_factor)?;
         self.check_screen_support(set, prepared, scheme, max_factor)?;
         let pattern = match scheme {
@@ -395,6 +411,30 @@ impl GpuTessellator {
             });
         }
         Ok(())
+    }
+
+    /// The view rows of `set` with `prepared`'s bounds ([`patch_view_rows`]), uploaded now
+    /// and marked as moved each frame by a [`crate::GpuStencils`] made with moving bounds
+    /// (which keeps rows 0–6 of each patch, its bounds' rest). Errors: as
+    /// [`GpuTessellator::prepare_screen`] for another set or a `prepared` without bounds.
+    /// Cost: O(E + P) cone computations and one upload.
+    pub(crate) fn moving_view_rows(
+        &mut self,
+        ctx: &GpuContext,
+        set: &SurfaceSet,
+        prepared: &Prepared,
+    ) -> Result<Vec<[f32; 4]>> {
+        self.check_screen_support(set, prepared, Scheme::Uniform, 1)?;
+        let rows = patch_view_rows(set, Some(prepared));
+        ctx.queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));
+        self.view.bounds_uploaded = true;
+        self.view.moving = true;
+        Ok(rows)
+    }
+
+    /// The patch view rows, for [`crate::GpuStencils`]'s moving-bounds pass.
+    pub(crate) fn patch_views(&self) -> &wgpu::Buffer {
+        &self.view.patch_views
     }
 
     /// Makes the GPU cull (frustum and normal cone, `cull.wgsl`) for `camera` in every
