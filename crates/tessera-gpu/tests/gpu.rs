@@ -1127,8 +1127,9 @@ fn cage_with_stencils(
 /// A deforming cage planned from the camera on the GPU (`GpuStencils::with_moving_bounds`), for
 /// both schemes — regular, isolated, split into sub-faces, Loop. At the rest pose, after the
 /// moving-bounds pass, the GPU's pixel-error plan equals the CPU's index for index (the pass
-/// keeps the rest rows and a tree's culling box bit for bit). Moved, every patch the CPU draws
-/// for the moved set is drawn (no patch culled by a stale box), the GPU's plan keeps every
+/// keeps the rest rows and a tree's culling box bit for bit). Moved, with the transition,
+/// semi-uniform and uniform schemes: every patch the CPU draws for the moved set is drawn
+/// (no patch culled by a stale box), the GPU's plan keeps every
 /// drawn patch's bound, measured with the moved set's own bounds, under its tolerance from
 /// the moved surface's box (but the patches the GPU reports failing at the cap), and its
 /// output equals the CPU engine's with that plan on the moved set. The refusals: criteria
@@ -1196,55 +1197,50 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                 .collect();
             on_gpu.write_positions(ctx, &moved).unwrap();
             record_stencils();
-            let screen = ScreenCriterion {
-                scheme: Scheme::Transition,
-                criterion: Criterion::PixelError(pixels),
-                max_factor: cap,
-                capacity: None,
-            };
-            screen_frame(&mut gpu, &set, &prepared, &camera, screen);
-            let report = gpu.read_screen_report(ctx).unwrap();
-            let plan = gpu.read_plan(ctx).unwrap();
-            moved_plans_differ += usize::from(plan.segments != drawn.segments);
             let mut moved_set = set.clone();
             stencils.apply(&moved, &mut moved_set).unwrap();
             let moved_prepared = Prepared::new(&moved_set, true);
-            let options =
-                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
-            let exact = Scheme::Transition
-                .plan_prepared(&moved_set, &moved_prepared, &Criterion::PixelError(pixels), &options)
-                .unwrap();
             let views = moved_prepared.views(&moved_set);
             let view = camera.view();
-            let mut scratch = tessera::pattern::LocalTessellation::default();
-            let mut missed = 0;
-            for (p, patch_view) in views.iter().enumerate() {
-                if !plan.is_visible(p) {
-                    assert!(!exact.plan.is_visible(p), "{name} moved: patch {p} is culled, the CPU draws it");
-                    continue;
+            let options =
+                PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
+            let criterion = Criterion::PixelError(pixels);
+            for scheme in [Scheme::Transition, Scheme::SemiUniform { max_level: 5 }, Scheme::Uniform] {
+                let name = format!("{name} moved, {scheme:?}");
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                screen_frame(&mut gpu, &set, &prepared, &camera, screen);
+                let report = gpu.read_screen_report(ctx).unwrap();
+                let plan = gpu.read_plan(ctx).unwrap();
+                if scheme == Scheme::Transition {
+                    moved_plans_differ += usize::from(plan.segments != drawn.segments);
                 }
-                let eps = patch_view.tolerance(&moved_set.patches[p], &view, pixels, false).unwrap();
-                let input = tessera::engine::layout::pattern_input(&moved_set, &plan, p);
-                let bound = tessera::criterion::tolerance::patch_bound(
-                    &moved_prepared.hessians[p],
-                    &input,
-                    &exact.pattern,
-                    &mut scratch,
+                let exact = scheme.plan_prepared(&moved_set, &moved_prepared, &criterion, &options).unwrap();
+                let mut scratch = tessera::pattern::LocalTessellation::default();
+                let mut missed = 0;
+                for (p, patch_view) in views.iter().enumerate() {
+                    if !plan.is_visible(p) {
+                        assert!(!exact.plan.is_visible(p), "{name}: patch {p} is culled, the CPU draws it");
+                        continue;
+                    }
+                    let eps = patch_view.tolerance(&moved_set.patches[p], &view, pixels, false).unwrap();
+                    let input = tessera::engine::layout::pattern_input(&moved_set, &plan, p);
+                    let bound = tessera::criterion::tolerance::patch_bound(
+                        &moved_prepared.hessians[p],
+                        &input,
+                        &exact.pattern,
+                        &mut scratch,
+                    );
+                    missed += usize::from(bound > eps * (1.0 + 1e-4));
+                }
+                // The uniform scheme has no check: its one factor at the cap is its report.
+                let capped = scheme == Scheme::Uniform && plan.segments.iter().any(|&s| s >= cap);
+                let failing = if capped { missed } else { report.failing_patches as usize };
+                assert!(
+                    missed <= failing,
+                    "{name}: {missed} patches miss their bound, the GPU reports {failing} failing"
                 );
-                missed += usize::from(bound > eps * (1.0 + 1e-4));
+                assert_gpu_equals_cpu_after_record(&name, &moved_set, &gpu, &plan, &exact.pattern);
             }
-            assert!(
-                missed <= report.failing_patches as usize,
-                "{name} moved: {missed} patches miss their bound, the GPU reports {} failing",
-                report.failing_patches
-            );
-            assert_gpu_equals_cpu_after_record(
-                &format!("{name} moved"),
-                &moved_set,
-                &gpu,
-                &plan,
-                &Transition,
-            );
         }
         if cage == "catmark_torus" {
             // What the pass does not move is refused.
