@@ -13,8 +13,9 @@
 //! A cage planned from the camera (culling, a pixel error) also needs each patch's view
 //! bounds — its box and sphere, normal cone, second-derivative and boundary-curve bounds —
 //! for the moved surface. [`GpuStencils::with_moving_bounds`] keeps the rest cage's and, per
-//! patch, what each cage vertex's displacement can add to them
-//! ([`tessera::subdivision::moving_bounds`], where the rule is proven); a second pass,
+//! patch, what each cage vertex's displacement can add to them beyond the affine map that
+//! best follows the patch's vertices ([`tessera::subdivision::moving_bounds`], where the rule
+//! is proven); a second pass,
 //! `moving_bounds.wgsl`, adds them up each frame from the same uploaded vertices (and
 //! rewrites an isolated patch's 16 slots, the box of its pieces that culling reads). The
 //! bounds are conservative and loosen as the cage moves away from its rest pose: the frame

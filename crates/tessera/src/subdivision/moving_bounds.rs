@@ -17,26 +17,35 @@
 //! [`crate::criterion::bounds::hessian`] and
 //! [`crate::criterion::tolerance::patch_curve_bounds`] of probes.
 //!
-//! **A translation is free.** The limit surface reproduces translations (a face's weights
-//! sum to one: `S(X₀ + t) = S(X₀) + t`), and a seminorm of derivatives is zero on a constant,
-//! so any `t` may be taken off every displacement first: `dⱼ − t` instead of `dⱼ`. Per patch,
-//! `t` is the mean displacement of the vertices it reads, which leaves the part of a bend or
-//! a scaling that varies across the neighbourhood, not its full size.
+//! **An affine motion is nearly free.** The limit surface is affine invariant (a face's
+//! weights sum to one): for `Y = A(X₀ − c₀) + c`, `S(Y) = A(S(X₀) − c₀) + c`. Write the
+//! moved cage as `X = Y + R`, so `S(X) = A(S(X₀) − c₀) + c + S(R)`. A seminorm of
+//! derivatives is zero on a constant and `N(A S) ≤ ‖A‖₂ N(S)`, so
+//! `N(S(X)) ≤ ‖A‖₂ N(S(X₀)) + Σⱼ |rⱼ| N(φⱼ x̂)`: any `A` and `c` are valid, and the better
+//! they fit the motion the smaller the residuals `rⱼ`. Per patch, over the vertices it reads:
+//! `c₀` their rest centroid, `c = c₀ + t` with `t` their mean displacement, and `A = I + M`
+//! with `M` the least-squares fit of the displacements' variation, `M = D Xᵀ (X Xᵀ + λI)⁻¹`
+//! (`X` the rest vertices less `c₀`, `D` the displacements less `t`, `λ` a millionth of the
+//! trace, so a flat neighbourhood still has an inverse). A rigid motion leaves residuals of
+//! rounding only and `‖A‖₂ = 1`; a scaling by `s`, `‖A‖₂ = s`. `‖A‖₂` is bounded by the
+//! square root of the largest Gershgorin row sum of `AᵀA` (exact for rotations and
+//! similarities).
 //!
-//! A control point moves by `t + Σⱼ wᵢⱼ (dⱼ − t)` (the weights sum to one), so it lies
-//! within `δ = Σⱼ |dⱼ − t| maxᵢ |wᵢⱼ|` (`wᵢⱼ` its stencil weights) of its rest place moved
-//! by `t`: the patch's **growth**. The rest box moved by `t` and grown by `δ` on every side,
-//! and the rest sphere moved by `t` with its radius plus `δ`, hold the moved points (and the
-//! surface, inside their hull). A normal cone does not move by a bounded amount this way, so
-//! a patch that moved at all has none (it is not culled as back-facing).
+//! A control point moves to `A(Pᵢ − c₀) + c + Σⱼ wᵢⱼ rⱼ`, so it lies within
+//! `δ = Σⱼ |rⱼ| maxᵢ |wᵢⱼ|` (`wᵢⱼ` its stencil weights) of its rest place mapped by the
+//! affine part: the patch's **growth**. The box of the rest box's corners mapped so, grown by
+//! `δ` on every side, and the rest sphere mapped (centre mapped, radius times `‖A‖₂`) with
+//! its radius plus `δ`, hold the moved points (and the surface, inside their hull). A normal
+//! cone does not move by a bounded amount this way, so a patch that moved at all has none
+//! (it is not culled as back-facing).
 //!
-//! **The rule**, one per patch: with `t` the mean of the `dⱼ` over the patch's terms, the rest
-//! bounds moved by `t`, plus `Σⱼ |dⱼ − t| tⱼ` for the patch's terms
-//! `tⱼ = (growth, uu, uv, vv, curve₀..₃)` ([`MovingBounds::moved`]), the growth widening the
-//! box and sphere. The bounds loosen as the cage moves away from `X₀`; a caller that wants
-//! them tight again rebuilds the set (and the terms' rest) at the new pose.
+//! **The rule**, one per patch ([`MovingBounds::moved`]): the affine fit, the rest box and
+//! sphere mapped by it, and each rest bound times `‖A‖₂` plus `Σⱼ |rⱼ| tⱼ` for the patch's
+//! terms `tⱼ = (growth, uu, uv, vv, curve₀..₃)`, the growth widening the box and sphere. The
+//! bounds loosen as the cage moves away from `X₀` in ways no affine map follows; a caller
+//! that wants them tight again rebuilds the set (and the terms' rest) at the new pose.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 use super::stencils::CageStencils;
@@ -116,23 +125,96 @@ impl MovingBounds {
         self.starts.len().saturating_sub(1)
     }
 
-    /// Patch `p`'s move for the cage moved from `rest` to `moved` (module doc): the
-    /// translation `t` its bounds' boxes and spheres move by, and the increments to add to
-    /// its rest bounds (the first widens the box and sphere). Preconditions: `p` is a patch;
-    /// both slices index every vertex of the terms. Cost: O(the patch's terms).
-    pub fn moved(&self, p: usize, rest: &[DVec3], moved: &[DVec3]) -> (DVec3, MovingTerm) {
+    /// Patch `p`'s move for the cage moved from `rest` to `moved` (module doc: the affine
+    /// fit, its stretch and the residuals' sums). Preconditions: `p` is a patch; both slices
+    /// index every vertex of the terms. Cost: O(the patch's terms).
+    pub fn moved(&self, p: usize, rest: &[DVec3], moved: &[DVec3]) -> PatchMove {
         let range = self.starts[p] as usize..self.starts[p + 1] as usize;
         let vertices = &self.vertices[range.clone()];
+        let n = vertices.len().max(1) as f64;
         let d = |v: u32| moved[v as usize] - rest[v as usize];
-        let t = vertices.iter().map(|&v| d(v)).sum::<DVec3>() / vertices.len().max(1) as f64;
-        let mut sum = [0f64; 8];
+        let from = vertices.iter().map(|&v| rest[v as usize]).sum::<DVec3>() / n;
+        let t = vertices.iter().map(|&v| d(v)).sum::<DVec3>() / n;
+        // Σ x xᵀ and Σ (d − t) xᵀ, x the rest vertex less the centroid.
+        let (mut xx, mut dx) = (DMat3::ZERO, DMat3::ZERO);
+        for &v in vertices {
+            let x = rest[v as usize] - from;
+            xx += outer(x, x);
+            dx += outer(d(v) - t, x);
+        }
+        let lambda = 1e-6 * (xx.x_axis.x + xx.y_axis.y + xx.z_axis.z) + f64::MIN_POSITIVE;
+        let m = dx * (xx + DMat3::from_diagonal(DVec3::splat(lambda))).inverse();
+        let m = if m.is_finite() { m } else { DMat3::ZERO };
+        let mut increments = [0f64; 8];
         for (&v, term) in vertices.iter().zip(&self.terms[range]) {
-            let off = (d(v) - t).length();
-            for (s, x) in sum.iter_mut().zip(term) {
-                *s += off * x;
+            let r = (d(v) - t - m * (rest[v as usize] - from)).length();
+            for (s, x) in increments.iter_mut().zip(term) {
+                *s += r * x;
             }
         }
-        (t, sum)
+        PatchMove { m, from, t, stretch: stretch(DMat3::IDENTITY + m), increments }
+    }
+}
+
+/// `a bᵀ`.
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// An upper bound of `‖a‖₂`: the square root of the largest Gershgorin row sum of `aᵀa` (its
+/// eigenvalues' bound; exact for a rotation or a similarity).
+fn stretch(a: DMat3) -> f64 {
+    let b = a.transpose() * a;
+    let rows = b.transpose();
+    [rows.x_axis, rows.y_axis, rows.z_axis].iter().map(|r| r.abs().element_sum()).fold(0.0, f64::max).sqrt()
+}
+
+/// How a patch's bounds move with its cage ([`MovingBounds::moved`], module doc): the affine
+/// part `x ↦ x + t + m (x − from)`, its stretch, and the residuals' sums.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchMove {
+    /// The affine part's `A − I`.
+    pub m: DMat3,
+    /// The rest centroid of the patch's vertices.
+    pub from: DVec3,
+    /// Their mean displacement.
+    pub t: DVec3,
+    /// An upper bound of `‖A‖₂`.
+    pub stretch: f64,
+    /// `Σⱼ |rⱼ| tⱼ`: the growth, then the amounts added to `uu`, `uv`, `vv` and the curves'
+    /// bounds after scaling them by the stretch.
+    pub increments: MovingTerm,
+}
+
+impl PatchMove {
+    /// Where the affine part takes the rest point `x`.
+    pub fn map(&self, x: DVec3) -> DVec3 {
+        x + self.t + self.m * (x - self.from)
+    }
+
+    /// The box and sphere that hold the moved control points, from the rest ones (`lo`, `hi`,
+    /// `centre`, `radius`): the mapped box's corners' box and the mapped sphere, grown by the
+    /// growth.
+    pub fn moved_box_and_sphere(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        centre: DVec3,
+        radius: f64,
+    ) -> (DVec3, DVec3, DVec3, f64) {
+        let g = self.increments[0];
+        let (mut mlo, mut mhi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for k in 0..8 {
+            let corner = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let q = self.map(corner);
+            mlo = mlo.min(q);
+            mhi = mhi.max(q);
+        }
+        (mlo - g, mhi + g, self.map(centre), self.stretch * radius + g)
     }
 }
 
@@ -187,7 +269,7 @@ mod tests {
                 .map(|p| {
                     let (s, c) = (0.5 * (p.z - lo.z) / (hi.z - lo.z)).sin_cos();
                     let jitter = DVec3::new(random(), random(), random()) * (0.05 * size);
-                    DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z)
+                    DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z) * 1.25
                         + jitter
                         + DVec3::new(0.3, -0.2, 0.1) * size
                 })
@@ -197,14 +279,15 @@ mod tests {
             let ranges = stencils.point_ranges(&set).unwrap();
             for p in 0..set.patches.len() {
                 let what = format!("{cage} patch {p}");
-                let (shift, inc) = terms.moved(p, &mesh.positions, &moved);
+                let motion = terms.moved(p, &mesh.positions, &moved);
+                let (inc, k2) = (motion.increments, motion.stretch);
                 let slack = |x: f64| x * (1.0 + 1e-9) + 1e-12 * size;
                 let h = bounds::hessian(&set.patches[p]);
                 for (k, (got, rest)) in
                     [(h.uu, rest_h[p].uu), (h.uv, rest_h[p].uv), (h.vv, rest_h[p].vv)].into_iter().enumerate()
                 {
                     assert!(
-                        got <= slack(rest + inc[1 + k]),
+                        got <= slack(k2 * rest + inc[1 + k]),
                         "{what}: second derivative {k}: {got} > {rest} + {}",
                         inc[1 + k]
                     );
@@ -212,7 +295,7 @@ mod tests {
                 }
                 let c = tolerance::patch_curve_bounds(&set.patches[p], &h);
                 for l in 0..4 {
-                    assert!(c[l] <= slack(rest_c[p][l] + inc[4 + l]), "{what}: curve {l}");
+                    assert!(c[l] <= slack(k2 * rest_c[p][l] + inc[4 + l]), "{what}: curve {l}");
                 }
                 // Every point of the patch's range (a tree's: all its leaves') moves at most
                 // the growth; the moved hull (a net, or a tree's visible leaves' box) stays in
@@ -223,21 +306,21 @@ mod tests {
                     let (q, rest) =
                         (stencils.rows().apply_row(r, &moved), stencils.rows().apply_row(r, &mesh.positions));
                     assert!(
-                        q.distance(rest + shift) <= g,
+                        q.distance(motion.map(rest)) <= g,
                         "{what}: a point moved {} > growth {g}",
-                        q.distance(rest + shift)
+                        q.distance(motion.map(rest))
                     );
                 }
+                let (lo, hi, centre, radius) =
+                    motion.moved_box_and_sphere(view.lo, view.hi, view.centre, view.radius);
+                let pad = 1e-12 * size;
                 for q in set.patches[p].control_points() {
                     assert!(
-                        (view.lo + shift - g).cmple(*q).all() && q.cmple(view.hi + shift + g).all(),
-                        "{what}: outside the grown box"
+                        (lo - pad).cmple(*q).all() && q.cmple(hi + pad).all(),
+                        "{what}: outside the moved box"
                     );
                     if matches!(set.patches[p], crate::surface::Patch::Bicubic(_)) {
-                        assert!(
-                            q.distance(view.centre + shift) <= view.radius + g,
-                            "{what}: outside the grown sphere"
-                        );
+                        assert!(q.distance(centre) <= radius + pad, "{what}: outside the moved sphere");
                     }
                 }
             }
