@@ -56,8 +56,9 @@ pub fn parse_tolerance(text: &str, diagonal: f64) -> Result<f64> {
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
 /// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
 fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
-    // The rows `nv` that columns `nu` need, None where `hu` alone exceeds the budget.
-    let rows = |nu: u32| -> Option<u64> {
+    // The height `hv` that columns `nu` leave each row, None where `hu` alone exceeds the
+    // budget.
+    let height = |nu: u32| -> Option<f64> {
         let hu = 1.0 / nu as f64;
         let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
         if c > 0.0 {
@@ -70,20 +71,39 @@ fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
         } else {
             1.0
         };
-        if hv <= 0.0 {
-            return None; // hu alone takes the whole budget (c = 0): no cell height is left
+        // hu alone takes the whole budget (c = 0): no cell height is left.
+        (hv > 0.0).then_some(hv)
+    };
+    // The rows `nv` that columns `nu` need.
+    let rows = |hv: f64| -> u64 {
+        if hv >= 1.0 {
+            1
+        } else {
+            ceil(1.0 / hv) as u64
         }
-        Some(if hv >= 1.0 { 1 } else { ceil(1.0 / hv) as u64 })
     };
     // `rows` only shrinks as `nu` grows, so no grid of `nu` or more columns has fewer than
     // `nu · rows(cap)` cells: the search stops there (one row less, against rounding).
-    let fewest_rows = rows(cap)?.saturating_sub(1).max(1);
+    let fewest_rows = rows(height(cap)?).saturating_sub(1).max(1);
     let mut best: Option<(u32, u32)> = None;
+    // The cells of the continuous grid, `nu / hv`, a lower bound of `nu · rows`: as a function
+    // of `nu` it falls to one minimum and rises after it (the cell area `hu · hv` on the
+    // bound's ellipse rises to one maximum as `hu` shrinks, then falls). Once it rises and
+    // is within a cell of the best grid, no later column count has fewer cells.
+    let mut last_area = f64::INFINITY;
     for nu in 1..=cap {
         if best.is_some_and(|(bu, bv)| nu as u64 * fewest_rows >= bu as u64 * bv as u64) {
             break;
         }
-        let Some(nv) = rows(nu) else { continue };
+        let Some(hv) = height(nu) else { continue };
+        let area = nu as f64 / hv;
+        if let Some((bu, bv)) = best {
+            if area > last_area && area > (bu as u64 * bv as u64) as f64 - 1.0 + 1e-6 {
+                break;
+            }
+        }
+        last_area = area;
+        let nv = rows(hv);
         if nv > cap as u64 {
             continue;
         }
@@ -983,8 +1003,12 @@ mod tests {
                 vv: scale * next() * 10f64.powf(2.0 * next() - 1.0),
             };
             let eps = 10f64.powf(-4.0 * next());
-            for cap in [1, 7, 64] {
-                let found = quad_grid(&m, eps, cap);
+            // The mixed term dominant too (the bound's quadratic form indefinite), and
+            // caps past the continuous grid's minimum.
+            let mixed = HessianBound { uv: scale * next() * 10f64.powf(2.0 * next()), ..m };
+            for (m, cap) in [(m, 1), (m, 7), (m, 64), (m, 1000), (mixed, 64), (mixed, 1000)] {
+                let m = &m;
+                let found = quad_grid(m, eps, cap);
                 assert_eq!(found, every_column_count(&m, eps, cap), "{m:?} eps {eps} cap {cap}");
                 anisotropic += usize::from(found.is_some_and(|(nu, nv)| nu > 1 && nv > 1 && nu != nv));
             }
