@@ -1009,7 +1009,7 @@ mod tests {
             for (m, cap) in [(m, 1), (m, 7), (m, 64), (m, 1000), (mixed, 64), (mixed, 1000)] {
                 let m = &m;
                 let found = quad_grid(m, eps, cap);
-                assert_eq!(found, every_column_count(&m, eps, cap), "{m:?} eps {eps} cap {cap}");
+                assert_eq!(found, every_column_count(m, eps, cap), "{m:?} eps {eps} cap {cap}");
                 anisotropic += usize::from(found.is_some_and(|(nu, nv)| nu > 1 && nv > 1 && nu != nv));
             }
         }
