@@ -125,13 +125,7 @@ impl GpuStencils {
         }
         let device = &ctx.device;
         let count = rows.destinations.len() as u32;
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("stencil rows"),
-            size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        ctx.queue.write_buffer(&uniform, 0, bytemuck::cast_slice(&[count, 0, 0, 0]));
+        let uniform = count_uniform(device, "stencil rows", count);
         let starts = storage_buffer(device, "stencil starts", &rows.starts);
         let terms = storage_buffer(device, "stencil terms", &rows.terms);
         let destinations = storage_buffer(device, "stencil destinations", &rows.destinations);
@@ -201,17 +195,11 @@ impl GpuStencils {
             rest.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32, 1.0]).collect();
         let device = &ctx.device;
         let patches = set.patches.len() as u32;
-        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("moving bounds"),
-            size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        ctx.queue.write_buffer(&uniform, 0, bytemuck::cast_slice(&[patches, 0, 0, 0]));
-        // Storage buffers may not be empty.
-        let nonempty = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+        let uniform = count_uniform(device, "moving bounds", patches);
         let starts = storage_buffer(device, "moving bounds starts", &bounds.starts);
-        let vertices = storage_buffer(device, "moving bounds vertices", &nonempty(&bounds.vertices));
+        let vertices = storage_buffer(device, "moving bounds vertices", &bounds.vertices);
+        // A set without terms (every face a hole) still binds one term: `storage_buffer`'s
+        // padding is 4 bytes, and the shader's array holds 16-byte rows.
         let terms = storage_buffer(
             device,
             "moving bounds terms",
@@ -298,4 +286,14 @@ impl GpuStencils {
             pass.dispatch_workgroups(x, y, 1);
         }
     }
+}
+
+/// A uniform buffer holding `count` (`vec4<u32>`'s first lane): a pass's element count.
+fn count_uniform(device: &wgpu::Device, label: &str, count: u32) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&[count, 0, 0, 0]),
+        usage: wgpu::BufferUsages::UNIFORM,
+    })
 }

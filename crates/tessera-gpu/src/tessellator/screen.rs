@@ -424,6 +424,7 @@ impl GpuTessellator {
         set: &SurfaceSet,
         prepared: &Prepared,
     ) -> Result<Vec<[f32; 4]>> {
+        // The set and bounds checks only (a uniform scheme has no check loop to budget).
         self.check_screen_support(set, prepared, Scheme::Uniform, 1)?;
         let rows = patch_view_rows(set, Some(prepared));
         ctx.queue.write_buffer(&self.view.patch_views, 0, bytemuck::cast_slice(&rows));

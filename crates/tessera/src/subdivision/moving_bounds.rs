@@ -96,11 +96,10 @@ impl MovingBounds {
                     .chunk_by(|a, b| a.0 == b.0)
                     .map(|of_vertex| {
                         points.fill(DVec3::ZERO);
-                        let mut growth = 0f64;
                         for &(_, i, w) in of_vertex {
                             points[i].x += w;
-                            growth = growth.max(points[i].x.abs());
                         }
+                        let growth = points.iter().map(|q| q.x.abs()).fold(0.0, f64::max);
                         let probe = stencils.with_points(&set.patches[p], &set.origins[p], &points);
                         let h = bounds::hessian(&probe);
                         let c = tolerance::patch_curve_bounds(&probe, &h);
