@@ -88,8 +88,7 @@ pub struct InputArgs {
     allow_outside_uris: bool,
     /// The surface a mesh input stands for. `auto`: the Catmull-Clark limit surface of an
     /// OBJ with any face that is not a triangle (a subdivision cage, with OpenSubdiv's tags),
-    /// PN triangles for everything else. `loop`: the Loop limit surface of a triangle cage
-    /// (CPU engine only, so far).
+    /// PN triangles for everything else. `loop`: the Loop limit surface of a triangle cage.
     #[arg(long, value_enum, default_value_t = SurfaceArg::Auto)]
     surface: SurfaceArg,
     /// How many levels subdivision cages isolate smooth features (extraordinary vertices,

@@ -73,10 +73,18 @@ pub(crate) struct FastEvaluator<'a> {
     /// The writer of triangle meshes at one uniform factor, where the current plan is one
     /// ([`FastEvaluator::fill_patterns`]).
     triangles: UniformTriangles,
-    /// The grid kernels apply to the current plan: every patch a bicubic with a local form
-    /// (polynomial, or rational within [`MIN_WEIGHT_RATIO`]), integer samplings
-    /// ([`FastEvaluator::retarget`]).
+    /// The grid kernels apply to the current plan: integer samplings, and some patch a
+    /// bicubic with a local form (polynomial, or rational within [`MIN_WEIGHT_RATIO`]);
+    /// they take that patch's edges and interior ([`FastEvaluator::retarget`]).
+    ///
+    /// A set that mixes kinds (a Catmull-Clark cage: regular faces are bicubics, isolated
+    /// ones trees) takes them on its bicubics, the others on [`PointBlocks`]: each vertex is
+    /// still evaluated once, by its owner, so which kernel a patch takes cannot open a crack.
+    /// Before, one patch without a grid form sent the whole set to [`PointBlocks`]: the
+    /// rook's 1,728 regular faces (of 3,064 patches) were evaluated point by point.
     grid: bool,
+    /// The grid kernels also take the corners: every patch has a grid form.
+    grid_corners: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
@@ -112,6 +120,7 @@ impl<'a> FastEvaluator<'a> {
             patterns: PatternCache::default(),
             triangles: UniformTriangles::for_set(set),
             grid: false,
+            grid_corners: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
             corners: Default::default(),
         }
@@ -120,7 +129,7 @@ impl<'a> FastEvaluator<'a> {
     /// Every corner entry's vertex record as the current plan's kernels evaluate it, evaluated
     /// once per set and kernel. Cost: O(corners) the first time, then O(1).
     pub(crate) fn corner_records(&self) -> &CornerRecords {
-        self.corners[usize::from(self.grid)].get_or_init(|| CornerRecords::evaluate(self.set, self))
+        self.corners[usize::from(self.grid_corners)].get_or_init(|| CornerRecords::evaluate(self.set, self))
     }
 
     /// Makes the tables of every factor `plan` uses (edge segments, interior factors, and
@@ -130,7 +139,8 @@ impl<'a> FastEvaluator<'a> {
     pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
         // Until `fill_patterns` sees the plan's pattern.
         self.triangles.deactivate();
-        self.grid = plan.kind == SamplingKind::Uniform && self.points.all_bicubic();
+        self.grid = plan.kind == SamplingKind::Uniform && self.points.any_bicubic();
+        self.grid_corners = self.grid && self.points.all_bicubic();
         if !self.grid {
             return false;
         }
@@ -184,9 +194,16 @@ impl<'a> FastEvaluator<'a> {
         &self.patterns
     }
 
-    /// Whether the grid kernels apply to the current plan (corners among them).
+    /// Whether the grid kernels apply to the current plan (to some patches).
+    #[cfg(test)]
     pub(crate) fn grid(&self) -> bool {
         self.grid
+    }
+
+    /// Whether the grid kernels take the current plan's corners ([`FastEvaluator::corners`]):
+    /// every patch is a bicubic with a local form.
+    pub(crate) fn grid_corners(&self) -> bool {
+        self.grid_corners
     }
 
     /// The evaluator of arbitrary parameter lists.
@@ -200,16 +217,25 @@ impl<'a> FastEvaluator<'a> {
     }
 
     /// Whether edge `e`'s samples are this evaluator's: a factor with tables, one normal
-    /// variant, not collapsed.
+    /// variant, not collapsed, an owner with a grid form.
     pub(crate) fn covers_edge(&self, plan: &Plan, e: usize) -> bool {
-        let edge = &self.set.topology.edges[e];
-        self.factor(plan.segments(e) as usize).is_some() && edge.variants == 1 && !edge.collapsed
+        let topo = &self.set.topology;
+        let edge = &topo.edges[e];
+        self.factor(plan.segments(e) as usize).is_some()
+            && edge.variants == 1
+            && !edge.collapsed
+            && self.points.grid_patch(topo.edge_uses(e)[0].patch as usize).is_some()
     }
 
-    /// The interior grid `[nu, nv]` of the patch with `input` when it is this evaluator's: a
-    /// quad whose pattern promises a grid of factors with tables.
-    pub(crate) fn covers_patch(&self, pattern: &dyn Pattern, input: &PatternInput) -> Option<[u32; 2]> {
-        if input.domain != Domain::Quad {
+    /// The interior grid `[nu, nv]` of patch `p` with `input` when it is this evaluator's: a
+    /// quad with a grid form whose pattern promises a grid of factors with tables.
+    pub(crate) fn covers_patch(
+        &self,
+        p: usize,
+        pattern: &dyn Pattern,
+        input: &PatternInput,
+    ) -> Option<[u32; 2]> {
+        if input.domain != Domain::Quad || self.points.grid_patch(p).is_none() {
             return None;
         }
         let grid = pattern.interior_grid(input)?;

@@ -419,7 +419,7 @@ fn evaluate_corners(
     fast: Option<&fast_evaluator::FastEvaluator<'_>>,
     mut out: VertexSlices<'_>,
 ) {
-    if let Some(f) = fast.filter(|f| f.grid()) {
+    if let Some(f) = fast.filter(|f| f.grid_corners()) {
         return f.corners(out);
     }
     let topo = &set.topology;
@@ -664,7 +664,7 @@ impl Writer<'_> {
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !local.interior.is_empty());
-        match fast.map(|f| (f, f.covers_patch(self.pattern, &input))) {
+        match fast.map(|f| (f, f.covers_patch(p, self.pattern, &input))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),
             Some((f, None)) => f.points().eval(set, p, &local.interior, verts),
             None => {

@@ -383,6 +383,8 @@ pub(crate) struct PointBlocks {
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
+    /// Some local is ([`PointBlocks::any_bicubic`]), decided once as `all_bicubic` is.
+    any_bicubic: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
@@ -814,6 +816,7 @@ impl PointBlocks {
             quartics: Vec::new(),
             loop_leaves: Vec::new(),
             all_bicubic: false,
+            any_bicubic: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
         // Each stored tree's first leaf and patch, in patch order.
@@ -846,8 +849,9 @@ impl PointBlocks {
                 loop_leaf(tree, i - first)
             })
             .collect();
-        blocks.all_bicubic =
-            blocks.locals.iter().all(|l| matches!(l, Local::Bicubic(_) | Local::Rational(_)));
+        let grid_form = |l: &Local| matches!(l, Local::Bicubic(_) | Local::Rational(_));
+        blocks.all_bicubic = blocks.locals.iter().all(grid_form);
+        blocks.any_bicubic = blocks.locals.iter().any(grid_form);
         blocks
     }
 
@@ -884,10 +888,15 @@ impl PointBlocks {
         self.form(p).is_some()
     }
 
-    /// Whether every patch is a bicubic with a local form, polynomial or rational (the grid
-    /// evaluator's precondition).
+    /// Whether every patch is a bicubic with a local form, polynomial or rational (where the
+    /// grid evaluator also takes the corners).
     pub(crate) fn all_bicubic(&self) -> bool {
         self.all_bicubic
+    }
+
+    /// Whether some patch is a bicubic with a local form (the grid kernels can serve it).
+    pub(crate) fn any_bicubic(&self) -> bool {
+        self.any_bicubic
     }
 
     /// Evaluates patch `p` of `set` at `uvs` into `out` (one vertex each: position, normal,

@@ -492,7 +492,7 @@ mod tests {
                     let covered = (0..set.patches.len())
                         .filter(|&p| {
                             let input = crate::engine::layout::pattern_input(&set, plan, p);
-                            evaluator.covers_patch(pattern, &input).is_some()
+                            evaluator.covers_patch(p, pattern, &input).is_some()
                         })
                         .count();
                     assert_eq!(covered, set.patches.len(), "{model}: every quad interior is a grid");
@@ -507,6 +507,62 @@ mod tests {
         }
         // Most plans mix several factors (the torus under a tolerance is uniform by symmetry).
         assert!(adaptive >= 15, "only {adaptive} of 24 plans use more than two edge factors");
+    }
+
+    /// Catmull-Clark cages mix regular faces (bicubics, on the grid kernels) with isolated
+    /// faces (trees, on [`PointBlocks`](super::super::point_blocks::PointBlocks)): every
+    /// bicubic's interior and every uniform edge a bicubic owns are the kernels', nothing
+    /// else is, and the mesh is the generic one index for index, uniform and adaptive.
+    #[test]
+    fn fast_path_matches_the_generic_engine_on_mixed_cages() {
+        use crate::scheme::{Criterion, PlanOptions, Scheme};
+        for cage in ["subdivision/catmark_pawn.obj", "subdivision/catmark_torus_creases0.obj"] {
+            let path = crate::test_support::data(cage);
+            let obj = crate::io::obj::read_obj(&path).expect("test cage");
+            let set = SurfaceSet::from_subdivision_cage(&obj, &path, Default::default()).expect("cage");
+            let bicubic = |p: usize| matches!(set.patches[p], Patch::Bicubic(_));
+            let regular = (0..set.patches.len()).filter(|&p| bicubic(p)).count();
+            assert!(regular > 0 && regular < set.patches.len(), "{cage}: a mixed set");
+            let (lo, hi) = set.bounds();
+            let camera = crate::camera::Camera::framing(lo, hi, 1280, 720);
+            let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+            let adaptive =
+                Scheme::Transition.plan(&set, &Criterion::PixelError(0.5), &options).expect("plan");
+            let plans: [(&str, Plan, &dyn crate::pattern::Pattern); 3] = [
+                ("uniform 5", Plan::uniform(&set, 5).unwrap(), &Uniform),
+                ("uniform 16", Plan::uniform(&set, 16).unwrap(), &Uniform),
+                ("transition 0.5 px", adaptive.plan.clone(), &adaptive.pattern),
+            ];
+            for (what, plan, pattern) in plans {
+                for avx2_fma in KERNELS {
+                    let f = FastEvaluator::with_kernels(&set, &plan, avx2_fma);
+                    assert!(f.grid() && !f.grid_corners(), "{cage} {what}");
+                    for p in 0..set.patches.len() {
+                        let input = crate::engine::layout::pattern_input(&set, &plan, p);
+                        let grid = pattern.interior_grid(&input).is_some();
+                        assert_eq!(
+                            f.covers_patch(p, pattern, &input).is_some(),
+                            grid && bicubic(p),
+                            "{cage} {what}"
+                        );
+                    }
+                    let topo = &set.topology;
+                    for e in (0..topo.edges.len())
+                        .filter(|&e| topo.edges[e].variants == 1 && !topo.edges[e].collapsed)
+                    {
+                        assert_eq!(f.covers_edge(&plan, e), bicubic(topo.edge_uses(e)[0].patch as usize));
+                    }
+                    let opts = EngineOptions::default();
+                    let mut layout = Layout::default();
+                    layout.build(&set, &plan, pattern, &opts).expect("layout");
+                    let mut mesh = Mesh::default();
+                    write_with(&set, &plan, pattern, &layout, opts, &mut mesh, Some(&f)).unwrap();
+                    let mut reference = Mesh::default();
+                    write_with(&set, &plan, pattern, &layout, opts, &mut reference, None).unwrap();
+                    assert_same_mesh(&mesh, &reference, &format!("{cage} {what} avx2_fma={avx2_fma}"));
+                }
+            }
+        }
     }
 
     #[test]
@@ -616,10 +672,10 @@ mod tests {
         other.segments[7] = 5;
         assert!(f.covers_edge(&plan, 7) && !f.covers_edge(&other, 7), "5 has no tables yet");
         let input = |interior| PatternInput::new(Domain::Quad, [4; 4], interior);
-        assert_eq!(f.covers_patch(&Uniform, &input([4, 4])), Some([4, 4]));
-        assert_eq!(f.covers_patch(&Uniform, &input([5, 5])), None, "a factor without tables");
+        assert_eq!(f.covers_patch(0, &Uniform, &input([4, 4])), Some([4, 4]));
+        assert_eq!(f.covers_patch(0, &Uniform, &input([5, 5])), None, "a factor without tables");
         let tri = PatternInput::new(Domain::Tri, [4; 4], [4, 4]);
-        assert_eq!(f.covers_patch(&Uniform, &tri), None, "triangles are not bicubic");
+        assert_eq!(f.covers_patch(0, &Uniform, &tri), None, "triangles are not bicubic");
         let mut fractional = plan.clone();
         fractional.kind = SamplingKind::Fractional(crate::sampling::Spacing::Symmetric);
         assert!(!FastEvaluator::new(&set, &fractional).grid());
@@ -630,10 +686,18 @@ mod tests {
         if let Patch::Bicubic(b) = &mut rational.patches[5] {
             b.weights[5] = 2.0;
         }
-        assert!(FastEvaluator::new(&rational, &plan).grid());
+        assert!(FastEvaluator::new(&rational, &plan).grid_corners());
         if let Patch::Bicubic(b) = &mut rational.patches[5] {
             b.weights[6] = 2.0 * MIN_WEIGHT_RATIO * 0.99;
         }
-        assert!(!FastEvaluator::new(&rational, &plan).grid());
+        // That patch alone leaves the kernels: its interior and the edges it owns; the
+        // corners, which the kernels take all or none of, too.
+        let f = FastEvaluator::new(&rational, &plan);
+        assert!(f.grid() && !f.grid_corners());
+        assert_eq!(f.covers_patch(5, &Uniform, &input([4, 4])), None);
+        assert_eq!(f.covers_patch(4, &Uniform, &input([4, 4])), Some([4, 4]));
+        let topo = &rational.topology;
+        let owner = |e: usize| topo.edge_uses(e)[0].patch as usize;
+        assert!((0..topo.edges.len()).all(|e| f.covers_edge(&plan, e) == (owner(e) != 5)));
     }
 }
