@@ -618,10 +618,15 @@ pub fn curve_bounds(set: &SurfaceSet, hessians: &[HessianBound]) -> Vec<[f64; 4]
 /// [`curve_bounds`] of one patch, whose own bound is `h`. Cost: O(1) for a net, O(leaves)
 /// for a Loop tree.
 pub fn patch_curve_bounds(patch: &Patch, h: &HessianBound) -> [f64; 4] {
-    if let Patch::Loop(tree) = patch {
+    match patch {
         // The quartic leaves (a regular patch's one) along each edge.
-        let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
-        return [a, b, c, 0.0];
+        Patch::Loop(tree) => {
+            let [a, b, c] = bounds::loop_tree_curve_bounds(tree);
+            return [a, b, c, 0.0];
+        }
+        // The cubic sides of the leaves along each edge.
+        Patch::Subdivision(tree) => return bounds::tree_curve_bounds(tree),
+        _ => {}
     }
     let mut out = [0.0; 4];
     for (l, o) in out.iter_mut().enumerate().take(patch.domain().corner_count()) {

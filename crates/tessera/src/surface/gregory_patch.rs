@@ -24,7 +24,7 @@ impl GregoryPatch {
     /// The bicubic Bézier net at `(u, v)` (rows along `v`, columns along `u`): the boundary
     /// points fixed, each interior point its corner's face-point pair blended rationally
     /// (weight 1 on `Fm` where the blend is undefined, at the corner itself).
-    fn bezier_net(&self, u: f64, v: f64) -> [[DVec3; 4]; 4] {
+    pub(crate) fn bezier_net(&self, u: f64, v: f64) -> [[DVec3; 4]; 4] {
         let g = &self.points;
         let (uc, vc) = (1.0 - u, 1.0 - v);
         let inv = |d: f64| if d <= 0.0 { 1.0 } else { 1.0 / d };
