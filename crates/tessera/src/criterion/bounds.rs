@@ -509,10 +509,12 @@ pub fn loop_tree_hessian(t: &crate::surface::TriangleTree) -> HessianBound {
 /// Second-derivative bounds of a Loop patch's three boundary curves (patch edges 0, 1, 2,
 /// each in its own parameter; a regular patch is a tree of one leaf, the whole triangle,
 /// whose sides are its boundary): the largest over the leaves with a side on the edge
-/// of the leaf's second derivative along it — a quartic leaf's by that side's five points
-/// ([`quartic_curve_second_derivative`]), a Gregory triangle's by its bound along the
-/// direction — times `1/h²` for a leaf of side `h`. [`loop_tree_hessian`] takes every leaf,
-/// the Gregory triangles at the patch's corners among them, for every edge. A turned leaf can
+/// of the leaf's second derivative along it — by that side's five points
+/// ([`quartic_curve_second_derivative`]), for a quartic leaf and for a Gregory triangle alike
+/// (its blends vanish on its sides) — times `1/h²` for a leaf of side `h`.
+/// [`loop_tree_hessian`] takes every leaf, the Gregory triangles' interior blends among them,
+/// for every edge; before 2026-12-05 a Gregory triangle's side took that bound along it,
+/// several times too large. A turned leaf can
 /// only lie along the hypotenuse; a swapped tree's edges 0 and 2 are the patch's 2 and 0.
 /// Cost: O(leaves).
 pub fn loop_tree_curve_bounds(t: &crate::surface::TriangleTree) -> [f64; 3] {
@@ -538,13 +540,10 @@ pub fn loop_tree_curve_bounds(t: &crate::surface::TriangleTree) -> [f64; 3] {
             };
             let along = match &leaf.patch {
                 TriangleLeafPatch::Quartic(q) => quartic_curve_second_derivative(q.edge_points(side)),
+                // A Gregory triangle's interior blends carry `w²st`, `s²tw`, `st²w`, which
+                // vanish on its sides: a side is the quartic of its boundary points.
                 TriangleLeafPatch::Gregory(g) => {
-                    let m = gregory_triangle_hessian(g);
-                    match side {
-                        0 => m.uu,
-                        1 => m.uu + 2.0 * m.uv + m.vv,
-                        _ => m.vv,
-                    }
+                    quartic_curve_second_derivative(g.blended(glam::DVec2::splat(0.25)).edge_points(side))
                 }
             };
             *bound = bound.max(along / (h * h));
