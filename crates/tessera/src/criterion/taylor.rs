@@ -59,7 +59,7 @@
 //! leaves (the surface is only piecewise smooth there) or on Gregory end caps — takes the
 //! *sampled* bound: the lattice refinement with the patch's second-derivative bound in place
 //! of the expansion, so the sampled error plus `1/n²` of that bound (`n` = 8 here, against
-//! 4 for an expansion's split: [`SAMPLED_LATTICE`]). It is as valid as the
+//! 4 for an expansion's split: `SAMPLED_LATTICE`). It is as valid as the
 //! second-derivative bound and only as tight as its margin allows: where that bound is
 //! loose (a Loop patch's covers its Gregory triangles' interior blends, a Catmull-Clark
 //! patch's its Gregory caps') the finer lattice makes up for much of it. Every caller takes the smaller of this bound and the second-derivative bound,
