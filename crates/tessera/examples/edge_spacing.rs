@@ -16,7 +16,8 @@
 //! strip too, which the estimate lets through without checking their bound; and the ceiling
 //! of an optimum is rounded for each edge on its own.
 //!
-//! Run: `cargo run --release --example edge_spacing [DATA_DIR]` (default `../shared/data`).
+//! Run from the repository root: `cargo run --release -p tessera --example edge_spacing [DATA_DIR]`
+//! (default `../shared/data`).
 
 use std::path::PathBuf;
 

@@ -355,13 +355,9 @@ pub fn hessian(p: &Patch) -> HessianBound {
 /// B-spline surface) and Gregory end caps do only approximately, as in OpenSubdiv; the
 /// property tests measure the error against the bound on every cage.
 pub fn tree_hessian(t: &crate::surface::PatchTree) -> HessianBound {
-    use crate::surface::patch_tree::LeafPatch;
     let mut m = HessianBound::default();
     for (leaf, _, size) in t.visible_leaves() {
-        let h = match &leaf.patch {
-            LeafPatch::Bezier(points) => bicubic_hessian(&RationalBicubic::polynomial(*points)),
-            LeafPatch::Gregory(g) => gregory_hessian(g),
-        };
+        let h = leaf_hessian(&leaf.patch);
         let s = 1.0 / (size * size);
         m.uu = m.uu.max(h.uu * s);
         m.uv = m.uv.max(h.uv * s);
@@ -372,6 +368,15 @@ pub fn tree_hessian(t: &crate::surface::PatchTree) -> HessianBound {
         std::mem::swap(&mut m.uu, &mut m.vv);
     }
     m
+}
+
+/// Second-derivative bounds of one leaf of a Catmull-Clark tree, in the leaf's parameters.
+fn leaf_hessian(leaf: &crate::surface::patch_tree::LeafPatch) -> HessianBound {
+    use crate::surface::patch_tree::LeafPatch;
+    match leaf {
+        LeafPatch::Bezier(points) => bicubic_hessian(&RationalBicubic::polynomial(*points)),
+        LeafPatch::Gregory(g) => gregory_hessian(g),
+    }
 }
 
 /// Second-derivative bounds of a Catmull-Clark patch's four boundary curves (patch edges 0
@@ -414,27 +419,20 @@ pub fn tree_curve_bounds(t: &crate::surface::PatchTree) -> [f64; 4] {
             LeafPatch::Gregory(g) => g.bezier_net(0.5, 0.5),
         };
         let (lo, hi) = (origin, origin + DVec2::splat(size));
+        // Per side of the view's square: the leaf's own side on it, or the side crossing the
+        // leaf (a quarter's view of a larger leaf), and the leaf's points along its own side.
         let sides = [
-            (lo.y, hi.y, 0.0, [net[0][0], net[0][1], net[0][2], net[0][3]]),
-            (lo.x, hi.x, 1.0, [net[0][3], net[1][3], net[2][3], net[3][3]]),
-            (lo.y, hi.y, 1.0, [net[3][0], net[3][1], net[3][2], net[3][3]]),
-            (lo.x, hi.x, 0.0, [net[0][0], net[1][0], net[2][0], net[3][0]]),
+            (lo.y == 0.0, lo.y < 0.0 && 0.0 < hi.y, [net[0][0], net[0][1], net[0][2], net[0][3]]),
+            (hi.x == 1.0, lo.x < 1.0 && 1.0 < hi.x, [net[0][3], net[1][3], net[2][3], net[3][3]]),
+            (hi.y == 1.0, lo.y < 1.0 && 1.0 < hi.y, [net[3][0], net[3][1], net[3][2], net[3][3]]),
+            (lo.x == 0.0, lo.x < 0.0 && 0.0 < hi.x, [net[0][0], net[1][0], net[2][0], net[3][0]]),
         ];
-        for (k, (from, to, at, points)) in sides.into_iter().enumerate() {
-            let along = if (k == 0 && from == at)
-                || (k == 2 && to == at)
-                || (k == 1 && to == at)
-                || (k == 3 && from == at)
-            {
-                // The leaf's own side lies on the view's.
+        for (k, (on, crosses, points)) in sides.into_iter().enumerate() {
+            let along = if on {
                 curve_second_derivative(points, [1.0; 4])
-            } else if from < at && at < to {
-                // The view's side crosses the leaf (a quarter's view of a larger leaf): an
-                // iso-curve inside it, bounded by the leaf's second derivative along it.
-                let m = match &leaf.patch {
-                    LeafPatch::Bezier(p) => bicubic_hessian(&RationalBicubic::polynomial(*p)),
-                    LeafPatch::Gregory(g) => gregory_hessian(g),
-                };
+            } else if crosses {
+                // An iso-curve inside the leaf, bounded by its second derivative along it.
+                let m = leaf_hessian(&leaf.patch);
                 if k % 2 == 0 {
                     m.uu
                 } else {
