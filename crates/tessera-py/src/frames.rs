@@ -58,7 +58,8 @@ struct Request<'a, 'py> {
     threshold: Option<f64>,
     /// SD-2's reverse projection.
     warp: bool,
-    /// The guaranteed bound of `tolerance` and `pixel_error`: "hessian" or "taylor".
+    /// The guaranteed bound of `tolerance` and `pixel_error`: "hessian", "taylor" or
+    /// "expansion".
     bound: &'a str,
 }
 
@@ -172,7 +173,11 @@ fn choose(
     let bound = match r.bound {
         "hessian" => ErrorBound::Hessian,
         "taylor" => ErrorBound::Taylor,
-        other => return Err(parameter_error(py, format!("bound={other:?}: use \"hessian\" or \"taylor\""))),
+        "expansion" => ErrorBound::Expansion,
+        other => {
+            let message = format!("bound={other:?}: use \"hessian\", \"taylor\" or \"expansion\"");
+            return Err(parameter_error(py, message));
+        }
     };
     let plan =
         PlanOptions { camera: Some(camera), cull: r.cull, max_factor: r.max_factor, max_triangles, bound };

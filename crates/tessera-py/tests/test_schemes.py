@@ -109,5 +109,8 @@ def test_the_taylor_bound_keeps_the_guarantee_with_fewer_triangles(data):
     taylor = tessera.tessellate(s, tolerance="0.1%", bound="taylor", corner_params=True)
     assert hessian.report["bound_met"] and taylor.report["bound_met"]
     assert taylor.triangle_count <= 0.8 * hessian.triangle_count
+    expansion = tessera.tessellate(s, tolerance="0.1%", bound="expansion")
+    assert expansion.report["bound_met"]
+    assert taylor.triangle_count < expansion.triangle_count < hessian.triangle_count
     with pytest.raises(tessera.ParameterError, match="bound="):
         tessera.tessellate(s, tolerance="0.1%", bound="exact")

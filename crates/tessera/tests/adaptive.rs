@@ -65,9 +65,10 @@ fn tolerance_bounds_hold_on_every_model() {
     tolerance_bounds_hold(&common::all_surface_models(), false);
 }
 
-/// Every scheme at 1 %, 0.1 % (transition also 0.01 %) of the diagonal, with both bounds, the
-/// measured error within the certified bound and, for transition with the Taylor bound, at
-/// least 0.8 of it; with `every_taylor` false the Taylor bound only for transition at 1 % and
+/// Every scheme at 1 %, 0.1 % (transition also 0.01 %) of the diagonal, with both bounds
+/// (transition also with the expansion bound), the measured error within the certified
+/// bound and, for transition with the Taylor bound, at least 0.8 of it; with `every_taylor`
+/// false the Taylor and expansion bounds only for transition at 1 % and
 /// 0.1 % (measuring every large mesh again at 0.01 % would add a minute of CI;
 /// `the_taylor_bound_cuts_triangles_at_the_same_guarantee`, `taylor_bound.rs` and `tessera
 /// bench --suite adaptive` cover the rest).
@@ -79,12 +80,15 @@ fn tolerance_bounds_hold(models: &[std::path::PathBuf], every_taylor: bool) {
             let eps = share * diagonal(&set);
             for (scheme, bound) in [Scheme::Transition, Scheme::Uniform, SEMI_UNIFORM]
                 .into_iter()
-                .flat_map(|s| [(s, ErrorBound::Hessian), (s, ErrorBound::Taylor)])
+                .flat_map(|s| [(s, ErrorBound::Hessian), (s, ErrorBound::Taylor), (s, ErrorBound::Expansion)])
             {
+                if bound == ErrorBound::Expansion && scheme != Scheme::Transition {
+                    continue; // the expansion bound's rules are the Taylor bound's (tested with every scheme)
+                }
                 if scheme != Scheme::Transition && share < 1e-3 {
                     continue; // uniform and dyadic outputs at 0.01% are large; 1% and 0.1% cover them
                 }
-                if bound == ErrorBound::Taylor
+                if bound != ErrorBound::Hessian
                     && !every_taylor
                     && (scheme != Scheme::Transition || share < 1e-3)
                 {
@@ -203,8 +207,9 @@ fn screen_space_bounds_hold_for_random_cameras_on_every_model() {
     screen_space_bounds_hold(&common::all_surface_models(), 20, 0.2);
 }
 
-/// `cases` seeded cameras per model; a camera plans with the Taylor bound with probability
-/// `taylor` (its planning is the slower on the large meshes).
+/// `cases` seeded cameras per model; a camera plans with the Taylor bound or (as likely) the
+/// expansion bound with probability `taylor` (their planning is the slower on the large
+/// meshes).
 fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32, taylor: f64) {
     for path in models {
         let set = common::load(path).unwrap();
@@ -222,12 +227,17 @@ fn screen_space_bounds_hold(models: &[std::path::PathBuf], cases: u32, taylor: f
                     any::<bool>(),
                     any::<bool>(),
                     proptest::bool::weighted(taylor),
+                    any::<bool>(),
                 ),
-                |((camera, px), cull, dyadic, taylor)| {
+                |((camera, px), cull, dyadic, taylor, expansion)| {
                     // Both adaptive patterns: CudaTess transition and semi-uniform (dyadic),
-                    // and both bounds.
+                    // and every bound.
                     let scheme = if dyadic { SEMI_UNIFORM } else { Scheme::Transition };
-                    let bound = if taylor { ErrorBound::Taylor } else { ErrorBound::Hessian };
+                    let bound = match (taylor, expansion) {
+                        (false, _) => ErrorBound::Hessian,
+                        (true, false) => ErrorBound::Taylor,
+                        (true, true) => ErrorBound::Expansion,
+                    };
                     let (plan, pattern, report) =
                         plan_with(&set, scheme, Criterion::PixelError(px), Some(camera), cull, bound);
                     prop_assert_eq!(

@@ -192,7 +192,8 @@ class Tessellator:
             (default; one second-derivative bound per patch, cheap to plan) or ``"taylor"``
             (the second derivatives where each triangle is, with a third-derivative remainder,
             and the error sampled on coarse triangles: fewer triangles for the same guarantee
-            on every surface kind, slower to plan).
+            on every surface kind, slower to plan) or ``"expansion"`` (the Taylor expansion
+            without the sampling, on polynomial patches and triangles: between the two).
         strips: also make triangle strips (``sd2``, ``esc``).
         corner_params: also give each triangle corner's patch parameters.
         max_triangles: refuse larger outputs (default: what 3/4 of the available memory holds).

@@ -80,6 +80,9 @@ pub struct TaylorBound {
     field: SecondDerivatives,
     /// Bounds on `|S_uuu|`, `|S_uuv|`, `|S_uvv|`, `|S_vvv|` over the domain.
     third: [f64; 4],
+    /// Whether queries may refine by sampling the patch (the lattice splits): false for
+    /// [`TaylorBound::expansion`].
+    refines: bool,
 }
 
 // The variants differ in size (600 bytes against 216), but a set's bounds live in one
@@ -160,7 +163,8 @@ impl Pieces {
 
 impl TaylorBound {
     /// No bound: [`TaylorBound::triangle_error`] is infinite.
-    pub const NONE: TaylorBound = TaylorBound { field: SecondDerivatives::None, third: [0.0; 4] };
+    pub const NONE: TaylorBound =
+        TaylorBound { field: SecondDerivatives::None, third: [0.0; 4], refines: true };
 
     /// The bound of `patch`: a Taylor expansion for the polynomial kinds (and a
     /// Catmull-Clark tree's Bézier leaves), the sampled refinement of the second-derivative
@@ -179,6 +183,7 @@ impl TaylorBound {
                 m: errors.copied().unwrap_or_else(|| hessian(patch).triangle_errors()),
             },
             third: [0.0; 4],
+            refines: true,
         };
         match patch {
             Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
@@ -211,7 +216,35 @@ impl TaylorBound {
     /// answers.
     fn tree(pieces: Pieces, leaves: impl Iterator<Item = TaylorBound>, whole: TaylorBound) -> TaylorBound {
         let (leaves, whole) = (leaves.collect(), Box::new(whole));
-        TaylorBound { field: SecondDerivatives::Tree { tree: pieces, leaves, whole }, third: [0.0; 4] }
+        TaylorBound {
+            field: SecondDerivatives::Tree { tree: pieces, leaves, whole },
+            third: [0.0; 4],
+            refines: true,
+        }
+    }
+
+    /// The expansion bound of `patch` ([`crate::criterion::ErrorBound::Expansion`]): the
+    /// Taylor expansion of a polynomial bicubic, a cubic Bézier triangle or a PN triangle,
+    /// with a cubic's control-point hull, and nothing that samples the patch — no lattice
+    /// splits, so a grid's bound is a walk over its cells, one evaluation a cell, and beyond
+    /// [`EXPANSION_WALK_CELLS`] cells the second-derivative nets' bound of every cell at once
+    /// ([`TaylorBound::nets_grid_error`]). Every other kind has none ([`TaylorBound::NONE`]:
+    /// its plans keep the second-derivative bound). This is the part of the Taylor bound whose
+    /// every query has a fixed, small cost, what an a-posteriori check on the GPU can
+    /// compute. Cost: O(control points).
+    pub fn expansion(patch: &Patch) -> TaylorBound {
+        let bound = match patch {
+            Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
+            Patch::BezierTriangle(t) => triangle(t),
+            Patch::Pn(pn) => triangle(&pn.geometry),
+            _ => return TaylorBound::NONE,
+        };
+        TaylorBound { refines: false, ..bound }
+    }
+
+    /// Whether queries refine by sampling the patch (false for [`TaylorBound::expansion`]).
+    pub(crate) fn refines(&self) -> bool {
+        self.refines
     }
 
     /// For a tree: the Bézier leaf whose closed square holds all of `points` (patch
@@ -332,7 +365,11 @@ impl TaylorBound {
             }
             SecondDerivatives::Bicubic { .. }
             | SecondDerivatives::Quartic { .. }
-            | SecondDerivatives::Sampled { .. } => (quadratic + remainder).min(self.split_error(t)),
+            | SecondDerivatives::Sampled { .. }
+                if self.refines =>
+            {
+                (quadratic + remainder).min(self.split_error(t))
+            }
             _ => quadratic + remainder,
         }
     }
@@ -514,6 +551,46 @@ impl TaylorBound {
         worst
     }
 
+    /// A bound over every triangle of the `nu × nv` grid at once (as
+    /// [`TaylorBound::grid_error`]), from the second derivatives' Bézier nets rather than
+    /// their values at each cell: each cell's bound ([`TaylorBound::cell_error`]) is
+    /// `bubble_max(|m_d|, |m_u|, |m_v|)` plus the remainder, with `m_u = S_uu·hu²/8`,
+    /// `m_v = S_vv·hv²/8` and `m_d = (S_uu·hu² ∓ 2·S_uv·hu·hv + S_vv·hv²)/8` at the cell's
+    /// centre. Each is a polynomial in the position — a bicubic's three nets, degree-elevated
+    /// to one 4 × 4 net; a cubic triangle's linear field, whose net is its corners — so its
+    /// norm is at most the largest norm of its control points (convex hull), and `bubble_max`
+    /// grows with each argument: the bound of the largest control points holds for every
+    /// cell. Tighter than the second-derivative bound (the three terms stay vectors, summed
+    /// before their norm), looser than the walk (one net for all cells). Infinite for other
+    /// kinds. Cost: 16 control points (3 for a triangle), whatever the grid.
+    pub fn nets_grid_error(&self, triangle_domain: bool, [nu, nv]: [u32; 2]) -> f64 {
+        let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+        let (mut legs_u, mut legs_v, mut diagonal) = (0.0f64, 0.0f64, 0.0f64);
+        let mut take = |[a, b, c]: [DVec3; 3]| {
+            let (a, b, c) = (a * (hu * hu), b * (2.0 * hu * hv), c * (hv * hv));
+            legs_u = legs_u.max(a.length());
+            legs_v = legs_v.max(c.length());
+            // A triangle's grid splits every cell along `u + v = const`; a quad's either way.
+            let rising = if triangle_domain { 0.0 } else { (a + c + b).length() };
+            diagonal = diagonal.max((a + c - b).length().max(rising));
+        };
+        match &self.field {
+            SecondDerivatives::Bicubic { uu, uv, vv, .. } => {
+                let uu: [[DVec3; 4]; 4] = elevate_u(&elevate_u::<2, 4, 3>(uu));
+                let uv: [[DVec3; 4]; 4] = elevate_v(&elevate_u::<3, 3, 4>(uv));
+                let vv: [[DVec3; 4]; 4] = elevate_v(&elevate_v::<4, 2, 3>(vv));
+                for i in 0..4 {
+                    for j in 0..4 {
+                        take([uu[i][j], uv[i][j], vv[i][j]]);
+                    }
+                }
+            }
+            SecondDerivatives::Triangle { corners, .. } => corners.iter().for_each(|&c| take(c)),
+            _ => return f64::INFINITY,
+        }
+        bubble_max([diagonal, legs_u, legs_v].map(|m| m / 8.0)) + self.remainder(DVec2::new(hu, hv) / 2.0)
+    }
+
     /// The lattice of [`TaylorBound::split_error`] and [`TaylorBound::cell_split_error`]:
     /// [`SAMPLED_LATTICE`] for the sampled bound, [`SPLIT_LATTICE`] for an expansion.
     fn lattice(&self) -> usize {
@@ -565,6 +642,9 @@ impl TaylorBound {
         let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
         let mut worst = floor;
         let full = nu as u64 * nv as u64;
+        if !self.refines && full > EXPANSION_WALK_CELLS {
+            return worst.max(self.nets_grid_error(triangle_domain, [nu, nv]).min(cap));
+        }
         for i in 0..nu {
             for j in 0..nv {
                 // `(i + di)/nu + (j + dj)/nv` against `full / full = 1`, in integers.
@@ -577,7 +657,7 @@ impl TaylorBound {
                     [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
                 let error = if !triangle_domain {
                     let cell = self.cell_error((a + d) / 2.0, hu, hv).min(cap);
-                    if cell > worst {
+                    if cell > worst && self.refines {
                         cell.min(self.cell_split_error(o, hu, hv))
                     } else {
                         cell
@@ -745,6 +825,39 @@ fn sub_net(net: &[DVec3; 10], p: [DVec3; 3]) -> [DVec3; 10] {
     out
 }
 
+/// The largest grid (in cells) whose cells [`TaylorBound::expansion`]'s grid bound walks one
+/// by one; a larger one takes [`TaylorBound::nets_grid_error`]. The walk keeps the plans'
+/// every gain at 0.1 % (teapot, teacup, spot, cow: the same triangles as an unlimited walk;
+/// 256 cells cost the teapot 3 %) and bounds a check's work a step: a 32 × 32 core.
+pub const EXPANSION_WALK_CELLS: u64 = 1024;
+
+/// A tensor net `M × N` raised one degree along u (the first index): the same polynomial,
+/// `P'_i = (i/M)·P_{i−1} + (1 − i/M)·P_i`.
+fn elevate_u<const M: usize, const N: usize, const M1: usize>(net: &[[DVec3; N]; M]) -> [[DVec3; N]; M1] {
+    debug_assert_eq!(M1, M + 1);
+    std::array::from_fn(|i| {
+        let t = i as f64 / M as f64;
+        std::array::from_fn(|j| {
+            let lower = if i > 0 { net[i - 1][j] * t } else { DVec3::ZERO };
+            let upper = if i < M { net[i][j] * (1.0 - t) } else { DVec3::ZERO };
+            lower + upper
+        })
+    })
+}
+
+/// A tensor net `M × N` raised one degree along v (the second index), as [`elevate_u`].
+fn elevate_v<const M: usize, const N: usize, const N1: usize>(net: &[[DVec3; N]; M]) -> [[DVec3; N1]; M] {
+    debug_assert_eq!(N1, N + 1);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let t = j as f64 / N as f64;
+            let lower = if j > 0 { net[i][j - 1] * t } else { DVec3::ZERO };
+            let upper = if j < N { net[i][j] * (1.0 - t) } else { DVec3::ZERO };
+            lower + upper
+        })
+    })
+}
+
 /// Bernstein weights of degree `n ≤ 3` at `t`.
 fn bernstein(n: usize, t: f64) -> [f64; 4] {
     let s = 1.0 - t;
@@ -794,6 +907,7 @@ fn bicubic(points: &[DVec3; 16]) -> TaylorBound {
             points: std::array::from_fn(|i| std::array::from_fn(|j| b(i, j))),
         },
         third: [uuu, uuv, uvv, vvv],
+        refines: true,
     }
 }
 
@@ -817,6 +931,7 @@ fn triangle(t: &BezierTriangle) -> TaylorBound {
     TaylorBound {
         field: SecondDerivatives::Triangle { corners, net: t.points },
         third: [uuu, uuv, uvv, vvv].map(|d| 6.0 * d.length()),
+        refines: true,
     }
 }
 
@@ -838,7 +953,11 @@ fn quartic(q: &QuarticTriangle) -> TaylorBound {
     let uuv = third(&|i, j, k| d_uu(i, j, k + 1) - d_uu(i + 1, j, k));
     let uvv = third(&|i, j, k| d_vv(i, j + 1, k) - d_vv(i + 1, j, k));
     let vvv = third(&|i, j, k| d_vv(i, j, k + 1) - d_vv(i + 1, j, k));
-    TaylorBound { field: SecondDerivatives::Quartic { net: q.clone() }, third: [uuu, uuv, uvv, vvv] }
+    TaylorBound {
+        field: SecondDerivatives::Quartic { net: q.clone() },
+        third: [uuu, uuv, uvv, vvv],
+        refines: true,
+    }
 }
 
 #[cfg(test)]
@@ -950,6 +1069,116 @@ mod tests {
             let hull = cubic_error_hull(&t.points, tri);
             assert!(measured <= hull * (1.0 + 1e-12) && hull <= 1.5 * measured, "{measured} {hull}");
         }
+    }
+
+    /// Degree elevation keeps a net's polynomial.
+    #[test]
+    fn elevated_nets_are_the_same_polynomials() {
+        let mut rng = Lcg(17);
+        let net = random_net(&mut rng);
+        let uu: [[DVec3; 4]; 2] = std::array::from_fn(|i| std::array::from_fn(|j| net[4 * i + j]));
+        let raised: [[DVec3; 4]; 3] = elevate_u(&uu);
+        let vv: [[DVec3; 2]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| net[2 * i + j]));
+        let raised_v: [[DVec3; 3]; 4] = elevate_v(&vv);
+        for _ in 0..20 {
+            let x = DVec2::new(rng.unit(), rng.unit());
+            assert!(net_at(&uu, x).distance(net_at(&raised, x)) < 1e-12);
+            assert!(net_at(&vv, x).distance(net_at(&raised_v, x)) < 1e-12);
+        }
+    }
+
+    /// The largest `|S − L|` over the triangles every grid of `n` cells can have (a quad's
+    /// cells split either way; a triangle's lattice halves), sampled densely.
+    fn measured_grid_error(p: &Patch, triangle_domain: bool, [nu, nv]: [u32; 2]) -> f64 {
+        let (hu, hv) = (1.0 / nu as f64, 1.0 / nv as f64);
+        let mut worst = 0.0f64;
+        for i in 0..nu {
+            for j in 0..nv {
+                let o = DVec2::new(i as f64 * hu, j as f64 * hv);
+                let [a, b, c, d] =
+                    [o, o + DVec2::new(hu, 0.0), o + DVec2::new(0.0, hv), o + DVec2::new(hu, hv)];
+                let halves: Vec<[DVec2; 3]> = if triangle_domain {
+                    if i + j >= nu {
+                        continue;
+                    }
+                    let mut h = vec![[a, b, c]];
+                    if i + j + 1 < nu {
+                        h.push([b, d, c]);
+                    }
+                    h
+                } else {
+                    vec![[a, b, c], [b, d, c], [a, b, d], [a, d, c]]
+                };
+                for t in halves {
+                    let at = t.map(|q| p.position(q));
+                    let n = 12;
+                    for k in 0..=n {
+                        for l in 0..=n - k {
+                            let (x, y) = (k as f64 / n as f64, l as f64 / n as f64);
+                            let q = t[0] * (1.0 - x - y) + t[1] * x + t[2] * y;
+                            let linear = at[0] * (1.0 - x - y) + at[1] * x + at[2] * y;
+                            worst = worst.max(p.position(q).distance(linear));
+                        }
+                    }
+                }
+            }
+        }
+        worst
+    }
+
+    /// The nets' bound of a whole grid holds when the grid's error is sampled, on random
+    /// bicubics and cubic triangles and grids from one cell to many, thin ones included;
+    /// and it is never below the bound of the walk over the quad's cells, which takes each
+    /// cell's own second derivatives.
+    #[test]
+    fn the_nets_bound_every_cell_of_a_grid() {
+        let mut rng = Lcg(23);
+        let (mut worst_share, mut checked) = (0.0f64, 0);
+        for _ in 0..40 {
+            let net = random_net(&mut rng);
+            let bicubic = Patch::Bicubic(RationalBicubic::polynomial(std::array::from_fn(|k| net[k])));
+            let tri = Patch::BezierTriangle(BezierTriangle { points: std::array::from_fn(|k| net[k]) });
+            for (p, triangle_domain) in [(bicubic, false), (tri, true)] {
+                let bound = TaylorBound::expansion(&p);
+                assert!(bound.is_some() && !bound.refines());
+                for n in [[1, 1], [2, 2], [3, 1], [1, 4], [5, 5], [8, 3]] {
+                    let n = if triangle_domain { [n[0], n[0]] } else { n };
+                    let nets = bound.nets_grid_error(triangle_domain, n);
+                    let measured = measured_grid_error(&p, triangle_domain, n);
+                    assert!(measured <= nets * (1.0 + 1e-9), "{n:?}: measured {measured} > {nets}");
+                    if !triangle_domain {
+                        let walk = bound.grid_error(false, n);
+                        assert!(walk <= nets * (1.0 + 1e-9), "{n:?}: walk {walk} > nets {nets}");
+                    }
+                    worst_share = worst_share.max(measured / nets);
+                    checked += 1;
+                }
+            }
+        }
+        // Not vacuous: on some grid the measured error comes close to the bound.
+        assert!(checked == 480 && worst_share > 0.5, "at most {worst_share:.3} of the bound measured");
+    }
+
+    /// Past [`EXPANSION_WALK_CELLS`] an expansion's grid bound is the nets' bound; below it,
+    /// the walk's; the full Taylor bound always walks.
+    #[test]
+    fn an_expansion_walks_small_grids_only() {
+        let mut rng = Lcg(29);
+        let net = random_net(&mut rng);
+        let p = Patch::Bicubic(RationalBicubic::polynomial(std::array::from_fn(|k| net[k])));
+        let (expansion, full) = (TaylorBound::expansion(&p), TaylorBound::of(&p));
+        let large = [40, 40];
+        assert!(40 * 40 > EXPANSION_WALK_CELLS);
+        assert_eq!(expansion.grid_error(false, large), expansion.nets_grid_error(false, large));
+        assert!(full.grid_error(false, large) < expansion.nets_grid_error(false, large));
+        let small = [30, 30];
+        assert!(expansion.grid_error(false, small) < expansion.nets_grid_error(false, small));
+        // Other kinds have no expansion bound.
+        let rational = Patch::Bicubic(RationalBicubic {
+            points: std::array::from_fn(|k| net[k]),
+            weights: std::array::from_fn(|k| 1.0 + 0.1 * k as f64),
+        });
+        assert!(!TaylorBound::expansion(&rational).is_some());
     }
 
     #[test]

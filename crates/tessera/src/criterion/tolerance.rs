@@ -280,8 +280,9 @@ fn taylor_quad_grid(t: &TaylorBound, m: &TriangleErrors, start: (u32, u32), eps:
         }
         scale *= 1.05;
     };
-    if t.samples() {
-        // Every grid a walk meets would be sampled whole: the scaled grid alone.
+    if t.samples() || !t.refines() {
+        // Every grid a walk meets would be sampled whole (or, for the expansion bound, whose
+        // every query must stay cheap: not searched): the scaled grid alone.
         return (nu1, nv1);
     }
     let cells = |g: (u32, u32)| g.0 as u64 * g.1 as u64;

@@ -408,7 +408,7 @@ impl Scheme {
                     &out.pattern,
                     cap as u32,
                     options.max_triangles,
-                    (options.bound == ErrorBound::Taylor).then(|| prepared.taylor_bounds(set)),
+                    prepared.bounds_for(set, options.bound),
                     &mut scratch.tolerance,
                     &mut out.plan,
                 )?;

@@ -350,12 +350,12 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     options.max_factor
                 ));
             }
-            if checked && options.bound == crate::criterion::ErrorBound::Taylor {
-                return refuse(
-                    "the Taylor bound planned on the GPU (its check computes the second-derivative \
-                     bound; plan this frame on the CPU)"
-                        .into(),
-                );
+            if checked && options.bound != crate::criterion::ErrorBound::Hessian {
+                return refuse(format!(
+                    "the {:?} bound planned on the GPU (its check computes the second-derivative \
+                     bound; plan this frame on the CPU)",
+                    options.bound
+                ));
             }
             Ok(())
         }
