@@ -104,6 +104,51 @@ fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
     return vec2<f32>(best);
 }
 
+// `tolerance::taylor_quad_grid` for the expansion bound (which searches no walk): from
+// `start`, the second-derivative bound's grid, the grid scaled by the square root of the
+// expansion bound's slack there, grown by 5 % until it meets `eps` (at `start` at the
+// latest); `start` where the expansion bound does not meet `eps` there. At most
+// EXPANSION_WALK_CELLS iterations a grid bound, and within lavapipe's loop budget while the
+// bound at `start` is above 1/400 of the tolerance (47 steps).
+fn expansion_quad_grid(x: Expansion, errors: TriangleErrors, start: vec2<u32>, eps: f32) -> vec2<u32> {
+    let at_start = expansion_grid_error(x, false, start.x, start.y, 3.0e38, hessian_cell(errors, start));
+    if (!(at_start <= eps)) { return start; }
+    var scale = sqrt(at_start / eps);
+    loop {
+        let n = clamp(vec2<u32>(ceil(vec2<f32>(start) * scale)), vec2<u32>(1u), start);
+        if (all(n == start) || expansion_grid_fits(x, false, n.x, n.y, eps, hessian_cell(errors, n))) {
+            return n;
+        }
+        scale = scale * 1.05;
+    }
+    return start;
+}
+
+// `tolerance::taylor_uniform_factor` for the expansion bound: the smallest n up to `start`
+// whose n × n grid's bound meets `eps` (bisection), `start` where none does.
+fn expansion_uniform_factor(x: Expansion, errors: TriangleErrors, tri: bool, start: f32, eps: f32) -> f32 {
+    var lo = 1u;
+    var hi = u32(max(start, 1.0));
+    let top = vec2<u32>(hi);
+    if (!expansion_grid_fits(x, tri, hi, hi, eps, hessian_cell(errors, top))) { return start; }
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (expansion_grid_fits(x, tri, mid, mid, eps, hessian_cell(errors, vec2<u32>(mid)))) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return f32(hi);
+}
+
+// The second-derivative bound of every triangle of the n.x × n.y grid
+// (`tolerance::grid_bound` without a Taylor bound): one cell's triangle.
+fn hessian_cell(errors: TriangleErrors, n: vec2<u32>) -> f32 {
+    let cell = vec2<f32>(1.0) / vec2<f32>(n);
+    return triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+}
+
 // `view::edge_factors_into`'s silhouetteness factor of edge e: s = 1 where the two normals
 // at the midpoint face opposite ways from the eye, 1 − (c·nL)(c·nR)/β near it (β = 1/4).
 fn silhouetteness_factor(e: u32) -> f32 {
@@ -251,12 +296,22 @@ fn patch_proposals(
     } else if (visible[p] != 0u) {
         let eps = patch_tolerance(p);
         let m = patch_views[row + 5u];
+        // With the expansion bound, its proposals from the second-derivative bound's.
+        var x = Expansion(p, EXPANSION_NONE, vec4<f32>(0.0));
+        if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
+        let errors = triangle_errors(m.xyz);
         if (view.interior_rule == INTERIOR_CORE && !patch_is_tri(p)) {
             // CudaTess's quads: the cheapest grid that meets the bound, its core.
-            let grid = quad_grid(m.xyz, eps, u32(view.cap));
+            var grid = quad_grid(m.xyz, eps, u32(view.cap));
+            if (x.kind != EXPANSION_NONE) {
+                grid = vec2<f32>(expansion_quad_grid(x, errors, vec2<u32>(grid), eps));
+            }
             out = vec4<f32>(grid.x, grid.y, grid.x, grid.y);
         } else {
-            let n = uniform_factor(m, eps);
+            var n = uniform_factor(m, eps);
+            if (x.kind != EXPANSION_NONE) {
+                n = expansion_uniform_factor(x, errors, patch_is_tri(p), min(n, view.cap), eps);
+            }
             for (var l = 0u; l < patch_corner_count(p); l = l + 1u) { out[l] = n; }
         }
         let curves = patch_views[row + 6u];

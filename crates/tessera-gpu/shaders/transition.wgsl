@@ -211,10 +211,13 @@ struct Sink {
     kept: u32,
     worst: f32,
     errors: TriangleErrors,
+    // The patch's expansion bound (`expansion.wgsl`; EXPANSION_NONE: the second-derivative
+    // bound alone).
+    expansion: Expansion,
 }
 
 fn sink(mode: u32, first: u32) -> Sink {
-    return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)));
+    return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)), Expansion(0u, EXPANSION_NONE, vec4<f32>(0.0)));
 }
 
 // Takes pattern triangle `tri` (local indices; ta, tb, tc its domain positions): counted or
@@ -223,7 +226,12 @@ fn sink(mode: u32, first: u32) -> Sink {
 // them over the built pattern.
 fn take(input: PatchInput, tri: vec3<u32>, ta: vec2<f32>, tb: vec2<f32>, tc: vec2<f32>, out: ptr<function, Sink>) {
     if ((*out).mode == SINK_CHECK) {
-        (*out).worst = max((*out).worst, triangle_error((*out).errors, ta, tb, tc));
+        // The expansion bound, dearer, only where it could raise the largest so far
+        // (`tolerance::triangles_bound`).
+        let e = triangle_error((*out).errors, ta, tb, tc);
+        if (e > (*out).worst) {
+            (*out).worst = max((*out).worst, min(e, expansion_triangle_error((*out).expansion, ta, tb, tc)));
+        }
         (*out).kept = (*out).kept + 1u;
         return;
     }

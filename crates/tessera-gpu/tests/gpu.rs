@@ -468,6 +468,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 criterion: Criterion::PixelError(uniform_pixels),
                 max_factor: cap,
                 capacity: None,
+                bound: Default::default(),
             };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
@@ -509,6 +510,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                     criterion,
                     max_factor: options.max_factor,
                     capacity: None,
+                    bound: Default::default(),
                 };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
@@ -677,6 +679,7 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
             criterion: Criterion::PixelError(pixels),
             max_factor: cap,
             capacity,
+            bound: Default::default(),
         };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let grown = record_until_complete(&mut gpu, &name);
@@ -729,7 +732,13 @@ fn capacity_at_the_cap_on_the_torus() {
         .find(|&cap| frame_triangles(cap) * 12 > limit)
         .unwrap_or_else(|| panic!("no cap up to 2048 passes the binding limit of {limit} bytes"));
     let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion, max_factor: cap, capacity: None };
+    let screen = ScreenCriterion {
+        scheme: Scheme::Uniform,
+        criterion,
+        max_factor: cap,
+        capacity: None,
+        bound: Default::default(),
+    };
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
     assert_eq!(draw[0], 0, "cap {cap}: an overflowing frame drew {} indices", draw[0]);
@@ -759,6 +768,7 @@ fn a_worst_case_past_the_u32_range_is_drawn_when_the_frame_fits() {
         criterion: Criterion::PixelError(pixels),
         max_factor: cap,
         capacity: Some(room),
+        bound: Default::default(),
     };
     // The framing camera at 1 px: a frame of thousands of triangles.
     let (lo, hi) = set.bounds();
@@ -818,6 +828,7 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                     criterion: Criterion::PixelError(pixels),
                     max_factor: cap,
                     capacity: None,
+                    bound: Default::default(),
                 };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let got = gpu.read_plan(ctx).unwrap();
@@ -885,8 +896,13 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
             let cpu = &planned.plan;
-            let screen =
-                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion {
+                scheme: Scheme::Transition,
+                criterion,
+                max_factor: cap,
+                capacity: None,
+                bound: Default::default(),
+            };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -1207,7 +1223,13 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let criterion = Criterion::PixelError(pixels);
             for scheme in [Scheme::Transition, Scheme::SemiUniform { max_level: 5 }, Scheme::Uniform] {
                 let name = format!("{name} moved, {scheme:?}");
-                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion {
+                    scheme,
+                    criterion,
+                    max_factor: cap,
+                    capacity: None,
+                    bound: Default::default(),
+                };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let report = gpu.read_screen_report(ctx).unwrap();
                 let plan = gpu.read_plan(ctx).unwrap();
@@ -1265,7 +1287,13 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                     },
                 ),
             ] {
-                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion {
+                    scheme,
+                    criterion,
+                    max_factor: cap,
+                    capacity: None,
+                    bound: Default::default(),
+                };
                 let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
                 assert!(
                     matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),

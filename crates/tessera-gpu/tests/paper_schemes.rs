@@ -230,7 +230,13 @@ fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
             let options =
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion {
+                scheme,
+                criterion,
+                max_factor: cap,
+                capacity: None,
+                bound: Default::default(),
+            };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -583,8 +589,13 @@ fn strips_written_on_the_gpu_equal_the_cpu_engines() {
         let prepared = tessera::scheme::Prepared::new(&set, true);
         let criterion =
             Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 7.0 };
-        let screen =
-            ScreenCriterion { scheme: Scheme::Sd2 { warp: false }, criterion, max_factor: 8, capacity: None };
+        let screen = ScreenCriterion {
+            scheme: Scheme::Sd2 { warp: false },
+            criterion,
+            max_factor: 8,
+            capacity: None,
+            bound: Default::default(),
+        };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         record_frame(&gpu);
         let plan = gpu.read_plan(ctx).unwrap();
@@ -607,7 +618,8 @@ fn strips_written_on_the_gpu_equal_the_cpu_engines() {
         gpu.prepare(ctx, &set, &planned.plan, &planned.pattern).unwrap();
         check(&format!("{model} esc"), &set, &mut gpu, &planned.plan, &planned.pattern);
         let prepared = tessera::scheme::Prepared::new(&set, true);
-        let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity: None };
+        let screen =
+            ScreenCriterion { scheme, criterion, max_factor: 64, capacity: None, bound: Default::default() };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         record_frame(&gpu);
         let plan = gpu.read_plan(ctx).unwrap();

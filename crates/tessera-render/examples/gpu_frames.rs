@@ -49,6 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         criterion: Criterion::PixelError(1.0),
         max_factor: 64,
         capacity: None,
+        bound: Default::default(),
     };
     engine.prepare_screen(&ctx, &set, &prepared, &framing, criterion)?;
 
