@@ -34,8 +34,18 @@ fn sweep(models: &[&str], cameras_per_model: usize, seed: u64, pixel_errors: &[f
                 let name = format!("{model} camera {c} {pixels} px");
                 let counts = &mut sweep.counts;
                 let scheme = tessera::scheme::Scheme::Transition;
-                let plan =
-                    checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, pixels, cap, counts);
+                let plan = checked_frame(
+                    scheme,
+                    tessera::scheme::ErrorBound::Hessian,
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    cap,
+                    counts,
+                );
                 sweep.most_rounds = sweep.most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
                 let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
                 let visible = (0..set.patches.len()).filter(|&p| plan.is_visible(p));
@@ -63,13 +73,11 @@ fn frames_without_a_check_report_no_rounds() {
     let prepared = Prepared::new(&set, true);
     let mut gpu = tessellator(&set);
     let camera = cameras(&set, 1, 3)[0];
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: tessera::scheme::Scheme::Uniform,
-        criterion: tessera::scheme::Criterion::PixelError(1.0),
-        max_factor: 8,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen = tessera_gpu::tessellator::ScreenCriterion::new(
+        tessera::scheme::Scheme::Uniform,
+        tessera::scheme::Criterion::PixelError(1.0),
+        8,
+    );
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert_eq!(
@@ -103,13 +111,8 @@ fn too_few_rounds_are_reported_and_the_plan_stays_crack_free() {
     assert!(cpu.report.unwrap().rounds > 2, "the case no longer needs many rounds");
     let mut gpu = tessellator(&set);
     gpu.set_check_rounds(2);
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion: Criterion::PixelError(0.5),
-        max_factor: 16,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(0.5), 16);
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert!(!report.converged && report.rounds == 2 && report.failing_patches > 0, "{report:?}");
@@ -141,13 +144,8 @@ fn checked_frames_past_the_check_cap_are_refused_not_truncated() {
     let mut gpu = tessellator(&set);
     let camera = cameras(&set, 1, 3)[0];
     let cap = tessera_gpu::tessellator::CHECK_MAX_FACTOR + 1;
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion: Criterion::PixelError(0.5),
-        max_factor: cap,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(0.5), cap);
     let err = gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap_err();
     assert!(
         matches!(err, tessera_gpu::GpuError::Tessera(tessera::Error::EngineNotSupported { .. })),
@@ -210,7 +208,7 @@ fn the_expansion_bound_planned_on_the_gpu_equals_the_cpu_plan() {
                 let pixels = [0.5, 2.0][(c + k) % 2];
                 for (b, bound) in [ErrorBound::Hessian, ErrorBound::Expansion].into_iter().enumerate() {
                     let name = format!("{model} camera {c} {scheme:?} {pixels} px {bound:?}");
-                    let plan = checked_frame_with(
+                    let plan = checked_frame(
                         scheme,
                         bound,
                         &name,

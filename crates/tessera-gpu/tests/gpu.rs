@@ -463,13 +463,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             let name = format!("{model} camera {c} uniform");
             let criterion = Criterion::PixelError(uniform_pixels);
             let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion {
-                scheme: Scheme::Uniform,
-                criterion: Criterion::PixelError(uniform_pixels),
-                max_factor: cap,
-                capacity: None,
-                bound: Default::default(),
-            };
+            let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(uniform_pixels), cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
             let drawn = gpu.read_plan(ctx).unwrap();
@@ -505,13 +499,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
                 let planned =
                     Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
-                let screen = ScreenCriterion {
-                    scheme: Scheme::Transition,
-                    criterion,
-                    max_factor: options.max_factor,
-                    capacity: None,
-                    bound: Default::default(),
-                };
+                let screen = ScreenCriterion::new(Scheme::Transition, criterion, options.max_factor);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
                 let drawn = gpu.read_plan(ctx).unwrap();
@@ -538,6 +526,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let scheme = Scheme::Transition;
                 let plan = checked_frame(
                     scheme,
+                    tessera::scheme::ErrorBound::Hessian,
                     &name,
                     &set,
                     &prepared,
@@ -562,6 +551,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let cap = 1 << cap.max(2).ilog2();
                 let plan = checked_frame(
                     scheme,
+                    tessera::scheme::ErrorBound::Hessian,
                     &name,
                     &set,
                     &prepared,
@@ -675,11 +665,8 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
         let name = format!("{model} cap {cap}, {start}");
         let mut gpu = tessellator(&set);
         let screen = ScreenCriterion {
-            scheme: Scheme::Uniform,
-            criterion: Criterion::PixelError(pixels),
-            max_factor: cap,
             capacity,
-            bound: Default::default(),
+            ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
         };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let grown = record_until_complete(&mut gpu, &name);
@@ -732,13 +719,7 @@ fn capacity_at_the_cap_on_the_torus() {
         .find(|&cap| frame_triangles(cap) * 12 > limit)
         .unwrap_or_else(|| panic!("no cap up to 2048 passes the binding limit of {limit} bytes"));
     let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion {
-        scheme: Scheme::Uniform,
-        criterion,
-        max_factor: cap,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen = ScreenCriterion::new(Scheme::Uniform, criterion, cap);
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
     assert_eq!(draw[0], 0, "cap {cap}: an overflowing frame drew {} indices", draw[0]);
@@ -764,11 +745,8 @@ fn a_worst_case_past_the_u32_range_is_drawn_when_the_frame_fits() {
     let cap = tessera::criterion::MAX_FACTOR;
     let room = Capacity { vertices: 1 << 20, triangles: 1 << 20 };
     let screen = |pixels| ScreenCriterion {
-        scheme: Scheme::Uniform,
-        criterion: Criterion::PixelError(pixels),
-        max_factor: cap,
         capacity: Some(room),
-        bound: Default::default(),
+        ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
     };
     // The framing camera at 1 px: a frame of thousands of triangles.
     let (lo, hi) = set.bounds();
@@ -823,13 +801,7 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                     PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
                 let criterion = Criterion::PixelError(pixels);
                 let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-                let screen = ScreenCriterion {
-                    scheme: Scheme::Uniform,
-                    criterion: Criterion::PixelError(pixels),
-                    max_factor: cap,
-                    capacity: None,
-                    bound: Default::default(),
-                };
+                let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let got = gpu.read_plan(ctx).unwrap();
                 frames += 1;
@@ -896,13 +868,7 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
             let cpu = &planned.plan;
-            let screen = ScreenCriterion {
-                scheme: Scheme::Transition,
-                criterion,
-                max_factor: cap,
-                capacity: None,
-                bound: Default::default(),
-            };
+            let screen = ScreenCriterion::new(Scheme::Transition, criterion, cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -1027,6 +993,7 @@ fn subdivision_cages_equal_the_cpu_engine(
             let name = format!("{cage} camera {c} transition 1 px");
             let plan = checked_frame(
                 Scheme::Transition,
+                tessera::scheme::ErrorBound::Hessian,
                 &name,
                 &set,
                 &prepared,
@@ -1040,7 +1007,18 @@ fn subdivision_cages_equal_the_cpu_engine(
             // And semi-uniform (paper 000): each patch's level checked a posteriori.
             let name = format!("{cage} camera {c} semi-uniform 1 px");
             let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
-            let plan = checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, 1.0, 16, &mut counts);
+            let plan = checked_frame(
+                scheme,
+                tessera::scheme::ErrorBound::Hessian,
+                &name,
+                &set,
+                &prepared,
+                &mut gpu,
+                &camera,
+                1.0,
+                16,
+                &mut counts,
+            );
             let pattern = tessera::pattern::semi_uniform::SemiUniform;
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
         }
@@ -1185,6 +1163,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let mut counts = SweepCounts::default();
             let drawn = checked_frame(
                 Scheme::Transition,
+                tessera::scheme::ErrorBound::Hessian,
                 &format!("{name} at rest"),
                 &set,
                 &prepared,
@@ -1223,13 +1202,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let criterion = Criterion::PixelError(pixels);
             for scheme in [Scheme::Transition, Scheme::SemiUniform { max_level: 5 }, Scheme::Uniform] {
                 let name = format!("{name} moved, {scheme:?}");
-                let screen = ScreenCriterion {
-                    scheme,
-                    criterion,
-                    max_factor: cap,
-                    capacity: None,
-                    bound: Default::default(),
-                };
+                let screen = ScreenCriterion::new(scheme, criterion, cap);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let report = gpu.read_screen_report(ctx).unwrap();
                 let plan = gpu.read_plan(ctx).unwrap();
@@ -1287,13 +1260,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                     },
                 ),
             ] {
-                let screen = ScreenCriterion {
-                    scheme,
-                    criterion,
-                    max_factor: cap,
-                    capacity: None,
-                    bound: Default::default(),
-                };
+                let screen = ScreenCriterion::new(scheme, criterion, cap);
                 let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
                 assert!(
                     matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),

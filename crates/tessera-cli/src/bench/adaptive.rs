@@ -41,10 +41,11 @@ enum Knob {
 /// Semi-uniform at level 8 (factors up to 256), as the tests, so the cap rarely stops a bound.
 const SEMI_UNIFORM: Scheme = Scheme::SemiUniform { max_level: 8 };
 
-const SCHEMES: [(&str, Knob); 7] = [
+const SCHEMES: [(&str, Knob); 8] = [
     ("uniform", Knob::Uniform),
     ("transition", Knob::Tolerance(Scheme::Transition, ErrorBound::Hessian)),
     ("transition-taylor", Knob::Tolerance(Scheme::Transition, ErrorBound::Taylor)),
+    ("transition-expansion", Knob::Tolerance(Scheme::Transition, ErrorBound::Expansion)),
     ("semi-uniform", Knob::Tolerance(SEMI_UNIFORM, ErrorBound::Hessian)),
     ("sd2", Knob::Distance(Scheme::Sd2 { warp: false })),
     ("fractional-odd", Knob::Distance(Scheme::Hardware(Partitioning::FractionalOdd))),
@@ -436,7 +437,8 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         "Each error-bounded scheme at tolerances of 1 %, 0.1 % and 0.01 % of the diagonal (the points of its knob grid; \
          the quick run has no 0.01 %): the measured max error (order 5, as above) and the plan's certified bound \
          (BoundReport::worst_bound, the largest over the patches). \"transition-taylor\" plans with ErrorBound::Taylor \
-         (tessera mesh --bound taylor), the others with the second-derivative bound."
+         (tessera mesh --bound taylor), \"transition-expansion\" with ErrorBound::Expansion (--bound expansion, \
+         what the GPU plans with), the others with the second-derivative bound."
             .to_string(),
     );
     Ok(vec![ratio, tightness, equal, curves])

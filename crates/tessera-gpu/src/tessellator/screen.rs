@@ -55,6 +55,15 @@ pub struct ScreenCriterion {
     pub bound: ErrorBound,
 }
 
+impl ScreenCriterion {
+    /// `scheme` under `criterion` with the factor cap `max_factor`: output room for the
+    /// worst case, planned with the second-derivative bound (set `capacity` and `bound` on
+    /// the result for others).
+    pub fn new(scheme: Scheme, criterion: Criterion, max_factor: u32) -> ScreenCriterion {
+        ScreenCriterion { scheme, criterion, max_factor, capacity: None, bound: ErrorBound::Hessian }
+    }
+}
+
 /// `view.wgsl`'s `View` uniform (member for member: the contract test, `contract.rs`, checks
 /// the offsets): the camera's basis and frustum, and the screen criterion of the frame.
 #[repr(C)]

@@ -309,14 +309,16 @@ pub fn all_models() -> Vec<String> {
     models
 }
 
-/// `scheme`'s pixel-error frame for `camera` (the transition or the semi-uniform scheme),
-/// planned on the GPU from the camera alone (culling, per-edge factors, the a-posteriori check
-/// of `check.wgsl`) and recorded, against `scheme`'s plan on the CPU with the same options:
+/// `scheme`'s pixel-error frame for `camera` (the transition or the semi-uniform scheme) with
+/// the error bound `bound`, planned on the GPU from the camera alone (culling, per-edge
+/// factors, the a-posteriori check of `check.wgsl`) and recorded, against `scheme`'s plan on
+/// the CPU with the same options:
 ///
 /// - the culled set equals the CPU's but for counted [`near_cull_tie`]s ([`check_culling`]);
 /// - the rounds converged within `DEFAULT_CHECK_ROUNDS`;
 /// - every visible patch's bound from the GPU's check is the CPU library's on the GPU's plan
-///   (`tolerance::patch_bound`, f64) within 1e-4 relative, and the patch meets its tolerance
+///   (`tolerance::checked_patch_bound`, f64) within 1e-4 relative (2e-3 with the expansion
+///   bound), and the patch meets its tolerance
 ///   by the CPU's bound but for at most the patches the GPU reports failing (at the cap, as
 ///   the CPU reports them);
 /// - with the same culled set, the plan (segments, interior factors), the fix rounds and the
@@ -325,24 +327,6 @@ pub fn all_models() -> Vec<String> {
 /// Returns the GPU's plan, for comparing its output with the CPU engine's.
 #[allow(clippy::too_many_arguments)]
 pub fn checked_frame(
-    scheme: tessera::scheme::Scheme,
-    name: &str,
-    set: &SurfaceSet,
-    prepared: &tessera::scheme::Prepared,
-    gpu: &mut GpuTessellator,
-    camera: &tessera::camera::Camera,
-    pixels: f64,
-    cap: u32,
-    counts: &mut SweepCounts,
-) -> Plan {
-    let bound = tessera::scheme::ErrorBound::Hessian;
-    checked_frame_with(scheme, bound, name, set, prepared, gpu, camera, pixels, cap, counts)
-}
-
-/// [`checked_frame`] with the error bound `bound` on both sides (the patches' bounds
-/// compared through `tolerance::checked_patch_bound`).
-#[allow(clippy::too_many_arguments)]
-pub fn checked_frame_with(
     scheme: tessera::scheme::Scheme,
     bound: tessera::scheme::ErrorBound,
     name: &str,
@@ -476,13 +460,7 @@ pub fn sd2_frame_from_the_camera(
     let options = PlanOptions { camera: Some(*camera), cull: true, max_factor, ..Default::default() };
     let planned = scheme.plan_prepared(set, prepared, &criterion, &options).unwrap();
     let cpu = &planned.plan;
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme,
-        criterion,
-        max_factor,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen = tessera_gpu::tessellator::ScreenCriterion::new(scheme, criterion, max_factor);
     screen_frame(gpu, set, prepared, camera, screen);
     let drawn = gpu.read_plan(ctx()).unwrap();
     check_culling(name, set, gpu, &cpu.visible, camera, counts);
@@ -555,13 +533,7 @@ pub fn esc_frame_from_the_camera(
     use tessera::scheme::{Criterion, PlanOptions, Scheme, SchemePattern};
     let ctx = ctx();
     let scheme = Scheme::Esc { max_level: 3 };
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme,
-        criterion,
-        max_factor: 64,
-        capacity: None,
-        bound: Default::default(),
-    };
+    let screen = tessera_gpu::tessellator::ScreenCriterion::new(scheme, criterion, 64);
     screen_frame(gpu, set, prepared, camera, screen);
     let plan = gpu.read_plan(ctx).unwrap();
     let esc = gpu.read_esc_pattern(ctx).unwrap();
