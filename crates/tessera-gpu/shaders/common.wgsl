@@ -92,15 +92,6 @@ fn patch_point_count(p: u32) -> u32 { return select(16u, 10u, patch_is_tri(p)); 
 // (`tree.wgsl` evaluates it).
 fn patch_is_subdivision(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 24u) != 0u; }
 
-// A cubic Bézier triangle's control point b(i, j, 3 − i − j) (`i` the exponent of
-// λ0 = 1 − u − v, `j` of u), at `BezierTriangle::index`.
-fn tri_index(i: u32, j: u32) -> u32 {
-    return (3u - i) * (4u - i) / 2u + (3u - i - j);
-}
-
-fn tri_point(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return control_points[p * CONTROL_POINTS + tri_index(i, j)].xyz;
-}
 
 // The plan's real factor of edge e (`Plan::factors`).
 fn edge_factor(e: u32) -> f32 { return bitcast<f32>(segments[params.edges + e]); }

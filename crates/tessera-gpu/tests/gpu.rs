@@ -420,9 +420,12 @@ fn uniform_pixel_error_root(
 ///   even cameras, the pixel error: CudaTess's per-edge factors and the a-posteriori check
 ///   on the GPU ([`checked_frame`]: the plan, the rounds and the capped patches
 ///   equal the CPU's but for counted ties, and every bound verified in f64);
-/// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
+/// - **semi-uniform, from the camera alone**, every camera: the pixel error's edge
 ///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
 ///   transition);
+/// - the checked frames (transition and semi-uniform) alternate between the
+///   second-derivative bound and the expansion bound (`ErrorBound::Expansion`, the GPU's
+///   `expansion.wgsl`);
 /// - **SD-2, from the camera alone**, on the triangle models, every fourth camera (the
 ///   others): the distance level function, every other time with the reverse projection
 ///   ([`sd2_frame_from_the_camera`]: real factors and depths as the CPU's, never three
@@ -432,6 +435,15 @@ fn uniform_pixel_error_root(
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
 /// index, positions within 1e-5 of the diagonal, the watertightness report).
 fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
+    // The checked frames alternate between the second-derivative and the expansion bound.
+    let expansion_every_other = |k: usize| {
+        use tessera::scheme::ErrorBound;
+        if k % 2 == 1 {
+            ErrorBound::Expansion
+        } else {
+            ErrorBound::Hessian
+        }
+    };
     use tessera::criterion::view::{Mapping, ViewCriterion};
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
@@ -521,12 +533,14 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 }
                 (name, drawn, planned.pattern)
             } else {
-                let name = format!("{model} camera {c} transition {pixels} px");
+                // Every other such frame with the expansion bound.
+                let bound = expansion_every_other(c / 2);
+                let name = format!("{model} camera {c} transition {pixels} px {bound:?}");
                 let cap = options.max_factor;
                 let scheme = Scheme::Transition;
                 let plan = checked_frame(
                     scheme,
-                    tessera::scheme::ErrorBound::Hessian,
+                    bound,
                     &name,
                     &set,
                     &prepared,
@@ -546,12 +560,13 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             // Semi-uniform: the pixel error's levels checked a posteriori on the GPU, under the
             // largest power-of-two cap within the cap.
             {
-                let name = format!("{model} camera {c} semi-uniform {pixels} px");
+                let bound = expansion_every_other(c);
+                let name = format!("{model} camera {c} semi-uniform {pixels} px {bound:?}");
                 let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
                 let cap = 1 << cap.max(2).ilog2();
                 let plan = checked_frame(
                     scheme,
-                    tessera::scheme::ErrorBound::Hessian,
+                    bound,
                     &name,
                     &set,
                     &prepared,
