@@ -98,7 +98,7 @@ fn check_patch(p: u32) -> bool {
     }
     let errors = triangle_errors(patch_views[PATCH_VIEW_ROW * p + 5u].xyz);
     // With the expansion bound every triangle's bound is the smaller of the two.
-    var x = Expansion(p, EXPANSION_NONE, vec4<f32>(0.0));
+    var x = no_expansion(p);
     if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
     var factors = first;
     var previous = 3.0e38;

@@ -22,11 +22,19 @@ const EXPANSION_WALK_CELLS: u32 = {{EXPANSION_WALK_CELLS}}u;
 // triangle's remainder exceeds this share of its quadratic part, its error hull is taken too.
 const HULL_WHEN_BITS: u32 = {{HULL_WHEN_BITS}}u;
 
-// One patch's expansion: its kind and the bounds on |S_uuu|, |S_uuv|, |S_uvv|, |S_vvv|.
+// One patch's expansion: its kind, the bounds on |S_uuu|, |S_uuv|, |S_uvv|, |S_vvv| and, for
+// a bicubic, on the fourth derivatives |S_uuuv|, |S_uuvv|, |S_uvvv| (`taylor::
+// ThirdDerivatives`; zero for a triangle, whose third derivatives are constant).
 struct Expansion {
     p: u32,
     kind: u32,
     third: vec4<f32>,
+    fourth: vec3<f32>,
+}
+
+// Patch p without an expansion bound (its plans keep the second-derivative bound).
+fn no_expansion(p: u32) -> Expansion {
+    return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0), vec3<f32>(0.0));
 }
 
 // A bicubic's point b(i, j) (`i` along u).
@@ -65,7 +73,7 @@ fn tri_dvv(p: u32, i: u32, j: u32) -> vec3<f32> {
 // bicubic`, `taylor::triangle`). Loops of a few steps, once per check or proposal.
 fn expansion_of(p: u32) -> Expansion {
     if (patch_is_subdivision(p)) {
-        return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0));
+        return no_expansion(p);
     }
     if (patch_is_tri(p)) {
         // (1, 0, 0) and its steps along u, (0, 1, 0), and v, (0, 0, 1).
@@ -73,27 +81,87 @@ fn expansion_of(p: u32) -> Expansion {
         let uuv = length(tri_duu(p, 0u, 0u) - tri_duu(p, 1u, 0u));
         let uvv = length(tri_dvv(p, 0u, 1u) - tri_dvv(p, 1u, 0u));
         let vvv = length(tri_dvv(p, 0u, 0u) - tri_dvv(p, 1u, 0u));
-        return Expansion(p, EXPANSION_TRIANGLE, 6.0 * vec4<f32>(uuu, uuv, uvv, vvv));
+        return Expansion(p, EXPANSION_TRIANGLE, 6.0 * vec4<f32>(uuu, uuv, uvv, vvv), vec3<f32>(0.0));
     }
     var polynomial = true;
     for (var k = 0u; k < 16u; k = k + 1u) {
         polynomial = polynomial && control_points[p * CONTROL_POINTS + k].w == 1.0;
     }
     if (!polynomial) {
-        return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0));
+        return no_expansion(p);
     }
     var third = vec4<f32>(0.0);
+    var fourth = vec3<f32>(0.0);
     for (var j = 0u; j < 4u; j = j + 1u) {
-        third.x = max(third.x, 6.0 * length(net_duu(p, 1u, j) - net_duu(p, 0u, j)));
-        third.w = max(third.w, 6.0 * length(net_dvv(p, j, 1u) - net_dvv(p, j, 0u)));
+        third.x = max(third.x, 6.0 * length(net_d3u(p, j)));
+        third.w = max(third.w, 6.0 * length(net_d3v(p, j)));
     }
     for (var i = 0u; i < 2u; i = i + 1u) {
         for (var j = 0u; j < 3u; j = j + 1u) {
-            third.y = max(third.y, 18.0 * length(net_duu(p, i, j + 1u) - net_duu(p, i, j)));
-            third.z = max(third.z, 18.0 * length(net_dvv(p, j + 1u, i) - net_dvv(p, j, i)));
+            third.y = max(third.y, 18.0 * length(net_d2u1v(p, i, j)));
+            third.z = max(third.z, 18.0 * length(net_d1u2v(p, j, i)));
         }
     }
-    return Expansion(p, EXPANSION_BICUBIC, third);
+    for (var j = 0u; j < 3u; j = j + 1u) {
+        fourth.x = max(fourth.x, 18.0 * length(net_d3u(p, j + 1u) - net_d3u(p, j)));
+        fourth.z = max(fourth.z, 18.0 * length(net_d3v(p, j + 1u) - net_d3v(p, j)));
+    }
+    for (var i = 0u; i < 2u; i = i + 1u) {
+        for (var j = 0u; j < 2u; j = j + 1u) {
+            fourth.y = max(fourth.y, 36.0 * length(net_d2u1v(p, i, j + 1u) - net_d2u1v(p, i, j)));
+        }
+    }
+    return Expansion(p, EXPANSION_BICUBIC, third, fourth);
+}
+
+// A bicubic's third differences (`taylor::ThirdDerivatives`): Δ³_u b at (0, j), Δ²_uΔ_v b at
+// (i, j), Δ_uΔ²_v b at (i, j), Δ³_v b at (i, 0).
+fn net_d3u(p: u32, j: u32) -> vec3<f32> { return net_duu(p, 1u, j) - net_duu(p, 0u, j); }
+fn net_d2u1v(p: u32, i: u32, j: u32) -> vec3<f32> { return net_duu(p, i, j + 1u) - net_duu(p, i, j); }
+fn net_d1u2v(p: u32, i: u32, j: u32) -> vec3<f32> { return net_dvv(p, i + 1u, j) - net_dvv(p, i, j); }
+fn net_d3v(p: u32, i: u32) -> vec3<f32> { return net_dvv(p, i, 1u) - net_dvv(p, i, 0u); }
+
+// `ThirdDerivatives::near`: bounds on the third derivatives over the box g ± delta, each at g
+// plus its derivatives' bounds times the half-sides, unrolled.
+fn third_near(x: Expansion, g: vec2<f32>, delta: vec2<f32>) -> vec4<f32> {
+    let p = x.p;
+    let u1 = bernstein1(g.x);
+    let u2 = bernstein2(g.x);
+    let u3 = bernstein3w(g.x);
+    let v1 = bernstein1(g.y);
+    let v2 = bernstein2(g.y);
+    let v3 = bernstein3w(g.y);
+    let uuu = 6.0 * row4(v3, net_d3u(p, 0u), net_d3u(p, 1u), net_d3u(p, 2u), net_d3u(p, 3u));
+    let vvv = 6.0 * row4(u3, net_d3v(p, 0u), net_d3v(p, 1u), net_d3v(p, 2u), net_d3v(p, 3u));
+    let uuv = 18.0 * row2(
+        u1,
+        row3(v2, net_d2u1v(p, 0u, 0u), net_d2u1v(p, 0u, 1u), net_d2u1v(p, 0u, 2u)),
+        row3(v2, net_d2u1v(p, 1u, 0u), net_d2u1v(p, 1u, 1u), net_d2u1v(p, 1u, 2u)),
+    );
+    let uvv = 18.0 * row3(
+        u2,
+        row2(v1, net_d1u2v(p, 0u, 0u), net_d1u2v(p, 0u, 1u)),
+        row2(v1, net_d1u2v(p, 1u, 0u), net_d1u2v(p, 1u, 1u)),
+        row2(v1, net_d1u2v(p, 2u, 0u), net_d1u2v(p, 2u, 1u)),
+    );
+    let du = abs(delta.x);
+    let dv = abs(delta.y);
+    let f = x.fourth;
+    return vec4<f32>(
+        length(uuu) + f.x * dv,
+        length(uuv) + f.x * du + f.y * dv,
+        length(uvv) + f.y * du + f.z * dv,
+        length(vvv) + f.z * du,
+    );
+}
+
+// `TaylorBound::remainder_at`: the remainder about g, a bicubic's third derivatives bounded on
+// the box g ± delta where that is smaller than the patch's bounds.
+fn expansion_remainder_at(x: Expansion, g: vec2<f32>, delta: vec2<f32>) -> f32 {
+    if (x.kind != EXPANSION_BICUBIC) { return expansion_remainder(x, delta); }
+    var local = x;
+    local.third = min(x.third, third_near(x, g, delta));
+    return expansion_remainder(local, delta);
 }
 
 // Bernstein weights of degree 1, 2, 3 at t (`taylor::bernstein`).
@@ -298,7 +366,7 @@ fn expansion_triangle_error(x: Expansion, t0: vec2<f32>, t1: vec2<f32>, t2: vec2
     let m = vec3<f32>(side_term(h, t2 - t1), side_term(h, t0 - t2), side_term(h, t1 - t0));
     let delta = max(abs(t0 - g), max(abs(t1 - g), abs(t2 - g)));
     let quadratic = bubble_max(m);
-    let remainder = expansion_remainder(x, delta);
+    let remainder = expansion_remainder_at(x, g, delta);
     if (x.kind == EXPANSION_TRIANGLE && remainder > bitcast<f32>(HULL_WHEN_BITS) * quadratic) {
         return min(quadratic + remainder, cubic_error_hull(x.p, t0, t1, t2));
     }
@@ -314,7 +382,7 @@ fn expansion_cell_error(x: Expansion, centre: vec2<f32>, hu: f32, hv: f32) -> f3
     let c = h[2] * (hv * hv);
     let diagonal = max(length(a + c - b), length(a + c + b)) / 8.0;
     return bubble_max(vec3<f32>(diagonal, length(a) / 8.0, length(c) / 8.0))
-        + expansion_remainder(x, vec2<f32>(hu, hv) / 2.0);
+        + expansion_remainder_at(x, centre, vec2<f32>(hu, hv) / 2.0);
 }
 
 // Degree elevation of one net row to degree 3 (`taylor::elevate_u` applied until cubic):
@@ -404,17 +472,18 @@ fn expansion_grid_error(x: Expansion, tri: bool, nu: u32, nv: u32, stop: f32, ca
         let b = a + vec2<f32>(hu, 0.0);
         let c = a + vec2<f32>(0.0, hv);
         let d = a + vec2<f32>(hu, hv);
-        var error: f32;
         if (!tri) {
-            error = min(expansion_cell_error(x, (a + d) / 2.0, hu, hv), cap);
+            worst = max(worst, min(expansion_cell_error(x, (a + d) / 2.0, hu, hv), cap));
         } else {
-            error = min(expansion_triangle_error(x, a, b, c), cap);
-            if (i + j + 2u <= nu) {
-                // Off the diagonal: the upper half too.
-                error = max(error, min(expansion_triangle_error(x, b, d, c), cap));
+            // The lower half, and off the diagonal the upper half: one call site in a loop
+            // (every call is inlined), two steps a cell.
+            let halves = select(1u, 2u, i + j + 2u <= nu);
+            for (var h = 0u; h < halves; h = h + 1u) {
+                let t0 = select(a, b, h == 1u);
+                let t1 = select(b, d, h == 1u);
+                worst = max(worst, min(expansion_triangle_error(x, t0, t1, c), cap));
             }
         }
-        worst = max(worst, error);
         if (worst > stop) { return worst; }
     }
     return worst;

@@ -107,39 +107,53 @@ fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
 // `tolerance::taylor_quad_grid` for the expansion bound (which searches no walk): from
 // `start`, the second-derivative bound's grid, the grid scaled by the square root of the
 // expansion bound's slack there, grown by 5 % until it meets `eps` (at `start` at the
-// latest); `start` where the expansion bound does not meet `eps` there. At most
+// latest); `start` where the expansion bound does not meet `eps` there. One call site of the
+// grid bound (every call is inlined): the first step bounds `start`. At most
 // EXPANSION_WALK_CELLS iterations a grid bound, and within lavapipe's loop budget while the
 // bound at `start` is above 1/400 of the tolerance (47 steps).
 fn expansion_quad_grid(x: Expansion, errors: TriangleErrors, start: vec2<u32>, eps: f32) -> vec2<u32> {
-    let at_start = expansion_grid_error(x, false, start.x, start.y, 3.0e38, hessian_cell(errors, start));
-    if (!(at_start <= eps)) { return start; }
-    var scale = sqrt(at_start / eps);
+    var n = start;
+    var scale = -1.0;
     loop {
-        let n = clamp(vec2<u32>(ceil(vec2<f32>(start) * scale)), vec2<u32>(1u), start);
-        if (all(n == start) || expansion_grid_fits(x, false, n.x, n.y, eps, hessian_cell(errors, n))) {
+        let at_start = scale < 0.0;
+        let stop = select(eps, 3.0e38, at_start);
+        let bound = expansion_grid_error(x, false, n.x, n.y, stop, hessian_cell(errors, n));
+        if (at_start) {
+            if (!(bound <= eps)) { return start; }
+            scale = sqrt(bound / eps);
+        } else if (bound <= eps) {
             return n;
+        } else {
+            scale = scale * 1.05;
         }
-        scale = scale * 1.05;
+        n = clamp(vec2<u32>(ceil(vec2<f32>(start) * scale)), vec2<u32>(1u), start);
+        if (all(n == start)) { return start; }
     }
     return start;
 }
 
 // `tolerance::taylor_uniform_factor` for the expansion bound: the smallest n up to `start`
-// whose n × n grid's bound meets `eps` (bisection), `start` where none does.
+// whose n × n grid's bound meets `eps` (bisection), `start` where none does. One call site
+// of the grid bound: the first probe is `start` itself.
 fn expansion_uniform_factor(x: Expansion, errors: TriangleErrors, tri: bool, start: f32, eps: f32) -> f32 {
     var lo = 1u;
     var hi = u32(max(start, 1.0));
-    let top = vec2<u32>(hi);
-    if (!expansion_grid_fits(x, tri, hi, hi, eps, hessian_cell(errors, top))) { return start; }
-    while (lo < hi) {
-        let mid = (lo + hi) / 2u;
-        if (expansion_grid_fits(x, tri, mid, mid, eps, hessian_cell(errors, vec2<u32>(mid)))) {
-            hi = mid;
+    var probe = hi;
+    var first = true;
+    loop {
+        let fits = expansion_grid_fits(x, tri, probe, probe, eps, hessian_cell(errors, vec2<u32>(probe)));
+        if (first) {
+            if (!fits) { return start; }
+            first = false;
+        } else if (fits) {
+            hi = probe;
         } else {
-            lo = mid + 1u;
+            lo = probe + 1u;
         }
+        if (lo >= hi) { return f32(hi); }
+        probe = (lo + hi) / 2u;
     }
-    return f32(hi);
+    return start;
 }
 
 // The second-derivative bound of every triangle of the n.x × n.y grid
@@ -297,7 +311,7 @@ fn patch_proposals(
         let eps = patch_tolerance(p);
         let m = patch_views[row + 5u];
         // With the expansion bound, its proposals from the second-derivative bound's.
-        var x = Expansion(p, EXPANSION_NONE, vec4<f32>(0.0));
+        var x = no_expansion(p);
         if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
         let errors = triangle_errors(m.xyz);
         if (view.interior_rule == INTERIOR_CORE && !patch_is_tri(p)) {

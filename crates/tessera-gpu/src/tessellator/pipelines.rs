@@ -266,7 +266,7 @@ const UNIFORM_SHADERS: PatternShaders = PatternShaders {
 
 /// The transition pattern: counts and triangles in one module.
 const TRANSITION_SHADERS: PatternShaders = PatternShaders {
-    count: ("transition", &[COMMON, LOCAL, BOUNDS, EXPANSION, TRANSITION, COUNT]),
+    count: ("transition", &[COMMON, LOCAL, BOUNDS, NO_EXPANSION, TRANSITION, COUNT]),
     vertices: (
         "vertices transition",
         &[
@@ -276,7 +276,7 @@ const TRANSITION_SHADERS: PatternShaders = PatternShaders {
             BEZIER_TRIANGLE,
             LOCAL,
             BOUNDS,
-            EXPANSION,
+            NO_EXPANSION,
             TRANSITION,
             GRID_VERTICES,
             WRITE_VERTICES,
