@@ -97,18 +97,15 @@ fn check_patch(p: u32) -> bool {
         return false;
     }
     let errors = triangle_errors(patch_views[PATCH_VIEW_ROW * p + 5u].xyz);
-    // With the expansion bound every triangle's bound is the smaller of the two.
-    var x = no_expansion(p);
-    if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
     var factors = first;
     var previous = 3.0e38;
     var bound = 0.0;
     var missed = false;
     loop {
         if (level) {
-            bound = semi_uniform_bound(p, factors.x, errors, x);
+            bound = semi_uniform_bound(p, factors.x, errors);
         } else {
-            bound = transition_bound(p, factors, errors, x);
+            bound = transition_bound(p, factors, errors);
         }
         if (bound <= eps) { break; }
         // No progress means the worst triangles follow the edges, not the core.
@@ -152,22 +149,18 @@ fn check_patch(p: u32) -> bool {
 
 // The largest error bound over patch p's transition pattern with interior `factors`. Every
 // core triangle is half a grid cell: one cell's triangle bounds them all
-// (`Pattern::grid_cells`, `tolerance::grid_bound`), or with the expansion bound the walk
-// over the grid's cells (`expansion_grid_error`: at most EXPANSION_WALK_CELLS); the walk
-// takes the strips. The core is never walked triangle by triangle, which also keeps a check
-// within lavapipe's 65,535 loop iterations an invocation (`local.wgsl`): a strip has at most
-// 2 · 64 steps.
-fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors, x: Expansion) -> f32 {
+// (`Pattern::grid_cells`, `tolerance::grid_bound`); the walk takes the strips. The core is
+// never walked, which also keeps a check within lavapipe's 65,535 loop iterations an
+// invocation (`local.wgsl`): a strip has at most 2 · 64 steps.
+fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors) -> f32 {
     let input = pattern_input(p, factors);
     let l = input.core;
     var out = sink(SINK_CHECK, 0u);
     out.errors = errors;
-    out.expansion = x;
     let core_cells = select((l.i_hi - l.i_lo) * (l.j_hi - l.j_lo), l.m, input.local.nc == 3u);
     if (core_cells > 0u) {
         let cell = vec2<f32>(1.0 / f32(l.nu), 1.0 / f32(l.nv));
-        let hessian = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
-        out.worst = expansion_grid_error(x, input.local.nc == 3u, l.nu, l.nv, 3.0e38, hessian);
+        out.worst = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
     }
     build_transition(input, &out);
     return out.worst;
@@ -176,11 +169,9 @@ fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors, x: Expan
 // The largest error bound over patch p's semi-uniform pattern at level n (`params_bound` over
 // `SemiUniform::build`'s triangles): the triangles with a corner on the boundary one by one,
 // after the snap (those it collapses are not in the pattern); the others are halves of grid
-// cells, bounded by one cell's triangle as `transition_bound` bounds a core — or, with the
-// expansion bound, whose bound differs from triangle to triangle, one by one too. Cost: O(n)
-// triangles (`semi_uniform.wgsl` says which ones can touch the boundary), O(n²) with the
-// expansion bound (a level at most 64: 8,192 triangles).
-fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors, x: Expansion) -> f32 {
+// cells, bounded by one cell's triangle as `transition_bound` bounds a core. Cost: O(n)
+// triangles (`semi_uniform.wgsl` says which ones can touch the boundary).
+fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
     let input = local_numbering(p);
     let m = countTrailingZeros(n);
     let tri = input.nc == 3u;
@@ -190,7 +181,7 @@ fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors, x: Expansion) -> f
         let len = row_length(tri, n, j);
         let whole = j == 0u || j + 1u >= n;
         for (var q = 0u; q < len; q = q + 1u) {
-            if (!whole && q >= 2u && q + 2u < len && x.kind == EXPANSION_NONE) {
+            if (!whole && q >= 2u && q + 2u < len) {
                 // The middle of a middle row: off the boundary, jump to its last two.
                 cells = true;
                 q = len - 3u;
@@ -202,8 +193,7 @@ fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors, x: Expansion) -> f
             let a = semi_uniform_param(input, n, m, g[0].x, g[0].y);
             let b = semi_uniform_param(input, n, m, g[1].x, g[1].y);
             let c = semi_uniform_param(input, n, m, g[2].x, g[2].y);
-            let e = triangle_error(errors, a, b, c);
-            if (e > worst) { worst = max(worst, min(e, expansion_triangle_error(x, a, b, c))); }
+            worst = max(worst, triangle_error(errors, a, b, c));
         }
     }
     if (cells) {

@@ -104,65 +104,6 @@ fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
     return vec2<f32>(best);
 }
 
-// `tolerance::taylor_quad_grid` for the expansion bound (which searches no walk): from
-// `start`, the second-derivative bound's grid, the grid scaled by the square root of the
-// expansion bound's slack there, grown by 5 % until it meets `eps` (at `start` at the
-// latest); `start` where the expansion bound does not meet `eps` there. One call site of the
-// grid bound (every call is inlined): the first step bounds `start`. At most
-// EXPANSION_WALK_CELLS iterations a grid bound, and within lavapipe's loop budget while the
-// bound at `start` is above 1/400 of the tolerance (47 steps).
-fn expansion_quad_grid(x: Expansion, errors: TriangleErrors, start: vec2<u32>, eps: f32) -> vec2<u32> {
-    var n = start;
-    var scale = -1.0;
-    loop {
-        let at_start = scale < 0.0;
-        let stop = select(eps, 3.0e38, at_start);
-        let bound = expansion_grid_error(x, false, n.x, n.y, stop, hessian_cell(errors, n));
-        if (at_start) {
-            if (!(bound <= eps)) { return start; }
-            scale = sqrt(bound / eps);
-        } else if (bound <= eps) {
-            return n;
-        } else {
-            scale = scale * 1.05;
-        }
-        n = clamp(vec2<u32>(ceil(vec2<f32>(start) * scale)), vec2<u32>(1u), start);
-        if (all(n == start)) { return start; }
-    }
-    return start;
-}
-
-// `tolerance::taylor_uniform_factor` for the expansion bound: the smallest n up to `start`
-// whose n × n grid's bound meets `eps` (bisection), `start` where none does. One call site
-// of the grid bound: the first probe is `start` itself.
-fn expansion_uniform_factor(x: Expansion, errors: TriangleErrors, tri: bool, start: f32, eps: f32) -> f32 {
-    var lo = 1u;
-    var hi = u32(max(start, 1.0));
-    var probe = hi;
-    var first = true;
-    loop {
-        let fits = expansion_grid_fits(x, tri, probe, probe, eps, hessian_cell(errors, vec2<u32>(probe)));
-        if (first) {
-            if (!fits) { return start; }
-            first = false;
-        } else if (fits) {
-            hi = probe;
-        } else {
-            lo = probe + 1u;
-        }
-        if (lo >= hi) { return f32(hi); }
-        probe = (lo + hi) / 2u;
-    }
-    return start;
-}
-
-// The second-derivative bound of every triangle of the n.x × n.y grid
-// (`tolerance::grid_bound` without a Taylor bound): one cell's triangle.
-fn hessian_cell(errors: TriangleErrors, n: vec2<u32>) -> f32 {
-    let cell = vec2<f32>(1.0) / vec2<f32>(n);
-    return triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
-}
-
 // `view::edge_factors_into`'s silhouetteness factor of edge e: s = 1 where the two normals
 // at the midpoint face opposite ways from the eye, 1 − (c·nL)(c·nR)/β near it (β = 1/4).
 fn silhouetteness_factor(e: u32) -> f32 {
@@ -310,22 +251,12 @@ fn patch_proposals(
     } else if (visible[p] != 0u) {
         let eps = patch_tolerance(p);
         let m = patch_views[row + 5u];
-        // With the expansion bound, its proposals from the second-derivative bound's.
-        var x = no_expansion(p);
-        if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
-        let errors = triangle_errors(m.xyz);
         if (view.interior_rule == INTERIOR_CORE && !patch_is_tri(p)) {
             // CudaTess's quads: the cheapest grid that meets the bound, its core.
-            var grid = quad_grid(m.xyz, eps, u32(view.cap));
-            if (x.kind != EXPANSION_NONE) {
-                grid = vec2<f32>(expansion_quad_grid(x, errors, vec2<u32>(grid), eps));
-            }
+            let grid = quad_grid(m.xyz, eps, u32(view.cap));
             out = vec4<f32>(grid.x, grid.y, grid.x, grid.y);
         } else {
-            var n = uniform_factor(m, eps);
-            if (x.kind != EXPANSION_NONE) {
-                n = expansion_uniform_factor(x, errors, patch_is_tri(p), min(n, view.cap), eps);
-            }
+            let n = uniform_factor(m, eps);
             for (var l = 0u; l < patch_corner_count(p); l = l + 1u) { out[l] = n; }
         }
         let curves = patch_views[row + 6u];

@@ -420,12 +420,9 @@ fn uniform_pixel_error_root(
 ///   even cameras, the pixel error: CudaTess's per-edge factors and the a-posteriori check
 ///   on the GPU ([`checked_frame`]: the plan, the rounds and the capped patches
 ///   equal the CPU's but for counted ties, and every bound verified in f64);
-/// - **semi-uniform, from the camera alone**, every camera: the pixel error's edge
+/// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
 ///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
 ///   transition);
-/// - the checked frames (transition and semi-uniform) alternate between the
-///   second-derivative bound and the expansion bound (`ErrorBound::Expansion`, the GPU's
-///   `expansion.wgsl`);
 /// - **SD-2, from the camera alone**, on the triangle models, every fourth camera (the
 ///   others): the distance level function, every other time with the reverse projection
 ///   ([`sd2_frame_from_the_camera`]: real factors and depths as the CPU's, never three
@@ -435,15 +432,6 @@ fn uniform_pixel_error_root(
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
 /// index, positions within 1e-5 of the diagonal, the watertightness report).
 fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
-    // The checked frames alternate between the second-derivative and the expansion bound.
-    let expansion_every_other = |k: usize| {
-        use tessera::scheme::ErrorBound;
-        if k % 2 == 1 {
-            ErrorBound::Expansion
-        } else {
-            ErrorBound::Hessian
-        }
-    };
     use tessera::criterion::view::{Mapping, ViewCriterion};
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
@@ -475,7 +463,12 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             let name = format!("{model} camera {c} uniform");
             let criterion = Criterion::PixelError(uniform_pixels);
             let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(uniform_pixels), cap);
+            let screen = ScreenCriterion {
+                scheme: Scheme::Uniform,
+                criterion: Criterion::PixelError(uniform_pixels),
+                max_factor: cap,
+                capacity: None,
+            };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
             let drawn = gpu.read_plan(ctx).unwrap();
@@ -511,7 +504,12 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
                 let planned =
                     Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
-                let screen = ScreenCriterion::new(Scheme::Transition, criterion, options.max_factor);
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Transition,
+                    criterion,
+                    max_factor: options.max_factor,
+                    capacity: None,
+                };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
                 let drawn = gpu.read_plan(ctx).unwrap();
@@ -533,14 +531,11 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 }
                 (name, drawn, planned.pattern)
             } else {
-                // Every other such frame with the expansion bound.
-                let bound = expansion_every_other(c / 2);
-                let name = format!("{model} camera {c} transition {pixels} px {bound:?}");
+                let name = format!("{model} camera {c} transition {pixels} px");
                 let cap = options.max_factor;
                 let scheme = Scheme::Transition;
                 let plan = checked_frame(
                     scheme,
-                    bound,
                     &name,
                     &set,
                     &prepared,
@@ -560,13 +555,11 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             // Semi-uniform: the pixel error's levels checked a posteriori on the GPU, under the
             // largest power-of-two cap within the cap.
             {
-                let bound = expansion_every_other(c);
-                let name = format!("{model} camera {c} semi-uniform {pixels} px {bound:?}");
+                let name = format!("{model} camera {c} semi-uniform {pixels} px");
                 let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
                 let cap = 1 << cap.max(2).ilog2();
                 let plan = checked_frame(
                     scheme,
-                    bound,
                     &name,
                     &set,
                     &prepared,
@@ -680,8 +673,10 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
         let name = format!("{model} cap {cap}, {start}");
         let mut gpu = tessellator(&set);
         let screen = ScreenCriterion {
+            scheme: Scheme::Uniform,
+            criterion: Criterion::PixelError(pixels),
+            max_factor: cap,
             capacity,
-            ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
         };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let grown = record_until_complete(&mut gpu, &name);
@@ -734,7 +729,7 @@ fn capacity_at_the_cap_on_the_torus() {
         .find(|&cap| frame_triangles(cap) * 12 > limit)
         .unwrap_or_else(|| panic!("no cap up to 2048 passes the binding limit of {limit} bytes"));
     let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion::new(Scheme::Uniform, criterion, cap);
+    let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion, max_factor: cap, capacity: None };
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
     assert_eq!(draw[0], 0, "cap {cap}: an overflowing frame drew {} indices", draw[0]);
@@ -760,8 +755,10 @@ fn a_worst_case_past_the_u32_range_is_drawn_when_the_frame_fits() {
     let cap = tessera::criterion::MAX_FACTOR;
     let room = Capacity { vertices: 1 << 20, triangles: 1 << 20 };
     let screen = |pixels| ScreenCriterion {
+        scheme: Scheme::Uniform,
+        criterion: Criterion::PixelError(pixels),
+        max_factor: cap,
         capacity: Some(room),
-        ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
     };
     // The framing camera at 1 px: a frame of thousands of triangles.
     let (lo, hi) = set.bounds();
@@ -816,7 +813,12 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                     PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
                 let criterion = Criterion::PixelError(pixels);
                 let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-                let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap);
+                let screen = ScreenCriterion {
+                    scheme: Scheme::Uniform,
+                    criterion: Criterion::PixelError(pixels),
+                    max_factor: cap,
+                    capacity: None,
+                };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let got = gpu.read_plan(ctx).unwrap();
                 frames += 1;
@@ -883,7 +885,8 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
             let cpu = &planned.plan;
-            let screen = ScreenCriterion::new(Scheme::Transition, criterion, cap);
+            let screen =
+                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -1008,7 +1011,6 @@ fn subdivision_cages_equal_the_cpu_engine(
             let name = format!("{cage} camera {c} transition 1 px");
             let plan = checked_frame(
                 Scheme::Transition,
-                tessera::scheme::ErrorBound::Hessian,
                 &name,
                 &set,
                 &prepared,
@@ -1022,18 +1024,7 @@ fn subdivision_cages_equal_the_cpu_engine(
             // And semi-uniform (paper 000): each patch's level checked a posteriori.
             let name = format!("{cage} camera {c} semi-uniform 1 px");
             let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
-            let plan = checked_frame(
-                scheme,
-                tessera::scheme::ErrorBound::Hessian,
-                &name,
-                &set,
-                &prepared,
-                &mut gpu,
-                &camera,
-                1.0,
-                16,
-                &mut counts,
-            );
+            let plan = checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, 1.0, 16, &mut counts);
             let pattern = tessera::pattern::semi_uniform::SemiUniform;
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
         }
@@ -1178,7 +1169,6 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let mut counts = SweepCounts::default();
             let drawn = checked_frame(
                 Scheme::Transition,
-                tessera::scheme::ErrorBound::Hessian,
                 &format!("{name} at rest"),
                 &set,
                 &prepared,
@@ -1217,7 +1207,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let criterion = Criterion::PixelError(pixels);
             for scheme in [Scheme::Transition, Scheme::SemiUniform { max_level: 5 }, Scheme::Uniform] {
                 let name = format!("{name} moved, {scheme:?}");
-                let screen = ScreenCriterion::new(scheme, criterion, cap);
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let report = gpu.read_screen_report(ctx).unwrap();
                 let plan = gpu.read_plan(ctx).unwrap();
@@ -1275,7 +1265,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                     },
                 ),
             ] {
-                let screen = ScreenCriterion::new(scheme, criterion, cap);
+                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
                 let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
                 assert!(
                     matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),

@@ -437,8 +437,8 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
         "Each error-bounded scheme at tolerances of 1 %, 0.1 % and 0.01 % of the diagonal (the points of its knob grid; \
          the quick run has no 0.01 %): the measured max error (order 5, as above) and the plan's certified bound \
          (BoundReport::worst_bound, the largest over the patches). \"transition-taylor\" plans with ErrorBound::Taylor \
-         (tessera mesh --bound taylor), \"transition-expansion\" with ErrorBound::Expansion (--bound expansion, \
-         what the GPU plans with), the others with the second-derivative bound."
+         (tessera mesh --bound taylor), \"transition-expansion\" with ErrorBound::Expansion \
+         (--bound expansion), the others with the second-derivative bound."
             .to_string(),
     );
     Ok(vec![ratio, tightness, equal, curves])

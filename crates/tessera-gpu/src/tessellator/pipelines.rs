@@ -3,11 +3,11 @@
 //! ([`constants`]), the bind group layouts, and `common.wgsl`'s uniform [`Params`].
 
 use super::screen::{
-    BOUND_EXPANSION, BOUND_HESSIAN, CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_ESC,
-    CRITERION_FIXED, CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE,
-    EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER, EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW,
-    ESC_THRESHOLD_ABSOLUTE, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE,
-    PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING, VERTEX_VIEW_ROW,
+    CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_ESC, CRITERION_FIXED,
+    CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE, EDGE_RULE_HARDWARE,
+    EDGE_RULE_INTEGER, EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW, ESC_THRESHOLD_ABSOLUTE,
+    INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING,
+    STATE_BINDING, VERTEX_VIEW_ROW,
 };
 use super::VERTEX_FLOATS;
 use crate::context::GpuContext;
@@ -138,10 +138,6 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("OUTPUT_GAP_INVERSE", gap_inverse as u32),
         ("ESC_MAX_SIDE", ESC_MAX_SIDE),
         ("ESC_GRID_WORDS", ESC_GRID_WORDS),
-        ("EXPANSION_WALK_CELLS", tessera::criterion::taylor::EXPANSION_WALK_CELLS as u32),
-        ("HULL_WHEN_BITS", (tessera::criterion::taylor::HULL_WHEN as f32).to_bits()),
-        ("BOUND_HESSIAN", BOUND_HESSIAN),
-        ("BOUND_EXPANSION", BOUND_EXPANSION),
     ]
 }
 
@@ -266,7 +262,7 @@ const UNIFORM_SHADERS: PatternShaders = PatternShaders {
 
 /// The transition pattern: counts and triangles in one module.
 const TRANSITION_SHADERS: PatternShaders = PatternShaders {
-    count: ("transition", &[COMMON, LOCAL, BOUNDS, NO_EXPANSION, TRANSITION, COUNT]),
+    count: ("transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]),
     vertices: (
         "vertices transition",
         &[
@@ -276,7 +272,6 @@ const TRANSITION_SHADERS: PatternShaders = PatternShaders {
             BEZIER_TRIANGLE,
             LOCAL,
             BOUNDS,
-            NO_EXPANSION,
             TRANSITION,
             GRID_VERTICES,
             WRITE_VERTICES,
@@ -540,8 +535,7 @@ impl Pipelines {
         };
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
-        let factors =
-            module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, BOUNDS, EXPANSION, FACTORS]);
+        let factors = module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS]);
         let uniform = UNIFORM_SHADERS.pipelines(device, &one);
         let transition = TRANSITION_SHADERS.pipelines(device, &one);
         let check = {
@@ -553,7 +547,6 @@ impl Pipelines {
                 FACTORS,
                 LOCAL,
                 BOUNDS,
-                EXPANSION,
                 TRANSITION,
                 UNIFORM_GRID,
                 SEMI_UNIFORM,

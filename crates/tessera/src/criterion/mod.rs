@@ -47,9 +47,10 @@ pub enum ErrorBound {
     /// ([`taylor::TaylorBound::expansion`]): the Taylor bound without its sampled
     /// refinements, so every query has a fixed, small cost. Polynomial bicubics, Bézier and
     /// PN triangles; other kinds keep the second-derivative bound. Between the two others in
-    /// triangles (teapot at 0.1 %: 12,642 / 9,670 / 8,128 for Hessian / Expansion / Taylor;
-    /// spot 23,224 / 11,332 / 11,332) and a tenth of the Taylor bound's planning time on
-    /// patches.
+    /// triangles (teapot at 0.1 %: 12,642 / 9,364 / 8,128 for Hessian / Expansion / Taylor;
+    /// spot 23,224 / 11,332 / 11,332) and a fifth of the Taylor bound's planning time on
+    /// patches. Planned on the CPU; it is the part of the Taylor bound a GPU check could
+    /// compute (`docs/ARCHITECTURE.md`, Known debts).
     Expansion,
 }
 

@@ -108,8 +108,10 @@ impl ThirdDerivatives {
         let dvv = |i: usize, j: usize| b(i, j + 2) - 2.0 * b(i, j + 1) + b(i, j);
         let uuu: [DVec3; 4] = std::array::from_fn(|j| duu(1, j) - duu(0, j));
         let vvv: [DVec3; 4] = std::array::from_fn(|i| dvv(i, 1) - dvv(i, 0));
-        let uuv: [[DVec3; 3]; 2] = std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j + 1) - duu(i, j)));
-        let uvv: [[DVec3; 2]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| dvv(i + 1, j) - dvv(i, j)));
+        let uuv: [[DVec3; 3]; 2] =
+            std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j + 1) - duu(i, j)));
+        let uvv: [[DVec3; 2]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|j| dvv(i + 1, j) - dvv(i, j)));
         let fourth = [
             18.0 * max_norm((0..3).map(|j| uuu[j + 1] - uuu[j])),
             36.0 * max_norm((0..2).flat_map(|i| (0..2).map(move |j| uuv[i][j + 1] - uuv[i][j]))),
@@ -287,8 +289,9 @@ impl TaylorBound {
     /// [`EXPANSION_WALK_CELLS`] cells the second-derivative nets' bound of every cell at once
     /// ([`TaylorBound::nets_grid_error`]). Every other kind has none ([`TaylorBound::NONE`]:
     /// its plans keep the second-derivative bound). This is the part of the Taylor bound whose
-    /// every query has a fixed, small cost, what an a-posteriori check on the GPU can
-    /// compute. Cost: O(control points).
+    /// every query has a fixed, small cost, which an a-posteriori check on the GPU could
+    /// compute. A bicubic's remainder takes third-derivative bounds near each expansion point
+    /// (`TaylorBound::remainder_at`). Cost: O(control points).
     pub fn expansion(patch: &Patch) -> TaylorBound {
         let bound = match patch {
             Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
@@ -774,9 +777,8 @@ pub fn bubble_max(a: [f64; 3]) -> f64 {
 
 /// Where a cubic triangle's remainder exceeds this share of its quadratic part, its error is
 /// also bounded by its control points ([`cubic_error_hull`]): below it the hull changed no
-/// plan of the mesh models (1 %, 0.1 %, 0.01 %) and doubled the planning time. (The GPU's
-/// expansion bound reads it too.)
-pub const HULL_WHEN: f64 = 0.05;
+/// plan of the mesh models (1 %, 0.1 %, 0.01 %) and doubled the planning time.
+const HULL_WHEN: f64 = 0.05;
 
 /// The lattice of [`TaylorBound::split_error`] for a Taylor expansion: `n` parts a side,
 /// `n²` leaves. Its leaves' own bounds are an expansion's, a sixteenth of the whole's and
@@ -1183,7 +1185,8 @@ mod tests {
                 let g = DVec2::new(rng.unit(), rng.unit());
                 let delta = DVec2::new(0.3 * rng.unit(), 0.3 * rng.unit());
                 let box_bound = third.near(g, delta);
-                let y = (g + (DVec2::new(rng.unit(), rng.unit()) * 2.0 - DVec2::ONE) * delta).clamp(DVec2::ZERO, DVec2::ONE);
+                let y = (g + (DVec2::new(rng.unit(), rng.unit()) * 2.0 - DVec2::ONE) * delta)
+                    .clamp(DVec2::ZERO, DVec2::ONE);
                 let at_y = third.near(y, DVec2::ZERO);
                 for k in 0..4 {
                     assert!(at_y[k] <= box_bound[k] * (1.0 + 1e-12) + 1e-12, "{k}: {at_y:?} {box_bound:?}");
