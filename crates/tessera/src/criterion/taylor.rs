@@ -102,16 +102,9 @@ struct ThirdDerivatives {
 }
 
 impl ThirdDerivatives {
-    fn of(points: &[DVec3; 16]) -> ThirdDerivatives {
-        let b = |i: usize, j: usize| points[4 * i + j];
-        let duu = |i: usize, j: usize| b(i + 2, j) - 2.0 * b(i + 1, j) + b(i, j);
-        let dvv = |i: usize, j: usize| b(i, j + 2) - 2.0 * b(i, j + 1) + b(i, j);
-        let uuu: [DVec3; 4] = std::array::from_fn(|j| duu(1, j) - duu(0, j));
-        let vvv: [DVec3; 4] = std::array::from_fn(|i| dvv(i, 1) - dvv(i, 0));
-        let uuv: [[DVec3; 3]; 2] =
-            std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j + 1) - duu(i, j)));
-        let uvv: [[DVec3; 2]; 3] =
-            std::array::from_fn(|i| std::array::from_fn(|j| dvv(i + 1, j) - dvv(i, j)));
+    /// The nets of the third differences (`[j]`, `[i][j]` and `[i]` as [`bicubic`] lists
+    /// them), and the fourth derivatives' bounds from their differences.
+    fn new(uuu: [DVec3; 4], uuv: [[DVec3; 3]; 2], uvv: [[DVec3; 2]; 3], vvv: [DVec3; 4]) -> ThirdDerivatives {
         let fourth = [
             18.0 * max_norm((0..3).map(|j| uuu[j + 1] - uuu[j])),
             36.0 * max_norm((0..2).flat_map(|i| (0..2).map(move |j| uuv[i][j + 1] - uuv[i][j]))),
@@ -293,15 +286,14 @@ impl TaylorBound {
     /// compute. A bicubic's remainder takes third-derivative bounds near each expansion point
     /// (`TaylorBound::remainder_at`). Cost: O(control points).
     pub fn expansion(patch: &Patch) -> TaylorBound {
-        let bound = match patch {
-            Patch::Bicubic(b) if b.is_polynomial() => bicubic(&b.points),
-            Patch::BezierTriangle(t) => triangle(t),
-            Patch::Pn(pn) => triangle(&pn.geometry),
+        let (bound, local) = match patch {
+            Patch::Bicubic(b) if b.is_polynomial() => {
+                let (bound, third) = bicubic_with_third(&b.points);
+                (bound, Some(Box::new(third)))
+            }
+            Patch::BezierTriangle(t) => (triangle(t), None),
+            Patch::Pn(pn) => (triangle(&pn.geometry), None),
             _ => return TaylorBound::NONE,
-        };
-        let local = match patch {
-            Patch::Bicubic(b) => Some(Box::new(ThirdDerivatives::of(&b.points))),
-            _ => None,
         };
         TaylorBound { refines: false, local, ..bound }
     }
@@ -971,6 +963,12 @@ fn net_at<const M: usize, const N: usize>(net: &[[DVec3; N]; M], x: DVec2) -> DV
 /// third-derivative bounds: `S_uuu = 6 Σ Δ³_u b·B³(v)`, `S_uuv = 18 Σ Δ²_uΔ_v b·B¹(u)B²(v)`,
 /// and their mirrors, each at most its largest coefficient.
 fn bicubic(points: &[DVec3; 16]) -> TaylorBound {
+    bicubic_with_third(points).0
+}
+
+/// [`bicubic`] and the nets of its third derivatives ([`ThirdDerivatives`]), whose largest
+/// control vectors are its third-derivative bounds.
+fn bicubic_with_third(points: &[DVec3; 16]) -> (TaylorBound, ThirdDerivatives) {
     let b = |i: usize, j: usize| points[4 * i + j];
     let du = |i: usize, j: usize| b(i + 1, j) - b(i, j);
     let duu = |i: usize, j: usize| du(i + 1, j) - du(i, j);
@@ -979,11 +977,17 @@ fn bicubic(points: &[DVec3; 16]) -> TaylorBound {
     let uu: [[DVec3; 4]; 2] = std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j) * 6.0));
     let uv: [[DVec3; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| duv(i, j) * 9.0));
     let vv: [[DVec3; 2]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| dvv(i, j) * 6.0));
-    let uuu = max_norm((0..4).map(|j| (duu(1, j) - duu(0, j)) * 6.0));
-    let uuv = max_norm((0..2).flat_map(|i| (0..3).map(move |j| (duu(i, j + 1) - duu(i, j)) * 18.0)));
-    let uvv = max_norm((0..3).flat_map(|i| (0..2).map(move |j| (dvv(i + 1, j) - dvv(i, j)) * 18.0)));
-    let vvv = max_norm((0..4).map(|i| (dvv(i, 1) - dvv(i, 0)) * 6.0));
-    TaylorBound {
+    let third = ThirdDerivatives::new(
+        std::array::from_fn(|j| duu(1, j) - duu(0, j)),
+        std::array::from_fn(|i| std::array::from_fn(|j| duu(i, j + 1) - duu(i, j))),
+        std::array::from_fn(|i| std::array::from_fn(|j| dvv(i + 1, j) - dvv(i, j))),
+        std::array::from_fn(|i| dvv(i, 1) - dvv(i, 0)),
+    );
+    let uuu = max_norm(third.uuu.iter().map(|&d| d * 6.0));
+    let uuv = max_norm(third.uuv.iter().flatten().map(|&d| d * 18.0));
+    let uvv = max_norm(third.uvv.iter().flatten().map(|&d| d * 18.0));
+    let vvv = max_norm(third.vvv.iter().map(|&d| d * 6.0));
+    let bound = TaylorBound {
         field: SecondDerivatives::Bicubic {
             uu,
             uv,
@@ -993,7 +997,8 @@ fn bicubic(points: &[DVec3; 16]) -> TaylorBound {
         third: [uuu, uuv, uvv, vvv],
         refines: true,
         local: None,
-    }
+    };
+    (bound, third)
 }
 
 /// A cubic Bézier triangle's second derivatives at its corners and its (constant) third
@@ -1167,7 +1172,7 @@ mod tests {
             let net = random_net(&mut rng);
             let points: [DVec3; 16] = std::array::from_fn(|k| net[k]);
             let patch = Patch::Bicubic(RationalBicubic::polynomial(points));
-            let (taylor, third) = (TaylorBound::of(&patch), ThirdDerivatives::of(&points));
+            let (taylor, third) = (TaylorBound::of(&patch), bicubic_with_third(&points).1);
             for _ in 0..10 {
                 let x = DVec2::new(0.1 + 0.8 * rng.unit(), 0.1 + 0.8 * rng.unit());
                 let h = 1e-5;
