@@ -160,7 +160,7 @@ impl Prepared {
 
     /// Every patch's [`taylor::TaylorBound::expansion`], computed on the first call and kept,
     /// for plans asked for [`ErrorBound::Expansion`]. Cost: the first call O(P), parallel,
-    /// about 700 bytes a patch; later calls nothing.
+    /// about a kilobyte a bicubic (its third derivatives' nets too); later calls nothing.
     pub fn expansion_bounds(&self, set: &SurfaceSet) -> &[taylor::TaylorBound] {
         use rayon::prelude::*;
         self.expansions.get_or_init(|| set.patches.par_iter().map(taylor::TaylorBound::expansion).collect())
