@@ -34,7 +34,14 @@ pub fn screen_criterion(
     options: &PlanOptions,
 ) -> Option<ScreenCriterion> {
     validate(scheme, criterion, options, set, Engine::GpuFromCamera).ok()?;
-    Some(ScreenCriterion { scheme, criterion: *criterion, max_factor: options.max_factor, capacity: None })
+    let bound = options.bound;
+    Some(ScreenCriterion {
+        scheme,
+        criterion: *criterion,
+        max_factor: options.max_factor,
+        capacity: None,
+        bound,
+    })
 }
 
 /// Plans and tessellates the frame of `camera` on the GPU `repeat` times (frames, from the

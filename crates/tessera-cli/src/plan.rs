@@ -129,8 +129,8 @@ pub struct CriterionArgs {
     /// triangle is with a third-derivative remainder, and the error sampled on coarse
     /// triangles (fewer triangles for the same guarantee on every surface kind; planned on
     /// the CPU, more slowly); `expansion`, the Taylor expansion without that sampling, on
-    /// polynomial patches and triangles (between the two; planned on the CPU, each query of
-    /// a fixed cost).
+    /// polynomial patches and triangles (between the two, each query of a fixed cost;
+    /// `--engine gpu` plans it on the GPU too).
     #[arg(long, value_enum, default_value = "hessian")]
     pub bound: BoundArg,
 }
@@ -143,7 +143,8 @@ pub enum BoundArg {
     /// The smaller of that and the Taylor bound at each triangle.
     Taylor,
     /// The smaller of the first and the Taylor expansion alone, without the sampled
-    /// refinements: between the two in triangles and planning time.
+    /// refinements: between the two in triangles and planning time; the GPU engine plans
+    /// with it too.
     Expansion,
 }
 

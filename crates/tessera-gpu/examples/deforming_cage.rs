@@ -91,8 +91,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let pad = (hi - lo) * 0.3;
             let camera = Camera::framing(lo - pad, hi + pad, 1280, 1024);
             let criterion = Criterion::PixelError(pixels);
-            let screen =
-                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: 32, capacity: None };
+            let screen = ScreenCriterion::new(Scheme::Transition, criterion, 32);
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
             (moving, &Transition)
         }

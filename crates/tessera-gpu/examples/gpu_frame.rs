@@ -111,7 +111,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     fmax,
                 };
                 let cap = scheme.factor_cap().min(fmax.ceil()) as u32;
-                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion::new(scheme, criterion, cap);
                 gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
                 format!(
                     "{}, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU",
@@ -131,16 +131,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 fmin: 1.0,
                 fmax: fmax as f64,
             };
-            let screen =
-                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: fmax, capacity: None };
+            let screen = ScreenCriterion::new(Scheme::Transition, criterion, fmax);
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
             format!("transition, silhouetteness factors 1 to {fmax} planned on the GPU, culled on the GPU")
         }
         (Some(px), false) => {
             let prepared = Prepared::new(&set, true);
             let scheme = if transition { Scheme::Transition } else { Scheme::Uniform };
-            let screen =
-                ScreenCriterion { scheme, criterion: Criterion::PixelError(px), max_factor, capacity: None };
+            let screen = ScreenCriterion::new(scheme, Criterion::PixelError(px), max_factor);
             gpu.prepare_screen(&ctx, &set, &prepared, &camera, screen)?;
             format!("{}, {px} px and cap {max_factor} planned on the GPU, culled on the GPU", scheme.name())
         }

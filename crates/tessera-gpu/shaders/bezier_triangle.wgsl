@@ -4,15 +4,6 @@
 // `BezierTriangle::index` order; a PN triangle's six normals (n200, n020, n002, n110, n011,
 // n101) in slots 10..16. Barycentrics (1 − u − v, u, v).
 
-// `BezierTriangle::index`.
-fn tri_index(i: u32, j: u32) -> u32 {
-    return (3u - i) * (4u - i) / 2u + (3u - i - j);
-}
-
-fn tri_point(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return control_points[p * CONTROL_POINTS + tri_index(i, j)].xyz;
-}
-
 fn ipow(x: f32, n: u32) -> f32 {
     var r = 1.0;
     for (var k = 0u; k < n; k = k + 1u) { r = r * x; }

@@ -12,8 +12,9 @@
 // The rounds run without the CPU. A round is four dispatches: `round_open` (one invocation:
 // does any patch fail?), `round_resolve` (per edge: the edges again from the grown proposals,
 // the changed ones into the plan, their patches marked), `round_close` (one invocation: did
-// any edge change?) and `round_check` (per patch: the re-check of the failing and marked
-// patches, each growing its proposals when it fails, as the CPU's next round would first).
+// any edge change?) and the re-check (`check_patches` again, per patch: the failing and
+// marked patches, each growing its proposals when it fails, as the CPU's next round would
+// first).
 // The two decisions write the indirect arguments of the two passes after them: zero
 // workgroups once the rounds have ended. The CPU ends the loop when no patch fails or
 // when a round changes no edge (every failing patch at the cap), and so do they; a frame
@@ -97,15 +98,18 @@ fn check_patch(p: u32) -> bool {
         return false;
     }
     let errors = triangle_errors(patch_views[PATCH_VIEW_ROW * p + 5u].xyz);
+    // With the expansion bound every triangle's bound is the smaller of the two.
+    var x = no_expansion(p);
+    if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
     var factors = first;
     var previous = 3.0e38;
     var bound = 0.0;
     var missed = false;
     loop {
         if (level) {
-            bound = semi_uniform_bound(p, factors.x, errors);
+            bound = semi_uniform_bound(p, factors.x, errors, x);
         } else {
-            bound = transition_bound(p, factors, errors);
+            bound = transition_bound(p, factors, errors, x);
         }
         if (bound <= eps) { break; }
         // No progress means the worst triangles follow the edges, not the core.
@@ -149,18 +153,22 @@ fn check_patch(p: u32) -> bool {
 
 // The largest error bound over patch p's transition pattern with interior `factors`. Every
 // core triangle is half a grid cell: one cell's triangle bounds them all
-// (`Pattern::grid_cells`, `tolerance::grid_bound`); the walk takes the strips. The core is
-// never walked, which also keeps a check within lavapipe's 65,535 loop iterations an
-// invocation (`local.wgsl`): a strip has at most 2 · 64 steps.
-fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors) -> f32 {
+// (`Pattern::grid_cells`, `tolerance::grid_bound`), or with the expansion bound the walk
+// over the grid's cells (`expansion_grid_error`: at most EXPANSION_WALK_CELLS); the walk
+// takes the strips. The core is never walked triangle by triangle, which also keeps a check
+// within lavapipe's 65,535 loop iterations an invocation (`local.wgsl`): a strip has at most
+// 2 · 64 steps.
+fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors, x: Expansion) -> f32 {
     let input = pattern_input(p, factors);
     let l = input.core;
     var out = sink(SINK_CHECK, 0u);
     out.errors = errors;
+    out.expansion = x;
     let core_cells = select((l.i_hi - l.i_lo) * (l.j_hi - l.j_lo), l.m, input.local.nc == 3u);
     if (core_cells > 0u) {
         let cell = vec2<f32>(1.0 / f32(l.nu), 1.0 / f32(l.nv));
-        out.worst = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+        let hessian = triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+        out.worst = expansion_grid_error(x, input.local.nc == 3u, l.nu, l.nv, 3.0e38, hessian);
     }
     build_transition(input, &out);
     return out.worst;
@@ -169,9 +177,11 @@ fn transition_bound(p: u32, factors: vec2<u32>, errors: TriangleErrors) -> f32 {
 // The largest error bound over patch p's semi-uniform pattern at level n (`params_bound` over
 // `SemiUniform::build`'s triangles): the triangles with a corner on the boundary one by one,
 // after the snap (those it collapses are not in the pattern); the others are halves of grid
-// cells, bounded by one cell's triangle as `transition_bound` bounds a core. Cost: O(n)
-// triangles (`semi_uniform.wgsl` says which ones can touch the boundary).
-fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
+// cells, bounded by one cell's triangle as `transition_bound` bounds a core — or, with the
+// expansion bound, whose bound differs from triangle to triangle, one by one too. Cost: O(n)
+// triangles (`semi_uniform.wgsl` says which ones can touch the boundary), O(n²) with the
+// expansion bound (a level at most 64: 8,192 triangles).
+fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors, x: Expansion) -> f32 {
     let input = local_numbering(p);
     let m = countTrailingZeros(n);
     let tri = input.nc == 3u;
@@ -181,7 +191,7 @@ fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
         let len = row_length(tri, n, j);
         let whole = j == 0u || j + 1u >= n;
         for (var q = 0u; q < len; q = q + 1u) {
-            if (!whole && q >= 2u && q + 2u < len) {
+            if (!whole && q >= 2u && q + 2u < len && x.kind == EXPANSION_NONE) {
                 // The middle of a middle row: off the boundary, jump to its last two.
                 cells = true;
                 q = len - 3u;
@@ -193,7 +203,8 @@ fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
             let a = semi_uniform_param(input, n, m, g[0].x, g[0].y);
             let b = semi_uniform_param(input, n, m, g[1].x, g[1].y);
             let c = semi_uniform_param(input, n, m, g[2].x, g[2].y);
-            worst = max(worst, triangle_error(errors, a, b, c));
+            let e = triangle_error(errors, a, b, c);
+            if (e > worst) { worst = max(worst, min(e, expansion_triangle_error(x, a, b, c))); }
         }
     }
     if (cells) {
@@ -201,19 +212,6 @@ fn semi_uniform_bound(p: u32, n: u32, errors: TriangleErrors) -> f32 {
         worst = max(worst, triangle_error(errors, vec2<f32>(0.0), vec2<f32>(h, 0.0), vec2<f32>(0.0, h)));
     }
     return worst;
-}
-
-// The first check of every patch, after the first resolve.
-@compute @workgroup_size(WORKGROUP)
-fn check_all(
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-    @builtin(local_invocation_index) lid: u32,
-) {
-    let p = thread_index(wid, nwg, lid);
-    if (p >= params.patches) { return; }
-    atomicStore(&checks[p].marked, 0u);
-    if (check_patch(p)) { atomicAdd(&state.failing, 1u); }
 }
 
 // A round starts only while some patch fails (`plan_limited`: `failing.is_empty()`); its
@@ -261,17 +259,22 @@ fn round_close() {
     write_round_args(atomicLoad(&state.done) == 0u);
 }
 
-// The re-check: the failing patches and those of changed edges.
+// The check: in the first check, after the first resolve, every patch (no fix round has
+// run: the frame cleared `state.rounds`); in a round's re-check (`round_close` counted the
+// round first) the failing patches and those of changed edges. One entry point for both, so
+// that the driver compiles the check and its bound once (lavapipe inlines every call).
 @compute @workgroup_size(WORKGROUP)
-fn round_check(
+fn check_patches(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
     let p = thread_index(wid, nwg, lid);
     if (p >= params.patches) { return; }
-    let marked = atomicLoad(&checks[p].marked) != 0u;
-    if (!marked && (checks[p].flags & 1u) == 0u) { return; }
+    if (atomicLoad(&state.rounds) != 0u) {
+        let marked = atomicLoad(&checks[p].marked) != 0u;
+        if (!marked && (checks[p].flags & 1u) == 0u) { return; }
+    }
     atomicStore(&checks[p].marked, 0u);
     if (check_patch(p)) { atomicAdd(&state.failing, 1u); }
 }

@@ -104,6 +104,59 @@ fn quad_grid(m: vec3<f32>, eps: f32, cap: u32) -> vec2<f32> {
     return vec2<f32>(best);
 }
 
+// The expansion bound's proposal from `start`, the second-derivative bound's (each side at
+// least 1): `start` where the expansion bound does not meet `eps` on its grid, else
+// - for a quad's core (`quad`): `tolerance::taylor_quad_grid` without the walk's search, the
+//   grid scaled by the square root of the bound's slack at `start`, grown by 5 % until it
+//   meets `eps` (at `start` at the latest);
+// - else `tolerance::taylor_uniform_factor`: the smallest n up to `start.x` whose n × n grid
+//   meets `eps` (bisection).
+// Both searches in one loop around one call of the grid bound: lavapipe inlines every call,
+// and its compilation time grows with each copy of the bound. At most EXPANSION_WALK_CELLS
+// iterations a grid bound; the quad search stays within lavapipe's loop budget while the
+// bound at `start` is above 1/400 of the tolerance (47 steps).
+fn expansion_proposal(x: Expansion, errors: TriangleErrors, tri: bool, quad: bool, start: vec2<f32>, eps: f32) -> vec2<f32> {
+    let top = vec2<u32>(max(start, vec2<f32>(1.0)));
+    var n = top;
+    var first = true;
+    var scale = 0.0;
+    var lo = 1u;
+    var hi = top.x;
+    loop {
+        // The quad search's first step takes the whole bound (its slack sets the scale).
+        let stop = select(eps, 3.0e38, first && quad);
+        let bound = expansion_grid_error(x, tri, n.x, n.y, stop, hessian_cell(errors, n));
+        let fits = bound <= eps;
+        if (first) {
+            if (!fits) { return start; }
+            first = false;
+            if (quad) { scale = sqrt(bound / eps); }
+        } else if (quad) {
+            if (fits) { return vec2<f32>(n); }
+            scale = scale * 1.05;
+        } else if (fits) {
+            hi = n.x;
+        } else {
+            lo = n.x + 1u;
+        }
+        if (quad) {
+            n = clamp(vec2<u32>(ceil(vec2<f32>(top) * scale)), vec2<u32>(1u), top);
+            if (all(n == top)) { return start; }
+        } else {
+            if (lo >= hi) { return vec2<f32>(f32(hi)); }
+            n = vec2<u32>((lo + hi) / 2u);
+        }
+    }
+    return start;
+}
+
+// The second-derivative bound of every triangle of the n.x × n.y grid
+// (`tolerance::grid_bound` without a Taylor bound): one cell's triangle.
+fn hessian_cell(errors: TriangleErrors, n: vec2<u32>) -> f32 {
+    let cell = vec2<f32>(1.0) / vec2<f32>(n);
+    return triangle_error(errors, vec2<f32>(0.0), vec2<f32>(cell.x, 0.0), vec2<f32>(0.0, cell.y));
+}
+
 // `view::edge_factors_into`'s silhouetteness factor of edge e: s = 1 where the two normals
 // at the midpoint face opposite ways from the eye, 1 − (c·nL)(c·nR)/β near it (β = 1/4).
 fn silhouetteness_factor(e: u32) -> f32 {
@@ -251,13 +304,24 @@ fn patch_proposals(
     } else if (visible[p] != 0u) {
         let eps = patch_tolerance(p);
         let m = patch_views[row + 5u];
-        if (view.interior_rule == INTERIOR_CORE && !patch_is_tri(p)) {
-            // CudaTess's quads: the cheapest grid that meets the bound, its core.
-            let grid = quad_grid(m.xyz, eps, u32(view.cap));
-            out = vec4<f32>(grid.x, grid.y, grid.x, grid.y);
+        // With the expansion bound, its proposals from the second-derivative bound's.
+        var x = no_expansion(p);
+        if (view.bound == BOUND_EXPANSION) { x = expansion_of(p); }
+        let errors = triangle_errors(m.xyz);
+        // CudaTess's quads: the cheapest grid that meets the bound, its core; else one
+        // factor for every edge and the interior.
+        let quad = view.interior_rule == INTERIOR_CORE && !patch_is_tri(p);
+        var proposal = vec2<f32>(uniform_factor(m, eps));
+        if (quad) { proposal = quad_grid(m.xyz, eps, u32(view.cap)); }
+        if (x.kind != EXPANSION_NONE) {
+            // One call site (see `expansion_proposal`).
+            let start = select(min(proposal, vec2<f32>(view.cap)), proposal, quad);
+            proposal = expansion_proposal(x, errors, patch_is_tri(p), quad, start, eps);
+        }
+        if (quad) {
+            out = vec4<f32>(proposal.x, proposal.y, proposal.x, proposal.y);
         } else {
-            let n = uniform_factor(m, eps);
-            for (var l = 0u; l < patch_corner_count(p); l = l + 1u) { out[l] = n; }
+            for (var l = 0u; l < patch_corner_count(p); l = l + 1u) { out[l] = proposal.x; }
         }
         let curves = patch_views[row + 6u];
         for (var l = 0u; l < patch_corner_count(p); l = l + 1u) {

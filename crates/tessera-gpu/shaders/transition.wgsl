@@ -211,10 +211,13 @@ struct Sink {
     kept: u32,
     worst: f32,
     errors: TriangleErrors,
+    // The patch's expansion bound (`expansion.wgsl`; EXPANSION_NONE: the second-derivative
+    // bound alone).
+    expansion: Expansion,
 }
 
 fn sink(mode: u32, first: u32) -> Sink {
-    return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)));
+    return Sink(mode, first, 0u, 0.0, triangle_errors(vec3<f32>(0.0)), no_expansion(0u));
 }
 
 // Takes pattern triangle `tri` (local indices; ta, tb, tc its domain positions): counted or
@@ -223,10 +226,21 @@ fn sink(mode: u32, first: u32) -> Sink {
 // them over the built pattern.
 fn take(input: PatchInput, tri: vec3<u32>, ta: vec2<f32>, tb: vec2<f32>, tc: vec2<f32>, out: ptr<function, Sink>) {
     if ((*out).mode == SINK_CHECK) {
-        (*out).worst = max((*out).worst, triangle_error((*out).errors, ta, tb, tc));
+        // The expansion bound, dearer, only where it could raise the largest so far
+        // (`tolerance::triangles_bound`).
+        let e = triangle_error((*out).errors, ta, tb, tc);
+        if (e > (*out).worst) {
+            (*out).worst = max((*out).worst, min(e, expansion_triangle_error((*out).expansion, ta, tb, tc)));
+        }
         (*out).kept = (*out).kept + 1u;
         return;
     }
+    take_core(input, tri, out);
+}
+
+// `take` of a core triangle, which the check never takes (it bounds the core's cells
+// together): counted or written.
+fn take_core(input: PatchInput, tri: vec3<u32>, out: ptr<function, Sink>) {
     // Through a local: naga 30's SPIR-V writer cannot pass a pointer to a member of a
     // pointed-to struct ("expression is not cached").
     var kept = (*out).kept;
@@ -292,18 +306,24 @@ fn walk(input: PatchInput, e: u32, out: ptr<function, Sink>) {
                 advance_outer = 2u * i + 1u > s;
             }
         }
+        // One `take` a step, after the choice: the check's bound (`expansion.wgsl`) is
+        // compiled once a walk, not once a branch (every call is inlined).
+        var tri: vec3<u32>;
+        var tb: vec2<f32>;
         if (advance_outer) {
-            let at = outer_position(input, e, i);
-            let next = outer_position(input, e, i + 1u);
-            take(input, vec3<u32>(o0, o1, n0), at, next, inner_position(input, e, j), out);
+            tri = vec3<u32>(o0, o1, n0);
+            tb = outer_position(input, e, i + 1u);
+        } else {
+            tri = vec3<u32>(o0, n1, n0);
+            tb = inner_position(input, e, j + 1u);
+        }
+        take(input, tri, outer_position(input, e, i), tb, inner_position(input, e, j), out);
+        if (advance_outer) {
             i = i + 1u;
             if (j < m && i < s) { d = d + 2 * span; }
             o0 = o1;
             if (i < s) { o1 = boundary_local(input.local, e, i + 1u); }
         } else {
-            let at = inner_position(input, e, j);
-            let next = inner_position(input, e, j + 1u);
-            take(input, vec3<u32>(o0, n1, n0), outer_position(input, e, i), next, at, out);
             j = j + 1u;
             if (j < m && i < s) { d = d - 2 * s32; }
             n0 = n1;
@@ -325,10 +345,9 @@ fn build_tri_transition(input: PatchInput, out: ptr<function, Sink>) {
             let a = grid_local(input, i0 + i, j0 + j);
             let b = grid_local(input, i0 + i + 1u, j0 + j);
             let d = grid_local(input, i0 + i, j0 + j + 1u);
-            let z = vec2<f32>(0.0); // positions: the check takes no core triangle
-            take(input, vec3<u32>(a, b, d), z, z, z, out);
+            take_core(input, vec3<u32>(a, b, d), out);
             if (i + j + 2u <= m) {
-                take(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), z, z, z, out);
+                take_core(input, vec3<u32>(b, grid_local(input, i0 + i + 1u, j0 + j + 1u), d), out);
             }
         }
     }
@@ -353,9 +372,8 @@ fn build_transition(input: PatchInput, out: ptr<function, Sink>) {
             let b = grid_local(input, i + 1u, j);
             let c = grid_local(input, i + 1u, j + 1u);
             let d = grid_local(input, i, j + 1u);
-            let z = vec2<f32>(0.0); // positions: the check takes no core triangle
-            take(input, vec3<u32>(a, b, c), z, z, z, out);
-            take(input, vec3<u32>(a, c, d), z, z, z, out);
+            take_core(input, vec3<u32>(a, b, c), out);
+            take_core(input, vec3<u32>(a, c, d), out);
         }
     }
     for (var e = 0u; e < 4u; e = e + 1u) {

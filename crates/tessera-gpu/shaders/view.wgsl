@@ -32,6 +32,12 @@ struct View {
     lo: f32,
     hi: f32,
     edge_rule: u32,
+    // The error bound of a pixel error's proposals and check: BOUND_HESSIAN (the prepared
+    // second-derivative bounds alone) or BOUND_EXPANSION (also `expansion.wgsl`'s).
+    bound: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(1) @binding(0) var<uniform> view: View;
@@ -98,6 +104,8 @@ const EDGE_RULE_HARDWARE: u32 = {{EDGE_RULE_HARDWARE}}u;
 const EDGE_RULE_POWER_OF_TWO: u32 = {{EDGE_RULE_POWER_OF_TWO}}u;
 const EDGE_RULE_SYMMETRIC: u32 = {{EDGE_RULE_SYMMETRIC}}u;
 const EDGE_VIEW_ROW: u32 = {{EDGE_VIEW_ROW}}u;
+const BOUND_HESSIAN: u32 = {{BOUND_HESSIAN}}u;
+const BOUND_EXPANSION: u32 = {{BOUND_EXPANSION}}u;
 const VERTEX_VIEW_ROW: u32 = {{VERTEX_VIEW_ROW}}u;
 
 // `u32::next_power_of_two` (x ≤ 2³¹).

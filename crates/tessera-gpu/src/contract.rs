@@ -88,6 +88,7 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("lo", offset_of!(ViewUniform, lo)),
             ("hi", offset_of!(ViewUniform, hi)),
             ("edge_rule", offset_of!(ViewUniform, edge_rule)),
+            ("bound", offset_of!(ViewUniform, bound)),
         ],
         size_of::<ViewUniform>(),
     );

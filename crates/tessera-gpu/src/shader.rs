@@ -15,8 +15,14 @@ pub mod sources {
     /// `threads.wgsl`: `thread_index`, the invocation numbering of [`super::grid`]'s dispatches.
     pub(crate) const THREADS: &str = include_str!("../shaders/threads.wgsl");
     /// `common.wgsl` after [`THREADS`]: the engine's bindings, constants and row accessors.
-    pub(crate) const COMMON: &str =
-        concat!(include_str!("../shaders/threads.wgsl"), include_str!("../shaders/common.wgsl"));
+    pub(crate) const COMMON: &str = concat!(
+        include_str!("../shaders/threads.wgsl"),
+        include_str!("../shaders/common.wgsl"),
+        include_str!("../shaders/triangle_net.wgsl"),
+    );
+    /// `triangle_net.wgsl`: `tri_point(p, i, j)`, a cubic Bézier triangle's control point
+    /// (part of `common.wgsl`'s modules; [`crate::shader::evaluation_wgsl`] brings its own).
+    pub const TRIANGLE_NET: &str = include_str!("../shaders/triangle_net.wgsl");
     pub(crate) const STENCILS: &str = include_str!("../shaders/stencils.wgsl");
     pub(crate) const MOVING_BOUNDS: &str = include_str!("../shaders/moving_bounds.wgsl");
     /// `bicubic.wgsl`: `bicubic_eval(p, uv)`, patch `p`'s position and normal as
@@ -25,7 +31,7 @@ pub mod sources {
     pub const BICUBIC: &str = include_str!("../shaders/bicubic.wgsl");
     /// `bezier_triangle.wgsl`: `triangle_eval` and `pn_eval` (cubic Bézier triangles, PN
     /// triangles) and `eval_patch(p, uv)`, which picks the evaluation by the patch row's kind
-    /// bits. Needs [`BICUBIC`] before it.
+    /// bits. Needs [`BICUBIC`] and [`TRIANGLE_NET`] before it.
     pub const BEZIER_TRIANGLE: &str = include_str!("../shaders/bezier_triangle.wgsl");
     /// `tree.wgsl`: `tree_eval(p, uv)`, a Catmull-Clark subdivision patch's position and
     /// normal as `tessera::surface::Patch::eval` computes them (the quadtree walked to the
@@ -46,6 +52,8 @@ pub mod sources {
     pub(crate) const FACTORS: &str = include_str!("../shaders/factors.wgsl");
     pub(crate) const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
     pub(crate) const BOUNDS: &str = include_str!("../shaders/bounds.wgsl");
+    pub(crate) const EXPANSION: &str = include_str!("../shaders/expansion.wgsl");
+    pub(crate) const NO_EXPANSION: &str = include_str!("../shaders/no_expansion.wgsl");
     pub(crate) const CHECK: &str = include_str!("../shaders/check.wgsl");
     pub(crate) const LOCAL: &str = include_str!("../shaders/local.wgsl");
     pub(crate) const GRID_VERTICES: &str = include_str!("../shaders/grid_vertices.wgsl");
@@ -63,14 +71,14 @@ pub mod sources {
 
 /// The patch evaluation of every patch kind, `eval_patch(p, uv)` ([`sources::BICUBIC`],
 /// [`sources::TREE`] or, for a set without subdivision patches, [`sources::NO_TREE`], then
-/// [`sources::BEZIER_TRIANGLE`]), for a shader that draws the engine's patches by the engine's
+/// [`sources::TRIANGLE_NET`] and [`sources::BEZIER_TRIANGLE`]), for a shader that draws the engine's patches by the engine's
 /// own evaluation rather than a copy. The shader that includes it declares what `common.wgsl`
 /// declares for it: the `control_points` array, the constant `CONTROL_POINTS`
 /// ([`crate::upload::CONTROL_POINTS`]), the `patch_rows` array with the constant `PATCH_ROW`,
 /// and the patch-row accessors `patch_is_tri` and `patch_has_pn_normals`.
 pub fn evaluation_wgsl(with_trees: bool) -> String {
     let trees = if with_trees { sources::TREE } else { sources::NO_TREE };
-    [sources::BICUBIC, trees, sources::BEZIER_TRIANGLE].concat()
+    [sources::BICUBIC, trees, sources::TRIANGLE_NET, sources::BEZIER_TRIANGLE].concat()
 }
 
 /// `source` with every `{{NAME}}` replaced by its value from `constants`.

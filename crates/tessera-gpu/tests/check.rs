@@ -34,8 +34,18 @@ fn sweep(models: &[&str], cameras_per_model: usize, seed: u64, pixel_errors: &[f
                 let name = format!("{model} camera {c} {pixels} px");
                 let counts = &mut sweep.counts;
                 let scheme = tessera::scheme::Scheme::Transition;
-                let plan =
-                    checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, pixels, cap, counts);
+                let plan = checked_frame(
+                    scheme,
+                    tessera::scheme::ErrorBound::Hessian,
+                    &name,
+                    &set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    cap,
+                    counts,
+                );
                 sweep.most_rounds = sweep.most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
                 let core = |p: usize| plan.interior[p][0] * plan.interior[p][1];
                 let visible = (0..set.patches.len()).filter(|&p| plan.is_visible(p));
@@ -63,12 +73,11 @@ fn frames_without_a_check_report_no_rounds() {
     let prepared = Prepared::new(&set, true);
     let mut gpu = tessellator(&set);
     let camera = cameras(&set, 1, 3)[0];
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: tessera::scheme::Scheme::Uniform,
-        criterion: tessera::scheme::Criterion::PixelError(1.0),
-        max_factor: 8,
-        capacity: None,
-    };
+    let screen = tessera_gpu::tessellator::ScreenCriterion::new(
+        tessera::scheme::Scheme::Uniform,
+        tessera::scheme::Criterion::PixelError(1.0),
+        8,
+    );
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert_eq!(
@@ -102,12 +111,8 @@ fn too_few_rounds_are_reported_and_the_plan_stays_crack_free() {
     assert!(cpu.report.unwrap().rounds > 2, "the case no longer needs many rounds");
     let mut gpu = tessellator(&set);
     gpu.set_check_rounds(2);
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion: Criterion::PixelError(0.5),
-        max_factor: 16,
-        capacity: None,
-    };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(0.5), 16);
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let report = gpu.read_screen_report(ctx()).unwrap();
     assert!(!report.converged && report.rounds == 2 && report.failing_patches > 0, "{report:?}");
@@ -139,12 +144,8 @@ fn checked_frames_past_the_check_cap_are_refused_not_truncated() {
     let mut gpu = tessellator(&set);
     let camera = cameras(&set, 1, 3)[0];
     let cap = tessera_gpu::tessellator::CHECK_MAX_FACTOR + 1;
-    let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion: Criterion::PixelError(0.5),
-        max_factor: cap,
-        capacity: None,
-    };
+    let screen =
+        tessera_gpu::tessellator::ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(0.5), cap);
     let err = gpu.prepare_screen(ctx(), &set, &prepared, &camera, screen).unwrap_err();
     assert!(
         matches!(err, tessera_gpu::GpuError::Tessera(tessera::Error::EngineNotSupported { .. })),
@@ -177,4 +178,61 @@ fn transition_factors_past_a_loop_limited_drivers_budget_are_refused() {
     } else {
         past.unwrap();
     }
+}
+
+/// The expansion bound planned on the GPU (`expansion.wgsl`, `ErrorBound::Expansion`): the
+/// proposals, checks and rounds give the CPU's plan with the same bound, and each patch's
+/// bound is the CPU's in f32, on bicubic patches, PN triangles and cubic Bézier triangles
+/// with both checked schemes; and the plans take fewer triangles than the second-derivative
+/// bound's on the same frames.
+#[test]
+fn the_expansion_bound_planned_on_the_gpu_equals_the_cpu_plan() {
+    use tessera::scheme::{ErrorBound, Scheme};
+    let spot = load("meshes/spot.obj");
+    let sets = [
+        ("patches/teapot.patches".to_string(), load("patches/teapot.patches")),
+        ("meshes/spot.obj".to_string(), spot.clone()),
+        ("meshes/spot.obj as Bézier triangles".to_string(), as_bezier_triangles(&spot)),
+    ];
+    let mut counts = SweepCounts::default();
+    let mut frames = 0;
+    let semi_uniform = tessera::pattern::semi_uniform::SemiUniform;
+    let schemes: [(Scheme, &dyn tessera::pattern::Pattern); 2] =
+        [(Scheme::Transition, &Transition), (Scheme::SemiUniform { max_level: 6 }, &semi_uniform)];
+    for (model, set) in &sets {
+        let prepared = Prepared::new(set, true);
+        let mut gpu = tessellator(set);
+        let mut triangles = [0usize; 2];
+        for (c, camera) in cameras(set, 3, 5).into_iter().enumerate() {
+            for (k, (scheme, pattern)) in schemes.into_iter().enumerate() {
+                let pixels = [0.5, 2.0][(c + k) % 2];
+                for (b, bound) in [ErrorBound::Hessian, ErrorBound::Expansion].into_iter().enumerate() {
+                    let name = format!("{model} camera {c} {scheme:?} {pixels} px {bound:?}");
+                    let plan = checked_frame(
+                        scheme,
+                        bound,
+                        &name,
+                        set,
+                        &prepared,
+                        &mut gpu,
+                        &camera,
+                        pixels,
+                        64,
+                        &mut counts,
+                    );
+                    let (_, mesh) = cpu(set, &plan, pattern);
+                    triangles[b] += mesh.triangle_count();
+                    if bound == ErrorBound::Expansion {
+                        assert_gpu_equals_cpu_after_record(&name, set, &gpu, &plan, pattern);
+                        frames += 1;
+                    }
+                }
+            }
+        }
+        eprintln!("{model}: {} triangles with the expansion bound, {} without", triangles[1], triangles[0]);
+        assert!(triangles[1] < triangles[0], "{model}: {triangles:?}");
+    }
+    eprintln!("{counts:?} in {frames} frames");
+    // f32 decisions near a tolerance may differ from the CPU's f64 ones (counted).
+    assert!(counts.check_ties * 10 <= frames, "{counts:?} in {frames} frames");
 }

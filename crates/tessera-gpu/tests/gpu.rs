@@ -420,7 +420,7 @@ fn uniform_pixel_error_root(
 ///   even cameras, the pixel error: CudaTess's per-edge factors and the a-posteriori check
 ///   on the GPU ([`checked_frame`]: the plan, the rounds and the capped patches
 ///   equal the CPU's but for counted ties, and every bound verified in f64);
-/// - **semi-uniform, from the camera alone**, every fourth camera: the pixel error's edge
+/// - **semi-uniform, from the camera alone**, every camera: the pixel error's edge
 ///   levels and patch levels checked a posteriori on the GPU ([`checked_frame`], as for
 ///   transition);
 /// - **SD-2, from the camera alone**, on the triangle models, every fourth camera (the
@@ -432,6 +432,10 @@ fn uniform_pixel_error_root(
 /// ([`assert_gpu_equals_cpu_after_record`]: offsets, triangle count, triangles index for
 /// index, positions within 1e-5 of the diagonal, the watertightness report).
 fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> SweepCounts {
+    // The checked frames plan with the second-derivative bound: the expansion bound's
+    // pipelines take lavapipe about half a minute to compile, and `tests/check.rs` compares
+    // its plans with the CPU's.
+    let bound = tessera::scheme::ErrorBound::Hessian;
     use tessera::criterion::view::{Mapping, ViewCriterion};
     use tessera::scheme::{Criterion, PlanOptions, Scheme};
     let ctx = ctx();
@@ -463,12 +467,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
             let name = format!("{model} camera {c} uniform");
             let criterion = Criterion::PixelError(uniform_pixels);
             let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion {
-                scheme: Scheme::Uniform,
-                criterion: Criterion::PixelError(uniform_pixels),
-                max_factor: cap,
-                capacity: None,
-            };
+            let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(uniform_pixels), cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut counts);
             let drawn = gpu.read_plan(ctx).unwrap();
@@ -504,12 +503,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let criterion = Criterion::View { criterion: ViewCriterion::Silhouetteness, fmin: 1.0, fmax };
                 let planned =
                     Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
-                let screen = ScreenCriterion {
-                    scheme: Scheme::Transition,
-                    criterion,
-                    max_factor: options.max_factor,
-                    capacity: None,
-                };
+                let screen = ScreenCriterion::new(Scheme::Transition, criterion, options.max_factor);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 check_culling(&name, &set, &gpu, &planned.plan.visible, &camera, &mut counts);
                 let drawn = gpu.read_plan(ctx).unwrap();
@@ -536,6 +530,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let scheme = Scheme::Transition;
                 let plan = checked_frame(
                     scheme,
+                    bound,
                     &name,
                     &set,
                     &prepared,
@@ -560,6 +555,7 @@ fn acceptance_sweep(models: &[String], cameras_per_model: usize, seed: u64) -> S
                 let cap = 1 << cap.max(2).ilog2();
                 let plan = checked_frame(
                     scheme,
+                    bound,
                     &name,
                     &set,
                     &prepared,
@@ -673,10 +669,8 @@ fn capacity_at_the_cap(model: &str, cap: u32) {
         let name = format!("{model} cap {cap}, {start}");
         let mut gpu = tessellator(&set);
         let screen = ScreenCriterion {
-            scheme: Scheme::Uniform,
-            criterion: Criterion::PixelError(pixels),
-            max_factor: cap,
             capacity,
+            ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
         };
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         let grown = record_until_complete(&mut gpu, &name);
@@ -729,7 +723,7 @@ fn capacity_at_the_cap_on_the_torus() {
         .find(|&cap| frame_triangles(cap) * 12 > limit)
         .unwrap_or_else(|| panic!("no cap up to 2048 passes the binding limit of {limit} bytes"));
     let mut gpu = tessellator(&set);
-    let screen = ScreenCriterion { scheme: Scheme::Uniform, criterion, max_factor: cap, capacity: None };
+    let screen = ScreenCriterion::new(Scheme::Uniform, criterion, cap);
     screen_frame(&mut gpu, &set, &prepared, &camera, screen);
     let draw: Vec<u32> = readback::read(ctx, gpu.indirect_buffer(), 5).unwrap();
     assert_eq!(draw[0], 0, "cap {cap}: an overflowing frame drew {} indices", draw[0]);
@@ -755,10 +749,8 @@ fn a_worst_case_past_the_u32_range_is_drawn_when_the_frame_fits() {
     let cap = tessera::criterion::MAX_FACTOR;
     let room = Capacity { vertices: 1 << 20, triangles: 1 << 20 };
     let screen = |pixels| ScreenCriterion {
-        scheme: Scheme::Uniform,
-        criterion: Criterion::PixelError(pixels),
-        max_factor: cap,
         capacity: Some(room),
+        ..ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap)
     };
     // The framing camera at 1 px: a frame of thousands of triangles.
     let (lo, hi) = set.bounds();
@@ -813,12 +805,7 @@ fn gpu_factors_equal_the_cpu_plans(cameras_per_model: usize, seed: u64) {
                     PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
                 let criterion = Criterion::PixelError(pixels);
                 let cpu = Scheme::Uniform.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-                let screen = ScreenCriterion {
-                    scheme: Scheme::Uniform,
-                    criterion: Criterion::PixelError(pixels),
-                    max_factor: cap,
-                    capacity: None,
-                };
+                let screen = ScreenCriterion::new(Scheme::Uniform, Criterion::PixelError(pixels), cap);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let got = gpu.read_plan(ctx).unwrap();
                 frames += 1;
@@ -885,8 +872,7 @@ fn silhouetteness_on_the_gpu(models: &[&str], cameras_per_model: usize, seed: u6
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let planned = Scheme::Transition.plan_prepared(&set, &prepared, &criterion, &options).unwrap();
             let cpu = &planned.plan;
-            let screen =
-                ScreenCriterion { scheme: Scheme::Transition, criterion, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion::new(Scheme::Transition, criterion, cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -1011,6 +997,7 @@ fn subdivision_cages_equal_the_cpu_engine(
             let name = format!("{cage} camera {c} transition 1 px");
             let plan = checked_frame(
                 Scheme::Transition,
+                tessera::scheme::ErrorBound::Hessian,
                 &name,
                 &set,
                 &prepared,
@@ -1024,7 +1011,18 @@ fn subdivision_cages_equal_the_cpu_engine(
             // And semi-uniform (paper 000): each patch's level checked a posteriori.
             let name = format!("{cage} camera {c} semi-uniform 1 px");
             let scheme = Scheme::SemiUniform { max_level: tessera::pattern::semi_uniform::MAX_LEVEL };
-            let plan = checked_frame(scheme, &name, &set, &prepared, &mut gpu, &camera, 1.0, 16, &mut counts);
+            let plan = checked_frame(
+                scheme,
+                tessera::scheme::ErrorBound::Hessian,
+                &name,
+                &set,
+                &prepared,
+                &mut gpu,
+                &camera,
+                1.0,
+                16,
+                &mut counts,
+            );
             let pattern = tessera::pattern::semi_uniform::SemiUniform;
             assert_gpu_equals_cpu_after_record(&name, &set, &gpu, &plan, &pattern);
         }
@@ -1169,6 +1167,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let mut counts = SweepCounts::default();
             let drawn = checked_frame(
                 Scheme::Transition,
+                tessera::scheme::ErrorBound::Hessian,
                 &format!("{name} at rest"),
                 &set,
                 &prepared,
@@ -1207,7 +1206,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
             let criterion = Criterion::PixelError(pixels);
             for scheme in [Scheme::Transition, Scheme::SemiUniform { max_level: 5 }, Scheme::Uniform] {
                 let name = format!("{name} moved, {scheme:?}");
-                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion::new(scheme, criterion, cap);
                 screen_frame(&mut gpu, &set, &prepared, &camera, screen);
                 let report = gpu.read_screen_report(ctx).unwrap();
                 let plan = gpu.read_plan(ctx).unwrap();
@@ -1265,7 +1264,7 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                     },
                 ),
             ] {
-                let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+                let screen = ScreenCriterion::new(scheme, criterion, cap);
                 let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
                 assert!(
                     matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),

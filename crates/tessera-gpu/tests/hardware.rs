@@ -347,8 +347,7 @@ fn hardware_plans_against_the_preconditions_are_refused() {
     // The scheme-level checks of `prepare_screen`.
     let prepared = Prepared::new(&set, true);
     let camera = cameras(&set, 1, 3)[0];
-    let screen =
-        |scheme, criterion, max_factor| ScreenCriterion { scheme, criterion, max_factor, capacity: None };
+    let screen = |scheme, criterion, max_factor| ScreenCriterion::new(scheme, criterion, max_factor);
     let odd_scheme = Scheme::Hardware(Partitioning::FractionalOdd);
     let refused = |gpu: &mut GpuTessellator, s: ScreenCriterion| {
         gpu.prepare_screen(ctx, &set, &prepared, &camera, s).is_err()
@@ -477,7 +476,7 @@ fn hardware_from_the_camera(
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let scheme = Scheme::Hardware(p);
             let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion::new(scheme, criterion, cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             assert!(!gpu.read_status(ctx).unwrap().0, "{name}: the frame overflowed its worst case");
             let visible = check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut sweep);
@@ -617,7 +616,7 @@ fn hardware_capacity_holds_the_worst_frame_or_grows() {
         for (start, capacity) in [("default room", None), ("room for 16 triangles", Some(tiny))] {
             let name = format!("{} {criterion:?}, {start}", p.name());
             let mut gpu = tessellator(&set);
-            let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity };
+            let screen = ScreenCriterion { capacity, ..ScreenCriterion::new(scheme, criterion, 64) };
             gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
             let grown = record_until_complete(&mut gpu, &name);
             assert_eq!(grown > 0, capacity.is_some(), "{name}: grown {grown} times");

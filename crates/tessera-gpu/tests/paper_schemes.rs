@@ -190,8 +190,18 @@ fn pixel_error_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
         for (c, camera) in cameras(set, 3, 17).into_iter().enumerate() {
             for (pixels, cap) in [(0.5, 8), (4.0, 32)] {
                 let name = format!("{model} camera {c} {pixels} px cap {cap}");
-                let plan =
-                    checked_frame(scheme, &name, set, &prepared, &mut gpu, &camera, pixels, cap, &mut counts);
+                let plan = checked_frame(
+                    scheme,
+                    tessera::scheme::ErrorBound::Hessian,
+                    &name,
+                    set,
+                    &prepared,
+                    &mut gpu,
+                    &camera,
+                    pixels,
+                    cap,
+                    &mut counts,
+                );
                 most_rounds = most_rounds.max(gpu.read_screen_report(ctx()).unwrap().rounds);
                 levels.extend(
                     (0..set.patches.len()).filter(|&p| plan.is_visible(p)).map(|p| plan.interior[p][0]),
@@ -230,7 +240,7 @@ fn silhouetteness_semi_uniform_planned_on_the_gpu_equals_the_cpu_plan() {
             let options =
                 PlanOptions { camera: Some(camera), cull: true, max_factor: cap, ..Default::default() };
             let cpu = scheme.plan_prepared(&set, &prepared, &criterion, &options).unwrap().plan;
-            let screen = ScreenCriterion { scheme, criterion, max_factor: cap, capacity: None };
+            let screen = ScreenCriterion::new(scheme, criterion, cap);
             screen_frame(&mut gpu, &set, &prepared, &camera, screen);
             let drawn = gpu.read_plan(ctx).unwrap();
             check_culling(&name, &set, &gpu, &cpu.visible, &camera, &mut SweepCounts::default());
@@ -583,8 +593,7 @@ fn strips_written_on_the_gpu_equal_the_cpu_engines() {
         let prepared = tessera::scheme::Prepared::new(&set, true);
         let criterion =
             Criterion::View { criterion: ViewCriterion::SilhouetteVertices, fmin: 1.5, fmax: 7.0 };
-        let screen =
-            ScreenCriterion { scheme: Scheme::Sd2 { warp: false }, criterion, max_factor: 8, capacity: None };
+        let screen = ScreenCriterion::new(Scheme::Sd2 { warp: false }, criterion, 8);
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         record_frame(&gpu);
         let plan = gpu.read_plan(ctx).unwrap();
@@ -607,7 +616,7 @@ fn strips_written_on_the_gpu_equal_the_cpu_engines() {
         gpu.prepare(ctx, &set, &planned.plan, &planned.pattern).unwrap();
         check(&format!("{model} esc"), &set, &mut gpu, &planned.plan, &planned.pattern);
         let prepared = tessera::scheme::Prepared::new(&set, true);
-        let screen = ScreenCriterion { scheme, criterion, max_factor: 64, capacity: None };
+        let screen = ScreenCriterion::new(scheme, criterion, 64);
         gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap();
         record_frame(&gpu);
         let plan = gpu.read_plan(ctx).unwrap();

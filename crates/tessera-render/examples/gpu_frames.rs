@@ -44,12 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let prepared = Prepared::new(&set, true);
     let (lo, hi) = set.bounds();
     let framing = Camera::framing(lo, hi, WIDTH, HEIGHT);
-    let criterion = ScreenCriterion {
-        scheme: Scheme::Transition,
-        criterion: Criterion::PixelError(1.0),
-        max_factor: 64,
-        capacity: None,
-    };
+    let criterion = ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(1.0), 64);
     engine.prepare_screen(&ctx, &set, &prepared, &framing, criterion)?;
 
     // Once: the application's pipeline, reading the engine's vertex layout.

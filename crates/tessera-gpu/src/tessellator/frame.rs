@@ -2,6 +2,7 @@
 //! for the last prepared plan or the GPU's own planning, and the rounds of the a-posteriori
 //! check within the factors pass. Nothing here reads back.
 
+use super::pipelines::CheckPipelines;
 use super::timer::begin_pass;
 use super::{GpuTessellator, PassTimer};
 use crate::shader;
@@ -67,20 +68,21 @@ impl GpuTessellator {
                         let (x, y) = grid(n);
                         c.dispatch_workgroups(x, y, 1);
                     }
-                } else {
+                } else if let Some((proposals, check)) = self.screen.and_then(|s| p.bound(s.bound)) {
+                    // Compiled by the `prepare_screen` that chose the bound.
                     if self.screen.is_some_and(|s| s.reads_depths()) {
                         c.set_pipeline(&p.vertex_depths);
                         let (x, y) = grid(self.view.vertices);
                         c.dispatch_workgroups(x, y, 1);
                     }
-                    c.set_pipeline(&p.patch_proposals);
+                    c.set_pipeline(proposals);
                     let (x, y) = grid(patches);
                     c.dispatch_workgroups(x, y, 1);
                     c.set_pipeline(&p.edge_segments);
                     let (x, y) = grid(e);
                     c.dispatch_workgroups(x, y, 1);
                     if self.screen.is_some_and(|s| s.checked()) {
-                        self.record_check(&mut c);
+                        self.record_check(&mut c, check);
                     } else {
                         c.set_pipeline(&p.interiors);
                         let (x, y) = grid(e.max(patches));
@@ -159,10 +161,9 @@ impl GpuTessellator {
     /// (`check.wgsl`): the first check of every patch, then [`DEFAULT_CHECK_ROUNDS`] rounds whose
     /// passes the GPU sizes itself (no work once the rounds have ended). Groups 0 and 1 are
     /// bound by the caller.
-    fn record_check(&self, c: &mut wgpu::ComputePass<'_>) {
-        let k = &self.pipelines.check;
+    fn record_check(&self, c: &mut wgpu::ComputePass<'_>, k: &CheckPipelines) {
         let (x, y) = shader::grid(self.set.patches.div_ceil(shader::WORKGROUP));
-        c.set_pipeline(&k.check_all);
+        c.set_pipeline(&k.check);
         c.dispatch_workgroups(x, y, 1);
         let args = &self.view.round_args;
         // The decisions bind the dispatch arguments as storage (their group 1: the frame state
@@ -179,7 +180,7 @@ impl GpuTessellator {
             c.set_pipeline(&k.resolve);
             c.dispatch_workgroups_indirect(args, 12);
             decide(c, &k.close);
-            c.set_pipeline(&k.recheck);
+            c.set_pipeline(&k.check);
             c.dispatch_workgroups_indirect(args, 0);
         }
     }

@@ -3,11 +3,11 @@
 //! ([`constants`]), the bind group layouts, and `common.wgsl`'s uniform [`Params`].
 
 use super::screen::{
-    CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_ESC, CRITERION_FIXED,
-    CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE, EDGE_RULE_HARDWARE,
-    EDGE_RULE_INTEGER, EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW, ESC_THRESHOLD_ABSOLUTE,
-    INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE, PATCH_VIEW_ROW, ROUND_ARGS_BINDING,
-    STATE_BINDING, VERTEX_VIEW_ROW,
+    BOUND_EXPANSION, BOUND_HESSIAN, CRITERION_DISTANCE_LINEAR, CRITERION_DISTANCE_QUADRATIC, CRITERION_ESC,
+    CRITERION_FIXED, CRITERION_PIXEL_ERROR, CRITERION_SILHOUETTENESS, CRITERION_VERTEX_SILHOUETTE,
+    EDGE_RULE_HARDWARE, EDGE_RULE_INTEGER, EDGE_RULE_POWER_OF_TWO, EDGE_RULE_SYMMETRIC, EDGE_VIEW_ROW,
+    ESC_THRESHOLD_ABSOLUTE, INTERIOR_CORE, INTERIOR_GLOBAL, INTERIOR_LEVEL, INTERIOR_MAX_EDGE,
+    PATCH_VIEW_ROW, ROUND_ARGS_BINDING, STATE_BINDING, VERTEX_VIEW_ROW,
 };
 use super::VERTEX_FLOATS;
 use crate::context::GpuContext;
@@ -138,6 +138,10 @@ pub(crate) fn constants() -> Vec<(&'static str, u32)> {
         ("OUTPUT_GAP_INVERSE", gap_inverse as u32),
         ("ESC_MAX_SIDE", ESC_MAX_SIDE),
         ("ESC_GRID_WORDS", ESC_GRID_WORDS),
+        ("EXPANSION_WALK_CELLS", tessera::criterion::taylor::EXPANSION_WALK_CELLS as u32),
+        ("HULL_WHEN_BITS", (tessera::criterion::taylor::HULL_WHEN as f32).to_bits()),
+        ("BOUND_HESSIAN", BOUND_HESSIAN),
+        ("BOUND_EXPANSION", BOUND_EXPANSION),
     ]
 }
 
@@ -262,7 +266,7 @@ const UNIFORM_SHADERS: PatternShaders = PatternShaders {
 
 /// The transition pattern: counts and triangles in one module.
 const TRANSITION_SHADERS: PatternShaders = PatternShaders {
-    count: ("transition", &[COMMON, LOCAL, BOUNDS, TRANSITION, COUNT]),
+    count: ("transition", &[COMMON, LOCAL, BOUNDS, NO_EXPANSION, TRANSITION, COUNT]),
     vertices: (
         "vertices transition",
         &[
@@ -272,6 +276,7 @@ const TRANSITION_SHADERS: PatternShaders = PatternShaders {
             BEZIER_TRIANGLE,
             LOCAL,
             BOUNDS,
+            NO_EXPANSION,
             TRANSITION,
             GRID_VERTICES,
             WRITE_VERTICES,
@@ -469,7 +474,17 @@ pub struct Pipelines {
     /// The strip passes of SD-2 and of ESC, compiled on first use ([`Pipelines::strips`]).
     sd2_strips: std::sync::OnceLock<StripPipelines>,
     esc_strips: std::sync::OnceLock<StripPipelines>,
+    /// The proposals and check of frames planned with the expansion bound, compiled on
+    /// first use ([`Pipelines::expansion`]).
+    expansion: std::sync::OnceLock<BoundPipelines>,
     main_pipeline_layout: wgpu::PipelineLayout,
+    rounds_pipeline_layout: wgpu::PipelineLayout,
+}
+
+/// The factors module's parts, with the expansion bound (`EXPANSION`) or without it
+/// (`NO_EXPANSION`).
+fn factors_parts(expansion: &'static str) -> [&'static str; 7] {
+    [COMMON, VIEW, CULL, HARDWARE_PARTITION, BOUNDS, expansion, FACTORS]
 }
 
 fn compute_pipeline(
@@ -535,32 +550,10 @@ impl Pipelines {
         };
         let args = module(device, "args", &[COMMON, INDIRECT_ARGS]);
         let cull = module(device, "cull", &[COMMON, VIEW, CULL]);
-        let factors = module(device, "factors", &[COMMON, VIEW, CULL, HARDWARE_PARTITION, FACTORS]);
+        let factors = module(device, "factors", &factors_parts(NO_EXPANSION));
         let uniform = UNIFORM_SHADERS.pipelines(device, &one);
         let transition = TRANSITION_SHADERS.pipelines(device, &one);
-        let check = {
-            let parts = [
-                COMMON,
-                VIEW,
-                CULL,
-                HARDWARE_PARTITION,
-                FACTORS,
-                LOCAL,
-                BOUNDS,
-                TRANSITION,
-                UNIFORM_GRID,
-                SEMI_UNIFORM,
-                CHECK,
-            ];
-            let m = module(device, "check", &parts);
-            CheckPipelines {
-                check_all: make(&with_view, &m, "check_all"),
-                open: make(&with_rounds, &m, "round_open"),
-                resolve: make(&with_view, &m, "round_resolve"),
-                close: make(&with_rounds, &m, "round_close"),
-                recheck: make(&with_view, &m, "round_check"),
-            }
-        };
+        let check = CheckPipelines::new(device, &with_view, &with_rounds, NO_EXPANSION);
         Pipelines {
             check,
             rounds_layout,
@@ -584,10 +577,46 @@ impl Pipelines {
             strips_pipeline_layout: with_strips,
             sd2_strips: std::sync::OnceLock::new(),
             esc_strips: std::sync::OnceLock::new(),
+            expansion: std::sync::OnceLock::new(),
+            rounds_pipeline_layout: with_rounds,
             main_layout,
             args_layout,
             view_layout,
         }
+    }
+
+    /// The proposals and the check of frames planned with the expansion bound
+    /// (`expansion.wgsl`, [`tessera::criterion::ErrorBound::Expansion`]), compiled on the
+    /// first call. Cost: the first call two WGSL compilations, which lavapipe's LLVM takes
+    /// about a minute over (it inlines the bound at each call site); later calls nothing.
+    pub(super) fn expansion(&self, device: &wgpu::Device) -> &BoundPipelines {
+        self.expansion.get_or_init(|| {
+            let factors = module(device, "factors with the expansion bound", &factors_parts(EXPANSION));
+            BoundPipelines {
+                patch_proposals: compute_pipeline(
+                    device,
+                    &self.view_pipeline_layout,
+                    &factors,
+                    "patch_proposals",
+                ),
+                check: CheckPipelines::new(
+                    device,
+                    &self.view_pipeline_layout,
+                    &self.rounds_pipeline_layout,
+                    EXPANSION,
+                ),
+            }
+        })
+    }
+
+    /// The proposals and the check a frame planned with `bound` (`Screen::bound`) records:
+    /// the second-derivative bound's, or the expansion bound's once [`Pipelines::expansion`]
+    /// compiled them (None before).
+    pub(super) fn bound(&self, bound: u32) -> Option<(&wgpu::ComputePipeline, &CheckPipelines)> {
+        if bound == BOUND_EXPANSION {
+            return self.expansion.get().map(|b| (&b.patch_proposals, &b.check));
+        }
+        Some((&self.patch_proposals, &self.check))
     }
 
     /// The hardware pattern's pipelines (`hardware.wgsl`), compiled on the first call.
@@ -723,15 +752,58 @@ pub(super) struct EscPlanPipelines {
     pub(super) grids: wgpu::ComputePipeline,
 }
 
-/// The a-posteriori check's pipelines (`check.wgsl`): the first check, then per round the
-/// opening decision, the resolve, the closing decision and the re-check.
+/// The a-posteriori check's pipelines (`check.wgsl`): the check (the first of every patch,
+/// and each round's re-check), and per round the opening decision, the resolve and the
+/// closing decision.
 #[derive(Debug)]
 pub(super) struct CheckPipelines {
-    pub(super) check_all: wgpu::ComputePipeline,
+    pub(super) check: wgpu::ComputePipeline,
     pub(super) open: wgpu::ComputePipeline,
     pub(super) resolve: wgpu::ComputePipeline,
     pub(super) close: wgpu::ComputePipeline,
-    pub(super) recheck: wgpu::ComputePipeline,
+}
+
+impl CheckPipelines {
+    /// Compiles `check.wgsl` with `expansion.wgsl` or its stand-in (`expansion`). Cost: one
+    /// WGSL compilation.
+    fn new(
+        device: &wgpu::Device,
+        with_view: &wgpu::PipelineLayout,
+        with_rounds: &wgpu::PipelineLayout,
+        expansion: &'static str,
+    ) -> CheckPipelines {
+        let parts = [
+            COMMON,
+            VIEW,
+            CULL,
+            HARDWARE_PARTITION,
+            FACTORS,
+            LOCAL,
+            BOUNDS,
+            expansion,
+            TRANSITION,
+            UNIFORM_GRID,
+            SEMI_UNIFORM,
+            CHECK,
+        ];
+        let label = if expansion == EXPANSION { "check with the expansion bound" } else { "check" };
+        let m = module(device, label, &parts);
+        let make = |layout: &wgpu::PipelineLayout, entry: &str| compute_pipeline(device, layout, &m, entry);
+        CheckPipelines {
+            check: make(with_view, "check_patches"),
+            open: make(with_rounds, "round_open"),
+            resolve: make(with_view, "round_resolve"),
+            close: make(with_rounds, "round_close"),
+        }
+    }
+}
+
+/// The passes whose code depends on the error bound (`Screen::bound`): the proposals and the
+/// a-posteriori check.
+#[derive(Debug)]
+pub(super) struct BoundPipelines {
+    pub(super) patch_proposals: wgpu::ComputePipeline,
+    pub(super) check: CheckPipelines,
 }
 
 /// `common.wgsl`'s `Params` (member for member: the contract test, `contract.rs`, checks the offsets).

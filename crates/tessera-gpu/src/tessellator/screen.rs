@@ -16,7 +16,7 @@ use tessera::camera::Camera;
 use tessera::criterion::resolve::{EdgeRule, InteriorRule};
 use tessera::criterion::view::{Mapping, ViewCriterion};
 use tessera::sampling::Spacing;
-use tessera::scheme::{validate, Criterion, Engine, PlanOptions, Prepared, Scheme};
+use tessera::scheme::{validate, Criterion, Engine, ErrorBound, PlanOptions, Prepared, Scheme};
 use tessera::surface::SurfaceSet;
 
 /// `view.wgsl`'s binding of the frame state, and `check.wgsl`'s of the rounds' arguments.
@@ -48,6 +48,20 @@ pub struct ScreenCriterion {
     /// needs more overflows (drawing nothing) until [`GpuTessellator::grow_if_overflowed`]
     /// grows it.
     pub capacity: Option<Capacity>,
+    /// The guaranteed bound a pixel error plans with (`PlanOptions::bound`):
+    /// [`ErrorBound::Hessian`] or [`ErrorBound::Expansion`] (the a-posteriori check and the
+    /// proposals then also compute the Taylor expansion, `expansion.wgsl`); the GPU refuses
+    /// [`ErrorBound::Taylor`], whose sampled refinements it does not compute.
+    pub bound: ErrorBound,
+}
+
+impl ScreenCriterion {
+    /// `scheme` under `criterion` with the factor cap `max_factor`: output room for the
+    /// worst case, planned with the second-derivative bound (set `capacity` and `bound` on
+    /// the result for others).
+    pub fn new(scheme: Scheme, criterion: Criterion, max_factor: u32) -> ScreenCriterion {
+        ScreenCriterion { scheme, criterion, max_factor, capacity: None, bound: ErrorBound::Hessian }
+    }
 }
 
 /// `view.wgsl`'s `View` uniform (member for member: the contract test, `contract.rs`, checks
@@ -71,6 +85,8 @@ pub(crate) struct ViewUniform {
     pub(crate) lo: f32,
     pub(crate) hi: f32,
     pub(crate) edge_rule: u32,
+    pub(crate) bound: u32,
+    pub(crate) _pad: [u32; 3],
 }
 
 /// `view.wgsl`'s interior rules, criteria and edge rules (substituted into it by
@@ -94,6 +110,10 @@ pub(super) const EDGE_RULE_INTEGER: u32 = 0;
 pub(super) const EDGE_RULE_HARDWARE: u32 = 1;
 pub(super) const EDGE_RULE_POWER_OF_TWO: u32 = 2;
 pub(super) const EDGE_RULE_SYMMETRIC: u32 = 3;
+/// `view.wgsl`'s error bounds of a pixel error: [`ErrorBound::Hessian`] and
+/// [`ErrorBound::Expansion`] (`expansion.wgsl`).
+pub(super) const BOUND_HESSIAN: u32 = 0;
+pub(super) const BOUND_EXPANSION: u32 = 1;
 /// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
 pub(super) const EDGE_VIEW_ROW: usize = 3;
 /// `vec4<f32>` per topology vertex after the edge rows ([`patch_view_rows`]).
@@ -110,6 +130,8 @@ pub(super) struct Screen {
     pub(super) cap: f64,
     pub(super) interior: u32,
     pub(super) edge_rule: u32,
+    /// [`BOUND_HESSIAN`] or [`BOUND_EXPANSION`].
+    pub(super) bound: u32,
 }
 
 impl Screen {
@@ -331,7 +353,7 @@ impl GpuTessellator {
         camera: &Camera,
         criterion: ScreenCriterion,
     ) -> Result<()> {
-        let ScreenCriterion { scheme, criterion, max_factor, capacity } = criterion;
+        let ScreenCriterion { scheme, criterion, max_factor, capacity, bound } = criterion;
         let reads_rest_rows = matches!(criterion, Criterion::View { .. } | Criterion::Esc { .. })
             || matches!(scheme, Scheme::Sd2 { .. } | Scheme::Esc { .. });
         if self.view.moving && reads_rest_rows {
@@ -343,7 +365,7 @@ impl GpuTessellator {
                 ),
             });
         }
-        let screen = screen_of(set, camera, scheme, criterion, max_factor)?;
+        let screen = screen_of(set, camera, scheme, criterion, max_factor, bound)?;
         self.check_screen_support(set, prepared, scheme, max_factor)?;
         let pattern = match scheme {
             Scheme::Esc { .. } => GpuPattern::Esc,
@@ -371,6 +393,9 @@ impl GpuTessellator {
         self.pattern = pattern;
         self.warped = scheme == (Scheme::Sd2 { warp: true });
         self.pipelines.compile(&ctx.device, self.pattern);
+        if screen.bound == BOUND_EXPANSION {
+            self.pipelines.expansion(&ctx.device);
+        }
         if self.strips.is_some() {
             self.pipelines.strips(&ctx.device, self.pattern);
         }
@@ -460,6 +485,7 @@ impl GpuTessellator {
             cap: 1.0,
             interior: INTERIOR_GLOBAL,
             edge_rule: EDGE_RULE_INTEGER,
+            bound: BOUND_HESSIAN,
         });
         let t = view.half_tangents;
         let uniform = ViewUniform {
@@ -479,6 +505,8 @@ impl GpuTessellator {
             lo: s.lo as f32,
             hi: s.hi as f32,
             edge_rule: s.edge_rule,
+            bound: s.bound,
+            _pad: [0; 3],
         };
         ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::bytes_of(&uniform));
     }
@@ -496,10 +524,12 @@ fn screen_of(
     scheme: Scheme,
     criterion: Criterion,
     max_factor: u32,
+    bound: ErrorBound,
 ) -> Result<Screen> {
     // ESC culls nothing (its levels are per object); every other frame culls on the GPU.
     let cull = !matches!(scheme, Scheme::Esc { .. });
-    let options = PlanOptions { camera: Some(*camera), cull, max_factor, ..PlanOptions::default() };
+    let options = PlanOptions { camera: Some(*camera), cull, max_factor, bound, ..PlanOptions::default() };
+    let bound = if bound == ErrorBound::Expansion { BOUND_EXPANSION } else { BOUND_HESSIAN };
     let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
     let cap = accepted.cap;
     let (kind, pixels, lo, hi) = match (scheme, criterion) {
@@ -542,6 +572,7 @@ fn screen_of(
                 cap: near,
                 interior,
                 edge_rule: rule,
+                bound,
             });
         }
         (_, Criterion::Tolerance(_) | Criterion::Esc { .. }) => {
@@ -560,5 +591,5 @@ fn screen_of(
         Some(EdgeRule::Fractional(Spacing::Symmetric)) => EDGE_RULE_SYMMETRIC,
         _ => EDGE_RULE_INTEGER,
     };
-    Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule })
+    Ok(Screen { criterion: kind, pixels, lo, hi, cap, interior, edge_rule, bound })
 }

@@ -49,8 +49,8 @@ pub enum ErrorBound {
     /// PN triangles; other kinds keep the second-derivative bound. Between the two others in
     /// triangles (teapot at 0.1 %: 12,642 / 9,364 / 8,128 for Hessian / Expansion / Taylor;
     /// spot 23,224 / 11,332 / 11,332) and a fifth of the Taylor bound's planning time on
-    /// patches. Planned on the CPU; it is the part of the Taylor bound a GPU check could
-    /// compute (`docs/ARCHITECTURE.md`, Known debts).
+    /// patches. The part of the Taylor bound the GPU's check computes too
+    /// ([`crate::scheme::Engine::GpuFromCamera`], `tessera-gpu`'s `expansion.wgsl`).
     Expansion,
 }
 

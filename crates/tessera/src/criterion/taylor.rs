@@ -770,7 +770,7 @@ pub fn bubble_max(a: [f64; 3]) -> f64 {
 /// Where a cubic triangle's remainder exceeds this share of its quadratic part, its error is
 /// also bounded by its control points ([`cubic_error_hull`]): below it the hull changed no
 /// plan of the mesh models (1 %, 0.1 %, 0.01 %) and doubled the planning time.
-const HULL_WHEN: f64 = 0.05;
+pub const HULL_WHEN: f64 = 0.05;
 
 /// The lattice of [`TaylorBound::split_error`] for a Taylor expansion: `n` parts a side,
 /// `n²` leaves. Its leaves' own bounds are an expansion's, a sixteenth of the whole's and

@@ -171,6 +171,31 @@ pub fn patch_bound(
     built_pattern_bound(&m.triangle_errors(), input, scratch, &mut Vec::new())
 }
 
+/// Guaranteed error bound of one patch under `input` as the a-posteriori check of a plan
+/// computes it: a pattern that is a grid ([`Pattern::grid_cells`]) bounded from its cells, a
+/// core's cells ([`Pattern::core_cells`]) together and the other triangles one by one, each
+/// the smaller of the second-derivative bound (`errors`) and, where given and the patch has
+/// one, `taylor` (the bound a plan with [`crate::criterion::ErrorBound::Taylor`] or
+/// [`crate::criterion::ErrorBound::Expansion`] takes: [`crate::criterion::Prepared::
+/// bounds_for`]). What the GPU's check is compared against. Cost: one pattern build, and an
+/// evaluation a cell or triangle with `taylor`.
+pub fn checked_patch_bound(
+    errors: &TriangleErrors,
+    taylor: Option<&TaylorBound>,
+    input: &PatternInput,
+    pattern: &dyn Pattern,
+    scratch: &mut LocalTessellation,
+) -> f64 {
+    let taylor = taylor.filter(|t| t.is_some()).map(|t| (t, input.domain));
+    if let Some(cells) = pattern.grid_cells(input) {
+        return grid_bound(errors, taylor, cells);
+    }
+    pattern.build(input, scratch);
+    let mut params = Vec::new();
+    crate::pattern::cache::local_params(input, scratch, &mut params);
+    core_params_bound(errors, taylor, pattern.core_cells(input), scratch, &params)
+}
+
 /// [`patch_bound`] of a pattern already built for `input`; `params` is a buffer for the
 /// parameters of its local vertices (computed once each, not once per triangle corner).
 fn built_pattern_bound(

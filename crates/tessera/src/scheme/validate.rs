@@ -350,12 +350,13 @@ fn check_engine(scheme: Scheme, criterion: &Criterion, options: &PlanOptions, en
                     options.max_factor
                 ));
             }
-            if checked && options.bound != crate::criterion::ErrorBound::Hessian {
-                return refuse(format!(
-                    "the {:?} bound planned on the GPU (its check computes the second-derivative \
-                     bound; plan this frame on the CPU)",
-                    options.bound
-                ));
+            if checked && options.bound == crate::criterion::ErrorBound::Taylor {
+                return refuse(
+                    "the Taylor bound planned on the GPU (its check computes the second-derivative \
+                     and expansion bounds, not the Taylor bound's sampled refinements: plan this \
+                     frame on the CPU, or with ErrorBound::Expansion)"
+                        .into(),
+                );
             }
             Ok(())
         }
@@ -453,6 +454,9 @@ mod tests {
             Engine::GpuFromCamera
         )));
         v(Scheme::Transition, Criterion::PixelError(0.5), &taylor, Engine::Gpu).unwrap();
+        // The expansion bound is the GPU's own (`expansion.wgsl`).
+        let expansion = PlanOptions { bound: crate::criterion::ErrorBound::Expansion, ..culled };
+        v(Scheme::Transition, Criterion::PixelError(0.5), &expansion, Engine::GpuFromCamera).unwrap();
         // The request's own errors come first, the same for every engine.
         for engine in [Engine::Cpu, Engine::Gpu, Engine::GpuFromCamera] {
             assert!(matches!(
