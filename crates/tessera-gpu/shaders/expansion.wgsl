@@ -5,18 +5,22 @@
 // dominates, its error's control-point hull; a grid's is the walk over its cells (one
 // expansion at each cell's centre) up to EXPANSION_WALK_CELLS cells, and past them the
 // second-derivative nets' bound of every cell at once. Polynomial bicubics, cubic Bézier
-// triangles and PN triangles; every other patch has none (EXPANSION_NONE: its plans keep the
-// second-derivative bound).
+// triangles and PN triangles (`taylor::ExpansionNet`); every other patch has none
+// (EXPANSION_NONE: its plans keep the second-derivative bound).
 //
-// The nets and third-derivative bounds are computed here from the patch's control points (a
-// frame whose cage moves reads the moved points), in f32 where the CPU computes in f64, so a
-// decision near its tolerance may differ (the tests count such frames). No code here loops
-// per cell or per triangle: lavapipe stops an invocation's loops after 65,535 iterations in
-// all (`local.wgsl`), and a check walks up to EXPANSION_WALK_CELLS cells a step.
+// The nets are read from the patch view rows at `view.expansion_rows` (`screen::
+// expansion_rows`): each patch's control net less its first point, differenced in f64, so
+// the second and third differences keep f32's precision relative to the patch's size (from
+// the absolute f32 control points a small PN triangle's bound was 1 % off the CPU's). A
+// decision near its tolerance may still differ from the CPU's f64 one (the tests count such
+// frames). No code here loops per cell or per triangle: lavapipe stops an invocation's loops
+// after 65,535 iterations in all (`local.wgsl`), and a check walks up to
+// EXPANSION_WALK_CELLS cells a step.
 
 const EXPANSION_NONE: u32 = 0u;
-const EXPANSION_BICUBIC: u32 = 1u;
-const EXPANSION_TRIANGLE: u32 = 2u;
+// The kinds of `screen::expansion_rows` (the first net row's w).
+const EXPANSION_BICUBIC: u32 = {{EXPANSION_BICUBIC}}u;
+const EXPANSION_TRIANGLE: u32 = {{EXPANSION_TRIANGLE}}u;
 const EXPANSION_WALK_CELLS: u32 = {{EXPANSION_WALK_CELLS}}u;
 // `taylor::HULL_WHEN` (its f32 bits: naga takes no bitcast in a constant): where a cubic
 // triangle's remainder exceeds this share of its quadratic part, its error hull is taken too.
@@ -37,9 +41,20 @@ fn no_expansion(p: u32) -> Expansion {
     return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0), vec3<f32>(0.0));
 }
 
-// A bicubic's point b(i, j) (`i` along u).
+// Row k of patch p's expansion net.
+fn net_row(p: u32, k: u32) -> vec4<f32> {
+    return patch_views[view.expansion_rows + p * CONTROL_POINTS + k];
+}
+
+// A bicubic's point b(i, j) (`i` along u), less b(0, 0).
 fn net_point(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return control_points[p * CONTROL_POINTS + 4u * i + j].xyz;
+    return net_row(p, 4u * i + j).xyz;
+}
+
+// A cubic triangle's point b(i, j, 3 − i − j) (`i` the exponent of λ0, `j` of u), less its
+// first point (`tri_index` of `triangle_net.wgsl`).
+fn tri_net_point(p: u32, i: u32, j: u32) -> vec3<f32> {
+    return net_row(p, tri_index(i, j)).xyz;
 }
 
 // A bicubic's second differences at (i, j): Δ²_u b, Δ_uΔ_v b, Δ²_v b.
@@ -57,25 +72,23 @@ fn net_dvv(p: u32, i: u32, j: u32) -> vec3<f32> {
 
 // A cubic triangle's second differences at base (i, j, k) of degree 1 (`taylor::triangle`).
 fn tri_duu(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return tri_point(p, i, j + 2u) - 2.0 * tri_point(p, i + 1u, j + 1u) + tri_point(p, i + 2u, j);
+    return tri_net_point(p, i, j + 2u) - 2.0 * tri_net_point(p, i + 1u, j + 1u) + tri_net_point(p, i + 2u, j);
 }
 
 fn tri_duv(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return tri_point(p, i, j + 1u) - tri_point(p, i + 1u, j) - tri_point(p, i + 1u, j + 1u)
-        + tri_point(p, i + 2u, j);
+    return tri_net_point(p, i, j + 1u) - tri_net_point(p, i + 1u, j) - tri_net_point(p, i + 1u, j + 1u)
+        + tri_net_point(p, i + 2u, j);
 }
 
 fn tri_dvv(p: u32, i: u32, j: u32) -> vec3<f32> {
-    return tri_point(p, i, j) - 2.0 * tri_point(p, i + 1u, j) + tri_point(p, i + 2u, j);
+    return tri_net_point(p, i, j) - 2.0 * tri_net_point(p, i + 1u, j) + tri_net_point(p, i + 2u, j);
 }
 
 // `TaylorBound::expansion` of patch p: its kind and third-derivative bounds (`taylor::
 // bicubic`, `taylor::triangle`). Loops of a few steps, once per check or proposal.
 fn expansion_of(p: u32) -> Expansion {
-    if (patch_is_subdivision(p)) {
-        return no_expansion(p);
-    }
-    if (patch_is_tri(p)) {
+    let kind = u32(net_row(p, 0u).w);
+    if (kind == EXPANSION_TRIANGLE) {
         // (1, 0, 0) and its steps along u, (0, 1, 0), and v, (0, 0, 1).
         let uuu = length(tri_duu(p, 0u, 1u) - tri_duu(p, 1u, 0u));
         let uuv = length(tri_duu(p, 0u, 0u) - tri_duu(p, 1u, 0u));
@@ -83,11 +96,7 @@ fn expansion_of(p: u32) -> Expansion {
         let vvv = length(tri_dvv(p, 0u, 0u) - tri_dvv(p, 1u, 0u));
         return Expansion(p, EXPANSION_TRIANGLE, 6.0 * vec4<f32>(uuu, uuv, uvv, vvv), vec3<f32>(0.0));
     }
-    var polynomial = true;
-    for (var k = 0u; k < 16u; k = k + 1u) {
-        polynomial = polynomial && control_points[p * CONTROL_POINTS + k].w == 1.0;
-    }
-    if (!polynomial) {
+    if (kind != EXPANSION_BICUBIC) {
         return no_expansion(p);
     }
     var third = vec4<f32>(0.0);
@@ -332,10 +341,10 @@ fn tri_value(n: array<vec3<f32>, 10>, q: vec3<f32>) -> vec3<f32> {
 // `taylor::cubic_error_hull` of patch p over the parameter triangle (t0, t1, t2).
 fn cubic_error_hull(p: u32, t0: vec2<f32>, t1: vec2<f32>, t2: vec2<f32>) -> f32 {
     let n = array<vec3<f32>, 10>(
-        tri_point(p, 0u, 0u), tri_point(p, 0u, 1u), tri_point(p, 0u, 2u), tri_point(p, 0u, 3u),
-        tri_point(p, 1u, 0u), tri_point(p, 1u, 1u), tri_point(p, 1u, 2u),
-        tri_point(p, 2u, 0u), tri_point(p, 2u, 1u),
-        tri_point(p, 3u, 0u),
+        tri_net_point(p, 0u, 0u), tri_net_point(p, 0u, 1u), tri_net_point(p, 0u, 2u), tri_net_point(p, 0u, 3u),
+        tri_net_point(p, 1u, 0u), tri_net_point(p, 1u, 1u), tri_net_point(p, 1u, 2u),
+        tri_net_point(p, 2u, 0u), tri_net_point(p, 2u, 1u),
+        tri_net_point(p, 3u, 0u),
     );
     let q0 = vec3<f32>(1.0 - t0.x - t0.y, t0.x, t0.y);
     let q1 = vec3<f32>(1.0 - t1.x - t1.y, t1.x, t1.y);

@@ -35,7 +35,9 @@ struct View {
     // The error bound of a pixel error's proposals and check: BOUND_HESSIAN (the prepared
     // second-derivative bounds alone) or BOUND_EXPANSION (also `expansion.wgsl`'s).
     bound: u32,
-    _pad0: u32,
+    // Where the expansion nets start in `patch_views` (`screen::expansion_rows`), once a
+    // frame planned with BOUND_EXPANSION appended them.
+    expansion_rows: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -49,7 +51,9 @@ struct View {
 // with the box's diagonal in w, and hi (`criterion::esc::Objects`). After the P patch rows,
 // EDGE_VIEW_ROW vec4 per edge: its midpoint as its first patch sees it with the edge's
 // minimum segments in w (`minimum_segments`), the normals there of its first and its last
-// patch (`Prepared::edge_midpoints`).
+// patch (`Prepared::edge_midpoints`). With the expansion bound, from `view.expansion_rows`
+// CONTROL_POINTS vec4 per patch: its expansion net less its first point, the kind in the
+// first row's w (`expansion.wgsl`).
 @group(1) @binding(1) var<storage, read_write> patch_views: array<vec4<f32>>;
 // Per patch, the factor it proposes for each local edge (0 for culled patches).
 @group(1) @binding(2) var<storage, read_write> proposals: array<vec4<f32>>;

@@ -89,6 +89,7 @@ fn shared_structs_match_their_wgsl_member_for_member() {
             ("hi", offset_of!(ViewUniform, hi)),
             ("edge_rule", offset_of!(ViewUniform, edge_rule)),
             ("bound", offset_of!(ViewUniform, bound)),
+            ("expansion_rows", offset_of!(ViewUniform, expansion_rows)),
         ],
         size_of::<ViewUniform>(),
     );

@@ -1271,6 +1271,16 @@ fn moving_bounds_plan_a_deforming_cage_from_the_camera() {
                     "{e}"
                 );
             }
+            // And the expansion bound, whose nets are uploaded at rest.
+            let screen = ScreenCriterion {
+                bound: tessera::scheme::ErrorBound::Expansion,
+                ..ScreenCriterion::new(Scheme::Transition, Criterion::PixelError(pixels), cap)
+            };
+            let e = gpu.prepare_screen(ctx, &set, &prepared, &camera, screen).unwrap_err();
+            assert!(
+                matches!(e, GpuError::Unsupported { .. }) && e.to_string().contains("moving cage"),
+                "{e}"
+            );
         }
     }
     assert!(moved_plans_differ > 0, "moving the cages never changed a plan");

@@ -86,7 +86,9 @@ pub(crate) struct ViewUniform {
     pub(crate) hi: f32,
     pub(crate) edge_rule: u32,
     pub(crate) bound: u32,
-    pub(crate) _pad: [u32; 3],
+    /// Where the expansion nets start in the patch view rows ([`expansion_rows`]).
+    pub(crate) expansion_rows: u32,
+    pub(crate) _pad: [u32; 2],
 }
 
 /// `view.wgsl`'s interior rules, criteria and edge rules (substituted into it by
@@ -114,6 +116,9 @@ pub(super) const EDGE_RULE_SYMMETRIC: u32 = 3;
 /// [`ErrorBound::Expansion`] (`expansion.wgsl`).
 pub(super) const BOUND_HESSIAN: u32 = 0;
 pub(super) const BOUND_EXPANSION: u32 = 1;
+/// `expansion.wgsl`'s kinds of expansion net ([`expansion_rows`]; 0 is none).
+pub(super) const EXPANSION_BICUBIC: u32 = 1;
+pub(super) const EXPANSION_TRIANGLE: u32 = 2;
 /// `vec4<f32>` per edge after the patch rows ([`patch_view_rows`]).
 pub(super) const EDGE_VIEW_ROW: usize = 3;
 /// `vec4<f32>` per topology vertex after the edge rows ([`patch_view_rows`]).
@@ -159,6 +164,8 @@ impl Screen {
 pub(super) struct ViewBuffers {
     pub(super) uniform: wgpu::Buffer,
     pub(super) patch_views: wgpu::Buffer,
+    /// Each patch's proposed factors (`view.wgsl`'s `proposals`).
+    pub(super) proposals: wgpu::Buffer,
     /// `view.wgsl`'s `FrameState`.
     pub(super) state: wgpu::Buffer,
     /// The check rows (`view.wgsl`'s `CheckRow`, per patch).
@@ -177,6 +184,10 @@ pub(super) struct ViewBuffers {
     pub(super) moving: bool,
     /// The set's topology vertices (their rows follow the edges').
     pub(super) vertices: u32,
+    /// Where the expansion nets ([`expansion_rows`]) start in `patch_views`, once a frame
+    /// planned with the expansion bound appended them (None before: most frames never
+    /// need them).
+    pub(super) expansion_rows: Option<u32>,
 }
 
 impl ViewBuffers {
@@ -213,6 +224,7 @@ impl ViewBuffers {
         ViewBuffers {
             uniform,
             patch_views,
+            proposals,
             state,
             checks,
             bind,
@@ -221,8 +233,64 @@ impl ViewBuffers {
             bounds_uploaded: false,
             moving: false,
             vertices,
+            expansion_rows: None,
         }
     }
+
+    /// Appends the expansion nets of `set` to `patch_views` ([`expansion_rows`]), once: a
+    /// larger buffer, the view rows uploaded again with the next frame, the bind group
+    /// remade. Cost: the first call O(P) and a buffer of 256 bytes a patch; later calls
+    /// nothing.
+    pub(super) fn add_expansion_rows(
+        &mut self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        set: &SurfaceSet,
+    ) -> u32 {
+        if let Some(at) = self.expansion_rows {
+            return at;
+        }
+        let base = patch_view_rows(set, None);
+        let at = base.len() as u32;
+        let mut rows = base;
+        rows.extend(expansion_rows(set));
+        self.patch_views = upload::storage_buffer(device, "patch views", &rows);
+        self.bind = shader::bind(
+            device,
+            layout,
+            &[&self.uniform, &self.patch_views, &self.proposals, &self.state, &self.checks],
+        );
+        self.bounds_uploaded = false;
+        self.expansion_rows = Some(at);
+        at
+    }
+}
+
+/// Per patch, [`upload::CONTROL_POINTS`] `vec4<f32>` for `expansion.wgsl`: the control net
+/// of its expansion bound (`taylor::ExpansionNet`: a polynomial bicubic's 16 points, a cubic
+/// or PN triangle's 10 at `BezierTriangle::index`) less the net's first point, differenced in
+/// f64 and then rounded, so the bound's second and third differences keep f32's precision
+/// relative to the patch's size, not to its distance from the origin (from the f32 control
+/// points, a small PN triangle's bound was 1 % off the CPU's); the first row's w holds the
+/// kind (`expansion.wgsl`'s EXPANSION_NONE, _BICUBIC, _TRIANGLE). Cost: O(P).
+fn expansion_rows(set: &SurfaceSet) -> Vec<[f32; 4]> {
+    use tessera::criterion::taylor::ExpansionNet;
+    let per_patch = upload::CONTROL_POINTS as usize;
+    let mut out = vec![[0.0f32; 4]; per_patch * set.patches.len()];
+    for (p, patch) in set.patches.iter().enumerate() {
+        let Some(net) = ExpansionNet::of(patch) else { continue };
+        let rows = &mut out[per_patch * p..per_patch * (p + 1)];
+        let points = net.points();
+        for (row, point) in rows.iter_mut().zip(points) {
+            let d = *point - points[0];
+            *row = [d.x as f32, d.y as f32, d.z as f32, 0.0];
+        }
+        rows[0][3] = match net {
+            ExpansionNet::Bicubic(_) => EXPANSION_BICUBIC,
+            ExpansionNet::Triangle(_) => EXPANSION_TRIANGLE,
+        } as f32;
+    }
+    out
 }
 
 /// Per patch, [`PATCH_VIEW_ROW`] `vec4<f32>` (`view.wgsl`): from
@@ -366,6 +434,13 @@ impl GpuTessellator {
             });
         }
         let screen = screen_of(set, camera, scheme, criterion, max_factor, bound)?;
+        if self.view.moving && screen.bound == BOUND_EXPANSION {
+            return Err(GpuError::Unsupported {
+                what: "the expansion bound on a moving cage (its control nets are uploaded once, at rest; \
+                       plan with the second-derivative bound, whose bounds move)"
+                    .into(),
+            });
+        }
         self.check_screen_support(set, prepared, scheme, max_factor)?;
         let pattern = match scheme {
             Scheme::Esc { .. } => GpuPattern::Esc,
@@ -378,6 +453,9 @@ impl GpuTessellator {
         };
         let worst = screen_worst_case(set, prepared, &screen, pattern, max_factor)?;
         self.reserve_screen(ctx, worst, capacity)?;
+        if screen.bound == BOUND_EXPANSION {
+            self.view.add_expansion_rows(&ctx.device, &self.pipelines.view_layout, set);
+        }
         if !self.view.bounds_uploaded {
             // View-independent and the same for every `Prepared` of the set: uploaded once.
             let rows = patch_view_rows(set, Some(prepared));
@@ -506,7 +584,8 @@ impl GpuTessellator {
             hi: s.hi as f32,
             edge_rule: s.edge_rule,
             bound: s.bound,
-            _pad: [0; 3],
+            expansion_rows: self.view.expansion_rows.unwrap_or(0),
+            _pad: [0; 2],
         };
         ctx.queue.write_buffer(&self.view.uniform, 0, bytemuck::bytes_of(&uniform));
     }
@@ -529,7 +608,9 @@ fn screen_of(
     // ESC culls nothing (its levels are per object); every other frame culls on the GPU.
     let cull = !matches!(scheme, Scheme::Esc { .. });
     let options = PlanOptions { camera: Some(*camera), cull, max_factor, bound, ..PlanOptions::default() };
-    let bound = if bound == ErrorBound::Expansion { BOUND_EXPANSION } else { BOUND_HESSIAN };
+    // Only a pixel error plans with a bound.
+    let expansion = bound == ErrorBound::Expansion && matches!(criterion, Criterion::PixelError(_));
+    let bound = if expansion { BOUND_EXPANSION } else { BOUND_HESSIAN };
     let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
     let cap = accepted.cap;
     let (kind, pixels, lo, hi) = match (scheme, criterion) {

@@ -286,14 +286,13 @@ impl TaylorBound {
     /// compute. A bicubic's remainder takes third-derivative bounds near each expansion point
     /// (`TaylorBound::remainder_at`). Cost: O(control points).
     pub fn expansion(patch: &Patch) -> TaylorBound {
-        let (bound, local) = match patch {
-            Patch::Bicubic(b) if b.is_polynomial() => {
-                let (bound, third) = bicubic_with_third(&b.points);
+        let (bound, local) = match ExpansionNet::of(patch) {
+            Some(ExpansionNet::Bicubic(points)) => {
+                let (bound, third) = bicubic_with_third(points);
                 (bound, Some(Box::new(third)))
             }
-            Patch::BezierTriangle(t) => (triangle(t), None),
-            Patch::Pn(pn) => (triangle(&pn.geometry), None),
-            _ => return TaylorBound::NONE,
+            Some(ExpansionNet::Triangle(t)) => (triangle(t), None),
+            None => return TaylorBound::NONE,
         };
         TaylorBound { refines: false, local, ..bound }
     }
@@ -764,6 +763,39 @@ pub fn bubble_max(a: [f64; 3]) -> f64 {
         edges.max(inside)
     } else {
         edges
+    }
+}
+
+/// The control net a patch's expansion bound is computed from ([`TaylorBound::expansion`]):
+/// the rule of which patches have one, for every engine (the GPU uploads these nets for its
+/// expansion bound).
+#[derive(Debug, Clone, Copy)]
+pub enum ExpansionNet<'a> {
+    /// A polynomial bicubic's 16 points, `4i + j` with `i` along u.
+    Bicubic(&'a [DVec3; 16]),
+    /// A cubic Bézier triangle, or a PN triangle's geometry: 10 points at
+    /// [`BezierTriangle::index`].
+    Triangle(&'a BezierTriangle),
+}
+
+impl ExpansionNet<'_> {
+    /// `patch`'s net; None for every patch without an expansion bound (rational bicubics,
+    /// subdivision and Loop patches). Cost: O(1), a bicubic's weights checked.
+    pub fn of(patch: &Patch) -> Option<ExpansionNet<'_>> {
+        match patch {
+            Patch::Bicubic(b) if b.is_polynomial() => Some(ExpansionNet::Bicubic(&b.points)),
+            Patch::BezierTriangle(t) => Some(ExpansionNet::Triangle(t)),
+            Patch::Pn(pn) => Some(ExpansionNet::Triangle(&pn.geometry)),
+            _ => None,
+        }
+    }
+
+    /// The net's points in storage order (16 or 10).
+    pub fn points(&self) -> &[DVec3] {
+        match self {
+            ExpansionNet::Bicubic(points) => &points[..],
+            ExpansionNet::Triangle(t) => &t.points[..],
+        }
     }
 }
 
