@@ -17,7 +17,6 @@
 // after 65,535 iterations in all (`local.wgsl`), and a check walks up to
 // EXPANSION_WALK_CELLS cells a step.
 
-const EXPANSION_NONE: u32 = 0u;
 // The kinds of `screen::expansion_rows` (the first net row's w).
 const EXPANSION_BICUBIC: u32 = {{EXPANSION_BICUBIC}}u;
 const EXPANSION_TRIANGLE: u32 = {{EXPANSION_TRIANGLE}}u;
@@ -25,21 +24,6 @@ const EXPANSION_WALK_CELLS: u32 = {{EXPANSION_WALK_CELLS}}u;
 // `taylor::HULL_WHEN` (its f32 bits: naga takes no bitcast in a constant): where a cubic
 // triangle's remainder exceeds this share of its quadratic part, its error hull is taken too.
 const HULL_WHEN_BITS: u32 = {{HULL_WHEN_BITS}}u;
-
-// One patch's expansion: its kind, the bounds on |S_uuu|, |S_uuv|, |S_uvv|, |S_vvv| and, for
-// a bicubic, on the fourth derivatives |S_uuuv|, |S_uuvv|, |S_uvvv| (`taylor::
-// ThirdDerivatives`; zero for a triangle, whose third derivatives are constant).
-struct Expansion {
-    p: u32,
-    kind: u32,
-    third: vec4<f32>,
-    fourth: vec3<f32>,
-}
-
-// Patch p without an expansion bound (its plans keep the second-derivative bound).
-fn no_expansion(p: u32) -> Expansion {
-    return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0), vec3<f32>(0.0));
-}
 
 // Row k of patch p's expansion net.
 fn net_row(p: u32, k: u32) -> vec4<f32> {
@@ -134,24 +118,19 @@ fn net_d3v(p: u32, i: u32) -> vec3<f32> { return net_dvv(p, i, 1u) - net_dvv(p, 
 // plus its derivatives' bounds times the half-sides, unrolled.
 fn third_near(x: Expansion, g: vec2<f32>, delta: vec2<f32>) -> vec4<f32> {
     let p = x.p;
-    let u1 = bernstein1(g.x);
-    let u2 = bernstein2(g.x);
-    let u3 = bernstein3w(g.x);
-    let v1 = bernstein1(g.y);
-    let v2 = bernstein2(g.y);
-    let v3 = bernstein3w(g.y);
-    let uuu = 6.0 * row4(v3, net_d3u(p, 0u), net_d3u(p, 1u), net_d3u(p, 2u), net_d3u(p, 3u));
-    let vvv = 6.0 * row4(u3, net_d3v(p, 0u), net_d3v(p, 1u), net_d3v(p, 2u), net_d3v(p, 3u));
+    let w = bernstein_at(g);
+    let uuu = 6.0 * row4(w.v3, net_d3u(p, 0u), net_d3u(p, 1u), net_d3u(p, 2u), net_d3u(p, 3u));
+    let vvv = 6.0 * row4(w.u3, net_d3v(p, 0u), net_d3v(p, 1u), net_d3v(p, 2u), net_d3v(p, 3u));
     let uuv = 18.0 * row2(
-        u1,
-        row3(v2, net_d2u1v(p, 0u, 0u), net_d2u1v(p, 0u, 1u), net_d2u1v(p, 0u, 2u)),
-        row3(v2, net_d2u1v(p, 1u, 0u), net_d2u1v(p, 1u, 1u), net_d2u1v(p, 1u, 2u)),
+        w.u1,
+        row3(w.v2, net_d2u1v(p, 0u, 0u), net_d2u1v(p, 0u, 1u), net_d2u1v(p, 0u, 2u)),
+        row3(w.v2, net_d2u1v(p, 1u, 0u), net_d2u1v(p, 1u, 1u), net_d2u1v(p, 1u, 2u)),
     );
     let uvv = 18.0 * row3(
-        u2,
-        row2(v1, net_d1u2v(p, 0u, 0u), net_d1u2v(p, 0u, 1u)),
-        row2(v1, net_d1u2v(p, 1u, 0u), net_d1u2v(p, 1u, 1u)),
-        row2(v1, net_d1u2v(p, 2u, 0u), net_d1u2v(p, 2u, 1u)),
+        w.u2,
+        row2(w.v1, net_d1u2v(p, 0u, 0u), net_d1u2v(p, 0u, 1u)),
+        row2(w.v1, net_d1u2v(p, 1u, 0u), net_d1u2v(p, 1u, 1u)),
+        row2(w.v1, net_d1u2v(p, 2u, 0u), net_d1u2v(p, 2u, 1u)),
     );
     let du = abs(delta.x);
     let dv = abs(delta.y);
@@ -171,6 +150,24 @@ fn expansion_remainder_at(x: Expansion, g: vec2<f32>, delta: vec2<f32>) -> f32 {
     var local = x;
     local.third = min(x.third, third_near(x, g, delta));
     return expansion_remainder(local, delta);
+}
+
+// The Bernstein weights of degree 1, 2 and 3 in u and in v at a point: what the nets of the
+// second and third derivatives are summed with there.
+struct Weights {
+    u1: vec2<f32>,
+    u2: vec3<f32>,
+    u3: vec4<f32>,
+    v1: vec2<f32>,
+    v2: vec3<f32>,
+    v3: vec4<f32>,
+}
+
+fn bernstein_at(at: vec2<f32>) -> Weights {
+    return Weights(
+        bernstein1(at.x), bernstein2(at.x), bernstein3w(at.x),
+        bernstein1(at.y), bernstein2(at.y), bernstein3w(at.y),
+    );
 }
 
 // Bernstein weights of degree 1, 2, 3 at t (`taylor::bernstein`).
@@ -216,31 +213,26 @@ fn expansion_second(x: Expansion, at: vec2<f32>) -> array<vec3<f32>, 3> {
             c0[2] * l.x + c1[2] * l.y + c2[2] * l.z,
         );
     }
-    let u1 = bernstein1(at.x);
-    let u2 = bernstein2(at.x);
-    let u3 = bernstein3w(at.x);
-    let v1 = bernstein1(at.y);
-    let v2 = bernstein2(at.y);
-    let v3 = bernstein3w(at.y);
+    let w = bernstein_at(at);
     // S_uu: 6 Δ²_u b over B¹(u) B³(v); S_uv: 9 ΔuΔv b over B²(u) B²(v); S_vv: 6 Δ²_v b over
     // B³(u) B¹(v).
     let uu = row2(
-        u1,
-        row4(v3, net_duu(p, 0u, 0u), net_duu(p, 0u, 1u), net_duu(p, 0u, 2u), net_duu(p, 0u, 3u)),
-        row4(v3, net_duu(p, 1u, 0u), net_duu(p, 1u, 1u), net_duu(p, 1u, 2u), net_duu(p, 1u, 3u)),
+        w.u1,
+        row4(w.v3, net_duu(p, 0u, 0u), net_duu(p, 0u, 1u), net_duu(p, 0u, 2u), net_duu(p, 0u, 3u)),
+        row4(w.v3, net_duu(p, 1u, 0u), net_duu(p, 1u, 1u), net_duu(p, 1u, 2u), net_duu(p, 1u, 3u)),
     );
     let uv = row3(
-        u2,
-        row3(v2, net_duv(p, 0u, 0u), net_duv(p, 0u, 1u), net_duv(p, 0u, 2u)),
-        row3(v2, net_duv(p, 1u, 0u), net_duv(p, 1u, 1u), net_duv(p, 1u, 2u)),
-        row3(v2, net_duv(p, 2u, 0u), net_duv(p, 2u, 1u), net_duv(p, 2u, 2u)),
+        w.u2,
+        row3(w.v2, net_duv(p, 0u, 0u), net_duv(p, 0u, 1u), net_duv(p, 0u, 2u)),
+        row3(w.v2, net_duv(p, 1u, 0u), net_duv(p, 1u, 1u), net_duv(p, 1u, 2u)),
+        row3(w.v2, net_duv(p, 2u, 0u), net_duv(p, 2u, 1u), net_duv(p, 2u, 2u)),
     );
     let vv = row4(
-        u3,
-        row2(v1, net_dvv(p, 0u, 0u), net_dvv(p, 0u, 1u)),
-        row2(v1, net_dvv(p, 1u, 0u), net_dvv(p, 1u, 1u)),
-        row2(v1, net_dvv(p, 2u, 0u), net_dvv(p, 2u, 1u)),
-        row2(v1, net_dvv(p, 3u, 0u), net_dvv(p, 3u, 1u)),
+        w.u3,
+        row2(w.v1, net_dvv(p, 0u, 0u), net_dvv(p, 0u, 1u)),
+        row2(w.v1, net_dvv(p, 1u, 0u), net_dvv(p, 1u, 1u)),
+        row2(w.v1, net_dvv(p, 2u, 0u), net_dvv(p, 2u, 1u)),
+        row2(w.v1, net_dvv(p, 3u, 0u), net_dvv(p, 3u, 1u)),
     );
     return array<vec3<f32>, 3>(6.0 * uu, 9.0 * uv, 6.0 * vv);
 }

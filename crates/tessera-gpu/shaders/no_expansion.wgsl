@@ -6,19 +6,6 @@
 // inlined: the frames that ask for it compile their own pipelines on first use
 // (`Pipelines::expansion`), the others never do.
 
-const EXPANSION_NONE: u32 = 0u;
-
-struct Expansion {
-    p: u32,
-    kind: u32,
-    third: vec4<f32>,
-    fourth: vec3<f32>,
-}
-
-fn no_expansion(p: u32) -> Expansion {
-    return Expansion(p, EXPANSION_NONE, vec4<f32>(0.0), vec3<f32>(0.0));
-}
-
 fn expansion_of(p: u32) -> Expansion {
     return no_expansion(p);
 }

@@ -52,8 +52,14 @@ pub mod sources {
     pub(crate) const FACTORS: &str = include_str!("../shaders/factors.wgsl");
     pub(crate) const TRANSITION: &str = include_str!("../shaders/transition.wgsl");
     pub(crate) const BOUNDS: &str = include_str!("../shaders/bounds.wgsl");
-    pub(crate) const EXPANSION: &str = include_str!("../shaders/expansion.wgsl");
-    pub(crate) const NO_EXPANSION: &str = include_str!("../shaders/no_expansion.wgsl");
+    /// `expansion.wgsl` after `expansion_type.wgsl`: the expansion bound.
+    pub(crate) const EXPANSION: &str =
+        concat!(include_str!("../shaders/expansion_type.wgsl"), include_str!("../shaders/expansion.wgsl"));
+    /// Its stand-in for the frames planned without it: the same type, no bound.
+    pub(crate) const NO_EXPANSION: &str = concat!(
+        include_str!("../shaders/expansion_type.wgsl"),
+        include_str!("../shaders/no_expansion.wgsl"),
+    );
     pub(crate) const CHECK: &str = include_str!("../shaders/check.wgsl");
     pub(crate) const LOCAL: &str = include_str!("../shaders/local.wgsl");
     pub(crate) const GRID_VERTICES: &str = include_str!("../shaders/grid_vertices.wgsl");
