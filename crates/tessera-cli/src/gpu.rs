@@ -34,13 +34,9 @@ pub fn screen_criterion(
     options: &PlanOptions,
 ) -> Option<ScreenCriterion> {
     validate(scheme, criterion, options, set, Engine::GpuFromCamera).ok()?;
-    let bound = options.bound;
     Some(ScreenCriterion {
-        scheme,
-        criterion: *criterion,
-        max_factor: options.max_factor,
-        capacity: None,
-        bound,
+        bound: options.bound,
+        ..ScreenCriterion::new(scheme, *criterion, options.max_factor)
     })
 }
 

@@ -88,10 +88,6 @@ fn patch_has_pn_normals(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u
 fn patch_corner_count(p: u32) -> u32 { return select(4u, 3u, patch_is_tri(p)); }
 // Control points of the patch's geometry (the rest of its 16 slots hold PN normals).
 fn patch_point_count(p: u32) -> u32 { return select(16u, 10u, patch_is_tri(p)); }
-// A Catmull-Clark (bit 3) or Loop (bit 4) subdivision patch, whose slots hold no Bézier net
-// (`tree.wgsl` evaluates it).
-fn patch_is_subdivision(p: u32) -> bool { return (patch_rows[p * PATCH_ROW + 12u] & 24u) != 0u; }
-
 
 // The plan's real factor of edge e (`Plan::factors`).
 fn edge_factor(e: u32) -> f32 { return bitcast<f32>(segments[params.edges + e]); }

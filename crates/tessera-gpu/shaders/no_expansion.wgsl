@@ -2,9 +2,9 @@
 // second-derivative bound: the names the proposals (`factors.wgsl`), the check
 // (`check.wgsl`) and the transition pattern (`transition.wgsl`) read, with no expansion
 // (EXPANSION_NONE), so that the driver removes every branch of the expansion bound. lavapipe
-// inlines every call and its LLVM compiles the bound's code for about a minute where it is
-// inlined: the frames that ask for it compile their own pipelines on first use
-// (`Pipelines::expansion`), the others never do.
+// inlines every call, and the bound's code takes its LLVM about 10 s to compile: the frames
+// that ask for it compile their own pipelines on first use (`Pipelines::expansion`), the
+// others never do.
 
 fn expansion_of(p: u32) -> Expansion {
     return no_expansion(p);

@@ -589,8 +589,8 @@ impl Pipelines {
 
     /// The proposals and the check of frames planned with the expansion bound
     /// (`expansion.wgsl`, [`tessera::criterion::ErrorBound::Expansion`]), compiled on the
-    /// first call. Cost: the first call two WGSL compilations, which lavapipe's LLVM takes
-    /// about a minute over (it inlines the bound at each call site); later calls nothing.
+    /// first call. Cost: the first call two WGSL compilations (lavapipe's first expansion
+    /// frame took 10 s on a cold shader cache); later calls nothing.
     pub(super) fn expansion(&self, device: &wgpu::Device) -> &BoundPipelines {
         self.expansion.get_or_init(|| {
             let factors = module(device, "factors with the expansion bound", &factors_parts(EXPANSION));

@@ -238,32 +238,46 @@ impl ViewBuffers {
     }
 
     /// Appends the expansion nets of `set` to `patch_views` ([`expansion_rows`]), once: a
-    /// larger buffer, the view rows uploaded again with the next frame, the bind group
-    /// remade. Cost: the first call O(P) and a buffer of 256 bytes a patch; later calls
-    /// nothing.
+    /// larger buffer with the nets after the view rows (which `prepare_screen` then uploads
+    /// again), the bind group remade. Cost: the first call O(P) and 256 bytes a patch more;
+    /// later calls nothing.
     pub(super) fn add_expansion_rows(
         &mut self,
-        device: &wgpu::Device,
+        ctx: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         set: &SurfaceSet,
-    ) -> u32 {
-        if let Some(at) = self.expansion_rows {
-            return at;
+    ) {
+        if self.expansion_rows.is_some() {
+            return;
         }
-        let base = patch_view_rows(set, None);
-        let at = base.len() as u32;
-        let mut rows = base;
-        rows.extend(expansion_rows(set));
-        self.patch_views = upload::storage_buffer(device, "patch views", &rows);
+        use wgpu::BufferUsages as U;
+        let at = view_row_count(set);
+        let nets = expansion_rows(set);
+        let size = (16 * (at + nets.len())) as u64;
+        self.patch_views = buffer(&ctx.device, "patch views", size, U::STORAGE | U::COPY_DST | U::COPY_SRC);
+        ctx.queue.write_buffer(&self.patch_views, 16 * at as u64, bytemuck::cast_slice(&nets));
         self.bind = shader::bind(
-            device,
+            &ctx.device,
             layout,
             &[&self.uniform, &self.patch_views, &self.proposals, &self.state, &self.checks],
         );
         self.bounds_uploaded = false;
-        self.expansion_rows = Some(at);
-        at
+        self.expansion_rows = Some(at as u32);
     }
+}
+
+/// Whether a frame of `criterion` asked for `bound` plans with the expansion bound (only a
+/// pixel error plans with a bound).
+fn plans_with_expansion(criterion: &Criterion, bound: ErrorBound) -> bool {
+    bound == ErrorBound::Expansion && matches!(criterion, Criterion::PixelError(_))
+}
+
+/// How many rows [`patch_view_rows`] makes for `set`: the patches', the edges' and the
+/// vertices'.
+fn view_row_count(set: &SurfaceSet) -> usize {
+    PATCH_VIEW_ROW as usize * set.patches.len()
+        + EDGE_VIEW_ROW * set.topology.edges.len()
+        + VERTEX_VIEW_ROW * set.topology.vertex_count as usize
 }
 
 /// Per patch, [`upload::CONTROL_POINTS`] `vec4<f32>` for `expansion.wgsl`: the control net
@@ -309,7 +323,7 @@ fn expansion_rows(set: &SurfaceSet) -> Vec<[f32; 4]> {
 /// computations, the midpoints' evaluations when `prepared` has none yet.
 fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4]> {
     let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
-    let mut out = Vec::with_capacity(PATCH_VIEW_ROW as usize * set.patches.len());
+    let mut out = Vec::with_capacity(view_row_count(set));
     let objects = prepared.map(|_| tessera::criterion::esc::Objects::of(set));
     for (p, patch) in set.patches.iter().enumerate() {
         let view = tessera::criterion::screen::PatchView::new(patch);
@@ -350,11 +364,9 @@ fn patch_view_rows(set: &SurfaceSet, prepared: Option<&Prepared>) -> Vec<[f32; 4
                 out.extend([v4(position, 0.0), v4(normal, 0.0)]);
             }
         }
-        None => {
-            let rows = EDGE_VIEW_ROW * edges.len() + VERTEX_VIEW_ROW * set.topology.vertex_count as usize;
-            out.resize(out.len() + rows, [0.0; 4]);
-        }
+        None => out.resize(view_row_count(set), [0.0; 4]),
     }
+    debug_assert_eq!(out.len(), view_row_count(set));
     out
 }
 
@@ -422,25 +434,21 @@ impl GpuTessellator {
         criterion: ScreenCriterion,
     ) -> Result<()> {
         let ScreenCriterion { scheme, criterion, max_factor, capacity, bound } = criterion;
+        // The edge, vertex and ESC rows and the expansion nets stay the rest cage's.
         let reads_rest_rows = matches!(criterion, Criterion::View { .. } | Criterion::Esc { .. })
-            || matches!(scheme, Scheme::Sd2 { .. } | Scheme::Esc { .. });
+            || matches!(scheme, Scheme::Sd2 { .. } | Scheme::Esc { .. })
+            || plans_with_expansion(&criterion, bound);
         if self.view.moving && reads_rest_rows {
             return Err(GpuError::Unsupported {
                 what: format!(
-                    "{scheme:?} with {criterion:?} on a moving cage (its moving bounds refresh the patches' \
-                     boxes and second-derivative bounds only; use a pixel error with the uniform, \
-                     transition or semi-uniform scheme)"
+                    "{scheme:?} with {criterion:?} and the {bound:?} bound on a moving cage (its moving \
+                     bounds refresh the patches' boxes and second-derivative bounds only; use a pixel \
+                     error with the second-derivative bound and the uniform, transition or \
+                     semi-uniform scheme)"
                 ),
             });
         }
         let screen = screen_of(set, camera, scheme, criterion, max_factor, bound)?;
-        if self.view.moving && screen.bound == BOUND_EXPANSION {
-            return Err(GpuError::Unsupported {
-                what: "the expansion bound on a moving cage (its control nets are uploaded once, at rest; \
-                       plan with the second-derivative bound, whose bounds move)"
-                    .into(),
-            });
-        }
         self.check_screen_support(set, prepared, scheme, max_factor)?;
         let pattern = match scheme {
             Scheme::Esc { .. } => GpuPattern::Esc,
@@ -454,7 +462,7 @@ impl GpuTessellator {
         let worst = screen_worst_case(set, prepared, &screen, pattern, max_factor)?;
         self.reserve_screen(ctx, worst, capacity)?;
         if screen.bound == BOUND_EXPANSION {
-            self.view.add_expansion_rows(&ctx.device, &self.pipelines.view_layout, set);
+            self.view.add_expansion_rows(ctx, &self.pipelines.view_layout, set);
         }
         if !self.view.bounds_uploaded {
             // View-independent and the same for every `Prepared` of the set: uploaded once.
@@ -608,9 +616,7 @@ fn screen_of(
     // ESC culls nothing (its levels are per object); every other frame culls on the GPU.
     let cull = !matches!(scheme, Scheme::Esc { .. });
     let options = PlanOptions { camera: Some(*camera), cull, max_factor, bound, ..PlanOptions::default() };
-    // Only a pixel error plans with a bound.
-    let expansion = bound == ErrorBound::Expansion && matches!(criterion, Criterion::PixelError(_));
-    let bound = if expansion { BOUND_EXPANSION } else { BOUND_HESSIAN };
+    let bound = if plans_with_expansion(&criterion, bound) { BOUND_EXPANSION } else { BOUND_HESSIAN };
     let accepted = validate(scheme, &criterion, &options, set, Engine::GpuFromCamera)?;
     let cap = accepted.cap;
     let (kind, pixels, lo, hi) = match (scheme, criterion) {

@@ -346,11 +346,8 @@ pub fn checked_frame(
     let cpu = scheme.plan_prepared(set, prepared, &criterion, &options).unwrap();
     let cpu_report = cpu.report.unwrap();
     let screen = tessera_gpu::tessellator::ScreenCriterion {
-        scheme,
-        criterion,
-        max_factor: cap,
-        capacity: None,
         bound,
+        ..tessera_gpu::tessellator::ScreenCriterion::new(scheme, criterion, cap)
     };
     screen_frame(gpu, set, prepared, camera, screen);
     let visible = check_culling(name, set, gpu, &cpu.plan.visible, camera, counts);
