@@ -57,11 +57,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let framing = Camera::framing(lo, hi, 1280, 1024);
     let offset = framing.eye - framing.target;
     let turn = DQuat::from_axis_angle(framing.up.normalize(), 20f64.to_radians());
-    let camera = Camera {
-        eye: framing.target + turn * offset * 0.67,
-        near: offset.length() * 1e-3,
-        ..framing
-    };
+    let camera =
+        Camera { eye: framing.target + turn * offset * 0.67, near: offset.length() * 1e-3, ..framing };
     let options = TessellatorOptions {
         plan: PlanOptions { cull: false, ..PlanOptions::default() },
         ..TessellatorOptions::default()
