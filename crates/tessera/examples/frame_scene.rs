@@ -4,9 +4,10 @@
 //! median frame time and each stage's median.
 //!
 //! `uniform16` instead runs the one torus at uniform factor 16 (1,048,576 triangles, 36 MB of
-//! output), `uniform64` at factor 64 (16,777,216 triangles, 570 MB: far beyond any L3).
+//! output), `uniform64` at factor 64 (16,777,216 triangles, 570 MB: far beyond any L3);
+//! `uniformN` at any factor `N`.
 //!
-//! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo|uniform16|uniform64 [FRAMES]]`
+//! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo|uniformN [FRAMES]]`
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -32,12 +33,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mesh = tessera::io::obj::read_obj(&path)?;
             SurfaceSet::pn_from_mesh(&tessera::scene::mesh_grid(&mesh, 11), &path, Default::default())?
         }
-        "uniform16" | "uniform64" => {
+        uniform if uniform.strip_prefix("uniform").is_some_and(|f| f.parse::<u32>().is_ok()) => {
             let file = tessera::io::patches::read_patches(&data.join("bench/torus_64x32.patches"))?;
             SurfaceSet::from_patch_file(&file, Default::default())
         }
         other => {
-            return Err(format!("unknown scene {other}: use torus, killeroo, uniform16 or uniform64").into())
+            return Err(format!("unknown scene {other}: use torus, killeroo or uniformN (N a factor)").into())
         }
     };
     println!("{which}: {} patches, built in {:.0} ms", set.patches.len(), ms(start));

@@ -7,35 +7,10 @@
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// The size of the last-level (L3) cache of CPU 0 in bytes, from Linux's sysfs; None where
-/// it does not say (another system, or a processor without one).
+/// The size of the last-level (L3) cache of CPU 0 in bytes (the library's, which decides from
+/// it whether a frame streams its indices).
 pub fn l3_bytes() -> Option<u64> {
-    let dir = std::path::Path::new("/sys/devices/system/cpu/cpu0/cache");
-    std::fs::read_dir(dir).ok()?.flatten().find_map(|entry| {
-        let level = std::fs::read_to_string(entry.path().join("level")).ok()?;
-        if level.trim() != "3" {
-            return None;
-        }
-        parse_cache_size(&std::fs::read_to_string(entry.path().join("size")).ok()?)
-    })
-}
-
-/// A sysfs cache size (`"36608K"`, `"260M"`, `"512"`) in bytes.
-fn parse_cache_size(text: &str) -> Option<u64> {
-    let t = text.trim();
-    let (digits, unit) = match t.char_indices().find(|(_, c)| !c.is_ascii_digit()) {
-        Some((i, _)) => t.split_at(i),
-        None => (t, ""),
-    };
-    let n: u64 = digits.parse().ok()?;
-    let scale = match unit.trim() {
-        "" => 1,
-        "K" | "k" => 1 << 10,
-        "M" => 1 << 20,
-        "G" => 1 << 30,
-        _ => return None,
-    };
-    n.checked_mul(scale)
+    tessera::engine::last_level_cache_bytes()
 }
 
 /// Memory fill bandwidth in GB/s (10⁹ bytes a second) with the threads of the current rayon
@@ -63,15 +38,6 @@ pub fn fill_bandwidth(bytes: usize, runs: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sysfs_cache_sizes_parse() {
-        assert_eq!(parse_cache_size("36608K\n"), Some(36608 * 1024));
-        assert_eq!(parse_cache_size("260M"), Some(260 << 20));
-        assert_eq!(parse_cache_size("512"), Some(512));
-        assert_eq!(parse_cache_size("big"), None);
-        assert_eq!(parse_cache_size("12X"), None);
-    }
 
     #[test]
     fn a_fill_has_a_finite_positive_rate() {

@@ -31,6 +31,8 @@ use rayon::prelude::*;
 pub(crate) mod fast_evaluator;
 pub mod layout;
 pub(crate) mod point_blocks;
+mod stream_store;
+pub use stream_store::last_level_cache_bytes;
 pub mod render_queues;
 pub(crate) mod tree_points;
 pub(crate) mod uniform_quads;
@@ -246,6 +248,14 @@ pub(crate) fn write_buffers(
     let topo = &set.topology;
     let MeshBuffers { positions, normals, uvs, vertex_patch, indices, triangle_patch } = out;
     let uniform = fast.filter(|f| f.triangles().active() && !corner_params);
+    let bytes = std::mem::size_of_val(&*positions)
+        + std::mem::size_of_val(&*normals)
+        + std::mem::size_of_val(&*uvs)
+        + std::mem::size_of_val(&*vertex_patch)
+        + std::mem::size_of_val(&*indices)
+        + std::mem::size_of_val(&*triangle_patch)
+        + std::mem::size_of_val(&*params);
+    let stream = stream_store::streams(bytes as u64);
     let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
     let mut all =
@@ -284,10 +294,15 @@ pub(crate) fn write_buffers(
     all.take_front(layout.interior_offsets[0] as usize);
     let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
     match uniform {
-        Some(f) => {
-            f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), patch_part, Pass::Indices)
-        }
-        None => writer.patches(0..set.patches.len(), patch_part, Pass::Indices),
+        Some(f) => f.triangles().patches(
+            set,
+            f.points(),
+            layout,
+            0..set.patches.len(),
+            patch_part,
+            Pass::Indices { stream },
+        ),
+        None => writer.patches(0..set.patches.len(), patch_part, Pass::Indices { stream }),
     }
     vertices_done
 }
@@ -297,8 +312,9 @@ pub(crate) fn write_buffers(
 pub(crate) enum Pass {
     /// Interior vertices (and, for patterns the cache does not hold, the local triangles).
     Vertices,
-    /// Triangles and triangle patches.
-    Indices,
+    /// Triangles and triangle patches; with `stream`, written by streaming stores (a frame
+    /// well past the cache, [`stream_store::streams`]).
+    Indices { stream: bool },
 }
 
 /// Makes `v` hold `len` elements, every one of which the writer then overwrites.
@@ -629,10 +645,14 @@ impl Writer<'_> {
                 };
                 match pass {
                     Pass::Vertices => self.patch_vertices(p, part, scratch),
-                    Pass::Indices => self.patch_indices(p, part, scratch),
+                    Pass::Indices { stream } => self.patch_indices(p, part, scratch, stream),
                 }
             }
         });
+        if pass == (Pass::Indices { stream: true }) {
+            // The task's streamed indices before its end is seen by the thread that joins it.
+            stream_store::fence();
+        }
     }
 
     /// Patch `p`'s pattern from the frame's cache, if it holds it, with the positions of its
@@ -701,7 +721,7 @@ impl Writer<'_> {
     /// numbering rule. Interior vertices are numbered in the same order locally and in the
     /// output, so every index maps by one addition (vectorized) and only boundary indices go
     /// through the patch's table.
-    fn patch_indices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
+    fn patch_indices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, stream: bool) {
         let PatchOut { idx, tp, params, .. } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let cached = self.cached(p).filter(|_| !self.general(p, params));
@@ -712,6 +732,17 @@ impl Writer<'_> {
         let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
         match cached {
             // The cache knows where the boundary indices are.
+            Some((_, local, boundary)) if stream => {
+                // Mapped in the thread's buffer (in the cache), then streamed out once.
+                let local = local.triangles.as_flattened();
+                let mapped = &mut scratch.indices;
+                mapped.clear();
+                mapped.extend(local.iter().map(|&l| l.wrapping_add(delta)));
+                for &i in boundary {
+                    mapped[i as usize] = scratch.vertex[local[i as usize] as usize];
+                }
+                stream_store::copy(idx, mapped);
+            }
             Some((_, local, boundary)) => {
                 let local = local.triangles.as_flattened();
                 idx.iter_mut().zip(local).for_each(|(out, &l)| *out = l.wrapping_add(delta));
@@ -727,7 +758,11 @@ impl Writer<'_> {
                 }
             }
         }
-        tp.fill(p as u32);
+        if stream {
+            stream_store::fill(tp, p as u32);
+        } else {
+            tp.fill(p as u32);
+        }
     }
 }
 
@@ -768,6 +803,8 @@ pub(crate) struct PatchScratch {
     patterns: RecentPatterns,
     generation: u64,
     vertex: Vec<u32>,
+    /// A patch's output indices before they are streamed out ([`Writer::patch_indices`]).
+    indices: Vec<u32>,
     param: Vec<[f32; 2]>,
     /// Parameters of an edge's inner samples.
     edge_params: Vec<glam::DVec2>,
@@ -793,6 +830,15 @@ pub(crate) fn with_scratch<R>(generation: u64, f: impl FnOnce(&mut PatchScratch)
             f(&mut scratch)
         }
         Err(_) => f(&mut PatchScratch { generation, ..PatchScratch::default() }),
+    })
+}
+
+/// Runs `f` with this thread's buffer for a patch's indices before they are streamed out
+/// (a fresh one if the thread's scratch is in use further up its stack).
+pub(crate) fn with_index_buffer<R>(f: impl FnOnce(&mut Vec<u32>) -> R) -> R {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut scratch) => f(&mut scratch.indices),
+        Err(_) => f(&mut Vec::new()),
     })
 }
 
@@ -1096,6 +1142,52 @@ mod tests {
                     params.iter().zip(want).all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)),
                     "case {k}"
                 );
+            }
+        }
+    }
+
+    /// A frame whose indices go out by streaming stores (`stream_store`, forced here) is the
+    /// frame written by plain stores, byte for byte: the uniform writers (the grid path on the
+    /// teapot, triangles by addition on a PN mesh and on a Loop cage) and the general one
+    /// (a transition plan of mixed factors: cached patterns and patterns staged between the
+    /// passes, some patches culled).
+    #[test]
+    fn streamed_frames_equal_plain_frames_byte_for_byte() {
+        use crate::io::{LoadOptions, SurfaceKind};
+        let cage = crate::test_support::data("subdivision/loop_xord_interior.obj");
+        let loop_cage =
+            crate::io::load(&cage, LoadOptions { surface: SurfaceKind::Loop, ..Default::default() });
+        for set in [teapot(), cow(), loop_cage.unwrap()] {
+            let mut mixed = Plan::uniform(&set, 1).unwrap();
+            for (e, s) in mixed.segments.iter_mut().enumerate() {
+                *s = 1 + (e as u32 * 7) % 9;
+            }
+            mixed.factors = mixed.segments.iter().map(|&s| s as f32).collect();
+            for (p, (interior, visible)) in mixed.interior.iter_mut().zip(&mut mixed.visible).enumerate() {
+                *interior = [1 + p as u32 % 9, 1 + (p as u32 / 3) % 9];
+                *visible = u32::from(p % 7 != 3);
+            }
+            let uniform = Plan::uniform(&set, 6).unwrap();
+            let cases: [(&Plan, &dyn Pattern); 2] = [(&uniform, &Uniform), (&mixed, &Transition)];
+            for (k, (plan, pattern)) in cases.into_iter().enumerate() {
+                let options = EngineOptions::default();
+                let mut layout = Layout::default();
+                layout.build(&set, plan, pattern, &options).unwrap();
+                let mut fast = fast_evaluator::FastEvaluator::new(&set, plan);
+                fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                let [plain, streamed] = [false, true].map(|stream| {
+                    stream_store::force_on_this_thread(Some(stream));
+                    let mut mesh = Mesh::default();
+                    write_with(&set, plan, pattern, &layout, options, &mut mesh, Some(&fast)).unwrap();
+                    stream_store::force_on_this_thread(None);
+                    mesh
+                });
+                assert!(!plain.indices.is_empty(), "case {k}: a frame with triangles");
+                assert_eq!(streamed.indices, plain.indices, "case {k}");
+                assert_eq!(streamed.triangle_patch, plain.triangle_patch, "case {k}");
+                let bits = |v: &[[f32; 3]]| v.iter().flat_map(|x| x.map(f32::to_bits)).collect::<Vec<_>>();
+                assert_eq!(bits(&streamed.positions), bits(&plain.positions), "case {k}");
+                assert_eq!(bits(&streamed.normals), bits(&plain.normals), "case {k}");
             }
         }
     }

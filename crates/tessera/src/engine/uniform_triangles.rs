@@ -19,7 +19,7 @@
 
 use super::layout::{pattern_input, Layout};
 use super::point_blocks::PointBlocks;
-use super::{Pass, PatchOut, VertexSlices};
+use super::{stream_store, Pass, PatchOut, VertexSlices};
 use crate::criterion::Plan;
 use crate::pattern::{LocalTessellation, Pattern, Slot};
 use crate::sampling::uniform_param;
@@ -172,12 +172,26 @@ impl UniformTriangles {
                 }
             }
             Pass::Vertices => {}
-            Pass::Indices => {
+            Pass::Indices { stream: false } => {
                 let chunks = idx.chunks_exact_mut(3 * triangles).zip(tp.chunks_exact_mut(triangles));
                 for (p, (idx, tp)) in patches.zip(chunks) {
                     self.triangles(set, layout, p, idx);
                     tp.fill(p as u32);
                 }
+            }
+            Pass::Indices { stream: true } => {
+                // Each patch's indices mapped in the thread's buffer, then streamed out once.
+                super::with_index_buffer(|mapped| {
+                    mapped.clear();
+                    mapped.resize(3 * triangles, 0);
+                    let chunks = idx.chunks_exact_mut(3 * triangles).zip(tp.chunks_exact_mut(triangles));
+                    for (p, (idx, tp)) in patches.zip(chunks) {
+                        self.triangles(set, layout, p, mapped);
+                        stream_store::copy(idx, mapped);
+                        stream_store::fill(tp, p as u32);
+                    }
+                });
+                stream_store::fence();
             }
         }
     }
