@@ -9,6 +9,9 @@
 //!
 //! `cargo run --release -p tessera --example frame_scene [-- torus|killeroo|uniformN [FRAMES]]`
 
+#[path = "common/stage_medians.rs"]
+mod stage_medians;
+
 use std::path::PathBuf;
 use std::time::Instant;
 use tessera::camera::Camera;
@@ -57,33 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Tessellator::new(&set, Scheme::Transition, Criterion::PixelError(0.5), options)?
     };
     println!("prepared in {:.0} ms", ms(start));
-    let mut stages: [Vec<f64>; 6] = Default::default();
-    let mut triangles = 0;
-    for _ in 0..frames {
-        triangles = tess.frame(Some(&camera))?.triangle_count();
-        let t = tess.timings();
-        for (s, d) in stages.iter_mut().zip([
-            t.criterion,
-            t.resolve,
-            t.layout,
-            t.write_vertices,
-            t.write_indices,
-            t.total(),
-        ]) {
-            s.push(d.as_secs_f64() * 1000.0);
-        }
-    }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    let [c, r, l, v, i, total] = stages.each_mut().map(median);
-    println!(
-        "{triangles} triangles; median frame {total:.2} ms over {frames} frames on {} threads: \
-         criterion {c:.2}, resolve {r:.2}, layout {l:.2}, write vertices {v:.2}, write indices {i:.2} ms",
-        rayon::current_num_threads()
-    );
-    Ok(())
+    stage_medians::run(&mut tess, &camera, frames)
 }
 
 fn ms(since: Instant) -> f64 {

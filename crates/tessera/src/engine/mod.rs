@@ -264,22 +264,17 @@ pub(crate) fn write_buffers(
     let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
     let patch_part =
         PatchOut { verts: all, idx: &mut *indices, tp: &mut *triangle_patch, params: &mut *params };
+    // A pass over every patch, by the uniform triangle writer where it applies.
+    let patches_pass = |out: PatchOut<'_>, pass: Pass| match uniform {
+        Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), out, pass),
+        None => writer.patches(0..set.patches.len(), out, pass),
+    };
     rayon::join(
         || {
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || match uniform {
-            Some(f) => f.triangles().patches(
-                set,
-                f.points(),
-                layout,
-                0..set.patches.len(),
-                patch_part,
-                Pass::Vertices,
-            ),
-            None => writer.patches(0..set.patches.len(), patch_part, Pass::Vertices),
-        },
+        || patches_pass(patch_part, Pass::Vertices),
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -293,17 +288,7 @@ pub(crate) fn write_buffers(
         VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     all.take_front(layout.interior_offsets[0] as usize);
     let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
-    match uniform {
-        Some(f) => f.triangles().patches(
-            set,
-            f.points(),
-            layout,
-            0..set.patches.len(),
-            patch_part,
-            Pass::Indices { stream },
-        ),
-        None => writer.patches(0..set.patches.len(), patch_part, Pass::Indices { stream }),
-    }
+    patches_pass(patch_part, Pass::Indices { stream });
     vertices_done
 }
 
