@@ -15,8 +15,6 @@ mod stage_medians;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use glam::DQuat;
-use tessera::camera::Camera;
 use tessera::scheme::{Criterion, PlanOptions, Scheme};
 use tessera::subdivision::CageOptions;
 use tessera::surface::patch_tree::LeafPatch;
@@ -54,14 +52,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     } else {
         (Scheme::Uniform, Criterion::Factor(if split { 8.0 } else { 16.0 }))
     };
-    // The subdivision suite's camera: halfway along the frame suite's walk (a 40° turn over
-    // the walk, closing to 0.34 of the framing distance).
+    // The subdivision suite's camera: halfway along the frame suite's walk.
     let (lo, hi) = set.bounds();
-    let framing = Camera::framing(lo, hi, 1280, 1024);
-    let offset = framing.eye - framing.target;
-    let turn = DQuat::from_axis_angle(framing.up.normalize(), 20f64.to_radians());
-    let camera =
-        Camera { eye: framing.target + turn * offset * 0.67, near: offset.length() * 1e-3, ..framing };
+    let camera = tessera::scene::walk(lo, hi, 3, 1280, 1024)[1];
     let options = TessellatorOptions {
         plan: PlanOptions { cull: false, ..PlanOptions::default() },
         ..TessellatorOptions::default()

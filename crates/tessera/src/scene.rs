@@ -7,11 +7,12 @@
 //! patch model with weights that are a function of position ([`position_weights`]), and
 //! the exact conics of revolution ([`sphere_octant`], [`cylinder`]).
 
+use crate::camera::Camera;
 use crate::io::patches::PatchFile;
 use crate::surface::subdivision_tags::{Corner, Crease};
 use crate::surface::RationalBicubic;
 use crate::surface::{PolygonFace, PolygonMesh};
-use glam::{DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 
 /// Offsets of `copies` copies of a box `lo..hi` laid out in a near-square grid in the box's
 /// two largest dimensions, a fifth of the box apart. Cost: O(copies).
@@ -158,6 +159,26 @@ pub fn cylinder(height: f64) -> PatchFile {
         file.lines.push(q + 2);
     }
     file
+}
+
+/// A walk of `frames` cameras through a scene bounded by `lo..hi`: it starts at the framing
+/// camera (the whole scene in view) and dollies in to
+/// a third of the distance while orbiting 40° about the up axis, so that later frames see
+/// fewer patches, nearer and larger. The frame and subdivision suites walk it; the
+/// `cage_frame` example takes the subdivision suite's camera, frame 1 of 3. Cost: O(frames).
+pub fn walk(lo: DVec3, hi: DVec3, frames: usize, width: u32, height: u32) -> Vec<Camera> {
+    let start = Camera::framing(lo, hi, width, height);
+    let offset = start.eye - start.target;
+    let axis = start.up.normalize();
+    (0..frames)
+        .map(|f| {
+            let t = if frames > 1 { f as f64 / (frames - 1) as f64 } else { 0.0 };
+            let turn = DQuat::from_axis_angle(axis, 40f64.to_radians() * t);
+            let distance = 1.0 - 0.66 * t;
+            let eye = start.target + turn * offset * distance;
+            Camera { eye, near: offset.length() * 1e-3, ..start }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -1,17 +1,12 @@
-//! The machine's memory as the speed suite reports it: the last-level cache's size and the
-//! rate at which one or more threads fill memory. A uniform frame writes its output once, so
+//! The machine's memory as the speed suite reports it: the rate at which one or more threads
+//! fill memory (the last-level cache's size beside it is the library's,
+//! `tessera::engine::last_level_cache_bytes`). A uniform frame writes its output once, so
 //! once the output is larger than the cache its speed is bounded by that fill rate; the
 //! rows give their output bytes per second as a share of it, which says how far a frame is
 //! from memory speed on *this* machine (whose cache may hold a whole frame, or not).
 
 use rayon::prelude::*;
 use std::time::Instant;
-
-/// The size of the last-level (L3) cache of CPU 0 in bytes (the library's, which decides from
-/// it whether a frame streams its indices).
-pub fn l3_bytes() -> Option<u64> {
-    tessera::engine::last_level_cache_bytes()
-}
 
 /// Memory fill bandwidth in GB/s (10⁹ bytes a second) with the threads of the current rayon
 /// pool: the median of `runs` timed fills of a `bytes` buffer (`slice::fill`, that is

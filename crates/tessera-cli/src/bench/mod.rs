@@ -239,7 +239,7 @@ fn machine() -> serde_json::Value {
     let load = std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|l| l.split_whitespace().next().and_then(|x| x.parse::<f64>().ok()));
-    let l3 = memory::l3_bytes();
+    let l3 = tessera::engine::last_level_cache_bytes();
     serde_json::json!({ "cpu": cpu, "cores": cores, "l3_bytes": l3, "load_1min_at_start": load })
 }
 

@@ -5,7 +5,7 @@
 pub mod teacups;
 
 use super::{BenchResult, Ctx};
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use tessera::camera::Camera;
 use tessera::surface::SurfaceSet;
 
@@ -36,24 +36,7 @@ pub fn teacups(ctx: &Ctx) -> BenchResult<(SurfaceSet, Vec<Camera>)> {
     Ok(teacups::teacups_scene(&cup)?)
 }
 
-/// A walk of `frames` cameras through a scene bounded by `lo..hi`: it starts at the framing
-/// camera (the whole scene in view) and dollies in to
-/// a third of the distance while orbiting 40° about the up axis, so that later frames see
-/// fewer patches, nearer and larger.
-pub fn walk(lo: DVec3, hi: DVec3, frames: usize, width: u32, height: u32) -> Vec<Camera> {
-    let start = Camera::framing(lo, hi, width, height);
-    let offset = start.eye - start.target;
-    let axis = start.up.normalize();
-    (0..frames)
-        .map(|f| {
-            let t = if frames > 1 { f as f64 / (frames - 1) as f64 } else { 0.0 };
-            let turn = DQuat::from_axis_angle(axis, 40f64.to_radians() * t);
-            let distance = 1.0 - 0.66 * t;
-            let eye = start.target + turn * offset * distance;
-            Camera { eye, near: offset.length() * 1e-3, ..start }
-        })
-        .collect()
-}
+pub use tessera::scene::walk;
 
 /// A small seeded generator (xorshift64*), so the cameras are the same on every run.
 struct Rng(u64);

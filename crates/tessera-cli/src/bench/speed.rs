@@ -173,7 +173,8 @@ pub fn run(ctx: &Ctx) -> BenchResult<Vec<Table>> {
          (criterion → resolve → layout → write, the stages `tessera mesh --stats` reports); Mtri/s = triangles / \
          frame median; ns/vertex = frame median / vertices. CPU rows run in rayon pools of the given size."
     ));
-    let l3 = memory::l3_bytes().map_or("unknown (no sysfs)".to_string(), |b| format!("{} MiB", b >> 20));
+    let l3 = tessera::engine::last_level_cache_bytes()
+        .map_or("unknown (no sysfs)".to_string(), |b| format!("{} MiB", b >> 20));
     let rates: Vec<String> =
         ctx.threads.iter().zip(&fill).map(|(t, f)| format!("{f:.1} GB/s with {t} thread(s)")).collect();
     table.note(format!(
