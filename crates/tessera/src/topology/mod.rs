@@ -127,6 +127,11 @@ pub struct Topology {
     /// Per patch, its pinched corners ([`Topology::pinched_corners`]); empty when no patch
     /// has one.
     pub patch_pinched: Vec<[bool; 4]>,
+    /// Where each edge's uses start in `uses` (and, last, their end): the edges' ranges are
+    /// consecutive, and reading them here rather than from `edges` (36 bytes an edge) takes a
+    /// frame's per-edge passes ([`Topology::edge_uses`]) one line in sixteen edges instead of
+    /// one in two.
+    use_starts: Vec<u32>,
 }
 
 fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
@@ -303,7 +308,15 @@ impl Topology {
             corner_entries,
             report,
             patch_pinched: Vec::new(),
+            use_starts: Vec::new(),
         };
+        topology.use_starts = topology.edges.iter().map(|e| e.uses.start).collect();
+        topology.use_starts.push(topology.uses.len() as u32);
+        debug_assert!(topology
+            .edges
+            .iter()
+            .enumerate()
+            .all(|(i, e)| e.uses.end == topology.use_starts[i + 1]));
         let pinched: Vec<[bool; 4]> = (0..keys.len())
             .map(|p| {
                 let nc = topology.patch_domains[p].corner_count();
@@ -325,8 +338,7 @@ impl Topology {
 
     /// The uses of edge `e`; the first is the owner.
     pub fn edge_uses(&self, e: usize) -> &[EdgeUse] {
-        let r = &self.edges[e].uses;
-        &self.uses[r.start as usize..r.end as usize]
+        &self.uses[self.use_starts[e] as usize..self.use_starts[e + 1] as usize]
     }
 }
 
