@@ -946,6 +946,21 @@ impl PointBlocks {
             // In f64 as the generic evaluation, compiled here for the wider instructions
             // (Rust never fuses a multiply and an add by itself, so the values are the same).
             let mut out = out;
+            if let Patch::Subdivision(tree) = &set.patches[p] {
+                // The same values, points on a leaf's corner read from its record.
+                let write = |k: usize, position, normal| {
+                    out.pos[k] = position;
+                    out.nrm[k] = normal;
+                    out.uv[k] = uvs[k].as_vec2().to_array();
+                    out.patch[k] = p as u32;
+                };
+                #[cfg(target_arch = "x86_64")]
+                if FMA {
+                    // SAFETY: `FMA` is only set in `eval_avx2_fma`, for a CPU with AVX2 and FMA.
+                    return unsafe { tree.outputs_each_avx(uvs, write) };
+                }
+                return tree.outputs_each(uvs, write);
+            }
             let put = |k: usize, point| out.put(k, p as u32, uvs[k], point);
             #[cfg(target_arch = "x86_64")]
             if FMA {

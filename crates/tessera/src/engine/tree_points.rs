@@ -87,6 +87,11 @@ pub(super) trait LeafTree {
     /// The point `f` in f64, as the generic evaluation of the patch at `uv` gives it.
     /// With `FMA`, the CPU has AVX2 and FMA.
     fn single<const FMA: bool>(&self, f: &Found, uv: DVec2) -> SurfacePoint;
+    /// The point `f` as [`LeafTree::single`] rounds it to the output, where the tree keeps
+    /// it ([`crate::surface::patch_tree::CornerPoint`]).
+    fn stored_point(&self, _f: &Found) -> Option<([f32; 3], [f32; 3])> {
+        None
+    }
 }
 
 impl LeafTree for PatchTree {
@@ -142,6 +147,11 @@ impl LeafTree for PatchTree {
     #[inline(always)]
     fn reverses_normal(&self) -> bool {
         self.is_transposed()
+    }
+
+    #[inline(always)]
+    fn stored_point(&self, f: &Found) -> Option<([f32; 3], [f32; 3])> {
+        self.corner_point(f.leaf as usize, f.st)
     }
 
     #[inline(always)]
@@ -341,6 +351,10 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
             None => {
                 for f in group {
                     let k = f.k as usize;
+                    if let Some((position, normal)) = tree.stored_point(f) {
+                        (out.pos[k], out.nrm[k]) = (position, normal);
+                        continue;
+                    }
                     let q = tree.single::<FMA>(f, uvs[k]);
                     out.pos[k] = q.position.as_vec3().to_array();
                     out.nrm[k] = q.normal.as_vec3().to_array();

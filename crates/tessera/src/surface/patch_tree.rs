@@ -162,6 +162,68 @@ struct TreeData {
     leaves: Vec<Leaf>,
     nodes: Vec<[Slot; 4]>,
     root: Slot,
+    /// Each leaf's output point at its own corner 0 ([`CornerPoint`]), in leaf order.
+    corners: Vec<CornerPoint>,
+}
+
+impl TreeData {
+    fn new(leaves: Vec<Leaf>, nodes: Vec<[Slot; 4]>, root: Slot) -> TreeData {
+        let corners = leaves.iter().map(CornerPoint::of).collect();
+        TreeData { leaves, nodes, root, corners }
+    }
+}
+
+/// A leaf's surface point at its corner 0 (`st = (0, 0)`) as the engine writes it: the
+/// position and unit normal rounded to `f32`, the normal that of the tree's own orientation.
+///
+/// **Why.** At a dyadic rate (Bfr's rate 16, or 8 on sub-faces) the samples of a deeply
+/// isolated face fall on the corners of its leaves: a step of the rate-16 grid is four leaves
+/// of level 6, and the search puts a point on a corner in the leaf above and to the right,
+/// at that leaf's corner 0. Evaluating it reads the leaf's first rows (three of the leaf's
+/// seven cache lines), then sums them and makes the normal, about 55 ns a point on
+/// `catmark_rook`, most of it waiting for the leaf's lines. This record is one aligned line's
+/// half. **Exact:** a view's derivatives are the leaf's scaled by a power of two
+/// (`view_size / size`), turned by quarter turns and exchanged where the view is transposed,
+/// so its normal `normalize(S_u × S_v)` is the leaf's own bit for bit, negated where the
+/// view is transposed (a power-of-two scaling of a cross product and its length rounds
+/// alike; [`robust_normal`](super::robust_normal)'s test is invariant too), and the position
+/// is the leaf's value there: the output is the evaluation's to the bit. A point whose
+/// normal takes the robust fallback (parallel derivatives, which depends on the view's
+/// parameters) or that lies on a Gregory end cap is not stored.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+pub(crate) struct CornerPoint {
+    pub(crate) position: [f32; 3],
+    pub(crate) normal: [f32; 3],
+    /// 1 where the record holds the point; 0 where the point is evaluated.
+    stored: u32,
+}
+
+impl CornerPoint {
+    /// `leaf`'s record, from the same sums [`PatchTree::derivatives`] takes there.
+    fn of(leaf: &Leaf) -> CornerPoint {
+        let none = CornerPoint { position: [0.0; 3], normal: [0.0; 3], stored: 0 };
+        let LeafPatch::Bezier(net) = &leaf.patch else { return none };
+        let (p, du, dv) = bezier_derivatives(net, DVec2::ZERO);
+        let n = du.cross(dv);
+        let scale = du.length_squared().max(dv.length_squared());
+        // `robust_normal`'s test for its first answer, `n.normalize()`.
+        if !(n.length_squared() > 1e-20 * scale * scale && n.is_finite()) {
+            return none;
+        }
+        CornerPoint {
+            position: p.as_vec3().to_array(),
+            normal: n.normalize().as_vec3().to_array(),
+            stored: 1,
+        }
+    }
+
+    /// The record's point where it holds one, the normal negated for a transposed view.
+    #[inline(always)]
+    pub(crate) fn point(&self, transposed: bool) -> Option<([f32; 3], [f32; 3])> {
+        let n = self.normal;
+        (self.stored != 0).then_some((self.position, if transposed { n.map(|x| -x) } else { n }))
+    }
 }
 
 /// Child slots of a quadtree node, by quadrant: `[u low v low, u high v low, u high v high,
@@ -201,7 +263,7 @@ impl PatchTree {
     /// [`PatchTree::locate`]). Precondition: the leaves tile `[0,1]²` as the nodes say.
     pub(crate) fn from_parts(leaves: Vec<Leaf>, nodes: Vec<[Slot; 4]>, root: Slot) -> PatchTree {
         let mut tree = PatchTree {
-            data: std::sync::Arc::new(TreeData { leaves, nodes, root }),
+            data: std::sync::Arc::new(TreeData::new(leaves, nodes, root)),
             hull: [DVec3::ZERO; 8],
             transposed: false,
             rotation: 0,
@@ -252,7 +314,7 @@ impl PatchTree {
                 ..*leaf
             })
             .collect();
-        let data = TreeData { leaves, nodes: self.data.nodes.clone(), root: self.data.root };
+        let data = TreeData::new(leaves, self.data.nodes.clone(), self.data.root);
         self.with_data(std::sync::Arc::new(data))
     }
 
@@ -392,6 +454,70 @@ impl PatchTree {
                 });
             }
         }
+    }
+
+    /// The engine's output at each of `uvs` (positions and unit normals rounded to `f32`, as
+    /// [`subdivision_point`](super::subdivision_point) of [`PatchTree::derivatives_each`]
+    /// gives them, bit for bit): a point at a leaf's corner 0 read from the leaf's
+    /// [`CornerPoint`] where it holds one, every other evaluated.
+    pub(crate) fn outputs_each(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
+        // SAFETY: without AVX, nothing is required of the CPU.
+        unsafe { self.outputs_each_with::<false>(uvs, each) }
+    }
+
+    /// [`PatchTree::outputs_each`] for callers compiled for AVX, as
+    /// [`PatchTree::derivatives_each_avx`]: the same values.
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) unsafe fn outputs_each_avx(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
+        // SAFETY: the caller's precondition.
+        unsafe { self.outputs_each_with::<true>(uvs, each) }
+    }
+
+    /// # Safety
+    /// With `AVX`, the CPU must support AVX.
+    #[inline(always)]
+    unsafe fn outputs_each_with<const AVX: bool>(
+        &self,
+        uvs: &[DVec2],
+        mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
+    ) {
+        prefetch_slice(&self.data.nodes);
+        let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
+        for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
+            for (slot, &uv) in found.iter_mut().zip(chunk) {
+                *slot = self.find(uv);
+                if slot.1 == DVec2::ZERO {
+                    prefetch_at::<TO_L1>((&self.data.corners[slot.0] as *const CornerPoint).cast());
+                } else {
+                    prefetch(&self.data.leaves[slot.0], slot.1);
+                }
+            }
+            for (i, &(leaf, st, size)) in found[..chunk.len()].iter().enumerate() {
+                let k = c * AHEAD + i;
+                if let Some((position, normal)) = self.corner_point(leaf, st) {
+                    each(k, position, normal);
+                    continue;
+                }
+                // SAFETY: passed on from the caller.
+                let d = unsafe { self.leaf_derivatives_with::<AVX>(&self.data.leaves[leaf], st, size) };
+                let q = super::subdivision_point(self, uvs[k], d);
+                each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
+            }
+        }
+    }
+
+    /// The output at `st` of `leaf` (as [`PatchTree::find`] gives them) from the leaf's
+    /// [`CornerPoint`], where `st` is its corner 0 and the record holds the point.
+    #[inline(always)]
+    pub(crate) fn corner_point(&self, leaf: usize, st: DVec2) -> Option<([f32; 3], [f32; 3])> {
+        if st != DVec2::ZERO {
+            return None;
+        }
+        self.data.corners[leaf].point(self.transposed)
     }
 
     /// [`PatchTree::derivatives`] of the point [`PatchTree::find`] placed at `st` in leaf
@@ -868,6 +994,104 @@ mod tests {
                 uvs.iter().filter(|&&uv| matches!(view.locate(uv).0.patch, LeafPatch::Gregory(_))).count();
         }
         assert!(gregory_points > 0, "the views reach the Gregory leaf");
+    }
+
+    /// `view`'s outputs at `uvs` by [`PatchTree::outputs_each`] (and its AVX build where the
+    /// CPU has AVX) against the evaluation rounded to `f32`, bit for bit; returns how many
+    /// points a [`CornerPoint`] gave.
+    fn assert_outputs_are_the_evaluation(what: &str, view: &PatchTree, uvs: &[DVec2]) -> usize {
+        let bits = |(p, n): ([f32; 3], [f32; 3])| (p.map(f32::to_bits), n.map(f32::to_bits));
+        let expected: Vec<_> = uvs
+            .iter()
+            .map(|&uv| {
+                let q = crate::surface::subdivision_point(view, uv, view.derivatives(uv));
+                bits((q.position.as_vec3().to_array(), q.normal.as_vec3().to_array()))
+            })
+            .collect();
+        let check = |got: &[Option<([f32; 3], [f32; 3])>], build: &str| {
+            for (k, g) in got.iter().enumerate() {
+                let g = g.unwrap_or_else(|| panic!("{what}, {build}: point {k} not handed over"));
+                assert_eq!(bits(g), expected[k], "{what}, {build}: point {k} at {:?}", uvs[k]);
+            }
+        };
+        let mut got = vec![None; uvs.len()];
+        view.outputs_each(uvs, |k, p, n| {
+            assert!(got[k].is_none(), "point {k} handed over twice");
+            got[k] = Some((p, n));
+        });
+        check(&got, "scalar");
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            let mut got = vec![None; uvs.len()];
+            // SAFETY: AVX is present (checked above).
+            unsafe { view.outputs_each_avx(uvs, |k, p, n| got[k] = Some((p, n))) };
+            check(&got, "AVX");
+        }
+        uvs.iter()
+            .filter(|&&uv| {
+                let (leaf, st, _) = view.find(uv);
+                view.corner_point(leaf, st).is_some()
+            })
+            .count()
+    }
+
+    #[test]
+    fn corner_records_give_every_views_points_bit_for_bit() {
+        let tree = tree();
+        let views = [
+            tree.clone(),
+            tree.transposed(),
+            tree.rotated(1),
+            tree.rotated(3).transposed(),
+            tree.quadrant(2),
+            tree.quadrant(1).rotated(2).transposed(),
+        ];
+        // Leaf corners (multiples of 1/4), the domain's edges and points between.
+        let uvs: Vec<DVec2> =
+            (0..=12).flat_map(|i| (0..=12).map(move |j| DVec2::new(i as f64, j as f64) / 12.0)).collect();
+        let stored: usize = views
+            .iter()
+            .enumerate()
+            .map(|(v, view)| assert_outputs_are_the_evaluation(&format!("view {v}"), view, &uvs))
+            .sum();
+        assert!(stored >= views.len() * 4, "only {stored} points from the records");
+    }
+
+    #[test]
+    fn corner_records_give_every_cages_points_bit_for_bit() {
+        // Creases (deep trees, Gregory end caps), n-gons (sub-face views, turned and
+        // transposed), boundaries.
+        let cages = [
+            "catmark_rook",
+            "catmark_cube_creases0",
+            "catmark_pole8",
+            "catmark_nonquads",
+            "catmark_xord_boundary",
+        ];
+        let (mut all_stored, mut all_points) = (0, 0);
+        for name in cages {
+            let path = crate::test_support::data(&format!("subdivision/{name}.obj"));
+            let mesh = crate::io::obj::read_obj(&path).expect("test cage");
+            let set = crate::surface::SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default())
+                .expect("test cage");
+            let (mut stored, mut points) = (0, 0);
+            for (p, patch) in set.patches.iter().enumerate() {
+                let crate::surface::Patch::Subdivision(view) = patch else { continue };
+                // Bfr's rate 16 (8 on sub-faces: the same points of the face) and 5.
+                for n in [16, 8, 5] {
+                    let uvs: Vec<DVec2> = (0..=n)
+                        .flat_map(|j| (0..=n).map(move |i| DVec2::new(i as f64, j as f64) / n as f64))
+                        .collect();
+                    stored +=
+                        assert_outputs_are_the_evaluation(&format!("{name} patch {p} at {n}"), view, &uvs);
+                    points += uvs.len();
+                }
+            }
+            assert!(points > 0, "{name}: no isolated face");
+            println!("{name}: {stored} of {points} points from the records");
+            (all_stored, all_points) = (all_stored + stored, all_points + points);
+        }
+        assert!(all_stored * 10 > all_points, "only {all_stored} of {all_points} points from the records");
     }
 
     #[test]
