@@ -291,18 +291,25 @@ impl<'a> Tessellator<'a> {
         let start = Instant::now();
         let planned = &self.planned;
         self.fast.retarget(&planned.plan);
-        self.fast.fill_patterns(&planned.plan, &planned.pattern, self.layout.triangle_count() as u64);
+        // The check's patterns, where it built them for this plan: the engine adds its own.
+        let mut built = self.scratch.check_patterns();
+        let triangles = self.layout.triangle_count() as u64;
+        let took = self.fast.fill_patterns(&planned.plan, &planned.pattern, triangles, built.as_deref_mut());
         let filled = start.elapsed();
         let fast = Some(&self.fast);
         let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
         let written = match out {
             Output::Mesh(mesh) => {
-                engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, mesh, fast)?
+                engine::write_with(self.set, plan, pattern, layout_ref, self.options.engine, mesh, fast)
             }
             Output::Buffers(buffers) => {
-                engine::write_into(self.set, plan, pattern, layout_ref, buffers, fast)?
+                engine::write_into(self.set, plan, pattern, layout_ref, buffers, fast)
             }
         };
+        if let (true, Some(built)) = (took, built) {
+            self.fast.return_patterns(built);
+        }
+        let written = written?;
         self.timings = FrameTimings {
             // The pattern cache's fill counts with the vertices, whose pass uses it first.
             write_vertices: filled + written.vertices,

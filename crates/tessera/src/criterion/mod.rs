@@ -232,6 +232,13 @@ pub struct PlanScratch {
 }
 
 impl PlanScratch {
+    /// The patterns the last plan's a-posteriori check built, for the engine that writes
+    /// that plan ([`tolerance::Scratch::take_patterns`]); None when it built none or they
+    /// were taken.
+    pub(crate) fn check_patterns(&mut self) -> Option<&mut crate::pattern::cache::PatternCache> {
+        self.tolerance.take_patterns()
+    }
+
     /// How long the last plan made with these buffers spent in its criterion stage
     /// (culling, tolerances) and in resolving (proposals, edges, checks), where the plan
     /// measures them (the error-bounded criteria); zero otherwise.

@@ -174,14 +174,32 @@ impl<'a> FastEvaluator<'a> {
 
     /// Prepares the writer's per-frame patterns for `plan` and `pattern` (`triangles`: the
     /// layout's count): the one pattern of a uniform triangle plan ([`UniformTriangles`]), or
-    /// else the distinct patterns ([`PatternCache::fill`]), for the writer to read instead of
-    /// building one per patch. Precondition: [`FastEvaluator::retarget`] saw `plan`.
-    pub(crate) fn fill_patterns(&mut self, plan: &Plan, pattern: &dyn Pattern, triangles: u64) {
+    /// else the distinct patterns ([`PatternCache::fill_inputs`]), for the writer to read
+    /// instead of building one per patch. `built`: patterns already built for this plan and
+    /// `pattern` (the a-posteriori check's), exchanged for the evaluator's own and only added
+    /// to; [`FastEvaluator::return_patterns`] gives them back after the write, so that each
+    /// table keeps its role (and its buffers' sizes) from frame to frame. Returns whether it
+    /// took them. Precondition: [`FastEvaluator::retarget`] saw `plan`.
+    pub(crate) fn fill_patterns(
+        &mut self,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        triangles: u64,
+        built: Option<&mut PatternCache>,
+    ) -> bool {
         if self.triangles.retarget(self.set, plan, pattern) {
             self.patterns.clear();
-        } else {
-            super::fill_pattern_cache(&mut self.patterns, self.set, plan, pattern, triangles);
+            return false;
         }
+        let took = built.map(|built| std::mem::swap(&mut self.patterns, built)).is_some();
+        super::fill_pattern_cache(&mut self.patterns, self.set, plan, pattern, triangles, took);
+        took
+    }
+
+    /// Gives back the patterns [`FastEvaluator::fill_patterns`] took (`built`, holding the
+    /// evaluator's own meanwhile), once the frame is written.
+    pub(crate) fn return_patterns(&mut self, built: &mut PatternCache) {
+        std::mem::swap(&mut self.patterns, built);
     }
 
     /// The writer of uniform triangle plans.

@@ -142,7 +142,7 @@ pub fn write(
     out: &mut Mesh,
 ) -> Result<()> {
     let mut fast = fast_evaluator::FastEvaluator::new(set, plan);
-    fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+    fast.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
     write_with(set, plan, pattern, layout, options, out, Some(&fast)).map(|_| ())
 }
 
@@ -838,6 +838,7 @@ pub(crate) fn fill_pattern_cache(
     plan: &Plan,
     pattern: &dyn Pattern,
     triangles: u64,
+    keep: bool,
 ) {
     let visible = plan.visible.iter().filter(|&&v| v != 0).count() as u64;
     if pattern.depends_on_patch() || triangles < MIN_TRIANGLES_PER_PATCH as u64 * visible {
@@ -845,7 +846,11 @@ pub(crate) fn fill_pattern_cache(
         return;
     }
     let input_of = |p: usize| plan.is_visible(p).then(|| layout::pattern_input(set, plan, p));
-    cache.fill_inputs(pattern, set.patches.len(), input_of, false);
+    if keep {
+        cache.extend_inputs(pattern, set.patches.len(), input_of, false);
+    } else {
+        cache.fill_inputs(pattern, set.patches.len(), input_of, false);
+    }
 }
 
 /// Per-patch mapping from local vertex indices to output vertices: the numbering rule of
@@ -1063,7 +1068,7 @@ mod tests {
                     let mut layout = Layout::default();
                     layout.build(&set, &plan, &Transition, &options).unwrap();
                     let mut fast = fast_evaluator::FastEvaluator::new(&set, &plan);
-                    fast.fill_patterns(&plan, &Transition, layout.triangle_count() as u64);
+                    fast.fill_patterns(&plan, &Transition, layout.triangle_count() as u64, None);
                     assert_eq!(
                         fast.patterns().distinct() > 0,
                         lowest > 1,
@@ -1159,7 +1164,7 @@ mod tests {
                 let mut layout = Layout::default();
                 layout.build(&set, plan, pattern, &options).unwrap();
                 let mut fast = fast_evaluator::FastEvaluator::new(&set, plan);
-                fast.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                fast.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
                 let [plain, streamed] = [false, true].map(|stream| {
                     stream_store::force_on_this_thread(Some(stream));
                     let mut mesh = Mesh::default();

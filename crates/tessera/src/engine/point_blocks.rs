@@ -1303,7 +1303,7 @@ mod tests {
                         super::super::fast_evaluator::FastEvaluator::with_kernels(set, plan, avx2_fma);
                     // The frame's distinct patterns, built once (where they pay), read by the
                     // writer instead of its per-patch builds, which the reference makes.
-                    evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                    evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
                     cached += usize::from(evaluator.patterns().distinct() > 0);
                     uniform_triangles += usize::from(evaluator.triangles().active());
                     let what = format!("{name} {scheme:?} {criterion:?} avx2_fma={avx2_fma}");
@@ -1418,7 +1418,7 @@ mod tests {
                 for avx2_fma in [false, true] {
                     let mut evaluator =
                         super::super::fast_evaluator::FastEvaluator::with_kernels(&set, plan, avx2_fma);
-                    evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                    evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
                     let what = format!("{} {scheme:?} {criterion:?} avx2_fma={avx2_fma}", path.display());
                     let size = lo.distance(hi);
                     let (fast, generic) = assert_fast_equals_generic(
@@ -1501,7 +1501,7 @@ mod tests {
                 let mut layout = Layout::default();
                 layout.build(&set, plan, pattern, &EngineOptions::default()).unwrap();
                 let mut evaluator = super::super::fast_evaluator::FastEvaluator::new(&set, plan);
-                evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64);
+                evaluator.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
                 // A few hundred evaluated points can fall mostly on the f64 fallback.
                 let kernels = layout.interior_offsets[set.patches.len()] - layout.corners > 2_000;
                 assert_fast_equals_generic(

@@ -274,7 +274,7 @@ mod tests {
         let mut layout = Layout::default();
         layout.build(&set, &plan, &Uniform, &options).unwrap();
         let mut fast = FastEvaluator::new(&set, &plan);
-        fast.fill_patterns(&plan, &Uniform, layout.triangle_count() as u64);
+        fast.fill_patterns(&plan, &Uniform, layout.triangle_count() as u64, None);
         assert!(fast.triangles().active());
         let (mut mesh, mut reference) = (Mesh::default(), Mesh::default());
         write_with(&set, &plan, &Uniform, &layout, options, &mut mesh, Some(&fast)).unwrap();

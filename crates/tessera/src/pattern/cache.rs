@@ -117,8 +117,8 @@ pub(crate) struct PatternCache {
     boundary: Vec<Vec<u32>>,
     /// Per slot, the parameters of the pattern's local vertices (filled on request).
     params: Vec<Vec<DVec2>>,
-    /// `params` holds this fill's tables.
-    with_params: bool,
+    /// Per slot in use, whether `params` holds its table.
+    has_params: Vec<bool>,
 }
 
 /// The parameters of every local vertex of `built` (made for `input`), in local order:
@@ -154,6 +154,13 @@ impl PatternCache {
     pub(crate) fn clear(&mut self) {
         self.index.clear();
         self.inputs.clear();
+        self.has_params.clear();
+        self.of_patch.clear();
+    }
+
+    /// Forgets which item has which pattern (every [`PatternCache::get`] answers None) but
+    /// keeps the patterns for a later [`PatternCache::extend_inputs`].
+    pub(crate) fn forget_items(&mut self) {
         self.of_patch.clear();
     }
 
@@ -169,11 +176,30 @@ impl PatternCache {
         input_of: impl Fn(usize) -> Option<PatternInput>,
         params: bool,
     ) {
-        debug_assert!(!pattern.depends_on_patch());
         self.clear();
+        self.extend_inputs(pattern, count, input_of, params);
+    }
+
+    /// [`PatternCache::fill_inputs`] keeping the patterns the cache holds: only inputs new
+    /// to it are built (and, with `params`, the parameter tables it lacks). For a second use
+    /// of one frame's patterns with the same pattern (the engine's write after the
+    /// a-posteriori check, which built most of them): the key is every bit of the input a
+    /// pattern reads, so a kept pattern is the one a build would make.
+    /// Precondition: the cache was filled for `pattern`, which does not depend on the patch.
+    /// Cost: one hash lookup per item (sequential), then the new builds (parallel).
+    pub(crate) fn extend_inputs(
+        &mut self,
+        pattern: &dyn Pattern,
+        count: usize,
+        input_of: impl Fn(usize) -> Option<PatternInput>,
+        params: bool,
+    ) {
+        debug_assert!(!pattern.depends_on_patch());
+        self.of_patch.clear();
         if self.of_patch.capacity() < count {
             self.of_patch.reserve(count);
         }
+        let kept = self.inputs.len();
         for i in 0..count {
             let Some(input) = input_of(i) else {
                 self.of_patch.push(NONE);
@@ -196,22 +222,34 @@ impl PatternCache {
         if params && self.params.len() < used {
             self.params.resize_with(used, Vec::new);
         }
-        let built = self.slots[..used].par_iter_mut().zip(&self.inputs).zip(&mut self.boundary[..used]);
+        self.has_params.resize(used, false);
+        let new = (&mut self.slots[kept..used]).into_par_iter().zip(&self.inputs[kept..used]);
+        let new = new.zip(&mut self.boundary[kept..used]);
         if params {
-            built.zip(&mut self.params[..used]).with_min_len(4).for_each(
-                |(((local, input), boundary), params)| {
-                    pattern.build(input, local);
-                    boundary_positions(input, local, boundary);
-                    local_params(input, local, params);
+            let new_params =
+                (&mut self.params[kept..used]).into_par_iter().zip(&mut self.has_params[kept..used]);
+            new.zip(new_params).with_min_len(4).for_each(|(((local, input), boundary), (params, has))| {
+                pattern.build(input, local);
+                boundary_positions(input, local, boundary);
+                local_params(input, local, params);
+                *has = true;
+            });
+            // Kept patterns built without their tables (none in the check's own rounds).
+            let kept_params = (&mut self.params[..kept]).into_par_iter().zip(&mut self.has_params[..kept]);
+            kept_params.zip(&self.inputs[..kept]).zip(&self.slots[..kept]).with_min_len(16).for_each(
+                |(((params, has), input), local)| {
+                    if !*has {
+                        local_params(input, local, params);
+                        *has = true;
+                    }
                 },
             );
         } else {
-            built.with_min_len(4).for_each(|((local, input), boundary)| {
+            new.with_min_len(4).for_each(|((local, input), boundary)| {
                 pattern.build(input, local);
                 boundary_positions(input, local, boundary);
             });
         }
-        self.with_params = params;
     }
 
     /// Patch `p`'s pattern input, pattern and the pattern's [`boundary_positions`], when the
@@ -226,7 +264,7 @@ impl PatternCache {
     /// [`PatternCache::fill_inputs`] made them (with `params`).
     pub(crate) fn params(&self, i: usize) -> Option<(&PatternInput, &LocalTessellation, &[DVec2])> {
         let slot = *self.of_patch.get(i)? as usize;
-        (self.with_params && slot != NONE as usize)
+        (slot != NONE as usize && self.has_params[slot])
             .then(|| (&self.inputs[slot], &self.slots[slot], &self.params[slot][..]))
     }
 

@@ -318,6 +318,7 @@ impl Scheme {
         scratch: &mut PlanScratch,
         out: &mut SchemePlan,
     ) -> Result<()> {
+        scratch.tolerance.forget_patterns();
         let accepted = validate(*self, criterion, options, set, Engine::Cpu)?;
         scratch.criterion_time = Default::default();
         scratch.resolve_time = Default::default();
