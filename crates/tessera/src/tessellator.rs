@@ -458,6 +458,33 @@ mod tests {
         assert!(tess.report().unwrap().worst_ratio <= 1.0);
     }
 
+    /// Frames fine enough that the a-posteriori check builds its patterns into a table, which
+    /// the engine then writes with (adding the inputs the check did not meet): the same
+    /// meshes as fresh tessellations, frame after frame, and the table really taken.
+    #[test]
+    fn frames_written_with_the_checks_patterns_equal_fresh_tessellations() {
+        let set = teapot();
+        let (lo, hi) = set.bounds();
+        let criterion = Criterion::PixelError(0.25);
+        let mut tess =
+            Tessellator::new(&set, Scheme::Transition, criterion, TessellatorOptions::default()).unwrap();
+        let mut taken = 0;
+        for k in 0..5 {
+            let mut camera = Camera::framing(lo, hi, 1280, 960);
+            camera.eye = camera.target + (camera.eye - camera.target) * (0.5 + 0.3 * k as f64);
+            let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+            let planned = Scheme::Transition.plan(&set, &criterion, &options).unwrap();
+            let fresh =
+                engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default()).unwrap();
+            let mesh = tess.frame(Some(&camera)).unwrap();
+            assert_eq!(*mesh, fresh, "frame {k}");
+            // The check's table is given back after the write, holding its patterns and the
+            // engine's; a check that built none leaves it empty.
+            taken += usize::from(tess.scratch.tolerance.held_patterns() > 0);
+        }
+        assert!(taken >= 3, "the engine took the check's patterns in {taken} frames of 5");
+    }
+
     #[test]
     fn a_criterion_the_scheme_refuses_is_refused_up_front() {
         let set = teapot();

@@ -472,6 +472,12 @@ impl Scratch {
     pub(crate) fn forget_patterns(&mut self) {
         self.patterns_fresh = false;
     }
+
+    /// How many distinct patterns the check's table holds (0 when the last check built none).
+    #[cfg(test)]
+    pub(crate) fn held_patterns(&self) -> usize {
+        self.patterns.distinct()
+    }
 }
 
 /// Builds a plan that meets `eps[p]` on every patch with `Some` tolerance (`None` = culled),
