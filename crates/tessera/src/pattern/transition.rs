@@ -223,12 +223,20 @@ impl QuadLayout {
                 out.interior.push(DVec2::new(i as f64 * su, j as f64 * sv));
             }
         }
+        out.triangles.reserve((2 * (self.i_hi - self.i_lo) * (self.j_hi - self.j_lo)) as usize);
         for j in self.j_lo..self.j_hi {
+            // A cell off the domain's boundary has interior corners only, numbered row after
+            // row: its indices by additions (what `local` gives them, without its cases;
+            // a core's cells are most of a fine pattern's triangles).
+            let inner_row = j > 0 && j + 1 < self.nv;
+            let row = b.interior.wrapping_add(j.wrapping_sub(1).wrapping_mul(self.nu - 1));
             for i in self.i_lo..self.i_hi {
-                let a = self.local(&b, i, j);
-                let bb = self.local(&b, i + 1, j);
-                let c = self.local(&b, i + 1, j + 1);
-                let d = self.local(&b, i, j + 1);
+                let [a, bb, c, d] = if inner_row && i > 0 && i + 1 < self.nu {
+                    let a = row + (i - 1);
+                    [a, a + 1, a + self.nu, a + self.nu - 1]
+                } else {
+                    [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(i, j)| self.local(&b, i, j))
+                };
                 out.triangles.push([a, bb, c]);
                 out.triangles.push([a, c, d]);
             }
