@@ -428,6 +428,14 @@ mod tests {
         )
     }
 
+    /// A fresh transition plan of `set` for `criterion` from `camera`, and its mesh.
+    fn fresh_transition(set: &SurfaceSet, criterion: &Criterion, camera: Camera) -> (SchemePlan, Mesh) {
+        let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
+        let planned = Scheme::Transition.plan(set, criterion, &options).unwrap();
+        let fresh = engine::tessellate(set, &planned.plan, &planned.pattern, Default::default()).unwrap();
+        (planned, fresh)
+    }
+
     /// Frames through the tessellator equal a fresh plan and tessellation per camera, with
     /// buffers reused from frame to frame, and a builder receives the same mesh.
     #[test]
@@ -441,10 +449,7 @@ mod tests {
         for k in 0..4 {
             let mut camera = Camera::framing(lo, hi, 640, 480);
             camera.eye = camera.target + (camera.eye - camera.target) * (1.0 + 0.7 * k as f64);
-            let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
-            let planned = Scheme::Transition.plan(&set, &criterion, &options).unwrap();
-            let fresh =
-                engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default()).unwrap();
+            let (planned, fresh) = fresh_transition(&set, &criterion, camera);
             let mesh = tess.frame(Some(&camera)).unwrap();
             assert_eq!(*mesh, fresh, "frame {k}");
             tess.frame_into(Some(&camera), &mut built).unwrap();
@@ -472,10 +477,7 @@ mod tests {
         for k in 0..5 {
             let mut camera = Camera::framing(lo, hi, 1280, 960);
             camera.eye = camera.target + (camera.eye - camera.target) * (0.5 + 0.3 * k as f64);
-            let options = PlanOptions { camera: Some(camera), ..PlanOptions::default() };
-            let planned = Scheme::Transition.plan(&set, &criterion, &options).unwrap();
-            let fresh =
-                engine::tessellate(&set, &planned.plan, &planned.pattern, Default::default()).unwrap();
+            let (_, fresh) = fresh_transition(&set, &criterion, camera);
             let mesh = tess.frame(Some(&camera)).unwrap();
             assert_eq!(*mesh, fresh, "frame {k}");
             // The check's table is given back after the write, holding its patterns and the
