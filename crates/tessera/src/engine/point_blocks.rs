@@ -961,13 +961,7 @@ impl PointBlocks {
                 }
                 return tree.outputs_each(uvs, write);
             }
-            let put = |k: usize, point| out.put(k, p as u32, uvs[k], point);
-            #[cfg(target_arch = "x86_64")]
-            if FMA {
-                // SAFETY: `FMA` is only set in `eval_avx2_fma`, for a CPU with AVX2 and FMA.
-                return unsafe { set.patches[p].eval_each_avx(uvs, put) };
-            }
-            set.patches[p].eval_each(uvs, put);
+            set.patches[p].eval_each(uvs, |k, point| out.put(k, p as u32, uvs[k], point));
             return;
         }
         // Short lists (the inner samples of a coarse edge, a small interior) in half-width

@@ -106,22 +106,6 @@ impl Patch {
         }
     }
 
-    /// [`Patch::eval_each`] for callers compiled for AVX ([`PatchTree::derivatives_each_avx`]).
-    ///
-    /// # Safety
-    /// The CPU must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    pub(crate) unsafe fn eval_each_avx(&self, uvs: &[DVec2], mut each: impl FnMut(usize, SurfacePoint)) {
-        match self {
-            // SAFETY: the caller's precondition.
-            Patch::Subdivision(t) => unsafe {
-                t.derivatives_each_avx(uvs, |k, d| each(k, subdivision_point(t, uvs[k], d)))
-            },
-            _ => self.eval_each(uvs, each),
-        }
-    }
-
     /// Position only. Cost: O(1), cheaper than [`Patch::eval`].
     pub fn position(&self, uv: DVec2) -> DVec3 {
         match self {

@@ -409,49 +409,31 @@ impl PatchTree {
     /// no gain that stood out of the noise; the batch as a whole, inlined into the engines'
     /// AVX2 path, did.) Cost: as many [`PatchTree::derivatives`].
     #[inline(always)]
-    pub fn derivatives_each(&self, uvs: &[DVec2], each: impl FnMut(usize, (DVec3, DVec3, DVec3))) {
-        // SAFETY: without AVX, nothing is required of the CPU.
-        unsafe { self.derivatives_each_with::<false>(uvs, each) }
+    pub fn derivatives_each(&self, uvs: &[DVec2], mut each: impl FnMut(usize, (DVec3, DVec3, DVec3))) {
+        self.found_ahead(uvs, false, |k, leaf, st, size| {
+            each(k, self.leaf_derivatives(&self.data.leaves[leaf], st, size))
+        });
     }
 
-    /// [`PatchTree::derivatives_each`] for callers compiled for AVX (the engines' AVX2
-    /// path): the Bézier sums are inlined into the caller, so their results stay in
-    /// registers. Through a call, profiles showed the caller stalling on reading back the
-    /// callee's wide stores (a fifth of the evaluation's samples). The same values.
-    ///
-    /// # Safety
-    /// The CPU must support AVX.
-    #[cfg(target_arch = "x86_64")]
+    /// `each(k, leaf, st, size)` for every point `k` of `uvs`, as [`PatchTree::find`] places
+    /// it, the points found [`AHEAD`] at a time with what evaluating them reads asked for
+    /// first ([`PatchTree::derivatives_each`]); with `corners`, a point at its leaf's corner
+    /// 0 asks for the leaf's [`CornerPoint`] instead of its net.
     #[inline(always)]
-    pub(crate) unsafe fn derivatives_each_avx(
-        &self,
-        uvs: &[DVec2],
-        each: impl FnMut(usize, (DVec3, DVec3, DVec3)),
-    ) {
-        // SAFETY: the caller's precondition.
-        unsafe { self.derivatives_each_with::<true>(uvs, each) }
-    }
-
-    /// # Safety
-    /// With `AVX`, the CPU must support AVX.
-    #[inline(always)]
-    unsafe fn derivatives_each_with<const AVX: bool>(
-        &self,
-        uvs: &[DVec2],
-        mut each: impl FnMut(usize, (DVec3, DVec3, DVec3)),
-    ) {
+    fn found_ahead(&self, uvs: &[DVec2], corners: bool, mut each: impl FnMut(usize, usize, DVec2, f64)) {
         prefetch_slice(&self.data.nodes);
         let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
         for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
             for (slot, &uv) in found.iter_mut().zip(chunk) {
                 *slot = self.find(uv);
-                prefetch(&self.data.leaves[slot.0], slot.1);
+                if corners && slot.1 == DVec2::ZERO {
+                    prefetch_at::<TO_L1>((&self.data.corners[slot.0] as *const CornerPoint).cast());
+                } else {
+                    prefetch(&self.data.leaves[slot.0], slot.1);
+                }
             }
-            for (k, &(leaf, st, size)) in found[..chunk.len()].iter().enumerate() {
-                // SAFETY: passed on from the caller.
-                each(c * AHEAD + k, unsafe {
-                    self.leaf_derivatives_with::<AVX>(&self.data.leaves[leaf], st, size)
-                });
+            for (i, &(leaf, st, size)) in found[..chunk.len()].iter().enumerate() {
+                each(c * AHEAD + i, leaf, st, size);
             }
         }
     }
@@ -465,8 +447,10 @@ impl PatchTree {
         unsafe { self.outputs_each_with::<false>(uvs, each) }
     }
 
-    /// [`PatchTree::outputs_each`] for callers compiled for AVX, as
-    /// [`PatchTree::derivatives_each_avx`]: the same values.
+    /// [`PatchTree::outputs_each`] for callers compiled for AVX (the engines' AVX2 path): the
+    /// Bézier sums are inlined into the caller, so their results stay in registers. Through a
+    /// call, profiles showed the caller stalling on reading back the callee's wide stores (a
+    /// fifth of the evaluation's samples). The same values.
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -485,29 +469,15 @@ impl PatchTree {
         uvs: &[DVec2],
         mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
     ) {
-        prefetch_slice(&self.data.nodes);
-        let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
-        for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
-            for (slot, &uv) in found.iter_mut().zip(chunk) {
-                *slot = self.find(uv);
-                if slot.1 == DVec2::ZERO {
-                    prefetch_at::<TO_L1>((&self.data.corners[slot.0] as *const CornerPoint).cast());
-                } else {
-                    prefetch(&self.data.leaves[slot.0], slot.1);
-                }
+        self.found_ahead(uvs, true, |k, leaf, st, size| {
+            if let Some((position, normal)) = self.corner_point(leaf, st) {
+                return each(k, position, normal);
             }
-            for (i, &(leaf, st, size)) in found[..chunk.len()].iter().enumerate() {
-                let k = c * AHEAD + i;
-                if let Some((position, normal)) = self.corner_point(leaf, st) {
-                    each(k, position, normal);
-                    continue;
-                }
-                // SAFETY: passed on from the caller.
-                let d = unsafe { self.leaf_derivatives_with::<AVX>(&self.data.leaves[leaf], st, size) };
-                let q = super::subdivision_point(self, uvs[k], d);
-                each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
-            }
-        }
+            // SAFETY: passed on from the caller.
+            let d = unsafe { self.leaf_derivatives_with::<AVX>(&self.data.leaves[leaf], st, size) };
+            let q = super::subdivision_point(self, uvs[k], d);
+            each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
+        });
     }
 
     /// The output at `st` of `leaf` (as [`PatchTree::find`] gives them) from the leaf's
@@ -522,7 +492,7 @@ impl PatchTree {
 
     /// [`PatchTree::derivatives`] of the point [`PatchTree::find`] placed at `st` in leaf
     /// `leaf` (of side `size`), for callers compiled for AVX as
-    /// [`PatchTree::derivatives_each_avx`] is: the same values.
+    /// [`PatchTree::outputs_each_avx`] is: the same values.
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -816,7 +786,7 @@ unsafe fn bezier_derivatives_avx(points: &[DVec3; 16], st: DVec2) -> (DVec3, DVe
 }
 
 /// The body of [`bezier_derivatives_avx`], to be inlined into functions compiled for AVX
-/// ([`PatchTree::derivatives_each_avx`]); elsewhere its intrinsics would be calls.
+/// ([`PatchTree::outputs_each_avx`]); elsewhere its intrinsics would be calls.
 ///
 /// # Safety
 /// The CPU must support AVX.
@@ -976,20 +946,8 @@ mod tests {
                 assert_eq!(bits(got), bits(view.derivatives(uvs[k])), "at {:?}", uvs[k]);
             });
             assert!(seen.iter().all(|&s| s), "every point handed over");
-            // The engines' AVX path: the same values, the zero terms at leaf borders left out.
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx") {
-                let mut seen = vec![false; uvs.len()];
-                // SAFETY: AVX is present (checked above).
-                unsafe {
-                    view.derivatives_each_avx(&uvs, |k, got| {
-                        assert!(!seen[k], "point {k} handed over twice");
-                        seen[k] = true;
-                        assert_eq!(bits(got), bits(view.derivatives(uvs[k])), "AVX path at {:?}", uvs[k]);
-                    })
-                };
-                assert!(seen.iter().all(|&s| s), "every point handed over");
-            }
+            // The engines' AVX path (`outputs_each_avx`) is checked against the evaluation
+            // by `corner_records_give_every_views_points_bit_for_bit`.
             gregory_points +=
                 uvs.iter().filter(|&&uv| matches!(view.locate(uv).0.patch, LeafPatch::Gregory(_))).count();
         }
