@@ -534,6 +534,13 @@ impl Writer<'_> {
             if offsets[e + 1] == offsets[e] {
                 continue;
             }
+            if let Some(end) = self.tree_run(e, edges.end) {
+                // Edges `e..end` are evaluated on their owners' trees, one stream of points.
+                let part = out.take_front((offsets[end] - offsets[e]) as usize);
+                self.tree_edge_run(e..end, part);
+                edges.start = end;
+                continue;
+            }
             if let Some(end) = self.owner_run(e, edges.end) {
                 // Edges `e..end` share their owner and lie one after the other in the output.
                 let part = out.take_front((offsets[end] - offsets[e]) as usize);
@@ -553,6 +560,57 @@ impl Writer<'_> {
                 }),
             }
         }
+    }
+
+    /// The end of the run of edges from `e` (before `end`) that [`Writer::tree_edge_run`]
+    /// evaluates as one stream: edges with one normal variant whose owner evaluates their
+    /// points one by one on its subdivision tree ([`PointBlocks::evaluates_on_tree`]), and
+    /// edges without inner samples between them. None for fewer than two such edges.
+    fn tree_run(&self, e: usize, end: usize) -> Option<usize> {
+        let f = self.fast?;
+        let (topo, offsets) = (&self.set.topology, &self.layout.edge_offsets);
+        if f.triangles().active() {
+            return None;
+        }
+        let on_tree = |x: usize| {
+            let inner = (offsets[x + 1] - offsets[x]) as usize;
+            topo.edges[x].variants == 1
+                && !f.covers_edge(self.plan, x)
+                && f.points().evaluates_on_tree(self.set, topo.edge_uses(x)[0].patch as usize, inner)
+        };
+        if !on_tree(e) {
+            return None;
+        }
+        let (mut last, mut count) = (e + 1, 1);
+        for x in e + 1..end {
+            if offsets[x + 1] == offsets[x] {
+                continue;
+            }
+            if !on_tree(x) {
+                break;
+            }
+            (last, count) = (x + 1, count + 1);
+        }
+        (count > 1).then_some(last)
+    }
+
+    /// The inner samples of `edges`, a run of [`Writer::tree_run`], evaluated by their owners
+    /// as one stream into `out` (their samples, one edge after the other).
+    fn tree_edge_run(&self, edges: std::ops::Range<usize>, out: VertexSlices<'_>) {
+        let (set, plan) = (self.set, self.plan);
+        let topo = &set.topology;
+        with_scratch(self.generation, |scratch| {
+            let (uvs, items) = (&mut scratch.edge_params, &mut scratch.tree_items);
+            items.clear();
+            for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
+                let owner = &topo.edge_uses(e)[0];
+                uvs.clear();
+                push_edge_params(plan, e, topo.patch_domains[owner.patch as usize], owner, uvs);
+                items.extend(uvs.iter().map(|&uv| (owner.patch, uv)));
+            }
+            let points = self.fast.expect("tree_run checked the evaluator").points();
+            points.eval_tree_stream(set, items, out);
+        });
     }
 
     /// The end of the run of edges from `e` (before `end`) that [`Writer::edge_run`]
@@ -793,6 +851,8 @@ pub(crate) struct PatchScratch {
     param: Vec<[f32; 2]>,
     /// Parameters of an edge's inner samples.
     edge_params: Vec<glam::DVec2>,
+    /// A run of edges' inner samples as (owner patch, parameters) ([`Writer::tree_edge_run`]).
+    tree_items: Vec<(u32, glam::DVec2)>,
 }
 
 impl PatchScratch {

@@ -912,6 +912,81 @@ impl PointBlocks {
         self.eval_with::<false>(set, p, uvs, out)
     }
 
+    /// Whether [`PointBlocks::eval`] takes `points` points of patch `p` of `set` one by one on
+    /// its subdivision tree ([`crate::surface::patch_tree::PatchTree::outputs_each`]): a Catmull-Clark tree too sparse
+    /// for [`super::tree_points::eval`]'s groups. Such points may be evaluated in a stream
+    /// with other patches' ([`PointBlocks::eval_tree_stream`]), with the same values.
+    /// Cost: O(1).
+    pub(crate) fn evaluates_on_tree(&self, set: &SurfaceSet, p: usize, points: usize) -> bool {
+        match (&set.patches[p], self.locals[p]) {
+            (Patch::Subdivision(tree), Local::Generic) => {
+                !super::tree_points::worth_grouping(&**tree, points)
+            }
+            _ => false,
+        }
+    }
+
+    /// Evaluates a stream of points on several patches, `items[k] = (patch, uv)`, into `out`
+    /// (vertex `k` each), with the values [`PointBlocks::eval`] gives each patch's points.
+    /// Why: the engine's edges have a few points each, each edge on its owner's tree, and
+    /// evaluated edge by edge every edge started with none of its leaves' loads in flight
+    /// ([`crate::surface::patch_tree::outputs_stream`] looks ahead across them).
+    /// Preconditions: every patch [`PointBlocks::evaluates_on_tree`] for its points (each
+    /// edge's count); `out` holds `items.len()` vertices. Cost: as many points of
+    /// [`crate::surface::patch_tree::PatchTree::outputs_each`], no allocation.
+    pub(crate) fn eval_tree_stream(&self, set: &SurfaceSet, items: &[(u32, DVec2)], out: VertexSlices<'_>) {
+        if self.avx2_fma {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`PointBlocks::for_set`).
+            return unsafe { self.eval_tree_stream_avx2_fma(set, items, out) };
+        }
+        self.eval_tree_stream_with::<false>(set, items, out)
+    }
+
+    /// [`PointBlocks::eval_tree_stream_with`] compiled for AVX2 and FMA.
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn eval_tree_stream_avx2_fma(
+        &self,
+        set: &SurfaceSet,
+        items: &[(u32, DVec2)],
+        out: VertexSlices<'_>,
+    ) {
+        self.eval_tree_stream_with::<true>(set, items, out)
+    }
+
+    #[inline(always)]
+    fn eval_tree_stream_with<const FMA: bool>(
+        &self,
+        set: &SurfaceSet,
+        items: &[(u32, DVec2)],
+        out: VertexSlices<'_>,
+    ) {
+        use crate::surface::patch_tree::{outputs_stream, PatchTree};
+        let item = |k: usize| -> (&PatchTree, DVec2) {
+            let (p, uv) = items[k];
+            match &set.patches[p as usize] {
+                Patch::Subdivision(tree) => (&**tree, uv),
+                _ => unreachable!("eval_tree_stream's precondition: points on subdivision trees"),
+            }
+        };
+        let write = |k: usize, position, normal| {
+            out.pos[k] = position;
+            out.nrm[k] = normal;
+            out.uv[k] = items[k].1.as_vec2().to_array();
+            out.patch[k] = items[k].0;
+        };
+        #[cfg(target_arch = "x86_64")]
+        if FMA {
+            // SAFETY: `FMA` is only set in `eval_tree_stream_avx2_fma`, for a CPU with AVX2 and FMA.
+            return unsafe { crate::surface::patch_tree::outputs_stream_avx(items.len(), item, write) };
+        }
+        outputs_stream(items.len(), item, write)
+    }
+
     /// [`PointBlocks::eval_with`] compiled for AVX2 and FMA (everything it calls is inlined).
     ///
     /// # Safety
@@ -1367,6 +1442,65 @@ mod tests {
         let r = crate::verify::watertight(&reference);
         assert_eq!(w.boundary_edges, r.boundary_edges, "{what}");
         (mesh, reference)
+    }
+
+    /// A stream of points on many trees ([`PointBlocks::eval_tree_stream`], the engine's runs
+    /// of edges) gives every point the bits its own patch's evaluation gives it, its
+    /// parameters and its patch: edge-like runs of seven points and a few interior points,
+    /// patch after patch, on four cages, with both instruction sets.
+    #[test]
+    fn tree_streams_give_each_patchs_points_bit_for_bit() {
+        let cages = ["catmark_rook", "catmark_cube_creases0", "catmark_xord_boundary", "catmark_nonquads"];
+        let mut streamed = 0;
+        for name in cages {
+            let path = crate::test_support::data(&format!("subdivision/{name}.obj"));
+            let set = SurfaceSet::from_subdivision_cage(
+                &crate::io::obj::read_obj(&path).unwrap(),
+                &path,
+                Default::default(),
+            )
+            .unwrap();
+            for avx2_fma in [false, has_avx2_fma()] {
+                let blocks = PointBlocks::for_set(&set, avx2_fma);
+                let (mut items, mut lists) = (Vec::new(), Vec::new());
+                for p in 0..set.patches.len() {
+                    let e = p % 4;
+                    let mut uvs: Vec<DVec2> =
+                        (1..8).map(|k| crate::surface::Domain::Quad.edge_point(e, k as f64 / 8.0)).collect();
+                    if p % 3 == 0 {
+                        uvs.extend([DVec2::new(0.3, 0.6), DVec2::new(0.5, 0.5), DVec2::new(0.75, 0.5)]);
+                    }
+                    if blocks.evaluates_on_tree(&set, p, uvs.len()) {
+                        items.extend(uvs.iter().map(|&uv| (p as u32, uv)));
+                        lists.push((p, uvs));
+                    }
+                }
+                assert!(lists.len() >= 4, "{name}: {} patches on sparse trees", lists.len());
+                let n = items.len();
+                let (mut pos, mut nrm, mut uv, mut patch) =
+                    (vec![[0f32; 3]; n], vec![[0f32; 3]; n], vec![[0f32; 2]; n], vec![0u32; n]);
+                let out = VertexSlices { pos: &mut pos, nrm: &mut nrm, uv: &mut uv, patch: &mut patch };
+                blocks.eval_tree_stream(&set, &items, out);
+                let mut k = 0;
+                for (p, uvs) in &lists {
+                    let m = uvs.len();
+                    let (mut pos1, mut nrm1, mut uv1, mut patch1) =
+                        (vec![[0f32; 3]; m], vec![[0f32; 3]; m], vec![[0f32; 2]; m], vec![0u32; m]);
+                    let out =
+                        VertexSlices { pos: &mut pos1, nrm: &mut nrm1, uv: &mut uv1, patch: &mut patch1 };
+                    blocks.eval(&set, *p, uvs, out);
+                    let bits = |v: &[[f32; 3]]| v.iter().map(|a| a.map(f32::to_bits)).collect::<Vec<_>>();
+                    let what = format!("{name} patch {p} avx2_fma={avx2_fma}");
+                    assert_eq!(bits(&pos[k..k + m]), bits(&pos1), "{what}: positions");
+                    assert_eq!(bits(&nrm[k..k + m]), bits(&nrm1), "{what}: normals");
+                    assert_eq!(&uv[k..k + m], &uv1[..], "{what}: parameters");
+                    assert_eq!(&patch[k..k + m], &patch1[..], "{what}: patches");
+                    k += m;
+                }
+                streamed += n;
+            }
+        }
+        assert!(streamed > 5000, "only {streamed} points streamed");
     }
 
     /// Subdivision cages: the grouped leaf kernels (`tree_points`, for dense points) and the

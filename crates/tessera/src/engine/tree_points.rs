@@ -41,7 +41,7 @@ use super::point_blocks::{
 };
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
-use crate::surface::patch_tree::{prefetch_slice_to_l2, LeafPatch, PatchTree};
+use crate::surface::patch_tree::{prefetch_slice_to_l2, LeafPatch, LeafSquare, PatchTree};
 use crate::surface::triangle_tree::TriangleLeafPatch;
 use crate::surface::{loop_point, subdivision_point, SurfacePoint, SurfaceSet, TriangleTree};
 
@@ -71,8 +71,11 @@ pub(super) trait LeafTree {
     fn leaf_count(&self) -> usize;
     /// The share of the tree's domain the patch covers (a view of a quadrant: a quarter).
     fn view_area(&self) -> f64;
-    /// The leaf of `uv` and `uv` in its parameters, as [`Found`] holds them (`k` unset).
-    fn find(&self, uv: DVec2) -> Found;
+    /// What a search keeps from point to point ([`PatchTree::find_near`]'s last leaf).
+    type Near: Default;
+    /// The leaf of `uv` and `uv` in its parameters, as [`Found`] holds them (`k` unset);
+    /// `near` is the last search's.
+    fn find(&self, uv: DVec2, near: &mut Self::Near) -> Found;
     /// Starts loading the quadtree's nodes (a hint).
     fn prefetch_nodes(&self) {}
     /// Starts loading what evaluating `leaf` at `st` reads (a hint).
@@ -96,6 +99,7 @@ pub(super) trait LeafTree {
 
 impl LeafTree for PatchTree {
     type Local = LocalPatch;
+    type Near = LeafSquare;
     /// Below it most groups would be single points, which pay for finding and grouping on
     /// top of their f64 evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead.
     /// Measured on one thread: grouping every list made `catmark_rook` at rate 16 (creases
@@ -116,8 +120,8 @@ impl LeafTree for PatchTree {
     }
 
     #[inline(always)]
-    fn find(&self, uv: DVec2) -> Found {
-        let (leaf, st, size) = PatchTree::find(self, uv);
+    fn find(&self, uv: DVec2, near: &mut LeafSquare) -> Found {
+        let (leaf, st, size) = PatchTree::find_near(self, uv, near);
         Found { leaf: leaf as u32, k: 0, st, size }
     }
 
@@ -180,6 +184,7 @@ pub(super) fn loop_leaf(tree: &TriangleTree, leaf: usize) -> LoopLeaf {
 
 impl LeafTree for TriangleTree {
     type Local = LoopLeaf;
+    type Near = ();
     /// Every list: Loop's f64 path has no look-ahead to lose, and finding a point's leaf is
     /// its cost whichever way. An edge's inner samples (a few leaves along it, but fewer points
     /// than the density rule asks of the whole tree) were a third of `loop_xord_interior`'s
@@ -203,7 +208,7 @@ impl LeafTree for TriangleTree {
     }
 
     #[inline(always)]
-    fn find(&self, uv: DVec2) -> Found {
+    fn find(&self, uv: DVec2, _: &mut ()) -> Found {
         let (leaf, st) = TriangleTree::find(self, uv);
         Found { leaf: leaf as u32, k: 0, st, size: 0.0 }
     }
@@ -294,8 +299,9 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     found.clear();
     tree.prefetch_nodes();
     let mut last = u32::MAX;
+    let mut near = T::Near::default();
     for (k, &uv) in uvs.iter().enumerate() {
-        let f = Found { k: k as u32, ..tree.find(uv) };
+        let f = Found { k: k as u32, ..tree.find(uv, &mut near) };
         if f.leaf != last {
             // What the group will read: the leaf's stored form where given, else its net.
             match locals {

@@ -226,6 +226,15 @@ impl CornerPoint {
     }
 }
 
+/// A leaf and its square in the tree's parameters ([`PatchTree::find_near`]); the default
+/// is empty, so that the first search walks.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LeafSquare {
+    leaf: usize,
+    origin: DVec2,
+    size: f64,
+}
+
 /// Child slots of a quadtree node, by quadrant: `[u low v low, u high v low, u high v high,
 /// u low v high]`; a child is a node (`Node(i)`) or a leaf (`Leaf(i)`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -350,6 +359,32 @@ impl PatchTree {
     /// ([`PatchTree::derivatives_each`]).
     pub(crate) fn find(&self, uv: DVec2) -> (usize, DVec2, f64) {
         let uv = self.tree_uv(uv);
+        let (leaf, origin, size) = self.leaf_square(uv);
+        (leaf, (uv - origin) / size, size)
+    }
+
+    /// [`PatchTree::find`], the same values, without walking the quadtree where `uv` lies in
+    /// `near`'s leaf (the last found), which then becomes the leaf found. Why: a pattern's
+    /// points come row by row, and a coarse leaf of a deep tree holds a run of each row
+    /// (`catmark_rook` at Bfr's rate 16: over half its isolated faces' points follow a point
+    /// of their own leaf), where a walk is a chain of dependent loads. The square is
+    /// half-open as the walk's comparisons make it, so the leaf and `st` are the walk's, bit
+    /// for bit. Cost: O(1) in `near`'s leaf, else O(depth).
+    #[inline(always)]
+    pub(crate) fn find_near(&self, uv: DVec2, near: &mut LeafSquare) -> (usize, DVec2, f64) {
+        let t = self.tree_uv(uv);
+        let LeafSquare { origin, size, .. } = *near;
+        if !(t.x >= origin.x && t.y >= origin.y && t.x < origin.x + size && t.y < origin.y + size) {
+            let (leaf, origin, size) = self.leaf_square(t);
+            *near = LeafSquare { leaf, origin, size };
+        }
+        (near.leaf, (t - near.origin) / near.size, near.size)
+    }
+
+    /// The leaf holding the tree's point `uv` (as [`PatchTree::find`] places it) and its
+    /// square, `(leaf, origin, size)`, from the quadtree's nodes alone. Cost: O(depth).
+    #[inline(always)]
+    fn leaf_square(&self, uv: DVec2) -> (usize, DVec2, f64) {
         let mut slot = self.data.root;
         let (mut origin, mut size) = (DVec2::ZERO, 1.0);
         loop {
@@ -359,7 +394,7 @@ impl PatchTree {
                         let leaf = &self.data.leaves[i as usize];
                         leaf.origin == origin && leaf.size == size
                     });
-                    return (i as usize, (uv - origin) / size, size);
+                    return (i as usize, origin, size);
                 }
                 Slot::Node(n) => {
                     size *= 0.5;
@@ -416,26 +451,10 @@ impl PatchTree {
     }
 
     /// `each(k, leaf, st, size)` for every point `k` of `uvs`, as [`PatchTree::find`] places
-    /// it, the points found [`AHEAD`] at a time with what evaluating them reads asked for
-    /// first ([`PatchTree::derivatives_each`]); with `corners`, a point at its leaf's corner
-    /// 0 asks for the leaf's [`CornerPoint`] instead of its net.
+    /// it ([`found_ahead`] of this tree alone).
     #[inline(always)]
     fn found_ahead(&self, uvs: &[DVec2], corners: bool, mut each: impl FnMut(usize, usize, DVec2, f64)) {
-        prefetch_slice(&self.data.nodes);
-        let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
-        for (c, chunk) in uvs.chunks(AHEAD).enumerate() {
-            for (slot, &uv) in found.iter_mut().zip(chunk) {
-                *slot = self.find(uv);
-                if corners && slot.1 == DVec2::ZERO {
-                    prefetch_at::<TO_L1>((&self.data.corners[slot.0] as *const CornerPoint).cast());
-                } else {
-                    prefetch(&self.data.leaves[slot.0], slot.1);
-                }
-            }
-            for (i, &(leaf, st, size)) in found[..chunk.len()].iter().enumerate() {
-                each(c * AHEAD + i, leaf, st, size);
-            }
-        }
+        found_ahead(uvs.len(), |k| (self, uvs[k]), corners, |k, _, leaf, st, size| each(k, leaf, st, size));
     }
 
     /// The engine's output at each of `uvs` (positions and unit normals rounded to `f32`, as
@@ -444,7 +463,7 @@ impl PatchTree {
     /// [`CornerPoint`] where it holds one, every other evaluated.
     pub(crate) fn outputs_each(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: without AVX, nothing is required of the CPU.
-        unsafe { self.outputs_each_with::<false>(uvs, each) }
+        unsafe { outputs_with::<false, _>(uvs.len(), |k| (self, uvs[k]), each) }
     }
 
     /// [`PatchTree::outputs_each`] for callers compiled for AVX (the engines' AVX2 path): the
@@ -458,26 +477,7 @@ impl PatchTree {
     #[inline(always)]
     pub(crate) unsafe fn outputs_each_avx(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: the caller's precondition.
-        unsafe { self.outputs_each_with::<true>(uvs, each) }
-    }
-
-    /// # Safety
-    /// With `AVX`, the CPU must support AVX.
-    #[inline(always)]
-    unsafe fn outputs_each_with<const AVX: bool>(
-        &self,
-        uvs: &[DVec2],
-        mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
-    ) {
-        self.found_ahead(uvs, true, |k, leaf, st, size| {
-            if let Some((position, normal)) = self.corner_point(leaf, st) {
-                return each(k, position, normal);
-            }
-            // SAFETY: passed on from the caller.
-            let d = unsafe { self.leaf_derivatives_with::<AVX>(&self.data.leaves[leaf], st, size) };
-            let q = super::subdivision_point(self, uvs[k], d);
-            each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
-        });
+        unsafe { outputs_with::<true, _>(uvs.len(), |k| (self, uvs[k]), each) }
     }
 
     /// The output at `st` of `leaf` (as [`PatchTree::find`] gives them) from the leaf's
@@ -652,6 +652,98 @@ impl PatchTree {
     pub fn depth(&self) -> u8 {
         self.data.leaves.iter().map(|l| l.level).max().unwrap_or(0)
     }
+}
+
+/// `each(k, view, leaf, st, size)` for each point `k < n` of a stream of points on trees,
+/// `item(k) = (view, uv)`, in order, as [`PatchTree::find`] places them: the points found
+/// [`AHEAD`] at a time, with what evaluating them reads asked for first; with `corners`, a
+/// point at its leaf's corner 0 asks for the leaf's [`CornerPoint`] instead of its net.
+/// Why ahead: a tessellation's points mostly fall in different leaves (at factor 8 a grid
+/// step is 8 of the deepest leaves), and profiles show the load of each point's leaf (a few
+/// hundred bytes) stalling ([`PatchTree::derivatives_each`]). Why a stream of trees: the
+/// engine's edges, a few points each on different trees, would start every edge with no
+/// load in flight ([`outputs_stream_avx`]).
+#[inline(always)]
+fn found_ahead<'t>(
+    n: usize,
+    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
+    corners: bool,
+    mut each: impl FnMut(usize, &'t PatchTree, usize, DVec2, f64),
+) {
+    let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
+    let mut views: [Option<&PatchTree>; AHEAD] = [None; AHEAD];
+    // The tree of the last point found (its data's address) and its last leaf.
+    let (mut tree, mut near) = (std::ptr::null(), LeafSquare::default());
+    for start in (0..n).step_by(AHEAD) {
+        let count = AHEAD.min(n - start);
+        for i in 0..count {
+            let (view, uv) = item(start + i);
+            if !std::ptr::eq(tree, &*view.data) {
+                tree = &*view.data;
+                near = LeafSquare::default();
+                prefetch_slice(&view.data.nodes);
+            }
+            let slot = view.find_near(uv, &mut near);
+            if corners && slot.1 == DVec2::ZERO {
+                prefetch_at::<TO_L1>((&view.data.corners[slot.0] as *const CornerPoint).cast());
+            } else {
+                prefetch(&view.data.leaves[slot.0], slot.1);
+            }
+            (found[i], views[i]) = (slot, Some(view));
+        }
+        for i in 0..count {
+            let (leaf, st, size) = found[i];
+            each(start + i, views[i].expect("found above"), leaf, st, size);
+        }
+    }
+}
+
+/// The engine's output (as [`PatchTree::outputs_each`] gives it, bit for bit) at each point
+/// `k < n` of a stream `item(k) = (view, uv)` of points on trees, handed to
+/// `each(k, position, normal)` in order. Made for the engine's edges: each edge's few
+/// points are on its owner's tree, and the look-ahead runs on from edge to edge.
+/// Cost: as many [`PatchTree::outputs_each`] points.
+pub(crate) fn outputs_stream<'t>(
+    n: usize,
+    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
+    each: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    // SAFETY: without AVX, nothing is required of the CPU.
+    unsafe { outputs_with::<false, _>(n, item, each) }
+}
+
+/// [`outputs_stream`] for callers compiled for AVX, as [`PatchTree::outputs_each_avx`].
+///
+/// # Safety
+/// The CPU must support AVX.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn outputs_stream_avx<'t>(
+    n: usize,
+    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
+    each: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    // SAFETY: the caller's precondition.
+    unsafe { outputs_with::<true, _>(n, item, each) }
+}
+
+/// # Safety
+/// With `AVX`, the CPU must support AVX.
+#[inline(always)]
+unsafe fn outputs_with<'t, const AVX: bool, F: Fn(usize) -> (&'t PatchTree, DVec2)>(
+    n: usize,
+    item: F,
+    mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
+) {
+    found_ahead(n, &item, true, |k, view, leaf, st, size| {
+        if let Some((position, normal)) = view.corner_point(leaf, st) {
+            return each(k, position, normal);
+        }
+        // SAFETY: passed on from the caller.
+        let d = unsafe { view.leaf_derivatives_with::<AVX>(&view.data.leaves[leaf], st, size) };
+        let q = super::subdivision_point(view, item(k).1, d);
+        each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
+    });
 }
 
 /// `uv` turned by `quarters` quarter turns about the square's centre, `(u, v) → (1 − v, u)`
@@ -952,6 +1044,41 @@ mod tests {
                 uvs.iter().filter(|&&uv| matches!(view.locate(uv).0.patch, LeafPatch::Gregory(_))).count();
         }
         assert!(gregory_points > 0, "the views reach the Gregory leaf");
+    }
+
+    #[test]
+    fn find_near_places_every_point_as_the_walk_does() {
+        let tree = tree();
+        let views =
+            [tree.clone(), tree.transposed(), tree.rotated(1), tree.quadrant(2), tree.quadrant(1).rotated(3)];
+        // Leaf borders (multiples of 1/4, the domain's edges) and points between, row by row
+        // (where the last leaf is met again), column by column, and scattered.
+        let grid = |i: usize, j: usize| DVec2::new(i as f64, j as f64) / 12.0;
+        let rows: Vec<DVec2> = (0..=12).flat_map(|j| (0..=12).map(move |i| grid(i, j))).collect();
+        let columns: Vec<DVec2> = rows.iter().map(|uv| DVec2::new(uv.y, uv.x)).collect();
+        let mut seed = 3u64;
+        let scattered: Vec<DVec2> = (0..500)
+            .map(|_| {
+                let [p] = points::<1>(&mut seed);
+                // Some of them on the borders: quarters of the domain.
+                let snap = |x: f64| if x > 0.5 { (x * 4.0).round() / 4.0 } else { x.abs() };
+                DVec2::new(snap(p.x), snap(p.y.abs()))
+            })
+            .collect();
+        let bits =
+            |(leaf, st, size): (usize, DVec2, f64)| (leaf, st.to_array().map(f64::to_bits), size.to_bits());
+        let mut walks_saved = 0;
+        for view in &views {
+            for uvs in [&rows, &columns, &scattered] {
+                let mut near = LeafSquare::default();
+                for &uv in uvs {
+                    let before = near;
+                    assert_eq!(bits(view.find_near(uv, &mut near)), bits(view.find(uv)), "at {uv:?}");
+                    walks_saved += usize::from(before.size > 0.0 && before.leaf == near.leaf);
+                }
+            }
+        }
+        assert!(walks_saved > 1000, "the last leaf is used ({walks_saved} points)");
     }
 
     /// `view`'s outputs at `uvs` by [`PatchTree::outputs_each`] (and its AVX build where the
