@@ -569,7 +569,7 @@ impl Writer<'_> {
     fn tree_run(&self, e: usize, end: usize) -> Option<usize> {
         let f = self.fast?;
         let (topo, offsets) = (&self.set.topology, &self.layout.edge_offsets);
-        if f.triangles().active() {
+        if f.triangles().active() || !f.points().any_tree() {
             return None;
         }
         let on_tree = |x: usize| {

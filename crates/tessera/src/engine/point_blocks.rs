@@ -385,6 +385,8 @@ pub(crate) struct PointBlocks {
     all_bicubic: bool,
     /// Some local is ([`PointBlocks::any_bicubic`]), decided once as `all_bicubic` is.
     any_bicubic: bool,
+    /// Some patch is a Catmull-Clark tree ([`PointBlocks::evaluates_on_tree`]).
+    any_tree: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
@@ -817,6 +819,7 @@ impl PointBlocks {
             loop_leaves: Vec::new(),
             all_bicubic: false,
             any_bicubic: false,
+            any_tree: set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_))),
             avx2_fma: avx2_fma && has_avx2_fma(),
         };
         // Each stored tree's first leaf and patch, in patch order.
@@ -912,12 +915,20 @@ impl PointBlocks {
         self.eval_with::<false>(set, p, uvs, out)
     }
 
+    /// Whether some patch is a Catmull-Clark tree.
+    pub(crate) fn any_tree(&self) -> bool {
+        self.any_tree
+    }
+
     /// Whether [`PointBlocks::eval`] takes `points` points of patch `p` of `set` one by one on
     /// its subdivision tree ([`crate::surface::patch_tree::PatchTree::outputs_each`]): a Catmull-Clark tree too sparse
     /// for [`super::tree_points::eval`]'s groups. Such points may be evaluated in a stream
     /// with other patches' ([`PointBlocks::eval_tree_stream`]), with the same values.
     /// Cost: O(1).
     pub(crate) fn evaluates_on_tree(&self, set: &SurfaceSet, p: usize, points: usize) -> bool {
+        if !self.any_tree {
+            return false;
+        }
         match (&set.patches[p], self.locals[p]) {
             (Patch::Subdivision(tree), Local::Generic) => {
                 !super::tree_points::worth_grouping(&**tree, points)
