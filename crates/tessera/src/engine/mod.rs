@@ -572,10 +572,10 @@ impl Writer<'_> {
         if f.triangles().active() || !f.points().any_tree() {
             return None;
         }
+        // (An owner on its tree has no grid form, so the grid kernels never cover such an edge.)
         let on_tree = |x: usize| {
             let inner = (offsets[x + 1] - offsets[x]) as usize;
             topo.edges[x].variants == 1
-                && !f.covers_edge(self.plan, x)
                 && f.points().evaluates_on_tree(self.set, topo.edge_uses(x)[0].patch as usize, inner)
         };
         if !on_tree(e) {

@@ -454,7 +454,12 @@ impl PatchTree {
     /// it ([`found_ahead`] of this tree alone).
     #[inline(always)]
     fn found_ahead(&self, uvs: &[DVec2], corners: bool, mut each: impl FnMut(usize, usize, DVec2, f64)) {
-        found_ahead(uvs.len(), |k| (self, uvs[k]), corners, |k, _, leaf, st, size| each(k, leaf, st, size));
+        found_ahead(
+            uvs.len(),
+            |k| (self, uvs[k]),
+            corners,
+            |k, _, _, leaf, st, size| each(k, leaf, st, size),
+        );
     }
 
     /// The engine's output at each of `uvs` (positions and unit normals rounded to `f32`, as
@@ -463,7 +468,7 @@ impl PatchTree {
     /// [`CornerPoint`] where it holds one, every other evaluated.
     pub(crate) fn outputs_each(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: without AVX, nothing is required of the CPU.
-        unsafe { outputs_with::<false, _>(uvs.len(), |k| (self, uvs[k]), each) }
+        unsafe { outputs_with::<false>(uvs.len(), |k| (self, uvs[k]), each) }
     }
 
     /// [`PatchTree::outputs_each`] for callers compiled for AVX (the engines' AVX2 path): the
@@ -477,7 +482,7 @@ impl PatchTree {
     #[inline(always)]
     pub(crate) unsafe fn outputs_each_avx(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: the caller's precondition.
-        unsafe { outputs_with::<true, _>(uvs.len(), |k| (self, uvs[k]), each) }
+        unsafe { outputs_with::<true>(uvs.len(), |k| (self, uvs[k]), each) }
     }
 
     /// The output at `st` of `leaf` (as [`PatchTree::find`] gives them) from the leaf's
@@ -654,7 +659,7 @@ impl PatchTree {
     }
 }
 
-/// `each(k, view, leaf, st, size)` for each point `k < n` of a stream of points on trees,
+/// `each(k, view, uv, leaf, st, size)` for each point `k < n` of a stream of points on trees,
 /// `item(k) = (view, uv)`, in order, as [`PatchTree::find`] places them: the points found
 /// [`AHEAD`] at a time, with what evaluating them reads asked for first; with `corners`, a
 /// point at its leaf's corner 0 asks for the leaf's [`CornerPoint`] instead of its net.
@@ -668,10 +673,10 @@ fn found_ahead<'t>(
     n: usize,
     item: impl Fn(usize) -> (&'t PatchTree, DVec2),
     corners: bool,
-    mut each: impl FnMut(usize, &'t PatchTree, usize, DVec2, f64),
+    mut each: impl FnMut(usize, &'t PatchTree, DVec2, usize, DVec2, f64),
 ) {
     let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
-    let mut views: [Option<&PatchTree>; AHEAD] = [None; AHEAD];
+    let mut points: [Option<(&PatchTree, DVec2)>; AHEAD] = [None; AHEAD];
     // The tree of the last point found (its data's address) and its last leaf.
     let (mut tree, mut near) = (std::ptr::null(), LeafSquare::default());
     for start in (0..n).step_by(AHEAD) {
@@ -689,11 +694,12 @@ fn found_ahead<'t>(
             } else {
                 prefetch(&view.data.leaves[slot.0], slot.1);
             }
-            (found[i], views[i]) = (slot, Some(view));
+            (found[i], points[i]) = (slot, Some((view, uv)));
         }
         for i in 0..count {
             let (leaf, st, size) = found[i];
-            each(start + i, views[i].expect("found above"), leaf, st, size);
+            let (view, uv) = points[i].expect("found above");
+            each(start + i, view, uv, leaf, st, size);
         }
     }
 }
@@ -709,7 +715,7 @@ pub(crate) fn outputs_stream<'t>(
     each: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
     // SAFETY: without AVX, nothing is required of the CPU.
-    unsafe { outputs_with::<false, _>(n, item, each) }
+    unsafe { outputs_with::<false>(n, item, each) }
 }
 
 /// [`outputs_stream`] for callers compiled for AVX, as [`PatchTree::outputs_each_avx`].
@@ -724,24 +730,24 @@ pub(crate) unsafe fn outputs_stream_avx<'t>(
     each: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
     // SAFETY: the caller's precondition.
-    unsafe { outputs_with::<true, _>(n, item, each) }
+    unsafe { outputs_with::<true>(n, item, each) }
 }
 
 /// # Safety
 /// With `AVX`, the CPU must support AVX.
 #[inline(always)]
-unsafe fn outputs_with<'t, const AVX: bool, F: Fn(usize) -> (&'t PatchTree, DVec2)>(
+unsafe fn outputs_with<'t, const AVX: bool>(
     n: usize,
-    item: F,
+    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
     mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
-    found_ahead(n, &item, true, |k, view, leaf, st, size| {
+    found_ahead(n, item, true, |k, view, uv, leaf, st, size| {
         if let Some((position, normal)) = view.corner_point(leaf, st) {
             return each(k, position, normal);
         }
         // SAFETY: passed on from the caller.
         let d = unsafe { view.leaf_derivatives_with::<AVX>(&view.data.leaves[leaf], st, size) };
-        let q = super::subdivision_point(view, item(k).1, d);
+        let q = super::subdivision_point(view, uv, d);
         each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
     });
 }
