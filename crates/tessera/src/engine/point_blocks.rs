@@ -26,9 +26,10 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
-use super::tree_points::{loop_leaf, LoopLeaf};
+use super::tree_points::{coarse_form, eval_sparse, loop_leaf, LoopLeaf, FORM_LEVEL};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
+use crate::surface::patch_tree::PatchTree;
 use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -334,6 +335,13 @@ enum Local {
     Quartic(u32),
     /// An irregular Loop patch: its tree's leaves start there in [`PointBlocks`]' `loop_leaves`.
     LoopTree(u32),
+    /// A Catmull-Clark tree: the f32 forms of its first `coarse` leaves
+    /// ([`super::tree_points::FORM_LEVEL`]) start at `first` in [`PointBlocks`]' `tree_forms`
+    /// (shared by the views of one tree).
+    CatmarkTree {
+        first: u32,
+        coarse: u8,
+    },
     /// A rational bicubic whose weights span more than f32 carries
     /// ([`super::uniform_quads::MIN_WEIGHT_RATIO`]): the generic f64 evaluation.
     Generic,
@@ -357,6 +365,8 @@ enum Form {
     /// A Loop tree whose leaves' forms the set keeps (made after every patch's form, into
     /// their place in [`PointBlocks`]' vector).
     LoopTree,
+    /// A Catmull-Clark tree (its coarse leaves' forms made after every patch's form).
+    CatmarkTree,
     Generic,
 }
 
@@ -380,6 +390,9 @@ pub(crate) struct PointBlocks {
     /// order: made once per set rather than once for every list of points that reaches a leaf
     /// (the interior's, each owned edge's).
     loop_leaves: Vec<LoopLeaf>,
+    /// The coarse leaves of each Catmull-Clark tree in f32 ([`super::tree_points::coarse_form`]),
+    /// once per tree, the trees in the order of their first view.
+    tree_forms: Vec<LocalPatch>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -805,9 +818,9 @@ impl PointBlocks {
                     None if store_loop_leaves => Form::LoopTree,
                     None => Form::Generic,
                 },
-                // Piecewise (isolated) patches take the generic evaluation, or their points
-                // grouped by leaf (`tree_points`).
-                Patch::Subdivision(_) => Form::Generic,
+                // Piecewise (isolated) patches: their points one by one, their coarse leaves'
+                // in f32, or grouped by leaf (`tree_points`).
+                Patch::Subdivision(_) => Form::CatmarkTree,
             })
             .collect::<Vec<_>>();
         let mut blocks = PointBlocks {
@@ -817,6 +830,7 @@ impl PointBlocks {
             triangles: Vec::new(),
             quartics: Vec::new(),
             loop_leaves: Vec::new(),
+            tree_forms: Vec::new(),
             all_bicubic: false,
             any_bicubic: false,
             any_tree: set.patches.iter().any(|p| matches!(p, Patch::Subdivision(_))),
@@ -824,6 +838,10 @@ impl PointBlocks {
         };
         // Each stored tree's first leaf and patch, in patch order.
         let (mut trees, mut stored) = (Vec::new(), 0usize);
+        // Each Catmull-Clark tree's first form and first view, in order; where each tree's
+        // forms start, by the tree's identity.
+        let (mut catmark, mut forms_made) = (Vec::new(), 0usize);
+        let mut catmark_first = std::collections::HashMap::new();
         for (p, form) in forms.into_iter().enumerate() {
             let local = match form {
                 Form::Bicubic(b) => Local::Bicubic(push(&mut blocks.bicubics, b)),
@@ -836,6 +854,16 @@ impl PointBlocks {
                     let first = stored as u32;
                     stored += tree.leaves().len();
                     Local::LoopTree(first)
+                }
+                Form::CatmarkTree => {
+                    let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("a tree's form") };
+                    let coarse = tree.coarse_leaves(FORM_LEVEL);
+                    let first = *catmark_first.entry(tree.leaves_id()).or_insert_with(|| {
+                        catmark.push((forms_made, p));
+                        forms_made += coarse;
+                        forms_made - coarse
+                    });
+                    Local::CatmarkTree { first: first as u32, coarse: coarse as u8 }
                 }
                 Form::Generic => Local::Generic,
             };
@@ -850,6 +878,15 @@ impl PointBlocks {
                 let (first, p) = trees[trees.partition_point(|&(first, _)| first <= i) - 1];
                 let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
                 loop_leaf(tree, i - first)
+            })
+            .collect();
+        blocks.tree_forms = (0..forms_made)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let (first, p) = catmark[catmark.partition_point(|&(first, _)| first <= i) - 1];
+                let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("a tree's form") };
+                coarse_form(tree, i - first)
             })
             .collect();
         let grid_form = |l: &Local| matches!(l, Local::Bicubic(_) | Local::Rational(_));
@@ -880,7 +917,7 @@ impl PointBlocks {
             Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
             Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
             Local::Quartic(i) => FormRef::Quartic(&self.quartics[i as usize]),
-            Local::LoopTree(_) | Local::Generic => return None,
+            Local::LoopTree(_) | Local::CatmarkTree { .. } | Local::Generic => return None,
         })
     }
 
@@ -921,8 +958,8 @@ impl PointBlocks {
     }
 
     /// Whether [`PointBlocks::eval`] takes `points` points of patch `p` of `set` one by one on
-    /// its subdivision tree ([`crate::surface::patch_tree::PatchTree::outputs_each`]): a Catmull-Clark tree too sparse
-    /// for [`super::tree_points::eval`]'s groups. Such points may be evaluated in a stream
+    /// its subdivision tree ([`super::tree_points::eval_sparse`]): a Catmull-Clark tree too
+    /// sparse for [`super::tree_points::eval`]'s groups. Such points may be evaluated in a stream
     /// with other patches' ([`PointBlocks::eval_tree_stream`]), with the same values.
     /// Cost: O(1).
     pub(crate) fn evaluates_on_tree(&self, set: &SurfaceSet, p: usize, points: usize) -> bool {
@@ -930,7 +967,7 @@ impl PointBlocks {
             return false;
         }
         match (&set.patches[p], self.locals[p]) {
-            (Patch::Subdivision(tree), Local::Generic) => {
+            (Patch::Subdivision(tree), Local::CatmarkTree { .. }) => {
                 !super::tree_points::worth_grouping(&**tree, points)
             }
             _ => false,
@@ -941,10 +978,10 @@ impl PointBlocks {
     /// (vertex `k` each), with the values [`PointBlocks::eval`] gives each patch's points.
     /// Why: the engine's edges have a few points each, each edge on its owner's tree, and
     /// evaluated edge by edge every edge started with none of its leaves' loads in flight
-    /// ([`crate::surface::patch_tree::outputs_stream`] looks ahead across them).
+    /// ([`super::tree_points::eval_sparse`] looks ahead across them).
     /// Preconditions: every patch [`PointBlocks::evaluates_on_tree`] for its points (each
     /// edge's count); `out` holds `items.len()` vertices. Cost: as many points of
-    /// [`crate::surface::patch_tree::PatchTree::outputs_each`], no allocation.
+    /// [`super::tree_points::eval_sparse`], no allocation.
     pub(crate) fn eval_tree_stream(&self, set: &SurfaceSet, items: &[(u32, DVec2)], out: VertexSlices<'_>) {
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
@@ -976,26 +1013,29 @@ impl PointBlocks {
         items: &[(u32, DVec2)],
         out: VertexSlices<'_>,
     ) {
-        use crate::surface::patch_tree::{outputs_stream, PatchTree};
-        let item = |k: usize| -> (&PatchTree, DVec2) {
-            let (p, uv) = items[k];
-            match &set.patches[p as usize] {
-                Patch::Subdivision(tree) => (&**tree, uv),
-                _ => unreachable!("eval_tree_stream's precondition: points on subdivision trees"),
+        eval_sparse::<FMA>(
+            set,
+            items.len(),
+            |k| {
+                let (p, uv) = items[k];
+                let (tree, forms) = self.tree(set, p as usize);
+                (p, tree, forms, uv)
+            },
+            out,
+        )
+    }
+
+    /// Patch `p`'s Catmull-Clark tree and its coarse leaves' forms ([`eval_sparse`]).
+    /// Precondition: `p` is a Catmull-Clark tree.
+    #[inline(always)]
+    fn tree<'s>(&'s self, set: &'s SurfaceSet, p: usize) -> (&'s PatchTree, &'s [LocalPatch]) {
+        match (&set.patches[p], self.locals[p]) {
+            (Patch::Subdivision(tree), Local::CatmarkTree { first, coarse }) => {
+                let first = first as usize;
+                (&**tree, &self.tree_forms[first..first + usize::from(coarse)])
             }
-        };
-        let write = |k: usize, position, normal| {
-            out.pos[k] = position;
-            out.nrm[k] = normal;
-            out.uv[k] = items[k].1.as_vec2().to_array();
-            out.patch[k] = items[k].0;
-        };
-        #[cfg(target_arch = "x86_64")]
-        if FMA {
-            // SAFETY: `FMA` is only set in `eval_tree_stream_avx2_fma`, for a CPU with AVX2 and FMA.
-            return unsafe { crate::surface::patch_tree::outputs_stream_avx(items.len(), item, write) };
+            _ => unreachable!("the precondition: a Catmull-Clark tree"),
         }
-        outputs_stream(items.len(), item, write)
     }
 
     /// [`PointBlocks::eval_with`] compiled for AVX2 and FMA (everything it calls is inlined).
@@ -1010,11 +1050,15 @@ impl PointBlocks {
 
     #[inline(always)]
     fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        if let Local::Generic | Local::LoopTree(_) = self.locals[p] {
+        if let Local::Generic | Local::LoopTree(_) | Local::CatmarkTree { .. } = self.locals[p] {
             use super::tree_points::{eval as grouped, worth_grouping};
             match (&set.patches[p], self.locals[p]) {
                 (Patch::Subdivision(tree), _) if worth_grouping(&**tree, uvs.len()) => {
                     return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
+                }
+                (Patch::Subdivision(_), _) => {
+                    let (tree, forms) = self.tree(set, p);
+                    return eval_sparse::<FMA>(set, uvs.len(), |k| (p as u32, tree, forms, uvs[k]), out);
                 }
                 (Patch::Loop(tree), Local::LoopTree(first)) if worth_grouping(&**tree, uvs.len()) => {
                     let first = first as usize;
@@ -1032,21 +1076,6 @@ impl PointBlocks {
             // In f64 as the generic evaluation, compiled here for the wider instructions
             // (Rust never fuses a multiply and an add by itself, so the values are the same).
             let mut out = out;
-            if let Patch::Subdivision(tree) = &set.patches[p] {
-                // The same values, points on a leaf's corner read from its record.
-                let write = |k: usize, position, normal| {
-                    out.pos[k] = position;
-                    out.nrm[k] = normal;
-                    out.uv[k] = uvs[k].as_vec2().to_array();
-                    out.patch[k] = p as u32;
-                };
-                #[cfg(target_arch = "x86_64")]
-                if FMA {
-                    // SAFETY: `FMA` is only set in `eval_avx2_fma`, for a CPU with AVX2 and FMA.
-                    return unsafe { tree.outputs_each_avx(uvs, write) };
-                }
-                return tree.outputs_each(uvs, write);
-            }
             set.patches[p].eval_each(uvs, |k, point| out.put(k, p as u32, uvs[k], point));
             return;
         }

@@ -41,7 +41,7 @@ use super::point_blocks::{
 };
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
-use crate::surface::patch_tree::{prefetch_slice_to_l2, LeafPatch, LeafSquare, PatchTree};
+use crate::surface::patch_tree::{prefetch_slice, prefetch_slice_to_l2, LeafPatch, LeafSquare, PatchTree};
 use crate::surface::triangle_tree::TriangleLeafPatch;
 use crate::surface::{loop_point, subdivision_point, SurfacePoint, SurfaceSet, TriangleTree};
 
@@ -405,6 +405,176 @@ fn blocks<const FMA: bool, const L: usize, T: LeafTree>(
     }
 }
 
+/// The finest level of a Catmull-Clark tree's leaves that [`super::point_blocks::PointBlocks`]
+/// keeps in f32 ([`coarse_form`]; [`PatchTree::coarse_leaves`]), for [`eval_sparse`].
+///
+/// **Why these.** A deep tree is sparse as a whole (most of its leaves are small and hold no
+/// point) while its few coarse leaves hold most of its points: at Bfr's rate 16 on
+/// `catmark_rook`, 61,000 of the 77,000 points a copy evaluates one by one lie in leaves of
+/// levels 1–3 (13 to 48 points a leaf), against 16,000 in the 97,000 leaves of levels 4–6 (a
+/// point in six leaves). Kept in f32 those points take the bicubic kernel, several at a
+/// time, without the f64 path's per-point sums, and without the cost of moving a net to its
+/// frame for every list that meets it. **Memory:** a tree has at most 85 leaves of levels ≤ 3
+/// (1 + 4 + 16 + 64), 208 bytes each, about half a leaf's own 424, and most trees far fewer.
+pub(crate) const FORM_LEVEL: u8 = 3;
+
+/// Leaf `leaf`'s f32 form as [`eval_sparse`] reads it: a Bézier leaf's net in its local frame;
+/// for an end cap (Gregory, evaluated in f64) a form whose `scale` is 0, which no local frame
+/// has ([`super::point_blocks::power_of_two_above`]). Cost: O(1).
+pub(super) fn coarse_form(tree: &PatchTree, leaf: usize) -> LocalPatch {
+    match &tree.leaves()[leaf].patch {
+        LeafPatch::Bezier(net) => LocalPatch::from_net(net),
+        LeafPatch::Gregory(_) => LocalPatch { origin: [0.0; 3], scale: 0.0, by_v: [[[0.0; 4]; 4]; 3] },
+    }
+}
+
+/// Points of one leaf's f32 form waiting to be evaluated together ([`eval_sparse`]).
+struct Pending<'t> {
+    form: Option<&'t LocalPatch>,
+    p: u32,
+    flip: bool,
+    count: usize,
+    k: [u32; LANES],
+    st: [DVec2; LANES],
+    uv: [DVec2; LANES],
+}
+
+impl Pending<'_> {
+    /// Evaluates the waiting points into `out` and empties the block.
+    #[inline(always)]
+    fn flush<const FMA: bool>(&mut self, set: &SurfaceSet, out: &mut VertexSlices<'_>) {
+        if self.count <= LANES / 2 {
+            self.lanes::<FMA, { LANES / 2 }>(set, out);
+        } else {
+            self.lanes::<FMA, LANES>(set, out);
+        }
+        self.count = 0;
+    }
+
+    #[inline(always)]
+    fn lanes<const FMA: bool, const L: usize>(&self, set: &SurfaceSet, out: &mut VertexSlices<'_>) {
+        let Some(form) = self.form else { return };
+        // Spare lanes repeat the last point: a real point, so its margin is meaningful.
+        let (mut u, mut v) = ([0f32; L], [0f32; L]);
+        for l in 0..L {
+            let st = self.st[l.min(self.count - 1)];
+            (u[l], v[l]) = (st.x as f32, st.y as f32);
+        }
+        let block = bicubic_block::<FMA, L>(form, &u, &v);
+        for l in 0..self.count {
+            let k = self.k[l] as usize;
+            let (pos, nrm) = block.lane_or_exact(l, set, self.p as usize, self.uv[l]);
+            // The kernel's normal is the leaf's; the f64 fallback's is already the view's.
+            let turn = self.flip && block.margin[l] > 0.0;
+            out.pos[k] = pos;
+            out.nrm[k] = if turn { nrm.map(|x| -x) } else { nrm };
+            out.uv[k] = self.uv[l].as_vec2().to_array();
+            out.patch[k] = self.p;
+        }
+    }
+}
+
+/// Evaluates a stream of points on Catmull-Clark trees, `item(k) = (patch, view, forms, uv)`
+/// (the patch's tree, [`coarse_form`] of each of its tree's first leaves, the point), into
+/// `out` (vertex `k` each: position, normal, parameters, patch id). Each point on its own
+/// rule, whatever the points around it, so that a point's value does not depend on the list
+/// it comes in (the engine's edges are evaluated as one stream or patch by patch): a point at
+/// its leaf's corner 0 from the leaf's [`crate::surface::patch_tree::CornerPoint`]; a point
+/// of a leaf with a form by the f32 bicubic kernel, consecutive points of one leaf in one
+/// block; every other in f64 ([`PatchTree::found_derivatives_avx`]). The leaves are found
+/// and asked for ahead ([`crate::surface::patch_tree::Lookahead`]). Preconditions: `out`
+/// holds `n` vertices; with `FMA`, the CPU has AVX2 and FMA. Cost: per point a leaf search
+/// (none in the last point's leaf), then a record's read, a kernel lane, or the f64
+/// evaluation; no allocation.
+#[inline(always)]
+pub(super) fn eval_sparse<'t, const FMA: bool>(
+    set: &'t SurfaceSet,
+    n: usize,
+    item: impl Fn(usize) -> (u32, &'t PatchTree, &'t [LocalPatch], DVec2),
+    mut out: VertexSlices<'_>,
+) {
+    use crate::surface::patch_tree::{Lookahead, AHEAD};
+    let empty = || Pending {
+        form: None,
+        p: 0,
+        flip: false,
+        count: 0,
+        k: [0; LANES],
+        st: [DVec2::ZERO; LANES],
+        uv: [DVec2::ZERO; LANES],
+    };
+    let mut pending: [Pending; OPEN_BLOCKS] = std::array::from_fn(|_| empty());
+    let mut next_slot = 0;
+    let mut ahead = Lookahead::default();
+    let stream = |k: usize| {
+        let (_, view, _, uv) = item(k);
+        (view, uv)
+    };
+    let prefetch = |k: usize, view: &PatchTree, leaf: usize, st: DVec2| match item(k).2.get(leaf) {
+        Some(form) if st != DVec2::ZERO => prefetch_slice(std::slice::from_ref(form)),
+        _ => view.prefetch_point(leaf, st, true),
+    };
+    for start in (0..n).step_by(AHEAD) {
+        for (i, f) in ahead.find(start, n, stream, prefetch).iter().flatten().enumerate() {
+            let k = start + i;
+            let (view, uv, leaf, st) = (f.view, f.uv, f.leaf, f.st);
+            let (p, _, forms, _) = item(k);
+            if let Some((position, normal)) = view.corner_point(leaf, st) {
+                (out.pos[k], out.nrm[k]) = (position, normal);
+            } else if let Some(form) = forms.get(leaf).filter(|f| f.scale != 0.0) {
+                let open = pending
+                    .iter()
+                    .position(|b| b.count > 0 && b.p == p && b.form.is_some_and(|f| std::ptr::eq(f, form)));
+                let slot = match open {
+                    Some(slot) => slot,
+                    None => {
+                        let slot = pending.iter().position(|b| b.count == 0).unwrap_or(next_slot);
+                        next_slot = (slot + 1) % OPEN_BLOCKS;
+                        slot
+                    }
+                };
+                let block = &mut pending[slot];
+                if block.count > 0 && open.is_none() {
+                    block.flush::<FMA>(set, &mut out);
+                }
+                if block.count == 0 {
+                    (block.form, block.p, block.flip) = (Some(form), p, view.is_transposed());
+                }
+                let at = block.count;
+                (block.k[at], block.st[at], block.uv[at]) = (k as u32, st, uv);
+                block.count += 1;
+                if block.count == LANES {
+                    block.flush::<FMA>(set, &mut out);
+                }
+                continue;
+            } else {
+                #[cfg(target_arch = "x86_64")]
+                let d = if FMA {
+                    // SAFETY: `FMA` is only set for a CPU with AVX2 and FMA (the caller's precondition).
+                    unsafe { view.found_derivatives_avx(leaf, st, f.size) }
+                } else {
+                    view.found_derivatives(leaf, st, f.size)
+                };
+                #[cfg(not(target_arch = "x86_64"))]
+                let d = view.found_derivatives(leaf, st, f.size);
+                let q = subdivision_point(view, uv, d);
+                (out.pos[k], out.nrm[k]) = (q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
+            }
+            out.uv[k] = uv.as_vec2().to_array();
+            out.patch[k] = p;
+        }
+    }
+    for block in &mut pending {
+        if block.count > 0 {
+            block.flush::<FMA>(set, &mut out);
+        }
+    }
+}
+
+/// How many leaves' blocks [`eval_sparse`] keeps open at once: a pattern's points come row by
+/// row, so a leaf's points are a run of each of several rows, between other leaves' runs.
+const OPEN_BLOCKS: usize = 4;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -504,6 +674,90 @@ mod tests {
             kernels += made.iter().sum::<usize>();
         }
         assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
+    }
+
+    /// Every isolated view of every Catmull-Clark cage that builds, at Bfr's rate 8 grid and
+    /// a scattered set of points, through [`PointBlocks`] as the engine calls it where the view
+    /// is too sparse to group ([`eval_sparse`]): every point within the f32 kernels' promise
+    /// of the generic f64 evaluation ([`assert_matches_f64`]); every point outside the coarse
+    /// leaves' forms ([`FORM_LEVEL`]) bit for bit the f64 path's
+    /// ([`PatchTree::outputs_each`]); and most of those inside them from the kernels. The
+    /// trees' leaves come coarsest first, so the forms are the leaves' first ones.
+    #[test]
+    fn sparse_points_match_the_f64_evaluation_on_every_catmark_cage() {
+        let cages = crate::test_support::data_files("subdivision", &["catmark_"]);
+        let n = 8;
+        let mut uvs: Vec<DVec2> =
+            (0..=n).flat_map(|j| (0..=n).map(move |i| DVec2::new(i as f64, j as f64) / n as f64)).collect();
+        let mut seed = 7u64;
+        uvs.extend((0..40).map(|_| {
+            let mut next = || {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (seed >> 11) as f64 / (1u64 << 53) as f64
+            };
+            DVec2::new(next(), next())
+        }));
+        let (mut sparse_views, mut coarse_points, mut coarse_kernels, mut fine_points) = (0, 0, 0, 0);
+        for path in &cages {
+            let mesh = crate::io::obj::read_obj(path).unwrap();
+            let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, path, Default::default()) else {
+                continue;
+            };
+            let (lo, hi) = set.bounds();
+            let size = lo.distance(hi) as f32;
+            let blocks = [false, true].map(|fma| PointBlocks::for_set(&set, fma));
+            for (p, patch) in set.patches.iter().enumerate() {
+                let Patch::Subdivision(view) = patch else { continue };
+                let levels: Vec<u8> = view.leaves().iter().map(|l| l.level).collect();
+                assert!(levels.is_sorted(), "{}: leaves coarsest first", path.display());
+                if !blocks[0].evaluates_on_tree(&set, p, uvs.len()) {
+                    continue;
+                }
+                sparse_views += 1;
+                let what = format!("{} patch {p}", path.display());
+                let made = assert_matches_f64(&what, &set, p, &uvs, size, |fma, out| {
+                    blocks[usize::from(fma)].eval(&set, p, &uvs, out)
+                });
+                let mut f64_path = vec![None; uvs.len()];
+                view.outputs_each(&uvs, |k, position, normal| f64_path[k] = Some((position, normal)));
+                let coarse = view.coarse_leaves(FORM_LEVEL);
+                let m = uvs.len();
+                let (mut pos, mut nrm, mut uv, mut ids) =
+                    (vec![[0f32; 3]; m], vec![[0f32; 3]; m], vec![[0f32; 2]; m], vec![0u32; m]);
+                blocks[0].eval(
+                    &set,
+                    p,
+                    &uvs,
+                    VertexSlices { pos: &mut pos, nrm: &mut nrm, uv: &mut uv, patch: &mut ids },
+                );
+                for (k, &at) in uvs.iter().enumerate() {
+                    let (leaf, st, _) = view.find(at);
+                    let stored = view.corner_point(leaf, st).is_some();
+                    let bezier = matches!(view.leaves()[leaf].patch, LeafPatch::Bezier(_));
+                    if leaf < coarse && bezier && !stored {
+                        coarse_points += 1;
+                        coarse_kernels += made[k];
+                    } else {
+                        fine_points += 1;
+                        assert_eq!(
+                            Some((pos[k], nrm[k])),
+                            f64_path[k],
+                            "{what} at {at:?}: the f64 path's bits"
+                        );
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "{sparse_views} sparse views: {coarse_points} points in coarse leaves ({coarse_kernels} normals from \
+             the kernels, both builds), {fine_points} others"
+        );
+        assert!(sparse_views >= 100, "only {sparse_views} sparse views");
+        assert!(fine_points > 1000, "only {fine_points} points outside the coarse leaves");
+        assert!(
+            coarse_kernels * 2 > coarse_points,
+            "only {coarse_kernels} of {coarse_points} normals from the kernels"
+        );
     }
 
     /// Every Loop patch of every manifold `loop_*` cage, as built and swapped (the opposite

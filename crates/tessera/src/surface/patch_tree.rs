@@ -167,7 +167,30 @@ struct TreeData {
 }
 
 impl TreeData {
-    fn new(leaves: Vec<Leaf>, nodes: Vec<[Slot; 4]>, root: Slot) -> TreeData {
+    /// The tree of `leaves` under `root`, its leaves put in order of level (coarsest first,
+    /// otherwise as given) and the nodes' leaf slots renumbered to match. Why: the coarse
+    /// leaves are a prefix, so a reader that keeps something for every leaf up to a level (the
+    /// engine's f32 forms, [`PatchTree::coarse_leaves`]) finds it at the leaf's own index.
+    fn new(leaves: Vec<Leaf>, mut nodes: Vec<[Slot; 4]>, mut root: Slot) -> TreeData {
+        let mut order: Vec<u32> = (0..leaves.len() as u32).collect();
+        order.sort_by_key(|&i| leaves[i as usize].level);
+        let leaves = if order.iter().enumerate().all(|(at, &i)| at == i as usize) {
+            leaves
+        } else {
+            let mut place = vec![0u32; leaves.len()];
+            for (at, &i) in order.iter().enumerate() {
+                place[i as usize] = at as u32;
+            }
+            let renumber = |slot: &mut Slot| {
+                if let Slot::Leaf(i) = slot {
+                    *i = place[*i as usize];
+                }
+            };
+            nodes.iter_mut().flatten().for_each(renumber);
+            renumber(&mut root);
+            let mut old: Vec<Option<Leaf>> = leaves.into_iter().map(Some).collect();
+            order.iter().map(|&i| old[i as usize].take().expect("a permutation")).collect()
+        };
         let corners = leaves.iter().map(CornerPoint::of).collect();
         TreeData { leaves, nodes, root, corners }
     }
@@ -283,9 +306,15 @@ impl PatchTree {
         tree
     }
 
-    /// The leaves of the whole tree (of every view of it).
+    /// The leaves of the whole tree (of every view of it), in order of level, coarsest first.
     pub fn leaves(&self) -> &[Leaf] {
         &self.data.leaves
+    }
+
+    /// How many leaves are of level `level` or coarser: the first ones of
+    /// [`PatchTree::leaves`]. Cost: O(log leaves).
+    pub fn coarse_leaves(&self, level: u8) -> usize {
+        self.data.leaves.partition_point(|leaf| leaf.level <= level)
     }
 
     /// Appends the points of every leaf of the tree (of every view of it) to `out`, leaf by
@@ -457,28 +486,39 @@ impl PatchTree {
         found_ahead(
             uvs.len(),
             |k| (self, uvs[k]),
-            corners,
+            |_, view, leaf, st| view.prefetch_point(leaf, st, corners),
             |k, _, _, leaf, st, size| each(k, leaf, st, size),
         );
     }
 
-    /// The engine's output at each of `uvs` (positions and unit normals rounded to `f32`, as
+    /// Starts loading what the engine reads for the point at `st` in `leaf`: with `corners`
+    /// and at the leaf's corner 0 its [`CornerPoint`], else the leaf's net (a hint).
+    #[inline(always)]
+    pub(crate) fn prefetch_point(&self, leaf: usize, st: DVec2, corners: bool) {
+        if corners && st == DVec2::ZERO {
+            prefetch_at::<TO_L1>((&self.data.corners[leaf] as *const CornerPoint).cast());
+        } else {
+            prefetch(&self.data.leaves[leaf], st);
+        }
+    }
+
+    /// The f64 output at each of `uvs` (positions and unit normals rounded to `f32`, as
     /// [`subdivision_point`](super::subdivision_point) of [`PatchTree::derivatives_each`]
     /// gives them, bit for bit): a point at a leaf's corner 0 read from the leaf's
-    /// [`CornerPoint`] where it holds one, every other evaluated.
+    /// [`CornerPoint`] where it holds one, every other evaluated. What the engine gives a
+    /// point outside the leaves it keeps in f32 (`engine::tree_points::eval_sparse`).
+    #[cfg(test)]
     pub(crate) fn outputs_each(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: without AVX, nothing is required of the CPU.
         unsafe { outputs_with::<false>(uvs.len(), |k| (self, uvs[k]), each) }
     }
 
-    /// [`PatchTree::outputs_each`] for callers compiled for AVX (the engines' AVX2 path): the
-    /// Bézier sums are inlined into the caller, so their results stay in registers. Through a
-    /// call, profiles showed the caller stalling on reading back the callee's wide stores (a
-    /// fifth of the evaluation's samples). The same values.
+    /// [`PatchTree::outputs_each`] compiled for AVX, as the engine's AVX2 path evaluates
+    /// (`found_derivatives_avx`, inlined into its caller): the same values.
     ///
     /// # Safety
     /// The CPU must support AVX.
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(test, target_arch = "x86_64"))]
     #[inline(always)]
     pub(crate) unsafe fn outputs_each_avx(&self, uvs: &[DVec2], each: impl FnMut(usize, [f32; 3], [f32; 3])) {
         // SAFETY: the caller's precondition.
@@ -496,8 +536,10 @@ impl PatchTree {
     }
 
     /// [`PatchTree::derivatives`] of the point [`PatchTree::find`] placed at `st` in leaf
-    /// `leaf` (of side `size`), for callers compiled for AVX as
-    /// [`PatchTree::outputs_each_avx`] is: the same values.
+    /// `leaf` (of side `size`), for callers compiled for AVX (the engine's AVX2 path): the
+    /// Bézier sums are inlined into the caller, so their results stay in registers. Through a
+    /// call, profiles showed the caller stalling on reading back the callee's wide stores (a
+    /// fifth of the evaluation's samples). The same values.
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -661,95 +703,105 @@ impl PatchTree {
 
 /// `each(k, view, uv, leaf, st, size)` for each point `k < n` of a stream of points on trees,
 /// `item(k) = (view, uv)`, in order, as [`PatchTree::find`] places them: the points found
-/// [`AHEAD`] at a time, with what evaluating them reads asked for first; with `corners`, a
-/// point at its leaf's corner 0 asks for the leaf's [`CornerPoint`] instead of its net.
+/// [`AHEAD`] at a time, and `prefetch(k, view, leaf, st)` called for each (to ask for what
+/// evaluating it reads) before any of them is evaluated.
 /// Why ahead: a tessellation's points mostly fall in different leaves (at factor 8 a grid
 /// step is 8 of the deepest leaves), and profiles show the load of each point's leaf (a few
 /// hundred bytes) stalling ([`PatchTree::derivatives_each`]). Why a stream of trees: the
 /// engine's edges, a few points each on different trees, would start every edge with no
-/// load in flight ([`outputs_stream_avx`]).
+/// load in flight (`engine::tree_points::eval_sparse`, through [`Lookahead`]).
 #[inline(always)]
-fn found_ahead<'t>(
+pub(crate) fn found_ahead<'t>(
     n: usize,
     item: impl Fn(usize) -> (&'t PatchTree, DVec2),
-    corners: bool,
+    prefetch: impl Fn(usize, &'t PatchTree, usize, DVec2),
     mut each: impl FnMut(usize, &'t PatchTree, DVec2, usize, DVec2, f64),
 ) {
-    let mut found = [(0, DVec2::ZERO, 1.0); AHEAD];
-    let mut points: [Option<(&PatchTree, DVec2)>; AHEAD] = [None; AHEAD];
-    // The tree of the last point found (its data's address) and its last leaf.
-    let (mut tree, mut near) = (std::ptr::null(), LeafSquare::default());
+    let mut ahead = Lookahead::default();
     for start in (0..n).step_by(AHEAD) {
-        let count = AHEAD.min(n - start);
-        for i in 0..count {
-            let (view, uv) = item(start + i);
-            if !std::ptr::eq(tree, &*view.data) {
-                tree = &*view.data;
-                near = LeafSquare::default();
-                prefetch_slice(&view.data.nodes);
-            }
-            let slot = view.find_near(uv, &mut near);
-            if corners && slot.1 == DVec2::ZERO {
-                prefetch_at::<TO_L1>((&view.data.corners[slot.0] as *const CornerPoint).cast());
-            } else {
-                prefetch(&view.data.leaves[slot.0], slot.1);
-            }
-            (found[i], points[i]) = (slot, Some((view, uv)));
-        }
-        for i in 0..count {
-            let (leaf, st, size) = found[i];
-            let (view, uv) = points[i].expect("found above");
-            each(start + i, view, uv, leaf, st, size);
+        for (i, f) in ahead.find(start, n, &item, &prefetch).iter().flatten().enumerate() {
+            each(start + i, f.view, f.uv, f.leaf, f.st, f.size);
         }
     }
 }
 
-/// The engine's output (as [`PatchTree::outputs_each`] gives it, bit for bit) at each point
-/// `k < n` of a stream `item(k) = (view, uv)` of points on trees, handed to
-/// `each(k, position, normal)` in order. Made for the engine's edges: each edge's few
-/// points are on its owner's tree, and the look-ahead runs on from edge to edge.
-/// Cost: as many [`PatchTree::outputs_each`] points.
-pub(crate) fn outputs_stream<'t>(
-    n: usize,
-    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
-    each: impl FnMut(usize, [f32; 3], [f32; 3]),
-) {
-    // SAFETY: without AVX, nothing is required of the CPU.
-    unsafe { outputs_with::<false>(n, item, each) }
+/// A point of a stream on trees and where [`PatchTree::find`] places it ([`Lookahead`]).
+#[derive(Clone, Copy)]
+pub(crate) struct FoundPoint<'t> {
+    pub(crate) view: &'t PatchTree,
+    pub(crate) uv: DVec2,
+    pub(crate) leaf: usize,
+    pub(crate) st: DVec2,
+    pub(crate) size: f64,
 }
 
-/// [`outputs_stream`] for callers compiled for AVX, as [`PatchTree::outputs_each_avx`].
-///
-/// # Safety
-/// The CPU must support AVX.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) unsafe fn outputs_stream_avx<'t>(
-    n: usize,
-    item: impl Fn(usize) -> (&'t PatchTree, DVec2),
-    each: impl FnMut(usize, [f32; 3], [f32; 3]),
-) {
-    // SAFETY: the caller's precondition.
-    unsafe { outputs_with::<true>(n, item, each) }
+/// [`found_ahead`]'s search, for a caller that evaluates the points in its own loop (whose
+/// body, inlined there, is compiled for the caller's instructions, where a closure's body
+/// may not be): the next [`AHEAD`] points of a stream at a time, each asked for before any
+/// is returned. Keeps the last tree and leaf found ([`PatchTree::find_near`]).
+pub(crate) struct Lookahead<'t> {
+    tree: *const TreeData,
+    near: LeafSquare,
+    found: [Option<FoundPoint<'t>>; AHEAD],
+}
+
+impl Default for Lookahead<'_> {
+    fn default() -> Self {
+        Lookahead { tree: std::ptr::null(), near: LeafSquare::default(), found: [None; AHEAD] }
+    }
+}
+
+impl<'t> Lookahead<'t> {
+    /// Points `start..` (at most [`AHEAD`], up to `n`) of the stream `item(k) = (view, uv)`,
+    /// found, `prefetch(k, view, leaf, st)` called for each before they are returned (all
+    /// `Some`).
+    #[inline(always)]
+    pub(crate) fn find(
+        &mut self,
+        start: usize,
+        n: usize,
+        item: impl Fn(usize) -> (&'t PatchTree, DVec2),
+        prefetch: impl Fn(usize, &'t PatchTree, usize, DVec2),
+    ) -> &[Option<FoundPoint<'t>>] {
+        let count = AHEAD.min(n - start);
+        for i in 0..count {
+            let (view, uv) = item(start + i);
+            if !std::ptr::eq(self.tree, &*view.data) {
+                self.tree = &*view.data;
+                self.near = LeafSquare::default();
+                prefetch_slice(&view.data.nodes);
+            }
+            let (leaf, st, size) = view.find_near(uv, &mut self.near);
+            prefetch(start + i, view, leaf, st);
+            self.found[i] = Some(FoundPoint { view, uv, leaf, st, size });
+        }
+        &self.found[..count]
+    }
 }
 
 /// # Safety
 /// With `AVX`, the CPU must support AVX.
+#[cfg(test)]
 #[inline(always)]
 unsafe fn outputs_with<'t, const AVX: bool>(
     n: usize,
     item: impl Fn(usize) -> (&'t PatchTree, DVec2),
     mut each: impl FnMut(usize, [f32; 3], [f32; 3]),
 ) {
-    found_ahead(n, item, true, |k, view, uv, leaf, st, size| {
-        if let Some((position, normal)) = view.corner_point(leaf, st) {
-            return each(k, position, normal);
-        }
-        // SAFETY: passed on from the caller.
-        let d = unsafe { view.leaf_derivatives_with::<AVX>(&view.data.leaves[leaf], st, size) };
-        let q = super::subdivision_point(view, uv, d);
-        each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
-    });
+    found_ahead(
+        n,
+        item,
+        |_, view, leaf, st| view.prefetch_point(leaf, st, true),
+        |k, view, uv, leaf, st, size| {
+            if let Some((position, normal)) = view.corner_point(leaf, st) {
+                return each(k, position, normal);
+            }
+            // SAFETY: passed on from the caller.
+            let d = unsafe { view.leaf_derivatives_with::<AVX>(&view.data.leaves[leaf], st, size) };
+            let q = super::subdivision_point(view, uv, d);
+            each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
+        },
+    );
 }
 
 /// `uv` turned by `quarters` quarter turns about the square's centre, `(u, v) → (1 − v, u)`
@@ -764,7 +816,7 @@ pub fn rotate(uv: DVec2, quarters: u8) -> DVec2 {
 
 /// Points whose leaves [`PatchTree::derivatives_each`] looks up before evaluating any: a few
 /// loads in flight, few enough that their leaves (eight of 424 bytes) stay in L1.
-const AHEAD: usize = 8;
+pub(crate) const AHEAD: usize = 8;
 
 /// Starts loading what evaluating `leaf` at `st` reads into the cache (a hint: no effect
 /// on results): its tag and, for a Bézier leaf, the rows of the net that [`live`] keeps.
@@ -884,7 +936,7 @@ unsafe fn bezier_derivatives_avx(points: &[DVec3; 16], st: DVec2) -> (DVec3, DVe
 }
 
 /// The body of [`bezier_derivatives_avx`], to be inlined into functions compiled for AVX
-/// ([`PatchTree::outputs_each_avx`]); elsewhere its intrinsics would be calls.
+/// ([`PatchTree::found_derivatives_avx`]); elsewhere its intrinsics would be calls.
 ///
 /// # Safety
 /// The CPU must support AVX.
