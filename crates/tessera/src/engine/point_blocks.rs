@@ -863,7 +863,8 @@ impl PointBlocks {
                         forms_made += coarse;
                         forms_made - coarse
                     });
-                    Local::CatmarkTree { first: first as u32, coarse: coarse as u8 }
+                    let coarse = u8::try_from(coarse).expect("at most 64 leaves of levels ≤ 3 tile a square");
+                    Local::CatmarkTree { first: first as u32, coarse }
                 }
                 Form::Generic => Local::Generic,
             };

@@ -13,7 +13,12 @@
 //! others or more. Such a group pays once for moving its leaf's net to a local frame and
 //! rounding it to f32, then takes the bicubic kernel's price per point. A point alone in its
 //! leaf (a deep tree's), or in a Catmull-Clark end cap (a Gregory patch), keeps the f64
-//! evaluation. Loop's trees are the same story with quartic triangles for bicubics
+//! evaluation.
+//!
+//! **Sparse trees** ([`eval_sparse`]): where a view's points are too few for its leaves to
+//! be worth sorting, they are taken in their list's order, and those in a tree's coarse
+//! leaves (levels 1–3, [`FORM_LEVEL`], whose f32 forms the set keeps once) go to the kernel
+//! in blocks of consecutive points of one leaf; the rest take the f64 path. Loop's trees are the same story with quartic triangles for bicubics
 //! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame), and their
 //! end caps, Gregory triangles, take the quartic kernel too, with each lane's blend of the
 //! face points added ([`super::point_blocks::gregory_block`]).
@@ -411,11 +416,13 @@ fn blocks<const FMA: bool, const L: usize, T: LeafTree>(
 /// **Why these.** A deep tree is sparse as a whole (most of its leaves are small and hold no
 /// point) while its few coarse leaves hold most of its points: at Bfr's rate 16 on
 /// `catmark_rook`, 61,000 of the 77,000 points a copy evaluates one by one lie in leaves of
-/// levels 1–3 (13 to 48 points a leaf), against 16,000 in the 97,000 leaves of levels 4–6 (a
+/// levels 1–3 (4 to 48 points a leaf), against 16,000 in the 97,000 leaves of levels 4–6 (a
 /// point in six leaves). Kept in f32 those points take the bicubic kernel, several at a
 /// time, without the f64 path's per-point sums, and without the cost of moving a net to its
-/// frame for every list that meets it. **Memory:** a tree has at most 85 leaves of levels ≤ 3
-/// (1 + 4 + 16 + 64), 208 bytes each, about half a leaf's own 424, and most trees far fewer.
+/// frame for every list that meets it (a level of 4 measured no faster). **Memory:** the
+/// leaves tile the tree's square, so at most 64 are of levels ≤ 3; 208 bytes each, about
+/// half a leaf's own 424 (the rook copied 65 times: 422,000 forms, 88 MB beside its trees'
+/// 3 GB).
 pub(crate) const FORM_LEVEL: u8 = 3;
 
 /// Leaf `leaf`'s f32 form as [`eval_sparse`] reads it: a Bézier leaf's net in its local frame;
@@ -573,6 +580,8 @@ pub(super) fn eval_sparse<'t, const FMA: bool>(
 
 /// How many leaves' blocks [`eval_sparse`] keeps open at once: a pattern's points come row by
 /// row, so a leaf's points are a run of each of several rows, between other leaves' runs.
+/// (One open block measured the same on the rook within the host's noise; four fill the
+/// blocks of a leaf that several rows cross.)
 const OPEN_BLOCKS: usize = 4;
 
 #[cfg(test)]
