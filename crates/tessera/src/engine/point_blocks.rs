@@ -1055,7 +1055,8 @@ impl PointBlocks {
             use super::tree_points::{eval as grouped, worth_grouping};
             match (&set.patches[p], self.locals[p]) {
                 (Patch::Subdivision(tree), _) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
+                    let (tree, forms) = self.tree(set, p);
+                    return grouped::<FMA, _>(set, p, tree, Some(forms), uvs, out);
                 }
                 (Patch::Subdivision(_), _) => {
                     let (tree, forms) = self.tree(set, p);

@@ -88,6 +88,11 @@ pub(super) trait LeafTree {
     /// Leaf `leaf`'s net in its local frame; None for an end cap without an f32 kernel (a
     /// Catmull-Clark Gregory patch, evaluated in f64).
     fn local(&self, leaf: usize) -> Option<Self::Local>;
+    /// Whether a stored `local` is a form (not a placeholder for a leaf that has none).
+    #[inline(always)]
+    fn is_form(_local: &Self::Local) -> bool {
+        true
+    }
     /// The leaf at each lane's parameters, its normal the leaf's own.
     fn block<const FMA: bool, const L: usize>(local: &Self::Local, u: &[f32; L], v: &[f32; L]) -> Block<L>;
     /// Whether the patch's normal is the opposite of its leaves' (module doc).
@@ -146,6 +151,12 @@ impl LeafTree for PatchTree {
             LeafPatch::Bezier(net) => Some(LocalPatch::from_net(net)),
             LeafPatch::Gregory(_) => None,
         }
+    }
+
+    /// An end cap's placeholder in the stored forms ([`coarse_form`]) is not.
+    #[inline(always)]
+    fn is_form(local: &LocalPatch) -> bool {
+        local.scale != 0.0
     }
 
     #[inline(always)]
@@ -282,7 +293,8 @@ pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
 /// [`VertexSlices::put`] does point by point, the leaves' local forms taken from `locals`
-/// where given (per leaf, in leaf order), else made for each group. Preconditions:
+/// where given (the first `locals.len()` leaves', in leaf order; [`LeafTree::is_form`]), else
+/// made for each group. Preconditions:
 /// `set.patches[p]` is `tree`; `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2
 /// and FMA. Cost: a leaf lookup per point and a sort of the points by leaf (O(n + leaves), or
 /// O(n log n) for fewer points than leaves); per group, moving its net to f32 once (unless
@@ -309,8 +321,8 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
         let f = Found { k: k as u32, ..tree.find(uv, &mut near) };
         if f.leaf != last {
             // What the group will read: the leaf's stored form where given, else its net.
-            match locals {
-                Some(locals) => prefetch_slice_to_l2(std::slice::from_ref(&locals[f.leaf as usize])),
+            match locals.and_then(|l| l.get(f.leaf as usize)) {
+                Some(local) => prefetch_slice_to_l2(std::slice::from_ref(local)),
                 None => tree.prefetch_leaf(f.leaf as usize, f.st),
             }
             last = f.leaf;
@@ -345,9 +357,9 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
         let leaf = group[0].leaf as usize;
         let made;
-        let local = match locals {
+        let local = match locals.and_then(|l| l.get(leaf)) {
             // A leaf's form already made: the kernel costs a lone point less than f64 does.
-            Some(locals) => Some(&locals[leaf]),
+            Some(local) => T::is_form(local).then_some(local),
             _ if group.len() < T::MIN_GROUP => None,
             None => {
                 made = tree.local(leaf);
@@ -528,7 +540,7 @@ pub(super) fn eval_sparse<'t, const FMA: bool>(
             let (p, _, forms, _) = item(k);
             if let Some((position, normal)) = view.corner_point(leaf, st) {
                 (out.pos[k], out.nrm[k]) = (position, normal);
-            } else if let Some(form) = forms.get(leaf).filter(|f| f.scale != 0.0) {
+            } else if let Some(form) = forms.get(leaf).filter(|f| PatchTree::is_form(f)) {
                 let open = pending
                     .iter()
                     .position(|b| b.count > 0 && b.p == p && b.form.is_some_and(|f| std::ptr::eq(f, form)));
@@ -767,6 +779,41 @@ mod tests {
             coarse_kernels * 2 > coarse_points,
             "only {coarse_kernels} of {coarse_points} normals from the kernels"
         );
+    }
+
+    /// The grouped path as the engine calls it, with the set's stored forms of the coarse
+    /// leaves ([`PointBlocks`]; [`LeafTree::is_form`] skips an end cap's placeholder): every
+    /// isolated view of two creased cages at a dense grid, against the generic f64 evaluation
+    /// ([`assert_matches_f64`]), most normals from the kernels.
+    #[test]
+    fn grouped_points_with_stored_forms_match_the_f64_evaluation() {
+        let n = 40;
+        let uvs: Vec<DVec2> =
+            (0..=n).flat_map(|j| (0..=n).map(move |i| DVec2::new(i as f64, j as f64) / n as f64)).collect();
+        let (mut views, mut points, mut kernels) = (0, 0, 0);
+        for cage in ["subdivision/catmark_cube_creases0.obj", "subdivision/catmark_rook.obj"] {
+            let path = crate::test_support::data(cage);
+            let mesh = crate::io::obj::read_obj(&path).unwrap();
+            let set = SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default()).unwrap();
+            let (lo, hi) = set.bounds();
+            let size = lo.distance(hi) as f32;
+            let blocks = [false, true].map(|fma| PointBlocks::for_set(&set, fma));
+            for (p, patch) in set.patches.iter().enumerate().step_by(7) {
+                let Patch::Subdivision(view) = patch else { continue };
+                if !worth_grouping(&**view, uvs.len()) {
+                    continue;
+                }
+                views += 1;
+                let made =
+                    assert_matches_f64(&format!("{cage} patch {p}"), &set, p, &uvs, size, |fma, out| {
+                        blocks[usize::from(fma)].eval(&set, p, &uvs, out)
+                    });
+                points += 2 * uvs.len();
+                kernels += made.iter().sum::<usize>();
+            }
+        }
+        assert!(views >= 50, "only {views} dense views");
+        assert!(kernels * 2 > points, "only {kernels} of {points} normals from the kernels");
     }
 
     /// Every Loop patch of every manifold `loop_*` cage, as built and swapped (the opposite
