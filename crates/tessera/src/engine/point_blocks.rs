@@ -870,26 +870,14 @@ impl PointBlocks {
             };
             blocks.locals.push(local);
         }
-        // Made straight into place, leaf by leaf in parallel: per-patch vectors moved into this
-        // one held every form twice at the peak.
-        blocks.loop_leaves = (0..stored)
-            .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let (first, p) = trees[trees.partition_point(|&(first, _)| first <= i) - 1];
-                let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
-                loop_leaf(tree, i - first)
-            })
-            .collect();
-        blocks.tree_forms = (0..forms_made)
-            .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let (first, p) = catmark[catmark.partition_point(|&(first, _)| first <= i) - 1];
-                let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("a tree's form") };
-                coarse_form(tree, i - first)
-            })
-            .collect();
+        blocks.loop_leaves = leaf_forms(stored, &trees, |p, leaf| {
+            let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
+            loop_leaf(tree, leaf)
+        });
+        blocks.tree_forms = leaf_forms(forms_made, &catmark, |p, leaf| {
+            let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("a tree's form") };
+            coarse_form(tree, leaf)
+        });
         let grid_form = |l: &Local| matches!(l, Local::Bicubic(_) | Local::Rational(_));
         blocks.all_bicubic = blocks.locals.iter().all(grid_form);
         blocks.any_bicubic = blocks.locals.iter().any(grid_form);
@@ -1123,6 +1111,24 @@ impl PointBlocks {
         out.uv.iter_mut().zip(uvs).for_each(|(x, uv)| *x = uv.as_vec2().to_array());
         out.patch.fill(p as u32);
     }
+}
+
+/// `count` leaf forms, form `i` made by `make(p, leaf)` for the tree of `starts` it falls in
+/// (`starts`: each tree's first form and a patch on it, in order), in parallel, straight into
+/// place: per-patch vectors moved into one held every form twice at the peak.
+fn leaf_forms<T: Send>(
+    count: usize,
+    starts: &[(usize, usize)],
+    make: impl Fn(usize, usize) -> T + Sync,
+) -> Vec<T> {
+    (0..count)
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            let (first, p) = starts[starts.partition_point(|&(first, _)| first <= i) - 1];
+            make(p, i - first)
+        })
+        .collect()
 }
 
 /// Appends `x` to `v` and returns its index.

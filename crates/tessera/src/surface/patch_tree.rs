@@ -451,16 +451,7 @@ impl PatchTree {
                         near.path[depth] = (n, origin, size);
                     }
                     depth += 1;
-                    size *= 0.5;
-                    let (right, up) = (uv.x >= origin.x + size, uv.y >= origin.y + size);
-                    let q = match (right, up) {
-                        (false, false) => 0,
-                        (true, false) => 1,
-                        (true, true) => 2,
-                        (false, true) => 3,
-                    };
-                    origin += DVec2::new(f64::from(u8::from(right)), f64::from(u8::from(up))) * size;
-                    slot = self.data.nodes[n as usize][q];
+                    slot = self.data.nodes[n as usize][quadrant_step(uv, &mut origin, &mut size)];
                 }
             }
         }
@@ -482,16 +473,7 @@ impl PatchTree {
                     return (i as usize, origin, size);
                 }
                 Slot::Node(n) => {
-                    size *= 0.5;
-                    let (right, up) = (uv.x >= origin.x + size, uv.y >= origin.y + size);
-                    let q = match (right, up) {
-                        (false, false) => 0,
-                        (true, false) => 1,
-                        (true, true) => 2,
-                        (false, true) => 3,
-                    };
-                    origin += DVec2::new(f64::from(u8::from(right)), f64::from(u8::from(up))) * size;
-                    slot = self.data.nodes[n as usize][q];
+                    slot = self.data.nodes[n as usize][quadrant_step(uv, &mut origin, &mut size)];
                 }
             }
         }
@@ -858,6 +840,22 @@ unsafe fn outputs_with<'t, const AVX: bool>(
             each(k, q.position.as_vec3().to_array(), q.normal.as_vec3().to_array());
         },
     );
+}
+
+/// One step of the quadtree's walk for `uv` from a node's square `origin + [0, size]²`: the
+/// child quadrant that holds it (see [`Slot`]: a point on a border goes up and to the right),
+/// `origin` and `size` moved to that child's square. The one rule of every walk.
+#[inline(always)]
+fn quadrant_step(uv: DVec2, origin: &mut DVec2, size: &mut f64) -> usize {
+    *size *= 0.5;
+    let (right, up) = (uv.x >= origin.x + *size, uv.y >= origin.y + *size);
+    *origin += DVec2::new(f64::from(u8::from(right)), f64::from(u8::from(up))) * *size;
+    match (right, up) {
+        (false, false) => 0,
+        (true, false) => 1,
+        (true, true) => 2,
+        (false, true) => 3,
+    }
 }
 
 /// Whether `t` lies in the half-open square `origin + [0, size)²`.
