@@ -13,15 +13,15 @@
 //! others or more. Such a group pays once for moving its leaf's net to a local frame and
 //! rounding it to f32, then takes the bicubic kernel's price per point. A point alone in its
 //! leaf (a deep tree's), or in a Catmull-Clark end cap (a Gregory patch), keeps the f64
-//! evaluation.
+//! evaluation. Loop's trees are the same story with quartic triangles for bicubics
+//! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame), and their
+//! end caps, Gregory triangles, take the quartic kernel too, with each lane's blend of the
+//! face points added ([`super::point_blocks::gregory_block`]).
 //!
 //! **Sparse trees** ([`eval_sparse`]): where a view's points are too few for its leaves to
 //! be worth sorting, they are taken in their list's order, and those in a tree's coarse
 //! leaves (levels 1–3, [`FORM_LEVEL`], whose f32 forms the set keeps once) go to the kernel
-//! in blocks of consecutive points of one leaf; the rest take the f64 path. Loop's trees are the same story with quartic triangles for bicubics
-//! (`loop_xord_interior` at rate 16: f64 point by point took 91–97 % of the frame), and their
-//! end caps, Gregory triangles, take the quartic kernel too, with each lane's blend of the
-//! face points added ([`super::point_blocks::gregory_block`]).
+//! in blocks of consecutive points of one leaf; the rest take the f64 path.
 //!
 //! **Same frame, same fallbacks.** The leaf's net is moved to the leaf's own local frame
 //! ([`super::point_blocks::local_frame`]), so f32 carries the leaf's detail at full relative

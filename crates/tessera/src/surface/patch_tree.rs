@@ -461,22 +461,14 @@ impl PatchTree {
     /// square, `(leaf, origin, size)`, from the quadtree's nodes alone. Cost: O(depth).
     #[inline(always)]
     fn leaf_square(&self, uv: DVec2) -> (usize, DVec2, f64) {
-        let mut slot = self.data.root;
-        let (mut origin, mut size) = (DVec2::ZERO, 1.0);
-        loop {
-            match slot {
-                Slot::Leaf(i) => {
-                    debug_assert!({
-                        let leaf = &self.data.leaves[i as usize];
-                        leaf.origin == origin && leaf.size == size
-                    });
-                    return (i as usize, origin, size);
-                }
-                Slot::Node(n) => {
-                    slot = self.data.nodes[n as usize][quadrant_step(uv, &mut origin, &mut size)];
-                }
-            }
-        }
+        // The walk from the root: an empty path.
+        let mut near = LeafSquare::default();
+        self.walk_near(uv, &mut near);
+        debug_assert!({
+            let leaf = &self.data.leaves[near.leaf];
+            leaf.origin == near.origin && leaf.size == near.size
+        });
+        (near.leaf, near.origin, near.size)
     }
 
     /// The tree's parameters of this view's point `uv` (an affine map: transposition,
@@ -512,20 +504,11 @@ impl PatchTree {
     /// AVX2 path, did.) Cost: as many [`PatchTree::derivatives`].
     #[inline(always)]
     pub fn derivatives_each(&self, uvs: &[DVec2], mut each: impl FnMut(usize, (DVec3, DVec3, DVec3))) {
-        self.found_ahead(uvs, false, |k, leaf, st, size| {
-            each(k, self.leaf_derivatives(&self.data.leaves[leaf], st, size))
-        });
-    }
-
-    /// `each(k, leaf, st, size)` for every point `k` of `uvs`, as [`PatchTree::find`] places
-    /// it ([`found_ahead`] of this tree alone).
-    #[inline(always)]
-    fn found_ahead(&self, uvs: &[DVec2], corners: bool, mut each: impl FnMut(usize, usize, DVec2, f64)) {
         found_ahead(
             uvs.len(),
             |k| (self, uvs[k]),
-            |_, view, leaf, st| view.prefetch_point(leaf, st, corners),
-            |k, _, _, leaf, st, size| each(k, leaf, st, size),
+            |_, view, leaf, st| view.prefetch_point(leaf, st, false),
+            |k, _, _, leaf, st, size| each(k, self.leaf_derivatives(&self.data.leaves[leaf], st, size)),
         );
     }
 
@@ -749,7 +732,7 @@ impl PatchTree {
 /// engine's edges, a few points each on different trees, would start every edge with no
 /// load in flight (`engine::tree_points::eval_sparse`, through [`Lookahead`]).
 #[inline(always)]
-pub(crate) fn found_ahead<'t>(
+fn found_ahead<'t>(
     n: usize,
     item: impl Fn(usize) -> (&'t PatchTree, DVec2),
     prefetch: impl Fn(usize, &'t PatchTree, usize, DVec2),
