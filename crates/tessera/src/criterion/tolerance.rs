@@ -12,6 +12,7 @@ use super::resolve::{self, EdgeRule, InteriorRule};
 use super::taylor::TaylorBound;
 use super::{Plan, Prepared};
 use crate::error::{Error, Result};
+use crate::pattern::cache::LocalParams;
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use crate::surface::{Domain, Patch, SurfaceSet};
 use rayon::prelude::*;
@@ -191,27 +192,29 @@ pub fn checked_patch_bound(
         return grid_bound(errors, taylor, cells);
     }
     pattern.build(input, scratch);
-    let mut params = Vec::new();
-    crate::pattern::cache::local_params(input, scratch, &mut params);
-    core_params_bound(errors, taylor, pattern.core_cells(input), scratch, &params)
+    let mut boundary = Vec::new();
+    crate::pattern::cache::boundary_params(input, &mut boundary);
+    let params = LocalParams { boundary: &boundary, interior: &scratch.interior };
+    let core = pattern.core_cells(input);
+    core_params_bound(errors, taylor, core, after_core(core, &scratch.triangles), params)
 }
 
 /// [`patch_bound`] of a pattern already built for `input`; `params` is a buffer for the
-/// parameters of its local vertices (computed once each, not once per triangle corner).
+/// parameters of its boundary vertices (computed once each, not once per triangle corner).
 fn built_pattern_bound(
     m: &TriangleErrors,
     input: &PatternInput,
     built: &LocalTessellation,
     params: &mut Vec<glam::DVec2>,
 ) -> f64 {
-    crate::pattern::cache::local_params(input, built, params);
-    params_bound(m, built, params)
-}
-
-/// The bound of the pattern `built` over its local-vertex parameters `params`
-/// ([`crate::pattern::cache::local_params`]): the largest triangle error.
-fn params_bound(errors: &TriangleErrors, built: &LocalTessellation, params: &[glam::DVec2]) -> f64 {
-    triangles_bound(errors, None, &built.triangles, params, 0.0)
+    crate::pattern::cache::boundary_params(input, params);
+    triangles_bound(
+        m,
+        None,
+        &built.triangles,
+        LocalParams { boundary: params, interior: &built.interior },
+        0.0,
+    )
 }
 
 /// The largest triangle error of `triangles` over `params`, and `at_least`: each triangle's
@@ -221,13 +224,13 @@ fn triangles_bound(
     errors: &TriangleErrors,
     taylor: Option<&TaylorBound>,
     triangles: &[[u32; 3]],
-    params: &[glam::DVec2],
+    params: LocalParams<'_>,
     at_least: f64,
 ) -> f64 {
     // The running largest error skips what cannot raise it ([`TriangleErrors::exceeds`]);
     // the Taylor bound, dearer, is computed only for a triangle that would raise it.
     triangles.iter().fold(at_least, |most, t| {
-        let t = t.map(|l| params[l as usize]);
+        let t = t.map(|l| params.get(l));
         match errors.exceeds(t, most) {
             None => most,
             Some(e) => most.max(taylor.map_or(e, |taylor| e.min(taylor.triangle_error_above(t, most)))),
@@ -235,23 +238,30 @@ fn triangles_bound(
     })
 }
 
-/// [`params_bound`] of a pattern whose first triangles are core cells
-/// ([`Pattern::core_cells`]): one cell's bound for them all ([`grid_bound`]), the rest one by
-/// one.
+/// The triangles of a whole pattern after its `core` ([`Pattern::core_cells`]): all of them
+/// where the count does not fit.
+fn after_core(core: Option<([u32; 2], u32)>, triangles: &[[u32; 3]]) -> &[[u32; 3]] {
+    match core {
+        Some((_, count)) if count as usize <= triangles.len() => &triangles[count as usize..],
+        _ => triangles,
+    }
+}
+
+/// The bound of a pattern whose triangles are a core of `core`'s cells
+/// ([`Pattern::core_cells`]), bounded together by one cell's bound ([`grid_bound`]), and
+/// `rest`, bounded one by one.
 fn core_params_bound(
     errors: &TriangleErrors,
     taylor: Option<(&TaylorBound, Domain)>,
     core: Option<([u32; 2], u32)>,
-    built: &LocalTessellation,
-    params: &[glam::DVec2],
+    rest: &[[u32; 3]],
+    params: LocalParams<'_>,
 ) -> f64 {
-    match core {
-        Some((cells, count)) if count > 0 && count as usize <= built.triangles.len() => {
-            let rest = &built.triangles[count as usize..];
-            triangles_bound(errors, taylor.map(|t| t.0), rest, params, grid_bound(errors, taylor, cells))
-        }
-        _ => triangles_bound(errors, taylor.map(|t| t.0), &built.triangles, params, 0.0),
-    }
+    let at_least = match core {
+        Some((cells, count)) if count > 0 => grid_bound(errors, taylor, cells),
+        _ => 0.0,
+    };
+    triangles_bound(errors, taylor.map(|t| t.0), rest, params, at_least)
 }
 
 /// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
@@ -930,15 +940,22 @@ fn check_patches(
                 let bound = match (grid, cached) {
                     // A pure grid (no strips): bounded from its cells, no build.
                     (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
-                    (None, Some((_, built, params))) => {
-                        core_params_bound(&errors[p], taylor, limit.pattern.core_cells(&input), built, params)
+                    (None, Some((cached, params))) => {
+                        let core = limit.pattern.core_cells(&input);
+                        // The cache leaves out the triangles of a core grid.
+                        let rest = match cached.core {
+                            Some(_) => &cached.local.triangles[..],
+                            None => after_core(core, &cached.local.triangles),
+                        };
+                        core_params_bound(&errors[p], taylor, core, rest, params)
                     }
                     // Neighbouring patches often share an input: the thread's last pattern
                     // is reused when it is the same.
                     (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
                         let slot = recent.get(generation, limit.pattern, &input, true);
-                        let (built, params) = (&slot.local, &slot.params[..]);
-                        core_params_bound(&errors[p], taylor, limit.pattern.core_cells(&input), built, params)
+                        let core = limit.pattern.core_cells(&input);
+                        let rest = after_core(core, &slot.local.triangles);
+                        core_params_bound(&errors[p], taylor, core, rest, slot.params())
                     }),
                 };
                 if bound <= e * (1.0 + 1e-9) {

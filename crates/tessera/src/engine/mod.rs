@@ -22,7 +22,7 @@ use crate::criterion::Plan;
 use crate::error::{Error, Result};
 use crate::mesh::strips::RESTART;
 use crate::mesh::{Mesh, MeshBuffers};
-use crate::pattern::cache::{next_generation, PatternCache, RecentPatterns, MIN_TRIANGLES_PER_PATCH};
+use crate::pattern::cache::{next_generation, Cached, PatternCache, RecentPatterns, MIN_TRIANGLES_PER_PATCH};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, Patch, SurfaceSet};
 use glam::DVec2;
@@ -698,11 +698,11 @@ impl Writer<'_> {
         }
     }
 
-    /// Patch `p`'s pattern from the frame's cache, if it holds it, with the positions of its
-    /// boundary indices.
-    fn cached(&self, p: usize) -> Option<(PatternInput, &LocalTessellation, &[u32])> {
-        let (input, local, boundary) = self.fast.and_then(|f| f.patterns().get(p))?;
-        Some((PatternInput { patch: p as u32, ..*input }, local, boundary))
+    /// Patch `p`'s pattern from the frame's cache, if it holds it (its input given patch
+    /// `p`): without the triangles of its core grid, if it has one.
+    fn cached(&self, p: usize) -> Option<(PatternInput, Cached<'_>)> {
+        let cached = self.fast.and_then(|f| f.patterns().get(p))?;
+        Some((PatternInput { patch: p as u32, ..*cached.input }, cached))
     }
 
     /// Whether patch `p`'s triangles take the general form: some may drop out at a repeated
@@ -719,10 +719,12 @@ impl Writer<'_> {
     fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
         let PatchOut { mut verts, idx, params, .. } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
-        let cached = self.cached(p);
-        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, ..)| input);
+        let general = self.general(p, params);
+        // The triangles in the general form need the whole pattern, core included.
+        let cached = self.cached(p).filter(|(_, c)| !general || c.core.is_none());
+        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, _)| input);
         let local = match cached {
-            Some((_, local, _)) => local,
+            Some((_, c)) => c.local,
             None => &scratch.patterns.get(self.generation, self.pattern, &input, false).local,
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
@@ -736,7 +738,6 @@ impl Writer<'_> {
                 }
             }
         }
-        let general = self.general(p, params);
         if !params.is_empty() {
             let map = LocalMap { set, plan, layout, input, patch: p };
             map.param_table(local, &mut scratch.param);
@@ -768,29 +769,38 @@ impl Writer<'_> {
         let PatchOut { idx, tp, params, .. } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let cached = self.cached(p).filter(|_| !self.general(p, params));
-        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, ..)| input);
+        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, _)| input);
         let map = LocalMap { set, plan, layout, input, patch: p };
         map.vertex_table(0, &mut scratch.vertex);
         let first = input.interior_base();
-        let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
+        let interior = layout.interior_vertex(p, 0);
+        let delta = interior.wrapping_sub(first);
         match cached {
-            // The cache knows where the boundary indices are.
-            Some((_, local, boundary)) if stream => {
-                // Mapped in the thread's buffer (in the cache), then streamed out once.
-                let local = local.triangles.as_flattened();
-                let mapped = &mut scratch.indices;
-                mapped.clear();
-                mapped.extend(local.iter().map(|&l| l.wrapping_add(delta)));
-                for &i in boundary {
-                    mapped[i as usize] = scratch.vertex[local[i as usize] as usize];
-                }
-                stream_store::copy(idx, mapped);
-            }
-            Some((_, local, boundary)) => {
-                let local = local.triangles.as_flattened();
-                idx.iter_mut().zip(local).for_each(|(out, &l)| *out = l.wrapping_add(delta));
-                for &i in boundary {
-                    idx[i as usize] = scratch.vertex[local[i as usize] as usize];
+            Some((_, cached)) => {
+                // The core by its rule, then the cached triangles after it; the cache knows
+                // where their boundary indices are.
+                let table = &scratch.vertex[..];
+                let (rest, core_triangles) = cached.after_core();
+                let write = |out: &mut [u32]| {
+                    let (core_out, rest_out) = out.split_at_mut(3 * core_triangles as usize);
+                    if let Some(core) = cached.core {
+                        core.write(interior, |l| table[l as usize], core_out);
+                    }
+                    let rest = rest.as_flattened();
+                    rest_out.iter_mut().zip(rest).for_each(|(out, &l)| *out = l.wrapping_add(delta));
+                    for &i in cached.boundary {
+                        rest_out[i as usize] = table[rest[i as usize] as usize];
+                    }
+                };
+                if stream {
+                    // Mapped in the thread's buffer (in the cache), then streamed out once.
+                    let mapped = &mut scratch.indices;
+                    mapped.clear();
+                    mapped.resize(idx.len(), 0);
+                    write(mapped);
+                    stream_store::copy(idx, mapped);
+                } else {
+                    write(idx);
                 }
             }
             // The first pass left the local indices here.

@@ -16,7 +16,7 @@
 //! frames fills the same slots with the same patterns: a second walk along a camera path
 //! allocates nothing, whichever threads built what.
 
-use super::{LocalTessellation, Pattern, PatternInput};
+use super::{CoreGrid, LocalTessellation, Pattern, PatternInput};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -109,23 +109,36 @@ pub(crate) struct PatternCache {
     /// patch's.
     inputs: Vec<PatternInput>,
     /// Every slot ever used; slots past `inputs.len()` keep their buffers for later frames.
+    /// A slot holds [`Pattern::build_after_core`]: a pattern with a [`Pattern::core_grid`]
+    /// without its core's triangles (`cores`), which the writer writes by the rule.
     slots: Vec<LocalTessellation>,
+    /// Per slot in use, the pattern's core grid, whose triangles its slot leaves out.
+    cores: Vec<Option<CoreGrid>>,
     /// Each patch's slot, or [`NONE`]; empty when the cache is off for the frame.
     of_patch: Vec<u32>,
     /// Per slot, the positions in the flat index list (`triangles.as_flattened()`) of the
     /// pattern's boundary vertices (corners and edge samples); see [`boundary_positions`].
     boundary: Vec<Vec<u32>>,
-    /// Per slot, the parameters of the pattern's local vertices (filled on request).
+    /// Per slot, the parameters of the pattern's boundary vertices ([`boundary_params`],
+    /// filled on request).
     params: Vec<Vec<DVec2>>,
     /// Per slot in use, whether `params` holds its table.
     has_params: Vec<bool>,
 }
 
 /// The parameters of every local vertex of `built` (made for `input`), in local order:
-/// corners, each edge's inner samples at `k / n`, the interior — the table the a-posteriori
-/// error check evaluates triangles on (`criterion::tolerance`), computed once per distinct
-/// pattern instead of once per patch.
+/// corners, each edge's inner samples at `k / n`, the interior. Cost: O(vertices).
 pub(crate) fn local_params(input: &PatternInput, built: &LocalTessellation, params: &mut Vec<DVec2>) {
+    boundary_params(input, params);
+    params.extend_from_slice(&built.interior);
+}
+
+/// The parameters of the boundary vertices of a pattern for `input`, in local order: corners,
+/// then each edge's inner samples at `k / n` — with the pattern's interior list
+/// ([`LocalParams`]) the table the a-posteriori error check evaluates triangles on
+/// (`criterion::tolerance`), computed once per distinct pattern instead of once per patch.
+/// Cost: O(boundary vertices).
+pub(crate) fn boundary_params(input: &PatternInput, params: &mut Vec<DVec2>) {
     let d = input.domain;
     let nc = d.corner_count();
     params.clear();
@@ -134,7 +147,26 @@ pub(crate) fn local_params(input: &PatternInput, built: &LocalTessellation, para
         let n = input.segments[e];
         params.extend((1..n).map(|k| d.edge_point(e, k as f64 / n as f64)));
     }
-    params.extend_from_slice(&built.interior);
+}
+
+/// The parameter of every local vertex of a pattern, without copying its interior: the
+/// boundary vertices' table ([`boundary_params`]) and the pattern's interior list.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LocalParams<'a> {
+    pub(crate) boundary: &'a [DVec2],
+    pub(crate) interior: &'a [DVec2],
+}
+
+impl LocalParams<'_> {
+    /// The parameter of local vertex `l`. Cost: O(1).
+    #[inline(always)]
+    pub(crate) fn get(&self, l: u32) -> DVec2 {
+        let l = l as usize;
+        match self.boundary.get(l) {
+            Some(&p) => p,
+            None => self.interior[l - self.boundary.len()],
+        }
+    }
 }
 
 /// The positions in `built`'s flat index list whose local vertex is a boundary vertex (below
@@ -154,6 +186,7 @@ impl PatternCache {
     pub(crate) fn clear(&mut self) {
         self.index.clear();
         self.inputs.clear();
+        self.cores.clear();
         self.has_params.clear();
         self.of_patch.clear();
     }
@@ -209,6 +242,7 @@ impl PatternCache {
             let slot = *self.index.entry(Key::of(&input)).or_insert(next);
             if slot == next {
                 self.inputs.push(input);
+                self.cores.push(pattern.core_grid(&input));
             }
             self.of_patch.push(slot);
         }
@@ -229,24 +263,22 @@ impl PatternCache {
             let new_params =
                 (&mut self.params[kept..used]).into_par_iter().zip(&mut self.has_params[kept..used]);
             new.zip(new_params).with_min_len(4).for_each(|(((local, input), boundary), (params, has))| {
-                pattern.build(input, local);
+                pattern.build_after_core(input, local);
                 boundary_positions(input, local, boundary);
-                local_params(input, local, params);
+                boundary_params(input, params);
                 *has = true;
             });
             // Kept patterns built without their tables (none in the check's own rounds).
             let kept_params = (&mut self.params[..kept]).into_par_iter().zip(&mut self.has_params[..kept]);
-            kept_params.zip(&self.inputs[..kept]).zip(&self.slots[..kept]).with_min_len(16).for_each(
-                |(((params, has), input), local)| {
-                    if !*has {
-                        local_params(input, local, params);
-                        *has = true;
-                    }
-                },
-            );
+            kept_params.zip(&self.inputs[..kept]).with_min_len(16).for_each(|((params, has), input)| {
+                if !*has {
+                    boundary_params(input, params);
+                    *has = true;
+                }
+            });
         } else {
             new.with_min_len(4).for_each(|((local, input), boundary)| {
-                pattern.build(input, local);
+                pattern.build_after_core(input, local);
                 boundary_positions(input, local, boundary);
             });
         }
@@ -255,23 +287,50 @@ impl PatternCache {
     /// Patch `p`'s pattern input, pattern and the pattern's [`boundary_positions`], when the
     /// cache holds them for this frame (the input's `patch` is the first patch's of that
     /// input: set it to `p`).
-    pub(crate) fn get(&self, p: usize) -> Option<(&PatternInput, &LocalTessellation, &[u32])> {
+    pub(crate) fn get(&self, p: usize) -> Option<Cached<'_>> {
         let slot = *self.of_patch.get(p)? as usize;
-        (slot != NONE as usize).then(|| (&self.inputs[slot], &self.slots[slot], &self.boundary[slot][..]))
+        (slot != NONE as usize).then(|| Cached {
+            input: &self.inputs[slot],
+            local: &self.slots[slot],
+            boundary: &self.boundary[slot],
+            core: self.cores[slot],
+        })
     }
 
-    /// Item `i`'s input, pattern and local-vertex parameters, when the last
+    /// Item `i`'s pattern and its local vertices' parameters, when the last
     /// [`PatternCache::fill_inputs`] made them (with `params`).
-    pub(crate) fn params(&self, i: usize) -> Option<(&PatternInput, &LocalTessellation, &[DVec2])> {
+    pub(crate) fn params(&self, i: usize) -> Option<(Cached<'_>, LocalParams<'_>)> {
         let slot = *self.of_patch.get(i)? as usize;
-        (slot != NONE as usize && self.has_params[slot])
-            .then(|| (&self.inputs[slot], &self.slots[slot], &self.params[slot][..]))
+        (slot != NONE as usize && self.has_params[slot]).then(|| {
+            let params = LocalParams { boundary: &self.params[slot], interior: &self.slots[slot].interior };
+            (self.get(i).expect("the slot is in use"), params)
+        })
     }
 
     /// How many distinct patterns this frame built (0 when the cache is off).
     #[cfg(test)]
     pub(crate) fn distinct(&self) -> usize {
         self.inputs.len()
+    }
+}
+
+/// A pattern in the cache ([`PatternCache::get`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Cached<'a> {
+    /// The input it was built for (its `patch` the first patch's of that input).
+    pub(crate) input: &'a PatternInput,
+    /// [`Pattern::build_after_core`]: the interior vertices, and the triangles after the core.
+    pub(crate) local: &'a LocalTessellation,
+    /// The [`boundary_positions`] of `local`'s triangles.
+    pub(crate) boundary: &'a [u32],
+    /// The core grid whose triangles `local` leaves out, where the pattern has one.
+    pub(crate) core: Option<CoreGrid>,
+}
+
+impl Cached<'_> {
+    /// The pattern's triangles after the core, and how many core triangles come before them.
+    pub(crate) fn after_core(&self) -> (&[[u32; 3]], u32) {
+        (&self.local.triangles, self.core.map_or(0, |c| c.triangle_count()))
     }
 }
 
@@ -296,8 +355,9 @@ pub(crate) struct RecentPattern {
     /// reusable (never built, or built for a pattern that depends on the patch).
     key: Option<(u64, PatternInput)>,
     pub(crate) local: LocalTessellation,
-    /// `local`'s local-vertex parameters, valid when `with_params`.
-    pub(crate) params: Vec<DVec2>,
+    /// `local`'s boundary vertices' parameters ([`boundary_params`]), valid when
+    /// `with_params`.
+    params: Vec<DVec2>,
     with_params: bool,
 }
 
@@ -329,10 +389,18 @@ impl RecentPatterns {
             slot.with_params = false;
         }
         if params && !slot.with_params {
-            local_params(input, &slot.local, &mut slot.params);
+            boundary_params(input, &mut slot.params);
             slot.with_params = true;
         }
         slot
+    }
+}
+
+impl RecentPattern {
+    /// The parameters of the pattern's local vertices (requested with `params`).
+    pub(crate) fn params(&self) -> LocalParams<'_> {
+        debug_assert!(self.with_params);
+        LocalParams { boundary: &self.params, interior: &self.local.interior }
     }
 }
 
@@ -378,11 +446,50 @@ mod tests {
         let mut cache = PatternCache::default();
         cache.fill_inputs(&Uniform, 2, |i| Some(if i == 0 { plain } else { pinched }), false);
         let (a, b) = (cache.get(0).unwrap(), cache.get(1).unwrap());
-        assert_eq!(*a.0, plain);
-        assert_eq!(*b.0, pinched);
-        assert_ne!(a.1.triangles, b.1.triangles, "the pinched corner was not cut");
+        assert_eq!(*a.input, plain);
+        assert_eq!(*b.input, pinched);
+        assert_ne!(a.local.triangles, b.local.triangles, "the pinched corner was not cut");
         let mut recent = RecentPatterns::default();
         let plain_triangles = recent.get(7, &Uniform, &plain, false).local.triangles.clone();
         assert_ne!(recent.get(7, &Uniform, &pinched, false).local.triangles, plain_triangles);
+    }
+
+    /// A pattern with a core grid is kept without its core, and the whole pattern is the
+    /// core by its rule followed by what the cache holds; the parameters read through
+    /// [`LocalParams`] are the whole table's.
+    #[test]
+    fn a_core_grid_is_left_out_and_its_rule_restores_the_pattern() {
+        use crate::pattern::transition::Transition;
+        let inputs = [
+            PatternInput::new(Domain::Quad, [3, 5, 4, 7], [4, 6]),
+            PatternInput::new(Domain::Quad, [6, 6, 6, 6], [6, 6]),
+            PatternInput {
+                pinched: [true, false, false, false],
+                ..PatternInput::new(Domain::Quad, [2, 5, 3, 4], [3, 4])
+            },
+            PatternInput::new(Domain::Tri, [3, 5, 4, 1], [5, 5]),
+        ];
+        let mut cache = PatternCache::default();
+        cache.fill_inputs(&Transition, inputs.len(), |i| Some(inputs[i]), true);
+        let mut cores = 0;
+        for (i, input) in inputs.iter().enumerate() {
+            let mut whole = LocalTessellation::default();
+            Transition.build(input, &mut whole);
+            let (cached, params) = cache.params(i).expect("filled with parameters");
+            let (rest, count) = cached.after_core();
+            let mut flat = vec![0; 3 * count as usize];
+            if let Some(core) = cached.core {
+                core.write(input.interior_base(), |l| l, &mut flat);
+                cores += 1;
+            }
+            flat.extend_from_slice(rest.as_flattened());
+            assert_eq!(flat, whole.triangles.as_flattened(), "{input:?}");
+            assert_eq!(cached.local.interior, whole.interior, "{input:?}");
+            let mut table = Vec::new();
+            local_params(input, &whole, &mut table);
+            let read: Vec<DVec2> = (0..table.len() as u32).map(|l| params.get(l)).collect();
+            assert_eq!(read, table, "{input:?}");
+        }
+        assert_eq!(cores, 2, "the unpinned quads have core grids, the others none");
     }
 }

@@ -8,12 +8,15 @@
 //! `(u, v)` domain.
 
 pub(crate) mod cache;
+pub mod core_grid;
 pub mod esc;
 pub mod hardware;
 pub mod sd2;
 pub mod semi_uniform;
 pub mod transition;
 pub mod uniform;
+
+pub use core_grid::CoreGrid;
 
 use crate::domain::Domain;
 use glam::DVec2;
@@ -187,6 +190,24 @@ pub trait Pattern: Sync {
         None
     }
 
+    /// `Some(core)` when the first [`CoreGrid::triangle_count`] triangles [`Pattern::build`]
+    /// gives for `input` are exactly `core`'s ([`CoreGrid::write`] with the input's interior
+    /// base and local indices) and its interior vertices are the grid's: an engine may then
+    /// write the core by the rule and keep only the rest of the pattern
+    /// ([`Pattern::build_after_core`]). `core_cells`, where both are given, counts the same
+    /// cells. None (the default) promises nothing. Cost: O(1).
+    fn core_grid(&self, _input: &PatternInput) -> Option<CoreGrid> {
+        None
+    }
+
+    /// [`Pattern::build`] without the triangles of [`Pattern::core_grid`] (all of them where
+    /// it gives none): the interior vertices, then the triangles after the core. The default
+    /// builds the whole pattern and removes the core; a pattern with a core overrides it to
+    /// skip building it. Cost: O(vertices + triangles after the core) for an override.
+    fn build_after_core(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        build_removing_core(self, input, out)
+    }
+
     /// True when, at each of a quad's corners 0 and 2 that the input marks pinched, every
     /// triangle [`Pattern::triangulate`] makes has a vertex off the corner's two edges (cells
     /// of a grid cut from corner 0 to corner 2 do at any such corner; the transition pattern
@@ -220,6 +241,18 @@ pub trait Pattern: Sync {
     /// exactly [`Pattern::build`]'s triangles, in order, with the same winding.
     fn strips(&self, _input: &PatternInput, _out: &mut Vec<u32>) -> bool {
         false
+    }
+}
+
+/// The default [`Pattern::build_after_core`]: the whole pattern, its core removed.
+pub fn build_removing_core<P: Pattern + ?Sized>(
+    pattern: &P,
+    input: &PatternInput,
+    out: &mut LocalTessellation,
+) {
+    pattern.build(input, out);
+    if let Some(core) = pattern.core_grid(input) {
+        out.triangles.drain(..core.triangle_count() as usize);
     }
 }
 

@@ -88,7 +88,7 @@
 //! The pattern assumes uniform edge samples (`t_k = k / segments`, `SamplingKind::Uniform`):
 //! its triangles have positive area for those positions.
 
-use super::{LocalTessellation, Pattern, PatternInput};
+use super::{CoreGrid, LocalTessellation, Pattern, PatternInput};
 use crate::domain::Domain;
 use glam::DVec2;
 
@@ -189,22 +189,10 @@ impl QuadLayout {
         }
     }
 
-    /// Local index of grid point `(i, j)` of the core. A point on the domain boundary lies on
+    /// The core rectangle, numbered by the grid rule: a point on the domain boundary lies on
     /// a side without strip, whose samples are exactly the grid points there.
-    #[inline]
-    fn local(&self, b: &Bases, i: u32, j: u32) -> u32 {
-        let (nu, nv) = (self.nu, self.nv);
-        match (i, j) {
-            (0, 0) => 0,
-            (i, 0) if i == nu => 1,
-            (i, j) if i == nu && j == nv => 2,
-            (0, j) if j == nv => 3,
-            (i, 0) => b.edge[0] + i - 1,
-            (i, j) if i == nu => b.edge[1] + j - 1,
-            (i, j) if j == nv => b.edge[2] + (nu - i) - 1,
-            (0, j) => b.edge[3] + (nv - j) - 1,
-            (i, j) => b.interior + (j - 1) * (nu - 1) + (i - 1),
-        }
+    fn core(&self, input: &PatternInput) -> CoreGrid {
+        CoreGrid::new(input, [self.nu, self.nv], [self.i_lo, self.j_lo], [self.i_hi, self.j_hi])
     }
 
     fn counts(&self, input: &PatternInput) -> (u32, u32) {
@@ -214,8 +202,8 @@ impl QuadLayout {
         ((self.nu - 1) * (self.nv - 1), core + strips)
     }
 
-    fn build(&self, input: &PatternInput, out: &mut LocalTessellation) {
-        let b = Bases::new(input);
+    /// The interior vertices, then the core's cells unless `strips_only`, then the strips.
+    fn build(&self, input: &PatternInput, out: &mut LocalTessellation, strips_only: bool) {
         // Same arithmetic as the uniform pattern so the all-matching case is bit-identical.
         let (su, sv) = (1.0 / self.nu as f64, 1.0 / self.nv as f64);
         for j in 1..self.nv {
@@ -223,23 +211,12 @@ impl QuadLayout {
                 out.interior.push(DVec2::new(i as f64 * su, j as f64 * sv));
             }
         }
-        out.triangles.reserve((2 * (self.i_hi - self.i_lo) * (self.j_hi - self.j_lo)) as usize);
-        for j in self.j_lo..self.j_hi {
-            // A cell off the domain's boundary has interior corners only, numbered row after
-            // row: its indices by additions (what `local` gives them, without its cases;
-            // a core's cells are most of a fine pattern's triangles).
-            let inner_row = j > 0 && j + 1 < self.nv;
-            let row = b.interior.wrapping_add(j.wrapping_sub(1).wrapping_mul(self.nu - 1));
-            for i in self.i_lo..self.i_hi {
-                let [a, bb, c, d] = if inner_row && i > 0 && i + 1 < self.nu {
-                    let a = row + (i - 1);
-                    [a, a + 1, a + self.nu, a + self.nu - 1]
-                } else {
-                    [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(i, j)| self.local(&b, i, j))
-                };
-                out.triangles.push([a, bb, c]);
-                out.triangles.push([a, c, d]);
-            }
+        let core = self.core(input);
+        let interior = input.interior_base();
+        if !strips_only {
+            let start = out.triangles.len();
+            out.triangles.resize(start + core.triangle_count() as usize, [0; 3]);
+            core.write(interior, |l| l, out.triangles[start..].as_flattened_mut());
         }
         for e in (0..4).filter(|&e| self.strip[e]) {
             let s = input.segments[e];
@@ -256,7 +233,7 @@ impl QuadLayout {
                 |k| (input.boundary_vertex(e, k), Domain::Quad.edge_point(e, k as f64 / s as f64)),
                 |t| {
                     let (i, j) = self.inner(e, t);
-                    (self.local(&b, i, j), DVec2::new(i as f64 * su, j as f64 * sv))
+                    (core.local(interior, i, j), DVec2::new(i as f64 * su, j as f64 * sv))
                 },
                 &mut out.triangles,
             );
@@ -510,7 +487,7 @@ impl Pattern for Transition {
         out.interior.clear();
         out.triangles.clear();
         match input.domain {
-            Domain::Quad => QuadLayout::new(input).build(input, out),
+            Domain::Quad => QuadLayout::new(input).build(input, out, false),
             Domain::Tri => TriLayout::new(input).build(input, out),
         }
     }
@@ -548,6 +525,22 @@ impl Pattern for Transition {
                 Some(([l.n, l.n], l.m * l.m))
             }
         }
+    }
+
+    /// Quads: the core rectangle, where [`Transition::core_cells`] promises its cells.
+    fn core_grid(&self, input: &PatternInput) -> Option<CoreGrid> {
+        let unpinned = !input.pinched.iter().any(|&p| p);
+        (input.domain == Domain::Quad && unpinned).then(|| QuadLayout::new(input).core(input))
+    }
+
+    /// The interior and the strips, without building the core's cells.
+    fn build_after_core(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        if self.core_grid(input).is_none() {
+            return super::build_removing_core(self, input, out);
+        }
+        out.interior.clear();
+        out.triangles.clear();
+        QuadLayout::new(input).build(input, out, true);
     }
 
     /// Quads: the core's grid, `(i/nu, j/nv)` row after row over every interior point (the
@@ -616,7 +609,40 @@ mod tests {
         if let Some(grid) = Transition.grid_cells(input) {
             assert_eq!((grid, count), (cells, t), "{input:?}: a pure grid is all core");
         }
+        check_core_grid(input, &out, count);
         out.triangles.len()
+    }
+
+    /// The core grid's promise ([`Pattern::core_grid`]) on the pattern `out` built for `input`
+    /// with `count` core cells: its rule gives the core's triangles, in the local numbering
+    /// and mapped like an engine maps them, and [`Pattern::build_after_core`] the rest.
+    fn check_core_grid(input: &PatternInput, out: &LocalTessellation, count: u32) {
+        let mut rest = LocalTessellation::default();
+        Transition.build_after_core(input, &mut rest);
+        assert_eq!(rest.interior, out.interior, "{input:?}: interior after the core");
+        let Some(core) = Transition.core_grid(input) else {
+            assert!(
+                input.domain == Domain::Tri || input.pinched.contains(&true),
+                "{input:?}: a quad has a core"
+            );
+            assert_eq!(rest.triangles, out.triangles, "{input:?}: no core, the whole pattern");
+            return;
+        };
+        assert_eq!(core.triangle_count(), count, "{input:?}: core_cells counts the core grid");
+        let (core_triangles, after) = out.triangles.split_at(count as usize);
+        assert_eq!(rest.triangles, after, "{input:?}: the triangles after the core");
+        let mut flat = vec![0; 3 * count as usize];
+        core.write(input.interior_base(), |l| l, &mut flat);
+        assert_eq!(flat, core_triangles.as_flattened(), "{input:?}: the core by its rule");
+        // As a writer maps them: interior vertices moved to 1000, boundary ones through a table.
+        let first = input.interior_base();
+        core.write(1000, |l| 5000 + l, &mut flat);
+        let mapped: Vec<u32> = core_triangles
+            .as_flattened()
+            .iter()
+            .map(|&l| if l < first { 5000 + l } else { 1000 + l - first })
+            .collect();
+        assert_eq!(flat, mapped, "{input:?}: the core mapped");
     }
 
     /// Whether `t` is a right triangle with legs `1/cells[0]` along u and `1/cells[1]` along v.
@@ -761,6 +787,7 @@ mod tests {
         let (_, count) = Transition.counts(input);
         assert_eq!(out.triangles.len() as u32, count, "{input:?}: triangle count");
         super::super::assert_tiles(input, &out, &local_params(input, &out), 1e-12);
+        check_core_grid(input, &out, Transition.core_cells(input).map_or(0, |c| c.1));
         // Corners joined by collapsed edges are one vertex (the smallest corner index).
         let mut corner: Vec<u32> = (0..nc as u32).collect();
         for _ in 0..nc {
@@ -922,6 +949,7 @@ mod tests {
                     let mut cut = LocalTessellation::default();
                     Transition.build(&input, &mut cut);
                     assert_eq!(cut, built, "{input:?}: the cut found something left to do");
+                    check_core_grid(&input, &cut, Transition.core_cells(&input).map_or(0, |c| c.1));
                     let mut p = Vec::new();
                     crate::pattern::cache::local_params(&input, &built, &mut p);
                     crate::pattern::assert_tiles(&input, &built, &p, 0.0);

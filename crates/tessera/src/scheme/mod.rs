@@ -157,6 +157,12 @@ impl Pattern for SchemePattern {
     fn core_cells(&self, input: &PatternInput) -> Option<([u32; 2], u32)> {
         self.inner().core_cells(input)
     }
+    fn core_grid(&self, input: &PatternInput) -> Option<crate::pattern::CoreGrid> {
+        self.inner().core_grid(input)
+    }
+    fn build_after_core(&self, input: &PatternInput, out: &mut LocalTessellation) {
+        self.inner().build_after_core(input, out)
+    }
     fn depends_on_patch(&self) -> bool {
         self.inner().depends_on_patch()
     }

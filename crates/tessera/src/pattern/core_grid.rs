@@ -1,0 +1,103 @@
+//! The core of a quad pattern as a rule instead of a list: a rectangle of cells of the
+//! `nu × nv` grid, triangulated cell by cell in a fixed order, its vertices numbered by the
+//! grid rule of the local numbering. A pattern that promises one ([`super::Pattern::core_grid`],
+//! the transition pattern's core) needs no list of the core's triangles: its builder and an
+//! engine's index writer both run [`CoreGrid::write`], the one loop that numbers them, with
+//! local indices or with output indices. A fine adaptive pattern is mostly core (the rook's
+//! distinct transition patterns at 0.5 px: 13 M triangles, a few hundred thousand in strips),
+//! so a frame's pattern cache then holds the strips alone.
+
+use super::PatternInput;
+
+/// The cells `lo[0]..hi[0]` × `lo[1]..hi[1]` of a quad's `cells[0] × cells[1]` grid, each cell
+/// `(i, j)` split along its diagonal from `(i, j)` to `(i + 1, j + 1)` into
+/// `[(i, j), (i+1, j), (i+1, j+1)]` and `[(i, j), (i+1, j+1), (i, j+1)]`, cells row after row
+/// (`j` outer), counter-clockwise. Grid point `(i, j)` is local vertex
+/// `interior + (j − 1)·(nu − 1) + (i − 1)` strictly inside the domain; on the boundary it is
+/// the corner or edge sample there, which requires the edges the rectangle reaches to have
+/// as many segments as the grid along them (as where a pattern puts no strip).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CoreGrid {
+    /// `[nu, nv]`.
+    pub cells: [u32; 2],
+    /// The rectangle's first cell.
+    pub lo: [u32; 2],
+    /// One past the rectangle's last cell (`lo ≤ hi ≤ cells`).
+    pub hi: [u32; 2],
+    /// Local index of each edge's first inner sample ([`PatternInput::edge_base`]).
+    edge: [u32; 4],
+}
+
+impl CoreGrid {
+    /// The rectangle `lo..hi` of the `cells` grid of quad `input`. Cost: O(1).
+    pub fn new(input: &PatternInput, cells: [u32; 2], lo: [u32; 2], hi: [u32; 2]) -> Self {
+        debug_assert!(lo[0] <= hi[0] && hi[0] <= cells[0] && lo[1] <= hi[1] && hi[1] <= cells[1]);
+        CoreGrid { cells, lo, hi, edge: std::array::from_fn(|e| input.edge_base(e)) }
+    }
+
+    /// The rectangle's triangles: two a cell.
+    pub fn triangle_count(&self) -> u32 {
+        2 * (self.hi[0] - self.lo[0]) * (self.hi[1] - self.lo[1])
+    }
+
+    /// Vertex of grid point `(i, j)`: the interior rule from `interior`, a boundary point's
+    /// local index through `boundary`.
+    #[inline]
+    fn index(&self, interior: u32, boundary: &impl Fn(u32) -> u32, i: u32, j: u32) -> u32 {
+        let [nu, nv] = self.cells;
+        let local = match (i, j) {
+            (0, 0) => 0,
+            (i, 0) if i == nu => 1,
+            (i, j) if i == nu && j == nv => 2,
+            (0, j) if j == nv => 3,
+            (i, 0) => self.edge[0] + i - 1,
+            (i, j) if i == nu => self.edge[1] + j - 1,
+            (i, j) if j == nv => self.edge[2] + (nu - i) - 1,
+            (0, j) => self.edge[3] + (nv - j) - 1,
+            (i, j) => return interior + (j - 1) * (nu - 1) + (i - 1),
+        };
+        boundary(local)
+    }
+
+    /// Vertex of grid point `(i, j)` in the local numbering ([`CoreGrid::write`] with the
+    /// pattern's own `interior` base and no mapping).
+    pub fn local(&self, interior: u32, i: u32, j: u32) -> u32 {
+        self.index(interior, &|l| l, i, j)
+    }
+
+    /// Writes the rectangle's triangles, flat (`out.len() = 3 · triangle_count()`), with
+    /// interior grid point `(1, 1)` numbered `interior` and the others after it by the grid
+    /// rule, and each boundary point's local index `l` written as `boundary(l)`. With the
+    /// pattern's own interior base and `|l| l`, the pattern's local triangles; with a patch's
+    /// first output interior vertex and its boundary table, its output indices. Cost: O(cells);
+    /// a cell off the boundary by additions.
+    pub fn write(&self, interior: u32, boundary: impl Fn(u32) -> u32, out: &mut [u32]) {
+        let [nu, nv] = self.cells;
+        let ([i_lo, j_lo], [i_hi, j_hi]) = (self.lo, self.hi);
+        debug_assert_eq!(out.len(), 3 * self.triangle_count() as usize);
+        // The columns whose cells have interior corners only, on a row off the boundary.
+        let (inner_lo, inner_hi) = (i_lo.max(1), i_hi.min(nu.saturating_sub(1)).max(i_lo.max(1)));
+        let mut cells = out.chunks_exact_mut(6);
+        let mut cell = |[a, b, c, d]: [u32; 4]| {
+            let out = cells.next().expect("out holds every cell");
+            out.copy_from_slice(&[a, b, c, a, c, d]);
+        };
+        let corners = |i: u32, j: u32| {
+            [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
+                .map(|(i, j)| self.index(interior, &boundary, i, j))
+        };
+        for j in j_lo..j_hi {
+            if j == 0 || j + 1 >= nv {
+                (i_lo..i_hi).for_each(|i| cell(corners(i, j)));
+                continue;
+            }
+            let row = interior + (j - 1) * (nu - 1);
+            (i_lo..inner_lo.min(i_hi)).for_each(|i| cell(corners(i, j)));
+            for i in inner_lo..inner_hi {
+                let a = row + (i - 1);
+                cell([a, a + 1, a + nu, a + nu - 1]);
+            }
+            (inner_hi.max(i_lo)..i_hi).for_each(|i| cell(corners(i, j)));
+        }
+    }
+}
