@@ -26,11 +26,11 @@
 //! **Watertight as before**: this changes how a point is computed, never which patch computes
 //! it; every shared vertex is still evaluated once, by its owner.
 
-use super::tree_points::{coarse_form, eval_sparse, loop_leaf, LoopLeaf, FORM_LEVEL};
+use super::tree_points::{catmark_leaf, eval_sparse, loop_leaf, CatmarkLeaf, LoopLeaf, FORM_LEVEL};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
 use crate::surface::patch_tree::PatchTree;
-use crate::surface::{BezierTriangle, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
+use crate::surface::{BezierTriangle, GregoryPatch, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -240,6 +240,44 @@ impl NormalField for () {
     }
 }
 
+/// A Gregory patch (Catmull-Clark's end caps, [`GregoryPatch`]) in its local frame, the
+/// frame of all its 20 points: the bicubic net with each interior point its corner's `Fm`,
+/// and each corner's `Fp − Fm`. A lane's blended net is that bicubic plus `w · (Fp − Fm)` at
+/// each interior point, `w` the lane's rational weight of `Fp` (as
+/// [`GregoryPatch::derivatives`] blends); the kernel is linear in the net, so it adds each
+/// interior point's basis (and its derivatives, the blend held fixed as OpenSubdiv holds it)
+/// times that, per lane ([`gregory_quad_block`]).
+pub(crate) struct LocalGregoryQuad {
+    net: LocalPatch,
+    /// `(Fp − Fm) / scale` of each corner, rounded to f32: `[corner][component]`.
+    spread: [[f32; 3]; 4],
+}
+
+/// Where each corner's blended point sits in a Gregory patch's bicubic net, `(i, j)` with `i`
+/// along `u` (as [`GregoryPatch::bezier_net`] puts them), and its `(Fp, Fm)` points.
+const GREGORY_QUAD_INTERIOR: [((usize, usize), (usize, usize)); 4] =
+    [((1, 1), (3, 4)), ((2, 1), (8, 9)), ((2, 2), (13, 14)), ((1, 2), (18, 19))];
+
+impl LocalGregoryQuad {
+    /// Cost: O(20), like [`LocalPatch::from_net`].
+    #[inline(always)]
+    pub(crate) fn new(g: &GregoryPatch) -> Self {
+        let frame = local_frame(&g.points);
+        let p = &g.points;
+        // Rows along v, columns along u, with Fm inside (see `crate::surface::gregory_patch`).
+        let net = [
+            [p[0], p[1], p[7], p[5]],
+            [p[2], p[4], p[9], p[6]],
+            [p[16], p[19], p[14], p[12]],
+            [p[15], p[17], p[11], p[10]],
+        ];
+        let points: [DVec3; 16] = std::array::from_fn(|k| net[k % 4][k / 4]);
+        let spread = GREGORY_QUAD_INTERIOR
+            .map(|(_, (fp, fm))| ((p[fp] - p[fm]) * (1.0 / frame.1)).as_vec3().to_array());
+        LocalGregoryQuad { net: LocalPatch::in_frame(&points, frame, |_| 1.0), spread }
+    }
+}
+
 /// A Gregory triangle (Loop's end caps, [`GregoryTriangle`]) in its local frame, the frame
 /// of all its 18 points: the quartic net with each interior point its corner's `Fp`, and each
 /// corner's `Fm − Fp`. The blended net of a lane is that quartic plus `g · (Fm − Fp)` at each
@@ -392,7 +430,7 @@ pub(crate) struct PointBlocks {
     loop_leaves: Vec<LoopLeaf>,
     /// The coarse leaves of each Catmull-Clark tree in f32 ([`super::tree_points::coarse_form`]),
     /// once per tree, the trees in the order of their first view.
-    tree_forms: Vec<LocalPatch>,
+    tree_forms: Vec<CatmarkLeaf>,
     /// Every local is a bicubic with a local form ([`PointBlocks::all_bicubic`]), decided
     /// once: the locals are large, and a walk over them costs a frame a pass over memory.
     all_bicubic: bool,
@@ -693,6 +731,41 @@ fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usi
     [combine::<FMA, L, M>(&t.du, &lower), combine::<FMA, L, M>(&t.dv, &lower)]
 }
 
+/// A Gregory patch at each lane's `(u, v)` ([`LocalGregoryQuad`]): the bicubic kernel's sums
+/// of the net with the `Fm`s, plus each corner's interior basis times the lane's blend weight
+/// of `Fp` times `Fp − Fm`; normal and reliability as every bicubic's.
+// Index loops over lanes (they vectorize).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+pub(crate) fn gregory_quad_block<const FMA: bool, const L: usize>(
+    g: &LocalGregoryQuad,
+    u: &[f32; L],
+    v: &[f32; L],
+) -> Block<L> {
+    let [mut pos, mut su, mut sv] = tensor_sums::<FMA, L, 3>(&g.net.by_v, u, v);
+    let (bu, du) = bernstein_lanes(u);
+    let (bv, dv) = bernstein_lanes(v);
+    for l in 0..L {
+        let (x, y) = (u[l], v[l]);
+        let (xc, yc) = (1.0 - x, 1.0 - y);
+        // `GregoryPatch::bezier_net`'s weights, 0 at a corner itself.
+        let ratio = |a: f32, d: f32| if d <= 0.0 { a } else { a / d };
+        let w = [ratio(x, x + y), ratio(y, xc + y), ratio(xc, xc + yc), ratio(yc, x + yc)];
+        for (c, ((i, j), _)) in GREGORY_QUAD_INTERIOR.into_iter().enumerate() {
+            let (b, bdu, bdv) = (bu[i][l] * bv[j][l], du[i][l] * bv[j][l], bu[i][l] * dv[j][l]);
+            for a in 0..3 {
+                let d = w[c] * g.spread[c][a];
+                pos[a][l] = madd::<FMA>(b, d, pos[a][l]);
+                su[a][l] = madd::<FMA>(bdu, d, su[a][l]);
+                sv[a][l] = madd::<FMA>(bdv, d, sv[a][l]);
+            }
+        }
+    }
+    let (nrm, margin) = cross_normals(&su, &sv);
+    to_model::<FMA, L>(&mut pos, &g.net.origin, g.net.scale);
+    Block { pos, nrm, margin }
+}
+
 /// A Gregory triangle at each lane's `(u, v)` ([`LocalGregory`]): the quartic kernel's sums
 /// of the net with the `Fp`s, plus each corner's interior basis times the lane's blend
 /// weight of `Fm` times `Fm − Fp`; normal and reliability as every triangle's.
@@ -876,7 +949,7 @@ impl PointBlocks {
         });
         blocks.tree_forms = leaf_forms(forms_made, &catmark, |p, leaf| {
             let Patch::Subdivision(tree) = &set.patches[p] else { unreachable!("a tree's form") };
-            coarse_form(tree, leaf)
+            catmark_leaf(tree, leaf)
         });
         let grid_form = |l: &Local| matches!(l, Local::Bicubic(_) | Local::Rational(_));
         blocks.all_bicubic = blocks.locals.iter().all(grid_form);
@@ -1017,7 +1090,7 @@ impl PointBlocks {
     /// Patch `p`'s Catmull-Clark tree and its coarse leaves' forms ([`eval_sparse`]).
     /// Precondition: `p` is a Catmull-Clark tree.
     #[inline(always)]
-    fn tree<'s>(&'s self, set: &'s SurfaceSet, p: usize) -> (&'s PatchTree, &'s [LocalPatch]) {
+    fn tree<'s>(&'s self, set: &'s SurfaceSet, p: usize) -> (&'s PatchTree, &'s [CatmarkLeaf]) {
         match (&set.patches[p], self.locals[p]) {
             (Patch::Subdivision(tree), Local::CatmarkTree { first, coarse }) => {
                 let first = first as usize;

@@ -42,7 +42,8 @@ use std::cell::RefCell;
 use glam::DVec2;
 
 use super::point_blocks::{
-    bicubic_block, gregory_block, triangle_block, Block, LocalGregory, LocalQuartic, LANES,
+    bicubic_block, gregory_block, gregory_quad_block, triangle_block, Block, LocalGregory, LocalGregoryQuad,
+    LocalQuartic, LANES,
 };
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
@@ -85,14 +86,8 @@ pub(super) trait LeafTree {
     fn prefetch_nodes(&self) {}
     /// Starts loading what evaluating `leaf` at `st` reads (a hint).
     fn prefetch_leaf(&self, _leaf: usize, _st: DVec2) {}
-    /// Leaf `leaf`'s net in its local frame; None for an end cap without an f32 kernel (a
-    /// Catmull-Clark Gregory patch, evaluated in f64).
+    /// Leaf `leaf`'s net in its local frame; None for a leaf without an f32 kernel.
     fn local(&self, leaf: usize) -> Option<Self::Local>;
-    /// Whether a stored `local` is a form (not a placeholder for a leaf that has none).
-    #[inline(always)]
-    fn is_form(_local: &Self::Local) -> bool {
-        true
-    }
     /// The leaf at each lane's parameters, its normal the leaf's own.
     fn block<const FMA: bool, const L: usize>(local: &Self::Local, u: &[f32; L], v: &[f32; L]) -> Block<L>;
     /// Whether the patch's normal is the opposite of its leaves' (module doc).
@@ -108,7 +103,7 @@ pub(super) trait LeafTree {
 }
 
 impl LeafTree for PatchTree {
-    type Local = LocalPatch;
+    type Local = CatmarkLeaf;
     type Near = LeafSquare;
     /// Below it most groups would be single points, which pay for finding and grouping on
     /// top of their f64 evaluation and lose [`PatchTree::derivatives_each`]'s look-ahead.
@@ -146,22 +141,13 @@ impl LeafTree for PatchTree {
     }
 
     #[inline(always)]
-    fn local(&self, leaf: usize) -> Option<LocalPatch> {
-        match &self.leaves()[leaf].patch {
-            LeafPatch::Bezier(net) => Some(LocalPatch::from_net(net)),
-            LeafPatch::Gregory(_) => None,
-        }
-    }
-
-    /// An end cap's placeholder in the stored forms ([`coarse_form`]) is not.
-    #[inline(always)]
-    fn is_form(local: &LocalPatch) -> bool {
-        local.scale != 0.0
+    fn local(&self, leaf: usize) -> Option<CatmarkLeaf> {
+        Some(catmark_leaf(self, leaf))
     }
 
     #[inline(always)]
-    fn block<const FMA: bool, const L: usize>(local: &LocalPatch, u: &[f32; L], v: &[f32; L]) -> Block<L> {
-        bicubic_block::<FMA, L>(local, u, v)
+    fn block<const FMA: bool, const L: usize>(local: &CatmarkLeaf, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+        local.block::<FMA, L>(u, v)
     }
 
     #[inline(always)]
@@ -183,6 +169,33 @@ impl LeafTree for PatchTree {
             return subdivision_point(self, uv, d);
         }
         subdivision_point(self, uv, self.found_derivatives(f.leaf as usize, f.st, f.size))
+    }
+}
+
+/// A Catmull-Clark leaf in its local frame: a bicubic piece or a Gregory end cap.
+pub(super) enum CatmarkLeaf {
+    Bicubic(LocalPatch),
+    Gregory(LocalGregoryQuad),
+}
+
+impl CatmarkLeaf {
+    /// The leaf at each lane's `(u, v)` (its own parameters).
+    #[inline(always)]
+    fn block<const FMA: bool, const L: usize>(&self, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+        match self {
+            CatmarkLeaf::Bicubic(net) => bicubic_block::<FMA, L>(net, u, v),
+            CatmarkLeaf::Gregory(g) => gregory_quad_block::<FMA, L>(g, u, v),
+        }
+    }
+}
+
+/// Leaf `leaf` of `tree` in its local frame ([`LeafTree::local`]; the coarse leaves'
+/// [`super::point_blocks::PointBlocks`] keeps per set, [`FORM_LEVEL`]). Cost: O(1).
+#[inline(always)]
+pub(super) fn catmark_leaf(tree: &PatchTree, leaf: usize) -> CatmarkLeaf {
+    match &tree.leaves()[leaf].patch {
+        LeafPatch::Bezier(net) => CatmarkLeaf::Bicubic(LocalPatch::from_net(net)),
+        LeafPatch::Gregory(g) => CatmarkLeaf::Gregory(LocalGregoryQuad::new(g)),
     }
 }
 
@@ -293,7 +306,7 @@ pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
 
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
 /// [`VertexSlices::put`] does point by point, the leaves' local forms taken from `locals`
-/// where given (the first `locals.len()` leaves', in leaf order; [`LeafTree::is_form`]), else
+/// where given (the first `locals.len()` leaves', in leaf order), else
 /// made for each group. Preconditions:
 /// `set.patches[p]` is `tree`; `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2
 /// and FMA. Cost: a leaf lookup per point and a sort of the points by leaf (O(n + leaves), or
@@ -359,7 +372,7 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
         let made;
         let local = match locals.and_then(|l| l.get(leaf)) {
             // A leaf's form already made: the kernel costs a lone point less than f64 does.
-            Some(local) => T::is_form(local).then_some(local),
+            Some(local) => Some(local),
             _ if group.len() < T::MIN_GROUP => None,
             None => {
                 made = tree.local(leaf);
@@ -423,7 +436,7 @@ fn blocks<const FMA: bool, const L: usize, T: LeafTree>(
 }
 
 /// The finest level of a Catmull-Clark tree's leaves that [`super::point_blocks::PointBlocks`]
-/// keeps in f32 ([`coarse_form`]; [`PatchTree::coarse_leaves`]), for [`eval_sparse`].
+/// keeps in f32 ([`catmark_leaf`]; [`PatchTree::coarse_leaves`]), for [`eval_sparse`].
 ///
 /// **Why these.** A deep tree is sparse as a whole (most of its leaves are small and hold no
 /// point) while its few coarse leaves hold most of its points: at Bfr's rate 16 on
@@ -437,19 +450,9 @@ fn blocks<const FMA: bool, const L: usize, T: LeafTree>(
 /// 3 GB).
 pub(crate) const FORM_LEVEL: u8 = 3;
 
-/// Leaf `leaf`'s f32 form as [`eval_sparse`] reads it: a Bézier leaf's net in its local frame;
-/// for an end cap (Gregory, evaluated in f64) a form whose `scale` is 0, which no local frame
-/// has ([`super::point_blocks::power_of_two_above`]). Cost: O(1).
-pub(super) fn coarse_form(tree: &PatchTree, leaf: usize) -> LocalPatch {
-    match &tree.leaves()[leaf].patch {
-        LeafPatch::Bezier(net) => LocalPatch::from_net(net),
-        LeafPatch::Gregory(_) => LocalPatch { origin: [0.0; 3], scale: 0.0, by_v: [[[0.0; 4]; 4]; 3] },
-    }
-}
-
 /// Points of one leaf's f32 form waiting to be evaluated together ([`eval_sparse`]).
 struct Pending<'t> {
-    form: Option<&'t LocalPatch>,
+    form: Option<&'t CatmarkLeaf>,
     p: u32,
     flip: bool,
     count: usize,
@@ -479,7 +482,7 @@ impl Pending<'_> {
             let st = self.st[l.min(self.count - 1)];
             (u[l], v[l]) = (st.x as f32, st.y as f32);
         }
-        let block = bicubic_block::<FMA, L>(form, &u, &v);
+        let block = form.block::<FMA, L>(&u, &v);
         for l in 0..self.count {
             let k = self.k[l] as usize;
             let (pos, nrm) = block.lane_or_exact(l, set, self.p as usize, self.uv[l]);
@@ -494,7 +497,7 @@ impl Pending<'_> {
 }
 
 /// Evaluates a stream of points on Catmull-Clark trees, `item(k) = (patch, view, forms, uv)`
-/// (the patch's tree, [`coarse_form`] of each of its tree's first leaves, the point), into
+/// (the patch's tree, [`catmark_leaf`] of each of its tree's first leaves, the point), into
 /// `out` (vertex `k` each: position, normal, parameters, patch id). Each point on its own
 /// rule, whatever the points around it, so that a point's value does not depend on the list
 /// it comes in (the engine's edges are evaluated as one stream or patch by patch): a point at
@@ -509,7 +512,7 @@ impl Pending<'_> {
 pub(super) fn eval_sparse<'t, const FMA: bool>(
     set: &'t SurfaceSet,
     n: usize,
-    item: impl Fn(usize) -> (u32, &'t PatchTree, &'t [LocalPatch], DVec2),
+    item: impl Fn(usize) -> (u32, &'t PatchTree, &'t [CatmarkLeaf], DVec2),
     mut out: VertexSlices<'_>,
 ) {
     use crate::surface::patch_tree::{Lookahead, AHEAD};
@@ -540,7 +543,7 @@ pub(super) fn eval_sparse<'t, const FMA: bool>(
             let (p, _, forms, _) = item(k);
             if let Some((position, normal)) = view.corner_point(leaf, st) {
                 (out.pos[k], out.nrm[k]) = (position, normal);
-            } else if let Some(form) = forms.get(leaf).filter(|f| PatchTree::is_form(f)) {
+            } else if let Some(form) = forms.get(leaf) {
                 let open = pending
                     .iter()
                     .position(|b| b.count > 0 && b.p == p && b.form.is_some_and(|f| std::ptr::eq(f, form)));
@@ -685,7 +688,7 @@ mod tests {
             (0..=n).flat_map(|j| (0..=n).map(move |i| DVec2::new(i as f64, j as f64) / n as f64)).collect();
         let (lo, hi) = set.bounds();
         let size = lo.distance(hi) as f32;
-        let mut kernels = 0;
+        let (mut kernels, mut cap_points, mut cap_kernels) = (0, 0, 0);
         for (v, view) in views.iter().enumerate() {
             set.patches[p] = Patch::Subdivision(Box::new(view.clone()));
             assert!(worth_grouping(view, uvs.len()), "view {v}: dense enough to group");
@@ -693,8 +696,20 @@ mod tests {
                 eval_either(fma, &set, p, view, &uvs, out)
             });
             kernels += made.iter().sum::<usize>();
+            for (k, &at) in uvs.iter().enumerate() {
+                if matches!(view.leaves()[view.find(at).0].patch, LeafPatch::Gregory(_)) {
+                    cap_points += 1;
+                    cap_kernels += made[k];
+                }
+            }
         }
         assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
+        // The end caps' points take their kernel too (but a group's lone points).
+        assert!(cap_points > 100, "only {cap_points} points in end caps");
+        assert!(
+            cap_kernels * 2 > cap_points,
+            "only {cap_kernels} of {cap_points} end caps' normals from the kernels"
+        );
     }
 
     /// Every isolated view of every Catmull-Clark cage that builds, at Bfr's rate 8 grid and
@@ -719,6 +734,7 @@ mod tests {
             DVec2::new(next(), next())
         }));
         let (mut sparse_views, mut coarse_points, mut coarse_kernels, mut fine_points) = (0, 0, 0, 0);
+        let (mut cap_points, mut cap_kernels) = (0, 0);
         for path in &cages {
             let mesh = crate::io::obj::read_obj(path).unwrap();
             let Ok(set) = SurfaceSet::from_subdivision_cage(&mesh, path, Default::default()) else {
@@ -754,10 +770,14 @@ mod tests {
                 for (k, &at) in uvs.iter().enumerate() {
                     let (leaf, st, _) = view.find(at);
                     let stored = view.corner_point(leaf, st).is_some();
-                    let bezier = matches!(view.leaves()[leaf].patch, LeafPatch::Bezier(_));
-                    if leaf < coarse && bezier && !stored {
+                    let end_cap = matches!(view.leaves()[leaf].patch, LeafPatch::Gregory(_));
+                    if leaf < coarse && !stored {
                         coarse_points += 1;
                         coarse_kernels += made[k];
+                        if end_cap {
+                            cap_points += 1;
+                            cap_kernels += made[k];
+                        }
                     } else {
                         fine_points += 1;
                         assert_eq!(
@@ -771,7 +791,12 @@ mod tests {
         }
         eprintln!(
             "{sparse_views} sparse views: {coarse_points} points in coarse leaves ({coarse_kernels} normals from \
-             the kernels, both builds), {fine_points} others"
+             the kernels, both builds; {cap_points} in end caps, {cap_kernels}), {fine_points} others"
+        );
+        assert!(cap_points > 100, "only {cap_points} points in coarse end caps");
+        assert!(
+            cap_kernels * 2 > cap_points,
+            "only {cap_kernels} of {cap_points} end caps' normals from the kernels"
         );
         assert!(sparse_views >= 100, "only {sparse_views} sparse views");
         assert!(fine_points > 1000, "only {fine_points} points outside the coarse leaves");
@@ -782,7 +807,7 @@ mod tests {
     }
 
     /// The grouped path as the engine calls it, with the set's stored forms of the coarse
-    /// leaves ([`PointBlocks`]; [`LeafTree::is_form`] skips an end cap's placeholder): every
+    /// leaves ([`PointBlocks`]; end caps among them): every
     /// isolated view of two creased cages at a dense grid, against the generic f64 evaluation
     /// ([`assert_matches_f64`]), most normals from the kernels.
     #[test]

@@ -141,7 +141,17 @@ impl<const C: usize> LocalPatch<C> {
     /// its control points `k`.
     #[inline(always)]
     fn with_weights(points: &[DVec3; 16], weight: impl Fn(usize) -> f64) -> LocalPatch<C> {
-        let (origin, scale) = local_frame(points);
+        LocalPatch::in_frame(points, local_frame(points), weight)
+    }
+
+    /// [`LocalPatch::with_weights`] in the frame `(origin, scale)` ([`local_frame`] of the
+    /// net, or of points around it).
+    #[inline(always)]
+    pub(crate) fn in_frame(
+        points: &[DVec3; 16],
+        (origin, scale): (DVec3, f64),
+        weight: impl Fn(usize) -> f64,
+    ) -> LocalPatch<C> {
         // Exact: a power of two.
         let inv = 1.0 / scale;
         let mut local =
