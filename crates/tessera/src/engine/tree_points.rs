@@ -42,7 +42,7 @@ use std::cell::RefCell;
 use glam::DVec2;
 
 use super::point_blocks::{
-    bicubic_block, gregory_block, gregory_quad_block, triangle_block, Block, LocalGregory, LocalGregoryQuad,
+    gregory_block, gregory_quad_block, leaf_block, triangle_block, Block, LocalGregory, LocalGregoryQuad,
     LocalQuartic, LANES,
 };
 use super::uniform_quads::LocalPatch;
@@ -183,7 +183,7 @@ impl CatmarkLeaf {
     #[inline(always)]
     fn block<const FMA: bool, const L: usize>(&self, u: &[f32; L], v: &[f32; L]) -> Block<L> {
         match self {
-            CatmarkLeaf::Bicubic(net) => bicubic_block::<FMA, L>(net, u, v),
+            CatmarkLeaf::Bicubic(net) => leaf_block::<FMA, L>(net, u, v),
             CatmarkLeaf::Gregory(g) => gregory_quad_block::<FMA, L>(g, u, v),
         }
     }
