@@ -75,29 +75,43 @@ impl CoreGrid {
         let [nu, nv] = self.cells;
         let ([i_lo, j_lo], [i_hi, j_hi]) = (self.lo, self.hi);
         debug_assert_eq!(out.len(), 3 * self.triangle_count() as usize);
-        // The columns whose cells have interior corners only, on a row off the boundary.
-        let (inner_lo, inner_hi) = (i_lo.max(1), i_hi.min(nu.saturating_sub(1)).max(i_lo.max(1)));
+        // The columns `a..b` whose cells have interior corners only, on a row off the
+        // boundary; the columns before and after them take the general rule.
+        let a = i_lo.max(1).min(i_hi);
+        let b = i_hi.min(nu.saturating_sub(1)).max(a);
         let mut cells = out.chunks_exact_mut(6);
         let mut cell = |[a, b, c, d]: [u32; 4]| {
             let out = cells.next().expect("out holds every cell");
             out.copy_from_slice(&[a, b, c, a, c, d]);
         };
-        let corners = |i: u32, j: u32| {
-            [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
-                .map(|(i, j)| self.index(interior, &boundary, i, j))
+        // A column's two points of row `j`, by the general rule.
+        let side = |i: u32, j: u32| {
+            [self.index(interior, &boundary, i, j), self.index(interior, &boundary, i, j + 1)]
         };
         for j in j_lo..j_hi {
-            if j == 0 || j + 1 >= nv {
-                (i_lo..i_hi).for_each(|i| cell(corners(i, j)));
-                continue;
+            let inner_row = j > 0 && j + 1 < nv;
+            let (fast_lo, fast_hi) = if inner_row { (a, b) } else { (i_hi, i_hi) };
+            // Left of the fast columns, then right of them, by the rule; each column's points
+            // numbered once (a cell's right side is the next one's left).
+            let mut left = side(i_lo, j);
+            for i in i_lo..fast_lo {
+                let right = side(i + 1, j);
+                cell([left[0], right[0], right[1], left[1]]);
+                left = right;
             }
-            let row = interior + (j - 1) * (nu - 1);
-            (i_lo..inner_lo.min(i_hi)).for_each(|i| cell(corners(i, j)));
-            for i in inner_lo..inner_hi {
+            let row = interior.wrapping_add(j.wrapping_sub(1).wrapping_mul(nu - 1));
+            for i in fast_lo..fast_hi {
                 let a = row + (i - 1);
                 cell([a, a + 1, a + nu, a + nu - 1]);
             }
-            (inner_hi.max(i_lo)..i_hi).for_each(|i| cell(corners(i, j)));
+            if fast_hi < i_hi {
+                left = side(fast_hi, j);
+            }
+            for i in fast_hi..i_hi {
+                let right = side(i + 1, j);
+                cell([left[0], right[0], right[1], left[1]]);
+                left = right;
+            }
         }
     }
 }
