@@ -461,15 +461,7 @@ pub fn tree_curve_bounds(t: &crate::surface::PatchTree) -> [f64; 4] {
 /// `v`), and the `uu` and `vv` constants are equal, so one set serves all four.
 pub fn gregory_hessian(g: &crate::surface::GregoryPatch) -> HessianBound {
     let p = &g.points;
-    // The Bézier net with Fm inside (rows along v, columns along u; see the Gregory module).
-    let net = [
-        [p[0], p[1], p[7], p[5]],
-        [p[2], p[4], p[9], p[6]],
-        [p[16], p[19], p[14], p[12]],
-        [p[15], p[17], p[11], p[10]],
-    ];
-    let points: [DVec3; 16] = std::array::from_fn(|k| net[k % 4][k / 4]);
-    let mut m = bicubic_hessian(&RationalBicubic::polynomial(points));
+    let mut m = bicubic_hessian(&RationalBicubic::polynomial(g.minus_net()));
     for c in 0..4 {
         let d = (p[5 * c + 3] - p[5 * c + 4]).length();
         m.uu += 18.0 * d;

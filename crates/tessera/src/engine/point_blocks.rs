@@ -276,17 +276,9 @@ impl LocalGregoryQuad {
     pub(crate) fn new(g: &GregoryPatch) -> Self {
         let frame = local_frame(&g.points);
         let p = &g.points;
-        // Rows along v, columns along u, with Fm inside (see `crate::surface::gregory_patch`).
-        let net = [
-            [p[0], p[1], p[7], p[5]],
-            [p[2], p[4], p[9], p[6]],
-            [p[16], p[19], p[14], p[12]],
-            [p[15], p[17], p[11], p[10]],
-        ];
-        let points: [DVec3; 16] = std::array::from_fn(|k| net[k % 4][k / 4]);
         let spread = GREGORY_QUAD_INTERIOR
             .map(|(_, (fp, fm))| ((p[fp] - p[fm]) * (1.0 / frame.1)).as_vec3().to_array());
-        LocalGregoryQuad { net: LocalPatch::in_frame(&points, frame, |_| 1.0), spread }
+        LocalGregoryQuad { net: LocalPatch::in_frame(&g.minus_net(), frame, |_| 1.0), spread }
     }
 }
 

@@ -33,6 +33,23 @@ impl GregoryPatch {
         let f1 = blend(v * inv(uc + v), 8);
         let f2 = blend(uc * inv(uc + vc), 13);
         let f3 = blend(vc * inv(u + vc), 18);
+        self.net_with([f0, f1, f2, f3])
+    }
+
+    /// The Bézier net with each interior point its corner's `Fm` (every blend's weight on
+    /// `Fp` zero), as `points[4*i + j]`, `i` along `u` (a `RationalBicubic`'s order): the
+    /// patch at `(u, v)` is this net plus, at each corner's interior point, the blend's
+    /// weight times `Fp − Fm`, which the second-derivative bound
+    /// (`criterion::bounds::gregory_hessian`) and the f32 kernel read.
+    pub(crate) fn minus_net(&self) -> [DVec3; 16] {
+        let g = &self.points;
+        let net = self.net_with([g[4], g[9], g[14], g[19]]);
+        std::array::from_fn(|k| net[k % 4][k / 4])
+    }
+
+    /// The net (rows along `v`, columns along `u`) with interior points `f`, corner by corner.
+    fn net_with(&self, [f0, f1, f2, f3]: [DVec3; 4]) -> [[DVec3; 4]; 4] {
+        let g = &self.points;
         [[g[0], g[1], g[7], g[5]], [g[2], f0, f1, g[6]], [g[16], f3, f2, g[12]], [g[15], g[17], g[11], g[10]]]
     }
 
