@@ -266,18 +266,18 @@ pub(crate) struct LocalGregoryQuad {
 }
 
 /// Where each corner's blended point sits in a Gregory patch's bicubic net, `(i, j)` with `i`
-/// along `u` (as [`GregoryPatch::bezier_net`] puts them), and its `(Fp, Fm)` points.
-const GREGORY_QUAD_INTERIOR: [((usize, usize), (usize, usize)); 4] =
-    [((1, 1), (3, 4)), ((2, 1), (8, 9)), ((2, 2), (13, 14)), ((1, 2), (18, 19))];
+/// along `u` (as [`GregoryPatch::bezier_net`] puts them).
+const GREGORY_QUAD_INTERIOR: [(usize, usize); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
 
 impl LocalGregoryQuad {
     /// Cost: O(20), like [`LocalPatch::from_net`].
     #[inline(always)]
     pub(crate) fn new(g: &GregoryPatch) -> Self {
         let frame = local_frame(&g.points);
+        // Corner `c`'s `Fp` and `Fm` are its points 3 and 4 (`crate::surface::gregory_patch`).
         let p = &g.points;
-        let spread = GREGORY_QUAD_INTERIOR
-            .map(|(_, (fp, fm))| ((p[fp] - p[fm]) * (1.0 / frame.1)).as_vec3().to_array());
+        let spread: [[f32; 3]; 4] =
+            std::array::from_fn(|c| ((p[5 * c + 3] - p[5 * c + 4]) * (1.0 / frame.1)).as_vec3().to_array());
         LocalGregoryQuad { net: LocalPatch::in_frame(&g.minus_net(), frame, |_| 1.0), spread }
     }
 }
@@ -786,7 +786,7 @@ pub(crate) fn gregory_quad_block<const FMA: bool, const L: usize>(
         // `GregoryPatch::bezier_net`'s weights, 0 at a corner itself.
         let ratio = |a: f32, d: f32| if d <= 0.0 { a } else { a / d };
         let w = [ratio(x, x + y), ratio(y, xc + y), ratio(xc, xc + yc), ratio(yc, x + yc)];
-        for (c, ((i, j), _)) in GREGORY_QUAD_INTERIOR.into_iter().enumerate() {
+        for (c, (i, j)) in GREGORY_QUAD_INTERIOR.into_iter().enumerate() {
             let (b, bdu, bdv) = (bu[i][l] * bv[j][l], du[i][l] * bv[j][l], bu[i][l] * dv[j][l]);
             for a in 0..3 {
                 let d = w[c] * g.spread[c][a];

@@ -86,8 +86,8 @@ pub(super) trait LeafTree {
     fn prefetch_nodes(&self) {}
     /// Starts loading what evaluating `leaf` at `st` reads (a hint).
     fn prefetch_leaf(&self, _leaf: usize, _st: DVec2) {}
-    /// Leaf `leaf`'s net in its local frame; None for a leaf without an f32 kernel.
-    fn local(&self, leaf: usize) -> Option<Self::Local>;
+    /// Leaf `leaf`'s net in its local frame.
+    fn local(&self, leaf: usize) -> Self::Local;
     /// The leaf at each lane's parameters, its normal the leaf's own.
     fn block<const FMA: bool, const L: usize>(local: &Self::Local, u: &[f32; L], v: &[f32; L]) -> Block<L>;
     /// Whether the patch's normal is the opposite of its leaves' (module doc).
@@ -141,8 +141,8 @@ impl LeafTree for PatchTree {
     }
 
     #[inline(always)]
-    fn local(&self, leaf: usize) -> Option<CatmarkLeaf> {
-        Some(catmark_leaf(self, leaf))
+    fn local(&self, leaf: usize) -> CatmarkLeaf {
+        catmark_leaf(self, leaf)
     }
 
     #[inline(always)]
@@ -208,7 +208,10 @@ pub(super) enum LoopLeaf {
 /// Leaf `leaf` of `tree` in its local frame ([`LeafTree::local`]): what
 /// [`super::point_blocks::PointBlocks`] keeps per leaf of a set for [`eval`]. Cost: O(1).
 pub(super) fn loop_leaf(tree: &TriangleTree, leaf: usize) -> LoopLeaf {
-    tree.local(leaf).expect("every Loop leaf has a local form")
+    match &tree.leaves()[leaf].patch {
+        TriangleLeafPatch::Quartic(q) => LoopLeaf::Quartic(LocalQuartic::from_net(&q.points)),
+        TriangleLeafPatch::Gregory(g) => LoopLeaf::Gregory(LocalGregory::new(g)),
+    }
 }
 
 impl LeafTree for TriangleTree {
@@ -253,11 +256,8 @@ impl LeafTree for TriangleTree {
     }
 
     #[inline(always)]
-    fn local(&self, leaf: usize) -> Option<LoopLeaf> {
-        Some(match &self.leaves()[leaf].patch {
-            TriangleLeafPatch::Quartic(q) => LoopLeaf::Quartic(LocalQuartic::from_net(&q.points)),
-            TriangleLeafPatch::Gregory(g) => LoopLeaf::Gregory(LocalGregory::new(g)),
-        })
+    fn local(&self, leaf: usize) -> LoopLeaf {
+        loop_leaf(self, leaf)
     }
 
     #[inline(always)]
@@ -376,7 +376,7 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
             _ if group.len() < T::MIN_GROUP => None,
             None => {
                 made = tree.local(leaf);
-                made.as_ref()
+                Some(&made)
             }
         };
         match local {
@@ -643,6 +643,14 @@ mod tests {
         kernels
     }
 
+    /// That `kernels` (summed over the builds, [`assert_matches_f64`]) is more than half of
+    /// `points`, which are more than `fewest`: most of those points' normals came from the
+    /// kernels, and the test saw enough of them.
+    fn assert_mostly_kernels(what: &str, kernels: usize, points: usize, fewest: usize) {
+        assert!(points > fewest, "only {points} points in {what}");
+        assert!(kernels * 2 > points, "only {kernels} of {points} normals from the kernels in {what}");
+    }
+
     /// [`eval`] with the kernels `fma` says (the engine's two builds).
     fn eval_either<T: LeafTree>(
         fma: bool,
@@ -704,12 +712,8 @@ mod tests {
             }
         }
         assert!(kernels * 4 > uvs.len() * views.len(), "only {kernels} normals from the kernels");
-        // The end caps' points take their kernel too (but a group's lone points).
-        assert!(cap_points > 100, "only {cap_points} points in end caps");
-        assert!(
-            cap_kernels * 2 > cap_points,
-            "only {cap_kernels} of {cap_points} end caps' normals from the kernels"
-        );
+        // The end caps' points take their kernel too (all but a group's lone points).
+        assert_mostly_kernels("end caps", cap_kernels, cap_points, 100);
     }
 
     /// Every isolated view of every Catmull-Clark cage that builds, at Bfr's rate 8 grid and
@@ -793,17 +797,10 @@ mod tests {
             "{sparse_views} sparse views: {coarse_points} points in coarse leaves ({coarse_kernels} normals from \
              the kernels, both builds; {cap_points} in end caps, {cap_kernels}), {fine_points} others"
         );
-        assert!(cap_points > 100, "only {cap_points} points in coarse end caps");
-        assert!(
-            cap_kernels * 2 > cap_points,
-            "only {cap_kernels} of {cap_points} end caps' normals from the kernels"
-        );
+        assert_mostly_kernels("coarse end caps", cap_kernels, cap_points, 100);
         assert!(sparse_views >= 100, "only {sparse_views} sparse views");
         assert!(fine_points > 1000, "only {fine_points} points outside the coarse leaves");
-        assert!(
-            coarse_kernels * 2 > coarse_points,
-            "only {coarse_kernels} of {coarse_points} normals from the kernels"
-        );
+        assert_mostly_kernels("coarse leaves", coarse_kernels, coarse_points, 0);
     }
 
     /// The grouped path as the engine calls it, with the set's stored forms of the coarse

@@ -42,8 +42,7 @@ impl GregoryPatch {
     /// weight times `Fp − Fm`, which the second-derivative bound
     /// (`criterion::bounds::gregory_hessian`) and the f32 kernel read.
     pub(crate) fn minus_net(&self) -> [DVec3; 16] {
-        let g = &self.points;
-        let net = self.net_with([g[4], g[9], g[14], g[19]]);
+        let net = self.net_with(std::array::from_fn(|c| self.points[5 * c + 4]));
         std::array::from_fn(|k| net[k % 4][k / 4])
     }
 
