@@ -723,24 +723,27 @@ impl Writer<'_> {
         // The triangles in the general form need the whole pattern, core included.
         let cached = self.cached(p).filter(|(_, c)| !general || c.core.is_none());
         let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, _)| input);
-        let local = match cached {
-            Some((_, c)) => c.local,
-            None => &scratch.patterns.get(self.generation, self.pattern, &input, false).local,
+        let (local, interior) = match cached {
+            Some((_, c)) => (c.local, c.interior),
+            None => {
+                let local = &scratch.patterns.get(self.generation, self.pattern, &input, false).local;
+                (local, &local.interior[..])
+            }
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
-        let fast = self.fast.filter(|_| !local.interior.is_empty());
+        let fast = self.fast.filter(|_| !interior.is_empty());
         match fast.map(|f| (f, f.covers_patch(p, self.pattern, &input))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),
-            Some((f, None)) => f.points().eval(set, p, &local.interior, verts),
+            Some((f, None)) => f.points().eval(set, p, interior, verts),
             None => {
-                for (k, &uv) in local.interior.iter().enumerate() {
+                for (k, &uv) in interior.iter().enumerate() {
                     verts.set(k, set, p as u32, uv);
                 }
             }
         }
         if !params.is_empty() {
             let map = LocalMap { set, plan, layout, input, patch: p };
-            map.param_table(local, &mut scratch.param);
+            map.param_table(interior, &mut scratch.param);
         }
         if cached.is_some() && !general {
             return;
@@ -973,7 +976,7 @@ impl LocalMap<'_> {
     }
 
     /// Parameters in this patch of every local index, in local order (f32 as stored).
-    fn param_table(&self, local: &LocalTessellation, table: &mut Vec<[f32; 2]>) {
+    fn param_table(&self, interior: &[glam::DVec2], table: &mut Vec<[f32; 2]>) {
         table.clear();
         let d = self.input.domain;
         let nc = d.corner_count();
@@ -984,7 +987,7 @@ impl LocalMap<'_> {
                 d.edge_point(e, self.plan.local_param(pe.edge as usize, k, pe.reversed)).as_vec2().to_array()
             }));
         }
-        table.extend(local.interior.iter().map(|uv| uv.as_vec2().to_array()));
+        table.extend(interior.iter().map(|uv| uv.as_vec2().to_array()));
     }
 }
 
@@ -1049,7 +1052,7 @@ pub fn corner_params(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, layou
                 let map = LocalMap { set, plan, layout, input, patch: p };
                 let mut table = std::mem::take(&mut scratch.param);
                 let local = scratch.pattern(pattern, &input);
-                map.param_table(local, &mut table);
+                map.param_table(&local.interior, &mut table);
                 let params = local
                     .triangles
                     .iter()

@@ -124,6 +124,14 @@ pub(crate) struct PatternCache {
     params: Vec<Vec<DVec2>>,
     /// Per slot in use, whether `params` holds its table.
     has_params: Vec<bool>,
+    /// Per slot in use, the index in `grids` of its core grid's points, which its slot
+    /// leaves out ([`Pattern::build_after_core`]), or [`NONE`]: the slot's own list.
+    interiors: Vec<u32>,
+    /// The interior points of each distinct core grid of the frame ([`CoreGrid::interior_points`]),
+    /// `grid_of.len()` in use; the others keep their buffers for later frames.
+    grids: Vec<Vec<DVec2>>,
+    /// Each distinct core grid's index in `grids`, by its cells (`nu << 32 | nv`).
+    grid_of: WordMap<u64, u32>,
 }
 
 /// The parameters of every local vertex of `built` (made for `input`), in local order:
@@ -189,6 +197,8 @@ impl PatternCache {
         self.cores.clear();
         self.has_params.clear();
         self.of_patch.clear();
+        self.interiors.clear();
+        self.grid_of.clear();
     }
 
     /// Forgets which item has which pattern (every [`PatternCache::get`] answers None) but
@@ -241,8 +251,11 @@ impl PatternCache {
             let next = self.inputs.len() as u32;
             let slot = *self.index.entry(Key::of(&input)).or_insert(next);
             if slot == next {
+                let core = pattern.core_grid(&input);
                 self.inputs.push(input);
-                self.cores.push(pattern.core_grid(&input));
+                self.cores.push(core);
+                let interior = core.map_or(NONE, |core| self.grid(core));
+                self.interiors.push(interior);
             }
             self.of_patch.push(slot);
         }
@@ -284,6 +297,23 @@ impl PatternCache {
         }
     }
 
+    /// The index in `grids` of `core`'s grid points, made unless the frame has them.
+    /// Cost: O(1), or O(points) for a grid new to the frame.
+    fn grid(&mut self, core: CoreGrid) -> u32 {
+        let [nu, nv] = core.cells;
+        let next = self.grid_of.len() as u32;
+        let index = *self.grid_of.entry((nu as u64) << 32 | nv as u64).or_insert(next);
+        if index == next {
+            if self.grids.len() <= next as usize {
+                self.grids.push(Vec::new());
+            }
+            let points = &mut self.grids[next as usize];
+            points.clear();
+            core.interior_points(points);
+        }
+        index
+    }
+
     /// Patch `p`'s pattern input, pattern and the pattern's [`boundary_positions`], when the
     /// cache holds them for this frame (the input's `patch` is the first patch's of that
     /// input: set it to `p`).
@@ -292,6 +322,10 @@ impl PatternCache {
         (slot != NONE as usize).then(|| Cached {
             input: &self.inputs[slot],
             local: &self.slots[slot],
+            interior: match self.interiors[slot] {
+                NONE => &self.slots[slot].interior,
+                grid => &self.grids[grid as usize],
+            },
             boundary: &self.boundary[slot],
             core: self.cores[slot],
         })
@@ -302,8 +336,8 @@ impl PatternCache {
     pub(crate) fn params(&self, i: usize) -> Option<(Cached<'_>, LocalParams<'_>)> {
         let slot = *self.of_patch.get(i)? as usize;
         (slot != NONE as usize && self.has_params[slot]).then(|| {
-            let params = LocalParams { boundary: &self.params[slot], interior: &self.slots[slot].interior };
-            (self.get(i).expect("the slot is in use"), params)
+            let cached = self.get(i).expect("the slot is in use");
+            (cached, LocalParams { boundary: &self.params[slot], interior: cached.interior })
         })
     }
 
@@ -319,8 +353,12 @@ impl PatternCache {
 pub(crate) struct Cached<'a> {
     /// The input it was built for (its `patch` the first patch's of that input).
     pub(crate) input: &'a PatternInput,
-    /// [`Pattern::build_after_core`]: the interior vertices, and the triangles after the core.
+    /// [`Pattern::build_after_core`]: the triangles after the core (and the interior
+    /// vertices where there is no core: read `interior`).
     pub(crate) local: &'a LocalTessellation,
+    /// The pattern's interior vertices: the core grid's points (shared by every pattern
+    /// with that grid) or the slot's own.
+    pub(crate) interior: &'a [DVec2],
     /// The [`boundary_positions`] of `local`'s triangles.
     pub(crate) boundary: &'a [u32],
     /// The core grid whose triangles `local` leaves out, where the pattern has one.
@@ -484,7 +522,7 @@ mod tests {
             }
             flat.extend_from_slice(rest.as_flattened());
             assert_eq!(flat, whole.triangles.as_flattened(), "{input:?}");
-            assert_eq!(cached.local.interior, whole.interior, "{input:?}");
+            assert_eq!(cached.interior, whole.interior, "{input:?}");
             let mut table = Vec::new();
             local_params(input, &whole, &mut table);
             let read: Vec<DVec2> = (0..table.len() as u32).map(|l| params.get(l)).collect();

@@ -8,6 +8,7 @@
 //! so a frame's pattern cache then holds the strips alone.
 
 use super::PatternInput;
+use glam::DVec2;
 
 /// The cells `lo[0]..hi[0]` × `lo[1]..hi[1]` of a quad's `cells[0] × cells[1]` grid, each cell
 /// `(i, j)` split along its diagonal from `(i, j)` to `(i + 1, j + 1)` into
@@ -29,6 +30,13 @@ pub struct CoreGrid {
 }
 
 impl CoreGrid {
+    /// Appends the interior points of the core's grid, which a pattern with a core grid has
+    /// for its interior vertices ([`super::Pattern::core_grid`]): [`grid_interior`] of
+    /// `cells`. Cost: O(points).
+    pub fn interior_points(&self, out: &mut Vec<DVec2>) {
+        grid_interior(self.cells, out);
+    }
+
     /// The rectangle `lo..hi` of the `cells` grid of quad `input`. Cost: O(1).
     pub fn new(input: &PatternInput, cells: [u32; 2], lo: [u32; 2], hi: [u32; 2]) -> Self {
         debug_assert!(lo[0] <= hi[0] && hi[0] <= cells[0] && lo[1] <= hi[1] && hi[1] <= cells[1]);
@@ -112,6 +120,20 @@ impl CoreGrid {
                 cell([left[0], right[0], right[1], left[1]]);
                 left = right;
             }
+        }
+    }
+}
+
+/// Appends the points `(i·(1/nu), j·(1/nv))` strictly inside the domain of the `nu × nv`
+/// grid (`cells`), row after row (`j` outer): the interior vertices of a quad pattern that
+/// is a grid inside its strips ([`super::Pattern::interior_grid`]), computed by one rule
+/// wherever they are needed so that they agree bit for bit. Cost: O(points).
+pub fn grid_interior([nu, nv]: [u32; 2], out: &mut Vec<DVec2>) {
+    let (su, sv) = (1.0 / nu as f64, 1.0 / nv as f64);
+    out.reserve((nu.saturating_sub(1) as usize) * (nv.saturating_sub(1) as usize));
+    for j in 1..nv {
+        for i in 1..nu {
+            out.push(DVec2::new(i as f64 * su, j as f64 * sv));
         }
     }
 }

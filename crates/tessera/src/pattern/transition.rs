@@ -202,14 +202,13 @@ impl QuadLayout {
         ((self.nu - 1) * (self.nv - 1), core + strips)
     }
 
-    /// The interior vertices, then the core's cells unless `strips_only`, then the strips.
+    /// The interior vertices and the core's cells unless `strips_only` (the core grid's
+    /// points are then left to [`CoreGrid::interior_points`]), then the strips.
     fn build(&self, input: &PatternInput, out: &mut LocalTessellation, strips_only: bool) {
         // Same arithmetic as the uniform pattern so the all-matching case is bit-identical.
         let (su, sv) = (1.0 / self.nu as f64, 1.0 / self.nv as f64);
-        for j in 1..self.nv {
-            for i in 1..self.nu {
-                out.interior.push(DVec2::new(i as f64 * su, j as f64 * sv));
-            }
+        if !strips_only {
+            super::core_grid::grid_interior([self.nu, self.nv], &mut out.interior);
         }
         let core = self.core(input);
         let interior = input.interior_base();
@@ -533,7 +532,7 @@ impl Pattern for Transition {
         (input.domain == Domain::Quad && unpinned).then(|| QuadLayout::new(input).core(input))
     }
 
-    /// The interior and the strips, without building the core's cells.
+    /// The strips alone: neither the core's cells nor its grid's points.
     fn build_after_core(&self, input: &PatternInput, out: &mut LocalTessellation) {
         if self.core_grid(input).is_none() {
             return super::build_removing_core(self, input, out);
@@ -619,8 +618,8 @@ mod tests {
     fn check_core_grid(input: &PatternInput, out: &LocalTessellation, count: u32) {
         let mut rest = LocalTessellation::default();
         Transition.build_after_core(input, &mut rest);
-        assert_eq!(rest.interior, out.interior, "{input:?}: interior after the core");
         let Some(core) = Transition.core_grid(input) else {
+            assert_eq!(rest.interior, out.interior, "{input:?}: no core, the whole interior");
             assert!(
                 input.domain == Domain::Tri || input.pinched.contains(&true),
                 "{input:?}: a quad has a core"
@@ -629,6 +628,10 @@ mod tests {
             return;
         };
         assert_eq!(core.triangle_count(), count, "{input:?}: core_cells counts the core grid");
+        assert!(rest.interior.is_empty(), "{input:?}: the core grid's points left out");
+        let mut points = Vec::new();
+        core.interior_points(&mut points);
+        assert_eq!(points, out.interior, "{input:?}: the interior is the core grid's points");
         let (core_triangles, after) = out.triangles.split_at(count as usize);
         assert_eq!(rest.triangles, after, "{input:?}: the triangles after the core");
         let mut flat = vec![0; 3 * count as usize];
