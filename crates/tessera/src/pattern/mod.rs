@@ -207,8 +207,9 @@ pub trait Pattern: Sync {
     /// it to skip building it. Cost: O(triangles after the core) for an override.
     ///
     /// Why the interior goes too: a fine adaptive frame's distinct patterns differ mostly in
-    /// their strips, and their interiors were most of what a frame's cache held (the rook's
-    /// at 0.5 px: 6 M points, 100 MB, against a few hundred distinct grids).
+    /// their strips, and their interiors were most of what a frame's cache held. The rook × 16
+    /// at 0.5 px has 10,152 distinct patterns with 6.2 M interior points (100 MB), and 1,671
+    /// distinct grids with 1.9 M; the check's stage took 75 → 63 ms (one thread).
     fn build_after_core(&self, input: &PatternInput, out: &mut LocalTessellation) {
         build_removing_core(self, input, out)
     }
