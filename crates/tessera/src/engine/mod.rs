@@ -734,7 +734,15 @@ impl Writer<'_> {
         let fast = self.fast.filter(|_| !interior.is_empty());
         match fast.map(|f| (f, f.covers_patch(p, self.pattern, &input))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),
-            Some((f, None)) => f.points().eval(set, p, interior, verts),
+            Some((f, None)) => {
+                // A pattern's interior that is a grid (a core grid's points are) lets a tree
+                // find its leaves' points by a walk instead of a search each.
+                let grid = match cached {
+                    Some((_, c)) if c.core.is_some() => c.core.map(|core| core.cells),
+                    _ => self.pattern.interior_grid(&input),
+                };
+                f.points().eval_grid(set, p, interior, grid, verts)
+            }
             None => {
                 for (k, &uv) in interior.iter().enumerate() {
                     verts.set(k, set, p as u32, uv);

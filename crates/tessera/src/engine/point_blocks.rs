@@ -1041,12 +1041,28 @@ impl PointBlocks {
     /// Preconditions: `out` holds `uvs.len()` vertices; `self` was made for `set`. Cost: about
     /// a tenth of the generic evaluation per point (less for PN triangles), no allocation.
     pub(crate) fn eval(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
+        self.eval_grid(set, p, uvs, None, out)
+    }
+
+    /// [`PointBlocks::eval`] where `uvs` may be the interior points of a `grid`
+    /// ([`crate::pattern::core_grid::grid_interior`]'s order): a Catmull-Clark tree then finds
+    /// its leaves' points by walking its quadtree with the grid
+    /// ([`crate::surface::PatchTree::grid_leaves`]). The same values as `eval`.
+    /// Preconditions: `eval`'s, and with `grid`, `uvs` is that grid's interior.
+    pub(crate) fn eval_grid(
+        &self,
+        set: &SurfaceSet,
+        p: usize,
+        uvs: &[DVec2],
+        grid: Option<[u32; 2]>,
+        out: VertexSlices<'_>,
+    ) {
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`PointBlocks::for_set`).
-            return unsafe { self.eval_avx2_fma(set, p, uvs, out) };
+            return unsafe { self.eval_avx2_fma(set, p, uvs, grid, out) };
         }
-        self.eval_with::<false>(set, p, uvs, out)
+        self.eval_with::<false>(set, p, uvs, grid, out)
     }
 
     /// Whether some patch is a Catmull-Clark tree.
@@ -1141,18 +1157,32 @@ impl PointBlocks {
     /// The CPU must support AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn eval_avx2_fma(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
-        self.eval_with::<true>(set, p, uvs, out)
+    unsafe fn eval_avx2_fma(
+        &self,
+        set: &SurfaceSet,
+        p: usize,
+        uvs: &[DVec2],
+        grid: Option<[u32; 2]>,
+        out: VertexSlices<'_>,
+    ) {
+        self.eval_with::<true>(set, p, uvs, grid, out)
     }
 
     #[inline(always)]
-    fn eval_with<const FMA: bool>(&self, set: &SurfaceSet, p: usize, uvs: &[DVec2], out: VertexSlices<'_>) {
+    fn eval_with<const FMA: bool>(
+        &self,
+        set: &SurfaceSet,
+        p: usize,
+        uvs: &[DVec2],
+        grid: Option<[u32; 2]>,
+        out: VertexSlices<'_>,
+    ) {
         if let Local::Generic | Local::LoopTree(_) | Local::CatmarkTree { .. } = self.locals[p] {
             use super::tree_points::{eval as grouped, worth_grouping};
             match (&set.patches[p], self.locals[p]) {
                 (Patch::Subdivision(tree), _) if worth_grouping(&**tree, uvs.len()) => {
                     let (tree, forms) = self.tree(set, p);
-                    return grouped::<FMA, _>(set, p, tree, Some(forms), uvs, out);
+                    return grouped::<FMA, _>(set, p, tree, Some(forms), uvs, grid, out);
                 }
                 (Patch::Subdivision(_), _) => {
                     let (tree, forms) = self.tree(set, p);
@@ -1161,11 +1191,11 @@ impl PointBlocks {
                 (Patch::Loop(tree), Local::LoopTree(first)) if worth_grouping(&**tree, uvs.len()) => {
                     let first = first as usize;
                     let leaves = &self.loop_leaves[first..first + tree.leaves().len()];
-                    return grouped::<FMA, _>(set, p, &**tree, Some(leaves), uvs, out);
+                    return grouped::<FMA, _>(set, p, &**tree, Some(leaves), uvs, grid, out);
                 }
                 // A set past the budget for stored forms (`LOOP_FORMS_BUDGET`).
                 (Patch::Loop(tree), Local::Generic) if worth_grouping(&**tree, uvs.len()) => {
-                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, out);
+                    return grouped::<FMA, _>(set, p, &**tree, None, uvs, grid, out);
                 }
                 _ => {}
             }

@@ -82,6 +82,18 @@ pub(super) trait LeafTree {
     /// The leaf of `uv` and `uv` in its parameters, as [`Found`] holds them (`k` unset);
     /// `near` is the last search's.
     fn find(&self, uv: DVec2, near: &mut Self::Near) -> Found;
+    /// Puts the interior points `uvs` of the `cells` grid into `grouped`, each leaf's points
+    /// together, as [`LeafTree::find`] would place them, and returns true; false (the
+    /// default), leaving `grouped` as it is, where the tree has no walk for a grid.
+    fn group_grid(
+        &self,
+        _uvs: &[DVec2],
+        _cells: [u32; 2],
+        _lines: &mut [Vec<f64>; 2],
+        _grouped: &mut Vec<Found>,
+    ) -> bool {
+        false
+    }
     /// Starts loading the quadtree's nodes (a hint).
     fn prefetch_nodes(&self) {}
     /// Starts loading what evaluating `leaf` at `st` reads (a hint).
@@ -128,6 +140,20 @@ impl LeafTree for PatchTree {
     fn find(&self, uv: DVec2, near: &mut LeafSquare) -> Found {
         let (leaf, st, size) = PatchTree::find_near(self, uv, near);
         Found { leaf: leaf as u32, k: 0, st, size }
+    }
+
+    #[inline(always)]
+    fn group_grid(
+        &self,
+        uvs: &[DVec2],
+        cells: [u32; 2],
+        lines: &mut [Vec<f64>; 2],
+        grouped: &mut Vec<Found>,
+    ) -> bool {
+        self.grid_leaves(uvs, cells, lines, |leaf, k, st, size| {
+            grouped.push(Found { leaf: leaf as u32, k: k as u32, st, size });
+        });
+        true
     }
 
     #[inline(always)]
@@ -290,6 +316,8 @@ struct Scratch {
     /// The points grouped by leaf (a counting sort of `found`: O(points + leaves), where a
     /// comparison sort took a third of a fine tessellation's time).
     grouped: Vec<Found>,
+    /// A grid's lines in the tree's coordinates ([`PatchTree::grid_leaves`]).
+    lines: [Vec<f64>; 2],
 }
 
 thread_local! {
@@ -307,10 +335,12 @@ pub(super) fn worth_grouping<T: LeafTree>(tree: &T, points: usize) -> bool {
 /// Evaluates patch `p` of `set`, the piecewise patch `tree`, at `uvs` into `out`, as
 /// [`VertexSlices::put`] does point by point, the leaves' local forms taken from `locals`
 /// where given (the first `locals.len()` leaves', in leaf order), else
-/// made for each group. Preconditions:
+/// made for each group. With `grid`, `uvs` are that grid's interior points, grouped by a walk
+/// of the tree where it has one ([`LeafTree::group_grid`]). Preconditions:
 /// `set.patches[p]` is `tree`; `out` holds `uvs.len()` vertices; with `FMA`, the CPU has AVX2
 /// and FMA. Cost: a leaf lookup per point and a sort of the points by leaf (O(n + leaves), or
-/// O(n log n) for fewer points than leaves); per group, moving its net to f32 once (unless
+/// O(n log n) for fewer points than leaves), or the grid's walk (O(nodes holding points +
+/// n)); per group, moving its net to f32 once (unless
 /// `locals` holds it) and the kernel's price per point; per single point, the f64 evaluation.
 /// No allocation once the thread's scratch has grown.
 #[inline(always)]
@@ -320,14 +350,78 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     tree: &T,
     locals: Option<&[T::Local]>,
     uvs: &[DVec2],
+    grid: Option<[u32; 2]>,
     mut out: VertexSlices<'_>,
 ) {
     // Taken out of the thread's slot and put back, not borrowed in a closure: a closure would
     // not be compiled for the caller's AVX2 and FMA.
     let mut scratch = SCRATCH.take();
-    let Scratch { found, starts, grouped } = &mut scratch;
-    found.clear();
+    let Scratch { found, starts, grouped, lines } = &mut scratch;
+    grouped.clear();
     tree.prefetch_nodes();
+    if grid.is_some_and(|cells| tree.group_grid(uvs, cells, lines, grouped)) {
+        // What each group will read, loading while the groups before it are evaluated.
+        for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
+            let f = &group[0];
+            match locals.and_then(|l| l.get(f.leaf as usize)) {
+                Some(local) => prefetch_slice_to_l2(std::slice::from_ref(local)),
+                None => tree.prefetch_leaf(f.leaf as usize, f.st),
+            }
+        }
+    } else {
+        search_and_sort(tree, locals, uvs, found, starts, grouped);
+    }
+    let flip = tree.reverses_normal();
+    for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
+        let leaf = group[0].leaf as usize;
+        let made;
+        let local = match locals.and_then(|l| l.get(leaf)) {
+            // A leaf's form already made: the kernel costs a lone point less than f64 does.
+            Some(local) => Some(local),
+            _ if group.len() < T::MIN_GROUP => None,
+            None => {
+                made = tree.local(leaf);
+                Some(&made)
+            }
+        };
+        match local {
+            Some(local) if group.len() <= LANES / 2 => {
+                blocks::<FMA, { LANES / 2 }, T>(set, p, local, flip, group, uvs, &mut out);
+            }
+            Some(local) => blocks::<FMA, LANES, T>(set, p, local, flip, group, uvs, &mut out),
+            None => {
+                for f in group {
+                    let k = f.k as usize;
+                    if let Some((position, normal)) = tree.stored_point(f) {
+                        (out.pos[k], out.nrm[k]) = (position, normal);
+                        continue;
+                    }
+                    let q = tree.single::<FMA>(f, uvs[k]);
+                    out.pos[k] = q.position.as_vec3().to_array();
+                    out.nrm[k] = q.normal.as_vec3().to_array();
+                }
+            }
+        }
+    }
+    SCRATCH.set(scratch);
+    out.uv.iter_mut().zip(uvs).for_each(|(x, uv)| *x = uv.as_vec2().to_array());
+    out.patch.fill(p as u32);
+}
+
+/// Finds the leaf of each of `uvs` ([`LeafTree::find`], into `found` in the list's order) and
+/// sorts them by leaf into `grouped` (`starts`: a counting sort's counters), starting to load
+/// what each group will read. Cost: a leaf lookup per point, and O(n + leaves), or O(n log n)
+/// for fewer points than leaves.
+#[inline(always)]
+fn search_and_sort<T: LeafTree>(
+    tree: &T,
+    locals: Option<&[T::Local]>,
+    uvs: &[DVec2],
+    found: &mut Vec<Found>,
+    starts: &mut Vec<u32>,
+    grouped: &mut Vec<Found>,
+) {
+    found.clear();
     let mut last = u32::MAX;
     let mut near = T::Near::default();
     for (k, &uv) in uvs.iter().enumerate() {
@@ -366,41 +460,6 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
             *at += 1;
         }
     }
-    let flip = tree.reverses_normal();
-    for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
-        let leaf = group[0].leaf as usize;
-        let made;
-        let local = match locals.and_then(|l| l.get(leaf)) {
-            // A leaf's form already made: the kernel costs a lone point less than f64 does.
-            Some(local) => Some(local),
-            _ if group.len() < T::MIN_GROUP => None,
-            None => {
-                made = tree.local(leaf);
-                Some(&made)
-            }
-        };
-        match local {
-            Some(local) if group.len() <= LANES / 2 => {
-                blocks::<FMA, { LANES / 2 }, T>(set, p, local, flip, group, uvs, &mut out);
-            }
-            Some(local) => blocks::<FMA, LANES, T>(set, p, local, flip, group, uvs, &mut out),
-            None => {
-                for f in group {
-                    let k = f.k as usize;
-                    if let Some((position, normal)) = tree.stored_point(f) {
-                        (out.pos[k], out.nrm[k]) = (position, normal);
-                        continue;
-                    }
-                    let q = tree.single::<FMA>(f, uvs[k]);
-                    out.pos[k] = q.position.as_vec3().to_array();
-                    out.nrm[k] = q.normal.as_vec3().to_array();
-                }
-            }
-        }
-    }
-    SCRATCH.set(scratch);
-    out.uv.iter_mut().zip(uvs).for_each(|(x, uv)| *x = uv.as_vec2().to_array());
-    out.patch.fill(p as u32);
 }
 
 /// The points of `group` (one leaf, whose net is `local`) in blocks of `L` lanes.
@@ -662,13 +721,78 @@ mod tests {
     ) {
         if fma {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `assert_matches_f64` asks for these kernels only where the CPU has AVX2 and FMA.
+            // SAFETY: the callers ask for these kernels only where the CPU has AVX2 and FMA.
             unsafe {
                 eval_avx2_fma(set, p, tree, uvs, out)
             };
         } else {
-            eval::<false, T>(set, p, tree, None, uvs, out);
+            eval::<false, T>(set, p, tree, None, uvs, None, out);
         }
+    }
+
+    /// A pattern's interior grid grouped by the tree's walk ([`LeafTree::group_grid`]) gives
+    /// every vertex the bits the search and sort give it, through [`PointBlocks`] as the
+    /// engine calls it (the coarse leaves' stored forms included): on isolated faces of the
+    /// creased cube and of the rook (end caps, creases, deep leaves), views of each (turned,
+    /// transposed), grids whose lines meet the leaves' borders and grids whose lines do not,
+    /// with both builds' kernels.
+    #[test]
+    fn grid_groups_give_the_searched_vertices_bit_for_bit() {
+        let mut compared = 0;
+        for cage in ["subdivision/catmark_cube_creases0.obj", "subdivision/catmark_rook.obj"] {
+            let path = crate::test_support::data(cage);
+            let mesh = crate::io::obj::read_obj(&path).unwrap();
+            let mut set = SurfaceSet::from_subdivision_cage(&mesh, &path, Default::default()).unwrap();
+            let trees: Vec<(usize, PatchTree)> = (set.patches.iter().enumerate())
+                .filter_map(|(p, patch)| match patch {
+                    Patch::Subdivision(t) => Some((p, (**t).clone())),
+                    _ => None,
+                })
+                .take(12)
+                .collect();
+            assert!(!trees.is_empty(), "{cage}: isolated faces");
+            for (p, tree) in trees {
+                let views = [tree.clone(), tree.transposed(), tree.rotated(1), tree.rotated(2).transposed()];
+                for view in views {
+                    set.patches[p] = Patch::Subdivision(Box::new(view.clone()));
+                    let blocks = [false, true].map(|fma| PointBlocks::for_set(&set, fma && has_avx2_fma()));
+                    for cells in [[8, 8], [16, 16], [13, 7], [5, 29], [2, 3]] {
+                        let mut uvs = Vec::new();
+                        crate::pattern::core_grid::grid_interior(cells, &mut uvs);
+                        for fma in [false, true] {
+                            if fma && !has_avx2_fma() {
+                                continue;
+                            }
+                            let run = |grid: Option<[u32; 2]>| {
+                                let m = uvs.len();
+                                let (mut pos, mut nrm, mut uv, mut patch) = (
+                                    vec![[0f32; 3]; m],
+                                    vec![[0f32; 3]; m],
+                                    vec![[0f32; 2]; m],
+                                    vec![0u32; m],
+                                );
+                                let out = VertexSlices {
+                                    pos: &mut pos,
+                                    nrm: &mut nrm,
+                                    uv: &mut uv,
+                                    patch: &mut patch,
+                                };
+                                blocks[usize::from(fma)].eval_grid(&set, p, &uvs, grid, out);
+                                let bits = |v: &[[f32; 3]]| {
+                                    v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>()
+                                };
+                                (bits(&pos), bits(&nrm), uv, patch)
+                            };
+                            assert!(run(Some(cells)) == run(None), "{cage} patch {p} {cells:?} fma {fma}");
+                            if worth_grouping(&view, uvs.len()) {
+                                compared += uvs.len();
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(compared > 10_000, "only {compared} grouped points compared");
     }
 
     /// Every view of an isolated face's tree (turned, transposed, a quarter) evaluated by
@@ -950,6 +1074,6 @@ mod tests {
         uvs: &[DVec2],
         out: VertexSlices<'_>,
     ) {
-        eval::<true, T>(set, p, tree, None, uvs, out)
+        eval::<true, T>(set, p, tree, None, uvs, None, out)
     }
 }

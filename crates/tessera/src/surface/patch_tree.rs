@@ -417,6 +417,62 @@ impl PatchTree {
         (near.leaf, (t - near.origin) / near.size, near.size)
     }
 
+    /// Every leaf of the view holding points of a grid's interior, with its points:
+    /// `each(leaf, k, st, size)` for each point `uvs[k]`, with the leaf, `st` and `size` that
+    /// [`PatchTree::find_near`] gives it, bit for bit; one leaf's points one after the other,
+    /// in the list's order. `uvs` must be the interior points of the `cells` grid, row after
+    /// row ([`crate::pattern::core_grid::grid_interior`]).
+    ///
+    /// Why: a pattern's interior is a grid, and a grid meets a quadtree's dyadic squares in
+    /// rectangles. The walk goes down the quadtree once with the ranges of the grid's columns
+    /// and rows in each node's square, each split at the node's middle by the walk's own
+    /// comparison, so a leaf gets all its points at once: no search per point and no sort of
+    /// the points by leaf. The view's map to the tree's square (a transposition, quarter
+    /// turns, the view's square) moves each axis of the grid to one axis of the tree, each
+    /// coordinate a monotone function of one grid index, so each split is a contiguous range.
+    /// Cost: O(nodes holding points + points); the leaves' data is not touched.
+    pub(crate) fn grid_leaves(
+        &self,
+        uvs: &[DVec2],
+        [nu, nv]: [u32; 2],
+        lines: &mut [Vec<f64>; 2],
+        mut each: impl FnMut(usize, usize, DVec2, f64),
+    ) {
+        let (cols, rows) = (nu.saturating_sub(1) as usize, nv.saturating_sub(1) as usize);
+        assert_eq!(uvs.len(), cols * rows, "the interior of a {nu} × {nv} grid");
+        if uvs.is_empty() {
+            return;
+        }
+        // The tree's x follows the view's v where the view is transposed or turned an odd
+        // number of quarters (each quarter turn exchanges the axes), else its u.
+        let swapped = self.transposed != (self.rotation % 2 == 1);
+        // Per tree axis, the grid lines' coordinates (a column's from the first row, a row's
+        // from the first column: the same for the whole line), ascending, and whether the
+        // grid index runs against them.
+        let column = |i: usize| self.tree_uv(uvs[i]);
+        let row = |j: usize| self.tree_uv(uvs[j * cols]);
+        let [xs, ys] = lines;
+        xs.clear();
+        ys.clear();
+        if swapped {
+            xs.extend((0..rows).map(|j| row(j).x));
+            ys.extend((0..cols).map(|i| column(i).y));
+        } else {
+            xs.extend((0..cols).map(|i| column(i).x));
+            ys.extend((0..rows).map(|j| row(j).y));
+        }
+        let falls = |line: &mut Vec<f64>| {
+            let falls = line.len() > 1 && line[0] > line[line.len() - 1];
+            if falls {
+                line.reverse();
+            }
+            falls
+        };
+        let falling = [falls(xs), falls(ys)];
+        let axes = Axes { xs, ys, falling, swapped, cols };
+        axes.visit(&self.data, self.data.root, DVec2::ZERO, 1.0, 0..xs.len(), 0..ys.len(), &mut each);
+    }
+
     /// The walk of [`PatchTree::leaf_square`] for `uv`, resumed from the deepest node of
     /// `near`'s path whose square holds `uv`, leaving the leaf found, its square and its path
     /// in `near`. Why: the next point of a row lies in a neighbour of the last leaf, mostly
@@ -825,6 +881,90 @@ unsafe fn outputs_with<'t, const AVX: bool>(
     );
 }
 
+/// A grid's lines in the tree's coordinates, for [`PatchTree::grid_leaves`].
+struct Axes<'a> {
+    /// The lines along the tree's x and y, ascending.
+    xs: &'a [f64],
+    ys: &'a [f64],
+    /// Per tree axis, whether the grid's index runs against the ascending order.
+    falling: [bool; 2],
+    /// Whether the tree's x follows the grid's rows (`j`) rather than its columns (`i`).
+    swapped: bool,
+    /// The grid's interior columns (points per row).
+    cols: usize,
+}
+
+impl Axes<'_> {
+    /// The points in `slot`'s square `origin + [0, size)²` whose tree coordinates are at
+    /// positions `x` of `xs` and `y` of `ys`, leaf by leaf. A node's square splits at its
+    /// middle as [`quadrant_step`] splits it (`≥` the middle goes up or right), so each
+    /// point reaches the leaf the walk reaches, with the same square.
+    #[allow(clippy::too_many_arguments)] // one recursion's state
+    fn visit(
+        &self,
+        data: &TreeData,
+        slot: Slot,
+        origin: DVec2,
+        size: f64,
+        x: std::ops::Range<usize>,
+        y: std::ops::Range<usize>,
+        each: &mut impl FnMut(usize, usize, DVec2, f64),
+    ) {
+        if x.is_empty() || y.is_empty() {
+            return;
+        }
+        let n = match slot {
+            Slot::Leaf(leaf) => return self.leaf(leaf as usize, origin, size, x, y, each),
+            Slot::Node(n) => n as usize,
+        };
+        let half = size * 0.5;
+        let (mx, my) = (origin.x + half, origin.y + half);
+        let xm = x.start + self.xs[x.clone()].partition_point(|&t| t < mx);
+        let ym = y.start + self.ys[y.clone()].partition_point(|&t| t < my);
+        let children = &data.nodes[n];
+        for (q, (dx, dy)) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].into_iter().enumerate() {
+            let xq = if dx == 0.0 { x.start..xm } else { xm..x.end };
+            let yq = if dy == 0.0 { y.start..ym } else { ym..y.end };
+            self.visit(data, children[q], origin + DVec2::new(dx, dy) * half, half, xq, yq, each);
+        }
+    }
+
+    /// A leaf's points (positions `x`, `y` of the tree's lines), in the grid's row order.
+    fn leaf(
+        &self,
+        leaf: usize,
+        origin: DVec2,
+        size: f64,
+        x: std::ops::Range<usize>,
+        y: std::ops::Range<usize>,
+        each: &mut impl FnMut(usize, usize, DVec2, f64),
+    ) {
+        // Grid indices of a range of positions, and each index's position.
+        let indices = |r: &std::ops::Range<usize>, len: usize, falling: bool| {
+            if falling {
+                len - r.end..len - r.start
+            } else {
+                r.clone()
+            }
+        };
+        let position =
+            |index: usize, len: usize, falling: bool| if falling { len - 1 - index } else { index };
+        let (nx, ny) = (self.xs.len(), self.ys.len());
+        let (gx, gy) = (indices(&x, nx, self.falling[0]), indices(&y, ny, self.falling[1]));
+        let (columns, rows) = if self.swapped { (gy, gx) } else { (gx, gy) };
+        for j in rows {
+            for i in columns.clone() {
+                let (a, b) = if self.swapped { (j, i) } else { (i, j) };
+                let t = DVec2::new(
+                    self.xs[position(a, nx, self.falling[0])],
+                    self.ys[position(b, ny, self.falling[1])],
+                );
+                each(leaf, j * self.cols + i, (t - origin) / size, size);
+            }
+        }
+    }
+}
+
 /// One step of the quadtree's walk for `uv` from a node's square `origin + [0, size]²`: the
 /// child quadrant that holds it (see [`Slot`]: a point on a border goes up and to the right),
 /// `origin` and `size` moved to that child's square. The one rule of every walk.
@@ -1180,6 +1320,57 @@ mod tests {
             }
         }
         assert!(walks_saved > 1000, "the last leaf is used ({walks_saved} points)");
+    }
+
+    /// The grid's walk places every interior point of a grid as the walk does, bit for bit,
+    /// each leaf's points together and in the list's order, on views turned, transposed
+    /// and quartered, and on grids whose lines fall on the leaves' borders and between.
+    #[test]
+    fn grid_leaves_place_every_point_as_the_walk_does() {
+        let tree = tree();
+        let views = [
+            tree.clone(),
+            tree.transposed(),
+            tree.rotated(1),
+            tree.rotated(2),
+            tree.rotated(3),
+            tree.transposed().rotated(1),
+            tree.transposed().rotated(2),
+            tree.quadrant(2),
+            tree.quadrant(1).rotated(3),
+            tree.quadrant(3).quadrant(0).transposed(),
+        ];
+        let grids = [[2, 2], [2, 9], [4, 4], [8, 8], [16, 8], [12, 12], [5, 7], [13, 3], [33, 17], [1, 6]];
+        let bits =
+            |(leaf, st, size): (usize, DVec2, f64)| (leaf, st.to_array().map(f64::to_bits), size.to_bits());
+        let mut multi = 0;
+        for view in &views {
+            for cells in grids {
+                let mut uvs = Vec::new();
+                crate::pattern::core_grid::grid_interior(cells, &mut uvs);
+                let mut seen = vec![false; uvs.len()];
+                let mut runs: Vec<(usize, Vec<usize>)> = Vec::new();
+                let mut lines = [Vec::new(), Vec::new()];
+                view.grid_leaves(&uvs, cells, &mut lines, |leaf, k, st, size| {
+                    assert!(!std::mem::replace(&mut seen[k], true), "{cells:?}: point {k} twice");
+                    assert_eq!(bits((leaf, st, size)), bits(view.find(uvs[k])), "{cells:?}: point {k}");
+                    match runs.last_mut() {
+                        Some((l, ks)) if *l == leaf => ks.push(k),
+                        _ => runs.push((leaf, vec![k])),
+                    }
+                });
+                assert!(seen.iter().all(|&s| s), "{cells:?}: every point");
+                let mut leaves: Vec<usize> = runs.iter().map(|r| r.0).collect();
+                leaves.sort_unstable();
+                leaves.dedup();
+                assert_eq!(leaves.len(), runs.len(), "{cells:?}: a leaf's points together");
+                for (_, ks) in &runs {
+                    assert!(ks.windows(2).all(|w| w[0] < w[1]), "{cells:?}: in the list's order");
+                    multi += usize::from(ks.len() > 1);
+                }
+            }
+        }
+        assert!(multi > 100, "leaves hold several points ({multi})");
     }
 
     /// `view`'s outputs at `uvs` by [`PatchTree::outputs_each`] (and its AVX build where the
