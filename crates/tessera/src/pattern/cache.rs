@@ -132,6 +132,8 @@ pub(crate) struct PatternCache {
     grids: Vec<Vec<DVec2>>,
     /// Each distinct core grid's index in `grids`, by its cells (`nu << 32 | nv`).
     grid_of: WordMap<u64, u32>,
+    /// The cells of each grid in use, in `grids`' order.
+    grid_cells: Vec<[u32; 2]>,
 }
 
 /// The parameters of every local vertex of `built` (made for `input`), in local order:
@@ -199,6 +201,7 @@ impl PatternCache {
         self.of_patch.clear();
         self.interiors.clear();
         self.grid_of.clear();
+        self.grid_cells.clear();
     }
 
     /// Forgets which item has which pattern (every [`PatternCache::get`] answers None) but
@@ -242,7 +245,7 @@ impl PatternCache {
         if self.of_patch.capacity() < count {
             self.of_patch.reserve(count);
         }
-        let kept = self.inputs.len();
+        let (kept, kept_grids) = (self.inputs.len(), self.grid_cells.len());
         for i in 0..count {
             let Some(input) = input_of(i) else {
                 self.of_patch.push(NONE);
@@ -259,6 +262,17 @@ impl PatternCache {
             }
             self.of_patch.push(slot);
         }
+        // The new grids' points, in parallel with each other (a few a frame are large).
+        let grids = self.grid_cells.len();
+        if self.grids.len() < grids {
+            self.grids.resize_with(grids, Vec::new);
+        }
+        let new_grids =
+            (&mut self.grids[kept_grids..grids]).into_par_iter().zip(&self.grid_cells[kept_grids..grids]);
+        new_grids.for_each(|(points, &cells)| {
+            points.clear();
+            super::core_grid::grid_interior(cells, points);
+        });
         let used = self.inputs.len();
         if self.slots.len() < used {
             self.slots.resize_with(used, LocalTessellation::default);
@@ -297,19 +311,15 @@ impl PatternCache {
         }
     }
 
-    /// The index in `grids` of `core`'s grid points, made unless the frame has them.
-    /// Cost: O(1), or O(points) for a grid new to the frame.
+    /// The index in `grids` of `core`'s grid points ([`CoreGrid::interior_points`]), a new
+    /// one where the frame has no such grid yet (its points made after the inputs' pass,
+    /// [`PatternCache::extend_inputs`]). Cost: O(1).
     fn grid(&mut self, core: CoreGrid) -> u32 {
         let [nu, nv] = core.cells;
         let next = self.grid_of.len() as u32;
         let index = *self.grid_of.entry((nu as u64) << 32 | nv as u64).or_insert(next);
         if index == next {
-            if self.grids.len() <= next as usize {
-                self.grids.push(Vec::new());
-            }
-            let points = &mut self.grids[next as usize];
-            points.clear();
-            core.interior_points(points);
+            self.grid_cells.push(core.cells);
         }
         index
     }
@@ -529,5 +539,14 @@ mod tests {
             assert_eq!(read, table, "{input:?}");
         }
         assert_eq!(cores, 2, "the unpinned quads have core grids, the others none");
+        // Extended with inputs of new grids and of a grid it has: each reads its own grid.
+        let more = [inputs[0], PatternInput::new(Domain::Quad, [5, 5, 2, 3], [5, 7]), inputs[1]];
+        cache.forget_items();
+        cache.extend_inputs(&Transition, more.len(), |i| Some(more[i]), false);
+        for (i, input) in more.iter().enumerate() {
+            let mut whole = LocalTessellation::default();
+            Transition.build(input, &mut whole);
+            assert_eq!(cache.get(i).expect("extended").interior, whole.interior, "{input:?}");
+        }
     }
 }
