@@ -737,9 +737,9 @@ impl Writer<'_> {
             Some((f, None)) => {
                 // A pattern's interior that is a grid (a core grid's points are) lets a tree
                 // find its leaves' points by a walk instead of a search each.
-                let grid = match cached {
-                    Some((_, c)) if c.core.is_some() => c.core.map(|core| core.cells),
-                    _ => self.pattern.interior_grid(&input),
+                let grid = match cached.and_then(|(_, c)| c.core) {
+                    Some(core) => Some(core.cells),
+                    None => self.pattern.interior_grid(&input),
                 };
                 f.points().eval_grid(set, p, interior, grid, verts)
             }

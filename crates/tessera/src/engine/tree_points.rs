@@ -362,11 +362,7 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     if grid.is_some_and(|cells| tree.group_grid(uvs, cells, lines, grouped)) {
         // What each group will read, loading while the groups before it are evaluated.
         for group in grouped.chunk_by(|a, b| a.leaf == b.leaf) {
-            let f = &group[0];
-            match locals.and_then(|l| l.get(f.leaf as usize)) {
-                Some(local) => prefetch_slice_to_l2(std::slice::from_ref(local)),
-                None => tree.prefetch_leaf(f.leaf as usize, f.st),
-            }
+            prefetch_group(tree, locals, &group[0]);
         }
     } else {
         search_and_sort(tree, locals, uvs, found, starts, grouped);
@@ -408,10 +404,20 @@ pub(super) fn eval<const FMA: bool, T: LeafTree>(
     out.patch.fill(p as u32);
 }
 
+/// Starts loading what the group of `f`'s leaf will read: the leaf's stored form where
+/// `locals` has it, else its net (a hint).
+#[inline(always)]
+fn prefetch_group<T: LeafTree>(tree: &T, locals: Option<&[T::Local]>, f: &Found) {
+    match locals.and_then(|l| l.get(f.leaf as usize)) {
+        Some(local) => prefetch_slice_to_l2(std::slice::from_ref(local)),
+        None => tree.prefetch_leaf(f.leaf as usize, f.st),
+    }
+}
+
 /// Finds the leaf of each of `uvs` ([`LeafTree::find`], into `found` in the list's order) and
-/// sorts them by leaf into `grouped` (`starts`: a counting sort's counters), starting to load
-/// what each group will read. Cost: a leaf lookup per point, and O(n + leaves), or O(n log n)
-/// for fewer points than leaves.
+/// sorts them by leaf into `grouped`, empty on entry (`starts`: a counting sort's counters),
+/// starting to load what each group will read. Cost: a leaf lookup per point, and
+/// O(n + leaves), or O(n log n) for fewer points than leaves.
 #[inline(always)]
 fn search_and_sort<T: LeafTree>(
     tree: &T,
@@ -427,16 +433,11 @@ fn search_and_sort<T: LeafTree>(
     for (k, &uv) in uvs.iter().enumerate() {
         let f = Found { k: k as u32, ..tree.find(uv, &mut near) };
         if f.leaf != last {
-            // What the group will read: the leaf's stored form where given, else its net.
-            match locals.and_then(|l| l.get(f.leaf as usize)) {
-                Some(local) => prefetch_slice_to_l2(std::slice::from_ref(local)),
-                None => tree.prefetch_leaf(f.leaf as usize, f.st),
-            }
+            prefetch_group(tree, locals, &f);
             last = f.leaf;
         }
         found.push(f);
     }
-    grouped.clear();
     let leaf_count = tree.leaf_count();
     if found.len() < leaf_count {
         // Fewer points than leaves: a comparison sort, O(n log n), costs less than a pass

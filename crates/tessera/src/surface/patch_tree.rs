@@ -921,11 +921,12 @@ impl Axes<'_> {
         let (mx, my) = (origin.x + half, origin.y + half);
         let xm = x.start + self.xs[x.clone()].partition_point(|&t| t < mx);
         let ym = y.start + self.ys[y.clone()].partition_point(|&t| t < my);
-        let children = &data.nodes[n];
-        for (q, (dx, dy)) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].into_iter().enumerate() {
-            let xq = if dx == 0.0 { x.start..xm } else { xm..x.end };
-            let yq = if dy == 0.0 { y.start..ym } else { ym..y.end };
-            self.visit(data, children[q], origin + DVec2::new(dx, dy) * half, half, xq, yq, each);
+        // The children by quadrant ([`QUADRANTS`], corners at `origin + half` exactly as the
+        // walk moves them: the squares are dyadic).
+        for (&child, corner) in data.nodes[n].iter().zip(QUADRANTS) {
+            let xq = if corner.x == 0.0 { x.start..xm } else { xm..x.end };
+            let yq = if corner.y == 0.0 { y.start..ym } else { ym..y.end };
+            self.visit(data, child, origin + corner * size, half, xq, yq, each);
         }
     }
 
