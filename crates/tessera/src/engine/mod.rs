@@ -256,6 +256,11 @@ pub(crate) fn write_buffers(
         + std::mem::size_of_val(&*triangle_patch)
         + std::mem::size_of_val(&*params);
     let stream = stream_store::streams(bytes as u64);
+    // Patches whose pattern the frame's cache does not hold map their triangles in the vertex
+    // pass, where their pattern is at hand (see `Pass::Vertices`); when no patch's is held, the
+    // index pass has nothing left to do.
+    let fuse = !stream && uniform.is_none();
+    let any_cached = fast.is_some_and(|f| f.patterns().holds_items());
     let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
     let mut all =
@@ -274,7 +279,7 @@ pub(crate) fn write_buffers(
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || patches_pass(patch_part, Pass::Vertices),
+        || patches_pass(patch_part, Pass::Vertices { indices: fuse }),
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -288,15 +293,25 @@ pub(crate) fn write_buffers(
         VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     all.take_front(layout.interior_offsets[0] as usize);
     let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
-    patches_pass(patch_part, Pass::Indices { stream });
+    if !fuse || any_cached {
+        patches_pass(patch_part, Pass::Indices { stream });
+    }
     vertices_done
 }
 
 /// Which of [`write_with`]'s passes a patch writer runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Pass {
-    /// Interior vertices (and, for patterns the cache does not hold, the local triangles).
-    Vertices,
+    /// Interior vertices and, for patterns the cache does not hold, their triangles: as
+    /// local indices left for the index pass, or with `indices` mapped to output vertices
+    /// with their triangle patches, which the index pass then skips.
+    ///
+    /// Why map them here: such a patch's pattern is at hand in this pass, and the index pass
+    /// would find its input and its vertex numbers again, then read back what this pass
+    /// wrote. On frames of small patterns (the Catmull-Clark torus at 0.5 px, 13 triangles a
+    /// patch) those per-patch steps were most of the index pass. Frames that stream their
+    /// indices ([`stream_store::streams`]) keep the two passes.
+    Vertices { indices: bool },
     /// Triangles and triangle patches; with `stream`, written by streaming stores (a frame
     /// well past the cache, [`stream_store::streams`]).
     Indices { stream: bool },
@@ -687,7 +702,7 @@ impl Writer<'_> {
                     },
                 };
                 match pass {
-                    Pass::Vertices => self.patch_vertices(p, part, scratch),
+                    Pass::Vertices { indices } => self.patch_vertices(p, part, scratch, indices),
                     Pass::Indices { stream } => self.patch_indices(p, part, scratch, stream),
                 }
             }
@@ -716,8 +731,8 @@ impl Writer<'_> {
     /// the last patch of the same input where the pattern allows), its interior vertices, its
     /// corner parameters, and — unless the second pass can read the pattern from the cache —
     /// its kept triangles as local indices, left in its index range for the second pass.
-    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch) {
-        let PatchOut { mut verts, idx, params, .. } = out;
+    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, indices: bool) {
+        let PatchOut { mut verts, idx, tp, params } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let general = self.general(p, params);
         // The triangles in the general form need the whole pattern, core included.
@@ -770,6 +785,24 @@ impl Writer<'_> {
             t += 1;
         }
         debug_assert_eq!(3 * t, idx.len());
+        if indices {
+            self.map_local_indices(p, input, idx, &mut scratch.vertex);
+            tp.fill(p as u32);
+        }
+    }
+
+    /// Maps patch `p`'s triangles in `idx`, local indices of its pattern for `input`, to
+    /// output vertices by the numbering rule: interior vertices are numbered in the same order
+    /// locally and in the output, so each maps by one addition, and only boundary indices go
+    /// through the patch's table (`table`, scratch).
+    fn map_local_indices(&self, p: usize, input: PatternInput, idx: &mut [u32], table: &mut Vec<u32>) {
+        let (set, plan, layout) = (self.set, self.plan, self.layout);
+        LocalMap { set, plan, layout, input, patch: p }.vertex_table(0, table);
+        let first = input.interior_base();
+        let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
+        for l in idx.iter_mut() {
+            *l = if *l >= first { l.wrapping_add(delta) } else { table[*l as usize] };
+        }
     }
 
     /// The second pass for one visible patch: its triangles mapped to output vertices by the
@@ -780,47 +813,45 @@ impl Writer<'_> {
         let PatchOut { idx, tp, params, .. } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let cached = self.cached(p).filter(|_| !self.general(p, params));
-        let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, _)| input);
+        let Some((input, cached)) = cached else {
+            if stream {
+                // The first pass left the local indices here.
+                let input = layout::pattern_input(set, plan, p);
+                self.map_local_indices(p, input, idx, &mut scratch.vertex);
+                stream_store::fill(tp, p as u32);
+            }
+            // Without streaming, the first pass mapped them (`Pass::Vertices`).
+            return;
+        };
         let map = LocalMap { set, plan, layout, input, patch: p };
         map.vertex_table(0, &mut scratch.vertex);
         let first = input.interior_base();
         let interior = layout.interior_vertex(p, 0);
         let delta = interior.wrapping_sub(first);
-        match cached {
-            Some((_, cached)) => {
-                // The core by its rule, then the cached triangles after it; the cache knows
-                // where their boundary indices are.
-                let table = &scratch.vertex[..];
-                let (rest, core_triangles) = cached.after_core();
-                let write = |out: &mut [u32]| {
-                    let (core_out, rest_out) = out.split_at_mut(3 * core_triangles as usize);
-                    if let Some(core) = cached.core {
-                        core.write(interior, |l| table[l as usize], core_out);
-                    }
-                    let rest = rest.as_flattened();
-                    rest_out.iter_mut().zip(rest).for_each(|(out, &l)| *out = l.wrapping_add(delta));
-                    for &i in cached.boundary {
-                        rest_out[i as usize] = table[rest[i as usize] as usize];
-                    }
-                };
-                if stream {
-                    // Mapped in the thread's buffer (in the cache), then streamed out once.
-                    let mapped = &mut scratch.indices;
-                    mapped.clear();
-                    mapped.resize(idx.len(), 0);
-                    write(mapped);
-                    stream_store::copy(idx, mapped);
-                } else {
-                    write(idx);
-                }
+        // The core by its rule, then the cached triangles after it; the cache knows where
+        // their boundary indices are.
+        let table = &scratch.vertex[..];
+        let (rest, core_triangles) = cached.after_core();
+        let write = |out: &mut [u32]| {
+            let (core_out, rest_out) = out.split_at_mut(3 * core_triangles as usize);
+            if let Some(core) = cached.core {
+                core.write(interior, |l| table[l as usize], core_out);
             }
-            // The first pass left the local indices here.
-            None => {
-                let table = &scratch.vertex[..];
-                for l in idx.iter_mut() {
-                    *l = if *l >= first { l.wrapping_add(delta) } else { table[*l as usize] };
-                }
+            let rest = rest.as_flattened();
+            rest_out.iter_mut().zip(rest).for_each(|(out, &l)| *out = l.wrapping_add(delta));
+            for &i in cached.boundary {
+                rest_out[i as usize] = table[rest[i as usize] as usize];
             }
+        };
+        if stream {
+            // Mapped in the thread's buffer (in the cache), then streamed out once.
+            let mapped = &mut scratch.indices;
+            mapped.clear();
+            mapped.resize(idx.len(), 0);
+            write(mapped);
+            stream_store::copy(idx, mapped);
+        } else {
+            write(idx);
         }
         if stream {
             stream_store::fill(tp, p as u32);
@@ -1221,9 +1252,11 @@ mod tests {
     /// frame written by plain stores, byte for byte: the uniform writers (the grid path on the
     /// teapot, triangles by addition on a PN mesh and on a Loop cage) and the general one
     /// (a transition plan of mixed factors: cached patterns and patterns staged between the
-    /// passes, some patches culled).
+    /// passes, some patches culled). So is the frame without the pattern cache, whose
+    /// patches map their triangles in the vertex pass (or, streamed, in the index pass), and
+    /// the generic evaluation's triangles.
     #[test]
-    fn streamed_frames_equal_plain_frames_byte_for_byte() {
+    fn streamed_and_uncached_frames_equal_plain_frames_byte_for_byte() {
         use crate::io::{LoadOptions, SurfaceKind};
         let cage = crate::test_support::data("subdivision/loop_xord_interior.obj");
         let loop_cage =
@@ -1246,19 +1279,35 @@ mod tests {
                 layout.build(&set, plan, pattern, &options).unwrap();
                 let mut fast = fast_evaluator::FastEvaluator::new(&set, plan);
                 fast.fill_patterns(plan, pattern, layout.triangle_count() as u64, None);
-                let [plain, streamed] = [false, true].map(|stream| {
+                // Without the frame's pattern cache, every patch maps its triangles in the
+                // vertex pass unless the frame streams (`Pass::Vertices`).
+                let uncached = fast_evaluator::FastEvaluator::new(&set, plan);
+                let frame = |stream: bool, fast: Option<&fast_evaluator::FastEvaluator<'_>>| {
                     stream_store::force_on_this_thread(Some(stream));
                     let mut mesh = Mesh::default();
-                    write_with(&set, plan, pattern, &layout, options, &mut mesh, Some(&fast)).unwrap();
+                    write_with(&set, plan, pattern, &layout, options, &mut mesh, fast).unwrap();
                     stream_store::force_on_this_thread(None);
                     mesh
-                });
+                };
+                let plain = frame(false, Some(&fast));
                 assert!(!plain.indices.is_empty(), "case {k}: a frame with triangles");
-                assert_eq!(streamed.indices, plain.indices, "case {k}");
-                assert_eq!(streamed.triangle_patch, plain.triangle_patch, "case {k}");
                 let bits = |v: &[[f32; 3]]| v.iter().flat_map(|x| x.map(f32::to_bits)).collect::<Vec<_>>();
-                assert_eq!(bits(&streamed.positions), bits(&plain.positions), "case {k}");
-                assert_eq!(bits(&streamed.normals), bits(&plain.normals), "case {k}");
+                for (other, what) in [
+                    (frame(true, Some(&fast)), "streamed"),
+                    (frame(false, Some(&uncached)), "uncached"),
+                    (frame(true, Some(&uncached)), "uncached, streamed"),
+                ] {
+                    assert_eq!(other.indices, plain.indices, "case {k}, {what}");
+                    assert_eq!(other.triangle_patch, plain.triangle_patch, "case {k}, {what}");
+                    assert_eq!(bits(&other.positions), bits(&plain.positions), "case {k}, {what}");
+                    assert_eq!(bits(&other.normals), bits(&plain.normals), "case {k}, {what}");
+                }
+                // The generic evaluation (no fast evaluator) numbers and connects alike.
+                for stream in [false, true] {
+                    let generic = frame(stream, None);
+                    assert_eq!(generic.indices, plain.indices, "case {k}, generic, streamed {stream}");
+                    assert_eq!(generic.triangle_patch, plain.triangle_patch, "case {k}, generic");
+                }
             }
         }
     }

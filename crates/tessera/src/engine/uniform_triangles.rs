@@ -159,7 +159,7 @@ impl UniformTriangles {
         }
         let PatchOut { verts, idx, tp, .. } = out;
         match pass {
-            Pass::Vertices if vertices > 0 => {
+            Pass::Vertices { .. } if vertices > 0 => {
                 for (i, p) in patches.enumerate() {
                     let r = i * vertices..(i + 1) * vertices;
                     let part = VertexSlices {
@@ -171,7 +171,7 @@ impl UniformTriangles {
                     points.eval(set, p, &self.local.interior, part);
                 }
             }
-            Pass::Vertices => {}
+            Pass::Vertices { .. } => {}
             Pass::Indices { stream: false } => {
                 let chunks = idx.chunks_exact_mut(3 * triangles).zip(tp.chunks_exact_mut(triangles));
                 for (p, (idx, tp)) in patches.zip(chunks) {
