@@ -549,6 +549,14 @@ impl Writer<'_> {
             if offsets[e + 1] == offsets[e] {
                 continue;
             }
+            // The grid kernels' edges first: the runs below never take one (a tree's owner
+            // has no grid form; an owner's run is of edges off the grid kernels), and asking
+            // whether an edge starts a run was most of the time a coarse frame's edges took
+            // beside their kernels.
+            if let Some(f) = self.fast.filter(|f| f.covers_edge(self.plan, e)) {
+                f.edge(self.plan, e, out.take_front((offsets[e + 1] - offsets[e]) as usize));
+                continue;
+            }
             if let Some(end) = self.tree_run(e, edges.end) {
                 // Edges `e..end` are evaluated on their owners' trees, one stream of points.
                 let part = out.take_front((offsets[end] - offsets[e]) as usize);
@@ -565,7 +573,6 @@ impl Writer<'_> {
             }
             let part = out.take_front((offsets[e + 1] - offsets[e]) as usize);
             match self.fast {
-                Some(f) if f.covers_edge(self.plan, e) => f.edge(self.plan, e, part),
                 Some(f) if f.triangles().active() && self.set.topology.edges[e].variants == 1 => {
                     f.triangles().edge(self.set, f.points(), e, part)
                 }
