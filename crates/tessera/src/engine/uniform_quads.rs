@@ -179,10 +179,24 @@ impl<const C: usize> LocalPatch<C> {
 
     /// The curve `u = i / n`, likewise (along `v`, cross derivative `∂/∂u`).
     #[inline(always)]
+    // Index loops mirror `Line::new`'s sum, over the other index of `by_v`.
+    #[allow(clippy::needless_range_loop)]
     pub(super) fn column(&self, basis: &Basis, i: usize) -> Line<C> {
-        // Columns are rare (two edges a patch): transpose here rather than store both forms.
-        let by_u = self.by_v.map(|q| std::array::from_fn(|a| std::array::from_fn(|b| q[b][a])));
-        Line::new(&by_u, basis, i, true)
+        // `Line::new` of the transposed net, summed in the same order (so the same bits),
+        // reading `by_v` across instead of transposing it first: a coarse frame's edges are
+        // half columns, and the transposition went through the stack.
+        let mut line = Line { c: [[0.0; 4]; C], d: [[0.0; 4]; C], column: true };
+        let (b, d) = &basis.at[i];
+        for c in 0..C {
+            for k in 0..4 {
+                let (b, d) = (b[k], d[k]);
+                for t in 0..4 {
+                    line.c[c][t] += self.by_v[c][t][k] * b;
+                    line.d[c][t] += self.by_v[c][t][k] * d;
+                }
+            }
+        }
+        line
     }
 }
 
