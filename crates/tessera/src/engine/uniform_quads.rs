@@ -179,20 +179,23 @@ impl<const C: usize> LocalPatch<C> {
 
     /// The curve `u = i / n`, likewise (along `v`, cross derivative `∂/∂u`).
     #[inline(always)]
-    // Index loops mirror `Line::new`'s sum, over the other index of `by_v`.
+    // Index loops mirror `Line::new`'s sums.
     #[allow(clippy::needless_range_loop)]
     pub(super) fn column(&self, basis: &Basis, i: usize) -> Line<C> {
-        // `Line::new` of the transposed net, summed in the same order (so the same bits),
-        // reading `by_v` across instead of transposing it first: a coarse frame's edges are
-        // half columns, and the transposition went through the stack.
+        // `Line::new` of the transposed net, each sum in the same order (so the same bits),
+        // as a dot product of a row of `by_v` instead of a transposed copy first: a coarse
+        // frame's edges are half columns, and the transposition went through the stack (the
+        // Catmull-Clark torus at 0.5 px: the vertex stage 15.5 → 14.2 ms, one thread; the
+        // k-outer loop of `Line::new` over the strided net measured 1.5 % slower on uniform
+        // factor 16).
         let mut line = Line { c: [[0.0; 4]; C], d: [[0.0; 4]; C], column: true };
         let (b, d) = &basis.at[i];
         for c in 0..C {
-            for k in 0..4 {
-                let (b, d) = (b[k], d[k]);
-                for t in 0..4 {
-                    line.c[c][t] += self.by_v[c][t][k] * b;
-                    line.d[c][t] += self.by_v[c][t][k] * d;
+            for t in 0..4 {
+                let q = &self.by_v[c][t];
+                for k in 0..4 {
+                    line.c[c][t] += q[k] * b[k];
+                    line.d[c][t] += q[k] * d[k];
                 }
             }
         }
