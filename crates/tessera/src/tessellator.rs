@@ -52,9 +52,12 @@ pub struct FrameTimings {
     pub layout: Duration,
     /// Vertex and index writes: `write_vertices + write_indices`, within timer resolution.
     pub write: Duration,
-    /// The write's first pass: every vertex record (corners, edge samples, interiors).
+    /// The write's first pass: every vertex record (corners, edge samples, interiors), and
+    /// the triangles of the patches whose pattern the frame's cache does not hold (unless the
+    /// frame streams its indices): their pattern is at hand there.
     pub write_vertices: Duration,
-    /// The write's second pass: every triangle (and the strips, when asked for).
+    /// The write's second pass: the other triangles (and the strips, when asked for). Near
+    /// zero on a frame of small patterns, whose first pass wrote every triangle.
     pub write_indices: Duration,
 }
 
