@@ -256,11 +256,11 @@ pub(crate) fn write_buffers(
         + std::mem::size_of_val(&*triangle_patch)
         + std::mem::size_of_val(&*params);
     let stream = stream_store::streams(bytes as u64);
-    // Patches whose pattern the frame's cache does not hold map their triangles in the vertex
-    // pass, where their pattern is at hand (see `Pass::Vertices`); when no patch's is held, the
-    // index pass has nothing left to do.
-    let fuse = !stream && uniform.is_none();
+    // Unless the frame streams, patches whose pattern the frame's cache does not hold map
+    // their triangles in the vertex pass (`Pass::Vertices`); when no patch's is held and the
+    // uniform writer is not the one, the index pass has nothing left to do.
     let any_cached = fast.is_some_and(|f| f.patterns().holds_items());
+    let index_pass = stream || uniform.is_some() || any_cached;
     let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
 
     let mut all =
@@ -279,7 +279,7 @@ pub(crate) fn write_buffers(
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || patches_pass(patch_part, Pass::Vertices { indices: fuse }),
+        || patches_pass(patch_part, Pass::Vertices { stream }),
     );
     // Split-normal entries take the position bits of their vertex's first entry.
     for (i, entry) in topo.corner_entries.iter().enumerate() {
@@ -293,7 +293,7 @@ pub(crate) fn write_buffers(
         VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
     all.take_front(layout.interior_offsets[0] as usize);
     let patch_part = PatchOut { verts: all, idx: indices, tp: triangle_patch, params };
-    if !fuse || any_cached {
+    if index_pass {
         patches_pass(patch_part, Pass::Indices { stream });
     }
     vertices_done
@@ -302,16 +302,17 @@ pub(crate) fn write_buffers(
 /// Which of [`write_with`]'s passes a patch writer runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Pass {
-    /// Interior vertices and, for patterns the cache does not hold, their triangles: as
-    /// local indices left for the index pass, or with `indices` mapped to output vertices
-    /// with their triangle patches, which the index pass then skips.
+    /// Interior vertices and, for patterns the cache does not hold, their triangles: with
+    /// `stream` (the frame's, as [`Pass::Indices`] gets it), as local indices left for the
+    /// index pass to map and stream out; without, mapped to output vertices with their
+    /// triangle patches, which the index pass then skips.
     ///
     /// Why map them here: such a patch's pattern is at hand in this pass, and the index pass
     /// would find its input and its vertex numbers again, then read back what this pass
     /// wrote. On frames of small patterns (the Catmull-Clark torus at 0.5 px, 13 triangles a
     /// patch) those per-patch steps were most of the index pass. Frames that stream their
     /// indices ([`stream_store::streams`]) keep the two passes.
-    Vertices { indices: bool },
+    Vertices { stream: bool },
     /// Triangles and triangle patches; with `stream`, written by streaming stores (a frame
     /// well past the cache, [`stream_store::streams`]).
     Indices { stream: bool },
@@ -709,7 +710,7 @@ impl Writer<'_> {
                     },
                 };
                 match pass {
-                    Pass::Vertices { indices } => self.patch_vertices(p, part, scratch, indices),
+                    Pass::Vertices { stream } => self.patch_vertices(p, part, scratch, stream),
                     Pass::Indices { stream } => self.patch_indices(p, part, scratch, stream),
                 }
             }
@@ -737,8 +738,9 @@ impl Writer<'_> {
     /// The first pass for one visible patch: its pattern (cached, or built and reused from
     /// the last patch of the same input where the pattern allows), its interior vertices, its
     /// corner parameters, and — unless the second pass can read the pattern from the cache —
-    /// its kept triangles as local indices, left in its index range for the second pass.
-    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, indices: bool) {
+    /// its kept triangles: mapped to output vertices with their triangle patches, or with
+    /// `stream` as local indices left in its index range for the second pass.
+    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, stream: bool) {
         let PatchOut { mut verts, idx, tp, params } = out;
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let general = self.general(p, params);
@@ -792,7 +794,7 @@ impl Writer<'_> {
             t += 1;
         }
         debug_assert_eq!(3 * t, idx.len());
-        if indices {
+        if !stream {
             self.map_local_indices(p, input, idx, &mut scratch.vertex);
             tp.fill(p as u32);
         }
