@@ -55,30 +55,77 @@ impl HessianBound {
             HessianBound { uu: self.uu / (s.x * s.x), uv: self.uv / (s.x * s.y), vv: self.vv / (s.y * s.y) }
                 .lambda()
         });
-        TriangleErrors { bound: *self, scales, lambdas }
+        TriangleErrors { bound: *self, scales: scales.map(|s| s * s), lambdas }
     }
 
     /// Filip's bound `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8` for a right triangle whose legs
-    /// run along the `u` and `v` axes (the cells of a grid); None for other triangles.
-    // Always, as `TriangleErrors::error`, its caller per triangle.
+    /// `(hu, hv)` follow the `u` and `v` axes (the half cells of a grid: [`axis_legs`]).
     #[inline(always)]
-    fn axis_aligned_error(&self, t: [DVec2; 3]) -> Option<f64> {
-        // Parameters computed as k/n along an edge and as i·(1/n) inside differ in the last
-        // bits; a skew of 1e-12 of the side changes the bound by less than that.
-        let flat = |x: f64, side: f64| x.abs() <= 1e-12 * side.abs();
-        for c in 0..3 {
-            let (a, b) = (t[(c + 1) % 3] - t[c], t[(c + 2) % 3] - t[c]);
-            let (du, dv) = if flat(a.y, a.x) && flat(b.x, b.y) {
-                (a.x, b.y)
-            } else if flat(a.x, a.y) && flat(b.y, b.x) {
-                (b.x, a.y)
-            } else {
-                continue;
-            };
-            let (hu, hv) = (du.abs(), dv.abs());
-            return Some((hu * hu * self.uu + 2.0 * hu * hv * self.uv + hv * hv * self.vv) / 8.0);
+    fn filip_error(&self, (hu, hv): (f64, f64)) -> f64 {
+        (hu * hu * self.uu + 2.0 * hu * hv * self.uv + hv * hv * self.vv) / 8.0
+    }
+}
+
+/// The legs `(|hu|, |hv|)` of a right triangle whose legs run along the `u` and `v` axes (the
+/// half cells of a grid, where Filip's bound applies); None for other triangles.
+fn axis_legs(t: [DVec2; 3]) -> Option<(f64, f64)> {
+    // Parameters computed as k/n along an edge and as i·(1/n) inside differ in the last
+    // bits; a skew of 1e-12 of the side changes the bound by less than that.
+    let flat = |x: f64, side: f64| x.abs() <= 1e-12 * side.abs();
+    for c in 0..3 {
+        let (a, b) = (t[(c + 1) % 3] - t[c], t[(c + 2) % 3] - t[c]);
+        if flat(a.y, a.x) && flat(b.x, b.y) {
+            return Some((a.x.abs(), b.y.abs()));
         }
-        None
+        if flat(a.x, a.y) && flat(b.y, b.x) {
+            return Some((b.x.abs(), a.y.abs()));
+        }
+    }
+    None
+}
+
+/// What the bound of a parameter triangle reads of the triangle, whatever the patch
+/// ([`TriangleErrors::shape_exceeds`]): its sides' squared extents along `u` and `v`, its
+/// area and, for a grid's half cell, its legs. A pattern's triangles are the same on every
+/// patch, so the a-posteriori check keeps their shapes with the pattern (for small
+/// patterns) and bounds each patch's pattern from them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriangleShape {
+    /// Each side's `(du², dv²)`: its squared length in the scaled coordinates `(a·u, b·v)`
+    /// is `du²·a² + dv²·b²`.
+    sides: [DVec2; 3],
+    /// The doubled area in `(u, v)`, squared (times `a²·b²` in the scaled coordinates).
+    doubled_area_squared: f64,
+    /// [`axis_legs`].
+    legs: Option<(f64, f64)>,
+}
+
+impl TriangleShape {
+    /// The shape of parameter triangle `t`. Cost: O(1).
+    #[inline(always)]
+    pub fn of(t: [DVec2; 3]) -> Self {
+        let side = |p: DVec2, q: DVec2| (q - p) * (q - p);
+        let doubled_area = (t[1] - t[0]).perp_dot(t[2] - t[0]);
+        TriangleShape {
+            sides: [side(t[1], t[2]), side(t[2], t[0]), side(t[0], t[1])],
+            doubled_area_squared: doubled_area * doubled_area,
+            legs: axis_legs(t),
+        }
+    }
+
+    /// The squared radius of its smallest enclosing disc in the coordinates `(a·u, b·v)`,
+    /// for `scale_squared = (a², b²)`.
+    #[inline(always)]
+    fn enclosing_radius_squared(&self, scale_squared: DVec2) -> f64 {
+        let s = self.sides.map(|d| d.dot(scale_squared));
+        let area = self.doubled_area_squared * (scale_squared.x * scale_squared.y);
+        enclosing_radius_squared(s, area)
+    }
+
+    /// Its longest side, squared, unscaled: the pattern's check bounds its largest
+    /// triangles first, so the others stop at their first bound.
+    pub fn longest_side_squared(&self) -> f64 {
+        self.sides.iter().map(|d| d.x + d.y).fold(0.0, f64::max)
     }
 }
 
@@ -88,6 +135,7 @@ impl HessianBound {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriangleErrors {
     bound: HessianBound,
+    /// The three scalings' `(a², b²)`.
     scales: [DVec2; 3],
     /// Largest eigenvalue of the bound in each scaling's coordinates.
     lambdas: [f64; 3],
@@ -109,20 +157,26 @@ impl TriangleErrors {
 impl TriangleErrors {
     /// [`TriangleErrors::error`] of `t` where it exceeds `at_least`, else None: the largest
     /// error over many triangles ([`crate::criterion::tolerance`]'s a-posteriori check) needs
-    /// no more. The cheaper bounds go first, and a triangle stops as soon as one of them is
-    /// at most `at_least` (the error is their minimum); [`TriangleErrors::error`] is this
-    /// with no threshold. Cost: three enclosing discs at most.
+    /// no more. [`TriangleErrors::shape_exceeds`] of `t`'s shape. Cost: O(1).
     #[inline(always)]
     pub fn exceeds(&self, t: [DVec2; 3], at_least: f64) -> Option<f64> {
-        let axis = self.bound.axis_aligned_error(t);
+        self.shape_exceeds(&TriangleShape::of(t), at_least)
+    }
+
+    /// The error of a triangle of shape `shape` where it exceeds `at_least`, else None. The
+    /// cheaper bounds go first, and a triangle stops as soon as one of them is at most
+    /// `at_least` (the error is their minimum); [`TriangleErrors::error`] is this with no
+    /// threshold. Cost: three enclosing discs at most, from squared lengths (no root).
+    #[inline(always)]
+    pub fn shape_exceeds(&self, shape: &TriangleShape, at_least: f64) -> Option<f64> {
+        let axis = shape.legs.map(|legs| self.bound.filip_error(legs));
         if axis.is_some_and(|a| a <= at_least) {
             return None;
         }
         let mut general = f64::INFINITY;
         for (s, lambda) in self.scales.iter().zip(self.lambdas) {
             // The bound with the domain measured in coordinates `(a·u, b·v)`.
-            let r = enclosing_radius(t.map(|p| p * *s));
-            general = general.min(lambda * r * r / 2.0);
+            general = general.min(lambda * shape.enclosing_radius_squared(*s) / 2.0);
             if general <= at_least {
                 return None;
             }
@@ -140,26 +194,38 @@ impl TriangleErrors {
     pub fn cell_error(&self, hu: f64, hv: f64) -> f64 {
         let mut general = f64::INFINITY;
         for (s, lambda) in self.scales.iter().zip(self.lambdas) {
-            let (a, b) = (s.x * hu, s.y * hv);
-            // λ·r²/2 with r² = (a² + b²)/4.
-            general = general.min(lambda * (a * a + b * b) / 8.0);
+            // λ·r²/2 with r² = (a²·hu² + b²·hv²)/4.
+            general = general.min(lambda * (s.x * hu * hu + s.y * hv * hv) / 8.0);
         }
-        let m = &self.bound;
-        general.min((hu * hu * m.uu + 2.0 * hu * hv * m.uv + hv * hv * m.vv) / 8.0)
+        general.min(self.bound.filip_error((hu, hv)))
     }
 }
 
 /// Radius of the smallest disc containing a triangle: half the longest side when the triangle
 /// is right or obtuse, else its circumradius.
 pub fn enclosing_radius(t: [DVec2; 3]) -> f64 {
-    let (a, b, c) =
-        ((t[1] - t[2]).length_squared(), (t[2] - t[0]).length_squared(), (t[0] - t[1]).length_squared());
-    let longest = a.max(b).max(c);
-    if 2.0 * longest >= a + b + c {
-        return longest.sqrt() / 2.0;
+    TriangleShape::of(t).enclosing_radius_squared(DVec2::ONE).sqrt()
+}
+
+/// The squared radius of the smallest disc containing a triangle whose squared sides are `s`
+/// and whose doubled area, squared, is `doubled_area_squared`: a quarter of the longest side's
+/// square when the triangle is right or obtuse, else the circumradius's, `s₀·s₁·s₂ / 4A²`
+/// (`A` the doubled area). No square root: the bound needs the square. Where that quotient
+/// is not a number (an area that underflowed: a flat patch's scalings are about 1e-150),
+/// `f64::MAX`: any value is a valid bound there, as the bound takes the smallest of its
+/// scalings', and a zero eigenvalue times it is still zero.
+#[inline(always)]
+fn enclosing_radius_squared(s: [f64; 3], doubled_area_squared: f64) -> f64 {
+    let longest = s[0].max(s[1]).max(s[2]);
+    if 2.0 * longest >= s[0] + s[1] + s[2] {
+        return longest / 4.0;
     }
-    let area2 = (t[1] - t[0]).perp_dot(t[2] - t[0]).abs();
-    (a * b * c).sqrt() / (2.0 * area2)
+    let r2 = s[0] * s[1] * s[2] / (4.0 * doubled_area_squared);
+    if r2.is_finite() {
+        r2
+    } else {
+        f64::MAX
+    }
 }
 
 /// The largest norm of `it`'s vectors (0 for none): a Bézier form's bound by its points.
@@ -770,15 +836,31 @@ mod tests {
                 t = [t[0], t[0] + DVec2::new(h, 0.0), t[0] + DVec2::new(0.0, w)];
             }
             let error = m.error(t);
-            // The bound written out: the smallest of the three scalings' and the axis one.
-            let scaled = m.scales.iter().zip(m.lambdas).map(|(s, lambda)| {
-                let r = enclosing_radius(t.map(|p| p * *s));
+            // The bound written out from the points: the smallest of the three scalings'
+            // (each the smallest enclosing disc of the scaled points, by its side lengths
+            // and circumradius) and, on a half cell, Filip's.
+            let disc = |t: [DVec2; 3]| {
+                let sides = [t[1] - t[2], t[2] - t[0], t[0] - t[1]].map(|d| d.length());
+                let longest = sides[0].max(sides[1]).max(sides[2]);
+                if 2.0 * longest * longest >= sides.iter().map(|l| l * l).sum::<f64>() {
+                    longest / 2.0
+                } else {
+                    sides[0] * sides[1] * sides[2] / (2.0 * (t[1] - t[0]).perp_dot(t[2] - t[0]).abs())
+                }
+            };
+            let scaled = m.scales.iter().zip(m.lambdas).map(|(squares, lambda)| {
+                let s = DVec2::new(squares.x.sqrt(), squares.y.sqrt());
+                let r = disc(t.map(|p| p * s));
                 lambda * r * r / 2.0
             });
-            let reference = scaled
-                .fold(f64::INFINITY, f64::min)
-                .min(m.bound.axis_aligned_error(t).unwrap_or(f64::INFINITY));
-            assert_eq!(error.to_bits(), reference.to_bits(), "triangle {k}");
+            let b = m.bound;
+            let filip = |(hu, hv): (f64, f64)| (hu * hu * b.uu + 2.0 * hu * hv * b.uv + hv * hv * b.vv) / 8.0;
+            let half_cell = (k % 4 == 0).then(|| filip(((t[1] - t[0]).x.abs(), (t[2] - t[0]).y.abs())));
+            let reference = scaled.fold(f64::INFINITY, f64::min).min(half_cell.unwrap_or(f64::INFINITY));
+            assert!(
+                (error - reference).abs() <= 1e-12 * reference,
+                "triangle {k}: {error} against {reference}"
+            );
             for at_least in [0.0, error * 0.5, error, error * (1.0 - 1e-15), error * 2.0] {
                 match m.exceeds(t, at_least) {
                     Some(e) => {

@@ -12,6 +12,7 @@
 
 pub mod bounds;
 pub mod esc;
+pub(crate) mod pattern_shapes;
 pub mod resolve;
 pub mod screen;
 pub mod sd2;

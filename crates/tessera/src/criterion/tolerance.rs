@@ -7,7 +7,7 @@
 //! proposal already covers the edge curve's own bound, so the maximum satisfies all of them.
 //! Interior factors are private to a patch and may be raised freely.
 
-use super::bounds::{self, HessianBound, TriangleErrors};
+use super::bounds::{self, HessianBound, TriangleErrors, TriangleShape};
 use super::resolve::{self, EdgeRule, InteriorRule};
 use super::taylor::TaylorBound;
 use super::{Plan, Prepared};
@@ -230,23 +230,49 @@ fn triangles_bound(
     params: LocalParams<'_>,
     at_least: f64,
 ) -> f64 {
+    let points = triangles.iter().map(|t| t.map(|l| params.get(l)));
+    let Some(taylor) = taylor else {
+        return shapes_bound(errors, points.map(TriangleShape::of), at_least);
+    };
     // The running largest error skips what cannot raise it ([`TriangleErrors::exceeds`]);
     // the Taylor bound, dearer, is computed only for a triangle that would raise it.
-    triangles.iter().fold(at_least, |most, t| {
-        let t = t.map(|l| params.get(l));
-        match errors.exceeds(t, most) {
-            None => most,
-            Some(e) => most.max(taylor.map_or(e, |taylor| e.min(taylor.triangle_error_above(t, most)))),
-        }
+    points.fold(at_least, |most, t| match errors.exceeds(t, most) {
+        None => most,
+        Some(e) => most.max(e.min(taylor.triangle_error_above(t, most))),
     })
+}
+
+/// The largest second-derivative bound of triangles of shapes `shapes`, and `at_least`. The
+/// running largest skips what cannot raise it ([`TriangleErrors::shape_exceeds`]), so the
+/// largest triangles first make the others cheap; the result is the same in any order.
+#[inline]
+pub(super) fn shapes_bound(
+    errors: &TriangleErrors,
+    shapes: impl IntoIterator<Item = TriangleShape>,
+    at_least: f64,
+) -> f64 {
+    shapes.into_iter().fold(at_least, |most, s| errors.shape_exceeds(&s, most).map_or(most, |e| most.max(e)))
 }
 
 /// The triangles of a whole pattern after its `core` ([`Pattern::core_cells`]): all of them
 /// where the count does not fit.
-fn after_core(core: Option<([u32; 2], u32)>, triangles: &[[u32; 3]]) -> &[[u32; 3]] {
+pub(super) fn after_core(core: Option<([u32; 2], u32)>, triangles: &[[u32; 3]]) -> &[[u32; 3]] {
     match core {
         Some((_, count)) if count as usize <= triangles.len() => &triangles[count as usize..],
         _ => triangles,
+    }
+}
+
+/// The bound of the cells of `core` ([`Pattern::core_cells`]) together ([`grid_bound`]); 0
+/// where there is none.
+fn core_bound(
+    errors: &TriangleErrors,
+    taylor: Option<(&TaylorBound, Domain)>,
+    core: Option<([u32; 2], u32)>,
+) -> f64 {
+    match core {
+        Some((cells, count)) if count > 0 => grid_bound(errors, taylor, cells),
+        _ => 0.0,
     }
 }
 
@@ -260,11 +286,7 @@ fn core_params_bound(
     rest: &[[u32; 3]],
     params: LocalParams<'_>,
 ) -> f64 {
-    let at_least = match core {
-        Some((cells, count)) if count > 0 => grid_bound(errors, taylor, cells),
-        _ => 0.0,
-    };
-    triangles_bound(errors, taylor.map(|t| t.0), rest, params, at_least)
+    triangles_bound(errors, taylor.map(|t| t.0), rest, params, core_bound(errors, taylor, core))
 }
 
 /// The bound of a pattern whose triangles are all halves of the cells of the `nu × nv` grid
@@ -940,6 +962,12 @@ fn check_patches(
                 let cached = patterns.params(i).filter(|_| interior == first);
                 let grid = limit.pattern.grid_cells(&input);
                 let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
+                // A small pattern's shapes, kept per pattern (not with a Taylor bound, which
+                // needs the triangles' places).
+                let small = |table: &mut super::pattern_shapes::PatternShapes| {
+                    let (core, shapes) = table.get(generation, limit.pattern, &input)?;
+                    Some(shapes_bound(&errors[p], shapes.iter().copied(), core_bound(&errors[p], None, core)))
+                };
                 let bound = match (grid, cached) {
                     // A pure grid (no strips): bounded from its cells, no build.
                     (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
@@ -952,14 +980,20 @@ fn check_patches(
                         };
                         core_params_bound(&errors[p], taylor, core, rest, params)
                     }
-                    // Neighbouring patches often share an input: the thread's last pattern
-                    // is reused when it is the same.
-                    (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
-                        let slot = recent.get(generation, limit.pattern, &input, true);
-                        let core = limit.pattern.core_cells(&input);
-                        let rest = after_core(core, &slot.local.triangles);
-                        core_params_bound(&errors[p], taylor, core, rest, slot.params())
-                    }),
+                    (None, None) => taylor
+                        .is_none()
+                        .then(|| super::pattern_shapes::with_pattern_shapes(small))
+                        .flatten()
+                        .unwrap_or_else(|| {
+                            // Neighbouring patches often share an input: the thread's last
+                            // pattern is reused when it is the same.
+                            crate::pattern::cache::with_recent_patterns(|recent| {
+                                let slot = recent.get(generation, limit.pattern, &input, true);
+                                let core = limit.pattern.core_cells(&input);
+                                let rest = after_core(core, &slot.local.triangles);
+                                core_params_bound(&errors[p], taylor, core, rest, slot.params())
+                            })
+                        }),
                 };
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
