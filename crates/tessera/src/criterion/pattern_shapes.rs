@@ -18,38 +18,23 @@
 //! would hash every patch's input.
 
 use super::bounds::TriangleShape;
-use crate::domain::Domain;
-use crate::pattern::cache::{boundary_params, LocalParams};
+use crate::pattern::cache::{boundary_params, small_input_index, LocalParams, SmallInputTable};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use glam::DVec2;
 
-/// The largest factor (edge segments and interior) of a pattern the table holds.
-const LARGEST_FACTOR: u32 = 8;
-
-/// Bits of a factor in the table's index (factors `1..=8` as `0..=7`).
-const FACTOR_BITS: u32 = 3;
-
-/// Index bits: the domain, four edges and two interior factors.
-const INDEX_BITS: u32 = 1 + 6 * FACTOR_BITS;
-
-/// A pattern's data in the table: its core grid ([`Pattern::core_cells`]) and the range of
-/// its other triangles' shapes.
-#[derive(Debug, Clone, Copy)]
+/// A pattern's data: its core grid ([`Pattern::core_cells`]) and its other triangles'
+/// shapes, largest first.
+#[derive(Debug, Default)]
 struct Entry {
-    index: u32,
     core: Option<([u32; 2], u32)>,
-    shapes: (u32, u32),
+    shapes: Vec<TriangleShape>,
 }
 
 /// One thread's patterns of one plan, by input.
 #[derive(Default)]
 pub(crate) struct PatternShapes {
-    /// The entry of each index (stale where it does not point back at the index).
-    slots: Vec<u16>,
-    entries: Vec<Entry>,
-    shapes: Vec<TriangleShape>,
-    /// The plan the entries belong to ([`crate::pattern::cache::next_generation`]).
-    generation: u64,
+    table: SmallInputTable<Entry>,
+    /// Buffers of a build.
     local: LocalTessellation,
     params: Vec<DVec2>,
 }
@@ -59,74 +44,32 @@ pub(crate) struct PatternShapes {
 pub(crate) type Shapes<'a> = (Option<([u32; 2], u32)>, &'a [TriangleShape]);
 
 impl PatternShapes {
-    /// The table's index of `input`: None unless every factor is in `1..=8`, the factors
-    /// are the integer segments, and no edge is collapsed and no corner pinched (inputs the
-    /// index cannot tell apart).
-    fn index(input: &PatternInput) -> Option<u32> {
-        let small = |n: u32| (1..=LARGEST_FACTOR).contains(&n);
-        let plain = !input.collapsed.iter().any(|&c| c) && !input.pinched.iter().any(|&p| p);
-        let integer = (0..4).all(|l| input.factors[l] == input.segments[l] as f64);
-        let [s0, s1, s2, s3] = input.segments;
-        let factors = [s0, s1, s2, s3, input.interior[0], input.interior[1]];
-        if !(plain && integer && factors.iter().all(|&n| small(n))) {
-            return None;
-        }
-        let index =
-            factors.iter().fold(u32::from(input.domain == Domain::Tri), |i, &n| i << FACTOR_BITS | (n - 1));
-        Some(index)
-    }
-
     /// The data of `input`'s pattern under `pattern` for plan `generation`, built into the
-    /// table unless it is there; None for an input the table does not hold ([`Self::index`])
-    /// or a pattern that depends on the patch. Cost: one table read; a pattern build, its
-    /// parameters and a sort of its shapes the first time in a plan.
+    /// table unless it is there; None for an input the table does not hold
+    /// ([`small_input_index`]) or a pattern that depends on the patch. Cost: one table read;
+    /// a pattern build, its parameters and a sort of its shapes the first time in a plan.
     pub(crate) fn get(
         &mut self,
         generation: u64,
         pattern: &dyn Pattern,
         input: &PatternInput,
     ) -> Option<Shapes<'_>> {
-        let index = Self::index(input)?;
+        let index = small_input_index(input)?;
         if pattern.depends_on_patch() {
             return None;
         }
-        if self.generation != generation {
-            self.generation = generation;
-            self.entries.clear();
-            self.shapes.clear();
-        }
-        if self.slots.is_empty() {
-            self.slots.resize(1 << INDEX_BITS, 0);
-        }
-        let slot = self.slots[index as usize] as usize;
-        let slot = match self.entries.get(slot) {
-            Some(e) if e.index == index => slot,
-            _ => {
-                let slot = self.entries.len();
-                if slot > u16::MAX as usize {
-                    return None;
-                }
-                self.build(pattern, input, index);
-                self.slots[index as usize] = slot as u16;
-                slot
-            }
-        };
-        let e = self.entries[slot];
-        Some((e.core, &self.shapes[e.shapes.0 as usize..e.shapes.1 as usize]))
-    }
-
-    /// Builds `input`'s pattern and appends its entry.
-    fn build(&mut self, pattern: &dyn Pattern, input: &PatternInput, index: u32) {
-        pattern.build(input, &mut self.local);
-        boundary_params(input, &mut self.params);
-        let params = LocalParams { boundary: &self.params, interior: &self.local.interior };
-        let core = pattern.core_cells(input);
-        let start = self.shapes.len();
-        let rest = super::tolerance::after_core(core, &self.local.triangles);
-        self.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
-        self.shapes[start..].sort_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
-        let shapes = (start as u32, self.shapes.len() as u32);
-        self.entries.push(Entry { index, core, shapes });
+        let PatternShapes { table, local, params } = self;
+        let entry = table.get_or_build(generation, index, |entry: &mut Entry| {
+            pattern.build(input, local);
+            boundary_params(input, params);
+            let params = LocalParams { boundary: params, interior: &local.interior };
+            entry.core = pattern.core_cells(input);
+            let rest = super::tolerance::after_core(entry.core, &local.triangles);
+            entry.shapes.clear();
+            entry.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
+            entry.shapes.sort_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
+        })?;
+        Some((entry.core, &entry.shapes))
     }
 }
 
@@ -147,17 +90,37 @@ pub(crate) fn with_pattern_shapes<R>(f: impl FnOnce(&mut PatternShapes) -> R) ->
 mod tests {
     use super::*;
     use crate::criterion::bounds::HessianBound;
+    use crate::domain::Domain;
     use crate::pattern::transition::Transition;
 
-    /// Every small input of both domains gets its own entry, and the entry's core and
-    /// shapes are the pattern's: the core's cells as the pattern gives them, and the
-    /// other triangles' shapes, as a multiset, with the largest first.
+    /// Asserts that `got` is `input`'s pattern's data: the core's cells as the pattern
+    /// gives them, and the other triangles' shapes, as a multiset, largest first.
+    fn assert_shapes_of(input: &PatternInput, (core, shapes): Shapes<'_>) {
+        assert_eq!(core, Transition.core_cells(input), "{input:?}");
+        let mut built = LocalTessellation::default();
+        Transition.build(input, &mut built);
+        let mut params = Vec::new();
+        boundary_params(input, &mut params);
+        let params = LocalParams { boundary: &params, interior: &built.interior };
+        let rest = crate::criterion::tolerance::after_core(core, &built.triangles);
+        let mut expected: Vec<_> = rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))).collect();
+        assert_eq!(shapes.len(), expected.len(), "{input:?}");
+        for s in shapes {
+            let at = expected.iter().position(|e| e == s).expect("a shape of the pattern");
+            expected.swap_remove(at);
+        }
+        let longest: Vec<f64> = shapes.iter().map(|s| s.longest_side_squared()).collect();
+        assert!(longest.windows(2).all(|w| w[0] >= w[1]), "{input:?}: not largest first");
+    }
+
+    /// Every small input of both domains gets its own entry, the first time and again; a
+    /// later plan's entries take the places of an earlier plan's, and none reads another's.
     #[test]
     fn each_small_input_reads_its_own_patterns_shapes() {
         let mut table = PatternShapes::default();
         let mut seen = std::collections::HashSet::new();
         let mut inputs = Vec::new();
-        for a in 1..=LARGEST_FACTOR {
+        for a in 1..=8 {
             for b in [1, 3, 8] {
                 for c in [2, 5] {
                     inputs.push(PatternInput::new(Domain::Tri, [a, b, c, 1], [a.max(b).max(c); 2]));
@@ -166,40 +129,20 @@ mod tests {
             }
         }
         for (round, input) in inputs.iter().chain(&inputs).enumerate() {
-            let index = PatternShapes::index(input).expect("small");
+            let index = small_input_index(input).expect("small");
             if round < inputs.len() {
                 assert!(seen.insert(index), "{input:?} shares index {index}");
             }
-            let (core, shapes) = table.get(1, &Transition, input).expect("held");
-            assert_eq!(core, Transition.core_cells(input), "{input:?}");
-            let mut built = LocalTessellation::default();
-            Transition.build(input, &mut built);
-            let mut params = Vec::new();
-            boundary_params(input, &mut params);
-            let params = LocalParams { boundary: &params, interior: &built.interior };
-            let rest = crate::criterion::tolerance::after_core(core, &built.triangles);
-            let mut expected: Vec<_> =
-                rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))).collect();
-            assert_eq!(shapes.len(), expected.len(), "{input:?}");
-            for s in shapes {
-                let at = expected.iter().position(|e| e == s).expect("a shape of the pattern");
-                expected.swap_remove(at);
-            }
-            let longest: Vec<f64> = shapes.iter().map(|s| s.longest_side_squared()).collect();
-            assert!(longest.windows(2).all(|w| w[0] >= w[1]), "{input:?}: not largest first");
+            assert_shapes_of(input, table.get(1, &Transition, input).expect("held"));
         }
-        // The entries belong to their plan: another generation builds them again.
-        let input = &inputs[3];
-        let before = table.entries.len();
-        table.get(2, &Transition, input).expect("held");
-        assert_eq!(table.entries.len(), 1, "a new plan starts an empty table (was {before})");
+        // The next plan, in another order: each input's entry now sits where another's
+        // was in the first plan.
+        for input in inputs.iter().rev() {
+            assert_shapes_of(input, table.get(2, &Transition, input).expect("held"));
+        }
         let m = HessianBound { uu: 3.0, uv: 1.0, vv: 2.0 }.triangle_errors();
-        assert!(table
-            .get(2, &Transition, input)
-            .unwrap()
-            .1
-            .iter()
-            .all(|s| m.shape_exceeds(s, -1.0).is_some()));
+        let (_, shapes) = table.get(2, &Transition, &inputs[5]).expect("held");
+        assert!(shapes.iter().all(|s| m.shape_exceeds(s, -1.0).is_some()));
     }
 
     /// Inputs the index cannot tell apart are not held: large factors, fractional factors,

@@ -387,6 +387,34 @@ impl Cached<'_> {
     }
 }
 
+/// The largest factor (edge segments and interior) of an input [`small_input_index`] numbers.
+const SMALL_INPUT_FACTOR: u32 = 8;
+
+/// Bits of a factor in [`small_input_index`] (factors `1..=8` as `0..=7`).
+const SMALL_FACTOR_BITS: u32 = 3;
+
+/// Bits of [`small_input_index`]: the domain, four edges and two interior factors.
+pub(crate) const SMALL_INPUT_INDEX_BITS: u32 = 1 + 6 * SMALL_FACTOR_BITS;
+
+/// A number below `2^SMALL_INPUT_INDEX_BITS` for each input of a small pattern, the same for
+/// inputs that differ only in their patch: a table of small patterns is then a direct read,
+/// no hash. None unless every factor is in `1..=8`, the factors are the integer segments,
+/// and no edge is collapsed and no corner pinched (what the number cannot tell apart).
+/// Cost: O(1).
+#[inline]
+pub(crate) fn small_input_index(input: &PatternInput) -> Option<u32> {
+    let small = |n: u32| (1..=SMALL_INPUT_FACTOR).contains(&n);
+    let plain = !input.collapsed.iter().any(|&c| c) && !input.pinched.iter().any(|&p| p);
+    let integer = (0..4).all(|l| input.factors[l] == input.segments[l] as f64);
+    let [s0, s1, s2, s3] = input.segments;
+    let factors = [s0, s1, s2, s3, input.interior[0], input.interior[1]];
+    if !(plain && integer && factors.iter().all(|&n| small(n))) {
+        return None;
+    }
+    let tri = u32::from(input.domain == crate::domain::Domain::Tri);
+    Some(factors.iter().fold(tri, |i, &n| i << SMALL_FACTOR_BITS | (n - 1)))
+}
+
 /// Slots of [`RecentPatterns`]: a power of two.
 const RECENT_PATTERNS: usize = 64;
 
@@ -400,6 +428,8 @@ pub(crate) struct RecentPatterns {
     /// The slot of the last request: neighbouring patches often share an input, and a
     /// comparison costs less than the hash.
     last: usize,
+    /// The small inputs' patterns ([`small_input_index`]) of the current call.
+    small: SmallInputTable<RecentPattern>,
 }
 
 #[derive(Default)]
@@ -424,10 +454,24 @@ impl RecentPatterns {
         input: &PatternInput,
         params: bool,
     ) -> &RecentPattern {
+        let reusable = !pattern.depends_on_patch();
+        if let Some(index) = small_input_index(input).filter(|_| reusable) {
+            let built = self.small.get_or_build(generation, index, |built: &mut RecentPattern| {
+                pattern.build(input, &mut built.local);
+                built.key = Some((generation, PatternInput { patch: 0, ..*input }));
+                built.with_params = false;
+            });
+            if let Some(slot) = built {
+                if params && !slot.with_params {
+                    boundary_params(input, &mut slot.params);
+                    slot.with_params = true;
+                }
+                return slot;
+            }
+        }
         if self.slots.is_empty() {
             self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
         }
-        let reusable = !pattern.depends_on_patch();
         let key = (generation, PatternInput { patch: 0, ..*input });
         let index = match reusable {
             true if self.slots[self.last].key == Some(key) => self.last,
@@ -446,6 +490,64 @@ impl RecentPatterns {
             slot.with_params = true;
         }
         slot
+    }
+}
+
+/// Items of a call by [`small_input_index`], each built once a call and none evicted: a
+/// direct read where a hashed table would hash every patch's input. Stale entries (an
+/// earlier call's) are told by their key; the items' buffers are kept from call to call.
+/// Memory: 2^19 `u16`s (1 MiB) once used, and the items.
+pub(crate) struct SmallInputTable<T> {
+    /// Each index's place in `items` (stale unless `keys` there holds the index).
+    places: Vec<u16>,
+    keys: Vec<u32>,
+    /// The first `count` are the current call's.
+    items: Vec<T>,
+    count: usize,
+    generation: u64,
+}
+
+impl<T> Default for SmallInputTable<T> {
+    fn default() -> Self {
+        SmallInputTable { places: Vec::new(), keys: Vec::new(), items: Vec::new(), count: 0, generation: 0 }
+    }
+}
+
+impl<T: Default> SmallInputTable<T> {
+    /// The item of `index` for call `generation` (a call's number, [`next_generation`]),
+    /// made by `build` (on a reused or default item) unless the call made it already; None
+    /// once the call has made as many items as a `u16` numbers. Cost: a table read; the
+    /// build the first time in a call.
+    pub(crate) fn get_or_build(
+        &mut self,
+        generation: u64,
+        index: u32,
+        build: impl FnOnce(&mut T),
+    ) -> Option<&mut T> {
+        if self.generation != generation {
+            self.generation = generation;
+            self.count = 0;
+        }
+        if self.places.is_empty() {
+            self.places.resize(1 << SMALL_INPUT_INDEX_BITS, 0);
+        }
+        let place = self.places[index as usize] as usize;
+        if place < self.count && self.keys[place] == index {
+            return Some(&mut self.items[place]);
+        }
+        let place = self.count;
+        if place > u16::MAX as usize {
+            return None;
+        }
+        if place == self.items.len() {
+            self.items.push(T::default());
+            self.keys.push(0);
+        }
+        self.count += 1;
+        self.places[index as usize] = place as u16;
+        self.keys[place] = index;
+        build(&mut self.items[place]);
+        Some(&mut self.items[place])
     }
 }
 
