@@ -403,16 +403,20 @@ pub(crate) const SMALL_INPUT_INDEX_BITS: u32 = 1 + 6 * SMALL_FACTOR_BITS;
 /// Cost: O(1).
 #[inline]
 pub(crate) fn small_input_index(input: &PatternInput) -> Option<u32> {
-    let small = |n: u32| (1..=SMALL_INPUT_FACTOR).contains(&n);
-    let plain = !input.collapsed.iter().any(|&c| c) && !input.pinched.iter().any(|&p| p);
-    let integer = (0..4).all(|l| input.factors[l] == input.segments[l] as f64);
+    // Branch-free tests: every patch of a frame asks, once in the check and once in the
+    // engine.
+    let flags = |b: [bool; 4]| u32::from_ne_bytes(b.map(u8::from));
+    let plain = flags(input.collapsed) | flags(input.pinched) == 0;
+    let integer = (0..4).fold(true, |all, l| all & (input.factors[l] == input.segments[l] as f64));
     let [s0, s1, s2, s3] = input.segments;
-    let factors = [s0, s1, s2, s3, input.interior[0], input.interior[1]];
-    if !(plain && integer && factors.iter().all(|&n| small(n))) {
+    // Factors 1..=8 as 0..=7; a zero wraps to a large number.
+    let factors = [s0, s1, s2, s3, input.interior[0], input.interior[1]].map(|n| n.wrapping_sub(1));
+    let small = factors.iter().fold(0, |any, &n| any | n) < SMALL_INPUT_FACTOR;
+    if !(plain & integer & small) {
         return None;
     }
     let tri = u32::from(input.domain == crate::domain::Domain::Tri);
-    Some(factors.iter().fold(tri, |i, &n| i << SMALL_FACTOR_BITS | (n - 1)))
+    Some(factors.iter().fold(tri, |i, &n| i << SMALL_FACTOR_BITS | n))
 }
 
 /// Slots of [`RecentPatterns`]: a power of two.
