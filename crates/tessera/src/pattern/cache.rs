@@ -497,13 +497,21 @@ impl RecentPatterns {
     }
 }
 
+/// Bits of the indices one page of a [`SmallInputTable`] holds.
+const PAGE_BITS: u32 = 10;
+
+/// A page of a [`SmallInputTable`]: the places of `2^PAGE_BITS` consecutive indices.
+type Page = [u16; 1 << PAGE_BITS];
+
 /// Items of a call by [`small_input_index`], each built once a call and none evicted: a
 /// direct read where a hashed table would hash every patch's input. Stale entries (an
 /// earlier call's) are told by their key; the items' buffers are kept from call to call.
-/// Memory: 2^19 `u16`s (1 MiB) once used, and the items.
+/// Memory: the items, and a 2 KiB page of places for each 1,024 consecutive indices in use
+/// (the interior factors and the last edge's are the index's low bits, so a frame's inputs
+/// share few pages), not the 1 MiB a flat table of every index would take on every thread.
 pub(crate) struct SmallInputTable<T> {
-    /// Each index's place in `items` (stale unless `keys` there holds the index).
-    places: Vec<u16>,
+    /// Each index's place in `items` by page (stale unless `keys` there holds the index).
+    pages: Vec<Option<Box<Page>>>,
     keys: Vec<u32>,
     /// The first `count` are the current call's.
     items: Vec<T>,
@@ -513,15 +521,15 @@ pub(crate) struct SmallInputTable<T> {
 
 impl<T> Default for SmallInputTable<T> {
     fn default() -> Self {
-        SmallInputTable { places: Vec::new(), keys: Vec::new(), items: Vec::new(), count: 0, generation: 0 }
+        SmallInputTable { pages: Vec::new(), keys: Vec::new(), items: Vec::new(), count: 0, generation: 0 }
     }
 }
 
 impl<T: Default> SmallInputTable<T> {
     /// The item of `index` for call `generation` (a call's number, [`next_generation`]),
     /// made by `build` (on a reused or default item) unless the call made it already; None
-    /// once the call has made as many items as a `u16` numbers. Cost: a table read; the
-    /// build the first time in a call.
+    /// once the call has made as many items as a `u16` numbers. Cost: two reads; the build
+    /// the first time in a call.
     pub(crate) fn get_or_build(
         &mut self,
         generation: u64,
@@ -532,10 +540,13 @@ impl<T: Default> SmallInputTable<T> {
             self.generation = generation;
             self.count = 0;
         }
-        if self.places.is_empty() {
-            self.places.resize(1 << SMALL_INPUT_INDEX_BITS, 0);
+        if self.pages.is_empty() {
+            self.pages.resize_with(1 << (SMALL_INPUT_INDEX_BITS - PAGE_BITS), || None);
         }
-        let place = self.places[index as usize] as usize;
+        let page =
+            self.pages[(index >> PAGE_BITS) as usize].get_or_insert_with(|| Box::new([0; 1 << PAGE_BITS]));
+        let entry = &mut page[(index & ((1 << PAGE_BITS) - 1)) as usize];
+        let place = *entry as usize;
         if place < self.count && self.keys[place] == index {
             return Some(&mut self.items[place]);
         }
@@ -543,12 +554,12 @@ impl<T: Default> SmallInputTable<T> {
         if place > u16::MAX as usize {
             return None;
         }
+        *entry = place as u16;
         if place == self.items.len() {
             self.items.push(T::default());
             self.keys.push(0);
         }
         self.count += 1;
-        self.places[index as usize] = place as u16;
         self.keys[place] = index;
         build(&mut self.items[place]);
         Some(&mut self.items[place])
