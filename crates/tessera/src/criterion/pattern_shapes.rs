@@ -22,54 +22,59 @@ use crate::pattern::cache::{boundary_params, small_input_index, LocalParams, Sma
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use glam::DVec2;
 
-/// A pattern's data: its core grid ([`Pattern::core_cells`]) and its other triangles'
-/// shapes, largest first.
+/// What the check reads of a pattern: whether it is a grid, else its core grid and its
+/// other triangles' shapes.
 #[derive(Debug, Default)]
-struct Entry {
-    core: Option<([u32; 2], u32)>,
-    shapes: Vec<TriangleShape>,
+pub(crate) struct PatternData {
+    /// [`Pattern::grid_cells`]: a grid's bound is its cells', and nothing else is kept.
+    pub(crate) grid: Option<[u32; 2]>,
+    /// [`Pattern::core_cells`].
+    pub(crate) core: Option<([u32; 2], u32)>,
+    /// The shapes of the triangles after the core, largest first.
+    pub(crate) shapes: Vec<TriangleShape>,
 }
 
 /// One thread's patterns of one plan, by input.
 #[derive(Default)]
 pub(crate) struct PatternShapes {
-    table: SmallInputTable<Entry>,
+    table: SmallInputTable<PatternData>,
     /// Buffers of a build.
     local: LocalTessellation,
     params: Vec<DVec2>,
 }
 
-/// A pattern's data: its core grid's cells and triangle count, and the shapes of its other
-/// triangles, largest first.
-pub(crate) type Shapes<'a> = (Option<([u32; 2], u32)>, &'a [TriangleShape]);
-
 impl PatternShapes {
-    /// The data of `input`'s pattern under `pattern` for plan `generation`, built into the
-    /// table unless it is there; None for an input the table does not hold
-    /// ([`small_input_index`]) or a pattern that depends on the patch. Cost: one table read;
-    /// a pattern build, its parameters and a sort of its shapes the first time in a plan.
+    /// The data of `input`'s pattern under `pattern` for plan `generation`, made unless the
+    /// table has it; None for an input the table does not hold ([`small_input_index`]) or a
+    /// pattern that depends on the patch. Cost: a table read; the first time in a plan, a
+    /// grid test, or a pattern build, its parameters and a sort of its shapes.
     pub(crate) fn get(
         &mut self,
         generation: u64,
         pattern: &dyn Pattern,
         input: &PatternInput,
-    ) -> Option<Shapes<'_>> {
+    ) -> Option<&PatternData> {
         let index = small_input_index(input)?;
         if pattern.depends_on_patch() {
             return None;
         }
         let PatternShapes { table, local, params } = self;
-        let entry = table.get_or_build(generation, index, |entry: &mut Entry| {
+        let data = table.get_or_build(generation, index, |data: &mut PatternData| {
+            data.grid = pattern.grid_cells(input);
+            data.core = None;
+            data.shapes.clear();
+            if data.grid.is_some() {
+                return;
+            }
             pattern.build(input, local);
             boundary_params(input, params);
             let params = LocalParams { boundary: params, interior: &local.interior };
-            entry.core = pattern.core_cells(input);
-            let rest = super::tolerance::after_core(entry.core, &local.triangles);
-            entry.shapes.clear();
-            entry.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
-            entry.shapes.sort_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
+            data.core = pattern.core_cells(input);
+            let rest = super::tolerance::after_core(data.core, &local.triangles);
+            data.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
+            data.shapes.sort_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
         })?;
-        Some((entry.core, &entry.shapes))
+        Some(data)
     }
 }
 
@@ -95,7 +100,13 @@ mod tests {
 
     /// Asserts that `got` is `input`'s pattern's data: the core's cells as the pattern
     /// gives them, and the other triangles' shapes, as a multiset, largest first.
-    fn assert_shapes_of(input: &PatternInput, (core, shapes): Shapes<'_>) {
+    fn assert_shapes_of(input: &PatternInput, data: &PatternData) {
+        assert_eq!(data.grid, Transition.grid_cells(input), "{input:?}");
+        if data.grid.is_some() {
+            assert!(data.core.is_none() && data.shapes.is_empty(), "{input:?}: a grid keeps nothing else");
+            return;
+        }
+        let (core, shapes) = (data.core, &data.shapes[..]);
         assert_eq!(core, Transition.core_cells(input), "{input:?}");
         let mut built = LocalTessellation::default();
         Transition.build(input, &mut built);
@@ -127,6 +138,9 @@ mod tests {
                     inputs.push(PatternInput::new(Domain::Quad, [a, b, c, 4], [a.min(c), b.min(4)]));
                 }
             }
+            // Grids: every edge as its interior.
+            inputs.push(PatternInput::new(Domain::Tri, [a, a, a, 1], [a; 2]));
+            inputs.push(PatternInput::new(Domain::Quad, [a, 9 - a, a, 9 - a], [a, 9 - a]));
         }
         for (round, input) in inputs.iter().chain(&inputs).enumerate() {
             let index = small_input_index(input).expect("small");
@@ -141,8 +155,10 @@ mod tests {
             assert_shapes_of(input, table.get(2, &Transition, input).expect("held"));
         }
         let m = HessianBound { uu: 3.0, uv: 1.0, vv: 2.0 }.triangle_errors();
-        let (_, shapes) = table.get(2, &Transition, &inputs[5]).expect("held");
-        assert!(shapes.iter().all(|s| m.shape_exceeds(s, -1.0).is_some()));
+        let shapes = &table.get(2, &Transition, &inputs[5]).expect("held").shapes;
+        assert!(!shapes.is_empty() && shapes.iter().all(|s| m.shape_exceeds(s, -1.0).is_some()));
+        let grids = inputs.iter().filter(|i| table.get(2, &Transition, i).unwrap().grid.is_some()).count();
+        assert!(grids > 0 && grids < inputs.len(), "{grids} grids: both kinds are tested");
     }
 
     /// Inputs the index cannot tell apart are not held: large factors, fractional factors,

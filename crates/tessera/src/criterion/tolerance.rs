@@ -959,41 +959,47 @@ fn check_patches(
                     // The output could not hold this pattern; the plan is refused at the end.
                     return (interior, f64::INFINITY, true);
                 }
-                let cached = patterns.params(i).filter(|_| interior == first);
-                let grid = limit.pattern.grid_cells(&input);
                 let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
-                // A small pattern's shapes, kept per pattern (not with a Taylor bound, which
-                // needs the triangles' places).
+                // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
+                // its triangles (not with a Taylor bound, which needs their places).
                 let small = |table: &mut super::pattern_shapes::PatternShapes| {
-                    let (core, shapes) = table.get(generation, limit.pattern, &input)?;
-                    Some(shapes_bound(&errors[p], shapes.iter().copied(), core_bound(&errors[p], None, core)))
+                    let data = table.get(generation, limit.pattern, &input)?;
+                    Some(match data.grid {
+                        Some(cells) => grid_bound(&errors[p], None, cells),
+                        None => {
+                            let core = core_bound(&errors[p], None, data.core);
+                            shapes_bound(&errors[p], data.shapes.iter().copied(), core)
+                        }
+                    })
                 };
-                let bound = match (grid, cached) {
-                    // A pure grid (no strips): bounded from its cells, no build.
-                    (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
-                    (None, Some((cached, params))) => {
-                        let core = limit.pattern.core_cells(&input);
-                        // The cache leaves out the triangles of a core grid.
-                        let rest = match cached.core {
-                            Some(_) => &cached.local.triangles[..],
-                            None => after_core(core, &cached.local.triangles),
-                        };
-                        core_params_bound(&errors[p], taylor, core, rest, params)
-                    }
-                    (None, None) => taylor
-                        .is_none()
-                        .then(|| super::pattern_shapes::with_pattern_shapes(small))
-                        .flatten()
-                        .unwrap_or_else(|| {
+                let small =
+                    taylor.is_none().then(|| super::pattern_shapes::with_pattern_shapes(small)).flatten();
+                let bound = match small {
+                    Some(bound) => bound,
+                    None => {
+                        let cached = patterns.params(i).filter(|_| interior == first);
+                        match (limit.pattern.grid_cells(&input), cached) {
+                            // A pure grid (no strips): bounded from its cells, no build.
+                            (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
+                            (None, Some((cached, params))) => {
+                                let core = limit.pattern.core_cells(&input);
+                                // The cache leaves out the triangles of a core grid.
+                                let rest = match cached.core {
+                                    Some(_) => &cached.local.triangles[..],
+                                    None => after_core(core, &cached.local.triangles),
+                                };
+                                core_params_bound(&errors[p], taylor, core, rest, params)
+                            }
                             // Neighbouring patches often share an input: the thread's last
                             // pattern is reused when it is the same.
-                            crate::pattern::cache::with_recent_patterns(|recent| {
+                            (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
                                 let slot = recent.get(generation, limit.pattern, &input, true);
                                 let core = limit.pattern.core_cells(&input);
                                 let rest = after_core(core, &slot.local.triangles);
                                 core_params_bound(&errors[p], taylor, core, rest, slot.params())
-                            })
-                        }),
+                            }),
+                        }
+                    }
                 };
                 if bound <= e * (1.0 + 1e-9) {
                     return (interior, bound, false);
