@@ -256,7 +256,21 @@ impl<'a> FastEvaluator<'a> {
         if input.domain != Domain::Quad || self.points.grid_patch(p).is_none() {
             return None;
         }
-        let grid = pattern.interior_grid(input)?;
+        self.covers_grid(p, input, pattern.interior_grid(input))
+    }
+
+    /// [`FastEvaluator::covers_patch`] where the pattern's [`Pattern::interior_grid`] of
+    /// `input` is known (`grid`).
+    pub(crate) fn covers_grid(
+        &self,
+        p: usize,
+        input: &PatternInput,
+        grid: Option<[u32; 2]>,
+    ) -> Option<[u32; 2]> {
+        if input.domain != Domain::Quad || self.points.grid_patch(p).is_none() {
+            return None;
+        }
+        let grid = grid?;
         (self.factor(grid[0] as usize).is_some() && self.factor(grid[1] as usize).is_some()).then_some(grid)
     }
 

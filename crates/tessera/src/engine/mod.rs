@@ -747,16 +747,22 @@ impl Writer<'_> {
         // The triangles in the general form need the whole pattern, core included.
         let cached = self.cached(p).filter(|(_, c)| !general || c.core.is_none());
         let input = cached.map_or_else(|| layout::pattern_input(set, plan, p), |(input, _)| input);
-        let (local, interior) = match cached {
-            Some((_, c)) => (c.local, c.interior),
+        // A pattern built here found its interior grid with the build (a test of its
+        // layout, which each patch would repeat); a cached one's is asked.
+        let (local, interior, grid) = match cached {
+            Some((_, c)) => (c.local, c.interior, None),
             None => {
-                let local = &scratch.patterns.get(self.generation, self.pattern, &input, false).local;
-                (local, &local.interior[..])
+                let built = scratch.patterns.get(self.generation, self.pattern, &input, false);
+                (&built.local, &built.local.interior[..], Some(built.interior_grid))
             }
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !interior.is_empty());
-        match fast.map(|f| (f, f.covers_patch(p, self.pattern, &input))) {
+        let covers = |f: &fast_evaluator::FastEvaluator<'_>| match grid {
+            Some(grid) => f.covers_grid(p, &input, grid),
+            None => f.covers_patch(p, self.pattern, &input),
+        };
+        match fast.map(|f| (f, covers(f))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),
             Some((f, None)) => {
                 // A pattern's interior that is a grid (a core grid's points are) lets a tree

@@ -446,6 +446,9 @@ pub(crate) struct RecentPattern {
     /// `with_params`.
     params: Vec<DVec2>,
     with_params: bool,
+    /// [`Pattern::interior_grid`] of the input, found with the build: the engine asks it of
+    /// every patch.
+    pub(crate) interior_grid: Option<[u32; 2]>,
 }
 
 impl RecentPatterns {
@@ -464,6 +467,7 @@ impl RecentPatterns {
                 pattern.build(input, &mut built.local);
                 built.key = Some((generation, PatternInput { patch: 0, ..*input }));
                 built.with_params = false;
+                built.interior_grid = pattern.interior_grid(input);
             });
             if let Some(slot) = built {
                 if params && !slot.with_params {
@@ -488,6 +492,7 @@ impl RecentPatterns {
             pattern.build(input, &mut slot.local);
             slot.key = reusable.then_some(key);
             slot.with_params = false;
+            slot.interior_grid = pattern.interior_grid(input);
         }
         if params && !slot.with_params {
             boundary_params(input, &mut slot.params);
