@@ -6,7 +6,7 @@
 //! to frame.
 
 use super::point_blocks::{has_avx2_fma, GridPatch, PointBlocks, LANES};
-use super::uniform_quads::{edge_line, store, Basis, GridLine, Line, LocalPatch};
+use super::uniform_quads::{store, Basis, GridLine, Line, LocalPatch};
 use super::uniform_triangles::UniformTriangles;
 use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
@@ -360,7 +360,7 @@ impl<'a> FastEvaluator<'a> {
     {
         let (p, local_edge, rev) = (owner.patch as usize, owner.local as usize, owner.reversed);
         let (basis, n) = (&tables.basis, tables.n);
-        let line = edge_line(local, basis, n, local_edge);
+        let line = local.edge(local_edge);
         // The line runs with the patch's grid index; canonical sample k sits at line index k
         // or n − k (edges 2 and 3 run against the grid, reversed edges against the patch).
         let flip = rev ^ (local_edge >= 2);

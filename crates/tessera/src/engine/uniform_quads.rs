@@ -178,7 +178,7 @@ impl<const C: usize> LocalPatch<C> {
     }
 
     /// The curve `u = i / n`, likewise (along `v`, cross derivative `∂/∂u`).
-    #[inline(always)]
+    #[cfg(test)]
     // Index loops mirror `Line::new`'s sums.
     #[allow(clippy::needless_range_loop)]
     pub(super) fn column(&self, basis: &Basis, i: usize) -> Line<C> {
@@ -373,8 +373,10 @@ pub(super) fn store(
     }
 }
 
-/// The grid line that local edge `e` of a patch runs along, as (row or column, index).
-pub(super) fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n: usize, e: usize) -> Line<C> {
+/// The grid line that local edge `e` of a patch runs along, as (row or column, index): the
+/// general rule, which [`LocalPatch::edge`] computes without the basis.
+#[cfg(test)]
+fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n: usize, e: usize) -> Line<C> {
     match e {
         0 => patch.row(basis, 0),
         1 => patch.column(basis, n),
@@ -383,10 +385,83 @@ pub(super) fn edge_line<const C: usize>(patch: &LocalPatch<C>, basis: &Basis, n:
     }
 }
 
+impl<const C: usize> LocalPatch<C> {
+    /// The line of local edge `e` (0: `v = 0`, 1: `u = 1`, 2: `v = 1`, 3: `u = 0`), the bits
+    /// of [`LocalPatch::row`] or [`LocalPatch::column`] at the end of any factor's basis,
+    /// whose Bernstein values there are 0 and 1 and derivatives 0 and ±3: only the two nonzero
+    /// terms of each sum are formed, in the same order from the same `0.0` (a sum that starts
+    /// at `+0.0` is never `−0.0`, so the zero terms it skips could not change it). An edge has
+    /// one or two inner samples on a coarse frame, and its line's sixteen-term sums were a
+    /// visible part of the edge pass. Cost: 4·C additions and multiplications each way.
+    #[inline(always)]
+    pub(super) fn edge(&self, e: usize) -> Line<C> {
+        let mut line = Line { c: [[0.0; 4]; C], d: [[0.0; 4]; C], column: e % 2 == 1 };
+        // The net's end at the edge (`k = 0` or 3) and the next row or column inward.
+        let (end, inner, sign) = if e == 0 || e == 3 { (0, 1, -3.0) } else { (3, 2, 3.0) };
+        for c in 0..C {
+            for t in 0..4 {
+                let q = |k: usize| if e % 2 == 0 { self.by_v[c][k][t] } else { self.by_v[c][t][k] };
+                line.c[c][t] = 0.0 + q(end);
+                // B'(0) = (−3, 3, 0, 0) and B'(1) = (0, 0, −3, 3): the sum runs k upward.
+                line.d[c][t] = if end == 0 {
+                    (0.0 + q(end) * sign) + q(inner) * -sign
+                } else {
+                    (0.0 + q(inner) * -sign) + q(end) * sign
+                };
+            }
+        }
+        line
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::fast_evaluator::FastEvaluator;
     use super::*;
+
+    /// An edge's line without the basis is the general rule's, bit for bit, for every
+    /// factor, on polynomial and rational nets with zeros of both signs among their points.
+    #[test]
+    fn edge_lines_are_the_rows_and_columns_at_the_ends_bit_for_bit() {
+        fn bits<const C: usize>(l: &Line<C>) -> Vec<u32> {
+            l.c.iter().chain(&l.d).flatten().map(|x| x.to_bits()).chain([l.column as u32]).collect()
+        }
+        fn check<const C: usize>(patch: &LocalPatch<C>, basis: &mut Basis) {
+            for n in [1, 2, 3, 7, 16, 64] {
+                basis.refill(n);
+                for e in 0..4 {
+                    assert_eq!(
+                        bits(&patch.edge(e)),
+                        bits(&edge_line(patch, basis, n, e)),
+                        "n = {n}, edge {e}"
+                    );
+                }
+            }
+        }
+        let mut rng = crate::test_support::Lcg(5);
+        let mut basis = Basis::default();
+        for round in 0..200 {
+            let mut net = [DVec3::ZERO; 16];
+            for q in net.iter_mut() {
+                *q = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - 1.0;
+            }
+            let mut polynomial = LocalPatch::from_net(&net);
+            // Zeros of both signs, where the sums' `0.0 +` decides the sign.
+            if round % 2 == 0 {
+                for (k, x) in polynomial.by_v.iter_mut().flatten().flatten().enumerate() {
+                    match k % 5 {
+                        0 => *x = 0.0,
+                        1 => *x = -0.0,
+                        _ => {}
+                    }
+                }
+            }
+            check(&polynomial, &mut basis);
+            let weights: [f64; 16] = std::array::from_fn(|_| 0.5 + rng.unit());
+            let rational = LocalPatch::<4>::in_frame(&net, local_frame(&net), |k| weights[k]);
+            check(&rational, &mut basis);
+        }
+    }
     use crate::criterion::Plan;
     use crate::engine::{write_with, EngineOptions, Layout};
     use crate::mesh::Mesh;
