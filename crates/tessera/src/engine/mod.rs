@@ -786,6 +786,17 @@ impl Writer<'_> {
         if cached.is_some() && !general {
             return;
         }
+        if !stream && !general {
+            // Every triangle kept as it is (no repeated corner, no parameters): mapped on the
+            // way out, in one pass.
+            debug_assert_eq!(idx.len(), 3 * local.triangles.len());
+            let map = self.local_index_map(p, input, &mut scratch.vertex);
+            for (out, tri) in idx.chunks_exact_mut(3).zip(&local.triangles) {
+                out.copy_from_slice(&tri.map(&map));
+            }
+            tp.fill(p as u32);
+            return;
+        }
         let mut t = 0;
         for tri in &local.triangles {
             if general && layout::degenerate_after_collapse(set, &input, p, tri) {
@@ -811,13 +822,28 @@ impl Writer<'_> {
     /// locally and in the output, so each maps by one addition, and only boundary indices go
     /// through the patch's table (`table`, scratch).
     fn map_local_indices(&self, p: usize, input: PatternInput, idx: &mut [u32], table: &mut Vec<u32>) {
+        let map = self.local_index_map(p, input, table);
+        for l in idx.iter_mut() {
+            *l = map(*l);
+        }
+    }
+
+    /// The numbering rule of [`Writer::map_local_indices`] for patch `p` with `input`: the
+    /// output vertex of each local index, its boundary vertices' through `table` (filled
+    /// here).
+    #[inline(always)]
+    fn local_index_map<'t>(
+        &self,
+        p: usize,
+        input: PatternInput,
+        table: &'t mut Vec<u32>,
+    ) -> impl Fn(u32) -> u32 + 't {
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         LocalMap { set, plan, layout, input, patch: p }.vertex_table(0, table);
         let first = input.interior_base();
         let delta = layout.interior_vertex(p, 0).wrapping_sub(first);
-        for l in idx.iter_mut() {
-            *l = if *l >= first { l.wrapping_add(delta) } else { table[*l as usize] };
-        }
+        let table = &*table;
+        move |l| if l >= first { l.wrapping_add(delta) } else { table[l as usize] }
     }
 
     /// The second pass for one visible patch: its triangles mapped to output vertices by the
