@@ -259,7 +259,8 @@ impl<'a> Tessellator<'a> {
         let (criterion, resolve) = self.scratch.stage_times();
         let planning = start.elapsed();
         let start = Instant::now();
-        self.layout.build(self.set, &planned.plan, &planned.pattern, &self.options.engine)?;
+        let counts = self.scratch.plan_counts();
+        self.layout.build_counted(self.set, &planned.plan, &planned.pattern, &self.options.engine, counts)?;
         self.laid_out = true;
         self.pending = FrameTimings {
             criterion,
@@ -488,6 +489,45 @@ mod tests {
             taken += usize::from(tess.scratch.tolerance.held_patterns() > 0);
         }
         assert!(taken >= 3, "the engine took the check's patterns in {taken} frames of 5");
+    }
+
+    /// The layout takes each patch's pattern counts from the a-posteriori check: they are
+    /// the counts of the pattern the engine writes for it (its final input, after the rounds
+    /// that raised edges, zero where culled), on a walk's frames of the teapot and of a
+    /// Catmull-Clark cage, with and without culling, and under the Taylor bound (whose
+    /// patterns the check does not keep, and whose frames here take rounds).
+    #[test]
+    fn the_checks_pattern_counts_are_those_of_the_written_patterns() {
+        use crate::criterion::ErrorBound;
+        use crate::pattern::Pattern;
+        let path = crate::test_support::data("subdivision/catmark_torus.obj");
+        let obj = crate::scene::mesh_grid(&crate::io::obj::read_obj(&path).expect("test cage"), 16);
+        let cage = SurfaceSet::from_subdivision_cage(&obj, &path, Default::default()).expect("cage");
+        let (mut rounds, mut culled, mut checked) = (0, 0, 0);
+        let cases = [(false, ErrorBound::Hessian), (true, ErrorBound::Hessian), (true, ErrorBound::Taylor)];
+        for (set, (cull, bound)) in [teapot(), cage].iter().flat_map(|set| cases.map(|c| (set, c))) {
+            let (lo, hi) = set.bounds();
+            let plan = PlanOptions { cull, bound, ..PlanOptions::default() };
+            let options = TessellatorOptions { plan, ..TessellatorOptions::default() };
+            let mut tess =
+                Tessellator::new(set, Scheme::Transition, Criterion::PixelError(0.5), options).unwrap();
+            for (k, camera) in crate::scene::walk(lo, hi, 4, 1280, 1024).into_iter().enumerate() {
+                tess.plan_frame(Some(&camera)).unwrap();
+                let counts = tess.scratch.plan_counts().expect("the check counted every patch");
+                let (plan, pattern) = (&tess.planned.plan, &tess.planned.pattern);
+                for (p, &c) in counts.iter().enumerate() {
+                    let expected = match plan.is_visible(p) {
+                        true => pattern.counts(&engine::layout::pattern_input(set, plan, p)),
+                        false => (0, 0),
+                    };
+                    assert_eq!(c, expected, "patch {p}, frame {k}, cull {cull}, {bound:?}");
+                    culled += usize::from(!plan.is_visible(p));
+                    checked += 1;
+                }
+                rounds += tess.report().unwrap().rounds;
+            }
+        }
+        assert!(rounds > 0 && culled > 0, "{rounds} rounds, {culled} culled of {checked}");
     }
 
     #[test]

@@ -240,6 +240,12 @@ impl PlanScratch {
         self.tolerance.take_patterns()
     }
 
+    /// The last plan's pattern counts per patch, where its a-posteriori check found them
+    /// ([`tolerance::Scratch::plan_counts`]), for the layout of that plan.
+    pub(crate) fn plan_counts(&self) -> Option<&[(u32, u32)]> {
+        self.tolerance.plan_counts()
+    }
+
     /// How long the last plan made with these buffers spent in its criterion stage
     /// (culling, tolerances) and in resolving (proposals, edges, checks), where the plan
     /// measures them (the error-bounded criteria); zero otherwise.

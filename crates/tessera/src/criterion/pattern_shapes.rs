@@ -28,6 +28,8 @@ use glam::DVec2;
 pub(crate) struct PatternData {
     /// [`Pattern::grid_cells`]: a grid's bound is its cells', and nothing else is kept.
     pub(crate) grid: Option<[u32; 2]>,
+    /// [`Pattern::counts`].
+    pub(crate) counts: (u32, u32),
     /// [`Pattern::core_cells`].
     pub(crate) core: Option<([u32; 2], u32)>,
     /// The shapes of the triangles after the core, largest first.
@@ -61,6 +63,7 @@ impl PatternShapes {
         let PatternShapes { table, local, params } = self;
         let data = table.get_or_build(generation, index, |data: &mut PatternData| {
             data.grid = pattern.grid_cells(input);
+            data.counts = pattern.counts(input);
             data.core = None;
             data.shapes.clear();
             if data.grid.is_some() {
@@ -102,6 +105,7 @@ mod tests {
     /// gives them, and the other triangles' shapes, as a multiset, largest first.
     fn assert_shapes_of(input: &PatternInput, data: &PatternData) {
         assert_eq!(data.grid, Transition.grid_cells(input), "{input:?}");
+        assert_eq!(data.counts, Transition.counts(input), "{input:?}");
         if data.grid.is_some() {
             assert!(data.core.is_none() && data.shapes.is_empty(), "{input:?}: a grid keeps nothing else");
             return;

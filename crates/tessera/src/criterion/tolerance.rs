@@ -462,9 +462,10 @@ pub fn minimum_interior(set: &SurfaceSet) -> Vec<[u32; 2]> {
         .collect()
 }
 
-/// One patch's a-posteriori result: its interior factors, its guaranteed bound, and whether
-/// the bound misses the tolerance.
-type Check = ([u32; 2], f64, bool);
+/// One patch's a-posteriori result: its interior factors, its guaranteed bound, whether the
+/// bound misses the tolerance, and its pattern's counts ([`Pattern::counts`]; zero for a
+/// culled patch or a refused plan).
+type Check = ([u32; 2], f64, bool, (u32, u32));
 
 /// A patch's first pattern to check: its domain, edge segments and smallest interior.
 type First = (Domain, [u32; 4], [u32; 2]);
@@ -489,6 +490,10 @@ pub(crate) struct Scratch {
     /// `patterns` holds the last plan's patterns, not yet handed to the engine
     /// ([`Scratch::take_patterns`]).
     patterns_fresh: bool,
+    /// The last plan's pattern counts per patch ([`Scratch::plan_counts`]), valid while
+    /// `counts_fresh`.
+    plan_counts: Vec<(u32, u32)>,
+    counts_fresh: bool,
 }
 
 impl Scratch {
@@ -502,10 +507,19 @@ impl Scratch {
         std::mem::take(&mut self.patterns_fresh).then_some(&mut self.patterns)
     }
 
-    /// Marks the patterns as no plan's: a plan made without the check must not hand the
-    /// engine an earlier plan's.
+    /// Marks the patterns and counts as no plan's: a plan made without the check must not
+    /// hand the engine an earlier plan's.
     pub(crate) fn forget_patterns(&mut self) {
         self.patterns_fresh = false;
+        self.counts_fresh = false;
+    }
+
+    /// The last plan's [`Pattern::counts`] of every patch (zero for culled ones), as its
+    /// check found them with each patch's final pattern: the layout's per-patch counts,
+    /// which it need not find again (issue 26's fusion of the check and the counts). None
+    /// when the last plan was not made by the check.
+    pub(crate) fn plan_counts(&self) -> Option<&[(u32, u32)]> {
+        self.counts_fresh.then_some(&self.plan_counts[..])
     }
 
     /// How many distinct patterns the check's table holds (0 when the last check built none).
@@ -579,8 +593,11 @@ pub(crate) fn plan_limited(
         per_patch,
         patterns,
         patterns_fresh,
+        plan_counts,
+        counts_fresh,
     } = scratch;
     *patterns_fresh = false;
+    *counts_fresh = false;
 
     // Each visible patch's proposal per local edge.
     proposals.resize(patches, [0.0; 4]);
@@ -693,6 +710,11 @@ pub(crate) fn plan_limited(
     limit.result()?;
     plan.interior.clear();
     plan.interior.extend(results.iter().map(|r| r.0));
+    plan_counts.clear();
+    plan_counts.extend(results.iter().map(|r| r.3));
+    // The check's inputs carry the segments as their factors: the engine's, except under a
+    // fractional rule, whose patterns read the real factors.
+    *counts_fresh = !matches!(rule, EdgeRule::Fractional(_));
     Ok(report)
 }
 
@@ -942,40 +964,42 @@ fn check_patches(
     // Each thread's pattern buffers are kept from call to call (a per-frame loop then
     // allocates none here).
     let generation = crate::pattern::cache::next_generation();
-    out.resize(which.len(), ([1; 2], 0.0, false));
+    out.resize(which.len(), ([1; 2], 0.0, false, (0, 0)));
     let items = out.par_iter_mut().zip(which).zip(firsts.par_iter()).enumerate();
     items.for_each(|(i, ((o, &p), &(domain, seg, interior)))| {
         let first = interior;
         let mut interior = interior;
         *o = (|| {
             if !admitted {
-                return (interior, f64::INFINITY, true);
+                return (interior, f64::INFINITY, true, (0, 0));
             }
-            let Some(e) = eps[p] else { return (interior, 0.0, false) };
+            let Some(e) = eps[p] else { return (interior, 0.0, false, (0, 0)) };
             let mut previous = f64::INFINITY;
             loop {
                 let input = input_of(p, domain, seg, interior);
                 if !limit.admit(p, &input) {
                     // The output could not hold this pattern; the plan is refused at the end.
-                    return (interior, f64::INFINITY, true);
+                    return (interior, f64::INFINITY, true, (0, 0));
                 }
                 let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
                 // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
                 // its triangles (not with a Taylor bound, which needs their places).
                 let small = |table: &mut super::pattern_shapes::PatternShapes| {
                     let data = table.get(generation, limit.pattern, &input)?;
-                    Some(match data.grid {
+                    let bound = match data.grid {
                         Some(cells) => grid_bound(&errors[p], None, cells),
                         None => {
                             let core = core_bound(&errors[p], None, data.core);
                             shapes_bound(&errors[p], data.shapes.iter().copied(), core)
                         }
-                    })
+                    };
+                    Some((bound, data.counts))
                 };
                 let small =
                     taylor.is_none().then(|| super::pattern_shapes::with_pattern_shapes(small)).flatten();
+                let counts = || small.map_or_else(|| limit.pattern.counts(&input), |s| s.1);
                 let bound = match small {
-                    Some(bound) => bound,
+                    Some((bound, _)) => bound,
                     None => {
                         let cached = patterns.params(i).filter(|_| interior == first);
                         match (limit.pattern.grid_cells(&input), cached) {
@@ -1002,12 +1026,12 @@ fn check_patches(
                     }
                 };
                 if bound <= e * (1.0 + 1e-9) {
-                    return (interior, bound, false);
+                    return (interior, bound, false, counts());
                 }
                 // No progress means the worst triangles follow the edges, not the core.
                 let stuck = bound >= previous * (1.0 - 1e-9);
                 if layout == InteriorRule::Global || interior[0].max(interior[1]) >= cap || stuck {
-                    return (interior, bound, true);
+                    return (interior, bound, true, counts());
                 }
                 previous = bound;
                 let grow = (bound / e).sqrt().max(1.05);

@@ -86,13 +86,28 @@ impl Layout {
         pattern: &dyn Pattern,
         options: &EngineOptions,
     ) -> Result<()> {
+        self.build_counted(set, plan, pattern, options, None)
+    }
+
+    /// [`Layout::build`] with the pattern counts of every patch given where the planner
+    /// found them (`counts[p]`: [`Pattern::counts`] of patch `p`'s pattern input, zero for a
+    /// culled patch; the a-posteriori check's, [`crate::criterion::PlanScratch::plan_counts`]),
+    /// so that no patch's input is gathered and counted again.
+    pub(crate) fn build_counted(
+        &mut self,
+        set: &SurfaceSet,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        options: &EngineOptions,
+        counts: Option<&[(u32, u32)]>,
+    ) -> Result<()> {
         plan.check(set)?;
         let topo = &set.topology;
         self.corners = topo.corner_entries.len() as u32;
         if let (Some(_), Some(_), false) = (topo.one_shape, plan.one_factor(), pattern.depends_on_patch()) {
             return self.build_one_input(set, plan, pattern, options);
         }
-        self.build_general(set, plan, pattern, options)
+        self.build_general(set, plan, pattern, options, counts.filter(|c| c.len() == set.patches.len()))
     }
 
     /// [`Layout::build`] for any plan: a count per visible patch, then the scans.
@@ -102,6 +117,7 @@ impl Layout {
         plan: &Plan,
         pattern: &dyn Pattern,
         options: &EngineOptions,
+        counts: Option<&[(u32, u32)]>,
     ) -> Result<()> {
         let topo = &set.topology;
         // Edges: inner samples per variant; none for collapsed edges or edges seen by no
@@ -127,27 +143,16 @@ impl Layout {
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
-        // Neighbouring patches often share an input: each task keeps its last count.
-        (0..set.patches.len())
-            .into_par_iter()
-            .map_init(
-                || None,
-                |last: &mut Option<(PatternInput, (u32, u32))>, p| {
-                    if !plan.is_visible(p) {
-                        return (0, 0);
-                    }
-                    let input = PatternInput { patch: 0, ..pattern_input(set, plan, p) };
-                    match *last {
-                        Some((seen, counts)) if seen == input && !pattern.depends_on_patch() => counts,
-                        _ => {
-                            let counts = pattern.counts(&PatternInput { patch: p as u32, ..input });
-                            *last = Some((input, counts));
-                            counts
-                        }
-                    }
-                },
-            )
-            .collect_into_vec(&mut self.counts);
+        if let Some(counts) = counts {
+            debug_assert!((0..set.patches.len()).all(|p| {
+                counts[p]
+                    == if plan.is_visible(p) { pattern.counts(&pattern_input(set, plan, p)) } else { (0, 0) }
+            }));
+            self.counts.clear();
+            self.counts.extend_from_slice(counts);
+        } else {
+            self.count_patterns(set, plan, pattern);
+        }
         let interior: u64 = self.counts.iter().map(|c| c.0 as u64).sum();
         let upper: u64 = self.counts.iter().map(|c| c.1 as u64).sum();
         check_size(total + interior, upper, options)?;
@@ -187,6 +192,31 @@ impl Layout {
         self.triangle_offsets.push(triangles);
         self.collapsed_triangles = upper - triangles as u64;
         Ok(())
+    }
+
+    /// Every patch's pattern counts into `self.counts` (zero for culled patches).
+    /// Neighbouring patches often share an input: each task keeps its last count.
+    fn count_patterns(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) {
+        (0..set.patches.len())
+            .into_par_iter()
+            .map_init(
+                || None,
+                |last: &mut Option<(PatternInput, (u32, u32))>, p| {
+                    if !plan.is_visible(p) {
+                        return (0, 0);
+                    }
+                    let input = PatternInput { patch: 0, ..pattern_input(set, plan, p) };
+                    match *last {
+                        Some((seen, counts)) if seen == input && !pattern.depends_on_patch() => counts,
+                        _ => {
+                            let counts = pattern.counts(&PatternInput { patch: p as u32, ..input });
+                            *last = Some((input, counts));
+                            counts
+                        }
+                    }
+                },
+            )
+            .collect_into_vec(&mut self.counts);
     }
 }
 
@@ -379,7 +409,7 @@ mod tests {
                     let (mut fast, mut general) = (Layout::default(), Layout::default());
                     fast.build(&set, &plan, pattern, &options).unwrap();
                     general.corners = fast.corners;
-                    general.build_general(&set, &plan, pattern, &options).unwrap();
+                    general.build_general(&set, &plan, pattern, &options, None).unwrap();
                     assert_eq!(fast.edge_offsets, general.edge_offsets);
                     assert_eq!(fast.interior_offsets, general.interior_offsets);
                     assert_eq!(fast.triangle_offsets, general.triangle_offsets);
