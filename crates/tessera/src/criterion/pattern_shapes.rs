@@ -77,7 +77,8 @@ impl PatternShapes {
             data.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
             // Unstable: a stable sort allocates its scratch, and the order of equal keys does not
             // change the largest bound.
-            data.shapes.sort_unstable_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
+            data.shapes
+                .sort_unstable_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
         })?;
         Some(data)
     }
