@@ -91,10 +91,7 @@ thread_local! {
 /// Runs `f` with this thread's table (a fresh one if the thread's is in use further up its
 /// stack, as when rayon runs another task inside a join).
 pub(crate) fn with_pattern_shapes<R>(f: impl FnOnce(&mut PatternShapes) -> R) -> R {
-    SHAPES.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut shapes) => f(&mut shapes),
-        Err(_) => f(&mut PatternShapes::default()),
-    })
+    crate::pattern::cache::with_thread_table(&SHAPES, f)
 }
 
 #[cfg(test)]

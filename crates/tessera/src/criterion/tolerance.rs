@@ -984,7 +984,7 @@ fn check_patches(
                 let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
                 // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
                 // its triangles (not with a Taylor bound, which needs their places).
-                let small = |table: &mut super::pattern_shapes::PatternShapes| {
+                let from_table = |table: &mut super::pattern_shapes::PatternShapes| {
                     let data = table.get(generation, limit.pattern, &input)?;
                     let bound = match data.grid {
                         Some(cells) => grid_bound(&errors[p], None, cells),
@@ -995,8 +995,10 @@ fn check_patches(
                     };
                     Some((bound, data.counts))
                 };
-                let small =
-                    taylor.is_none().then(|| super::pattern_shapes::with_pattern_shapes(small)).flatten();
+                let small = taylor
+                    .is_none()
+                    .then(|| super::pattern_shapes::with_pattern_shapes(from_table))
+                    .flatten();
                 let counts = || small.map_or_else(|| limit.pattern.counts(&input), |s| s.1);
                 let bound = match small {
                     Some((bound, _)) => bound,

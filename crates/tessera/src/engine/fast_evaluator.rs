@@ -245,32 +245,31 @@ impl<'a> FastEvaluator<'a> {
             && self.points.grid_patch(topo.edge_uses(e)[0].patch as usize).is_some()
     }
 
-    /// The interior grid `[nu, nv]` of patch `p` with `input` when it is this evaluator's: a
-    /// quad with a grid form whose pattern promises a grid of factors with tables.
+    /// [`FastEvaluator::covers_grid`] asking `pattern` for the grid.
+    #[cfg(test)]
     pub(crate) fn covers_patch(
         &self,
         p: usize,
         pattern: &dyn Pattern,
         input: &PatternInput,
     ) -> Option<[u32; 2]> {
-        if input.domain != Domain::Quad || self.points.grid_patch(p).is_none() {
-            return None;
-        }
-        self.covers_grid(p, input, pattern.interior_grid(input))
+        self.covers_grid(p, input, || pattern.interior_grid(input))
     }
 
-    /// [`FastEvaluator::covers_patch`] where the pattern's [`Pattern::interior_grid`] of
-    /// `input` is known (`grid`).
+    /// The interior grid `[nu, nv]` of patch `p` with `input` when it is this evaluator's: a
+    /// quad with a grid form whose pattern promises a grid (its [`Pattern::interior_grid`] of
+    /// `input`, from `grid`, asked only of such a quad: a built pattern knows it) of factors
+    /// with tables.
     pub(crate) fn covers_grid(
         &self,
         p: usize,
         input: &PatternInput,
-        grid: Option<[u32; 2]>,
+        grid: impl FnOnce() -> Option<[u32; 2]>,
     ) -> Option<[u32; 2]> {
         if input.domain != Domain::Quad || self.points.grid_patch(p).is_none() {
             return None;
         }
-        let grid = grid?;
+        let grid = grid()?;
         (self.factor(grid[0] as usize).is_some() && self.factor(grid[1] as usize).is_some()).then_some(grid)
     }
 
@@ -378,10 +377,10 @@ impl<'a> FastEvaluator<'a> {
     }
 
     /// Evaluates the interior of patch `p` on the grid `[nu, nv]` (precondition: the grid
-    /// [`FastEvaluator::covers_patch`] gave): the `(nu − 1)(nv − 1)` grid points, row after
+    /// [`FastEvaluator::covers_grid`] gave): the `(nu − 1)(nv − 1)` grid points, row after
     /// row.
     pub(crate) fn interior(&self, p: usize, grid: [u32; 2], out: VertexSlices<'_>) {
-        let [tu, tv] = grid.map(|n| self.factor(n as usize).expect("covers_patch checked the factors"));
+        let [tu, tv] = grid.map(|n| self.factor(n as usize).expect("covers_grid checked the factors"));
         if self.avx2_fma {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).

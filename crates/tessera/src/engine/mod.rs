@@ -758,9 +758,8 @@ impl Writer<'_> {
         };
         // A patch without interior vertices (most, in a distant view) asks no evaluator.
         let fast = self.fast.filter(|_| !interior.is_empty());
-        let covers = |f: &fast_evaluator::FastEvaluator<'_>| match grid {
-            Some(grid) => f.covers_grid(p, &input, grid),
-            None => f.covers_patch(p, self.pattern, &input),
+        let covers = |f: &fast_evaluator::FastEvaluator<'_>| {
+            f.covers_grid(p, &input, || grid.unwrap_or_else(|| self.pattern.interior_grid(&input)))
         };
         match fast.map(|f| (f, covers(f))) {
             Some((f, Some(grid))) => f.interior(p, grid, verts),

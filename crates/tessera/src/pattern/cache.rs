@@ -394,7 +394,7 @@ const SMALL_INPUT_FACTOR: u32 = 8;
 const SMALL_FACTOR_BITS: u32 = 3;
 
 /// Bits of [`small_input_index`]: the domain, four edges and two interior factors.
-pub(crate) const SMALL_INPUT_INDEX_BITS: u32 = 1 + 6 * SMALL_FACTOR_BITS;
+const SMALL_INPUT_INDEX_BITS: u32 = 1 + 6 * SMALL_FACTOR_BITS;
 
 /// A number below `2^SMALL_INPUT_INDEX_BITS` for each input of a small pattern, the same for
 /// inputs that differ only in their patch: a table of small patterns is then a direct read,
@@ -462,25 +462,19 @@ impl RecentPatterns {
         params: bool,
     ) -> &RecentPattern {
         let reusable = !pattern.depends_on_patch();
+        let key = (generation, PatternInput { patch: 0, ..*input });
         if let Some(index) = small_input_index(input).filter(|_| reusable) {
-            let built = self.small.get_or_build(generation, index, |built: &mut RecentPattern| {
-                pattern.build(input, &mut built.local);
-                built.key = Some((generation, PatternInput { patch: 0, ..*input }));
-                built.with_params = false;
-                built.interior_grid = pattern.interior_grid(input);
-            });
+            let built = self
+                .small
+                .get_or_build(generation, index, |b: &mut RecentPattern| b.build(pattern, input, Some(key)));
             if let Some(slot) = built {
-                if params && !slot.with_params {
-                    boundary_params(input, &mut slot.params);
-                    slot.with_params = true;
-                }
+                slot.with_params(input, params);
                 return slot;
             }
         }
         if self.slots.is_empty() {
             self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
         }
-        let key = (generation, PatternInput { patch: 0, ..*input });
         let index = match reusable {
             true if self.slots[self.last].key == Some(key) => self.last,
             true => input_hash(input) as usize % RECENT_PATTERNS,
@@ -489,16 +483,28 @@ impl RecentPatterns {
         self.last = index;
         let slot = &mut self.slots[index];
         if !reusable || slot.key != Some(key) {
-            pattern.build(input, &mut slot.local);
-            slot.key = reusable.then_some(key);
-            slot.with_params = false;
-            slot.interior_grid = pattern.interior_grid(input);
+            slot.build(pattern, input, reusable.then_some(key));
         }
-        if params && !slot.with_params {
-            boundary_params(input, &mut slot.params);
-            slot.with_params = true;
-        }
+        slot.with_params(input, params);
         slot
+    }
+}
+
+impl RecentPattern {
+    /// Builds `input`'s pattern here, for `key` (None: not to be reused).
+    fn build(&mut self, pattern: &dyn Pattern, input: &PatternInput, key: Option<(u64, PatternInput)>) {
+        pattern.build(input, &mut self.local);
+        self.key = key;
+        self.with_params = false;
+        self.interior_grid = pattern.interior_grid(input);
+    }
+
+    /// Finds the parameters of the local vertices, with `params`, unless they are here.
+    fn with_params(&mut self, input: &PatternInput, params: bool) {
+        if params && !self.with_params {
+            boundary_params(input, &mut self.params);
+            self.with_params = true;
+        }
     }
 }
 
@@ -594,9 +600,18 @@ thread_local! {
 /// further up its stack, as when rayon runs another task inside a join). The a-posteriori
 /// error check builds through it; the engine keeps its own in its per-thread scratch.
 pub(crate) fn with_recent_patterns<R>(f: impl FnOnce(&mut RecentPatterns) -> R) -> R {
-    RECENT.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut recent) => f(&mut recent),
-        Err(_) => f(&mut RecentPatterns::default()),
+    with_thread_table(&RECENT, f)
+}
+
+/// Runs `f` with this thread's `table` (a fresh one if the thread's is in use further up its
+/// stack, as when rayon runs another task inside a join).
+pub(crate) fn with_thread_table<T: Default, R>(
+    table: &'static std::thread::LocalKey<std::cell::RefCell<T>>,
+    f: impl FnOnce(&mut T) -> R,
+) -> R {
+    table.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut table) => f(&mut table),
+        Err(_) => f(&mut T::default()),
     })
 }
 
