@@ -554,8 +554,8 @@ impl Writer<'_> {
             // has no grid form; an owner's run is of edges off the grid kernels), and asking
             // whether an edge starts a run was most of the time a coarse frame's edges took
             // beside their kernels.
-            if let Some(f) = self.fast.filter(|f| f.covers_edge(self.plan, e)) {
-                f.edge(self.plan, e, out.take_front((offsets[e + 1] - offsets[e]) as usize));
+            let inner = (offsets[e + 1] - offsets[e]) as usize;
+            if self.fast.is_some_and(|f| f.edge(self.plan, e, inner, &mut out)) {
                 continue;
             }
             if let Some(end) = self.tree_run(e, edges.end) {

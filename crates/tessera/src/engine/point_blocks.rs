@@ -419,6 +419,13 @@ pub(crate) enum GridPatch<'a> {
     Rational(&'a LocalPatch<4>),
 }
 
+/// Where a patch's local bicubic form lies among [`PointBlocks`]' forms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct GridFormKey {
+    pub rational: bool,
+    pub index: u32,
+}
+
 /// Every patch of a set in its local frame, made once per set: a table of eight bytes a
 /// patch and each kind's forms in patch order. Cost: O(P) to build, 200–400 bytes a patch
 /// (an isolated Loop patch: 476 bytes a leaf of its tree).
@@ -1004,6 +1011,26 @@ impl PointBlocks {
             FormRef::Bicubic(local) => Some(GridPatch::Polynomial(local)),
             FormRef::Rational(local) => Some(GridPatch::Rational(local)),
             FormRef::Triangle(_) | FormRef::Quartic(_) => None,
+        }
+    }
+
+    /// Where patch `p`'s local bicubic form lies, where it is a bicubic that has one: a key
+    /// for [`PointBlocks::grid_form`], which reads the form without asking the per-patch
+    /// table again.
+    pub(crate) fn grid_form_key(&self, p: usize) -> Option<GridFormKey> {
+        match self.locals[p] {
+            Local::Bicubic(i) => Some(GridFormKey { rational: false, index: i }),
+            Local::Rational(i) => Some(GridFormKey { rational: true, index: i }),
+            _ => None,
+        }
+    }
+
+    /// The local bicubic form at `key` ([`PointBlocks::grid_form_key`]).
+    #[inline(always)]
+    pub(crate) fn grid_form(&self, key: GridFormKey) -> GridPatch<'_> {
+        match key.rational {
+            false => GridPatch::Polynomial(&self.bicubics[key.index as usize]),
+            true => GridPatch::Rational(&self.rationals[key.index as usize]),
         }
     }
 
