@@ -352,6 +352,7 @@ impl<'a> VertexSlices<'a> {
     }
 
     /// Vertices `r`, borrowed.
+    #[inline(always)]
     fn range(&mut self, r: std::ops::Range<usize>) -> VertexSlices<'_> {
         VertexSlices {
             pos: &mut self.pos[r.clone()],
@@ -699,19 +700,13 @@ impl Writer<'_> {
             for p in patches.filter(|&p| self.plan.is_visible(p)) {
                 let t = (tris[p] - t0) as usize..(tris[p + 1] - t0) as usize;
                 let v = (verts[p] - v0) as usize..(verts[p + 1] - v0) as usize;
-                let part = PatchOut {
-                    verts: out.verts.range(v),
-                    idx: &mut out.idx[3 * t.start..3 * t.end],
-                    tp: &mut out.tp[t.clone()],
-                    params: if out.params.is_empty() {
-                        &mut []
-                    } else {
-                        &mut out.params[3 * t.start..3 * t.end]
-                    },
-                };
+                // The patch's part is cut from `out` by the callee: made here and passed by
+                // value, its slices went through the stack in two widths, and reading them
+                // back stalled on each patch (a coarse frame's patches loop spent about 4 %
+                // of the frame on that one load).
                 match pass {
-                    Pass::Vertices { stream } => self.patch_vertices(p, part, scratch, stream),
-                    Pass::Indices { stream } => self.patch_indices(p, part, scratch, stream),
+                    Pass::Vertices { stream } => self.patch_vertices(p, &mut out, (v, t), scratch, stream),
+                    Pass::Indices { stream } => self.patch_indices(p, &mut out, (v, t), scratch, stream),
                 }
             }
         });
@@ -740,8 +735,15 @@ impl Writer<'_> {
     /// corner parameters, and — unless the second pass can read the pattern from the cache —
     /// its kept triangles: mapped to output vertices with their triangle patches, or with
     /// `stream` as local indices left in its index range for the second pass.
-    fn patch_vertices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, stream: bool) {
-        let PatchOut { mut verts, idx, tp, params } = out;
+    fn patch_vertices(
+        &self,
+        p: usize,
+        out: &mut PatchOut<'_>,
+        (v, t): (std::ops::Range<usize>, std::ops::Range<usize>),
+        scratch: &mut PatchScratch,
+        stream: bool,
+    ) {
+        let PatchOut { mut verts, idx, tp, params } = out.part(v, t);
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let general = self.general(p, params);
         // The triangles in the general form need the whole pattern, core included.
@@ -849,8 +851,15 @@ impl Writer<'_> {
     /// numbering rule. Interior vertices are numbered in the same order locally and in the
     /// output, so every index maps by one addition (vectorized) and only boundary indices go
     /// through the patch's table.
-    fn patch_indices(&self, p: usize, out: PatchOut<'_>, scratch: &mut PatchScratch, stream: bool) {
-        let PatchOut { idx, tp, params, .. } = out;
+    fn patch_indices(
+        &self,
+        p: usize,
+        out: &mut PatchOut<'_>,
+        (v, t): (std::ops::Range<usize>, std::ops::Range<usize>),
+        scratch: &mut PatchScratch,
+        stream: bool,
+    ) {
+        let PatchOut { idx, tp, params, .. } = out.part(v, t);
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let cached = self.cached(p).filter(|_| !self.general(p, params));
         let Some((input, cached)) = cached else {
@@ -917,6 +926,17 @@ impl<'a> VertexSlices<'a> {
 }
 
 impl<'a> PatchOut<'a> {
+    /// Vertices `v` and triangles `t` of this output, borrowed.
+    #[inline(always)]
+    fn part(&mut self, v: std::ops::Range<usize>, t: std::ops::Range<usize>) -> PatchOut<'_> {
+        PatchOut {
+            verts: self.verts.range(v),
+            idx: &mut self.idx[3 * t.start..3 * t.end],
+            tp: &mut self.tp[t.clone()],
+            params: if self.params.is_empty() { &mut [] } else { &mut self.params[3 * t.start..3 * t.end] },
+        }
+    }
+
     /// Splits off the output of patches `start..end`.
     fn split_off_front(&mut self, end: usize, layout: &Layout, start: usize) -> PatchOut<'a> {
         let t = (layout.triangle_offsets[end] - layout.triangle_offsets[start]) as usize;
@@ -1048,7 +1068,24 @@ impl LocalMap<'_> {
         let nc = self.input.domain.corner_count();
         table.extend((0..nc).map(|c| self.corner_vertex(c)));
         for e in 0..nc {
-            table.extend((1..self.input.segments[e]).map(|k| self.edge_vertex(e, k)));
+            // `edge_vertex` of each sample, its edge's entries read once: the samples of one
+            // edge run by one through its output range, forwards or backwards.
+            let pe = self.set.topology.patch_edges[self.patch][e];
+            let inner = self.input.segments[e].saturating_sub(1);
+            if pe.collapsed {
+                let corner = self.corner_vertex(e);
+                table.extend((0..inner).map(|_| corner));
+                continue;
+            }
+            let edge = pe.edge as usize;
+            let segments = self.plan.segments(edge);
+            let first = self.layout.edge_vertex(edge, pe.variant as u32, segments, 1);
+            if pe.reversed {
+                // Sample k is canonical sample segments − k.
+                table.extend((1..=inner).map(|k| first + (segments - k) - 1));
+            } else {
+                table.extend((0..inner).map(|j| first + j));
+            }
         }
         let base = self.layout.interior_vertex(self.patch, 0);
         table.extend((0..interior as u32).map(|j| base + j));

@@ -462,11 +462,13 @@ impl RecentPatterns {
         params: bool,
     ) -> &RecentPattern {
         let reusable = !pattern.depends_on_patch();
-        let key = (generation, PatternInput { patch: 0, ..*input });
+        // The key is made where it is needed: a copy of the input on every call read back,
+        // just after the caller wrote it, stalled the load (different widths).
+        let key = || (generation, PatternInput { patch: 0, ..*input });
         if let Some(index) = small_input_index(input).filter(|_| reusable) {
-            let built = self
-                .small
-                .get_or_build(generation, index, |b: &mut RecentPattern| b.build(pattern, input, Some(key)));
+            let built = self.small.get_or_build(generation, index, |b: &mut RecentPattern| {
+                b.build(pattern, input, Some(key()))
+            });
             if let Some(slot) = built {
                 slot.with_params(input, params);
                 return slot;
@@ -475,6 +477,7 @@ impl RecentPatterns {
         if self.slots.is_empty() {
             self.slots.resize_with(RECENT_PATTERNS, RecentPattern::default);
         }
+        let key = key();
         let index = match reusable {
             true if self.slots[self.last].key == Some(key) => self.last,
             true => input_hash(input) as usize % RECENT_PATTERNS,
