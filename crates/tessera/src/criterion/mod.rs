@@ -108,6 +108,7 @@ pub struct Prepared {
     /// empty unless asked for.
     pub curves: Vec<[f64; 4]>,
     views: std::sync::OnceLock<Vec<screen::PatchView>>,
+    boxes: std::sync::OnceLock<Vec<[glam::DVec3; 2]>>,
     triangle_errors: std::sync::OnceLock<Vec<bounds::TriangleErrors>>,
     taylor: std::sync::OnceLock<Vec<taylor::TaylorBound>>,
     expansions: std::sync::OnceLock<Vec<taylor::TaylorBound>>,
@@ -128,6 +129,7 @@ impl Prepared {
             curves: if with_bounds { tolerance::curve_bounds(set, &hessians) } else { Vec::new() },
             hessians,
             views: Default::default(),
+            boxes: Default::default(),
             triangle_errors: Default::default(),
             taylor: Default::default(),
             expansions: Default::default(),
@@ -193,6 +195,14 @@ impl Prepared {
     pub fn views(&self, set: &SurfaceSet) -> &[screen::PatchView] {
         use rayon::prelude::*;
         self.views.get_or_init(|| set.patches.par_iter().map(screen::PatchView::new).collect())
+    }
+
+    /// Every patch's control-point box ([`screen::PatchView::bounding_box`]), computed on the
+    /// first call and kept beside the views: the pixel tolerance of every frame reads these
+    /// alone ([`screen::tolerances_into`]). Precondition as [`Prepared::views`]. Cost: the
+    /// first call O(P) (and the views, if not made yet); later calls nothing.
+    pub fn boxes(&self, set: &SurfaceSet) -> &[[glam::DVec3; 2]] {
+        self.boxes.get_or_init(|| self.views(set).iter().map(screen::PatchView::bounding_box).collect())
     }
 
     /// Position and normal of every topology vertex (the view criteria's data), computed on

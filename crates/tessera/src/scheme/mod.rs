@@ -384,6 +384,7 @@ impl Scheme {
                         screen::tolerances_into(
                             set,
                             prepared.views(set),
+                            prepared.boxes(set),
                             &camera.view(),
                             px,
                             options.cull,
