@@ -127,9 +127,12 @@ impl Layout {
         let edges = topo.edges.len();
         self.edge_offsets.clear();
         self.edge_offsets.resize(edges + 1, 0);
+        // Where nothing is culled every edge is seen: its uses are not read (one pass over
+        // the visibility row instead of a search of each edge's uses).
+        let all_visible = plan.visible.iter().fold(true, |all, &v| all & (v != 0));
         self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024).for_each(
             |(e, (count, edge))| {
-                let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
+                let seen = all_visible || topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
                 *count =
                     if !edge.collapsed && seen { (plan.segments(e) - 1) * edge.variants as u32 } else { 0 };
             },
