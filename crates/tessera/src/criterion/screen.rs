@@ -254,8 +254,10 @@ pub fn tolerances(set: &SurfaceSet, camera: &Camera, pixels: f64, cull: bool) ->
     set.patches.par_iter().map(|p| patch_tolerance(p, camera, pixels, cull)).collect()
 }
 
-/// [`tolerances`] from prepared [`PatchView`]s (one per patch), into `out` (resized; no
-/// allocation once it has the capacity). Cost: O(P) box transforms, parallel.
+/// [`tolerances`] from prepared [`PatchView`]s and their boxes (`boxes[p]` is
+/// `views[p].bounding_box()`; one per patch), into `out` (resized; no allocation once it has
+/// the capacity). Without `cull` only the boxes are read. Cost: O(P) box transforms,
+/// parallel.
 pub fn tolerances_into(
     set: &SurfaceSet,
     views: &[PatchView],
@@ -275,8 +277,9 @@ pub fn tolerances_into(
             .for_each(|(o, &[lo, hi])| *o = Some(box_tolerance(lo, hi, camera, pixels)));
         return;
     }
-    out.par_iter_mut().zip(&set.patches).zip(views.par_iter().zip(boxes)).for_each(|((o, patch), (v, b))| {
-        *o = (!v.culled(patch, camera)).then(|| box_tolerance(b[0], b[1], camera, pixels));
+    // Culling reads the views; their own boxes serve.
+    out.par_iter_mut().zip(&set.patches).zip(views).for_each(|((o, patch), v)| {
+        *o = v.tolerance(patch, camera, pixels, cull);
     });
 }
 

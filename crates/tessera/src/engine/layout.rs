@@ -129,7 +129,7 @@ impl Layout {
         self.edge_offsets.resize(edges + 1, 0);
         // Where nothing is culled every edge is seen: its uses are not read (one pass over
         // the visibility row instead of a search of each edge's uses).
-        let all_visible = plan.visible.iter().fold(true, |all, &v| all & (v != 0));
+        let all_visible = plan.visible.iter().all(|&v| v != 0);
         self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024).for_each(
             |(e, (count, edge))| {
                 let seen = all_visible || topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
