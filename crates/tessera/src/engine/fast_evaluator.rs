@@ -6,7 +6,7 @@
 //! to frame.
 
 use super::point_blocks::{has_avx2_fma, GridFormKey, GridPatch, PointBlocks, LANES};
-use super::uniform_quads::{store, Basis, GridLine, Line, LocalPatch};
+use super::uniform_quads::{store, Basis, GridLanes, GridLine, Line, LocalPatch};
 use super::uniform_triangles::UniformTriangles;
 use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
@@ -76,6 +76,10 @@ struct GridEdge {
     form: Option<GridFormKey>,
 }
 
+/// Factors below this (both ways) may have [`GridLanes`]: a grid of at most [`LANES`]
+/// interior points with at least two rows has factors of at most 5 along `u` and 9 along `v`.
+const LANE_GRIDS: usize = 10;
+
 /// The evaluator: everything its tasks share. It evaluates every point the engine asks for,
 /// on the grid kernels of this module where the plan and pattern allow, on
 /// [`PointBlocks`] elsewhere.
@@ -110,6 +114,11 @@ pub(crate) struct FastEvaluator<'a> {
     /// Per edge, its owner and the owner's grid form where the grid kernels can take the
     /// edge ([`GridEdge`]).
     grid_edges: Vec<GridEdge>,
+    /// The lanes of each small grid `(nu, nv)` evaluated in one block ([`GridLanes`]), at
+    /// `nu · LANE_GRIDS + nv`, made with the factors' tables.
+    grid_lanes: Vec<Option<GridLanes>>,
+    /// The largest factor `grid_lanes` was made for.
+    lanes_top: usize,
     /// Every corner entry's vertex record, evaluated on first use, without and with the grid
     /// kernels (which evaluate corners in their own way): 36 bytes a corner.
     corners: [OnceLock<CornerRecords>; 2],
@@ -149,6 +158,8 @@ impl<'a> FastEvaluator<'a> {
             tables: Vec::new(),
             points,
             grid_edges,
+            grid_lanes: Vec::new(),
+            lanes_top: 0,
             patterns: PatternCache::default(),
             triangles: UniformTriangles::for_set(set),
             grid: false,
@@ -192,6 +203,20 @@ impl<'a> FastEvaluator<'a> {
             if tables.n != n {
                 tables.fill(n as u32);
             }
+        }
+        let top = max.min(LANE_GRIDS - 1);
+        if top > self.lanes_top {
+            // Factors 1 to `top` all have tables now, and a grid's lanes depend on its factors
+            // alone: made once, again only for a plan with larger factors than any before.
+            self.lanes_top = top;
+            self.grid_lanes = (0..LANE_GRIDS * LANE_GRIDS)
+                .map(|at| {
+                    let (nu, nv) = (at / LANE_GRIDS, at % LANE_GRIDS);
+                    (nu <= top && nv <= top)
+                        .then(|| GridLanes::new(&self.tables[nu].basis, &self.tables[nv].basis, nu, nv))
+                        .flatten()
+                })
+                .collect();
         }
         if max > DENSE {
             for n in plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()) {
@@ -259,6 +284,14 @@ impl<'a> FastEvaluator<'a> {
     /// The evaluator of arbitrary parameter lists.
     pub(crate) fn points(&self) -> &PointBlocks {
         &self.points
+    }
+
+    /// The lanes of the grid `(nu, nv)`, where it is one [`GridLanes`] takes.
+    fn grid_lanes(&self, nu: usize, nv: usize) -> Option<&GridLanes> {
+        if nu >= LANE_GRIDS || nv >= LANE_GRIDS {
+            return None;
+        }
+        self.grid_lanes.get(nu * LANE_GRIDS + nv)?.as_ref()
     }
 
     /// The tables of factor `n`, when made.
@@ -467,6 +500,25 @@ impl<'a> FastEvaluator<'a> {
         mut out: VertexSlices<'_>,
     ) {
         let m = tu.n - 1;
+        if let Some(lanes) = self.grid_lanes(tu.n, tv.n) {
+            // The whole interior in one block (a small grid of two rows or more).
+            debug_assert_eq!(out.pos.len(), m * (tv.n - 1));
+            let block = match self.local(p) {
+                GridPatch::Polynomial(local) => local.grid_block::<FMA>(lanes),
+                GridPatch::Rational(local) => local.grid_block::<FMA>(lanes),
+            };
+            let point = |l: usize| (1 + l % m, 1 + l / m);
+            block.write(out.pos, out.nrm, |l| {
+                let (i, j) = point(l);
+                self.exact(p, DVec2::new(tu.grid[i], tv.grid[j]))
+            });
+            for (l, uv) in out.uv.iter_mut().enumerate() {
+                let (i, j) = point(l);
+                *uv = [tu.grid32[i], tv.grid32[j]];
+            }
+            out.patch.fill(p as u32);
+            return;
+        }
         match self.local(p) {
             GridPatch::Polynomial(local) => {
                 for j in 1..tv.n {

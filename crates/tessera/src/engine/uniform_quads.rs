@@ -300,20 +300,36 @@ impl<const C: usize> Line<C> {
 
 /// The grid kernel of one form of patch: polynomial (`Line<3>`) or rational (`Line<4>`).
 pub(super) trait GridLine {
+    /// Each lane's sums: component values and derivatives along and across its line.
+    type Sums;
     /// Points `t0 .. t0 + LANES` of the grid along the line (past `n`, copies of point `n`),
     /// in the model's frame.
     fn block<const FMA: bool>(&self, basis: &Basis, t0: usize, origin: &[f32; 3], scale: f32) -> Block;
+    /// The points of lanes whose sums are `sums`, on rows (`column` false) or columns: what
+    /// [`GridLine::block`] does after the sums, lane by lane.
+    fn finish<const FMA: bool>(sums: Self::Sums, column: bool, origin: &[f32; 3], scale: f32) -> Block;
 }
 
 impl GridLine for Line<3> {
+    type Sums = [[[f32; LANES]; 3]; 3];
+
     #[inline(always)]
     fn block<const FMA: bool>(&self, basis: &Basis, t0: usize, origin: &[f32; 3], scale: f32) -> Block {
-        let [mut pos, along, across] = self.sums::<FMA>(basis, t0);
+        Self::finish::<FMA>(self.sums::<FMA>(basis, t0), self.column, origin, scale)
+    }
+
+    #[inline(always)]
+    fn finish<const FMA: bool>(
+        [mut pos, along, across]: Self::Sums,
+        column: bool,
+        origin: &[f32; 3],
+        scale: f32,
+    ) -> Block {
         // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column. Written as
         // whole-array lane loops, one quantity at a time, so that each becomes SIMD code. The
         // reliability rule is `point_blocks::cross_normals`'s; calling that function here
         // measured 1.4× slower in this kernel (torus, factor 16), so the loops stay inline.
-        let sign = if self.column { -1.0 } else { 1.0 };
+        let sign = if column { -1.0 } else { 1.0 };
         let ([ax, ay, az], [cx, cy, cz]) = (along, across);
         let mut nrm = [[0f32; LANES]; 3];
         let [nx, ny, nz] = &mut nrm;
@@ -342,15 +358,120 @@ impl GridLine for Line<3> {
 }
 
 impl GridLine for Line<4> {
+    type Sums = [[[f32; LANES]; 4]; 3];
+
     #[inline(always)]
     fn block<const FMA: bool>(&self, basis: &Basis, t0: usize, origin: &[f32; 3], scale: f32) -> Block {
-        let [h, h_along, h_across] = self.sums::<FMA>(basis, t0);
+        Self::finish::<FMA>(self.sums::<FMA>(basis, t0), self.column, origin, scale)
+    }
+
+    #[inline(always)]
+    fn finish<const FMA: bool>(
+        [h, h_along, h_across]: Self::Sums,
+        column: bool,
+        origin: &[f32; 3],
+        scale: f32,
+    ) -> Block {
         let [mut pos, along, across] = rational_quotient::<FMA, LANES>(&h, &h_along, &h_across);
         // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column.
         let (nrm, margin) =
-            if self.column { cross_normals(&across, &along) } else { cross_normals(&along, &across) };
+            if column { cross_normals(&across, &along) } else { cross_normals(&along, &across) };
         to_model::<FMA, LANES>(&mut pos, origin, scale);
         Block { pos, nrm, margin }
+    }
+}
+
+/// The interior of a small grid of factors `(nu, nv)`, `nv ≥ 3`, at most [`LANES`] points, in
+/// one block: lane `l` is grid point `(1 + l % (nu − 1), 1 + l / (nu − 1))`, the interior's
+/// order. Each lane holds the basis values of its own point: along `v` to form its row's
+/// curve, along `u` to evaluate it.
+///
+/// Why: a coarse frame's grids have one to three points a row (the Catmull-Clark torus at
+/// 0.5 px: 2×3, 2×4, 3×3), and a block of lanes a row spent most of its lanes on padding and
+/// its setup on a point or two. The rows' curves are formed in the lanes by the operations
+/// [`LocalPatch::row`] does, each lane on its own, so every point keeps its bits.
+pub(super) struct GridLanes {
+    /// `bv[k][l] = B_k(v_l)`, `dv[k][l] = B_k'(v_l)`, likewise `bu`, `du` along `u`.
+    bv: [[f32; LANES]; 4],
+    dv: [[f32; LANES]; 4],
+    bu: [[f32; LANES]; 4],
+    du: [[f32; LANES]; 4],
+}
+
+impl GridLanes {
+    /// The lanes of the grid `(nu, nv)` from the factors' bases; None unless `nv ≥ 3` and the
+    /// grid has at least one and at most [`LANES`] interior points. Lanes past the last point
+    /// repeat it (a real point, which does not spoil [`Block::all_ok`]).
+    pub(super) fn new(u: &Basis, v: &Basis, nu: usize, nv: usize) -> Option<GridLanes> {
+        let m = nu.checked_sub(1)?;
+        let count = m * nv.checked_sub(1)?;
+        if nv < 3 || m == 0 || count > LANES {
+            return None;
+        }
+        let mut lanes = GridLanes {
+            bv: [[0.0; LANES]; 4],
+            dv: [[0.0; LANES]; 4],
+            bu: [[0.0; LANES]; 4],
+            du: [[0.0; LANES]; 4],
+        };
+        for l in 0..LANES {
+            let p = l.min(count - 1);
+            let (i, j) = (1 + p % m, 1 + p / m);
+            for k in 0..4 {
+                lanes.bv[k][l] = v.b[k][j];
+                lanes.dv[k][l] = v.d[k][j];
+                lanes.bu[k][l] = u.b[k][i];
+                lanes.du[k][l] = u.d[k][i];
+            }
+        }
+        Some(lanes)
+    }
+}
+
+impl<const C: usize> LocalPatch<C> {
+    /// The interior points of the grid `lanes` describes ([`GridLanes`]), in the model's
+    /// frame: lane for lane the bits of [`LocalPatch::row`] of the point's row and
+    /// [`GridLine::block`] at its column. Cost: one block, and the rows' curves formed in the
+    /// lanes (4·4·C multiplications and additions each way).
+    // Index loops mirror `Line::new`'s and `Line::sums`'s (and vectorize over the lanes).
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub(super) fn grid_block<const FMA: bool>(&self, lanes: &GridLanes) -> Block
+    where
+        Line<C>: GridLine<Sums = [[[f32; LANES]; C]; 3]>,
+    {
+        // Each lane's row curve, as `Line::new` sums it: over `k` from 0.0, a product then a
+        // sum each (never fused).
+        let mut c = [[[0f32; LANES]; 4]; C];
+        let mut d = [[[0f32; LANES]; 4]; C];
+        for comp in 0..C {
+            for k in 0..4 {
+                let (b, db) = (&lanes.bv[k], &lanes.dv[k]);
+                for t in 0..4 {
+                    let q = self.by_v[comp][k][t];
+                    for l in 0..LANES {
+                        c[comp][t][l] += q * b[l];
+                        d[comp][t][l] += q * db[l];
+                    }
+                }
+            }
+        }
+        // Each lane's point on its curve, as `Line::sums` sums it.
+        let mut pos = [[0f32; LANES]; C];
+        let mut along = [[0f32; LANES]; C];
+        let mut across = [[0f32; LANES]; C];
+        for k in 0..4 {
+            let (b, db) = (&lanes.bu[k], &lanes.du[k]);
+            for comp in 0..C {
+                let (ck, dk) = (&c[comp][k], &d[comp][k]);
+                for l in 0..LANES {
+                    pos[comp][l] = madd::<FMA>(b[l], ck[l], pos[comp][l]);
+                    along[comp][l] = madd::<FMA>(db[l], ck[l], along[comp][l]);
+                    across[comp][l] = madd::<FMA>(b[l], dk[l], across[comp][l]);
+                }
+            }
+        }
+        Line::<C>::finish::<FMA>([pos, along, across], false, &self.origin, self.scale)
     }
 }
 
@@ -462,6 +583,74 @@ mod tests {
             check(&rational, &mut basis);
         }
     }
+    /// A small grid's interior in one block ([`LocalPatch::grid_block`]) is, lane for lane,
+    /// the row-by-row kernel's (its row's line, then a block along it), bit for bit: on
+    /// polynomial and rational nets with zeros of both signs, with and without fused
+    /// multiply-adds, for every grid [`GridLanes`] takes (and it takes no other).
+    #[test]
+    fn a_small_grids_block_is_its_rows_bit_for_bit() {
+        fn bits(block: &Block, l: usize) -> [u32; 7] {
+            let b = |x: f32| x.to_bits();
+            let (p, n) = (&block.pos, &block.nrm);
+            [p[0][l], p[1][l], p[2][l], n[0][l], n[1][l], n[2][l], block.margin[l]].map(b)
+        }
+        fn check<const C: usize, const FMA: bool>(patch: &LocalPatch<C>, bases: &[Basis]) -> usize
+        where
+            Line<C>: GridLine<Sums = [[[f32; LANES]; C]; 3]>,
+        {
+            let mut grids = 0;
+            for nu in 1..bases.len() {
+                for nv in 1..bases.len() {
+                    let (u, v) = (&bases[nu], &bases[nv]);
+                    let Some(lanes) = GridLanes::new(u, v, nu, nv) else {
+                        assert!(nv < 3 || nu < 2 || (nu - 1) * (nv - 1) > LANES, "({nu}, {nv})");
+                        continue;
+                    };
+                    grids += 1;
+                    let block = patch.grid_block::<FMA>(&lanes);
+                    let m = nu - 1;
+                    for l in 0..m * (nv - 1) {
+                        let (i, j) = (1 + l % m, 1 + l / m);
+                        let row = patch.row(v, j).block::<FMA>(u, i, &patch.origin, patch.scale);
+                        assert_eq!(bits(&block, l), bits(&row, 0), "({nu}, {nv}), point ({i}, {j})");
+                    }
+                }
+            }
+            grids
+        }
+        let bases: Vec<Basis> = (0..12)
+            .map(|n| {
+                let mut b = Basis::default();
+                b.refill(n.max(1));
+                b
+            })
+            .collect();
+        let mut rng = crate::test_support::Lcg(9);
+        for round in 0..100 {
+            let mut net = [DVec3::ZERO; 16];
+            for q in net.iter_mut() {
+                *q = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - 1.0;
+            }
+            let mut polynomial = LocalPatch::from_net(&net);
+            if round % 2 == 0 {
+                for (k, x) in polynomial.by_v.iter_mut().flatten().flatten().enumerate() {
+                    match k % 5 {
+                        0 => *x = 0.0,
+                        1 => *x = -0.0,
+                        _ => {}
+                    }
+                }
+            }
+            let weights: [f64; 16] = std::array::from_fn(|_| 0.5 + rng.unit());
+            let rational = LocalPatch::<4>::in_frame(&net, local_frame(&net), |k| weights[k]);
+            // (2, 3) to (2, 9), (3, 3) to (3, 5), (4, 3), (5, 3).
+            assert_eq!(check::<3, false>(&polynomial, &bases), 12);
+            assert_eq!(check::<3, true>(&polynomial, &bases), 12);
+            assert_eq!(check::<4, false>(&rational, &bases), 12);
+            assert_eq!(check::<4, true>(&rational, &bases), 12);
+        }
+    }
+
     use crate::criterion::Plan;
     use crate::engine::{write_with, EngineOptions, Layout};
     use crate::mesh::Mesh;
