@@ -562,26 +562,32 @@ mod tests {
         let mut rng = crate::test_support::Lcg(5);
         let mut basis = Basis::default();
         for round in 0..200 {
-            let mut net = [DVec3::ZERO; 16];
-            for q in net.iter_mut() {
-                *q = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - 1.0;
-            }
-            let mut polynomial = LocalPatch::from_net(&net);
-            // Zeros of both signs, where the sums' `0.0 +` decides the sign.
-            if round % 2 == 0 {
-                for (k, x) in polynomial.by_v.iter_mut().flatten().flatten().enumerate() {
-                    match k % 5 {
-                        0 => *x = 0.0,
-                        1 => *x = -0.0,
-                        _ => {}
-                    }
-                }
-            }
+            let (polynomial, rational) = random_nets(&mut rng, round % 2 == 0);
             check(&polynomial, &mut basis);
-            let weights: [f64; 16] = std::array::from_fn(|_| 0.5 + rng.unit());
-            let rational = LocalPatch::<4>::in_frame(&net, local_frame(&net), |k| weights[k]);
             check(&rational, &mut basis);
         }
+    }
+
+    /// A random net in `[-1, 1]³` as a polynomial patch (with `zeros`, zeros of both signs
+    /// among its points, where sums from `0.0` decide the sign) and, weighted in `[0.5, 1.5]`,
+    /// as a rational one.
+    fn random_nets(rng: &mut crate::test_support::Lcg, zeros: bool) -> (LocalPatch<3>, LocalPatch<4>) {
+        let mut net = [DVec3::ZERO; 16];
+        for q in net.iter_mut() {
+            *q = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - 1.0;
+        }
+        let mut polynomial = LocalPatch::from_net(&net);
+        if zeros {
+            for (k, x) in polynomial.by_v.iter_mut().flatten().flatten().enumerate() {
+                match k % 5 {
+                    0 => *x = 0.0,
+                    1 => *x = -0.0,
+                    _ => {}
+                }
+            }
+        }
+        let weights: [f64; 16] = std::array::from_fn(|_| 0.5 + rng.unit());
+        (polynomial, LocalPatch::<4>::in_frame(&net, local_frame(&net), |k| weights[k]))
     }
     /// A small grid's interior in one block ([`LocalPatch::grid_block`]) is, lane for lane,
     /// the row-by-row kernel's (its row's line, then a block along it), bit for bit: on
@@ -627,22 +633,7 @@ mod tests {
             .collect();
         let mut rng = crate::test_support::Lcg(9);
         for round in 0..100 {
-            let mut net = [DVec3::ZERO; 16];
-            for q in net.iter_mut() {
-                *q = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - 1.0;
-            }
-            let mut polynomial = LocalPatch::from_net(&net);
-            if round % 2 == 0 {
-                for (k, x) in polynomial.by_v.iter_mut().flatten().flatten().enumerate() {
-                    match k % 5 {
-                        0 => *x = 0.0,
-                        1 => *x = -0.0,
-                        _ => {}
-                    }
-                }
-            }
-            let weights: [f64; 16] = std::array::from_fn(|_| 0.5 + rng.unit());
-            let rational = LocalPatch::<4>::in_frame(&net, local_frame(&net), |k| weights[k]);
+            let (polynomial, rational) = random_nets(&mut rng, round % 2 == 0);
             // (2, 3) to (2, 9), (3, 3) to (3, 5), (4, 3), (5, 3).
             assert_eq!(check::<3, false>(&polynomial, &bases), 12);
             assert_eq!(check::<3, true>(&polynomial, &bases), 12);
