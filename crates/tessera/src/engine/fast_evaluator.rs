@@ -6,7 +6,7 @@
 //! to frame.
 
 use super::point_blocks::{has_avx2_fma, GridFormKey, GridPatch, PointBlocks, LANES};
-use super::uniform_quads::{store, Basis, GridLanes, GridLine, Line, LocalPatch};
+use super::uniform_quads::{store, Basis, EdgePairLanes, GridLanes, GridLine, Line, LocalPatch};
 use super::uniform_triangles::UniformTriangles;
 use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
@@ -80,6 +80,13 @@ struct GridEdge {
 /// interior points with at least two rows has factors of at most 5 along `u` and 9 along `v`.
 const LANE_GRIDS: usize = 10;
 
+/// Where the lanes of a pair of edges of factors `na`, `nb` (lines against them where
+/// `flip_a`, `flip_b`) lie in [`FastEvaluator`]'s `edge_pairs`; None for factors without.
+fn edge_pair_at((na, flip_a): (usize, bool), (nb, flip_b): (usize, bool)) -> Option<usize> {
+    (na < LANE_GRIDS && nb < LANE_GRIDS)
+        .then(|| (2 * na + usize::from(flip_a)) * 2 * LANE_GRIDS + 2 * nb + usize::from(flip_b))
+}
+
 /// The evaluator: everything its tasks share. It evaluates every point the engine asks for,
 /// on the grid kernels of this module where the plan and pattern allow, on
 /// [`PointBlocks`] elsewhere.
@@ -117,7 +124,10 @@ pub(crate) struct FastEvaluator<'a> {
     /// The lanes of each small grid `(nu, nv)` evaluated in one block ([`GridLanes`]), at
     /// `nu · LANE_GRIDS + nv`, made with the factors' tables.
     grid_lanes: Vec<Option<GridLanes>>,
-    /// The largest factor `grid_lanes` was made for.
+    /// The lanes of each pair of edges evaluated in one block ([`EdgePairLanes`]), at
+    /// [`edge_pair_at`] of their factors and directions, made with the factors' tables.
+    edge_pairs: Vec<Option<EdgePairLanes>>,
+    /// The largest factor `grid_lanes` and `edge_pairs` were made for.
     lanes_top: usize,
     /// Every corner entry's vertex record, evaluated on first use, without and with the grid
     /// kernels (which evaluate corners in their own way): 36 bytes a corner.
@@ -159,6 +169,7 @@ impl<'a> FastEvaluator<'a> {
             points,
             grid_edges,
             grid_lanes: Vec::new(),
+            edge_pairs: Vec::new(),
             lanes_top: 0,
             patterns: PatternCache::default(),
             triangles: UniformTriangles::for_set(set),
@@ -216,6 +227,13 @@ impl<'a> FastEvaluator<'a> {
                         .then(|| GridLanes::new(&self.tables[nu].basis, &self.tables[nv].basis, nu, nv))
                         .flatten()
                 })
+                .collect();
+            let edge = |at: usize| {
+                let (n, flip) = (at / 2, at % 2 == 1);
+                (n <= top).then(|| (&self.tables[n].basis, n, flip))
+            };
+            self.edge_pairs = (0..4 * LANE_GRIDS * LANE_GRIDS)
+                .map(|at| EdgePairLanes::new(edge(at / (2 * LANE_GRIDS))?, edge(at % (2 * LANE_GRIDS))?))
                 .collect();
         }
         if max > DENSE {
@@ -394,6 +412,94 @@ impl<'a> FastEvaluator<'a> {
         }
         self.edge_with::<false>(tables, owner, form, out);
         true
+    }
+
+    /// Evaluates the inner samples of edges `e` and `e + 1` (`inner` each: the layout's
+    /// counts) in one block into the front of `out` (taken off it), where both are this
+    /// evaluator's, one polynomial patch owns both, and their samples fill at most one block
+    /// ([`EdgePairLanes`]); says whether it did. The bits are those of
+    /// [`FastEvaluator::edge`] of each.
+    pub(crate) fn edge_pair(
+        &self,
+        plan: &Plan,
+        e: usize,
+        inner: [usize; 2],
+        out: &mut VertexSlices<'_>,
+    ) -> bool {
+        let (a, b) = (self.grid_edges[e], self.grid_edges[e + 1]);
+        let (Some(form), Some(form_b)) = (a.form, b.form) else { return false };
+        if form != form_b || form.rational || inner[0] == 0 || inner[1] == 0 {
+            return false;
+        }
+        let n = [plan.segments(e) as usize, plan.segments(e + 1) as usize];
+        let flip = |u: EdgeUse| u.reversed ^ (u.local >= 2);
+        let at = edge_pair_at((n[0], flip(a.owner)), (n[1], flip(b.owner)));
+        let Some(lanes) = at.and_then(|at| self.edge_pairs.get(at)?.as_ref()) else { return false };
+        let (Some(ta), Some(tb)) = (self.factor(n[0]), self.factor(n[1])) else { return false };
+        debug_assert_eq!(inner, [n[0] - 1, n[1] - 1], "edges of one normal variant");
+        let out = out.take_front(inner[0] + inner[1]);
+        let edges = [(a.owner, ta), (b.owner, tb)];
+        if self.avx2_fma {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `avx2_fma` is only set where the CPU has AVX2 and FMA (`FastEvaluator::build`).
+            unsafe {
+                self.edge_pair_avx2_fma(form, lanes, edges, out)
+            };
+            #[cfg(target_arch = "x86_64")]
+            return true;
+        }
+        self.edge_pair_with::<false>(form, lanes, edges, out);
+        true
+    }
+
+    /// [`FastEvaluator::edge_pair_with`] compiled for AVX2 and FMA (everything it calls is
+    /// inlined).
+    ///
+    /// # Safety
+    /// The CPU must support AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn edge_pair_avx2_fma(
+        &self,
+        form: GridFormKey,
+        lanes: &EdgePairLanes,
+        edges: [(EdgeUse, &FactorTables); 2],
+        out: VertexSlices<'_>,
+    ) {
+        self.edge_pair_with::<true>(form, lanes, edges, out)
+    }
+
+    /// The inner samples of two edges of the polynomial patch `form`, one block.
+    #[inline(always)]
+    fn edge_pair_with<const FMA: bool>(
+        &self,
+        form: GridFormKey,
+        lanes: &EdgePairLanes,
+        edges: [(EdgeUse, &FactorTables); 2],
+        out: VertexSlices<'_>,
+    ) {
+        let GridPatch::Polynomial(local) = self.points.grid_form(form) else {
+            unreachable!("edge_pair takes polynomial patches")
+        };
+        let [(a, ta), (b, tb)] = edges;
+        let block =
+            local.edge_pair_block::<FMA>(lanes, &local.edge(a.local as usize), &local.edge(b.local as usize));
+        let first = ta.n - 1;
+        // Lane `l`'s edge tables, direction and canonical sample.
+        let sample = |l: usize| match l < first {
+            true => (ta, a, l + 1),
+            false => (tb, b, l - first + 1),
+        };
+        let p = a.patch as usize;
+        block.write(out.pos, out.nrm, |l| {
+            let (t, u, k) = sample(l);
+            self.exact(p, t.edge_uv[u.local as usize][u.reversed as usize][k])
+        });
+        for (l, uv) in out.uv.iter_mut().enumerate() {
+            let (t, u, k) = sample(l);
+            *uv = t.edge_uv32[u.local as usize][u.reversed as usize][k];
+        }
+        out.patch.fill(p as u32);
     }
 
     /// [`FastEvaluator::edge_with`] compiled for AVX2 and FMA (everything it calls is inlined).

@@ -556,8 +556,18 @@ impl Writer<'_> {
             // whether an edge starts a run was most of the time a coarse frame's edges took
             // beside their kernels.
             let inner = (offsets[e + 1] - offsets[e]) as usize;
-            if self.fast.is_some_and(|f| f.edge(self.plan, e, inner, &mut out)) {
-                continue;
+            if let Some(f) = self.fast {
+                // Two edges of one owner in one block where they fit, else the edge alone.
+                if e + 1 < edges.end {
+                    let next = (offsets[e + 2] - offsets[e + 1]) as usize;
+                    if f.edge_pair(self.plan, e, [inner, next], &mut out) {
+                        edges.start = e + 2;
+                        continue;
+                    }
+                }
+                if f.edge(self.plan, e, inner, &mut out) {
+                    continue;
+                }
             }
             if let Some(end) = self.tree_run(e, edges.end) {
                 // Edges `e..end` are evaluated on their owners' trees, one stream of points.

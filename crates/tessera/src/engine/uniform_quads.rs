@@ -319,17 +319,26 @@ impl GridLine for Line<3> {
     }
 
     #[inline(always)]
-    fn finish<const FMA: bool>(
-        [mut pos, along, across]: Self::Sums,
-        column: bool,
+    fn finish<const FMA: bool>(sums: Self::Sums, column: bool, origin: &[f32; 3], scale: f32) -> Block {
+        Self::finish_signed::<FMA>(sums, [if column { -1.0 } else { 1.0 }; LANES], origin, scale)
+    }
+}
+
+impl Line<3> {
+    /// [`GridLine::finish`] with each lane's orientation: `sign[l]` is −1 where lane `l` lies
+    /// on a column, 1 on a row.
+    #[inline(always)]
+    fn finish_signed<const FMA: bool>(
+        [mut pos, along, across]: [[[f32; LANES]; 3]; 3],
+        sign: [f32; LANES],
         origin: &[f32; 3],
         scale: f32,
     ) -> Block {
-        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column. Written as
-        // whole-array lane loops, one quantity at a time, so that each becomes SIMD code. The
-        // reliability rule is `point_blocks::cross_normals`'s; calling that function here
-        // measured 1.4× slower in this kernel (torus, factor 16), so the loops stay inline.
-        let sign = if column { -1.0 } else { 1.0 };
+        // ∂S/∂u × ∂S/∂v: along × across on a row, across × along on a column (the same
+        // product, negated). Written as whole-array lane loops, one quantity at a time, so
+        // that each becomes SIMD code. The reliability rule is `point_blocks::cross_normals`'s;
+        // calling that function here measured 1.4× slower in this kernel (torus, factor 16), so
+        // the loops stay inline.
         let ([ax, ay, az], [cx, cy, cz]) = (along, across);
         let mut nrm = [[0f32; LANES]; 3];
         let [nx, ny, nz] = &mut nrm;
@@ -347,7 +356,7 @@ impl GridLine for Line<3> {
             // neither derivative so short that rounding turns it.
             let long = a2 >= MIN_DERIVATIVE2 && c2 >= MIN_DERIVATIVE2;
             margin[l] = if long { n2 - MIN_SIN2 * (a2 * c2) } else { -1.0 };
-            let inv = sign / n2.sqrt();
+            let inv = sign[l] / n2.sqrt();
             nx[l] *= inv;
             ny[l] *= inv;
             nz[l] *= inv;
@@ -475,6 +484,87 @@ impl<const C: usize> LocalPatch<C> {
     }
 }
 
+/// The inner samples of two edges of one polynomial patch in one block: lanes `0..first` the
+/// first edge's samples `k = 1..n_a` in order, then the second's. Each lane holds the basis
+/// values of its point along its own edge's line (`t = k`, or `n − k` where the line runs
+/// against the edge), and takes its line's coefficients.
+///
+/// Why: a coarse frame's edges have one to three inner samples (the Catmull-Clark torus at
+/// 0.5 px: 1.7 an edge), and a block an edge spent most of its lanes on padding; a patch
+/// owns its edges one after another, so two of them fill one block. The basis values are
+/// tables made once per pair of factors and directions: stored lane by lane for each edge
+/// (`LineLanes`, `docs/BENCHMARKS.md`), the reads waited on the stores.
+pub(super) struct EdgePairLanes {
+    b: [[f32; LANES]; 4],
+    d: [[f32; LANES]; 4],
+    /// The first edge's lanes.
+    first: usize,
+}
+
+impl EdgePairLanes {
+    /// The lanes of an edge of factor `na` (its line against it where `flip_a`) and one of
+    /// factor `nb`, from the factors' bases; None unless each has an inner sample and the two
+    /// have at most [`LANES`]. Lanes past the last sample repeat it.
+    pub(super) fn new(
+        (a, na, flip_a): (&Basis, usize, bool),
+        (b, nb, flip_b): (&Basis, usize, bool),
+    ) -> Option<EdgePairLanes> {
+        let (ca, cb) = (na.checked_sub(1)?, nb.checked_sub(1)?);
+        if ca == 0 || cb == 0 || ca + cb > LANES {
+            return None;
+        }
+        let mut lanes = EdgePairLanes { b: [[0.0; LANES]; 4], d: [[0.0; LANES]; 4], first: ca };
+        for l in 0..LANES {
+            let q = l.min(ca + cb - 1);
+            let (basis, n, flip, k) =
+                if q < ca { (a, na, flip_a, q + 1) } else { (b, nb, flip_b, q - ca + 1) };
+            let t = if flip { n - k } else { k };
+            for i in 0..4 {
+                lanes.b[i][l] = basis.b[i][t];
+                lanes.d[i][l] = basis.d[i][t];
+            }
+        }
+        Some(lanes)
+    }
+}
+
+impl LocalPatch<3> {
+    /// The samples of the lines `a` and `b` of this patch in the lanes `lanes` describes
+    /// ([`EdgePairLanes`]), in the model's frame: lane for lane the bits of
+    /// [`GridLine::block`] of the lane's own line. Cost: one block, and each coefficient
+    /// chosen per lane.
+    // Index loops mirror `Line::sums`'s (and vectorize over the lanes).
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub(super) fn edge_pair_block<const FMA: bool>(
+        &self,
+        lanes: &EdgePairLanes,
+        a: &Line<3>,
+        b: &Line<3>,
+    ) -> Block {
+        let first = lanes.first;
+        let pick =
+            |x: f32, y: f32| -> [f32; LANES] { std::array::from_fn(|l| if l < first { x } else { y }) };
+        let mut pos = [[0f32; LANES]; 3];
+        let mut along = [[0f32; LANES]; 3];
+        let mut across = [[0f32; LANES]; 3];
+        for k in 0..4 {
+            let (bk, dk) = (&lanes.b[k], &lanes.d[k]);
+            for comp in 0..3 {
+                let (ck, ek) = (pick(a.c[comp][k], b.c[comp][k]), pick(a.d[comp][k], b.d[comp][k]));
+                for l in 0..LANES {
+                    pos[comp][l] = madd::<FMA>(bk[l], ck[l], pos[comp][l]);
+                    along[comp][l] = madd::<FMA>(dk[l], ck[l], along[comp][l]);
+                    across[comp][l] = madd::<FMA>(bk[l], ek[l], across[comp][l]);
+                }
+            }
+        }
+        let sign = |line: &Line<3>| if line.column { -1.0 } else { 1.0 };
+        let signs = pick(sign(a), sign(b));
+        Line::<3>::finish_signed::<FMA>([pos, along, across], signs, &self.origin, self.scale)
+    }
+}
+
 /// Writes lane `l` of `block`, or the f64 evaluation `exact()` where the lane is unreliable.
 #[inline(always)]
 pub(super) fn store(
@@ -565,6 +655,65 @@ mod tests {
             let (polynomial, rational) = random_nets(&mut rng, round % 2 == 0);
             check(&polynomial, &mut basis);
             check(&rational, &mut basis);
+        }
+    }
+
+    /// Two edges' samples in one block ([`LocalPatch::edge_pair_block`]) are, lane for lane,
+    /// each edge's own block along its line, bit for bit (normals of columns negated as the
+    /// lines' own blocks negate them, zeros included): every pair of local edges, factors and
+    /// directions [`EdgePairLanes`] takes (and it takes no other), with and without fused
+    /// multiply-adds, on nets with zeros of both signs.
+    #[test]
+    fn an_edge_pairs_block_is_its_edges_bit_for_bit() {
+        fn bits(block: &Block, l: usize) -> [u32; 7] {
+            let b = |x: f32| x.to_bits();
+            let (p, n) = (&block.pos, &block.nrm);
+            [p[0][l], p[1][l], p[2][l], n[0][l], n[1][l], n[2][l], block.margin[l]].map(b)
+        }
+        fn check<const FMA: bool>(patch: &LocalPatch<3>, bases: &[Basis]) -> usize {
+            let mut pairs = 0;
+            for (na, nb) in (1..bases.len()).flat_map(|a| (1..bases.len()).map(move |b| (a, b))) {
+                for (flip_a, flip_b) in [(false, false), (false, true), (true, false), (true, true)] {
+                    let Some(lanes) = EdgePairLanes::new((&bases[na], na, flip_a), (&bases[nb], nb, flip_b))
+                    else {
+                        assert!(na < 2 || nb < 2 || na + nb - 2 > LANES, "({na}, {nb})");
+                        continue;
+                    };
+                    pairs += 1;
+                    for (ea, eb) in (0..4).flat_map(|a| (0..4).map(move |b| (a, b))) {
+                        let (la, lb) = (patch.edge(ea), patch.edge(eb));
+                        let block = patch.edge_pair_block::<FMA>(&lanes, &la, &lb);
+                        let lanes_of = [(&la, na, flip_a, 0), (&lb, nb, flip_b, na - 1)];
+                        for (line, n, flip, first) in lanes_of {
+                            for k in 1..n {
+                                let t = if flip { n - k } else { k };
+                                let own = line.block::<FMA>(&bases[n], t, &patch.origin, patch.scale);
+                                let l = first + k - 1;
+                                assert_eq!(
+                                    bits(&block, l),
+                                    bits(&own, 0),
+                                    "({na}, {nb}), edges ({ea}, {eb}), lane {l}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+            pairs
+        }
+        let bases: Vec<Basis> = (0..11)
+            .map(|n| {
+                let mut b = Basis::default();
+                b.refill(n.max(1));
+                b
+            })
+            .collect();
+        let mut rng = crate::test_support::Lcg(13);
+        for round in 0..20 {
+            let (polynomial, _) = random_nets(&mut rng, round % 2 == 0);
+            // Factor pairs with 2 to 8 samples in all, each in four directions.
+            assert_eq!(check::<false>(&polynomial, &bases), 4 * 28);
+            assert_eq!(check::<true>(&polynomial, &bases), 4 * 28);
         }
     }
 
