@@ -665,11 +665,6 @@ mod tests {
     /// multiply-adds, on nets with zeros of both signs.
     #[test]
     fn an_edge_pairs_block_is_its_edges_bit_for_bit() {
-        fn bits(block: &Block, l: usize) -> [u32; 7] {
-            let b = |x: f32| x.to_bits();
-            let (p, n) = (&block.pos, &block.nrm);
-            [p[0][l], p[1][l], p[2][l], n[0][l], n[1][l], n[2][l], block.margin[l]].map(b)
-        }
         fn check<const FMA: bool>(patch: &LocalPatch<3>, bases: &[Basis]) -> usize {
             let mut pairs = 0;
             for (na, nb) in (1..bases.len()).flat_map(|a| (1..bases.len()).map(move |b| (a, b))) {
@@ -690,8 +685,8 @@ mod tests {
                                 let own = line.block::<FMA>(&bases[n], t, &patch.origin, patch.scale);
                                 let l = first + k - 1;
                                 assert_eq!(
-                                    bits(&block, l),
-                                    bits(&own, 0),
+                                    block_bits(&block, l),
+                                    block_bits(&own, 0),
                                     "({na}, {nb}), edges ({ea}, {eb}), lane {l}"
                                 );
                             }
@@ -701,13 +696,7 @@ mod tests {
             }
             pairs
         }
-        let bases: Vec<Basis> = (0..11)
-            .map(|n| {
-                let mut b = Basis::default();
-                b.refill(n.max(1));
-                b
-            })
-            .collect();
+        let bases = bases_up_to(10);
         let mut rng = crate::test_support::Lcg(13);
         for round in 0..20 {
             let (polynomial, _) = random_nets(&mut rng, round % 2 == 0);
@@ -715,6 +704,24 @@ mod tests {
             assert_eq!(check::<false>(&polynomial, &bases), 4 * 28);
             assert_eq!(check::<true>(&polynomial, &bases), 4 * 28);
         }
+    }
+
+    /// The bits of lane `l` of `block`: position, normal, margin.
+    fn block_bits(block: &Block, l: usize) -> [u32; 7] {
+        let (p, n) = (&block.pos, &block.nrm);
+        [p[0][l], p[1][l], p[2][l], n[0][l], n[1][l], n[2][l], block.margin[l]].map(f32::to_bits)
+    }
+
+    /// The bases of factors 0 to `n` (factor 0's as factor 1's, so that `bases[n]` is
+    /// factor `n`'s).
+    fn bases_up_to(n: usize) -> Vec<Basis> {
+        (0..=n)
+            .map(|n| {
+                let mut b = Basis::default();
+                b.refill(n.max(1));
+                b
+            })
+            .collect()
     }
 
     /// A random net in `[-1, 1]³` as a polynomial patch (with `zeros`, zeros of both signs
@@ -744,11 +751,6 @@ mod tests {
     /// multiply-adds, for every grid [`GridLanes`] takes (and it takes no other).
     #[test]
     fn a_small_grids_block_is_its_rows_bit_for_bit() {
-        fn bits(block: &Block, l: usize) -> [u32; 7] {
-            let b = |x: f32| x.to_bits();
-            let (p, n) = (&block.pos, &block.nrm);
-            [p[0][l], p[1][l], p[2][l], n[0][l], n[1][l], n[2][l], block.margin[l]].map(b)
-        }
         fn check<const C: usize, const FMA: bool>(patch: &LocalPatch<C>, bases: &[Basis]) -> usize
         where
             Line<C>: GridLine<Sums = [[[f32; LANES]; C]; 3]>,
@@ -767,19 +769,17 @@ mod tests {
                     for l in 0..m * (nv - 1) {
                         let (i, j) = (1 + l % m, 1 + l / m);
                         let row = patch.row(v, j).block::<FMA>(u, i, &patch.origin, patch.scale);
-                        assert_eq!(bits(&block, l), bits(&row, 0), "({nu}, {nv}), point ({i}, {j})");
+                        assert_eq!(
+                            block_bits(&block, l),
+                            block_bits(&row, 0),
+                            "({nu}, {nv}), point ({i}, {j})"
+                        );
                     }
                 }
             }
             grids
         }
-        let bases: Vec<Basis> = (0..12)
-            .map(|n| {
-                let mut b = Basis::default();
-                b.refill(n.max(1));
-                b
-            })
-            .collect();
+        let bases = bases_up_to(11);
         let mut rng = crate::test_support::Lcg(9);
         for round in 0..100 {
             let (polynomial, rational) = random_nets(&mut rng, round % 2 == 0);
