@@ -60,37 +60,7 @@ impl PatchView {
     pub fn bounding_box(&self) -> [DVec3; 2] {
         [self.lo, self.hi]
     }
-}
 
-/// The object-space tolerance of a patch whose control points lie in the world box
-/// `lo..hi`, for `pixels` of screen error from `view`: the box's eight corners in camera
-/// space, the nearest depth and the widest ratios to it bound every point's screen scale.
-/// The rule of [`PatchView::tolerance`] and of [`tolerances_into`]. Cost: eight point
-/// transforms, sixteen divisions.
-pub fn box_tolerance(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
-    let t = view.half_tangents;
-    // Camera-space corners of the world-space box around the control points.
-    let corners: [DVec3; 8] = std::array::from_fn(|i| {
-        view.to_camera(DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        ))
-    });
-    let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
-    let (z, tx, ty) = if z_min >= view.near {
-        let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
-        let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
-        (z_min, tx, ty)
-    } else {
-        // The box reaches the near plane: only points inside the frustum are seen, where
-        // z ≥ near and the ratios stay within the field of view.
-        (view.near, t.x, t.y)
-    };
-    pixels * z / (view.focal_pixels * (1.0 + tx * tx + ty * ty).sqrt())
-}
-
-impl PatchView {
     /// [`culled`] with the view-independent data precomputed. The bounding sphere decides
     /// each frustum plane it lies wholly inside of; only the planes it reaches test the
     /// control points, so the answer is that of the control-point test.
@@ -240,6 +210,34 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
         return None;
     }
     Some((axis, cos_min.clamp(-1.0, 1.0).acos()))
+}
+
+/// The object-space tolerance of a patch whose control points lie in the world box
+/// `lo..hi`, for `pixels` of screen error from `view`: the box's eight corners in camera
+/// space, the nearest depth and the widest ratios to it bound every point's screen scale.
+/// The rule of [`PatchView::tolerance`] and of [`tolerances_into`]. Cost: eight point
+/// transforms, sixteen divisions.
+pub fn box_tolerance(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
+    let t = view.half_tangents;
+    // Camera-space corners of the world-space box around the control points.
+    let corners: [DVec3; 8] = std::array::from_fn(|i| {
+        view.to_camera(DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        ))
+    });
+    let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+    let (z, tx, ty) = if z_min >= view.near {
+        let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
+        let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
+        (z_min, tx, ty)
+    } else {
+        // The box reaches the near plane: only points inside the frustum are seen, where
+        // z ≥ near and the ratios stay within the field of view.
+        (view.near, t.x, t.y)
+    };
+    pixels * z / (view.focal_pixels * (1.0 + tx * tx + ty * ty).sqrt())
 }
 
 /// True when no point of the patch can face the eye: the normal cone (half-angle `α`) and the

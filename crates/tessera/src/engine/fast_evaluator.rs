@@ -87,6 +87,13 @@ fn edge_pair_at((na, flip_a): (usize, bool), (nb, flip_b): (usize, bool)) -> Opt
         .then(|| (2 * na + usize::from(flip_a)) * 2 * LANE_GRIDS + 2 * nb + usize::from(flip_b))
 }
 
+/// Whether the line of the edge `owner` uses runs against the edge: the line runs with the
+/// patch's grid index, so canonical sample `k` sits at line index `k`, or `n − k` where this
+/// is true (edges 2 and 3 run against the grid, reversed edges against the patch).
+fn runs_against(owner: EdgeUse) -> bool {
+    owner.reversed ^ (owner.local >= 2)
+}
+
 /// The evaluator: everything its tasks share. It evaluates every point the engine asks for,
 /// on the grid kernels of this module where the plan and pattern allow, on
 /// [`PointBlocks`] elsewhere.
@@ -432,8 +439,7 @@ impl<'a> FastEvaluator<'a> {
             return false;
         }
         let n = [plan.segments(e) as usize, plan.segments(e + 1) as usize];
-        let flip = |u: EdgeUse| u.reversed ^ (u.local >= 2);
-        let at = edge_pair_at((n[0], flip(a.owner)), (n[1], flip(b.owner)));
+        let at = edge_pair_at((n[0], runs_against(a.owner)), (n[1], runs_against(b.owner)));
         let Some(lanes) = at.and_then(|at| self.edge_pairs.get(at)?.as_ref()) else { return false };
         let (Some(ta), Some(tb)) = (self.factor(n[0]), self.factor(n[1])) else { return false };
         debug_assert_eq!(inner, [n[0] - 1, n[1] - 1], "edges of one normal variant");
@@ -547,9 +553,7 @@ impl<'a> FastEvaluator<'a> {
         let (p, local_edge, rev) = (owner.patch as usize, owner.local as usize, owner.reversed);
         let (basis, n) = (&tables.basis, tables.n);
         let line = local.edge(local_edge);
-        // The line runs with the patch's grid index; canonical sample k sits at line index k
-        // or n − k (edges 2 and 3 run against the grid, reversed edges against the patch).
-        let flip = rev ^ (local_edge >= 2);
+        let flip = runs_against(owner);
         let uvs = &tables.edge_uv[local_edge][rev as usize];
         let uvs32 = &tables.edge_uv32[local_edge][rev as usize];
         for t0 in (1..n).step_by(LANES) {

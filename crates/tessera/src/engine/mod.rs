@@ -1037,6 +1037,29 @@ pub(crate) fn fill_pattern_cache(
 
 /// Per-patch mapping from local vertex indices to output vertices: the numbering rule of
 /// [`layout`] applied to one patch.
+/// Where a patch's samples of one edge lie in the output ([`LocalMap::edge_samples`]).
+#[derive(Clone, Copy)]
+enum EdgeSamples {
+    /// A collapsed curve: every sample is the corner's vertex.
+    Corner(u32),
+    /// Canonical samples `1..segments` from `first` on; the patch's sample `k` is canonical
+    /// sample `segments − k` where it runs against the edge.
+    Run { first: u32, segments: u32, reversed: bool },
+}
+
+impl EdgeSamples {
+    /// The output vertex of the patch's sample `k` (`1 ≤ k < segments`).
+    #[inline(always)]
+    fn vertex(self, k: u32) -> u32 {
+        match self {
+            EdgeSamples::Corner(c) => c,
+            EdgeSamples::Run { first, segments, reversed } => {
+                first + if reversed { segments - k } else { k } - 1
+            }
+        }
+    }
+}
+
 struct LocalMap<'a> {
     set: &'a SurfaceSet,
     plan: &'a Plan,
@@ -1061,15 +1084,22 @@ impl LocalMap<'_> {
 
     /// Output vertex of the patch's own sample `k` of local edge `e`.
     fn edge_vertex(&self, e: usize, k: u32) -> u32 {
+        self.edge_samples(e).vertex(k)
+    }
+
+    /// Where the samples of local edge `e` lie in the output, its entries read once (a
+    /// patch's table reads every sample of an edge).
+    #[inline(always)]
+    fn edge_samples(&self, e: usize) -> EdgeSamples {
         let pe = self.set.topology.patch_edges[self.patch][e];
-        let edge = pe.edge as usize;
         if pe.collapsed {
             // Every sample of a collapsed curve is its single point: the corner.
-            return self.corner_vertex(e);
+            return EdgeSamples::Corner(self.corner_vertex(e));
         }
+        let edge = pe.edge as usize;
         let segments = self.plan.segments(edge);
-        let kc = if pe.reversed { segments - k } else { k };
-        self.layout.edge_vertex(edge, pe.variant as u32, segments, kc)
+        let first = self.layout.edge_vertex(edge, pe.variant as u32, segments, 1);
+        EdgeSamples::Run { first, segments, reversed: pe.reversed }
     }
 
     /// The output vertex of every local index, in local order. Cost: O(local vertices).
@@ -1078,24 +1108,8 @@ impl LocalMap<'_> {
         let nc = self.input.domain.corner_count();
         table.extend((0..nc).map(|c| self.corner_vertex(c)));
         for e in 0..nc {
-            // `edge_vertex` of each sample, its edge's entries read once: the samples of one
-            // edge run by one through its output range, forwards or backwards.
-            let pe = self.set.topology.patch_edges[self.patch][e];
-            let inner = self.input.segments[e].saturating_sub(1);
-            if pe.collapsed {
-                let corner = self.corner_vertex(e);
-                table.extend((0..inner).map(|_| corner));
-                continue;
-            }
-            let edge = pe.edge as usize;
-            let segments = self.plan.segments(edge);
-            let first = self.layout.edge_vertex(edge, pe.variant as u32, segments, 1);
-            if pe.reversed {
-                // Sample k is canonical sample segments − k.
-                table.extend((1..=inner).map(|k| first + (segments - k) - 1));
-            } else {
-                table.extend((0..inner).map(|j| first + j));
-            }
+            let samples = self.edge_samples(e);
+            table.extend((1..self.input.segments[e]).map(|k| samples.vertex(k)));
         }
         let base = self.layout.interior_vertex(self.patch, 0);
         table.extend((0..interior as u32).map(|j| base + j));
