@@ -54,13 +54,29 @@ pub fn parse_tolerance(text: &str, diagonal: f64) -> Result<f64> {
     Ok(if relative { v / 100.0 * diagonal } else { v })
 }
 
+/// `1.0 / n as f64` for `n < 65`: the same correctly rounded quotients, read instead of
+/// divided. The grid search divides three times and takes a root per column count, and the
+/// proposals of a coarse frame try about four counts a patch.
+static RECIPROCALS: [f64; 65] = {
+    let mut r = [0.0; 65];
+    let mut n = 1;
+    while n < 65 {
+        r[n] = 1.0 / n as f64;
+        n += 1;
+    }
+    r
+};
+
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
 /// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
 fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
     // The height `hv` that columns `nu` leave each row, None where `hu` alone exceeds the
     // budget.
     let height = |nu: u32| -> Option<f64> {
-        let hu = 1.0 / nu as f64;
+        let hu = match RECIPROCALS.get(nu as usize) {
+            Some(&r) => r,
+            None => 1.0 / nu as f64,
+        };
         let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
         if c > 0.0 {
             return None;
