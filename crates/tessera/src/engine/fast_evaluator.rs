@@ -497,7 +497,7 @@ impl<'a> FastEvaluator<'a> {
             false => (tb, b, l - first + 1),
         };
         let p = a.patch as usize;
-        block.write(out.pos, out.nrm, |l| {
+        block.write::<FMA>(out.pos, out.nrm, |l| {
             let (t, u, k) = sample(l);
             self.exact(p, t.edge_uv[u.local as usize][u.reversed as usize][k])
         });
@@ -618,7 +618,7 @@ impl<'a> FastEvaluator<'a> {
                 GridPatch::Rational(local) => local.grid_block::<FMA>(lanes),
             };
             let point = |l: usize| (1 + l % m, 1 + l / m);
-            block.write(out.pos, out.nrm, |l| {
+            block.write::<FMA>(out.pos, out.nrm, |l| {
                 let (i, j) = point(l);
                 self.exact(p, DVec2::new(tu.grid[i], tv.grid[j]))
             });
@@ -663,7 +663,7 @@ impl<'a> FastEvaluator<'a> {
         for (b, (pos, nrm)) in chunks.enumerate() {
             let t0 = 1 + b * LANES;
             let block = line.block::<FMA>(&tu.basis, t0, &local.origin, local.scale);
-            block.write(pos, nrm, |l| self.exact(p, DVec2::new(tu.grid[t0 + l], v)));
+            block.write::<FMA>(pos, nrm, |l| self.exact(p, DVec2::new(tu.grid[t0 + l], v)));
         }
         let v = tv.grid32[j];
         out.uv.iter_mut().zip(&tu.grid32[1..tu.n]).for_each(|(x, &u)| *x = [u, v]);

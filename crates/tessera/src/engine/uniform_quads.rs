@@ -234,14 +234,31 @@ impl Block {
         self.margin.iter().fold(true, |all, &m| all & (m > 0.0))
     }
 
-    /// Writes lanes `0..pos.len()`, taking `exact(l)` where a lane is unreliable.
+    /// Writes lanes `0..pos.len()`, taking `exact(l)` where a lane is unreliable. `AVX`: the
+    /// caller is compiled for AVX (the kernels' fast build), so a whole block may be stored
+    /// by [`store_points`].
     #[inline(always)]
-    pub(super) fn write(
+    pub(super) fn write<const AVX: bool>(
         &self,
         pos: &mut [[f32; 3]],
         nrm: &mut [[f32; 3]],
         exact: impl Fn(usize) -> SurfacePoint,
     ) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX && self.all_ok() {
+            if let (Ok(pos), Ok(nrm)) = (
+                <&mut [f32; 3 * LANES]>::try_from(pos.as_flattened_mut()),
+                <&mut [f32; 3 * LANES]>::try_from(nrm.as_flattened_mut()),
+            ) {
+                // SAFETY: `AVX` is only set in code compiled for AVX2 and FMA, which only
+                // runs where the CPU has them (`point_blocks::has_avx2_fma`).
+                unsafe {
+                    store_points(&self.pos, pos);
+                    store_points(&self.nrm, nrm);
+                }
+                return;
+            }
+        }
         if self.all_ok() {
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 *pos = [self.pos[0][l], self.pos[1][l], self.pos[2][l]];
@@ -253,6 +270,38 @@ impl Block {
             }
         }
     }
+}
+
+/// Stores a whole block's component lanes (`c[component][lane]`) as its eight points
+/// `x₀ y₀ z₀ x₁ …`, interleaved in registers: six unpacks, three shuffles and three lane
+/// swaps, then three vector stores. Lane by lane a block's points were 24 single stores,
+/// most of them lane extracts, and a uniform frame's grid rows are nearly all whole blocks;
+/// the compiler's own interleaving of the same array (`array::from_fn`) went through single
+/// inserts and made the vertex stage slower.
+///
+/// # Safety
+/// The CPU must support AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn store_points(c: &[[f32; LANES]; 3], out: &mut [f32; 3 * LANES]) {
+    use std::arch::x86_64::*;
+    const _: () = assert!(LANES == 8, "one AVX register of f32 lanes");
+    let (x, y, z) =
+        (_mm256_loadu_ps(c[0].as_ptr()), _mm256_loadu_ps(c[1].as_ptr()), _mm256_loadu_ps(c[2].as_ptr()));
+    // Within each 128-bit half (points 0–3, and 4–7 alike): x0 y0 x1 y1, x2 y2 x3 y3, …
+    let (xy_lo, xy_hi) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
+    let (yz_lo, yz_hi) = (_mm256_unpacklo_ps(y, z), _mm256_unpackhi_ps(y, z));
+    let (zx_lo, zx_hi) = (_mm256_unpacklo_ps(z, x), _mm256_unpackhi_ps(z, x));
+    // The half's twelve values: x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3.
+    let a = _mm256_shuffle_ps::<0b11_00_01_00>(xy_lo, zx_lo);
+    let b = _mm256_shuffle_ps::<0b01_00_11_10>(yz_lo, xy_hi);
+    let d = _mm256_shuffle_ps::<0b11_10_11_00>(zx_hi, yz_hi);
+    // Points 0–3 (the low halves) before points 4–7 (the high ones).
+    let out = out.as_mut_ptr();
+    _mm256_storeu_ps(out, _mm256_permute2f128_ps::<0x20>(a, b));
+    _mm256_storeu_ps(out.add(8), _mm256_permute2f128_ps::<0x30>(d, a));
+    _mm256_storeu_ps(out.add(16), _mm256_permute2f128_ps::<0x31>(b, d));
 }
 
 impl<const C: usize> Line<C> {
@@ -703,6 +752,65 @@ mod tests {
             // Factor pairs with 2 to 8 samples in all, each in four directions.
             assert_eq!(check::<false>(&polynomial, &bases), 4 * 28);
             assert_eq!(check::<true>(&polynomial, &bases), 4 * 28);
+        }
+    }
+
+    /// A whole block stored through the AVX interleaving ([`store_points`]) writes the bits
+    /// that lane-by-lane stores write, and a block that is not whole (or has an unreliable
+    /// lane) is written lane by lane either way, nothing past its points.
+    #[test]
+    fn whole_blocks_store_the_points_that_lane_stores_store() {
+        let avx = super::super::point_blocks::has_avx2_fma();
+        #[cfg(target_arch = "x86_64")]
+        assert!(avx, "the x86-64 machines tessera is tested on have AVX2 and FMA");
+        // Distinct bits in every slot, with a negative zero, a subnormal and an infinity.
+        let value = |c: usize, l: usize, k: f32| match (c, l) {
+            (0, 0) => -0.0,
+            (1, 3) => f32::from_bits(7),
+            (2, 7) => f32::INFINITY,
+            _ => k * (1.0 + c as f32) + l as f32 * 0.125,
+        };
+        let mut block = Block {
+            pos: std::array::from_fn(|c| std::array::from_fn(|l| value(c, l, 1.5))),
+            nrm: std::array::from_fn(|c| std::array::from_fn(|l| value(c, l, -2.25))),
+            margin: [1.0; LANES],
+        };
+        let exact = |l: usize| SurfacePoint {
+            position: glam::DVec3::splat(100.0 + l as f64),
+            normal: glam::DVec3::Z,
+        };
+        let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for unreliable in [None, Some(5)] {
+            block.margin = std::array::from_fn(|l| if Some(l) == unreliable { 0.0 } else { 1.0 });
+            for n in 1..=LANES {
+                let mut written = [[[9.0f32; 3]; LANES + 1]; 4];
+                let [lane_pos, lane_nrm, avx_pos, avx_nrm] = &mut written;
+                block.write::<false>(&mut lane_pos[..n], &mut lane_nrm[..n], exact);
+                if avx {
+                    block.write::<true>(&mut avx_pos[..n], &mut avx_nrm[..n], exact);
+                } else {
+                    // Not x86-64: only the lane stores exist.
+                    avx_pos[..n].copy_from_slice(&lane_pos[..n]);
+                    avx_nrm[..n].copy_from_slice(&lane_nrm[..n]);
+                }
+                let what = format!("{n} points, unreliable lane {unreliable:?}");
+                assert_eq!(bits(&written[0]), bits(&written[2]), "positions: {what}");
+                assert_eq!(bits(&written[1]), bits(&written[3]), "normals: {what}");
+                for (l, (p, q)) in written[0].iter().zip(&written[1]).enumerate().take(n) {
+                    let expected = match Some(l) == unreliable {
+                        true => ([100.0 + l as f32; 3], [0.0, 0.0, 1.0]),
+                        false => (
+                            std::array::from_fn(|c| block.pos[c][l]),
+                            std::array::from_fn(|c| block.nrm[c][l]),
+                        ),
+                    };
+                    assert_eq!(bits(&[*p, *q]), bits(&[expected.0, expected.1]), "lane {l}: {what}");
+                }
+                assert!(
+                    written.iter().all(|w| w[n..].iter().flatten().all(|&x| x == 9.0)),
+                    "past the points: {what}"
+                );
+            }
         }
     }
 
