@@ -629,22 +629,27 @@ impl<'a> FastEvaluator<'a> {
             out.patch.fill(p as u32);
             return;
         }
+        // Row after row, each given the rest of the interior: a row's last block may store
+        // a whole block, spilling into the next row, which then overwrites it.
         match self.local(p) {
             GridPatch::Polynomial(local) => {
                 for j in 1..tv.n {
-                    self.interior_row::<FMA, 3>(p, local, tu, tv, j, out.take_front(m));
+                    self.interior_row::<FMA, 3>(p, local, tu, tv, j, &mut out, (j - 1) * m);
                 }
             }
             GridPatch::Rational(local) => {
                 for j in 1..tv.n {
-                    self.interior_row::<FMA, 4>(p, local, tu, tv, j, out.take_front(m));
+                    self.interior_row::<FMA, 4>(p, local, tu, tv, j, &mut out, (j - 1) * m);
                 }
             }
         }
     }
 
     /// Interior vertices `i = 1..nu` of grid row `j` (`1 ≤ j < nv`) of patch `p`: the row's
-    /// curve from the `v` tables, its points from the `u` tables.
+    /// curve from the `v` tables, its points from the `u` tables, written from `start` in the
+    /// interior's `out` (points past the row may be overwritten: see
+    /// [`Block::write_front`](super::uniform_quads::Block::write_front)).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn interior_row<const FMA: bool, const C: usize>(
         &self,
@@ -653,20 +658,24 @@ impl<'a> FastEvaluator<'a> {
         tu: &FactorTables,
         tv: &FactorTables,
         j: usize,
-        out: VertexSlices<'_>,
+        out: &mut VertexSlices<'_>,
+        start: usize,
     ) where
         Line<C>: GridLine,
     {
         let line = local.row(&tv.basis, j);
         let v = tv.grid[j];
-        let chunks = out.pos.chunks_mut(LANES).zip(out.nrm.chunks_mut(LANES));
-        for (b, (pos, nrm)) in chunks.enumerate() {
+        let m = tu.n - 1;
+        for b in 0..m.div_ceil(LANES) {
             let t0 = 1 + b * LANES;
+            let (k, count) = (start + b * LANES, LANES.min(m - b * LANES));
             let block = line.block::<FMA>(&tu.basis, t0, &local.origin, local.scale);
-            block.write::<FMA>(pos, nrm, |l| self.exact(p, DVec2::new(tu.grid[t0 + l], v)));
+            block.write_front::<FMA>(&mut out.pos[k..], &mut out.nrm[k..], count, |l| {
+                self.exact(p, DVec2::new(tu.grid[t0 + l], v))
+            });
         }
         let v = tv.grid32[j];
-        out.uv.iter_mut().zip(&tu.grid32[1..tu.n]).for_each(|(x, &u)| *x = [u, v]);
-        out.patch.fill(p as u32);
+        out.uv[start..start + m].iter_mut().zip(&tu.grid32[1..tu.n]).for_each(|(x, &u)| *x = [u, v]);
+        out.patch[start..start + m].fill(p as u32);
     }
 }

@@ -244,21 +244,38 @@ impl Block {
         nrm: &mut [[f32; 3]],
         exact: impl Fn(usize) -> SurfacePoint,
     ) {
+        let count = pos.len();
+        self.write_front::<AVX>(pos, nrm, count, exact)
+    }
+
+    /// Writes lanes `0..count` to the front of `pos` and `nrm`, taking `exact(l)` where a
+    /// lane is unreliable. Where every lane is reliable and the slices hold [`LANES`] points,
+    /// the whole block is stored ([`store_points`], `AVX` only): the points past `count` then
+    /// hold the spare lanes' values, which the caller must overwrite (a grid row's next
+    /// row does).
+    #[inline(always)]
+    pub(super) fn write_front<const AVX: bool>(
+        &self,
+        pos: &mut [[f32; 3]],
+        nrm: &mut [[f32; 3]],
+        count: usize,
+        exact: impl Fn(usize) -> SurfacePoint,
+    ) {
         #[cfg(target_arch = "x86_64")]
         if AVX && self.all_ok() {
-            if let (Ok(pos), Ok(nrm)) = (
-                <&mut [f32; 3 * LANES]>::try_from(pos.as_flattened_mut()),
-                <&mut [f32; 3 * LANES]>::try_from(nrm.as_flattened_mut()),
-            ) {
+            if let (Some((pos, _)), Some((nrm, _))) =
+                (pos.split_first_chunk_mut::<LANES>(), nrm.split_first_chunk_mut::<LANES>())
+            {
                 // SAFETY: `AVX` is only set in code compiled for AVX2 and FMA, which only
                 // runs where the CPU has them (`point_blocks::has_avx2_fma`).
                 unsafe {
-                    store_points(&self.pos, pos);
-                    store_points(&self.nrm, nrm);
+                    store_points(&self.pos, pos.as_flattened_mut().try_into().expect("LANES points"));
+                    store_points(&self.nrm, nrm.as_flattened_mut().try_into().expect("LANES points"));
                 }
                 return;
             }
         }
+        let (pos, nrm) = (&mut pos[..count], &mut nrm[..count]);
         if self.all_ok() {
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 *pos = [self.pos[0][l], self.pos[1][l], self.pos[2][l]];
