@@ -294,6 +294,20 @@ impl StageSeries {
         self.vertices.push(vertices);
     }
 
+    /// Appends `other`'s frames after this series' own.
+    pub fn append(&mut self, mut other: StageSeries) {
+        self.criterion.append(&mut other.criterion);
+        self.resolve.append(&mut other.resolve);
+        self.layout.append(&mut other.layout);
+        self.write.append(&mut other.write);
+        self.write_vertices.append(&mut other.write_vertices);
+        self.write_indices.append(&mut other.write_indices);
+        self.total.append(&mut other.total);
+        self.triangles.append(&mut other.triangles);
+        self.vertices.append(&mut other.vertices);
+        self.culled.append(&mut other.culled);
+    }
+
     /// The stages with their names, in pipeline order, then the whole frame.
     fn stages(&self) -> [(&'static str, &Vec<f64>); 5] {
         [

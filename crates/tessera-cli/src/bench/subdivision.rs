@@ -11,6 +11,12 @@
 //! adaptive rows the rates tessera's own plan chose, face by face and edge by edge
 //! ([`face_rates`]), so both tessellate the same edges into the same segments. Without the
 //! program the tessera columns are still measured and a note says how to build it.
+//!
+//! The two alternate, round by round (a tessera frame, then a call of `bfr_bench` with one
+//! warm-up pass and one timed pass), and each side's median over the rounds is reported: on
+//! a shared host whose speed moved by up to half from one minute to the next, a ratio of
+//! tessera's frames to Bfr's passes timed a minute later read anywhere from 2.3× to 4.1× on
+//! one machine in one evening.
 
 use super::table::{num, Cell, Table};
 use super::{frames, median_p95, scenes, BenchResult, Ctx, StageSeries};
@@ -121,40 +127,52 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
             } else {
                 (Scheme::Uniform, Criterion::Factor(factor as f64), format!("uniform, Bfr rate {BFR_RATE}"))
             };
-            let cameras = vec![Some(camera); runs];
             for &threads in &ctx.threads {
                 ctx.step(&format!("subdivision: {name} {what}, {threads} threads"));
-                let (series, rates) = ctx.on_threads(threads, || -> BenchResult<_> {
-                    let options = TessellatorOptions {
-                        plan: PlanOptions { cull: false, ..PlanOptions::default() },
-                        ..Default::default()
-                    };
-                    let mut tess = Tessellator::new(&set, scheme, criterion, options)?;
-                    let series = frames(&mut tess, &cameras, true)?;
-                    let plan = tess.plan().ok_or("the frame left no plan")?;
-                    Ok((series, adaptive.then(|| face_rates(&set, plan, &mesh))))
-                })??;
-                let mut bfr_args = vec!["--rate".to_string(), BFR_RATE.to_string()];
-                if let Some(rates) = rates {
-                    std::fs::write(&rates_file, rates?)
-                        .map_err(|e| format!("{}: {e}", rates_file.display()))?;
-                    bfr_args = vec!["--adaptive-rates".into(), rates_file.display().to_string()];
-                }
-                bfr_args.extend(["--scheme".into(), if case.loop_ { "loop" } else { "catmark" }.into()]);
-                let bfr_row = match &bfr {
-                    Some(program) => Some(run_bfr(program, &path, case.copies, threads, runs, &bfr_args)?),
-                    None => None,
+                let options = TessellatorOptions {
+                    plan: PlanOptions { cull: false, ..PlanOptions::default() },
+                    ..Default::default()
                 };
+                let mut tess = Tessellator::new(&set, scheme, criterion, options)?;
+                let mut bfr_args = vec!["--rate".to_string(), BFR_RATE.to_string()];
+                bfr_args.extend(["--scheme".into(), if case.loop_ { "loop" } else { "catmark" }.into()]);
+                // Rounds that alternate the two, so that both sample the same moments of a
+                // shared host (whose speed moved by up to half from minute to minute while
+                // one ran its passes after the other's).
+                let mut series = StageSeries::default();
+                let mut bfr_passes = Vec::new();
+                for round in 0..runs {
+                    let (frames, rates) = ctx.on_threads(threads, || -> BenchResult<_> {
+                        // A fresh pool: one frame warms its threads, then one is timed.
+                        let frames = frames(&mut tess, &[Some(camera)], true)?;
+                        let plan = tess.plan().ok_or("the frame left no plan")?;
+                        Ok((frames, (adaptive && round == 0).then(|| face_rates(&set, plan, &mesh))))
+                    })??;
+                    series.append(frames);
+                    if let Some(rates) = rates {
+                        std::fs::write(&rates_file, rates?)
+                            .map_err(|e| format!("{}: {e}", rates_file.display()))?;
+                        bfr_args[..2]
+                            .clone_from_slice(&["--adaptive-rates".into(), rates_file.display().to_string()]);
+                    }
+                    if let Some(program) = &bfr {
+                        bfr_passes.push(run_bfr(program, &path, case.copies, threads, &bfr_args)?);
+                    }
+                }
+                let bfr_row = BfrRun::median(&bfr_passes);
                 table.row(row(&name, mesh.faces.len(), &what, threads, &series, bfr_row.as_ref()));
             }
         }
     }
     table.note(format!(
-        "tessera: medians of {runs} `Tessellator::frame`s into reused buffers after a warm-up frame (criterion to \
-         last index, positions and normals in f32), the cage copied with `tessera::scene::mesh_grid` and loaded \
-         once ({}). Bfr: `tools/osd-oracle/bfr_bench` (`Bfr::Surface<double>`, default options; each pass builds \
-         every face's surface with its topology cache, tessellates with `Bfr::Tessellation`, evaluates position \
-         and normal at every point and writes the facets), median of {runs} passes, the same copies. Uniform: \
+        "{runs} rounds a row, each a tessera frame then a Bfr pass, so that both sample the same moments of a \
+         shared host. tessera: in each round a warm-up frame, then one timed `Tessellator::frame` into reused \
+         buffers (criterion to last index, positions and normals in f32); the median of the {runs}; the cage \
+         copied with `tessera::scene::mesh_grid` and loaded once ({}). Bfr: `tools/osd-oracle/bfr_bench` \
+         (`Bfr::Surface<double>`, default options; each pass builds every face's surface with its topology \
+         cache, tessellates with `Bfr::Tessellation`, evaluates position and normal at every point and writes \
+         the facets), in each round a warm-up pass, then one timed pass; the median of the {runs}, the same \
+         copies. Uniform: \
          Bfr's rate 16, tessera's factor 16 on whole quads and 8 on the sub-faces of a cage split into them. \
          Adaptive: tessera's transition scheme at 0.5 px from one camera (halfway along the frame suite's walk, \
          no culling); Bfr gets the rates of tessera's plan for every edge of every face. \
@@ -222,20 +240,35 @@ fn row(
     cells
 }
 
-/// What `bfr_bench` reports on its last line.
+/// Bfr's triangles and time: of one timed pass, or the median of a row's rounds.
 struct BfrRun {
     triangles: usize,
     median_ms: f64,
     mtri_per_s: f64,
 }
 
-/// Runs `bfr_bench` on `copies` copies of `cage` with `threads` threads and `runs` passes.
+impl BfrRun {
+    /// The median pass of `passes` (by time), None if there are none.
+    fn median(passes: &[BfrRun]) -> Option<BfrRun> {
+        let mut ms: Vec<f64> = passes.iter().map(|b| b.median_ms).collect();
+        ms.sort_by(f64::total_cmp);
+        let median_ms = *ms.get(ms.len() / 2)?;
+        let triangles = passes[0].triangles;
+        Some(BfrRun { triangles, median_ms, mtri_per_s: triangles as f64 / median_ms / 1e3 })
+    }
+}
+
+/// Bfr's passes in one call of `bfr_bench`: the first warms it (its allocations, its caches
+/// of the cage), the second is timed.
+const BFR_PASSES: usize = 2;
+
+/// Runs `bfr_bench` on `copies` copies of `cage` with `threads` threads for [`BFR_PASSES`]
+/// passes; its last pass's figures.
 fn run_bfr(
     program: &Path,
     cage: &Path,
     copies: usize,
     threads: usize,
-    runs: usize,
     args: &[String],
 ) -> BenchResult<BfrRun> {
     let out = std::process::Command::new(program)
@@ -245,7 +278,7 @@ fn run_bfr(
             "--copies",
             &copies.to_string(),
             "--repeat",
-            &runs.to_string(),
+            &BFR_PASSES.to_string(),
         ])
         .args(args)
         .arg(cage)
@@ -265,14 +298,16 @@ fn run_bfr(
         .ok_or_else(|| format!("{}: no result line in its output:\n{stdout}", program.display()).into())
 }
 
-/// The `bfr_bench faces F triangles T … median_ms M mtri_per_s X` line.
+/// The last pass's `repeat R ms M triangles T … mtri_per_s X` line, of a run that reached
+/// its closing `bfr_bench faces …` line.
 fn parse_bfr(stdout: &str) -> Option<BfrRun> {
-    let line = stdout.lines().rev().find(|l| l.starts_with("bfr_bench "))?;
+    stdout.lines().rev().find(|l| l.starts_with("bfr_bench "))?;
+    let line = stdout.lines().rev().find(|l| l.starts_with("repeat "))?;
     let words: Vec<&str> = line.split_whitespace().collect();
     let value = |key: &str| words.windows(2).find(|w| w[0] == key).map(|w| w[1]);
     Some(BfrRun {
         triangles: value("triangles")?.parse().ok()?,
-        median_ms: value("median_ms")?.parse().ok()?,
+        median_ms: value("ms")?.parse().ok()?,
         mtri_per_s: value("mtri_per_s")?.parse().ok()?,
     })
 }
@@ -356,13 +391,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn bfr_bench_result_lines_parse() {
-        let out = "# bfr_bench opensubdiv 3.5.0 …\nrepeat 0 ms 12.5 triangles 8 points 9 nolimit 0 failed 0 mtri_per_s 0.6\n\
-                   bfr_bench faces 32 triangles 16384 points 8320 threads 2 rate 16 setup_ms 0.2 median_ms 1.25 mtri_per_s 13.1\n";
+    fn bfr_bench_result_lines_parse_to_the_last_pass() {
+        let out = "# bfr_bench opensubdiv 3.5.0 …\n\
+                   repeat 0 ms 12.5 triangles 16384 points 9 nolimit 0 failed 0 mtri_per_s 1.3\n\
+                   repeat 1 ms 1.25 triangles 16384 points 9 nolimit 0 failed 0 mtri_per_s 13.1\n\
+                   bfr_bench faces 32 triangles 16384 points 8320 threads 2 rate 16 setup_ms 0.2 median_ms 6.9 mtri_per_s 2.4\n";
         let run = parse_bfr(out).unwrap();
         assert_eq!(run.triangles, 16384);
         assert_eq!(run.median_ms, 1.25);
         assert_eq!(run.mtri_per_s, 13.1);
-        assert!(parse_bfr("repeat 0 ms 1\n").is_none());
+        // A run cut short (no closing line) has no figures.
+        assert!(parse_bfr("repeat 0 ms 1 triangles 8 mtri_per_s 1\n").is_none());
+    }
+
+    #[test]
+    fn a_rows_bfr_figures_are_its_median_pass() {
+        let pass = |ms: f64| BfrRun { triangles: 1000, median_ms: ms, mtri_per_s: 1.0 / ms };
+        let row = BfrRun::median(&[pass(3.0), pass(1.0), pass(5.0), pass(2.0), pass(4.0)]).unwrap();
+        assert_eq!(row.median_ms, 3.0);
+        assert_eq!(row.mtri_per_s, 1000.0 / 3.0 / 1e3);
+        assert!(BfrRun::median(&[]).is_none());
     }
 }
