@@ -134,8 +134,9 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
                     ..Default::default()
                 };
                 let mut tess = Tessellator::new(&set, scheme, criterion, options)?;
-                let mut bfr_args = vec!["--rate".to_string(), BFR_RATE.to_string()];
-                bfr_args.extend(["--scheme".into(), if case.loop_ { "loop" } else { "catmark" }.into()]);
+                let scheme_args =
+                    ["--scheme".to_string(), if case.loop_ { "loop" } else { "catmark" }.into()];
+                let mut rate_args = ["--rate".to_string(), BFR_RATE.to_string()];
                 // Rounds that alternate the two, so that both sample the same moments of a
                 // shared host (whose speed moved by up to half from minute to minute while
                 // one ran its passes after the other's).
@@ -152,11 +153,11 @@ pub fn run(ctx: &Ctx, bfr: Option<&Path>) -> BenchResult<Vec<Table>> {
                     if let Some(rates) = rates {
                         std::fs::write(&rates_file, rates?)
                             .map_err(|e| format!("{}: {e}", rates_file.display()))?;
-                        bfr_args[..2]
-                            .clone_from_slice(&["--adaptive-rates".into(), rates_file.display().to_string()]);
+                        rate_args = ["--adaptive-rates".into(), rates_file.display().to_string()];
                     }
                     if let Some(program) = &bfr {
-                        bfr_passes.push(run_bfr(program, &path, case.copies, threads, &bfr_args)?);
+                        let args = [rate_args.clone(), scheme_args.clone()].concat();
+                        bfr_passes.push(run_bfr(program, &path, case.copies, threads, &args)?);
                     }
                 }
                 let bfr_row = BfrRun::median(&bfr_passes);
@@ -226,7 +227,7 @@ fn row(
     match bfr {
         Some(b) => cells.extend([
             b.triangles.into(),
-            num(b.median_ms, 1),
+            num(b.ms, 1),
             num(b.mtri_per_s, 1),
             num(mtri / b.mtri_per_s, 2),
             num(given_mtri, 1),
@@ -243,18 +244,18 @@ fn row(
 /// Bfr's triangles and time: of one timed pass, or the median of a row's rounds.
 struct BfrRun {
     triangles: usize,
-    median_ms: f64,
+    ms: f64,
     mtri_per_s: f64,
 }
 
 impl BfrRun {
     /// The median pass of `passes` (by time), None if there are none.
     fn median(passes: &[BfrRun]) -> Option<BfrRun> {
-        let mut ms: Vec<f64> = passes.iter().map(|b| b.median_ms).collect();
-        ms.sort_by(f64::total_cmp);
-        let median_ms = *ms.get(ms.len() / 2)?;
+        let mut times: Vec<f64> = passes.iter().map(|b| b.ms).collect();
+        times.sort_by(f64::total_cmp);
+        let ms = *times.get(times.len() / 2)?;
         let triangles = passes[0].triangles;
-        Some(BfrRun { triangles, median_ms, mtri_per_s: triangles as f64 / median_ms / 1e3 })
+        Some(BfrRun { triangles, ms, mtri_per_s: triangles as f64 / ms / 1e3 })
     }
 }
 
@@ -307,7 +308,7 @@ fn parse_bfr(stdout: &str) -> Option<BfrRun> {
     let value = |key: &str| words.windows(2).find(|w| w[0] == key).map(|w| w[1]);
     Some(BfrRun {
         triangles: value("triangles")?.parse().ok()?,
-        median_ms: value("ms")?.parse().ok()?,
+        ms: value("ms")?.parse().ok()?,
         mtri_per_s: value("mtri_per_s")?.parse().ok()?,
     })
 }
@@ -398,7 +399,7 @@ mod tests {
                    bfr_bench faces 32 triangles 16384 points 8320 threads 2 rate 16 setup_ms 0.2 median_ms 6.9 mtri_per_s 2.4\n";
         let run = parse_bfr(out).unwrap();
         assert_eq!(run.triangles, 16384);
-        assert_eq!(run.median_ms, 1.25);
+        assert_eq!(run.ms, 1.25);
         assert_eq!(run.mtri_per_s, 13.1);
         // A run cut short (no closing line) has no figures.
         assert!(parse_bfr("repeat 0 ms 1 triangles 8 mtri_per_s 1\n").is_none());
@@ -406,9 +407,9 @@ mod tests {
 
     #[test]
     fn a_rows_bfr_figures_are_its_median_pass() {
-        let pass = |ms: f64| BfrRun { triangles: 1000, median_ms: ms, mtri_per_s: 1.0 / ms };
+        let pass = |ms: f64| BfrRun { triangles: 1000, ms, mtri_per_s: 1.0 / ms };
         let row = BfrRun::median(&[pass(3.0), pass(1.0), pass(5.0), pass(2.0), pass(4.0)]).unwrap();
-        assert_eq!(row.median_ms, 3.0);
+        assert_eq!(row.ms, 3.0);
         assert_eq!(row.mtri_per_s, 1000.0 / 3.0 / 1e3);
         assert!(BfrRun::median(&[]).is_none());
     }

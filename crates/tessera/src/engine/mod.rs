@@ -1035,8 +1035,6 @@ pub(crate) fn fill_pattern_cache(
     }
 }
 
-/// Per-patch mapping from local vertex indices to output vertices: the numbering rule of
-/// [`layout`] applied to one patch.
 /// Where a patch's samples of one edge lie in the output ([`LocalMap::edge_samples`]).
 #[derive(Clone, Copy)]
 enum EdgeSamples {
@@ -1060,6 +1058,8 @@ impl EdgeSamples {
     }
 }
 
+/// Per-patch mapping from local vertex indices to output vertices: the numbering rule of
+/// [`layout`] applied to one patch.
 struct LocalMap<'a> {
     set: &'a SurfaceSet,
     plan: &'a Plan,

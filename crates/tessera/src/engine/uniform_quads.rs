@@ -261,8 +261,9 @@ impl Block {
         count: usize,
         exact: impl Fn(usize) -> SurfacePoint,
     ) {
+        let all_ok = self.all_ok();
         #[cfg(target_arch = "x86_64")]
-        if AVX && self.all_ok() {
+        if AVX && all_ok {
             if let (Some((pos, _)), Some((nrm, _))) =
                 (pos.split_first_chunk_mut::<LANES>(), nrm.split_first_chunk_mut::<LANES>())
             {
@@ -276,7 +277,7 @@ impl Block {
             }
         }
         let (pos, nrm) = (&mut pos[..count], &mut nrm[..count]);
-        if self.all_ok() {
+        if all_ok {
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 *pos = [self.pos[0][l], self.pos[1][l], self.pos[2][l]];
                 *nrm = [self.nrm[0][l], self.nrm[1][l], self.nrm[2][l]];
@@ -827,6 +828,22 @@ mod tests {
                     written.iter().all(|w| w[n..].iter().flatten().all(|&x| x == 9.0)),
                     "past the points: {what}"
                 );
+                // Given room for a whole block, `write_front` writes the same first `n`
+                // points; a whole block's spare lanes land after them, and nothing past it.
+                let mut room = [[[9.0f32; 3]; LANES + 1]; 2];
+                let [front_pos, front_nrm] = &mut room;
+                block.write_front::<true>(front_pos, front_nrm, n, exact);
+                assert_eq!(bits(&room[0][..n]), bits(&written[0][..n]), "front positions: {what}");
+                assert_eq!(bits(&room[1][..n]), bits(&written[1][..n]), "front normals: {what}");
+                let whole = avx && unreliable.is_none();
+                for l in n..LANES {
+                    let expected = match whole {
+                        true => std::array::from_fn(|c| block.pos[c][l]),
+                        false => [9.0; 3],
+                    };
+                    assert_eq!(bits(&room[0][l..=l]), bits(&[expected]), "spare lane {l}: {what}");
+                }
+                assert!(room.iter().all(|w| w[LANES] == [9.0; 3]), "past the block: {what}");
             }
         }
     }
