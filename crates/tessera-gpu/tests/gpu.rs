@@ -624,13 +624,13 @@ fn acceptance_sweep_on_the_small_models() {
 }
 
 #[test]
-#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each, uniform, transition, semi-uniform, SD-2 and ESC"]
-fn acceptance_sweep_on_every_model_20_cameras() {
-    // The three meshes of over 40,000 patches take 10 cameras each (they dominate the time;
+#[ignore = "slow tier: every patch and mesh model, 10 seeded cameras each, uniform, transition, semi-uniform, SD-2 and ESC"]
+fn acceptance_sweep_on_every_model_10_cameras() {
+    // The three meshes of over 40,000 patches take 4 cameras each (they dominate the time;
     // at factors 1 and 2 most of their work is the CPU side of the comparison).
     let (rest, large) = models_by_size();
-    let mut counts = acceptance_sweep(&rest, 20, 2026);
-    counts.add(&acceptance_sweep(&large, 10, 2026));
+    let mut counts = acceptance_sweep(&rest, 10, 2026);
+    counts.add(&acceptance_sweep(&large, 4, 2026));
     assert!(counts.check_rounds > 0, "no pixel-error transition frame needed a fix round: {counts:?}");
     // The check's decisions met no f32 rounding tie in these frames: none is allowed, so a
     // difference is a bug until shown to be a tie.
@@ -1094,10 +1094,10 @@ fn loop_cages_equal_the_cpu_engine() {
 }
 
 /// Every manifold Loop cage (`loop_val2_interior` has an edge of four triangles, which the
-/// Loop surface refuses) on the GPU as on the CPU, from 20 cameras each.
+/// Loop surface refuses) on the GPU as on the CPU, from 8 cameras each.
 #[test]
-#[ignore = "slow tier (every Loop cage, 20 cameras): scripts/test runs it"]
-fn loop_cages_equal_the_cpu_engine_on_every_cage_20_cameras() {
+#[ignore = "slow tier (every Loop cage, 8 cameras): scripts/test runs it"]
+fn loop_cages_equal_the_cpu_engine_on_every_cage_8_cameras() {
     let mut cages: Vec<String> = std::fs::read_dir(data_dir().join("subdivision"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
@@ -1106,7 +1106,7 @@ fn loop_cages_equal_the_cpu_engine_on_every_cage_20_cameras() {
         .collect();
     cages.sort();
     assert!(cages.len() >= 11, "{cages:?}");
-    subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::Loop, &cages, &[3], 20);
+    subdivision_cages_equal_the_cpu_engine(tessera::io::SurfaceKind::Loop, &cages, &[3], 8);
 }
 
 /// `subdivision/{cage}.obj`, its set and its stencils: Catmull-Clark, or Loop with `loop_`.

@@ -577,11 +577,11 @@ fn hardware_from_the_camera_on_the_gpu_equals_the_cpu_plan() {
 }
 
 #[test]
-#[ignore = "slow tier: every patch and mesh model, 20 seeded cameras each (10 on the three meshes over 40,000 patches), every partitioning"]
-fn hardware_from_the_camera_on_every_model_20_cameras() {
+#[ignore = "slow tier: every patch and mesh model, 10 seeded cameras each (4 on the three meshes over 40,000 patches), every partitioning"]
+fn hardware_from_the_camera_on_every_model_10_cameras() {
     let (rest, large) = models_by_size();
-    let (mut sweep, mut counts) = hardware_from_the_camera(&rest, load, 20, 2026, 3);
-    let (more_sweep, more) = hardware_from_the_camera(&large, load, 10, 2026, 3);
+    let (mut sweep, mut counts) = hardware_from_the_camera(&rest, load, 10, 2026, 3);
+    let (more_sweep, more) = hardware_from_the_camera(&large, load, 4, 2026, 3);
     sweep.add(&more_sweep);
     counts.frames += more.frames;
     counts.edges += more.edges;

@@ -202,9 +202,9 @@ fn screen_space_bounds_hold_for_random_cameras_on_the_fast_models() {
 }
 
 #[test]
-#[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
+#[ignore = "slow tier (every model, 10 cameras): scripts/test runs it"]
 fn screen_space_bounds_hold_for_random_cameras_on_every_model() {
-    screen_space_bounds_hold(&common::all_surface_models(), 20, 0.2);
+    screen_space_bounds_hold(&common::all_surface_models(), 10, 0.2);
 }
 
 /// `cases` seeded cameras per model; a camera plans with the Taylor bound or (as likely) the

@@ -7,7 +7,8 @@
 //!
 //! The fast tier takes a few cages that cover the cases (extraordinary vertices, non-quads,
 //! creases, holes, boundaries of each rule); the slow tier (`#[ignore]`d, run by
-//! `scripts/test`) every manifold `catmark_*` and `loop_*` cage with 20 cameras.
+//! `scripts/test`) every manifold `catmark_*` and `loop_*` cage with 20 cameras (the tolerance
+//! bounds: measured on every frame of up to 3 M triangles, the plan's guarantee on all).
 
 mod common;
 
@@ -205,6 +206,9 @@ fn every_cage_is_watertight_through_every_scheme() {
     watertight_through_every_scheme(false);
 }
 
+/// The largest frame [`tolerance_bounds_hold`] writes and measures on the slow tier.
+const MEASURED_TRIANGLES: usize = 3_000_000;
+
 fn tolerance_bounds_hold(fast: bool) {
     for (path, kind) in cages(fast) {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -232,6 +236,15 @@ fn tolerance_bounds_hold(fast: bool) {
             let report = report.expect("a tolerance plan reports its bounds");
             assert_eq!(report.capped_patches, 0, "{name}");
             assert!(report.worst_bound <= eps * (1.0 + 1e-9), "{name}");
+            // Writing and measuring 10–15 M triangles (the rook, the bishop and the creased
+            // Loop cages at 0.01 %) took most of the slow tier's time: past 3 M triangles the
+            // plan's guarantee is checked above, and the measured error on the smaller frames.
+            let mut layout = tessera::engine::Layout::default();
+            layout.build(&set, &plan, &pattern, &EngineOptions::default()).unwrap();
+            if !fast && layout.triangle_count() > MEASURED_TRIANGLES {
+                println!("{name} {share} {bound:?}: {} triangles, bound only", layout.triangle_count());
+                continue;
+            }
             let options = EngineOptions { corner_params: true, ..Default::default() };
             let mesh = tessellate(&set, &plan, &pattern, options).unwrap();
             let err = verify::approximation_error(&mesh, &set, 5).unwrap();

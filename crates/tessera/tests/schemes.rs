@@ -36,7 +36,7 @@ fn view(kind: u8, fmin: f64, fmax: f64) -> Criterion {
 }
 
 /// The fast tier runs the scheme properties on [`common::fast_models`] with a few cameras; the
-/// slow tier (`#[ignore]`d, run by `scripts/test`) on every model with 20 cameras each.
+/// slow tier (`#[ignore]`d, run by `scripts/test`) on every model with 10 cameras each.
 #[derive(Debug, Clone, Copy)]
 enum Tier {
     Fast,
@@ -47,7 +47,7 @@ impl Tier {
     fn cameras(self) -> u32 {
         match self {
             Tier::Fast => 6,
-            Tier::Slow => 20,
+            Tier::Slow => 10,
         }
     }
 
@@ -120,7 +120,7 @@ fn semi_uniform_is_watertight_and_its_render_queues_match() {
 }
 
 #[test]
-#[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
+#[ignore = "slow tier (every model, 10 cameras): scripts/test runs it"]
 fn semi_uniform_is_watertight_and_its_render_queues_match_on_every_model() {
     semi_uniform_is_watertight_and_its_render_queues_match_in(Tier::Slow);
 }
@@ -247,7 +247,7 @@ fn sd2_is_two_different_watertight_and_strips_decode() {
 }
 
 #[test]
-#[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
+#[ignore = "slow tier (every model, 10 cameras): scripts/test runs it"]
 fn sd2_is_two_different_watertight_and_strips_decode_on_every_model() {
     sd2_is_two_different_watertight_and_strips_decode_in(Tier::Slow);
 }
@@ -286,7 +286,7 @@ fn hardware_partitionings_are_watertight() {
 }
 
 #[test]
-#[ignore = "slow tier (every model, 20 cameras): scripts/test runs it"]
+#[ignore = "slow tier (every model, 10 cameras): scripts/test runs it"]
 fn hardware_partitionings_are_watertight_on_every_model() {
     hardware_partitionings_are_watertight_in(Tier::Slow);
 }
