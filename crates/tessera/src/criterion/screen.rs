@@ -67,22 +67,24 @@ impl PatchView {
     pub fn culled(&self, patch: &Patch, view: &View) -> bool {
         let t = view.half_tangents;
         let c = view.to_camera(self.centre);
-        // Signed distances to the six planes, positive outside; the side planes pass through
-        // the eye with normals (±1, 0, −t)/√(1+t²) in camera space.
+        // Signed distances to the six planes, positive outside, each times its plane normal's
+        // length (the side planes pass through the eye with normals (±1, 0, −t), of length
+        // √(1+t²), in camera space), against the margin times that length: no division.
         let (nx, ny) = (view.side_norms.x, view.side_norms.y);
-        let distances = [
+        let scaled = [
             view.near - c.z,
             c.z - view.far,
-            (c.x - t.x * c.z) / nx,
-            (-c.x - t.x * c.z) / nx,
-            (c.y - t.y * c.z) / ny,
-            (-c.y - t.y * c.z) / ny,
+            c.x - t.x * c.z,
+            -c.x - t.x * c.z,
+            c.y - t.y * c.z,
+            -c.y - t.y * c.z,
         ];
         // Rounding of the transforms is far below this margin.
         let margin = self.radius + 1e-9 * (self.radius + c.length() + view.far);
-        for (plane, &d) in distances.iter().enumerate() {
+        let lengths = [1.0, 1.0, nx, nx, ny, ny];
+        for (plane, (&d, length)) in scaled.iter().zip(lengths).enumerate() {
             // Where d < −margin every control point is inside this plane.
-            if d >= -margin && all_outside(patch, view, plane) {
+            if d >= -margin * length && all_outside(patch, view, plane) {
                 return true;
             }
         }
@@ -219,19 +221,23 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
 /// transforms, sixteen divisions.
 pub fn box_tolerance(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
     let t = view.half_tangents;
-    // Camera-space corners of the world-space box around the control points.
-    let corners: [DVec3; 8] = std::array::from_fn(|i| {
-        view.to_camera(DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        ))
-    });
-    let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+    // Camera-space corners of the world-space box around the control points, one array per
+    // coordinate. Each is `View::to_camera`'s sum of three products in its order, so the
+    // same bits; but a product is formed once for each of the two values its axis takes
+    // (18 products, not 72), and the ratios below divide whole arrays (vector lanes).
+    let (dlo, dhi) = (lo - view.eye, hi - view.eye);
+    let coordinate = |a: DVec3| -> [f64; 8] {
+        let (x, y, z) = ([dlo.x * a.x, dhi.x * a.x], [dlo.y * a.y, dhi.y * a.y], [dlo.z * a.z, dhi.z * a.z]);
+        std::array::from_fn(|i| x[i & 1] + y[(i >> 1) & 1] + z[i >> 2])
+    };
+    let (xs, ys, zs) = (coordinate(view.right), coordinate(view.up), coordinate(view.forward));
+    let z_min = zs.iter().copied().fold(f64::INFINITY, f64::min);
     let (z, tx, ty) = if z_min >= view.near {
-        let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
-        let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
-        (z_min, tx, ty)
+        let ratio = |us: &[f64; 8]| -> f64 {
+            let r: [f64; 8] = std::array::from_fn(|i| (us[i] / zs[i]).abs());
+            r.into_iter().fold(0.0, f64::max)
+        };
+        (z_min, ratio(&xs), ratio(&ys))
     } else {
         // The box reaches the near plane: only points inside the frustum are seen, where
         // z ≥ near and the ratios stay within the field of view.
@@ -376,5 +382,63 @@ mod tests {
         }
         // Both kinds of culling happened, so both paths were compared.
         assert!(culled[0] > 100 && culled[1] > 100, "culled by frustum, by cone: {culled:?}");
+    }
+
+    /// [`box_tolerance`] as first written: each corner transformed by `View::to_camera`.
+    fn box_tolerance_by_corners(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
+        let t = view.half_tangents;
+        let corners: [DVec3; 8] = std::array::from_fn(|i| {
+            view.to_camera(DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            ))
+        });
+        let z_min = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+        let (z, tx, ty) = if z_min >= view.near {
+            let tx = corners.iter().map(|c| (c.x / c.z).abs()).fold(0.0, f64::max);
+            let ty = corners.iter().map(|c| (c.y / c.z).abs()).fold(0.0, f64::max);
+            (z_min, tx, ty)
+        } else {
+            (view.near, t.x, t.y)
+        };
+        pixels * z / (view.focal_pixels * (1.0 + tx * tx + ty * ty).sqrt())
+    }
+
+    /// The per-axis products give every corner the bits `View::to_camera` gives it, so the
+    /// tolerance is the same to the last bit: boxes in front of, around and behind the eye,
+    /// from seeded cameras.
+    #[test]
+    fn box_tolerance_equals_the_corner_by_corner_form_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut near_boxes, mut far_boxes) = (0, 0);
+        for k in 0..200 {
+            let mut camera = Camera::framing(DVec3::splat(-1.0), DVec3::splat(1.0), 1280, 1024);
+            camera.eye = DVec3::new(next(), next(), next()) * 3.0 * (1 + k % 4) as f64;
+            camera.target = DVec3::new(next(), next(), next()) * 0.5;
+            let view = camera.view();
+            for _ in 0..50 {
+                let a = DVec3::new(next(), next(), next()) * 2.0;
+                let b = a + DVec3::new(next().abs(), next().abs(), next().abs()) * 0.3;
+                let pixels = 0.1 + next().abs();
+                let (got, want) = (box_tolerance(a, b, &view, pixels), box_tolerance_by_corners(a, b, &view, pixels));
+                assert_eq!(got.to_bits(), want.to_bits(), "camera {k}: box {a} {b}");
+                let corner = |i: usize| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b, a);
+                let z_min = (0..8).map(|i| view.to_camera(corner(i)).z).fold(f64::INFINITY, f64::min);
+                if z_min >= view.near {
+                    far_boxes += 1
+                } else {
+                    near_boxes += 1
+                }
+            }
+        }
+        // Both branches were compared.
+        assert!(near_boxes > 100 && far_boxes > 100, "{near_boxes} {far_boxes}");
     }
 }
