@@ -427,9 +427,11 @@ mod tests {
                 let a = DVec3::new(next(), next(), next()) * 2.0;
                 let b = a + DVec3::new(next().abs(), next().abs(), next().abs()) * 0.3;
                 let pixels = 0.1 + next().abs();
-                let (got, want) = (box_tolerance(a, b, &view, pixels), box_tolerance_by_corners(a, b, &view, pixels));
+                let (got, want) =
+                    (box_tolerance(a, b, &view, pixels), box_tolerance_by_corners(a, b, &view, pixels));
                 assert_eq!(got.to_bits(), want.to_bits(), "camera {k}: box {a} {b}");
-                let corner = |i: usize| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b, a);
+                let corner =
+                    |i: usize| DVec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b, a);
                 let z_min = (0..8).map(|i| view.to_camera(corner(i)).z).fold(f64::INFINITY, f64::min);
                 if z_min >= view.near {
                     far_boxes += 1

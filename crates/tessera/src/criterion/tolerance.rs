@@ -67,16 +67,23 @@ static RECIPROCALS: [f64; 65] = {
     r
 };
 
+/// `1 / n`, from [`RECIPROCALS`] where it holds it (the same quotient: a division is exact
+/// to the last bit wherever it is done).
+#[inline]
+fn reciprocal(n: u32) -> f64 {
+    match RECIPROCALS.get(n as usize) {
+        Some(&r) if n > 0 => r,
+        _ => 1.0 / n as f64,
+    }
+}
+
 /// The smallest grid `(nu, nv)` (fewest cells) whose cells meet Filip's bound
 /// `(hu²·Muu + 2·hu·hv·Muv + hv²·Mvv)/8 ≤ ε`, with both factors ≤ `cap`; None if impossible.
 fn quad_grid(m: &HessianBound, eps: f64, cap: u32) -> Option<(u32, u32)> {
     // The height `hv` that columns `nu` leave each row, None where `hu` alone exceeds the
     // budget.
     let height = |nu: u32| -> Option<f64> {
-        let hu = match RECIPROCALS.get(nu as usize) {
-            Some(&r) => r,
-            None => 1.0 / nu as f64,
-        };
+        let hu = reciprocal(nu);
         let (a, b, c) = (m.vv, 2.0 * m.uv * hu, m.uu * hu * hu - 8.0 * eps);
         if c > 0.0 {
             return None;
@@ -158,13 +165,27 @@ fn ceil(x: f64) -> f64 {
 
 /// Smallest factor `n` whose uniform triangle grid meets the bound (`hu = hv = 1/n`).
 fn uniform_factor(m: &HessianBound, eps: f64) -> f64 {
-    ceil(((m.uu + 2.0 * m.uv + m.vv) / (8.0 * eps)).sqrt()).max(1.0)
+    at_least_one_root(m.uu + 2.0 * m.uv + m.vv, 8.0 * eps)
 }
 
 /// Segments a boundary curve needs on its own: `sqrt(M_edge / 8ε)` from the bound of its
 /// four control points ([`curve_bounds`]) — data both neighbours share.
 fn curve_factor(m_edge: f64, eps: f64) -> f64 {
-    ceil((m_edge / (8.0 * eps)).sqrt()).max(1.0)
+    at_least_one_root(m_edge, 8.0 * eps)
+}
+
+/// `⌈√(m / d)⌉`, at least 1, bit for bit, without the division and the root where `m ≤ d`
+/// and `d > 0`: the quotient is then at most 1 (division by a positive number rounds
+/// monotonically, and `d / d = 1`), so the root is too (or NaN) and the result is 1. In a distant view most patches need one segment an
+/// edge, and the proposals' divisions and roots (five of each a patch) were what bounded
+/// that pass. Everything else, NaN included, takes the whole expression.
+#[inline]
+fn at_least_one_root(m: f64, d: f64) -> f64 {
+    if m <= d && d > 0.0 {
+        1.0
+    } else {
+        ceil((m / d).sqrt()).max(1.0)
+    }
 }
 
 /// The four control points (and weights) of a patch's boundary curve `local`, from corner
@@ -312,7 +333,7 @@ fn core_params_bound(
 /// the grid's cells of the smaller of the two (a core grid's cells are among them). No
 /// pattern is built. Cost: O(1), or one evaluation a cell with a Taylor bound.
 fn grid_bound(m: &TriangleErrors, taylor: Option<(&TaylorBound, Domain)>, [nu, nv]: [u32; 2]) -> f64 {
-    let hessian = m.cell_error(1.0 / nu as f64, 1.0 / nv as f64);
+    let hessian = m.cell_error(reciprocal(nu), reciprocal(nv));
     match taylor {
         Some((t, domain)) => t.grid_error_within(domain == Domain::Tri, [nu, nv], hessian),
         None => hessian,
@@ -1078,6 +1099,40 @@ mod tests {
                 matches!(&e, Error::InvalidParameter { name: "tolerance", reason } if reason.starts_with(bad)),
                 "{bad:?}: {e}"
             );
+        }
+    }
+
+    /// The short cut for one segment gives the whole expression's bits: quotients just below,
+    /// at and just above 1 (where rounding could land either side), zero, huge and tiny
+    /// values, infinities and NaN; and the table's reciprocals are the divisions'.
+    #[test]
+    fn at_least_one_root_and_reciprocal_are_the_divisions_bit_for_bit() {
+        let whole = |m: f64, d: f64| ceil((m / d).sqrt()).max(1.0);
+        let mut values = vec![0.0, -0.0, 1e-300, 5e-324, 1e300, f64::MAX, f64::INFINITY, f64::NAN, -1.0];
+        let mut x = 1e-12;
+        while x < 1e12 {
+            values.push(x);
+            x *= 1.37;
+        }
+        let mut pairs = 0;
+        for &d in &values {
+            for &m in &values {
+                assert_eq!(at_least_one_root(m, d).to_bits(), whole(m, d).to_bits(), "{m} / {d}");
+                pairs += 1;
+            }
+            // Around m = d, a few ulps either way, and around the squares of 2 and 3.
+            for scale in [1.0, 4.0, 9.0] {
+                let centre = d * scale;
+                for k in -4i64..=4 {
+                    let m = f64::from_bits((centre.to_bits() as i64 + k).max(0) as u64);
+                    assert_eq!(at_least_one_root(m, d).to_bits(), whole(m, d).to_bits(), "{m} / {d}");
+                    pairs += 1;
+                }
+            }
+        }
+        assert!(pairs > 10_000);
+        for n in 0..200u32 {
+            assert_eq!(reciprocal(n).to_bits(), (1.0 / n as f64).to_bits(), "{n}");
         }
     }
 
