@@ -410,13 +410,8 @@ mod tests {
     /// from seeded cameras.
     #[test]
     fn box_tolerance_equals_the_corner_by_corner_form_bit_for_bit() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = crate::test_support::Lcg(2026);
+        let mut next = move || rng.unit53() * 2.0 - 1.0;
         let (mut near_boxes, mut far_boxes) = (0, 0);
         for k in 0..200 {
             let mut camera = Camera::framing(DVec3::splat(-1.0), DVec3::splat(1.0), 1280, 1024);
