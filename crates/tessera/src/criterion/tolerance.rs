@@ -617,7 +617,7 @@ pub(crate) fn plan_limited(
         computed_curves = curve_bounds(set, hessians);
         &computed_curves
     };
-    let mut report = BoundReport { culled: eps.iter().filter(|e| e.is_none()).count(), ..Default::default() };
+    let mut report = BoundReport::default();
     let Scratch {
         proposals,
         changed,
@@ -672,17 +672,32 @@ pub(crate) fn plan_limited(
     plan.depths.clear();
     plan.lattice_offsets.clear();
     plan.lattice.clear();
-    plan.visible.clear();
-    plan.visible.extend(eps.iter().map(|e| u32::from(e.is_some())));
+    // The per-patch rows are written in parallel, each element once (`resize` keeps a row of
+    // the right length as it is): on two threads a sequential pass over 92,160 patches was
+    // a pass the second core idled through.
+    plan.visible.resize(patches, 0);
+    report.culled = plan
+        .visible
+        .par_iter_mut()
+        .zip(eps)
+        .map(|(v, e)| {
+            *v = u32::from(e.is_some());
+            usize::from(e.is_none())
+        })
+        .sum();
     resolve::edges(set, proposals, rule, interior, &caps, &mut plan.segments, &mut plan.factors);
     if per_patch.len() != patches {
         per_patch.clear();
         per_patch.extend((0..patches).map(|_| AtomicU64::new(0)));
     }
-    per_patch.iter_mut().for_each(|c| *c.get_mut() = 0);
+    if max_triangles != u64::MAX {
+        // Only a limit reads them (`Limit::admit`, `Limit::reserve`).
+        per_patch.par_iter_mut().for_each(|c| *c.get_mut() = 0);
+    }
     let limit = Limit::new(pattern, max_triangles, per_patch);
     which.clear();
-    which.extend(0..patches);
+    which.resize(patches, 0);
+    which.par_iter_mut().enumerate().for_each(|(i, w)| *w = i);
     let mut check =
         |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>, keep| {
             let inputs =
@@ -735,20 +750,22 @@ pub(crate) fn plan_limited(
             results[p] = rechecked[i];
         }
     }
-    for (p, r) in results.iter().enumerate() {
-        if let Some(e) = eps[p] {
-            report.worst_bound = report.worst_bound.max(r.1);
-            report.worst_ratio = report.worst_ratio.max(r.1 / e);
-            if r.2 {
-                report.capped_patches += 1;
-            }
-        }
-    }
     limit.result()?;
-    plan.interior.clear();
-    plan.interior.extend(results.iter().map(|r| r.0));
-    plan_counts.clear();
-    plan_counts.extend(results.iter().map(|r| r.3));
+    // The plan's interiors, the counts and the report's figures in one parallel pass (the
+    // largest of bounds is the same in any order).
+    plan.interior.resize(patches, [0; 2]);
+    plan_counts.resize(patches, (0, 0));
+    let rows = plan.interior.par_iter_mut().zip(plan_counts.par_iter_mut()).zip(results.par_iter()).zip(eps);
+    let (worst_bound, worst_ratio, capped) = rows
+        .map(|(((interior, counts), r), e)| {
+            (*interior, *counts) = (r.0, r.3);
+            match e {
+                Some(e) => (r.1, r.1 / e, usize::from(r.2)),
+                None => (0.0, 0.0, 0),
+            }
+        })
+        .reduce(|| (0.0, 0.0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2 + b.2));
+    (report.worst_bound, report.worst_ratio, report.capped_patches) = (worst_bound, worst_ratio, capped);
     // The check's inputs carry the segments as their factors: the engine's, except under a
     // fractional rule, whose patterns read the real factors.
     *counts_fresh = !matches!(rule, EdgeRule::Fractional(_));
