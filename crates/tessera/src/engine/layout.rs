@@ -149,26 +149,36 @@ impl Layout {
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
-        if let Some(counts) = counts {
-            debug_assert!((0..set.patches.len()).all(|p| {
-                counts[p]
-                    == if plan.is_visible(p) { pattern.counts(&pattern_input(set, plan, p)) } else { (0, 0) }
-            }));
-            self.counts.clear();
-            self.counts.extend_from_slice(counts);
-        } else {
-            self.count_patterns(set, plan, pattern);
-        }
-        let interior: u64 = self.counts.iter().map(|c| c.0 as u64).sum();
-        let upper: u64 = self.counts.iter().map(|c| c.1 as u64).sum();
+        // The check's counts are read where they are (no copy); the layout counts only
+        // without them.
+        let counts: &[(u32, u32)] = match counts {
+            Some(counts) => {
+                debug_assert!((0..set.patches.len()).all(|p| {
+                    counts[p]
+                        == if plan.is_visible(p) {
+                            pattern.counts(&pattern_input(set, plan, p))
+                        } else {
+                            (0, 0)
+                        }
+                }));
+                counts
+            }
+            None => {
+                self.count_patterns(set, plan, pattern);
+                &self.counts
+            }
+        };
+        let (interior, upper) =
+            counts.iter().fold((0u64, 0u64), |(v, t), c| (v + c.0 as u64, t + c.1 as u64));
         check_size(total + interior, upper, options)?;
-        let generation = super::next_generation();
-        self.kept.clear();
-        if topo.one_shape.is_some() {
+        // Scans: both totals fit u32 now (check_size).
+        let offsets = (&mut self.interior_offsets, &mut self.triangle_offsets);
+        let triangles = if topo.one_shape.is_some() {
             // No patch has a repeated corner: every triangle is kept.
-            self.kept.extend(self.counts.iter().map(|c| c.1));
+            scan_counts(total as u32, counts.iter().copied(), offsets)
         } else {
-            self.counts
+            let generation = super::next_generation();
+            counts
                 .par_iter()
                 .enumerate()
                 .map(|(p, &(_, t))| {
@@ -183,19 +193,8 @@ impl Layout {
                     })
                 })
                 .collect_into_vec(&mut self.kept);
-        }
-        // Scan: both totals fit u32 now (check_size).
-        self.interior_offsets.clear();
-        self.triangle_offsets.clear();
-        let (mut vertices, mut triangles) = (total as u32, 0u32);
-        for (&(v, _), &t) in self.counts.iter().zip(&self.kept) {
-            self.interior_offsets.push(vertices);
-            self.triangle_offsets.push(triangles);
-            vertices += v;
-            triangles += t;
-        }
-        self.interior_offsets.push(vertices);
-        self.triangle_offsets.push(triangles);
+            scan_counts(total as u32, counts.iter().zip(&self.kept).map(|(&(v, _), &t)| (v, t)), offsets)
+        };
         self.collapsed_triangles = upper - triangles as u64;
         Ok(())
     }
@@ -224,6 +223,29 @@ impl Layout {
             )
             .collect_into_vec(&mut self.counts);
     }
+}
+
+/// The patches' first interior vertex and first triangle (`P + 1` entries each, written
+/// into `interior` and `triangles`, cleared first) from their `(vertices, triangles)`, the
+/// vertices after `start`; returns the triangle total. Precondition: the totals fit `u32`.
+/// Cost: O(P), sequential.
+fn scan_counts(
+    start: u32,
+    counts: impl Iterator<Item = (u32, u32)>,
+    (interior, triangles): (&mut Vec<u32>, &mut Vec<u32>),
+) -> u32 {
+    interior.clear();
+    triangles.clear();
+    let (mut v, mut t) = (start, 0u32);
+    for (vertices, kept) in counts {
+        interior.push(v);
+        triangles.push(t);
+        v += vertices;
+        t += kept;
+    }
+    interior.push(v);
+    triangles.push(t);
+    t
 }
 
 impl Layout {
