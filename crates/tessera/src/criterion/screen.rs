@@ -217,8 +217,8 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
 /// The object-space tolerance of a patch whose control points lie in the world box
 /// `lo..hi`, for `pixels` of screen error from `view`: the box's eight corners in camera
 /// space, the nearest depth and the widest ratios to it bound every point's screen scale.
-/// The rule of [`PatchView::tolerance`] and of [`tolerances_into`]. Cost: eight point
-/// transforms, sixteen divisions.
+/// The rule of [`PatchView::tolerance`] and of [`tolerances_into`]. Cost: 18 products for
+/// the eight corners, sixteen divisions.
 pub fn box_tolerance(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
     let t = view.half_tangents;
     // Camera-space corners of the world-space box around the control points, one array per

@@ -8,6 +8,7 @@
 //! Interior factors are private to a patch and may be raised freely.
 
 use super::bounds::{self, HessianBound, TriangleErrors, TriangleShape};
+use super::pattern_shapes::PatternShapes;
 use super::resolve::{self, EdgeRule, InteriorRule};
 use super::taylor::TaylorBound;
 use super::{Plan, Prepared};
@@ -176,9 +177,10 @@ fn curve_factor(m_edge: f64, eps: f64) -> f64 {
 
 /// `⌈√(m / d)⌉`, at least 1, bit for bit, without the division and the root where `m ≤ d`
 /// and `d > 0`: the quotient is then at most 1 (division by a positive number rounds
-/// monotonically, and `d / d = 1`), so the root is too (or NaN) and the result is 1. In a distant view most patches need one segment an
-/// edge, and the proposals' divisions and roots (five of each a patch) were what bounded
-/// that pass. Everything else, NaN included, takes the whole expression.
+/// monotonically, and `d / d = 1`), so the root is too (or NaN) and the result is 1. In a
+/// distant view most patches need one segment an edge, and the proposals' divisions and
+/// roots (five of each a patch) were what bounded that pass. Everything else, NaN included,
+/// takes the whole expression.
 #[inline]
 fn at_least_one_root(m: f64, d: f64) -> f64 {
     if m <= d && d > 0.0 {
@@ -690,12 +692,11 @@ pub(crate) fn plan_limited(
         per_patch.clear();
         per_patch.extend((0..patches).map(|_| AtomicU64::new(0)));
     }
-    if max_triangles != u64::MAX {
-        // Only a limit reads them (`Limit::admit`, `Limit::reserve`).
-        per_patch.par_iter_mut().for_each(|c| *c.get_mut() = 0);
-    }
     let limit = Limit::new(pattern, max_triangles, per_patch);
-    which.clear();
+    if !limit.unlimited() {
+        // Only a limit reads them (`Limit::admit`, `Limit::reserve`).
+        limit.per_patch.par_iter().for_each(|c| c.store(0, Ordering::Relaxed));
+    }
     which.resize(patches, 0);
     which.par_iter_mut().enumerate().for_each(|(i, w)| *w = i);
     let mut check =
@@ -1019,88 +1020,90 @@ fn check_patches(
     // allocates none here).
     let generation = crate::pattern::cache::next_generation();
     out.resize(which.len(), ([1; 2], 0.0, false, (0, 0)));
+    // One patch's check: its first pattern, then larger interiors until the bound is met,
+    // the cap is reached or the bound stops shrinking. `table` is the thread's pattern-shape
+    // table (`i` the patch's place in `which`).
+    let check_one = |i: usize, p: usize, (domain, seg, first): First, table: &mut PatternShapes| -> Check {
+        let mut interior = first;
+        if !admitted {
+            return (interior, f64::INFINITY, true, (0, 0));
+        }
+        let Some(e) = eps[p] else { return (interior, 0.0, false, (0, 0)) };
+        let mut previous = f64::INFINITY;
+        loop {
+            let input = input_of(p, domain, seg, interior);
+            if !limit.admit(p, &input) {
+                // The output could not hold this pattern; the plan is refused at the end.
+                return (interior, f64::INFINITY, true, (0, 0));
+            }
+            let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
+            // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
+            // its triangles (not with a Taylor bound, which needs their places).
+            let small = match taylor {
+                Some(_) => None,
+                None => table.get(generation, limit.pattern, &input).map(|data| {
+                    let bound = match data.grid {
+                        Some(cells) => grid_bound(&errors[p], None, cells),
+                        None => {
+                            let core = core_bound(&errors[p], None, data.core);
+                            shapes_bound(&errors[p], data.shapes.iter().copied(), core)
+                        }
+                    };
+                    (bound, data.counts)
+                }),
+            };
+            let counts = || small.map_or_else(|| limit.pattern.counts(&input), |s| s.1);
+            let bound = match small {
+                Some((bound, _)) => bound,
+                None => {
+                    let cached = patterns.params(i).filter(|_| interior == first);
+                    match (limit.pattern.grid_cells(&input), cached) {
+                        // A pure grid (no strips): bounded from its cells, no build.
+                        (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
+                        (None, Some((cached, params))) => {
+                            let core = limit.pattern.core_cells(&input);
+                            // The cache leaves out the triangles of a core grid.
+                            let rest = match cached.core {
+                                Some(_) => &cached.local.triangles[..],
+                                None => after_core(core, &cached.local.triangles),
+                            };
+                            core_params_bound(&errors[p], taylor, core, rest, params)
+                        }
+                        // Neighbouring patches often share an input: the thread's last
+                        // pattern is reused when it is the same.
+                        (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
+                            let slot = recent.get(generation, limit.pattern, &input, true);
+                            let core = limit.pattern.core_cells(&input);
+                            let rest = after_core(core, &slot.local.triangles);
+                            core_params_bound(&errors[p], taylor, core, rest, slot.params())
+                        }),
+                    }
+                }
+            };
+            if bound <= e * (1.0 + 1e-9) {
+                return (interior, bound, false, counts());
+            }
+            // No progress means the worst triangles follow the edges, not the core.
+            let stuck = bound >= previous * (1.0 - 1e-9);
+            if layout == InteriorRule::Global || interior[0].max(interior[1]) >= cap || stuck {
+                return (interior, bound, true, counts());
+            }
+            previous = bound;
+            let grow = (bound / e).sqrt().max(1.05);
+            interior = interior.map(|n| ((n as f64 * grow).ceil() as u32).clamp(n + 1, cap));
+            if layout == InteriorRule::Level {
+                interior = interior.map(|n| n.next_power_of_two().min(cap));
+            }
+        }
+    };
     // In runs of patches, so that a run asks for its thread's pattern table once (a
     // thread-local borrow per patch was 2–3 % of the torus grid's frame).
     const RUN: usize = 256;
     let runs = out.par_chunks_mut(RUN).zip(which.par_chunks(RUN)).zip(firsts.par_chunks(RUN)).enumerate();
     runs.for_each(|(run, ((outs, patches), firsts))| {
         super::pattern_shapes::with_pattern_shapes(|table| {
-            let items = outs.iter_mut().zip(patches).zip(firsts).enumerate();
-            for (k, ((o, &p), &(domain, seg, interior))) in items {
-                let i = run * RUN + k;
-                let first = interior;
-                let mut interior = interior;
-                *o = (|| {
-                    if !admitted {
-                        return (interior, f64::INFINITY, true, (0, 0));
-                    }
-                    let Some(e) = eps[p] else { return (interior, 0.0, false, (0, 0)) };
-                    let mut previous = f64::INFINITY;
-                    loop {
-                        let input = input_of(p, domain, seg, interior);
-                        if !limit.admit(p, &input) {
-                            // The output could not hold this pattern; the plan is refused at the end.
-                            return (interior, f64::INFINITY, true, (0, 0));
-                        }
-                        let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
-                        // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
-                        // its triangles (not with a Taylor bound, which needs their places).
-                        let from_table = |table: &mut super::pattern_shapes::PatternShapes| {
-                            let data = table.get(generation, limit.pattern, &input)?;
-                            let bound = match data.grid {
-                                Some(cells) => grid_bound(&errors[p], None, cells),
-                                None => {
-                                    let core = core_bound(&errors[p], None, data.core);
-                                    shapes_bound(&errors[p], data.shapes.iter().copied(), core)
-                                }
-                            };
-                            Some((bound, data.counts))
-                        };
-                        let small = taylor.is_none().then(|| from_table(table)).flatten();
-                        let counts = || small.map_or_else(|| limit.pattern.counts(&input), |s| s.1);
-                        let bound = match small {
-                            Some((bound, _)) => bound,
-                            None => {
-                                let cached = patterns.params(i).filter(|_| interior == first);
-                                match (limit.pattern.grid_cells(&input), cached) {
-                                    // A pure grid (no strips): bounded from its cells, no build.
-                                    (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
-                                    (None, Some((cached, params))) => {
-                                        let core = limit.pattern.core_cells(&input);
-                                        // The cache leaves out the triangles of a core grid.
-                                        let rest = match cached.core {
-                                            Some(_) => &cached.local.triangles[..],
-                                            None => after_core(core, &cached.local.triangles),
-                                        };
-                                        core_params_bound(&errors[p], taylor, core, rest, params)
-                                    }
-                                    // Neighbouring patches often share an input: the thread's last
-                                    // pattern is reused when it is the same.
-                                    (None, None) => crate::pattern::cache::with_recent_patterns(|recent| {
-                                        let slot = recent.get(generation, limit.pattern, &input, true);
-                                        let core = limit.pattern.core_cells(&input);
-                                        let rest = after_core(core, &slot.local.triangles);
-                                        core_params_bound(&errors[p], taylor, core, rest, slot.params())
-                                    }),
-                                }
-                            }
-                        };
-                        if bound <= e * (1.0 + 1e-9) {
-                            return (interior, bound, false, counts());
-                        }
-                        // No progress means the worst triangles follow the edges, not the core.
-                        let stuck = bound >= previous * (1.0 - 1e-9);
-                        if layout == InteriorRule::Global || interior[0].max(interior[1]) >= cap || stuck {
-                            return (interior, bound, true, counts());
-                        }
-                        previous = bound;
-                        let grow = (bound / e).sqrt().max(1.05);
-                        interior = interior.map(|n| ((n as f64 * grow).ceil() as u32).clamp(n + 1, cap));
-                        if layout == InteriorRule::Level {
-                            interior = interior.map(|n| n.next_power_of_two().min(cap));
-                        }
-                    }
-                })();
+            for (k, ((o, &p), &f)) in outs.iter_mut().zip(patches).zip(firsts).enumerate() {
+                *o = check_one(run * RUN + k, p, f, table);
             }
         });
     });
