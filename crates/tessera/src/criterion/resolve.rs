@@ -155,9 +155,8 @@ pub fn edges(
     use rayon::prelude::*;
     let topo = &set.topology;
     let edges = topo.edges.len();
-    segments.clear();
+    // Every entry is written below: no clearing pass first (on the main thread alone).
     segments.resize(edges, 0);
-    factors.clear();
     factors.resize(edges, 0.0);
     // Every edge on its own: parallel, in runs large enough to outweigh the scheduling, each
     // a plain loop with the rule's arm chosen once (`edge` inlined into each arm; called per

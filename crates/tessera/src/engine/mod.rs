@@ -281,10 +281,14 @@ pub(crate) fn write_buffers(
         },
         || patches_pass(patch_part, Pass::Vertices { stream }),
     );
-    // Split-normal entries take the position bits of their vertex's first entry.
-    for (i, entry) in topo.corner_entries.iter().enumerate() {
-        if entry.position_entry as usize != i {
-            positions[i] = positions[entry.position_entry as usize];
+    // Split-normal entries take the position bits of their vertex's first entry. (A vertex
+    // has one entry, or more where its normals split: without splits, no pass on the main
+    // thread alone.)
+    if topo.corner_entries.len() != topo.vertex_count as usize {
+        for (i, entry) in topo.corner_entries.iter().enumerate() {
+            if entry.position_entry as usize != i {
+                positions[i] = positions[entry.position_entry as usize];
+            }
         }
     }
     let vertices_done = std::time::Instant::now();
