@@ -208,7 +208,7 @@ const fn gregory_interior() -> [(usize, f64, PointDifferences); 3] {
 /// A Bézier triangle of degree `d` (`N` control points; `M` those of degree `d − 1`: cubic
 /// `<10, 6>`, quartic `<15, 10>`) in its local frame, with the multinomial coefficients folded
 /// into the control points so that each sum is over bare monomials.
-pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6, F: NormalField = PnField> {
+pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6> {
     origin: [f32; 3],
     scale: f32,
     /// `pos[c][m] = d!/(i!j!k!) · b_ijk`, component `c`, `m` in [`exponents`] order.
@@ -218,38 +218,22 @@ pub(crate) struct LocalTriangle<const N: usize = 10, const M: usize = 6, F: Norm
     du: [[f32; M]; 3],
     /// Likewise with `b_{i,j,k+1}`.
     dv: [[f32; M]; 3],
-    /// The PN normal field, where the kind has one ([`NormalField`]).
-    pn: F,
 }
 
-/// A quartic Bézier triangle in its local frame: Loop's regular pieces. No normal field:
-/// Loop's trees keep a form per leaf ([`PointBlocks`]), 76 bytes fewer each to stream.
-pub(crate) type LocalQuartic = LocalTriangle<15, 10, ()>;
+/// A quartic Bézier triangle in its local frame: Loop's regular pieces.
+pub(crate) type LocalQuartic = LocalTriangle<15, 10>;
 
-/// What a [`LocalTriangle`] holds of a PN normal field.
-pub(crate) trait NormalField: Default {
-    /// The field's coefficients `[c][m]` in [`PN_NORMAL`] order; None for a plain Bézier
-    /// triangle (normal from the derivatives).
-    fn field(&self) -> Option<&[[f32; 6]; 3]>;
-}
-
-/// A cubic triangle's field: PN triangles have one, Bézier triangles none (they share the
-/// form so that one vector holds both).
-pub(crate) type PnField = Option<[[f32; 6]; 3]>;
-
-impl NormalField for PnField {
-    #[inline(always)]
-    fn field(&self) -> Option<&[[f32; 6]; 3]> {
-        self.as_ref()
-    }
-}
-
-/// No field (quartic triangles).
-impl NormalField for () {
-    #[inline(always)]
-    fn field(&self) -> Option<&[[f32; 6]; 3]> {
-        None
-    }
+/// A PN triangle in its local frame: its cubic's positions as [`LocalTriangle`]'s, and its
+/// quadratic normal field in place of the derivatives, which it never reads. 212 bytes
+/// where the triangle's form with both took 356: a frame of many small patterns (the
+/// killeroo herd: 91,476 forms, past the cache) reads each form in two passes.
+pub(crate) struct LocalPn {
+    origin: [f32; 3],
+    scale: f32,
+    /// As [`LocalTriangle`]'s.
+    pos: [[f32; 10]; 3],
+    /// The normal field's coefficients `[c][m]`, `m` in [`PN_NORMAL`] order.
+    field: [[f32; 6]; 3],
 }
 
 /// A Gregory patch (Catmull-Clark's end caps, [`GregoryPatch`]) in its local frame, the
@@ -306,7 +290,7 @@ impl LocalGregory {
     }
 }
 
-impl<const N: usize, const M: usize, F: NormalField> LocalTriangle<N, M, F> {
+impl<const N: usize, const M: usize> LocalTriangle<N, M> {
     /// The Bézier triangle of degree `d` with control points `net` in [`exponents`] order.
     /// Cost: O(N), every index and coefficient a constant. Inlined: the grouped leaves
     /// (`tree_points`) make one a group, in their caller's instructions, where it was a
@@ -328,7 +312,6 @@ impl<const N: usize, const M: usize, F: NormalField> LocalTriangle<N, M, F> {
             pos: [[0.0; N]; 3],
             du: [[0.0; M]; 3],
             dv: [[0.0; M]; 3],
-            pn: F::default(),
         };
         let coefficients = const { multinomials::<N>() };
         for (m, (&q, &c)) in net.iter().zip(&coefficients).enumerate() {
@@ -350,18 +333,17 @@ impl<const N: usize, const M: usize, F: NormalField> LocalTriangle<N, M, F> {
     }
 }
 
-impl LocalTriangle {
-    fn new(t: &BezierTriangle, pn_normals: Option<&[DVec3; 6]>) -> LocalTriangle {
-        let mut local = LocalTriangle::from_net(&t.points);
-        local.pn = pn_normals.map(|n| {
-            let mut out = [[0.0; 6]; 3];
-            for (m, n) in n.iter().enumerate() {
-                let n = n.as_vec3().to_array();
-                (0..3).for_each(|a| out[a][m] = n[a]);
-            }
-            out
-        });
-        local
+impl LocalPn {
+    /// The PN triangle of geometry `t` and normal field `normals`, its positions as
+    /// [`LocalTriangle::from_net`] makes them. Cost: O(1).
+    fn new(t: &BezierTriangle, normals: &[DVec3; 6]) -> LocalPn {
+        let LocalTriangle { origin, scale, pos, .. } = LocalTriangle::<10, 6>::from_net(&t.points);
+        let mut field = [[0.0; 6]; 3];
+        for (m, n) in normals.iter().enumerate() {
+            let n = n.as_vec3().to_array();
+            (0..3).for_each(|a| field[a][m] = n[a]);
+        }
+        LocalPn { origin, scale, pos, field }
     }
 }
 
@@ -373,6 +355,7 @@ enum Local {
     Bicubic(u32),
     Rational(u32),
     Triangle(u32),
+    Pn(u32),
     /// A regular Loop patch (one quartic piece).
     Quartic(u32),
     /// An irregular Loop patch: its tree's leaves start there in [`PointBlocks`]' `loop_leaves`.
@@ -395,6 +378,7 @@ enum FormRef<'a> {
     Bicubic(&'a LocalPatch),
     Rational(&'a LocalPatch<4>),
     Triangle(&'a LocalTriangle),
+    Pn(&'a LocalPn),
     Quartic(&'a LocalQuartic),
 }
 
@@ -403,6 +387,7 @@ enum Form {
     Bicubic(LocalPatch),
     Rational(LocalPatch<4>),
     Triangle(LocalTriangle),
+    Pn(LocalPn),
     Quartic(LocalQuartic),
     /// A Loop tree whose leaves' forms the set keeps (made after every patch's form, into
     /// their place in [`PointBlocks`]' vector).
@@ -434,6 +419,7 @@ pub(crate) struct PointBlocks {
     bicubics: Vec<LocalPatch>,
     rationals: Vec<LocalPatch<4>>,
     triangles: Vec<LocalTriangle>,
+    pns: Vec<LocalPn>,
     quartics: Vec<LocalQuartic>,
     /// Every leaf of each irregular Loop patch's tree, in its local frame, the trees in patch
     /// order: made once per set rather than once for every list of points that reaches a leaf
@@ -765,8 +751,8 @@ fn lambda_powers<const L: usize>(d: usize, u: &[f32; L], v: &[f32; L]) -> [[[f32
 /// A Bézier triangle's `∂S/∂u` and `∂S/∂v` (local frame) of each lane, from its
 /// [`lambda_powers`].
 #[inline(always)]
-fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize, F: NormalField>(
-    t: &LocalTriangle<N, M, F>,
+fn derivative_sums<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
     powers: &[[[f32; L]; 5]; 3],
 ) -> [[[f32; L]; 3]; 2] {
     let lower = monomials(powers, &const { exponents::<M>() });
@@ -822,7 +808,7 @@ pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
     let powers = lambda_powers::<L>(4, u, v);
     let basis = monomials(&powers, &const { exponents::<15>() });
     let mut pos = combine::<FMA, L, 15>(&g.net.pos, &basis);
-    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10, _>(&g.net, &powers);
+    let [mut su, mut sv] = derivative_sums::<FMA, L, 15, 10>(&g.net, &powers);
     let lower = monomials(&powers, &const { exponents::<10>() });
     let mut weights = [[0f32; L]; 3];
     for l in 0..L {
@@ -852,42 +838,54 @@ pub(crate) fn gregory_block<const FMA: bool, const L: usize>(
     Block { pos, nrm, margin }
 }
 
-/// A Bézier triangle (cubic, quartic) or a PN triangle at each lane's `(u, v)`.
+/// A Bézier triangle (cubic, quartic) at each lane's `(u, v)`: normals from the derivatives.
 #[inline(always)]
-pub(crate) fn triangle_block<
-    const FMA: bool,
-    const L: usize,
-    const N: usize,
-    const M: usize,
-    F: NormalField,
->(
-    t: &LocalTriangle<N, M, F>,
+pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, const M: usize>(
+    t: &LocalTriangle<N, M>,
     u: &[f32; L],
     v: &[f32; L],
 ) -> Block<L> {
+    triangle_lanes::<FMA, L, N>(&t.pos, (&t.origin, t.scale), u, v, |powers| {
+        let [su, sv] = derivative_sums::<FMA, L, N, M>(t, powers);
+        cross_normals(&su, &sv)
+    })
+}
+
+/// A PN triangle at each lane's `(u, v)`: normals from its quadratic field, normalised.
+#[inline(always)]
+pub(crate) fn pn_block<const FMA: bool, const L: usize>(t: &LocalPn, u: &[f32; L], v: &[f32; L]) -> Block<L> {
+    triangle_lanes::<FMA, L, 10>(&t.pos, (&t.origin, t.scale), u, v, |powers| {
+        let mut n = combine::<FMA, L, 6>(&t.field, &monomials(powers, &PN_NORMAL));
+        let mut margin = [0f32; L];
+        let [nx, ny, nz] = &mut n;
+        for l in 0..L {
+            let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
+            margin[l] = n2 - MIN_PN_NORMAL2;
+            let inv = 1.0 / n2.sqrt();
+            nx[l] *= inv;
+            ny[l] *= inv;
+            nz[l] *= inv;
+        }
+        (n, margin)
+    })
+}
+
+/// The lanes of a triangle form of `N` control points `pos` (in the local frame `(origin,
+/// scale)`): positions from the monomials of each lane's `(u, v)`, normals and margins by
+/// `normals` from the lanes' [`lambda_powers`] — the rule [`triangle_block`] and
+/// [`pn_block`] share.
+#[inline(always)]
+fn triangle_lanes<const FMA: bool, const L: usize, const N: usize>(
+    pos: &[[f32; N]; 3],
+    (origin, scale): (&[f32; 3], f32),
+    u: &[f32; L],
+    v: &[f32; L],
+    normals: impl FnOnce(&[[[f32; L]; 5]; 3]) -> ([[f32; L]; 3], [f32; L]),
+) -> Block<L> {
     let powers = lambda_powers::<L>(const { degree(N) }, u, v);
-    let mut pos = combine::<FMA, L, N>(&t.pos, &monomials(&powers, &const { exponents::<N>() }));
-    let (nrm, margin) = match t.pn.field() {
-        None => {
-            let [su, sv] = derivative_sums::<FMA, L, N, M, _>(t, &powers);
-            cross_normals(&su, &sv)
-        }
-        Some(field) => {
-            let mut n = combine::<FMA, L, 6>(field, &monomials(&powers, &PN_NORMAL));
-            let mut margin = [0f32; L];
-            let [nx, ny, nz] = &mut n;
-            for l in 0..L {
-                let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
-                margin[l] = n2 - MIN_PN_NORMAL2;
-                let inv = 1.0 / n2.sqrt();
-                nx[l] *= inv;
-                ny[l] *= inv;
-                nz[l] *= inv;
-            }
-            (n, margin)
-        }
-    };
-    to_model::<FMA, L>(&mut pos, &t.origin, t.scale);
+    let mut pos = combine::<FMA, L, N>(pos, &monomials(&powers, &const { exponents::<N>() }));
+    let (nrm, margin) = normals(&powers);
+    to_model::<FMA, L>(&mut pos, origin, scale);
     Block { pos, nrm, margin }
 }
 
@@ -925,8 +923,8 @@ impl PointBlocks {
             .map(|p| match p {
                 Patch::Bicubic(b) if b.is_polynomial() => Form::Bicubic(LocalPatch::new(b)),
                 Patch::Bicubic(b) => LocalPatch::rational(b).map_or(Form::Generic, Form::Rational),
-                Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::new(t, None)),
-                Patch::Pn(t) => Form::Triangle(LocalTriangle::new(&t.geometry, Some(&t.normals))),
+                Patch::BezierTriangle(t) => Form::Triangle(LocalTriangle::from_net(&t.points)),
+                Patch::Pn(t) => Form::Pn(LocalPn::new(&t.geometry, &t.normals)),
                 // A regular Loop triangle is one quartic piece, in the patch's parameters.
                 Patch::Loop(t) => match t.regular_net() {
                     Some(q) => Form::Quartic(LocalQuartic::from_net(&q.points)),
@@ -943,6 +941,7 @@ impl PointBlocks {
             bicubics: Vec::new(),
             rationals: Vec::new(),
             triangles: Vec::new(),
+            pns: Vec::new(),
             quartics: Vec::new(),
             loop_leaves: Vec::new(),
             tree_forms: Vec::new(),
@@ -962,6 +961,7 @@ impl PointBlocks {
                 Form::Bicubic(b) => Local::Bicubic(push(&mut blocks.bicubics, b)),
                 Form::Rational(r) => Local::Rational(push(&mut blocks.rationals, r)),
                 Form::Triangle(t) => Local::Triangle(push(&mut blocks.triangles, t)),
+                Form::Pn(t) => Local::Pn(push(&mut blocks.pns, t)),
                 Form::Quartic(t) => Local::Quartic(push(&mut blocks.quartics, t)),
                 Form::LoopTree => {
                     let Patch::Loop(tree) = &set.patches[p] else { unreachable!("a Loop patch's form") };
@@ -1010,7 +1010,7 @@ impl PointBlocks {
         match self.form(p)? {
             FormRef::Bicubic(local) => Some(GridPatch::Polynomial(local)),
             FormRef::Rational(local) => Some(GridPatch::Rational(local)),
-            FormRef::Triangle(_) | FormRef::Quartic(_) => None,
+            FormRef::Triangle(_) | FormRef::Pn(_) | FormRef::Quartic(_) => None,
         }
     }
 
@@ -1040,6 +1040,7 @@ impl PointBlocks {
             Local::Bicubic(i) => FormRef::Bicubic(&self.bicubics[i as usize]),
             Local::Rational(i) => FormRef::Rational(&self.rationals[i as usize]),
             Local::Triangle(i) => FormRef::Triangle(&self.triangles[i as usize]),
+            Local::Pn(i) => FormRef::Pn(&self.pns[i as usize]),
             Local::Quartic(i) => FormRef::Quartic(&self.quartics[i as usize]),
             Local::LoopTree(_) | Local::CatmarkTree { .. } | Local::Generic => return None,
         })
@@ -1054,10 +1055,11 @@ impl PointBlocks {
     #[inline(always)]
     pub(crate) fn prefetch_form(&self, p: usize) {
         use crate::surface::patch_tree::prefetch_slice;
-        if self.triangles.is_empty() && self.quartics.is_empty() {
+        if self.triangles.is_empty() && self.pns.is_empty() && self.quartics.is_empty() {
             return;
         }
         match self.locals.get(p) {
+            Some(Local::Pn(i)) => prefetch_slice(std::slice::from_ref(&self.pns[*i as usize])),
             Some(Local::Triangle(i)) => prefetch_slice(std::slice::from_ref(&self.triangles[*i as usize])),
             Some(Local::Quartic(i)) => prefetch_slice(std::slice::from_ref(&self.quartics[*i as usize])),
             _ => {}
@@ -1285,8 +1287,9 @@ impl PointBlocks {
             let block = match form {
                 FormRef::Bicubic(b) => bicubic_block::<FMA, L>(b, &u, &v),
                 FormRef::Rational(r) => rational_block::<FMA, L>(r, &u, &v),
-                FormRef::Triangle(t) => triangle_block::<FMA, L, 10, 6, _>(t, &u, &v),
-                FormRef::Quartic(t) => triangle_block::<FMA, L, 15, 10, _>(t, &u, &v),
+                FormRef::Triangle(t) => triangle_block::<FMA, L, 10, 6>(t, &u, &v),
+                FormRef::Pn(t) => pn_block::<FMA, L>(t, &u, &v),
+                FormRef::Quartic(t) => triangle_block::<FMA, L, 15, 10>(t, &u, &v),
             };
             for (l, (pos, nrm)) in pos.iter_mut().zip(nrm).enumerate() {
                 (*pos, *nrm) = block.lane_or_exact(l, set, p, uv[l]);

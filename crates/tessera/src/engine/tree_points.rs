@@ -289,7 +289,7 @@ impl LeafTree for TriangleTree {
     #[inline(always)]
     fn block<const FMA: bool, const L: usize>(local: &LoopLeaf, u: &[f32; L], v: &[f32; L]) -> Block<L> {
         match local {
-            LoopLeaf::Quartic(q) => triangle_block::<FMA, L, 15, 10, _>(q, u, v),
+            LoopLeaf::Quartic(q) => triangle_block::<FMA, L, 15, 10>(q, u, v),
             LoopLeaf::Gregory(g) => gregory_block::<FMA, L>(g, u, v),
         }
     }
