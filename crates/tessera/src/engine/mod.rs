@@ -560,7 +560,7 @@ impl Writer<'_> {
                 continue;
             }
             // The form of the owner a few edges ahead, asked for in time: a frame of many
-            // small patterns reads its forms from memory (the killeroo herd's, 33 MB).
+            // small patterns reads its forms from memory (the killeroo herd's, 19 MB).
             if let Some(f) = self.fast.filter(|_| e + FORM_LEAD < self.set.topology.edges.len()) {
                 f.points().prefetch_form(self.set.topology.edge_uses(e + FORM_LEAD)[0].patch as usize);
             }
