@@ -80,8 +80,17 @@ impl PatchView {
             -c.y - t.y * c.z,
         ];
         // Rounding of the transforms is far below this margin.
-        let margin = self.radius + 1e-9 * (self.radius + c.length() + view.far);
+        let margin_of = |length: f64| self.radius + 1e-9 * (self.radius + length + view.far);
         let lengths = [1.0, 1.0, nx, nx, ny, ny];
+        // First with a margin at least the exact one, from a length at least `c.length()`
+        // (its L1 norm, raised well past the rounding of both) and no square root: a
+        // sphere wholly inside every plane by it is inside by the exact margin too, and
+        // most patches in view are.
+        let above = margin_of((c.x.abs() + c.y.abs() + c.z.abs()) * (1.0 + 1e-12));
+        if scaled.iter().zip(lengths).all(|(&d, length)| d < -above * length) {
+            return self.back_facing(view.eye);
+        }
+        let margin = margin_of(c.length());
         for (plane, (&d, length)) in scaled.iter().zip(lengths).enumerate() {
             // Where d < −margin every control point is inside this plane.
             if d >= -margin * length && all_outside(patch, view, plane) {
