@@ -113,6 +113,13 @@ impl PatchView {
         if axis.dot(to_eye) >= 0.0 {
             return false;
         }
+        self.beyond_cone(axis, to_eye)
+    }
+
+    /// The back-facing test in full, for the cone `axis` and the direction `to_eye` from
+    /// the centre to the eye.
+    #[inline]
+    fn beyond_cone(&self, axis: DVec3, to_eye: DVec3) -> bool {
         let dist = to_eye.length();
         if dist <= self.radius {
             return false;
@@ -359,11 +366,8 @@ mod tests {
         (frustum, back)
     }
 
-    /// The prepared test culls exactly what the direct one does, over many cameras around and
-    /// inside two models (a patch model and PN triangles): the sphere only skips planes it
-    /// lies wholly inside, and the cosine form of the cone test agrees with the angles.
-    #[test]
-    fn prepared_culling_equals_the_control_point_test() {
+    /// The culling tests' models: a patch model (the teapot) and PN triangles (spot).
+    fn culling_models() -> [SurfaceSet; 2] {
         let teapot = SurfaceSet::from_patch_file(
             &read_patches(&data("patches/teapot.patches")).expect("test model"),
             Default::default(),
@@ -375,6 +379,15 @@ mod tests {
             Default::default(),
         )
         .expect("test model");
+        [teapot, spot]
+    }
+
+    /// The prepared test culls exactly what the direct one does, over many cameras around and
+    /// inside two models (a patch model and PN triangles): the sphere only skips planes it
+    /// lies wholly inside, and the cosine form of the cone test agrees with the angles.
+    #[test]
+    fn prepared_culling_equals_the_control_point_test() {
+        let [teapot, spot] = culling_models();
         let mut culled = [0usize; 2];
         for set in [&teapot, &spot] {
             let views: Vec<PatchView> = set.patches.iter().map(PatchView::new).collect();
@@ -400,43 +413,13 @@ mod tests {
         assert!(culled[0] > 100 && culled[1] > 100, "culled by frustum, by cone: {culled:?}");
     }
 
-    /// [`PatchView::back_facing`] without its first test (the eye on the axis's side), as
-    /// it was first written.
-    fn back_facing_in_full(view: &PatchView, eye: DVec3) -> bool {
-        let Some((axis, _)) = view.cone else { return false };
-        let to_eye = eye - view.centre;
-        let dist = to_eye.length();
-        if dist <= view.radius {
-            return false;
-        }
-        let (sin_a, cos_a) = view.cone_sin_cos;
-        let sin_b = view.radius / dist;
-        let cos_b = (1.0 - sin_b * sin_b).max(0.0).sqrt();
-        let (sin_t, cos_t) = (sin_a * cos_b + cos_a * sin_b, cos_a * cos_b - sin_a * sin_b);
-        if cos_t <= 0.0 {
-            return false;
-        }
-        let cos_g = axis.dot(to_eye / dist).clamp(-1.0, 1.0);
-        cos_g < -sin_t - 1e-12
-    }
-
     /// The axis-side test changes no answer: eyes all around each patch of two models, and
     /// eyes on the plane through the patch's centre across its axis (where `axis · to_eye`
     /// is 0 up to rounding, either sign), also nudged off it by a few ulps. A first test
     /// that let eyes a little behind that plane through (`≥ −0.3 |to_eye|`) fails it.
     #[test]
     fn the_axis_side_test_gives_the_full_tests_answers() {
-        let teapot = SurfaceSet::from_patch_file(
-            &read_patches(&data("patches/teapot.patches")).expect("test model"),
-            Default::default(),
-        );
-        let path = data("meshes/spot.obj");
-        let spot = SurfaceSet::pn_from_mesh(
-            &crate::io::obj::read_obj(&path).expect("test model"),
-            &path,
-            Default::default(),
-        )
-        .expect("test model");
+        let [teapot, spot] = culling_models();
         let mut rng = crate::test_support::Lcg(26);
         let (mut compared, mut back) = (0usize, 0usize);
         for set in [&teapot, &spot] {
@@ -452,7 +435,7 @@ mod tests {
                     let on_plane = view.centre + (across * a.cos() + other * a.sin()) * r;
                     let tiny = axis * (r * f64::EPSILON * (rng.unit53() - 0.5) * 8.0);
                     for eye in [view.centre + around.normalize_or_zero() * r, on_plane, on_plane + tiny] {
-                        let full = back_facing_in_full(&view, eye);
+                        let full = view.beyond_cone(axis, eye - view.centre);
                         assert_eq!(view.back_facing(eye), full, "eye {eye} of a patch at {}", view.centre);
                         compared += 1;
                         back += usize::from(full);
