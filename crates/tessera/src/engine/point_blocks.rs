@@ -845,48 +845,45 @@ pub(crate) fn triangle_block<const FMA: bool, const L: usize, const N: usize, co
     u: &[f32; L],
     v: &[f32; L],
 ) -> Block<L> {
-    triangle_lanes::<FMA, L, N>(&t.pos, (&t.origin, t.scale), u, v, |powers| {
-        let [su, sv] = derivative_sums::<FMA, L, N, M>(t, powers);
-        cross_normals(&su, &sv)
-    })
+    let (mut pos, powers) = triangle_positions::<FMA, L, N>(&t.pos, u, v);
+    let [su, sv] = derivative_sums::<FMA, L, N, M>(t, &powers);
+    let (nrm, margin) = cross_normals(&su, &sv);
+    to_model::<FMA, L>(&mut pos, &t.origin, t.scale);
+    Block { pos, nrm, margin }
 }
 
 /// A PN triangle at each lane's `(u, v)`: normals from its quadratic field, normalised.
 #[inline(always)]
 pub(crate) fn pn_block<const FMA: bool, const L: usize>(t: &LocalPn, u: &[f32; L], v: &[f32; L]) -> Block<L> {
-    triangle_lanes::<FMA, L, 10>(&t.pos, (&t.origin, t.scale), u, v, |powers| {
-        let mut n = combine::<FMA, L, 6>(&t.field, &monomials(powers, &PN_NORMAL));
-        let mut margin = [0f32; L];
-        let [nx, ny, nz] = &mut n;
-        for l in 0..L {
-            let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
-            margin[l] = n2 - MIN_PN_NORMAL2;
-            let inv = 1.0 / n2.sqrt();
-            nx[l] *= inv;
-            ny[l] *= inv;
-            nz[l] *= inv;
-        }
-        (n, margin)
-    })
+    let (mut pos, powers) = triangle_positions::<FMA, L, 10>(&t.pos, u, v);
+    let mut nrm = combine::<FMA, L, 6>(&t.field, &monomials(&powers, &PN_NORMAL));
+    let mut margin = [0f32; L];
+    let [nx, ny, nz] = &mut nrm;
+    for l in 0..L {
+        let n2 = nx[l] * nx[l] + ny[l] * ny[l] + nz[l] * nz[l];
+        margin[l] = n2 - MIN_PN_NORMAL2;
+        let inv = 1.0 / n2.sqrt();
+        nx[l] *= inv;
+        ny[l] *= inv;
+        nz[l] *= inv;
+    }
+    to_model::<FMA, L>(&mut pos, &t.origin, t.scale);
+    Block { pos, nrm, margin }
 }
 
-/// The lanes of a triangle form of `N` control points `pos` (in the local frame `(origin,
-/// scale)`): positions from the monomials of each lane's `(u, v)`, normals and margins by
-/// `normals` from the lanes' [`lambda_powers`] — the rule [`triangle_block`] and
-/// [`pn_block`] share.
+/// The local positions of a triangle form of `N` control points `pos` at each lane's
+/// `(u, v)`, from the monomials of the lanes' [`lambda_powers`], and those powers (for the
+/// normals): the rule [`triangle_block`] and [`pn_block`] share. (Not a function taking the
+/// normals as a closure: a closure is compiled for the AVX2 and FMA of its caller only where
+/// it is inlined, and on Loop's trees it was not, making every `mul_add` a library call.)
 #[inline(always)]
-fn triangle_lanes<const FMA: bool, const L: usize, const N: usize>(
+fn triangle_positions<const FMA: bool, const L: usize, const N: usize>(
     pos: &[[f32; N]; 3],
-    (origin, scale): (&[f32; 3], f32),
     u: &[f32; L],
     v: &[f32; L],
-    normals: impl FnOnce(&[[[f32; L]; 5]; 3]) -> ([[f32; L]; 3], [f32; L]),
-) -> Block<L> {
+) -> ([[f32; L]; 3], [[[f32; L]; 5]; 3]) {
     let powers = lambda_powers::<L>(const { degree(N) }, u, v);
-    let mut pos = combine::<FMA, L, N>(pos, &monomials(&powers, &const { exponents::<N>() }));
-    let (nrm, margin) = normals(&powers);
-    to_model::<FMA, L>(&mut pos, origin, scale);
-    Block { pos, nrm, margin }
+    (combine::<FMA, L, N>(pos, &monomials(&powers, &const { exponents::<N>() })), powers)
 }
 
 /// The most memory [`PointBlocks`] gives the leaf forms of Loop's trees (1 GiB: 2.2 million
@@ -1047,21 +1044,21 @@ impl PointBlocks {
     }
 
     /// Asks for patch `p`'s form to be brought into the cache, a few patches before it is
-    /// evaluated: a hint, which changes no value. Only a triangle's form (PN, Bézier, Loop's
-    /// regular quartics): a bicubic's points come from the grid kernels' own forms, and on
-    /// the torus grid asking for its form here made the vertex stage 14 % slower. Nothing
-    /// where `p` is out of range or has no such form. Cost: O(1), up to six prefetches (a
-    /// cubic Bézier triangle's form is 280 bytes, a PN triangle's 208, a quartic's 436).
+    /// evaluated: a hint, which changes no value. Only a cubic triangle's form (PN, Bézier;
+    /// Loop's quartics measured no different with it): a bicubic's points come from the
+    /// grid kernels' own forms, and on the torus grid asking for its form here made the
+    /// vertex stage 14 % slower. Nothing where `p` is out of range or has no such form.
+    /// Cost: O(1), up to five prefetches (a cubic Bézier triangle's form is 280 bytes, a PN
+    /// triangle's 208).
     #[inline(always)]
     pub(crate) fn prefetch_form(&self, p: usize) {
         use crate::surface::patch_tree::prefetch_slice;
-        if self.triangles.is_empty() && self.pns.is_empty() && self.quartics.is_empty() {
+        if self.triangles.is_empty() && self.pns.is_empty() {
             return;
         }
         match self.locals.get(p) {
             Some(Local::Pn(i)) => prefetch_slice(std::slice::from_ref(&self.pns[*i as usize])),
             Some(Local::Triangle(i)) => prefetch_slice(std::slice::from_ref(&self.triangles[*i as usize])),
-            Some(Local::Quartic(i)) => prefetch_slice(std::slice::from_ref(&self.quartics[*i as usize])),
             _ => {}
         }
     }
