@@ -1107,8 +1107,8 @@ fn check_patches(
                 // The bound's data of a patch a few ahead, asked for in time (96 bytes a
                 // patch: the grid's 8.8 MB are past the core's own cache, and the patches
                 // in view come in runs between culled ones, which the check skips).
-                if let Some(&ahead) = patches.get(k + ERRORS_LEAD) {
-                    crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(&errors[ahead]));
+                if let Some(ahead) = patches.get(k + ERRORS_LEAD).and_then(|&q| errors.get(q)) {
+                    crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(ahead));
                 }
                 *o = check_one(run * RUN + k, p, f, table);
             }
