@@ -418,6 +418,13 @@ impl Plan {
         crate::sampling::param(self.kind, &self.row(e), k)
     }
 
+    /// Edge `e`'s inner parameters `k = 1 .. segments − 1` in canonical orientation, in order
+    /// ([`crate::sampling::params`]: [`Plan::param`]'s values, shared work done once).
+    #[inline]
+    pub fn inner_params(&self, e: usize) -> impl Iterator<Item = f64> + '_ {
+        crate::sampling::params(self.kind, &self.row(e), 1..self.segments[e])
+    }
+
     /// The `k`-th parameter of edge `e` as seen by a patch that runs along it reversed or not.
     #[inline]
     pub fn local_param(&self, e: usize, k: u32, reversed: bool) -> f64 {

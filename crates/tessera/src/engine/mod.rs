@@ -464,10 +464,9 @@ fn evaluate_corners(
 /// Appends the parameters, in the domain `d` of the patch of use `u`, of edge `e`'s inner
 /// samples `k = 1 .. segments − 1` in canonical order: where that patch evaluates them.
 fn push_edge_params(plan: &Plan, e: usize, d: Domain, u: &crate::topology::EdgeUse, uvs: &mut Vec<DVec2>) {
-    uvs.extend((1..plan.segments(e)).map(|k| {
-        let t = plan.param(e, k);
-        d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })
-    }));
+    uvs.extend(
+        plan.inner_params(e).map(|t| d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })),
+    );
 }
 
 /// The inner samples of edge `e`, evaluated once per normal variant by a patch of that

@@ -73,6 +73,26 @@ pub fn param(kind: SamplingKind, row: &EdgeRow<'_>, k: u32) -> f64 {
     }
 }
 
+/// [`param`] of every `k` in `ks`, in order: the same values bit for bit, with what they
+/// share found once (a hardware partition of the factor, which [`param`] finds anew for
+/// each `k`). For a writer that reads an edge's samples in a row. Cost: O(1) + O(1) per `k`.
+#[inline]
+pub fn params<'a>(
+    kind: SamplingKind,
+    row: &EdgeRow<'a>,
+    ks: std::ops::Range<u32>,
+) -> impl Iterator<Item = f64> + 'a {
+    let row = *row;
+    let axis = match kind {
+        SamplingKind::Fractional(Spacing::Hardware(p)) => Some(hardware::Axis::edge(row.factor as f64, p)),
+        _ => None,
+    };
+    ks.map(move |k| match &axis {
+        Some(axis) => axis.param(k),
+        None => param(kind, &row, k),
+    })
+}
+
 /// Parameter `k` of `segments` equal steps: `k / segments`, exactly 1 at the end. Cost: O(1).
 #[inline]
 pub fn uniform_param(segments: u32, k: u32) -> f64 {
@@ -104,3 +124,45 @@ mod symmetric;
 
 pub use hardware::Partitioning;
 pub use symmetric::{symmetric_param, symmetric_segments, warped_param};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `params` is `param` for every `k`, bit for bit, on every kind and across each
+    /// partitioning's factor range (the writer reads edges through `params`, the other
+    /// engines through `param`).
+    #[test]
+    fn params_in_a_row_are_param_of_each_k() {
+        let lattice: Vec<u32> = (0..=40).map(|k| k * k).collect();
+        let mut kinds = vec![SamplingKind::Uniform, SamplingKind::Warped, SamplingKind::Lattice];
+        kinds.push(SamplingKind::Fractional(Spacing::Symmetric));
+        for p in [
+            Partitioning::Integer,
+            Partitioning::Pow2,
+            Partitioning::FractionalOdd,
+            Partitioning::FractionalEven,
+        ] {
+            kinds.push(SamplingKind::Fractional(Spacing::Hardware(p)));
+        }
+        let mut checked = 0;
+        for kind in kinds {
+            for step in 0..=250 {
+                let factor = 1.0 + step as f32 * 0.127;
+                let segments = match kind {
+                    SamplingKind::Fractional(spacing) => spacing_segments(factor as f64, spacing),
+                    SamplingKind::Lattice => (step % 40 + 1) as u32,
+                    _ => factor.ceil() as u32,
+                };
+                let factor =
+                    if kind == SamplingKind::Lattice { (segments * segments) as f32 } else { factor };
+                let row = EdgeRow { segments, factor, depths: [0.7, 1.9], lattice: &lattice };
+                let one_by_one: Vec<u64> = (0..=segments).map(|k| param(kind, &row, k).to_bits()).collect();
+                let in_a_row: Vec<u64> = params(kind, &row, 0..segments + 1).map(f64::to_bits).collect();
+                assert_eq!(in_a_row, one_by_one, "{kind:?}, factor {factor}");
+                checked += one_by_one.len();
+            }
+        }
+        assert!(checked > 8 * 251 * 2);
+    }
+}
