@@ -64,7 +64,16 @@ pub(crate) const EPSILON: f32 = 1.0 / 65536.0;
 /// `x ≥ 0` (below 2¹⁵) to fixed point, rounding to nearest, ties to even, as the hardware's
 /// float-to-fixed conversion does. Exact: `x · 2¹⁶` of an `f32` is exact in `f64`.
 pub(crate) fn to_fixed(x: f32) -> Fixed {
-    (x as f64 * ONE as f64).round_ties_even() as Fixed
+    // Adding and removing 1.5 · 2⁵² rounds to an integer, ties to even (the default rounding
+    // of every addition), for any |v| < 2⁵¹: `round_ties_even` itself is a libm call on
+    // targets without SSE4.1, and every edge of a frame converts its factor a few times.
+    const MAGIC: f64 = 1.5 * (1u64 << 52) as f64;
+    let v = x as f64 * ONE as f64;
+    if v.abs() < (1u64 << 51) as f64 {
+        ((v + MAGIC) - MAGIC) as Fixed
+    } else {
+        v.round_ties_even() as Fixed
+    }
 }
 
 /// Fixed point to `f64`, exactly.
@@ -141,11 +150,7 @@ impl Axis {
         let odd_less = i64::from(odd);
         let floor_segments = ((floor * 2) >> FRACTION_BITS) - odd_less;
         let ceil_segments = ((ceil * 2) >> FRACTION_BITS) - odd_less;
-        let points = if odd {
-            (fixed_ceil(HALF + (f + 1) / 2) * 2) >> FRACTION_BITS
-        } else {
-            ((fixed_ceil((f + 1) / 2) * 2) >> FRACTION_BITS) + 1
-        };
+        let points = Axis::point_count(f, odd);
         Axis {
             odd,
             half_fraction: half - floor,
@@ -157,12 +162,29 @@ impl Axis {
         }
     }
 
+    /// How many points the partition of fixed-point factor `f` with the given parity has
+    /// (without the rest of [`Axis::new`]'s work: its two divisions).
+    fn point_count(f: Fixed, odd: bool) -> i64 {
+        if odd {
+            (fixed_ceil(HALF + (f + 1) / 2) * 2) >> FRACTION_BITS
+        } else {
+            ((fixed_ceil((f + 1) / 2) * 2) >> FRACTION_BITS) + 1
+        }
+    }
+
+    /// The processed factor of an edge: clamped, rounded and converted as the hardware does
+    /// with an edge factor `> 0`, and its parity.
+    fn edge_factor(factor: f64, partitioning: Partitioning) -> (Fixed, bool) {
+        let (lo, hi) = partitioning.range();
+        let f = clamp(factor as f32, lo, hi, partitioning);
+        (to_fixed(f), parity_odd(f, partitioning, false))
+    }
+
     /// The partition of an edge with real factor `factor` under `partitioning` (clamped,
     /// rounded and converted as the hardware does with an edge factor `> 0`).
     pub fn edge(factor: f64, partitioning: Partitioning) -> Axis {
-        let (lo, hi) = partitioning.range();
-        let f = clamp(factor as f32, lo, hi, partitioning);
-        Axis::new(to_fixed(f), parity_odd(f, partitioning, false))
+        let (f, odd) = Axis::edge_factor(factor, partitioning);
+        Axis::new(f, odd)
     }
 
     /// Number of segments.
@@ -228,7 +250,8 @@ pub(crate) fn parity_odd(f: f32, partitioning: Partitioning, inside: bool) -> bo
 
 /// Segments of an edge with real factor `factor`. Cost: O(1).
 pub fn edge_segments(factor: f64, partitioning: Partitioning) -> u32 {
-    Axis::edge(factor, partitioning).segments()
+    let (f, odd) = Axis::edge_factor(factor, partitioning);
+    (Axis::point_count(f, odd) - 1) as u32
 }
 
 /// Parameter of point `k` of an edge with real factor `factor`. Cost: O(1).

@@ -165,4 +165,21 @@ mod tests {
         }
         assert!(checked > 8 * 251 * 2);
     }
+
+    /// The fixed-point conversion rounds to nearest, ties to even, as `round_ties_even`
+    /// does: on exact ties (odd multiples of 2⁻¹⁷), beside them and across the factors'
+    /// range.
+    #[test]
+    fn to_fixed_rounds_ties_to_even() {
+        let mut ties = 0;
+        for n in (0..(80u32 << 17)).step_by(7) {
+            let x = n as f32 / 131072.0;
+            for x in [x, f32::from_bits(x.to_bits().wrapping_sub(1)), f32::from_bits(x.to_bits() + 1)] {
+                let expected = (x as f64 * 65536.0).round_ties_even() as i64;
+                assert_eq!(hardware::to_fixed(x), expected, "{x}");
+            }
+            ties += usize::from(n % 2 == 1);
+        }
+        assert!(ties > 1 << 19);
+    }
 }
