@@ -298,7 +298,8 @@ impl<'a> Tessellator<'a> {
         // The check's patterns, where it built them for this plan: the engine adds its own.
         let mut built = self.scratch.check_patterns();
         let triangles = self.layout.triangle_count() as u64;
-        let took = self.fast.fill_patterns(&planned.plan, &planned.pattern, triangles, built.as_deref_mut());
+        // The distinct patterns are found by the write, beside its edges.
+        let took = self.fast.defer_patterns(&planned.plan, &planned.pattern, triangles, built.as_deref_mut());
         let filled = start.elapsed();
         let fast = Some(&self.fast);
         let (plan, pattern, layout_ref) = (&planned.plan, &planned.pattern, &self.layout);
@@ -315,7 +316,8 @@ impl<'a> Tessellator<'a> {
         }
         let written = written?;
         self.timings = FrameTimings {
-            // The pattern cache's fill counts with the vertices, whose pass uses it first.
+            // The pattern cache's fill runs in the vertex pass (beside the edges), and counts
+            // with it.
             write_vertices: filled + written.vertices,
             write_indices: written.indices,
             write: start.elapsed(),

@@ -17,7 +17,7 @@ use crate::surface::{Domain, SurfacePoint, SurfaceSet};
 use crate::topology::EdgeUse;
 use glam::DVec2;
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Mutex, MutexGuard, OnceLock};
 
 /// The tables of one factor `n`: bases, grid parameters, edge parameters.
 #[derive(Default)]
@@ -105,8 +105,12 @@ pub(crate) struct FastEvaluator<'a> {
     /// Every patch in its local frame; each is needed by several tasks (its corners, edges
     /// and rows), so it is made once.
     points: PointBlocks,
-    /// The current plan's distinct patterns ([`FastEvaluator::fill_patterns`]).
-    patterns: PatternCache,
+    /// The current plan's distinct patterns ([`FastEvaluator::fill_patterns`]), or the fill
+    /// the write is to run ([`FastEvaluator::defer_patterns`]). Behind a lock only so that
+    /// the write can fill the table on one side of its join while the other side evaluates
+    /// corners and edges through this evaluator: locked twice a frame, never by two threads
+    /// at once.
+    patterns: Mutex<FramePatterns>,
     /// The writer of triangle meshes at one uniform factor, where the current plan is one
     /// ([`FastEvaluator::fill_patterns`]).
     triangles: UniformTriangles,
@@ -139,6 +143,38 @@ pub(crate) struct FastEvaluator<'a> {
     /// Every corner entry's vertex record, evaluated on first use, without and with the grid
     /// kernels (which evaluate corners in their own way): 36 bytes a corner.
     corners: [OnceLock<CornerRecords>; 2],
+}
+
+/// A frame's distinct patterns, and the fill they wait for where it was deferred
+/// ([`FastEvaluator::defer_patterns`]).
+#[derive(Default)]
+pub(crate) struct FramePatterns {
+    cache: PatternCache,
+    pending: Option<PendingFill>,
+}
+
+/// What [`super::fill_pattern_cache`] needs beside the plan and pattern.
+#[derive(Clone, Copy)]
+struct PendingFill {
+    /// The layout's triangle count.
+    triangles: u64,
+    /// Keep the patterns the table holds (the check's, for this plan).
+    keep: bool,
+}
+
+impl FramePatterns {
+    /// Runs the pending fill, if any, for `plan` and `pattern`.
+    fn fill(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) {
+        if let Some(PendingFill { triangles, keep }) = self.pending.take() {
+            super::fill_pattern_cache(&mut self.cache, set, plan, pattern, triangles, keep);
+        }
+    }
+
+    /// The table, once filled.
+    pub(crate) fn cache(&self) -> &PatternCache {
+        debug_assert!(self.pending.is_none());
+        &self.cache
+    }
 }
 
 impl<'a> FastEvaluator<'a> {
@@ -178,7 +214,7 @@ impl<'a> FastEvaluator<'a> {
             grid_lanes: Vec::new(),
             edge_pairs: Vec::new(),
             lanes_top: 0,
-            patterns: PatternCache::default(),
+            patterns: Mutex::default(),
             triangles: UniformTriangles::for_set(set),
             grid: false,
             grid_corners: false,
@@ -269,19 +305,47 @@ impl<'a> FastEvaluator<'a> {
         triangles: u64,
         built: Option<&mut PatternCache>,
     ) -> bool {
+        let took = self.defer_patterns(plan, pattern, triangles, built);
+        self.patterns.get_mut().unwrap_or_else(|e| e.into_inner()).fill(self.set, plan, pattern);
+        took
+    }
+
+    /// [`FastEvaluator::fill_patterns`] with the distinct patterns left for the write to
+    /// find, for the same `plan` and `pattern` ([`super::write_with`]): it does so beside its
+    /// corners and edges, which do not read them. The table's fill is one hash lookup per
+    /// visible patch on one thread; on the cow's adaptive frames (5,804 patches), a sixth of
+    /// the frame on two threads when it ran before the write.
+    pub(crate) fn defer_patterns(
+        &mut self,
+        plan: &Plan,
+        pattern: &dyn Pattern,
+        triangles: u64,
+        built: Option<&mut PatternCache>,
+    ) -> bool {
+        let patterns = self.patterns.get_mut().unwrap_or_else(|e| e.into_inner());
+        patterns.pending = None;
         if self.triangles.retarget(self.set, plan, pattern) {
-            self.patterns.clear();
+            patterns.cache.clear();
             return false;
         }
-        let took = built.map(|built| std::mem::swap(&mut self.patterns, built)).is_some();
-        super::fill_pattern_cache(&mut self.patterns, self.set, plan, pattern, triangles, took);
+        let took = built.map(|built| std::mem::swap(&mut patterns.cache, built)).is_some();
+        patterns.pending = Some(PendingFill { triangles, keep: took });
         took
     }
 
     /// Gives back the patterns [`FastEvaluator::fill_patterns`] took (`built`, holding the
     /// evaluator's own meanwhile), once the frame is written.
     pub(crate) fn return_patterns(&mut self, built: &mut PatternCache) {
-        std::mem::swap(&mut self.patterns, built);
+        std::mem::swap(&mut self.patterns.get_mut().unwrap_or_else(|e| e.into_inner()).cache, built);
+    }
+
+    /// The current plan's distinct patterns, filled first where the fill was deferred (for
+    /// `plan` and `pattern`: the plan and pattern the fill was asked for). Cost: the fill, or
+    /// O(1); blocks while another thread holds them (none does but the write).
+    pub(crate) fn frame_patterns(&self, plan: &Plan, pattern: &dyn Pattern) -> MutexGuard<'_, FramePatterns> {
+        let mut patterns = self.patterns.lock().unwrap_or_else(|e| e.into_inner());
+        patterns.fill(self.set, plan, pattern);
+        patterns
     }
 
     /// The writer of uniform triangle plans.
@@ -289,9 +353,10 @@ impl<'a> FastEvaluator<'a> {
         &self.triangles
     }
 
-    /// The current plan's distinct patterns.
-    pub(crate) fn patterns(&self) -> &PatternCache {
-        &self.patterns
+    /// The current plan's distinct patterns (filled: [`FastEvaluator::fill_patterns`]).
+    #[cfg(test)]
+    pub(crate) fn patterns(&mut self) -> &PatternCache {
+        &self.patterns.get_mut().unwrap_or_else(|e| e.into_inner()).cache
     }
 
     /// Whether the grid kernels apply to the current plan (to some patches).

@@ -256,12 +256,7 @@ pub(crate) fn write_buffers(
         + std::mem::size_of_val(&*triangle_patch)
         + std::mem::size_of_val(&*params);
     let stream = stream_store::streams(bytes as u64);
-    // Unless the frame streams, patches whose pattern the frame's cache does not hold map
-    // their triangles in the vertex pass (`Pass::Vertices`); when no patch's is held and the
-    // uniform writer is not the one, the index pass has nothing left to do.
-    let any_cached = fast.is_some_and(|f| f.patterns().holds_items());
-    let index_pass = stream || uniform.is_some() || any_cached;
-    let writer = Writer { set, plan, pattern, layout, fast, generation: next_generation() };
+    let writer = Writer { set, plan, pattern, layout, fast, patterns: None, generation: next_generation() };
 
     let mut all =
         VertexSlices { pos: &mut *positions, nrm: &mut *normals, uv: &mut *uvs, patch: &mut *vertex_patch };
@@ -269,18 +264,29 @@ pub(crate) fn write_buffers(
     let edge_part = all.take_front(layout.interior_offsets[0] as usize - layout.corners as usize);
     let patch_part =
         PatchOut { verts: all, idx: &mut *indices, tp: &mut *triangle_patch, params: &mut *params };
-    // A pass over every patch, by the uniform triangle writer where it applies.
-    let patches_pass = |out: PatchOut<'_>, pass: Pass| match uniform {
-        Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), out, pass),
-        None => writer.patches(0..set.patches.len(), out, pass),
+    // A pass over every patch, by the uniform triangle writer where it applies; the others
+    // read the frame's patterns, filled first where that was left to the write (the corners
+    // and edges, which do not read them, are written meanwhile).
+    let patches_pass = |out: PatchOut<'_>, pass: Pass| {
+        let patterns = fast.map(|f| f.frame_patterns(plan, pattern));
+        let writer = Writer { patterns: patterns.as_deref().map(|p| p.cache()), ..writer };
+        match uniform {
+            Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), out, pass),
+            None => writer.patches(0..set.patches.len(), out, pass),
+        }
+        // Unless the frame streams, patches whose pattern the frame's cache does not hold
+        // map their triangles in the vertex pass (`Pass::Vertices`); when no patch's is
+        // held and the uniform writer is not the one, the index pass has nothing left to do.
+        writer.patterns.is_some_and(|p| p.holds_items())
     };
-    rayon::join(
+    let ((), any_cached) = rayon::join(
         || {
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
         || patches_pass(patch_part, Pass::Vertices { stream }),
     );
+    let index_pass = stream || uniform.is_some() || any_cached;
     // Split-normal entries take the position bits of their vertex's first entry. (A vertex
     // has one entry, or more where its normals split: without splits, no pass on the main
     // thread alone.)
@@ -526,6 +532,9 @@ struct Writer<'a> {
     pattern: &'a dyn Pattern,
     layout: &'a Layout,
     fast: Option<&'a fast_evaluator::FastEvaluator<'a>>,
+    /// The frame's distinct patterns, for the patch passes (the fast evaluator's, once
+    /// filled).
+    patterns: Option<&'a PatternCache>,
     /// This call's number, so that a thread's scratch built in an earlier call (for another
     /// pattern) is never taken for this one's.
     generation: u64,
@@ -745,7 +754,7 @@ impl Writer<'_> {
     /// Patch `p`'s pattern from the frame's cache, if it holds it (its input given patch
     /// `p`): without the triangles of its core grid, if it has one.
     fn cached(&self, p: usize) -> Option<(PatternInput, Cached<'_>)> {
-        let cached = self.fast.and_then(|f| f.patterns().get(p))?;
+        let cached = self.patterns.and_then(|c| c.get(p))?;
         Some((PatternInput { patch: p as u32, ..*cached.input }, cached))
     }
 
