@@ -23,7 +23,7 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// The bits of a pattern input that a pattern may read (everything but the patch index).
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 struct Key {
     segments: [u32; 4],
     interior: [u32; 2],
@@ -37,6 +37,22 @@ struct Key {
 pub(crate) fn input_hash(input: &PatternInput) -> u64 {
     use std::hash::{BuildHasher, BuildHasherDefault};
     BuildHasherDefault::<WordHasher>::default().hash_one(Key::of(input))
+}
+
+impl std::hash::Hash for Key {
+    /// Eight words, without the length prefixes and byte chunks the derived hash of the
+    /// arrays writes: the key is hashed once per visible patch per frame.
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        let pair = |a: u32, b: u32| a as u64 | (b as u64) << 32;
+        let [s0, s1, s2, s3] = self.segments;
+        state.write_u64(pair(s0, s1));
+        state.write_u64(pair(s2, s3));
+        state.write_u64(pair(self.interior[0], self.interior[1]));
+        for f in self.factors {
+            state.write_u64(f);
+        }
+        state.write_u64(self.flags as u64);
+    }
 }
 
 impl Key {
@@ -246,13 +262,22 @@ impl PatternCache {
             self.of_patch.reserve(count);
         }
         let (kept, kept_grids) = (self.inputs.len(), self.grid_cells.len());
+        // Neighbouring items often share an input: a comparison with the last key costs
+        // less than the hash and the probe.
+        let mut last: Option<(Key, u32)> = None;
         for i in 0..count {
             let Some(input) = input_of(i) else {
                 self.of_patch.push(NONE);
                 continue;
             };
+            let key = Key::of(&input);
+            if let Some((_, slot)) = last.filter(|(seen, _)| *seen == key) {
+                self.of_patch.push(slot);
+                continue;
+            }
             let next = self.inputs.len() as u32;
-            let slot = *self.index.entry(Key::of(&input)).or_insert(next);
+            let slot = *self.index.entry(key).or_insert(next);
+            last = Some((key, slot));
             if slot == next {
                 let core = pattern.core_grid(&input);
                 self.inputs.push(input);
