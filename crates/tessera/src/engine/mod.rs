@@ -27,6 +27,7 @@ use crate::pattern::{LocalTessellation, Pattern, PatternInput, Slot};
 use crate::surface::{Domain, Patch, SurfaceSet};
 use glam::DVec2;
 use rayon::prelude::*;
+use stream_store::IndexWrites;
 
 pub(crate) mod fast_evaluator;
 pub mod layout;
@@ -255,7 +256,8 @@ pub(crate) fn write_buffers(
         + std::mem::size_of_val(&*indices)
         + std::mem::size_of_val(&*triangle_patch)
         + std::mem::size_of_val(&*params);
-    let stream = stream_store::streams(bytes as u64);
+    let writes = stream_store::index_writes(bytes as u64);
+    let stream = writes == IndexWrites::Streamed;
     let writer = Writer { set, plan, pattern, layout, fast, patterns: None, generation: next_generation() };
 
     let mut all =
@@ -274,19 +276,17 @@ pub(crate) fn write_buffers(
             Some(f) => f.triangles().patches(set, f.points(), layout, 0..set.patches.len(), out, pass),
             None => writer.patches(0..set.patches.len(), out, pass),
         }
-        // Unless the frame streams, patches whose pattern the frame's cache does not hold
-        // map their triangles in the vertex pass (`Pass::Vertices`); when no patch's is
-        // held and the uniform writer is not the one, the index pass has nothing left to do.
-        writer.patterns.is_some_and(|p| p.holds_items())
     };
-    let ((), any_cached) = rayon::join(
+    rayon::join(
         || {
             write_corners(set, fast, corner_part);
             writer.edges(0..topo.edges.len(), edge_part);
         },
-        || patches_pass(patch_part, Pass::Vertices { stream }),
+        || patches_pass(patch_part, Pass::Vertices { writes }),
     );
-    let index_pass = stream || uniform.is_some() || any_cached;
+    // Within the cache, the vertex pass maps every patch's triangles too (`Pass::Vertices`);
+    // the uniform triangle writer keeps its own two passes.
+    let index_pass = writes != IndexWrites::WithVertices || uniform.is_some();
     // Split-normal entries take the position bits of their vertex's first entry. (A vertex
     // has one entry, or more where its normals split: without splits, no pass on the main
     // thread alone.)
@@ -312,19 +312,22 @@ pub(crate) fn write_buffers(
 /// Which of [`write_with`]'s passes a patch writer runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Pass {
-    /// Interior vertices and, for patterns the cache does not hold, their triangles: with
-    /// `stream` (the frame's, as [`Pass::Indices`] gets it), as local indices left for the
-    /// index pass to map and stream out; without, mapped to output vertices with their
-    /// triangle patches, which the index pass then skips.
+    /// Interior vertices and their triangles, by the frame's [`IndexWrites`]: within the
+    /// cache every patch's triangles mapped to output vertices with their triangle patches,
+    /// and no index pass follows; past it, a pattern the cache holds leaves its triangles to
+    /// the index pass, and one it does not hold maps them here (or, streamed, leaves its local
+    /// indices for the index pass to map and stream out).
     ///
-    /// Why map them here: such a patch's pattern is at hand in this pass, and the index pass
-    /// would find its input and its vertex numbers again, then read back what this pass
-    /// wrote. On frames of small patterns (the Catmull-Clark torus at 0.5 px, 13 triangles a
-    /// patch) those per-patch steps were most of the index pass. Frames that stream their
-    /// indices ([`stream_store::streams`]) keep the two passes.
-    Vertices { stream: bool },
+    /// Why map them here: the patch's pattern and numbers are at hand in this pass, and an
+    /// index pass would find its input and its vertex numbers again (for a pattern built
+    /// here, also read back what this pass wrote), and cost a parallel pass more. On frames
+    /// of small patterns (the Catmull-Clark torus at 0.5 px, 13 triangles a patch) those
+    /// per-patch steps were most of the index pass; on the cow's adaptive frames (5,804
+    /// patches, all cached) a separate pass cost 5 % of the frame. Frames past the cache keep
+    /// the two passes ([`IndexWrites::OwnPass`]).
+    Vertices { writes: IndexWrites },
     /// Triangles and triangle patches; with `stream`, written by streaming stores (a frame
-    /// well past the cache, [`stream_store::streams`]).
+    /// well past the cache, [`IndexWrites::Streamed`]).
     Indices { stream: bool },
 }
 
@@ -740,7 +743,7 @@ impl Writer<'_> {
                 // back stalled on each patch (a coarse frame's patches loop spent about 4 %
                 // of the frame on that one load).
                 match pass {
-                    Pass::Vertices { stream } => self.patch_vertices(p, &mut out, (v, t), scratch, stream),
+                    Pass::Vertices { writes } => self.patch_vertices(p, &mut out, (v, t), scratch, writes),
                     Pass::Indices { stream } => self.patch_indices(p, &mut out, (v, t), scratch, stream),
                 }
             }
@@ -776,8 +779,9 @@ impl Writer<'_> {
         out: &mut PatchOut<'_>,
         (v, t): (std::ops::Range<usize>, std::ops::Range<usize>),
         scratch: &mut PatchScratch,
-        stream: bool,
+        writes: IndexWrites,
     ) {
+        let stream = writes == IndexWrites::Streamed;
         let PatchOut { mut verts, idx, tp, params } = out.part(v, t);
         let (set, plan, layout) = (self.set, self.plan, self.layout);
         let general = self.general(p, params);
@@ -819,7 +823,12 @@ impl Writer<'_> {
             let map = LocalMap { set, plan, layout, input, patch: p };
             map.param_table(interior, &mut scratch.param);
         }
-        if cached.is_some() && !general {
+        if let (Some((input, cached)), false) = (cached, general) {
+            // Mapped here, while the patch's numbers are at hand, unless the frame's output
+            // passes the cache: the index pass then maps them (and streams them out).
+            if writes == IndexWrites::WithVertices {
+                self.cached_indices(p, input, cached, idx, tp, scratch, false);
+            }
             return;
         }
         if !stream && !general {
@@ -895,7 +904,7 @@ impl Writer<'_> {
         stream: bool,
     ) {
         let PatchOut { idx, tp, params, .. } = out.part(v, t);
-        let (set, plan, layout) = (self.set, self.plan, self.layout);
+        let (set, plan) = (self.set, self.plan);
         let cached = self.cached(p).filter(|_| !self.general(p, params));
         let Some((input, cached)) = cached else {
             if stream {
@@ -907,6 +916,24 @@ impl Writer<'_> {
             // Without streaming, the first pass mapped them (`Pass::Vertices`).
             return;
         };
+        self.cached_indices(p, input, cached, idx, tp, scratch, stream);
+    }
+
+    /// Patch `p`'s triangles from its cached pattern (`input`, `cached`): mapped to output
+    /// vertices by the numbering rule into `idx`, with their triangle patches into `tp`; with
+    /// `stream`, mapped in the thread's buffer and streamed out.
+    #[allow(clippy::too_many_arguments)]
+    fn cached_indices(
+        &self,
+        p: usize,
+        input: PatternInput,
+        cached: Cached<'_>,
+        idx: &mut [u32],
+        tp: &mut [u32],
+        scratch: &mut PatchScratch,
+        stream: bool,
+    ) {
+        let (set, plan, layout) = (self.set, self.plan, self.layout);
         let map = LocalMap { set, plan, layout, input, patch: p };
         map.vertex_table(0, &mut scratch.vertex);
         let first = input.interior_base();
@@ -1133,8 +1160,13 @@ impl LocalMap<'_> {
         let nc = self.input.domain.corner_count();
         table.extend((0..nc).map(|c| self.corner_vertex(c)));
         for e in 0..nc {
-            let samples = self.edge_samples(e);
-            table.extend((1..self.input.segments[e]).map(|k| samples.vertex(k)));
+            // By the samples' kind, not a test per sample: small patterns are mostly edges.
+            let inner = self.input.segments[e].saturating_sub(1);
+            match self.edge_samples(e) {
+                EdgeSamples::Corner(c) => table.extend(std::iter::repeat_n(c, inner as usize)),
+                EdgeSamples::Run { first, reversed: false, .. } => table.extend(first..first + inner),
+                EdgeSamples::Run { first, reversed: true, .. } => table.extend((first..first + inner).rev()),
+            }
         }
         let base = self.layout.interior_vertex(self.patch, 0);
         table.extend((0..interior as u32).map(|j| base + j));
@@ -1374,8 +1406,9 @@ mod tests {
         }
     }
 
-    /// A frame whose indices go out by streaming stores (`stream_store`, forced here) is the
-    /// frame written by plain stores, byte for byte: the uniform writers (the grid path on the
+    /// A frame whose indices go out in their own pass, by plain or by streaming stores
+    /// (`stream_store::IndexWrites`, forced here), is the frame whose vertex pass writes them,
+    /// byte for byte: the uniform writers (the grid path on the
     /// teapot, triangles by addition on a PN mesh and on a Loop cage) and the general one
     /// (a transition plan of mixed factors: cached patterns and patterns staged between the
     /// passes, some patches culled). So is the frame without the pattern cache, whose
@@ -1408,20 +1441,23 @@ mod tests {
                 // Without the frame's pattern cache, every patch maps its triangles in the
                 // vertex pass unless the frame streams (`Pass::Vertices`).
                 let uncached = fast_evaluator::FastEvaluator::new(&set, plan);
-                let frame = |stream: bool, fast: Option<&fast_evaluator::FastEvaluator<'_>>| {
-                    stream_store::force_on_this_thread(Some(stream));
+                let frame = |writes: IndexWrites, fast: Option<&fast_evaluator::FastEvaluator<'_>>| {
+                    stream_store::force_on_this_thread(Some(writes));
                     let mut mesh = Mesh::default();
                     write_with(&set, plan, pattern, &layout, options, &mut mesh, fast).unwrap();
                     stream_store::force_on_this_thread(None);
                     mesh
                 };
-                let plain = frame(false, Some(&fast));
+                use IndexWrites::{OwnPass, Streamed, WithVertices};
+                let plain = frame(WithVertices, Some(&fast));
                 assert!(!plain.indices.is_empty(), "case {k}: a frame with triangles");
                 let bits = |v: &[[f32; 3]]| v.iter().flat_map(|x| x.map(f32::to_bits)).collect::<Vec<_>>();
                 for (other, what) in [
-                    (frame(true, Some(&fast)), "streamed"),
-                    (frame(false, Some(&uncached)), "uncached"),
-                    (frame(true, Some(&uncached)), "uncached, streamed"),
+                    (frame(OwnPass, Some(&fast)), "index pass"),
+                    (frame(Streamed, Some(&fast)), "streamed"),
+                    (frame(WithVertices, Some(&uncached)), "uncached"),
+                    (frame(OwnPass, Some(&uncached)), "uncached, index pass"),
+                    (frame(Streamed, Some(&uncached)), "uncached, streamed"),
                 ] {
                     assert_eq!(other.indices, plain.indices, "case {k}, {what}");
                     assert_eq!(other.triangle_patch, plain.triangle_patch, "case {k}, {what}");
@@ -1429,9 +1465,9 @@ mod tests {
                     assert_eq!(bits(&other.normals), bits(&plain.normals), "case {k}, {what}");
                 }
                 // The generic evaluation (no fast evaluator) numbers and connects alike.
-                for stream in [false, true] {
-                    let generic = frame(stream, None);
-                    assert_eq!(generic.indices, plain.indices, "case {k}, generic, streamed {stream}");
+                for writes in [WithVertices, OwnPass, Streamed] {
+                    let generic = frame(writes, None);
+                    assert_eq!(generic.indices, plain.indices, "case {k}, generic, {writes:?}");
                     assert_eq!(generic.triangle_patch, plain.triangle_patch, "case {k}, generic");
                 }
             }

@@ -11,22 +11,37 @@
 //! the size of a typical cache (factor 16, 36 MB) lost a third (1.55 → 2.05 ms on one
 //! thread): a loop writing into the same buffers finds much of them still cached, which a
 //! streaming store gives up. So a frame streams its indices only where its output passes
-//! twice the cache a core can count on ([`streams`]); the values are the same either way.
+//! twice the cache a core can count on ([`index_writes`]); the values are the same either way.
 
 use std::sync::OnceLock;
 
-/// The most of the last-level cache [`streams`] counts on: a large L3 is shared by many
+/// The most of the last-level cache [`index_writes`] counts on: a large L3 is shared by many
 /// cores (the 480 MiB the VM above reports held far less of a frame than that), and the L3
 /// of the machines most users have is 16–64 MiB.
 const CACHE_COUNTED_ON: u64 = 64 << 20;
 
-/// The cache size [`streams`] assumes where the system does not say.
+/// The cache size [`index_writes`] assumes where the system does not say.
 const ASSUMED_CACHE_BYTES: u64 = 32 << 20;
 
-/// Whether a frame of `output_bytes` (vertices, indices, triangle patches, parameters)
-/// streams its indices: more than twice the last-level cache ([`last_level_cache_bytes`],
-/// asked once a process), counted at most [`CACHE_COUNTED_ON`]. Cost: O(1).
-pub(crate) fn streams(output_bytes: u64) -> bool {
+/// How a frame writes its triangles ([`index_writes`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum IndexWrites {
+    /// In the vertex pass, each patch's after its vertices: an output within the cache.
+    WithVertices,
+    /// In a pass of their own, by plain stores: an output past the cache. Bursts into the
+    /// index arrays between each patch's vertex writes broke the store streams the two
+    /// passes keep: the torus at factor 16 (36 MB) 1.35 → 1.66 ms on two threads with its
+    /// triangles in the vertex pass (a 32 MiB L3).
+    OwnPass,
+    /// In a pass of their own, by streaming stores: an output past twice the cache.
+    Streamed,
+}
+
+/// How a frame of `output_bytes` (vertices, indices, triangle patches, parameters) writes its
+/// triangles, by the last-level cache ([`last_level_cache_bytes`], asked once a process),
+/// counted at most [`CACHE_COUNTED_ON`]: streamed past twice the cache, in their own pass
+/// past it, with the vertices within it. Cost: O(1).
+pub(crate) fn index_writes(output_bytes: u64) -> IndexWrites {
     #[cfg(test)]
     if let Some(forced) = FORCED.get() {
         return forced;
@@ -34,19 +49,25 @@ pub(crate) fn streams(output_bytes: u64) -> bool {
     static CACHE: OnceLock<u64> = OnceLock::new();
     let cache =
         *CACHE.get_or_init(|| last_level_cache_bytes().unwrap_or(ASSUMED_CACHE_BYTES).min(CACHE_COUNTED_ON));
-    output_bytes > 2 * cache
+    if output_bytes > 2 * cache {
+        IndexWrites::Streamed
+    } else if output_bytes > cache {
+        IndexWrites::OwnPass
+    } else {
+        IndexWrites::WithVertices
+    }
 }
 
 #[cfg(test)]
 thread_local! {
-    /// [`streams`]' answer on this thread where a test sets it ([`force_on_this_thread`]).
-    static FORCED: std::cell::Cell<Option<bool>> = const { std::cell::Cell::new(None) };
+    /// [`index_writes`]' answer on this thread where a test sets it ([`force_on_this_thread`]).
+    static FORCED: std::cell::Cell<Option<IndexWrites>> = const { std::cell::Cell::new(None) };
 }
 
-/// Makes [`streams`] answer `forced` on this thread (None: by the frame's size again), so a
-/// test can write one frame both ways.
+/// Makes [`index_writes`] answer `forced` on this thread (None: by the frame's size again),
+/// so a test can write one frame every way.
 #[cfg(test)]
-pub(crate) fn force_on_this_thread(forced: Option<bool>) {
+pub(crate) fn force_on_this_thread(forced: Option<IndexWrites>) {
     FORCED.set(forced);
 }
 

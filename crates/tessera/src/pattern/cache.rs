@@ -381,11 +381,6 @@ impl PatternCache {
     pub(crate) fn distinct(&self) -> usize {
         self.inputs.len()
     }
-
-    /// Whether [`PatternCache::get`] may answer Some for some item. Cost: O(1).
-    pub(crate) fn holds_items(&self) -> bool {
-        !self.of_patch.is_empty()
-    }
 }
 
 /// A pattern in the cache ([`PatternCache::get`]).
