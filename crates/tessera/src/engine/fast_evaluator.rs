@@ -5,6 +5,7 @@
 //! frames, Bernstein bases per factor, corner records, the frame's pattern cache) from frame
 //! to frame.
 
+use super::edge_params::UniformEdgeParams;
 use super::point_blocks::{has_avx2_fma, GridFormKey, GridPatch, PointBlocks, LANES};
 use super::uniform_quads::{store, Basis, EdgePairLanes, GridLanes, GridLine, Line, LocalPatch};
 use super::uniform_triangles::UniformTriangles;
@@ -12,7 +13,7 @@ use super::{CornerRecords, VertexSlices};
 use crate::criterion::Plan;
 use crate::pattern::cache::PatternCache;
 use crate::pattern::{Pattern, PatternInput};
-use crate::sampling::{uniform_param, SamplingKind};
+use crate::sampling::SamplingKind;
 use crate::surface::{Domain, SurfacePoint, SurfaceSet};
 use crate::topology::EdgeUse;
 use glam::DVec2;
@@ -28,10 +29,10 @@ struct FactorTables {
     grid: Vec<f64>,
     /// `grid` rounded to f32, the interior vertices' parameters.
     grid32: Vec<f32>,
-    /// Per local edge and reversed flag, the f64 parameters of canonical sample `k` in the
-    /// owner's domain, as the generic engine evaluates edge vertices.
-    edge_uv: [[Vec<DVec2>; 2]; 4],
-    /// `edge_uv` rounded to f32, the edge vertices' parameters.
+    /// Per domain, local edge and reversed flag, the f64 parameters of canonical sample `k`
+    /// in the owner's domain, as the generic engine evaluates edge vertices.
+    edges: UniformEdgeParams,
+    /// The quad's `edges` rounded to f32, the edge vertices' parameters.
     edge_uv32: [[Vec<[f32; 2]>; 2]; 4],
 }
 
@@ -46,17 +47,11 @@ impl FactorTables {
         self.grid.extend((0..=nu).map(|i| i as f64 * step));
         self.grid32.clear();
         self.grid32.extend((0..=nu).map(|i| (i as f64 * step) as f32));
-        let d = Domain::Quad;
-        for (e, (by_direction, by_direction32)) in
-            self.edge_uv.iter_mut().zip(&mut self.edge_uv32).enumerate()
-        {
-            for (rev, (uvs, uvs32)) in by_direction.iter_mut().zip(by_direction32).enumerate() {
-                uvs.clear();
-                uvs.extend((0..=n).map(|k| {
-                    let t = uniform_param(n, k);
-                    d.edge_point(e, if rev == 1 { 1.0 - t } else { t })
-                }));
+        self.edges.fill(n);
+        for (e, by_direction32) in self.edge_uv32.iter_mut().enumerate() {
+            for (rev, uvs32) in by_direction32.iter_mut().enumerate() {
                 uvs32.clear();
+                let uvs = self.edges.get(Domain::Quad, e, rev == 1);
                 uvs32.extend(uvs.iter().map(|uv| uv.as_vec2().to_array()));
             }
         }
@@ -126,6 +121,9 @@ pub(crate) struct FastEvaluator<'a> {
     grid: bool,
     /// The grid kernels also take the corners: every patch has a grid form.
     grid_corners: bool,
+    /// The current plan samples its edges uniformly: `tables` holds its factors' edge
+    /// parameters ([`FastEvaluator::uniform_edge_params`]).
+    uniform: bool,
     /// Run the kernels compiled for AVX2 and FMA. Only ever true where the CPU has both:
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
@@ -218,6 +216,7 @@ impl<'a> FastEvaluator<'a> {
             triangles: UniformTriangles::for_set(set),
             grid: false,
             grid_corners: false,
+            uniform: false,
             avx2_fma: avx2_fma && has_avx2_fma(),
             corners: Default::default(),
         }
@@ -236,9 +235,10 @@ impl<'a> FastEvaluator<'a> {
     pub(crate) fn retarget(&mut self, plan: &Plan) -> bool {
         // Until `fill_patterns` sees the plan's pattern.
         self.triangles.deactivate();
-        self.grid = plan.kind == SamplingKind::Uniform && self.points.any_bicubic();
+        self.uniform = plan.kind == SamplingKind::Uniform;
+        self.grid = self.uniform && self.points.any_bicubic();
         self.grid_corners = self.grid && self.points.all_bicubic();
-        if !self.grid {
+        if !self.uniform {
             return false;
         }
         // Every factor up to the plan's largest (at most DENSE) gets its tables: a max is one
@@ -257,6 +257,19 @@ impl<'a> FastEvaluator<'a> {
             if tables.n != n {
                 tables.fill(n as u32);
             }
+        }
+        if max > DENSE {
+            for n in plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()) {
+                let n = n as usize;
+                if n > DENSE && self.tables[n].n != n {
+                    self.tables[n].fill(n as u32);
+                }
+            }
+        }
+        if !self.grid {
+            // The tables serve the edge parameters of any uniform plan; the lanes only the
+            // grid kernels.
+            return false;
         }
         let top = max.min(LANE_GRIDS - 1);
         if top > self.lanes_top {
@@ -278,14 +291,6 @@ impl<'a> FastEvaluator<'a> {
             self.edge_pairs = (0..4 * LANE_GRIDS * LANE_GRIDS)
                 .map(|at| EdgePairLanes::new(edge(at / (2 * LANE_GRIDS))?, edge(at % (2 * LANE_GRIDS))?))
                 .collect();
-        }
-        if max > DENSE {
-            for n in plan.segments.iter().copied().chain(plan.interior.iter().flatten().copied()) {
-                let n = n as usize;
-                if n > DENSE && self.tables[n].n != n {
-                    self.tables[n].fill(n as u32);
-                }
-            }
         }
         true
     }
@@ -369,6 +374,15 @@ impl<'a> FastEvaluator<'a> {
     /// every patch is a bicubic with a local form.
     pub(crate) fn grid_corners(&self) -> bool {
         self.grid_corners
+    }
+
+    /// The parameters of the inner samples `1 .. n − 1` of an edge of `n` segments of the
+    /// current plan, in the domain `d` of the patch of use `u`, in canonical order (what
+    /// `push_edge_params` computes), from the factor's tables; None where the plan does not
+    /// sample uniformly or `n` has no tables. Cost: O(1).
+    pub(crate) fn uniform_edge_params(&self, n: u32, d: Domain, u: &EdgeUse) -> Option<&[DVec2]> {
+        let tables = self.tables.get(n as usize).filter(|t| self.uniform && t.edges.factor() == n)?;
+        Some(&tables.edges.get(d, u.local as usize, u.reversed)[1..n as usize])
     }
 
     /// The evaluator of arbitrary parameter lists.
@@ -564,7 +578,7 @@ impl<'a> FastEvaluator<'a> {
         let p = a.patch as usize;
         block.write::<FMA>(out.pos, out.nrm, |l| {
             let (t, u, k) = sample(l);
-            self.exact(p, t.edge_uv[u.local as usize][u.reversed as usize][k])
+            self.exact(p, t.edges.get(Domain::Quad, u.local as usize, u.reversed)[k])
         });
         for (l, uv) in out.uv.iter_mut().enumerate() {
             let (t, u, k) = sample(l);
@@ -619,7 +633,7 @@ impl<'a> FastEvaluator<'a> {
         let (basis, n) = (&tables.basis, tables.n);
         let line = local.edge(local_edge);
         let flip = runs_against(owner);
-        let uvs = &tables.edge_uv[local_edge][rev as usize];
+        let uvs = tables.edges.get(Domain::Quad, local_edge, rev);
         let uvs32 = &tables.edge_uv32[local_edge][rev as usize];
         for t0 in (1..n).step_by(LANES) {
             let block = line.block::<FMA>(basis, t0, &local.origin, local.scale);

@@ -29,6 +29,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 use stream_store::IndexWrites;
 
+mod edge_params;
 pub(crate) mod fast_evaluator;
 pub mod layout;
 pub(crate) mod point_blocks;
@@ -706,11 +707,15 @@ impl Writer<'_> {
         with_scratch(self.generation, |scratch| {
             let uvs = &mut scratch.edge_params;
             uvs.clear();
+            let fast = self.fast.expect("owner_run checked the evaluator");
             for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
-                push_edge_params(plan, e, d, &topo.edge_uses(e)[0], uvs);
+                let u = &topo.edge_uses(e)[0];
+                match fast.uniform_edge_params(plan.segments(e), d, u) {
+                    Some(params) => uvs.extend_from_slice(params),
+                    None => push_edge_params(plan, e, d, u, uvs),
+                }
             }
-            let points = self.fast.expect("owner_run checked the evaluator").points();
-            points.eval(set, owner, uvs, out);
+            fast.points().eval(set, owner, uvs, out);
         });
     }
 

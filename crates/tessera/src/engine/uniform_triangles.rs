@@ -17,14 +17,13 @@
 //! This changes how the output is written, never what it is: the tests compare it with the
 //! generic writer's index for index. Evaluation is [`PointBlocks`]' as elsewhere.
 
+use super::edge_params::UniformEdgeParams;
 use super::layout::{pattern_input, Layout};
 use super::point_blocks::PointBlocks;
 use super::{stream_store, Pass, PatchOut, VertexSlices};
 use crate::criterion::Plan;
 use crate::pattern::{LocalTessellation, Pattern, Slot};
-use crate::sampling::uniform_param;
 use crate::surface::{Domain, SurfaceSet};
-use glam::DVec2;
 
 /// Groups of a triangle patch's local vertices: corners 0–2, the inner samples of edges 0–2
 /// (`3 + e`); the interior (6, never coded: see `UniformTriangles::interior`) and one unused,
@@ -58,10 +57,9 @@ pub(crate) struct UniformTriangles {
     /// The corners on the patch's boundary, as (place in the flattened triangles, code: group
     /// in the low [`GROUP_BITS`], index in the group above).
     boundary: Vec<(u32, u32)>,
-    /// `edge_uv[e][reversed]`: the parameters, in the domain of a patch whose local edge `e`
-    /// this is, of the edge's canonical inner samples `k = 1 .. n − 1`, as the generic writer
-    /// computes them.
-    edge_uv: [[Vec<DVec2>; 2]; 3],
+    /// The parameters, in the domain of a patch whose local edge this is, of the edge's
+    /// canonical samples, as the generic writer computes them.
+    edges: UniformEdgeParams,
 }
 
 impl UniformTriangles {
@@ -99,18 +97,10 @@ impl UniformTriangles {
             self.interior.push(0);
             self.boundary.push((at as u32, code));
         }
-        if self.n != n {
-            for (e, by_direction) in self.edge_uv.iter_mut().enumerate() {
-                for (reversed, uvs) in by_direction.iter_mut().enumerate() {
-                    uvs.clear();
-                    uvs.extend((1..n).map(|k| {
-                        let t = uniform_param(n, k);
-                        Domain::Tri.edge_point(e, if reversed == 1 { 1.0 - t } else { t })
-                    }));
-                }
-            }
-            self.n = n;
+        if self.edges.factor() != n {
+            self.edges.fill(n);
         }
+        self.n = n;
         self.active = true;
         true
     }
@@ -129,8 +119,8 @@ impl UniformTriangles {
     /// and the edge has one normal variant) with its owner patch, in canonical order.
     pub(crate) fn edge(&self, set: &SurfaceSet, points: &PointBlocks, e: usize, out: VertexSlices<'_>) {
         let owner = set.topology.edge_uses(e)[0];
-        let uvs = &self.edge_uv[owner.local as usize][owner.reversed as usize];
-        points.eval(set, owner.patch as usize, uvs, out);
+        let uvs = self.edges.get(Domain::Tri, owner.local as usize, owner.reversed);
+        points.eval(set, owner.patch as usize, &uvs[1..self.n as usize], out);
     }
 
     /// Pass `pass` of the interiors and triangles of `patches` into `out` (their share of the
