@@ -150,6 +150,8 @@ pub(crate) struct PatternCache {
     grid_of: WordMap<u64, u32>,
     /// The cells of each grid in use, in `grids`' order.
     grid_cells: Vec<[u32; 2]>,
+    /// The chunks of [`PatternCache::extend_inputs`]' parallel pass.
+    chunks: Vec<ChunkInputs>,
 }
 
 /// The parameters of every local vertex of `built` (made for `input`), in local order:
@@ -230,12 +232,13 @@ impl PatternCache {
     /// for item `i`), building each distinct input once; with `params`, also the parameters of
     /// every local vertex of each pattern (the a-posteriori check's table, see
     /// [`PatternCache::params`]). Precondition: the pattern does not depend on the patch.
-    /// Cost: one hash lookup per item (sequential), then the distinct builds (parallel).
+    /// Cost: one hash lookup per item (parallel), one per chunk's distinct input
+    /// (sequential), then the distinct builds (parallel).
     pub(crate) fn fill_inputs(
         &mut self,
         pattern: &dyn Pattern,
         count: usize,
-        input_of: impl Fn(usize) -> Option<PatternInput>,
+        input_of: impl Fn(usize) -> Option<PatternInput> + Sync,
         params: bool,
     ) {
         self.clear();
@@ -248,45 +251,52 @@ impl PatternCache {
     /// a-posteriori check, which built most of them): the key is every bit of the input a
     /// pattern reads, so a kept pattern is the one a build would make.
     /// Precondition: the cache was filled for `pattern`, which does not depend on the patch.
-    /// Cost: one hash lookup per item (sequential), then the new builds (parallel).
+    /// Cost: one hash lookup per item (parallel), one per chunk's distinct input
+    /// (sequential), then the new builds (parallel).
     pub(crate) fn extend_inputs(
         &mut self,
         pattern: &dyn Pattern,
         count: usize,
-        input_of: impl Fn(usize) -> Option<PatternInput>,
+        input_of: impl Fn(usize) -> Option<PatternInput> + Sync,
         params: bool,
     ) {
         debug_assert!(!pattern.depends_on_patch());
-        self.of_patch.clear();
-        if self.of_patch.capacity() < count {
-            self.of_patch.reserve(count);
-        }
         let (kept, kept_grids) = (self.inputs.len(), self.grid_cells.len());
-        // Neighbouring items often share an input: a comparison with the last key costs
-        // less than the hash and the probe.
-        let mut last: Option<(Key, u32)> = None;
-        for i in 0..count {
-            let Some(input) = input_of(i) else {
-                self.of_patch.push(NONE);
-                continue;
-            };
-            let key = Key::of(&input);
-            if let Some((_, slot)) = last.filter(|(seen, _)| *seen == key) {
-                self.of_patch.push(slot);
-                continue;
-            }
-            let next = self.inputs.len() as u32;
-            let slot = *self.index.entry(key).or_insert(next);
-            last = Some((key, slot));
-            if slot == next {
-                let core = pattern.core_grid(&input);
-                self.inputs.push(input);
-                self.cores.push(core);
-                let interior = core.map_or(NONE, |core| self.grid(core));
-                self.interiors.push(interior);
-            }
-            self.of_patch.push(slot);
+        // Each chunk's distinct inputs in parallel, in the order they first occur, and each
+        // item's place among its chunk's (`of_patch` holds those places meanwhile).
+        let chunks = count.div_ceil(DEDUP_CHUNK);
+        if self.chunks.len() < chunks {
+            self.chunks.resize_with(chunks, ChunkInputs::default);
         }
+        self.of_patch.resize(count, NONE);
+        let parts = self.of_patch.par_chunks_mut(DEDUP_CHUNK).zip(&mut self.chunks[..chunks]).enumerate();
+        parts.for_each(|(c, (places, chunk))| chunk.find(c * DEDUP_CHUNK, places, &input_of));
+        // Then the table's slots, chunk after chunk: the slots of the sequential pass (the
+        // inputs in the order they first occur), a lookup per chunk's distinct input.
+        for c in 0..chunks {
+            let chunk = &mut self.chunks[c];
+            chunk.slots.clear();
+            for &(key, input) in &chunk.distinct {
+                let next = self.inputs.len() as u32;
+                let slot = *self.index.entry(key).or_insert(next);
+                if slot == next {
+                    let core = pattern.core_grid(&input);
+                    self.inputs.push(input);
+                    self.cores.push(core);
+                    let interior =
+                        core.map_or(NONE, |core| grid_index(&mut self.grid_of, &mut self.grid_cells, core));
+                    self.interiors.push(interior);
+                }
+                chunk.slots.push(slot);
+            }
+        }
+        // Each item's slot from its place in its chunk.
+        let parts = self.of_patch.par_chunks_mut(DEDUP_CHUNK).zip(&self.chunks[..chunks]);
+        parts.for_each(|(places, chunk)| {
+            for place in places.iter_mut().filter(|p| **p != NONE) {
+                *place = chunk.slots[*place as usize];
+            }
+        });
         // The new grids' points, in parallel with each other (a few a frame are large).
         let grids = self.grid_cells.len();
         if self.grids.len() < grids {
@@ -336,19 +346,6 @@ impl PatternCache {
         }
     }
 
-    /// The index in `grids` of `core`'s grid points ([`CoreGrid::interior_points`]), a new
-    /// one where the frame has no such grid yet (its points made after the inputs' pass,
-    /// [`PatternCache::extend_inputs`]). Cost: O(1).
-    fn grid(&mut self, core: CoreGrid) -> u32 {
-        let [nu, nv] = core.cells;
-        let next = self.grid_of.len() as u32;
-        let index = *self.grid_of.entry((nu as u64) << 32 | nv as u64).or_insert(next);
-        if index == next {
-            self.grid_cells.push(core.cells);
-        }
-        index
-    }
-
     /// Patch `p`'s pattern input, pattern and the pattern's [`boundary_positions`], when the
     /// cache holds them for this frame (the input's `patch` is the first patch's of that
     /// input: set it to `p`).
@@ -380,6 +377,69 @@ impl PatternCache {
     #[cfg(test)]
     pub(crate) fn distinct(&self) -> usize {
         self.inputs.len()
+    }
+}
+
+/// The index in a cache's `grids` of `core`'s grid points ([`CoreGrid::interior_points`]), a
+/// new one where the frame has no such grid yet (`grid_of` and `grid_cells`: the cache's; its
+/// points made after the inputs' pass, [`PatternCache::extend_inputs`]). Cost: O(1).
+fn grid_index(grid_of: &mut WordMap<u64, u32>, grid_cells: &mut Vec<[u32; 2]>, core: CoreGrid) -> u32 {
+    let [nu, nv] = core.cells;
+    let next = grid_of.len() as u32;
+    let index = *grid_of.entry((nu as u64) << 32 | nv as u64).or_insert(next);
+    if index == next {
+        grid_cells.push(core.cells);
+    }
+    index
+}
+
+/// Items a task of [`PatternCache::extend_inputs`]' parallel pass takes.
+const DEDUP_CHUNK: usize = 512;
+
+/// One chunk of items in [`PatternCache::extend_inputs`]: its distinct inputs, then their
+/// slots in the table. Kept from call to call (its buffers and map keep their capacity).
+#[derive(Default)]
+struct ChunkInputs {
+    /// The chunk's distinct inputs by key, in the order they first occur.
+    distinct: Vec<(Key, PatternInput)>,
+    /// Each distinct key's place in `distinct`.
+    places: WordMap<Key, u32>,
+    /// Each distinct input's slot in the table (`distinct`'s order).
+    slots: Vec<u32>,
+}
+
+impl ChunkInputs {
+    /// Finds the distinct inputs of items `first ..` (one per element of `places`) and writes
+    /// each item's place among them into `places` ([`NONE`] for an item without an input).
+    fn find(
+        &mut self,
+        first: usize,
+        places: &mut [u32],
+        input_of: &(impl Fn(usize) -> Option<PatternInput> + Sync),
+    ) {
+        self.distinct.clear();
+        self.places.clear();
+        // Neighbouring items often share an input: a comparison with the last key costs
+        // less than the hash and the probe.
+        let mut last: Option<(Key, u32)> = None;
+        for (k, place) in places.iter_mut().enumerate() {
+            let Some(input) = input_of(first + k) else {
+                *place = NONE;
+                continue;
+            };
+            let key = Key::of(&input);
+            if let Some((_, at)) = last.filter(|(seen, _)| *seen == key) {
+                *place = at;
+                continue;
+            }
+            let next = self.distinct.len() as u32;
+            let at = *self.places.entry(key).or_insert(next);
+            if at == next {
+                self.distinct.push((key, input));
+            }
+            last = Some((key, at));
+            *place = at;
+        }
     }
 }
 
