@@ -257,7 +257,8 @@ pub(crate) fn write_buffers(
         + std::mem::size_of_val(&*indices)
         + std::mem::size_of_val(&*triangle_patch)
         + std::mem::size_of_val(&*params);
-    let writes = stream_store::index_writes(bytes as u64);
+    let writes =
+        stream_store::index_writes(bytes as u64, layout.triangle_count() as u64, set.patches.len() as u64);
     let stream = writes == IndexWrites::Streamed;
     let writer = Writer { set, plan, pattern, layout, fast, patterns: None, generation: next_generation() };
 
@@ -285,8 +286,8 @@ pub(crate) fn write_buffers(
         },
         || patches_pass(patch_part, Pass::Vertices { writes }),
     );
-    // Within the cache, the vertex pass maps every patch's triangles too (`Pass::Vertices`);
-    // the uniform triangle writer keeps its own two passes.
+    // Within the cache and for small patterns, the vertex pass maps every patch's triangles
+    // too (`Pass::Vertices`); the uniform triangle writer keeps its own two passes.
     let index_pass = writes != IndexWrites::WithVertices || uniform.is_some();
     // Split-normal entries take the position bits of their vertex's first entry. (A vertex
     // has one entry, or more where its normals split: without splits, no pass on the main
@@ -314,9 +315,9 @@ pub(crate) fn write_buffers(
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Pass {
     /// Interior vertices and their triangles, by the frame's [`IndexWrites`]: within the
-    /// cache every patch's triangles mapped to output vertices with their triangle patches,
-    /// and no index pass follows; past it, a pattern the cache holds leaves its triangles to
-    /// the index pass, and one it does not hold maps them here (or, streamed, leaves its local
+    /// cache and for small patterns, every patch's triangles mapped to output vertices with
+    /// their triangle patches, and no index pass follows; otherwise a pattern the cache holds
+    /// leaves its triangles to the index pass, and one it does not hold maps them here (or, streamed, leaves its local
     /// indices for the index pass to map and stream out).
     ///
     /// Why map them here: the patch's pattern and numbers are at hand in this pass, and an
@@ -324,8 +325,8 @@ pub(crate) enum Pass {
     /// here, also read back what this pass wrote), and cost a parallel pass more. On frames
     /// of small patterns (the Catmull-Clark torus at 0.5 px, 13 triangles a patch) those
     /// per-patch steps were most of the index pass; on the cow's adaptive frames (5,804
-    /// patches, all cached) a separate pass cost 5 % of the frame. Frames past the cache keep
-    /// the two passes ([`IndexWrites::OwnPass`]).
+    /// patches, all cached) a separate pass cost 3–5 % of the frame. Frames past the cache,
+    /// or of large patterns, keep the two passes ([`IndexWrites::OwnPass`]).
     Vertices { writes: IndexWrites },
     /// Triangles and triangle patches; with `stream`, written by streaming stores (a frame
     /// well past the cache, [`IndexWrites::Streamed`]).

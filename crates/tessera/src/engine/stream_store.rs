@@ -26,22 +26,30 @@ const ASSUMED_CACHE_BYTES: u64 = 32 << 20;
 /// How a frame writes its triangles ([`index_writes`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum IndexWrites {
-    /// In the vertex pass, each patch's after its vertices: an output within the cache.
+    /// In the vertex pass, each patch's after its vertices: an output within the cache, of
+    /// small patterns.
     WithVertices,
-    /// In a pass of their own, by plain stores: an output past the cache. Bursts into the
-    /// index arrays between each patch's vertex writes broke the store streams the two
-    /// passes keep: the torus at factor 16 (36 MB) 1.35 → 1.66 ms on two threads with its
-    /// triangles in the vertex pass (a 32 MiB L3).
+    /// In a pass of their own, by plain stores: an output past the cache, or of large
+    /// patterns. Bursts into the index arrays between each patch's vertex writes broke the
+    /// store streams the two passes keep: the torus at factor 16 (36 MB, 512 triangles a
+    /// patch) 1.35 → 1.66 ms on two threads with its triangles in the vertex pass (a 32 MiB
+    /// L3), and at 0.001 % of its diagonal (15 MB, 214 a patch) 17 % slower on one thread
+    /// beside another process, where the cow's frames (29 to 73 a patch) gained 1.5–3 %.
     OwnPass,
     /// In a pass of their own, by streaming stores: an output past twice the cache.
     Streamed,
 }
 
-/// How a frame of `output_bytes` (vertices, indices, triangle patches, parameters) writes its
-/// triangles, by the last-level cache ([`last_level_cache_bytes`], asked once a process),
-/// counted at most [`CACHE_COUNTED_ON`]: streamed past twice the cache, in their own pass
-/// past it, with the vertices within it. Cost: O(1).
-pub(crate) fn index_writes(output_bytes: u64) -> IndexWrites {
+/// Patterns of more triangles than this on average keep their triangles in a pass of their
+/// own ([`IndexWrites::OwnPass`]).
+const WITH_VERTICES_TRIANGLES: u64 = 128;
+
+/// How a frame of `output_bytes` (vertices, indices, triangle patches, parameters),
+/// `triangles` over `patches` patches, writes its triangles, by the last-level cache
+/// ([`last_level_cache_bytes`], asked once a process), counted at most
+/// [`CACHE_COUNTED_ON`]: streamed past twice the cache, in their own pass past it or where
+/// patterns average more than [`WITH_VERTICES_TRIANGLES`], else with the vertices. Cost: O(1).
+pub(crate) fn index_writes(output_bytes: u64, triangles: u64, patches: u64) -> IndexWrites {
     #[cfg(test)]
     if let Some(forced) = FORCED.get() {
         return forced;
@@ -51,7 +59,7 @@ pub(crate) fn index_writes(output_bytes: u64) -> IndexWrites {
         *CACHE.get_or_init(|| last_level_cache_bytes().unwrap_or(ASSUMED_CACHE_BYTES).min(CACHE_COUNTED_ON));
     if output_bytes > 2 * cache {
         IndexWrites::Streamed
-    } else if output_bytes > cache {
+    } else if output_bytes > cache || triangles > WITH_VERTICES_TRIANGLES * patches {
         IndexWrites::OwnPass
     } else {
         IndexWrites::WithVertices
