@@ -481,14 +481,14 @@ fn push_edge_params(plan: &Plan, e: usize, d: Domain, u: &crate::topology::EdgeU
 }
 
 /// The inner samples of edge `e`, evaluated once per normal variant by a patch of that
-/// variant (in blocks where `points` is given); variants after the first copy the first's
-/// position bits. `uvs` is scratch.
+/// variant (in blocks where `fast` is given, its parameters from its tables where they hold
+/// them); variants after the first copy the first's position bits. `uvs` is scratch.
 fn write_edge(
     set: &SurfaceSet,
     plan: &Plan,
     e: usize,
     out: VertexSlices<'_>,
-    points: Option<&point_blocks::PointBlocks>,
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
     uvs: &mut Vec<DVec2>,
 ) {
     let topo = &set.topology;
@@ -499,7 +499,10 @@ fn write_edge(
         let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
         let d = topo.patch_domains[u.patch as usize];
         uvs.clear();
-        push_edge_params(plan, e, d, u, uvs);
+        match fast.and_then(|f| f.uniform_edge_params(plan.segments(e), d, u)) {
+            Some(params) => uvs.extend_from_slice(params),
+            None => push_edge_params(plan, e, d, u, uvs),
+        }
         let r = variant * inner..(variant + 1) * inner;
         let mut part = VertexSlices {
             pos: &mut pos[r.clone()],
@@ -507,8 +510,8 @@ fn write_edge(
             uv: &mut uv[r.clone()],
             patch: &mut patch[r.clone()],
         };
-        match points {
-            Some(points) => points.eval(set, u.patch as usize, uvs, part),
+        match fast {
+            Some(f) => f.points().eval(set, u.patch as usize, uvs, part),
             None => {
                 for (k, &q) in uvs.iter().enumerate() {
                     part.set(k, set, u.patch, q);
@@ -615,8 +618,7 @@ impl Writer<'_> {
                     f.triangles().edge(self.set, f.points(), e, part)
                 }
                 fast => with_scratch(self.generation, |scratch| {
-                    let points = fast.map(|f| f.points());
-                    write_edge(self.set, self.plan, e, part, points, &mut scratch.edge_params)
+                    write_edge(self.set, self.plan, e, part, fast, &mut scratch.edge_params)
                 }),
             }
         }
@@ -662,14 +664,21 @@ impl Writer<'_> {
         with_scratch(self.generation, |scratch| {
             let (uvs, items) = (&mut scratch.edge_params, &mut scratch.tree_items);
             items.clear();
+            let fast = self.fast.expect("tree_run checked the evaluator");
             for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
                 let owner = &topo.edge_uses(e)[0];
-                uvs.clear();
-                push_edge_params(plan, e, topo.patch_domains[owner.patch as usize], owner, uvs);
-                items.extend(uvs.iter().map(|&uv| (owner.patch, uv)));
+                let d = topo.patch_domains[owner.patch as usize];
+                let params = match fast.uniform_edge_params(plan.segments(e), d, owner) {
+                    Some(params) => params,
+                    None => {
+                        uvs.clear();
+                        push_edge_params(plan, e, d, owner, uvs);
+                        &uvs[..]
+                    }
+                };
+                items.extend(params.iter().map(|&uv| (owner.patch, uv)));
             }
-            let points = self.fast.expect("tree_run checked the evaluator").points();
-            points.eval_tree_stream(set, items, out);
+            fast.points().eval_tree_stream(set, items, out);
         });
     }
 
