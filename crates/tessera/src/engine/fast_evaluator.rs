@@ -317,9 +317,9 @@ impl<'a> FastEvaluator<'a> {
 
     /// [`FastEvaluator::fill_patterns`] with the distinct patterns left for the write to
     /// find, for the same `plan` and `pattern` ([`super::write_with`]): it does so beside its
-    /// corners and edges, which do not read them. The table's fill is one hash lookup per
-    /// visible patch on one thread; on the cow's adaptive frames (5,804 patches), a sixth of
-    /// the frame on two threads when it ran before the write.
+    /// corners and edges, which do not read them. The table's fill, a hash lookup per
+    /// visible patch, took a sixth of the cow's adaptive frames (5,804 patches, two
+    /// threads) when it ran on one thread before the write.
     pub(crate) fn defer_patterns(
         &mut self,
         plan: &Plan,
