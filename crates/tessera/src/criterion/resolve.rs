@@ -12,6 +12,7 @@
 use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
 use crate::sampling::{spacing_segments, Spacing};
 use crate::surface::{Domain, SurfaceSet};
+use rayon::prelude::*;
 
 /// What each patch proposes for its local edges (`[0..corner_count]`; 0 = no wish, as for
 /// culled patches).
@@ -152,7 +153,6 @@ pub fn edges(
     segments: &mut Vec<u32>,
     factors: &mut Vec<f32>,
 ) {
-    use rayon::prelude::*;
     let topo = &set.topology;
     let edges = topo.edges.len();
     // Every entry is written below: no clearing pass first (on the main thread alone).
@@ -190,8 +190,8 @@ pub fn edges(
     }
 }
 
-/// Interior factors of every patch from its edges' segments by `rule` (into `out`, cleared
-/// first). Cost: O(P).
+/// Interior factors of every patch from its edges' segments by `rule` (into `out`, resized to
+/// one row a patch). Cost: O(P), parallel.
 pub fn interiors(
     set: &SurfaceSet,
     segments: &[u32],
@@ -200,39 +200,45 @@ pub fn interiors(
     out: &mut Vec<[u32; 2]>,
 ) {
     let topo = &set.topology;
-    out.clear();
-    out.extend((0..set.patches.len()).map(|p| {
-        let domain = set.topology.patch_domains[p];
-        let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
-        let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
-        let minimum = caps.minimum_interior[p];
-        match (rule, domain) {
-            (InteriorRule::Global, _) => [largest, largest],
-            (InteriorRule::Core, Domain::Quad) => {
-                [s(0).min(s(2)).max(minimum[0]), s(1).min(s(3)).max(minimum[1])]
-            }
-            (InteriorRule::Core, Domain::Tri) | (InteriorRule::MaxEdge, _) => [largest, largest],
-            (InteriorRule::Level, _) => {
-                let n =
-                    largest.max(minimum[0]).max(minimum[1]).next_power_of_two().min(caps.max_factor as u32);
-                [n, n]
+    // In parallel, each element once (`resize` keeps a row of the right length as it is).
+    out.resize(set.patches.len(), [0; 2]);
+    out.par_iter_mut().enumerate().with_min_len(1024).for_each(|(p, out)| {
+        *out = {
+            let domain = set.topology.patch_domains[p];
+            let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
+            let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
+            let minimum = caps.minimum_interior[p];
+            match (rule, domain) {
+                (InteriorRule::Global, _) => [largest, largest],
+                (InteriorRule::Core, Domain::Quad) => {
+                    [s(0).min(s(2)).max(minimum[0]), s(1).min(s(3)).max(minimum[1])]
+                }
+                (InteriorRule::Core, Domain::Tri) | (InteriorRule::MaxEdge, _) => [largest, largest],
+                (InteriorRule::Level, _) => {
+                    let n = largest
+                        .max(minimum[0])
+                        .max(minimum[1])
+                        .next_power_of_two()
+                        .min(caps.max_factor as u32);
+                    [n, n]
+                }
             }
         }
-    }));
+    });
 }
 
 /// Per-use proposals from one factor per edge (criteria that judge an edge by its own data,
-/// such as the view criteria): every use of edge `e` proposes `per_edge[e]`. Cost: O(P).
+/// such as the view criteria): every use of edge `e` proposes `per_edge[e]`. Cost: O(P),
+/// parallel.
 pub fn from_edge_factors(set: &SurfaceSet, per_edge: &[f64], out: &mut Vec<Proposals>) {
     let topo = &set.topology;
-    out.clear();
-    out.extend((0..set.patches.len()).map(|p| {
-        let mut row = [0.0; 4];
+    out.resize(set.patches.len(), [0.0; 4]);
+    out.par_iter_mut().enumerate().with_min_len(1024).for_each(|(p, row)| {
+        *row = [0.0; 4];
         for (l, r) in row.iter_mut().enumerate().take(set.topology.patch_domains[p].corner_count()) {
             *r = per_edge[topo.patch_edges[p][l].edge as usize];
         }
-        row
-    }));
+    });
 }
 
 #[cfg(test)]

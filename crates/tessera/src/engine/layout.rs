@@ -130,16 +130,27 @@ impl Layout {
         // Where nothing is culled every edge is seen: its uses are not read (one pass over
         // the visibility row instead of a search of each edge's uses).
         let all_visible = plan.visible.iter().all(|&v| v != 0);
-        self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024).for_each(
-            |(e, (count, edge))| {
+        let edge_counts =
+            self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024);
+        let count_edges = || {
+            edge_counts.for_each(|(e, (count, edge))| {
                 // Without a branch per use: with culling on, about half the patches are
                 // culled in no predictable order, and `any`'s early exit mispredicted.
                 let seen = all_visible
                     || topo.edge_uses(e).iter().fold(0, |seen, u| seen | plan.visible[u.patch as usize]) != 0;
                 let kept = u32::from(!edge.collapsed && seen);
                 *count = kept * (plan.segments(e) - 1) * edge.variants as u32;
-            },
-        );
+            })
+        };
+        // The patterns' counts (where the check did not leave them) beside the edges' counts:
+        // one parallel pass for both, not two.
+        let layout_counts = &mut self.counts;
+        match counts {
+            Some(_) => count_edges(),
+            None => {
+                rayon::join(count_edges, || count_patterns(set, plan, pattern, layout_counts));
+            }
+        }
         let mut total = self.corners as u64;
         for offset in self.edge_offsets.iter_mut() {
             let count = *offset as u64;
@@ -163,10 +174,7 @@ impl Layout {
                 }));
                 counts
             }
-            None => {
-                self.count_patterns(set, plan, pattern);
-                &self.counts
-            }
+            None => &self.counts,
         };
         let (interior, upper) =
             counts.iter().fold((0u64, 0u64), |(v, t), c| (v + c.0 as u64, t + c.1 as u64));
@@ -198,31 +206,31 @@ impl Layout {
         self.collapsed_triangles = upper - triangles as u64;
         Ok(())
     }
+}
 
-    /// Every patch's pattern counts into `self.counts` (zero for culled patches).
-    /// Neighbouring patches often share an input: each task keeps its last count.
-    fn count_patterns(&mut self, set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern) {
-        (0..set.patches.len())
-            .into_par_iter()
-            .map_init(
-                || None,
-                |last: &mut Option<(PatternInput, (u32, u32))>, p| {
-                    if !plan.is_visible(p) {
-                        return (0, 0);
+/// Every patch's pattern counts into `counts` (zero for culled patches). Neighbouring patches
+/// often share an input: each task keeps its last count.
+fn count_patterns(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, counts: &mut Vec<(u32, u32)>) {
+    (0..set.patches.len())
+        .into_par_iter()
+        .map_init(
+            || None,
+            |last: &mut Option<(PatternInput, (u32, u32))>, p| {
+                if !plan.is_visible(p) {
+                    return (0, 0);
+                }
+                let input = PatternInput { patch: 0, ..pattern_input(set, plan, p) };
+                match *last {
+                    Some((seen, counts)) if seen == input && !pattern.depends_on_patch() => counts,
+                    _ => {
+                        let counts = pattern.counts(&PatternInput { patch: p as u32, ..input });
+                        *last = Some((input, counts));
+                        counts
                     }
-                    let input = PatternInput { patch: 0, ..pattern_input(set, plan, p) };
-                    match *last {
-                        Some((seen, counts)) if seen == input && !pattern.depends_on_patch() => counts,
-                        _ => {
-                            let counts = pattern.counts(&PatternInput { patch: p as u32, ..input });
-                            *last = Some((input, counts));
-                            counts
-                        }
-                    }
-                },
-            )
-            .collect_into_vec(&mut self.counts);
-    }
+                }
+            },
+        )
+        .collect_into_vec(counts);
 }
 
 /// The patches' first interior vertex and first triangle (`P + 1` entries each, written
