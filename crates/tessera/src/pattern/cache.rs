@@ -404,6 +404,10 @@ struct ChunkInputs {
     distinct: Vec<(Key, PatternInput)>,
     /// Each distinct key's place in `distinct`.
     places: WordMap<Key, u32>,
+    /// The same for the inputs [`small_input_index`] numbers, by that number: one word to
+    /// hash and compare instead of the key's eight (the cow's adaptive frames have only
+    /// such inputs).
+    small_places: WordMap<u32, u32>,
     /// Each distinct input's slot in the table (`distinct`'s order).
     slots: Vec<u32>,
 }
@@ -419,14 +423,32 @@ impl ChunkInputs {
     ) {
         self.distinct.clear();
         self.places.clear();
+        self.small_places.clear();
         // Neighbouring items often share an input: a comparison with the last key costs
         // less than the hash and the probe.
         let mut last: Option<(Key, u32)> = None;
+        let mut last_small: Option<(u32, u32)> = None;
         for (k, place) in places.iter_mut().enumerate() {
             let Some(input) = input_of(first + k) else {
                 *place = NONE;
                 continue;
             };
+            // Equal small numbers are equal keys and the other way round, and no other key
+            // equals one with a small number: the two maps share out the inputs.
+            if let Some(index) = small_input_index(&input) {
+                if let Some((_, at)) = last_small.filter(|(seen, _)| *seen == index) {
+                    *place = at;
+                    continue;
+                }
+                let next = self.distinct.len() as u32;
+                let at = *self.small_places.entry(index).or_insert(next);
+                if at == next {
+                    self.distinct.push((Key::of(&input), input));
+                }
+                last_small = Some((index, at));
+                *place = at;
+                continue;
+            }
             let key = Key::of(&input);
             if let Some((_, at)) = last.filter(|(seen, _)| *seen == key) {
                 *place = at;
