@@ -203,27 +203,22 @@ pub fn interiors(
     // In parallel, each element once (`resize` keeps a row of the right length as it is).
     out.resize(set.patches.len(), [0; 2]);
     out.par_iter_mut().enumerate().with_min_len(1024).for_each(|(p, out)| {
-        *out = {
-            let domain = set.topology.patch_domains[p];
-            let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
-            let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
-            let minimum = caps.minimum_interior[p];
-            match (rule, domain) {
-                (InteriorRule::Global, _) => [largest, largest],
-                (InteriorRule::Core, Domain::Quad) => {
-                    [s(0).min(s(2)).max(minimum[0]), s(1).min(s(3)).max(minimum[1])]
-                }
-                (InteriorRule::Core, Domain::Tri) | (InteriorRule::MaxEdge, _) => [largest, largest],
-                (InteriorRule::Level, _) => {
-                    let n = largest
-                        .max(minimum[0])
-                        .max(minimum[1])
-                        .next_power_of_two()
-                        .min(caps.max_factor as u32);
-                    [n, n]
-                }
+        let domain = set.topology.patch_domains[p];
+        let s = |l: usize| segments[topo.patch_edges[p][l].edge as usize];
+        let largest = (0..domain.corner_count()).map(s).max().unwrap_or(1);
+        let minimum = caps.minimum_interior[p];
+        *out = match (rule, domain) {
+            (InteriorRule::Global, _) => [largest, largest],
+            (InteriorRule::Core, Domain::Quad) => {
+                [s(0).min(s(2)).max(minimum[0]), s(1).min(s(3)).max(minimum[1])]
             }
-        }
+            (InteriorRule::Core, Domain::Tri) | (InteriorRule::MaxEdge, _) => [largest, largest],
+            (InteriorRule::Level, _) => {
+                let n =
+                    largest.max(minimum[0]).max(minimum[1]).next_power_of_two().min(caps.max_factor as u32);
+                [n, n]
+            }
+        };
     });
 }
 

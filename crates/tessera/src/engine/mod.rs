@@ -317,8 +317,8 @@ pub(crate) enum Pass {
     /// Interior vertices and their triangles, by the frame's [`IndexWrites`]: within the
     /// cache and for small patterns, every patch's triangles mapped to output vertices with
     /// their triangle patches, and no index pass follows; otherwise a pattern the cache holds
-    /// leaves its triangles to the index pass, and one it does not hold maps them here (or, streamed, leaves its local
-    /// indices for the index pass to map and stream out).
+    /// leaves its triangles to the index pass, and one it does not hold maps them here (or,
+    /// streamed, leaves its local indices for the index pass to map and stream out).
     ///
     /// Why map them here: the patch's pattern and numbers are at hand in this pass, and an
     /// index pass would find its input and its vertex numbers again (for a pattern built
@@ -473,11 +473,25 @@ fn evaluate_corners(
 }
 
 /// Appends the parameters, in the domain `d` of the patch of use `u`, of edge `e`'s inner
-/// samples `k = 1 .. segments − 1` in canonical order: where that patch evaluates them.
-fn push_edge_params(plan: &Plan, e: usize, d: Domain, u: &crate::topology::EdgeUse, uvs: &mut Vec<DVec2>) {
-    uvs.extend(
-        plan.inner_params(e).map(|t| d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })),
-    );
+/// samples `k = 1 .. segments − 1` in canonical order: where that patch evaluates them. From
+/// `fast`'s per-factor tables where it holds the edge's factor (the same values, without a
+/// division and a placement per sample). Cost: O(segments).
+#[inline]
+fn push_edge_params(
+    plan: &Plan,
+    e: usize,
+    d: Domain,
+    u: &crate::topology::EdgeUse,
+    fast: Option<&fast_evaluator::FastEvaluator<'_>>,
+    uvs: &mut Vec<DVec2>,
+) {
+    match fast.and_then(|f| f.uniform_edge_params(plan.segments(e), d, u)) {
+        Some(params) => uvs.extend_from_slice(params),
+        None => uvs.extend(
+            plan.inner_params(e)
+                .map(|t| d.edge_point(u.local as usize, if u.reversed { 1.0 - t } else { t })),
+        ),
+    }
 }
 
 /// The inner samples of edge `e`, evaluated once per normal variant by a patch of that
@@ -499,10 +513,7 @@ fn write_edge(
         let Some(u) = uses.iter().find(|u| u.variant as usize == variant) else { continue };
         let d = topo.patch_domains[u.patch as usize];
         uvs.clear();
-        match fast.and_then(|f| f.uniform_edge_params(plan.segments(e), d, u)) {
-            Some(params) => uvs.extend_from_slice(params),
-            None => push_edge_params(plan, e, d, u, uvs),
-        }
+        push_edge_params(plan, e, d, u, fast, uvs);
         let r = variant * inner..(variant + 1) * inner;
         let mut part = VertexSlices {
             pos: &mut pos[r.clone()],
@@ -667,16 +678,9 @@ impl Writer<'_> {
             let fast = self.fast.expect("tree_run checked the evaluator");
             for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
                 let owner = &topo.edge_uses(e)[0];
-                let d = topo.patch_domains[owner.patch as usize];
-                let params = match fast.uniform_edge_params(plan.segments(e), d, owner) {
-                    Some(params) => params,
-                    None => {
-                        uvs.clear();
-                        push_edge_params(plan, e, d, owner, uvs);
-                        &uvs[..]
-                    }
-                };
-                items.extend(params.iter().map(|&uv| (owner.patch, uv)));
+                uvs.clear();
+                push_edge_params(plan, e, topo.patch_domains[owner.patch as usize], owner, Some(fast), uvs);
+                items.extend(uvs.iter().map(|&uv| (owner.patch, uv)));
             }
             fast.points().eval_tree_stream(set, items, out);
         });
@@ -719,11 +723,7 @@ impl Writer<'_> {
             uvs.clear();
             let fast = self.fast.expect("owner_run checked the evaluator");
             for e in edges.filter(|&e| self.layout.edge_offsets[e + 1] > self.layout.edge_offsets[e]) {
-                let u = &topo.edge_uses(e)[0];
-                match fast.uniform_edge_params(plan.segments(e), d, u) {
-                    Some(params) => uvs.extend_from_slice(params),
-                    None => push_edge_params(plan, e, d, u, uvs),
-                }
+                push_edge_params(plan, e, d, &topo.edge_uses(e)[0], Some(fast), uvs);
             }
             fast.points().eval(set, owner, uvs, out);
         });
