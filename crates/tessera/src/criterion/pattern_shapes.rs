@@ -13,12 +13,19 @@
 //! first, cheapest bound ([`super::bounds::TriangleErrors::shape_exceeds`]); the largest
 //! bound is the same in any order.
 //!
+//! Larger patterns are kept by their slot in the check's pattern table
+//! ([`crate::pattern::cache::PatternCache`], which holds each distinct first pattern once),
+//! from the second patch of that slot a thread checks: a frame of a few large patterns
+//! repeated (the torus at 0.001 % of its diagonal: one pattern of 214 triangles for 2,048
+//! patches) then looks up no parameter and forms no shape per patch, while a frame whose
+//! patterns are all distinct pays nothing but a mark per slot.
+//!
 //! Written by hand: a direct-mapped table over the small inputs (an index of a few bits a
 //! factor) with per-thread buffers kept from plan to plan is a few lines, and a general map
 //! would hash every patch's input.
 
 use super::bounds::TriangleShape;
-use crate::pattern::cache::{boundary_params, small_input_index, LocalParams, SmallInputTable};
+use crate::pattern::cache::{boundary_params, small_input_index, Cached, LocalParams, SmallInputTable};
 use crate::pattern::{LocalTessellation, Pattern, PatternInput};
 use glam::DVec2;
 
@@ -40,27 +47,43 @@ pub(crate) struct PatternData {
 #[derive(Default)]
 pub(crate) struct PatternShapes {
     table: SmallInputTable<PatternData>,
+    /// Per slot of the check's pattern table, the call that last checked a patch of it on
+    /// this thread, whether its data was made in that call, and the data.
+    slots: Vec<(u64, bool, PatternData)>,
     /// Buffers of a build.
     local: LocalTessellation,
     params: Vec<DVec2>,
 }
 
+/// A patch's pattern as the check's pattern table holds it ([`PatternCache::params`]): the
+/// pattern, its local vertices' parameters and its slot.
+///
+/// [`PatternCache::params`]: crate::pattern::cache::PatternCache::params
+pub(crate) type CachedPattern<'a> = (Cached<'a>, LocalParams<'a>, usize);
+
 impl PatternShapes {
     /// The data of `input`'s pattern under `pattern` for plan `generation`, made unless the
-    /// table has it; None for an input the table does not hold ([`small_input_index`]) or a
-    /// pattern that depends on the patch. Cost: a table read; the first time in a plan, a
-    /// grid test, or a pattern build, its parameters and a sort of its shapes.
-    pub(crate) fn get(
+    /// table has it; None for a pattern that depends on the patch, and for an input the
+    /// small table does not hold ([`small_input_index`]) unless the check's pattern table
+    /// holds it (`cached()`, asked only then) and this thread checked another patch of that
+    /// slot in this call.
+    /// Cost: a table read; the first time in a plan, a grid test, or a pattern build (from
+    /// `cached`: none), its parameters and a sort of its shapes.
+    pub(crate) fn get<'c>(
         &mut self,
         generation: u64,
         pattern: &dyn Pattern,
         input: &PatternInput,
+        cached: impl FnOnce() -> Option<CachedPattern<'c>>,
     ) -> Option<&PatternData> {
-        let index = small_input_index(input)?;
         if pattern.depends_on_patch() {
             return None;
         }
-        let PatternShapes { table, local, params } = self;
+        let Some(index) = small_input_index(input) else {
+            let (cached, params, slot) = cached()?;
+            return self.of_slot(generation, pattern, cached, params, slot);
+        };
+        let PatternShapes { table, local, params, .. } = self;
         let data = table.get_or_build(generation, index, |data: &mut PatternData| {
             data.grid = pattern.grid_cells(input);
             data.counts = pattern.counts(input);
@@ -74,13 +97,60 @@ impl PatternShapes {
             let params = LocalParams { boundary: params, interior: &local.interior };
             data.core = pattern.core_cells(input);
             let rest = super::tolerance::after_core(data.core, &local.triangles);
-            data.shapes.extend(rest.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
-            // Unstable: a stable sort allocates its scratch, and the order of equal keys does not
-            // change the largest bound.
-            data.shapes
-                .sort_unstable_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
+            data.set_shapes(rest, params);
         })?;
         Some(data)
+    }
+
+    /// [`PatternShapes::get`] of a pattern the check's table holds in `slot` (`cached`, its
+    /// local parameters `params`): None the first time this thread sees the slot in call
+    /// `generation` (most slots of a frame of distinct patterns are seen once), the data,
+    /// made from `cached`, from the second time on. Cost: a read; the second time, the grid
+    /// test, counts, and the shapes of the triangles after the core and their sort.
+    fn of_slot(
+        &mut self,
+        generation: u64,
+        pattern: &dyn Pattern,
+        cached: Cached<'_>,
+        params: LocalParams<'_>,
+        slot: usize,
+    ) -> Option<&PatternData> {
+        if self.slots.len() <= slot {
+            self.slots.resize_with(slot + 1, Default::default);
+        }
+        let (seen, made, data) = &mut self.slots[slot];
+        if *seen != generation {
+            (*seen, *made) = (generation, false);
+            return None;
+        }
+        if !*made {
+            *made = true;
+            let input = cached.input;
+            data.grid = pattern.grid_cells(input);
+            data.counts = pattern.counts(input);
+            data.core = None;
+            data.shapes.clear();
+            if data.grid.is_none() {
+                data.core = pattern.core_cells(input);
+                // The cache leaves out the triangles of a core grid.
+                let rest = match cached.core {
+                    Some(_) => &cached.local.triangles[..],
+                    None => super::tolerance::after_core(data.core, &cached.local.triangles),
+                };
+                data.set_shapes(rest, params);
+            }
+        }
+        Some(data)
+    }
+}
+
+impl PatternData {
+    /// The shapes of `triangles` (local vertices, parameters `params`), largest first.
+    fn set_shapes(&mut self, triangles: &[[u32; 3]], params: LocalParams<'_>) {
+        self.shapes.extend(triangles.iter().map(|t| TriangleShape::of(t.map(|l| params.get(l)))));
+        // Unstable: a stable sort allocates its scratch, and the order of equal keys does not
+        // change the largest bound.
+        self.shapes.sort_unstable_by(|a, b| b.longest_side_squared().total_cmp(&a.longest_side_squared()));
     }
 }
 
@@ -151,18 +221,53 @@ mod tests {
             if round < inputs.len() {
                 assert!(seen.insert(index), "{input:?} shares index {index}");
             }
-            assert_shapes_of(input, table.get(1, &Transition, input).expect("held"));
+            assert_shapes_of(input, table.get(1, &Transition, input, || None).expect("held"));
         }
         // The next plan, in another order: each input's entry now sits where another's
         // was in the first plan.
         for input in inputs.iter().rev() {
-            assert_shapes_of(input, table.get(2, &Transition, input).expect("held"));
+            assert_shapes_of(input, table.get(2, &Transition, input, || None).expect("held"));
         }
         let m = HessianBound { uu: 3.0, uv: 1.0, vv: 2.0 }.triangle_errors();
-        let shapes = &table.get(2, &Transition, &inputs[5]).expect("held").shapes;
+        let shapes = &table.get(2, &Transition, &inputs[5], || None).expect("held").shapes;
         assert!(!shapes.is_empty() && shapes.iter().all(|s| m.shape_exceeds(s, -1.0).is_some()));
-        let grids = inputs.iter().filter(|i| table.get(2, &Transition, i).unwrap().grid.is_some()).count();
+        let grids =
+            inputs.iter().filter(|i| table.get(2, &Transition, i, || None).unwrap().grid.is_some()).count();
         assert!(grids > 0 && grids < inputs.len(), "{grids} grids: both kinds are tested");
+    }
+
+    /// Inputs past the small table are kept by their slot in the check's pattern table: not
+    /// on a thread's first patch of the slot in a call, and from its second on with the
+    /// pattern's own data (a grid, or the core and the other triangles' shapes), in every
+    /// later call alike.
+    #[test]
+    fn large_patterns_are_kept_by_slot_from_their_second_patch() {
+        let inputs = [
+            PatternInput::new(Domain::Quad, [12, 9, 11, 10], [12, 9]),
+            PatternInput::new(Domain::Quad, [16, 16, 16, 16], [16, 16]),
+            PatternInput::new(Domain::Tri, [9, 11, 10, 1], [11, 11]),
+            PatternInput::new(Domain::Quad, [3, 20, 5, 9], [4, 20]),
+        ];
+        let n = inputs.len();
+        assert!(inputs.iter().all(|i| small_input_index(i).is_none()), "all past the small table");
+        let mut cache = crate::pattern::cache::PatternCache::default();
+        cache.fill_inputs(&Transition, 2 * n, |i| Some(inputs[i % n]), true);
+        let mut table = PatternShapes::default();
+        let mut grids = 0;
+        for generation in [1, 2] {
+            for i in 0..2 * n {
+                let cached = cache.params(i).expect("filled with parameters");
+                let data = table.get(generation, &Transition, &inputs[i % n], || Some(cached));
+                if i < n {
+                    assert!(data.is_none(), "{:?}: the slot's first patch", inputs[i % n]);
+                } else {
+                    let data = data.expect("the slot's second patch");
+                    grids += usize::from(data.grid.is_some());
+                    assert_shapes_of(&inputs[i % n], data);
+                }
+            }
+        }
+        assert!(grids > 0 && grids < 2 * n, "{grids} grids: both kinds are tested");
     }
 
     /// Inputs the index cannot tell apart are not held: large factors, fractional factors,
@@ -171,13 +276,13 @@ mod tests {
     fn inputs_outside_the_index_are_not_held() {
         let mut table = PatternShapes::default();
         let plain = PatternInput::new(Domain::Quad, [2, 3, 2, 3], [2, 3]);
-        assert!(table.get(1, &Transition, &plain).is_some());
+        assert!(table.get(1, &Transition, &plain, || None).is_some());
         let large = PatternInput::new(Domain::Quad, [9, 3, 2, 3], [2, 3]);
         let fractional = PatternInput { factors: [2.5, 3.0, 2.0, 3.0], ..plain };
         let collapsed = PatternInput { collapsed: [false, true, false, false], ..plain };
         let pinched = PatternInput { pinched: [false, false, true, false], ..plain };
         for input in [large, fractional, collapsed, pinched] {
-            assert!(table.get(1, &Transition, &input).is_none(), "{input:?}");
+            assert!(table.get(1, &Transition, &input, || None).is_none(), "{input:?}");
         }
     }
 }

@@ -1037,11 +1037,12 @@ fn check_patches(
                 return (interior, f64::INFINITY, true, (0, 0));
             }
             let taylor = taylor.map(|t| (&t[p], domain)).filter(|t| t.0.is_some());
-            // A small pattern's data, kept per pattern: a grid's cells, or the shapes of
-            // its triangles (not with a Taylor bound, which needs their places).
+            let cached = || patterns.params(i).filter(|_| interior == first);
+            // A small or repeated pattern's data, kept per pattern: a grid's cells, or the
+            // shapes of its triangles (not with a Taylor bound, which needs their places).
             let small = match taylor {
                 Some(_) => None,
-                None => table.get(generation, limit.pattern, &input).map(|data| {
+                None => table.get(generation, limit.pattern, &input, cached).map(|data| {
                     let bound = match data.grid {
                         Some(cells) => grid_bound(&errors[p], None, cells),
                         None => {
@@ -1056,11 +1057,10 @@ fn check_patches(
             let bound = match small {
                 Some((bound, _)) => bound,
                 None => {
-                    let cached = patterns.params(i).filter(|_| interior == first);
-                    match (limit.pattern.grid_cells(&input), cached) {
+                    match (limit.pattern.grid_cells(&input), cached()) {
                         // A pure grid (no strips): bounded from its cells, no build.
                         (Some(cells), _) => grid_bound(&errors[p], taylor, cells),
-                        (None, Some((cached, params))) => {
+                        (None, Some((cached, params, _))) => {
                             let core = limit.pattern.core_cells(&input);
                             // The cache leaves out the triangles of a core grid.
                             let rest = match cached.core {

@@ -364,12 +364,13 @@ impl PatternCache {
     }
 
     /// Item `i`'s pattern and its local vertices' parameters, when the last
-    /// [`PatternCache::fill_inputs`] made them (with `params`).
-    pub(crate) fn params(&self, i: usize) -> Option<(Cached<'_>, LocalParams<'_>)> {
+    /// [`PatternCache::fill_inputs`] made them (with `params`), with the pattern's slot (the
+    /// same for every item of that input until the cache is cleared).
+    pub(crate) fn params(&self, i: usize) -> Option<(Cached<'_>, LocalParams<'_>, usize)> {
         let slot = *self.of_patch.get(i)? as usize;
         (slot != NONE as usize && self.has_params[slot]).then(|| {
             let cached = self.get(i).expect("the slot is in use");
-            (cached, LocalParams { boundary: &self.params[slot], interior: cached.interior })
+            (cached, LocalParams { boundary: &self.params[slot], interior: cached.interior }, slot)
         })
     }
 
@@ -773,7 +774,7 @@ mod tests {
         for (i, input) in inputs.iter().enumerate() {
             let mut whole = LocalTessellation::default();
             Transition.build(input, &mut whole);
-            let (cached, params) = cache.params(i).expect("filled with parameters");
+            let (cached, params, _) = cache.params(i).expect("filled with parameters");
             let (rest, count) = cached.after_core();
             let mut flat = vec![0; 3 * count as usize];
             if let Some(core) = cached.core {
