@@ -198,3 +198,52 @@ pub fn grid_interior([nu, nv]: [u32; 2], out: &mut Vec<DVec2>) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::Domain;
+
+    /// The rectangle's triangles as the type documents them, cell by cell, each point by
+    /// [`CoreGrid::index`]: the oracle of [`CoreGrid::write`]'s faster loops.
+    fn by_the_rule(core: &CoreGrid, interior: u32, boundary: &impl Fn(u32) -> u32) -> Vec<u32> {
+        let point = |i, j| core.index(interior, boundary, i, j);
+        let mut out = Vec::new();
+        for j in core.lo[1]..core.hi[1] {
+            for i in core.lo[0]..core.hi[0] {
+                let [a, b, c, d] = [point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)];
+                out.extend([a, b, c, a, c, d]);
+            }
+        }
+        out
+    }
+
+    /// Random rectangles of grids from 1×1 to 80×75 (the fast groups of four, the columns
+    /// left and right of them, whole rows on the boundary), with the pattern's own numbering
+    /// and a writer's mapping: the vertices the rule gives, cell for cell.
+    #[test]
+    fn write_gives_every_cell_the_rules_vertices() {
+        let mut rng = crate::test_support::Lcg(11);
+        let mut cases = 0;
+        for (nu, nv) in [(1, 1), (1, 4), (4, 1), (2, 3), (5, 5), (9, 14), (13, 8), (40, 3), (70, 75), (80, 6)]
+        {
+            for _ in 0..12 {
+                let mut pick = |n: u32| (rng.unit() * (n + 1) as f64) as u32 % (n + 1);
+                let (i0, i1) = (pick(nu), pick(nu));
+                let (j0, j1) = (pick(nv), pick(nv));
+                let input = PatternInput::new(Domain::Quad, [nu, nv, nu, nv], [nu, nv]);
+                let core =
+                    CoreGrid::new(&input, [nu, nv], [i0.min(i1), j0.min(j1)], [i0.max(i1), j0.max(j1)]);
+                let interior = input.interior_base();
+                let mut out = vec![0; 3 * core.triangle_count() as usize];
+                core.write(interior, |l| l, &mut out);
+                assert_eq!(out, by_the_rule(&core, interior, &|l| l), "{core:?}");
+                let mapped = |l: u32| 7000 + 3 * l;
+                core.write(123_456, mapped, &mut out);
+                assert_eq!(out, by_the_rule(&core, 123_456, &mapped), "{core:?} mapped");
+                cases += 1;
+            }
+        }
+        assert_eq!(cases, 120);
+    }
+}
