@@ -228,6 +228,16 @@ impl Block {
         self.margin[l] > 0.0
     }
 
+    /// The block with its lanes in reverse order.
+    #[inline(always)]
+    pub(super) fn reversed(&self) -> Block {
+        let flip = |mut lanes: [f32; LANES]| {
+            lanes.reverse();
+            lanes
+        };
+        Block { pos: self.pos.map(flip), nrm: self.nrm.map(flip), margin: flip(self.margin) }
+    }
+
     /// Every lane is reliable (branch-free, so that it vectorizes).
     #[inline(always)]
     fn all_ok(&self) -> bool {
