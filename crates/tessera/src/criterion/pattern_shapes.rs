@@ -16,9 +16,9 @@
 //! Larger patterns are kept by their slot in the check's pattern table
 //! ([`crate::pattern::cache::PatternCache`], which holds each distinct first pattern once),
 //! from the second patch of that slot a thread checks: a frame of a few large patterns
-//! repeated (the torus at 0.001 % of its diagonal: one pattern of 214 triangles for 2,048
-//! patches) then looks up no parameter and forms no shape per patch, while a frame whose
-//! patterns are all distinct pays nothing but a mark per slot.
+//! repeated (the torus at 0.001 % of its diagonal: 18 patterns of about 214 triangles for
+//! 2,048 patches) then looks up no parameter and forms no shape per patch, while a frame
+//! whose patterns are all distinct pays nothing but a mark per slot.
 //!
 //! Written by hand: a direct-mapped table over the small inputs (an index of a few bits a
 //! factor) with per-thread buffers kept from plan to plan is a few lines, and a general map
