@@ -268,8 +268,9 @@ impl<'a> Tessellator<'a> {
         let (criterion, resolve) = self.scratch.stage_times();
         let planning = start.elapsed();
         let start = Instant::now();
-        let counts = self.scratch.plan_counts();
-        self.layout.build_counted(self.set, &planned.plan, &planned.pattern, &self.options.engine, counts)?;
+        let (counts, edge_counts) = (self.scratch.plan_counts(), self.scratch.edge_counts());
+        let (plan, pattern, options) = (&planned.plan, &planned.pattern, &self.options.engine);
+        self.layout.build_counted(self.set, plan, pattern, options, counts, edge_counts)?;
         self.laid_out = true;
         self.pending = FrameTimings {
             criterion,
@@ -528,7 +529,10 @@ mod tests {
     /// the counts of the pattern the engine writes for it (its final input, after the rounds
     /// that raised edges, zero where culled), on a walk's frames of the teapot and of a
     /// Catmull-Clark cage, with and without culling, and under the Taylor bound (whose
-    /// patterns the check does not keep, and whose frames here take rounds).
+    /// patterns the check does not keep, and whose frames here take rounds). Likewise each
+    /// edge's inner samples, counted as the plan resolved its edges: a row per normal variant
+    /// of its final segments where a visible patch uses it and its curve is not a point
+    /// (the teapot's lid apex), none otherwise.
     #[test]
     fn the_checks_pattern_counts_are_those_of_the_written_patterns() {
         use crate::criterion::ErrorBound;
@@ -537,6 +541,7 @@ mod tests {
         let obj = crate::scene::mesh_grid(&crate::io::obj::read_obj(&path).expect("test cage"), 16);
         let cage = SurfaceSet::from_subdivision_cage(&obj, &path, Default::default()).expect("cage");
         let (mut rounds, mut culled, mut checked) = (0, 0, 0);
+        let (mut unseen, mut collapsed, mut inner) = (0, 0, 0);
         let cases = [(false, ErrorBound::Hessian), (true, ErrorBound::Hessian), (true, ErrorBound::Taylor)];
         for (set, (cull, bound)) in [teapot(), cage].iter().flat_map(|set| cases.map(|c| (set, c))) {
             let (lo, hi) = set.bounds();
@@ -557,10 +562,25 @@ mod tests {
                     culled += usize::from(!plan.is_visible(p));
                     checked += 1;
                 }
+                let edge_counts = tess.scratch.edge_counts().expect("the check counted every edge");
+                assert_eq!(edge_counts.len(), set.topology.edges.len());
+                for (e, (&c, edge)) in edge_counts.iter().zip(&set.topology.edges).enumerate() {
+                    let seen = set.topology.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
+                    let expected = match seen && !edge.collapsed {
+                        true => (plan.segments(e) - 1) * edge.variants as u32,
+                        false => 0,
+                    };
+                    assert_eq!(c, expected, "edge {e}, frame {k}, cull {cull}, {bound:?}");
+                    unseen += usize::from(!seen && plan.segments(e) > 1);
+                    collapsed += usize::from(seen && edge.collapsed && plan.segments(e) > 1);
+                    inner += usize::from(c > 0);
+                }
                 rounds += tess.report().unwrap().rounds;
             }
         }
         assert!(rounds > 0 && culled > 0, "{rounds} rounds, {culled} culled of {checked}");
+        // Edges whose segments alone would have counted samples: unseen, and collapsed.
+        assert!(unseen > 0 && collapsed > 0 && inner > 0, "{unseen} unseen, {collapsed} collapsed, {inner}");
     }
 
     #[test]

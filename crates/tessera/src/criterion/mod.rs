@@ -256,6 +256,12 @@ impl PlanScratch {
         self.tolerance.plan_counts()
     }
 
+    /// The last plan's inner samples per edge, where its a-posteriori check counted them
+    /// ([`tolerance::Scratch::edge_counts`]), for the layout of that plan.
+    pub(crate) fn edge_counts(&self) -> Option<&[u32]> {
+        self.tolerance.edge_counts()
+    }
+
     /// How long the last plan made with these buffers spent in its criterion stage
     /// (culling, tolerances) and in resolving (proposals, edges, checks), where the plan
     /// measures them (the error-bounded criteria); zero otherwise.

@@ -9,14 +9,20 @@
 //! [`InteriorRule`]. Both read only data every patch agrees on, so the plan is crack-free by
 //! construction, and every engine (CPU or GPU) reads the same rows.
 
+use crate::engine::layout;
 use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
 use crate::sampling::{spacing_segments, Spacing};
 use crate::surface::{Domain, SurfaceSet};
 use rayon::prelude::*;
 
-/// What each patch proposes for its local edges (`[0..corner_count]`; 0 = no wish, as for
-/// culled patches).
+/// What each patch proposes for its local edges (`[0..corner_count]`; 0 or less = no wish).
 pub type Proposals = [f64; 4];
+
+/// The proposal of a culled patch where a plan counts its edges with them
+/// ([`edges_counted`]): below every real proposal, so that an edge's largest proposal tells
+/// whether a visible patch uses it, and no wish ([`edge`] takes the largest of 0 and the
+/// proposals).
+pub const CULLED: f64 = -1.0;
 
 /// How a resolved real factor becomes an edge sampling.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,14 +77,45 @@ fn round_factor(x: f64) -> u32 {
 /// apply. Cost: O(uses of `e`).
 #[inline(always)]
 fn edge(set: &SurfaceSet, proposals: &[Proposals], rule: EdgeRule, caps: &Caps<'_>, e: usize) -> (u32, f32) {
-    let cap = caps.max_factor.max(1.0);
     let wanted = set
         .topology
         .edge_uses(e)
         .iter()
         .map(|u| proposals[u.patch as usize][u.local as usize])
-        .fold(0.0, f64::max)
-        .min(cap);
+        .fold(0.0, f64::max);
+    settle(wanted, rule, caps, e)
+}
+
+/// [`edge`] and the edge's inner samples in the output ([`layout::edge_samples`]), seen
+/// where a patch of `visible` uses it: one walk over its uses for both.
+#[inline(always)]
+fn counted_edge(
+    set: &SurfaceSet,
+    proposals: &[Proposals],
+    visible: &[u32],
+    rule: EdgeRule,
+    caps: &Caps<'_>,
+    e: usize,
+) -> (u32, f32, u32) {
+    let uses = set.topology.edge_uses(e);
+    let wanted = uses.iter().map(|u| proposals[u.patch as usize][u.local as usize]).fold(CULLED, f64::max);
+    // The largest of 0 and the proposals, as `edge` finds it.
+    let (s, f) = settle(wanted.max(0.0), rule, caps, e);
+    let edge = &set.topology.edges[e];
+    // A proposal of 0 or more comes from a visible patch. Only an edge without one (culled
+    // all round, or proposed NaN) that would have inner samples asks the visibility row:
+    // rarely, so that branch is predicted, where asking for every culled edge mispredicted
+    // (culled and visible edges alternate in no order).
+    let ask = (wanted < 0.0) & (layout::edge_samples(edge, true, s) != 0);
+    let seen = if ask { uses.iter().any(|u| visible[u.patch as usize] != 0) } else { wanted >= 0.0 };
+    (s, f, layout::edge_samples(edge, seen, s))
+}
+
+/// The rest of [`edge`] from the largest proposal, `wanted`.
+#[inline(always)]
+fn settle(wanted: f64, rule: EdgeRule, caps: &Caps<'_>, e: usize) -> (u32, f32) {
+    let cap = caps.max_factor.max(1.0);
+    let wanted = wanted.min(cap);
     let minimum = caps.minimum_segments[e].max(1);
     match rule {
         EdgeRule::Integer => {
@@ -187,6 +224,50 @@ pub fn edges(
             .unwrap_or(1);
         segments.iter_mut().for_each(|s| *s = n);
         factors.iter_mut().for_each(|f| *f = n as f32);
+    }
+}
+
+/// [`edges`] for an interior rule other than [`InteriorRule::Global`], with each edge's inner
+/// samples in the output written into `counts` (resized) as the layout counts them
+/// ([`layout::edge_samples`]; an edge is seen where a patch `p` with `visible[p] != 0` uses
+/// it). The layout then reads them ([`crate::engine::layout::Layout::build_counted`])
+/// instead of walking every edge's uses a second time in a pass of its own. Cost: O(E) plus
+/// the edge uses, parallel.
+#[allow(clippy::too_many_arguments)]
+pub fn edges_counted(
+    set: &SurfaceSet,
+    proposals: &[Proposals],
+    rule: EdgeRule,
+    caps: &Caps<'_>,
+    visible: &[u32],
+    segments: &mut Vec<u32>,
+    factors: &mut Vec<f32>,
+    counts: &mut Vec<u32>,
+) {
+    let edges = set.topology.edges.len();
+    segments.resize(edges, 0);
+    factors.resize(edges, 0.0);
+    counts.resize(edges, 0);
+    // As in `edges`, the rule's arm chosen once.
+    fn resolve_all(
+        (segments, factors, counts): (&mut [u32], &mut [f32], &mut [u32]),
+        resolve: impl Fn(usize) -> (u32, f32, u32) + Sync,
+    ) {
+        const RUN: usize = 4096;
+        let runs =
+            segments.par_chunks_mut(RUN).zip(factors.par_chunks_mut(RUN)).zip(counts.par_chunks_mut(RUN));
+        runs.enumerate().for_each(|(c, ((s, f), n))| {
+            for (i, ((s, f), n)) in s.iter_mut().zip(f).zip(n).enumerate() {
+                (*s, *f, *n) = resolve(c * RUN + i);
+            }
+        })
+    }
+    let rows = (&mut segments[..], &mut factors[..], &mut counts[..]);
+    let edge = |rule, e| counted_edge(set, proposals, visible, rule, caps, e);
+    match rule {
+        EdgeRule::Integer => resolve_all(rows, |e| edge(EdgeRule::Integer, e)),
+        EdgeRule::PowerOfTwo => resolve_all(rows, |e| edge(EdgeRule::PowerOfTwo, e)),
+        EdgeRule::Fractional(_) => resolve_all(rows, |e| edge(rule, e)),
     }
 }
 
@@ -368,6 +449,68 @@ mod tests {
             );
         }
         assert!(changed_edges > 1000, "the raises change edges: {changed_edges}");
+    }
+
+    /// Resolving with the layout's counts (`edges_counted`, culled patches proposing
+    /// [`CULLED`]) gives the segments and factors `edges` gives (culled patches proposing
+    /// nothing), and each edge's inner samples: a row per variant of its segments where a
+    /// visible patch uses it, none otherwise — also where only culled patches use an edge
+    /// whose minimum is 3 segments, and where a visible patch proposes NaN.
+    #[test]
+    fn counting_edges_with_their_resolution_gives_the_layouts_counts() {
+        let path = crate::test_support::data("meshes/cow.obj");
+        let mesh = crate::io::obj::read_obj(&path).unwrap();
+        let set = SurfaceSet::pn_from_mesh(&mesh, &path, Default::default()).unwrap();
+        let topo = &set.topology;
+        let (edge_count, patch_count) = (topo.edges.len(), set.patches.len());
+        let mut rng = crate::test_support::Lcg(11);
+        let minimum: Vec<u32> = (0..edge_count).map(|_| 1 + (rng.below(3) == 0) as u32 * 2).collect();
+        let minimum_interior = vec![[1, 1]; patch_count];
+        let caps = Caps { max_factor: 24.0, minimum_segments: &minimum, minimum_interior: &minimum_interior };
+        let odd = Spacing::Hardware(crate::sampling::Partitioning::FractionalOdd);
+        let (mut unseen_with_minimum, mut nan, mut counted) = (0, 0, 0);
+        for rule in [EdgeRule::Integer, EdgeRule::PowerOfTwo, EdgeRule::Fractional(odd)] {
+            let visible: Vec<u32> = (0..patch_count).map(|_| u32::from(rng.below(2) == 0)).collect();
+            let wishes: Vec<Proposals> = (0..patch_count)
+                .map(|_| {
+                    std::array::from_fn(|_| if rng.below(50) == 0 { f64::NAN } else { 12.0 * rng.unit() })
+                })
+                .collect();
+            let proposals_of = |culled: f64| -> Vec<Proposals> {
+                wishes.iter().zip(&visible).map(|(&w, &v)| if v != 0 { w } else { [culled; 4] }).collect()
+            };
+            let (mut expected_s, mut expected_f) = (Vec::new(), Vec::new());
+            edges(
+                &set,
+                &proposals_of(0.0),
+                rule,
+                InteriorRule::Core,
+                &caps,
+                &mut expected_s,
+                &mut expected_f,
+            );
+            let (mut s, mut f, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+            edges_counted(&set, &proposals_of(CULLED), rule, &caps, &visible, &mut s, &mut f, &mut counts);
+            assert_eq!(s, expected_s, "{rule:?}");
+            let bits = |f: &[f32]| f.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&f), bits(&expected_f), "{rule:?}");
+            for (e, edge) in topo.edges.iter().enumerate() {
+                let uses = topo.edge_uses(e);
+                let seen = uses.iter().any(|u| visible[u.patch as usize] != 0);
+                let expected = if seen && !edge.collapsed { (s[e] - 1) * edge.variants as u32 } else { 0 };
+                assert_eq!(counts[e], expected, "edge {e}, {rule:?}");
+                unseen_with_minimum += usize::from(!seen && s[e] > 1);
+                let proposed = |u: &crate::topology::EdgeUse| wishes[u.patch as usize][u.local as usize];
+                nan += usize::from(
+                    seen && uses.iter().all(|u| visible[u.patch as usize] == 0 || proposed(u).is_nan()),
+                );
+                counted += usize::from(counts[e] > 0);
+            }
+        }
+        assert!(
+            unseen_with_minimum > 100 && nan > 0 && counted > 1000,
+            "{unseen_with_minimum} {nan} {counted}"
+        );
     }
 
     #[test]

@@ -533,6 +533,10 @@ pub(crate) struct Scratch {
     /// `counts_fresh`.
     plan_counts: Vec<(u32, u32)>,
     counts_fresh: bool,
+    /// The last plan's inner samples per edge ([`Scratch::edge_counts`]), valid while
+    /// `edge_counts_fresh`.
+    edge_counts: Vec<u32>,
+    edge_counts_fresh: bool,
 }
 
 impl Scratch {
@@ -551,6 +555,7 @@ impl Scratch {
     pub(crate) fn forget_patterns(&mut self) {
         self.patterns_fresh = false;
         self.counts_fresh = false;
+        self.edge_counts_fresh = false;
     }
 
     /// The last plan's [`Pattern::counts`] of every patch (zero for culled ones), as its
@@ -559,6 +564,14 @@ impl Scratch {
     /// when the last plan was not made by the check.
     pub(crate) fn plan_counts(&self) -> Option<&[(u32, u32)]> {
         self.counts_fresh.then_some(&self.plan_counts[..])
+    }
+
+    /// The last plan's inner samples of every edge in the output
+    /// ([`crate::engine::layout::edge_samples`]), counted as its edges were resolved: the
+    /// layout's per-edge counts, which it need not find again. None when the last plan was
+    /// not made by the check, or had one interior for the whole mesh.
+    pub(crate) fn edge_counts(&self) -> Option<&[u32]> {
+        self.edge_counts_fresh.then_some(&self.edge_counts[..])
     }
 
     /// How many distinct patterns the check's table holds (0 when the last check built none).
@@ -634,15 +647,22 @@ pub(crate) fn plan_limited(
         patterns_fresh,
         plan_counts,
         counts_fresh,
+        edge_counts,
+        edge_counts_fresh,
     } = scratch;
     *patterns_fresh = false;
     *counts_fresh = false;
+    *edge_counts_fresh = false;
 
     // Each visible patch's proposal per local edge.
     proposals.resize(patches, [0.0; 4]);
     proposals.par_iter_mut().enumerate().for_each(|(p, out)| {
+        // A culled patch wishes nothing, and says so by its sign ([`resolve::CULLED`]).
+        let Some(e) = eps[p] else {
+            *out = [resolve::CULLED; 4];
+            return;
+        };
         *out = [0.0; 4];
-        let Some(e) = eps[p] else { return };
         let domain = set.topology.patch_domains[p];
         let m = &hessians[p];
         let taylor = taylor.map(|t| &t[p]).filter(|t| t.is_some());
@@ -687,7 +707,15 @@ pub(crate) fn plan_limited(
             usize::from(e.is_none())
         })
         .sum();
-    resolve::edges(set, proposals, rule, interior, &caps, &mut plan.segments, &mut plan.factors);
+    // The layout's edge counts with the edges (one walk over their uses), except where one
+    // interior is the whole mesh's.
+    let counted = interior != InteriorRule::Global;
+    if counted {
+        let rows = (&mut plan.segments, &mut plan.factors, &mut *edge_counts);
+        resolve::edges_counted(set, proposals, rule, &caps, &plan.visible, rows.0, rows.1, rows.2);
+    } else {
+        resolve::edges(set, proposals, rule, interior, &caps, &mut plan.segments, &mut plan.factors);
+    }
     if per_patch.len() != patches {
         per_patch.clear();
         per_patch.extend((0..patches).map(|_| AtomicU64::new(0)));
@@ -743,7 +771,12 @@ pub(crate) fn plan_limited(
             break; // every failing patch is at the cap
         }
         for &(e, s, f) in changed.iter() {
-            (plan.segments[e as usize], plan.factors[e as usize]) = (s, f);
+            let e = e as usize;
+            (plan.segments[e], plan.factors[e]) = (s, f);
+            if counted {
+                let seen = topo.edge_uses(e).iter().any(|u| plan.visible[u.patch as usize] != 0);
+                edge_counts[e] = crate::engine::layout::edge_samples(&topo.edges[e], seen, s);
+            }
         }
         report.rounds += 1;
         check(&plan.segments, proposals, which, rechecked, true);
@@ -770,6 +803,7 @@ pub(crate) fn plan_limited(
     // The check's inputs carry the segments as their factors: the engine's, except under a
     // fractional rule, whose patterns read the real factors.
     *counts_fresh = !matches!(rule, EdgeRule::Fractional(_));
+    *edge_counts_fresh = counted;
     Ok(report)
 }
 

@@ -27,6 +27,7 @@ use crate::criterion::Plan;
 use crate::error::Result;
 use crate::pattern::{Pattern, PatternInput, Slot};
 use crate::surface::SurfaceSet;
+use crate::topology::Edge;
 use rayon::prelude::*;
 
 /// Where every vertex and triangle of one tessellation goes (see the module doc).
@@ -86,13 +87,15 @@ impl Layout {
         pattern: &dyn Pattern,
         options: &EngineOptions,
     ) -> Result<()> {
-        self.build_counted(set, plan, pattern, options, None)
+        self.build_counted(set, plan, pattern, options, None, None)
     }
 
     /// [`Layout::build`] with the pattern counts of every patch given where the planner
     /// found them (`counts[p]`: [`Pattern::counts`] of patch `p`'s pattern input, zero for a
     /// culled patch; the a-posteriori check's, [`crate::criterion::PlanScratch::plan_counts`]),
-    /// so that no patch's input is gathered and counted again.
+    /// so that no patch's input is gathered and counted again, and likewise each edge's inner
+    /// samples where the planner counted them (`edge_counts[e]`: [`edge_samples`] of edge `e`,
+    /// [`crate::criterion::resolve::edges_counted`]).
     pub(crate) fn build_counted(
         &mut self,
         set: &SurfaceSet,
@@ -100,6 +103,7 @@ impl Layout {
         pattern: &dyn Pattern,
         options: &EngineOptions,
         counts: Option<&[(u32, u32)]>,
+        edge_counts: Option<&[u32]>,
     ) -> Result<()> {
         plan.check(set)?;
         let topo = &set.topology;
@@ -107,7 +111,15 @@ impl Layout {
         if let (Some(_), Some(_), false) = (topo.one_shape, plan.one_factor(), pattern.depends_on_patch()) {
             return self.build_one_input(set, plan, pattern, options);
         }
-        self.build_general(set, plan, pattern, options, counts.filter(|c| c.len() == set.patches.len()))
+        let counts = counts.filter(|c| c.len() == set.patches.len());
+        self.build_general(
+            set,
+            plan,
+            pattern,
+            options,
+            counts,
+            edge_counts.filter(|c| c.len() == topo.edges.len()),
+        )
     }
 
     /// [`Layout::build`] for any plan: a count per visible patch, then the scans.
@@ -118,18 +130,17 @@ impl Layout {
         pattern: &dyn Pattern,
         options: &EngineOptions,
         counts: Option<&[(u32, u32)]>,
+        given_edge_counts: Option<&[u32]>,
     ) -> Result<()> {
         let topo = &set.topology;
-        // Edges: inner samples per variant; none for collapsed edges or edges seen by no
-        // visible patch (nothing refers to them).
-        // Counts in parallel (segments ≤ MAX_FACTOR and ≤ 255 variants: a count fits u32),
-        // then the scan in place.
+        // Edges: inner samples per variant ([`edge_samples`]), counted in parallel where the
+        // planner did not count them, then scanned.
         let edges = topo.edges.len();
         self.edge_offsets.clear();
         self.edge_offsets.resize(edges + 1, 0);
         // Where nothing is culled every edge is seen: its uses are not read (one pass over
         // the visibility row instead of a search of each edge's uses).
-        let all_visible = plan.visible.iter().all(|&v| v != 0);
+        let all_visible = given_edge_counts.is_none() && plan.visible.iter().all(|&v| v != 0);
         let edge_counts =
             self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024);
         let count_edges = || {
@@ -138,24 +149,40 @@ impl Layout {
                 // culled in no predictable order, and `any`'s early exit mispredicted.
                 let seen = all_visible
                     || topo.edge_uses(e).iter().fold(0, |seen, u| seen | plan.visible[u.patch as usize]) != 0;
-                let kept = u32::from(!edge.collapsed && seen);
-                *count = kept * (plan.segments(e) - 1) * edge.variants as u32;
+                *count = edge_samples(edge, seen, plan.segments(e));
             })
         };
         // The patterns' counts (where the check did not leave them) beside the edges' counts:
         // one parallel pass for both, not two.
         let layout_counts = &mut self.counts;
-        match counts {
-            Some(_) => count_edges(),
-            None => {
+        match (given_edge_counts, counts) {
+            (Some(_), Some(_)) => {}
+            (Some(_), None) => count_patterns(set, plan, pattern, layout_counts),
+            (None, Some(_)) => count_edges(),
+            (None, None) => {
                 rayon::join(count_edges, || count_patterns(set, plan, pattern, layout_counts));
             }
         }
         let mut total = self.corners as u64;
-        for offset in self.edge_offsets.iter_mut() {
-            let count = *offset as u64;
-            *offset = total.min(u32::MAX as u64) as u32;
-            total += count;
+        match given_edge_counts {
+            Some(given) => {
+                debug_assert!((0..edges).all(|e| {
+                    let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
+                    given[e] == edge_samples(&topo.edges[e], seen, plan.segments(e))
+                }));
+                for (offset, &count) in self.edge_offsets.iter_mut().zip(given) {
+                    *offset = total.min(u32::MAX as u64) as u32;
+                    total += count as u64;
+                }
+                self.edge_offsets[edges] = total.min(u32::MAX as u64) as u32;
+            }
+            None => {
+                for offset in self.edge_offsets.iter_mut() {
+                    let count = *offset as u64;
+                    *offset = total.min(u32::MAX as u64) as u32;
+                    total += count;
+                }
+            }
         }
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
@@ -206,6 +233,16 @@ impl Layout {
         self.collapsed_triangles = upper - triangles as u64;
         Ok(())
     }
+}
+
+/// The inner samples edge `edge` adds to the output with `segments` segments: one row per
+/// normal variant, none where its curve is collapsed or no visible patch uses it (`seen`;
+/// nothing refers to them). The one rule of the layout's counts and of the planner's
+/// ([`crate::criterion::resolve::edges_counted`]). Segments ≤ `MAX_FACTOR` and ≤ 255 variants:
+/// a count fits u32. Cost: O(1).
+#[inline(always)]
+pub(crate) fn edge_samples(edge: &Edge, seen: bool, segments: u32) -> u32 {
+    u32::from(!edge.collapsed && seen) * (segments - 1) * edge.variants as u32
 }
 
 /// Every patch's pattern counts into `counts` (zero for culled patches). Neighbouring patches
@@ -445,7 +482,7 @@ mod tests {
                     let (mut fast, mut general) = (Layout::default(), Layout::default());
                     fast.build(&set, &plan, pattern, &options).unwrap();
                     general.corners = fast.corners;
-                    general.build_general(&set, &plan, pattern, &options, None).unwrap();
+                    general.build_general(&set, &plan, pattern, &options, None, None).unwrap();
                     assert_eq!(fast.edge_offsets, general.edge_offsets);
                     assert_eq!(fast.interior_offsets, general.interior_offsets);
                     assert_eq!(fast.triangle_offsets, general.triangle_offsets);
