@@ -101,14 +101,14 @@ fn counted_edge(
     let wanted = uses.iter().map(|u| proposals[u.patch as usize][u.local as usize]).fold(CULLED, f64::max);
     // The largest of 0 and the proposals, as `edge` finds it.
     let (s, f) = settle(wanted.max(0.0), rule, caps, e);
-    let edge = &set.topology.edges[e];
+    let topo = &set.topology;
     // A proposal of 0 or more comes from a visible patch. Only an edge without one (culled
     // all round, or proposed NaN) that would have inner samples asks the visibility row:
     // rarely, so that branch is predicted, where asking for every culled edge mispredicted
     // (culled and visible edges alternate in no order).
-    let ask = (wanted < 0.0) & (layout::edge_samples(edge, true, s) != 0);
+    let ask = (wanted < 0.0) & (layout::edge_samples(topo, e, true, s) != 0);
     let seen = if ask { uses.iter().any(|u| visible[u.patch as usize] != 0) } else { wanted >= 0.0 };
-    (s, f, layout::edge_samples(edge, seen, s))
+    (s, f, layout::edge_samples(topo, e, seen, s))
 }
 
 /// The rest of [`edge`] from the largest proposal, `wanted`.
@@ -256,11 +256,16 @@ pub fn edges_counted(
         const RUN: usize = 4096;
         let runs =
             segments.par_chunks_mut(RUN).zip(factors.par_chunks_mut(RUN)).zip(counts.par_chunks_mut(RUN));
-        runs.enumerate().for_each(|(c, ((s, f), n))| {
-            for (i, ((s, f), n)) in s.iter_mut().zip(f).zip(n).enumerate() {
-                (*s, *f, *n) = resolve(c * RUN + i);
-            }
-        })
+        runs.enumerate().for_each(|(c, ((s, f), n))| run(c * RUN, s, f, n, &resolve))
+    }
+    // A function of its own: its rows, arguments, are known to the compiler not to overlap
+    // the data `resolve` reads, which it then keeps in registers instead of reading the
+    // pointers to it again for every edge.
+    #[inline(never)]
+    fn run(first: usize, s: &mut [u32], f: &mut [f32], n: &mut [u32], resolve: &impl Fn(usize) -> (u32, f32, u32)) {
+        for (i, ((s, f), n)) in s.iter_mut().zip(f).zip(n).enumerate() {
+            (*s, *f, *n) = resolve(first + i);
+        }
     }
     let rows = (&mut segments[..], &mut factors[..], &mut counts[..]);
     let edge = |rule, e| counted_edge(set, proposals, visible, rule, caps, e);

@@ -775,7 +775,7 @@ pub(crate) fn plan_limited(
             (plan.segments[e], plan.factors[e]) = (s, f);
             if counted {
                 let seen = topo.edge_uses(e).iter().any(|u| plan.visible[u.patch as usize] != 0);
-                edge_counts[e] = crate::engine::layout::edge_samples(&topo.edges[e], seen, s);
+                edge_counts[e] = crate::engine::layout::edge_samples(topo, e, seen, s);
             }
         }
         report.rounds += 1;

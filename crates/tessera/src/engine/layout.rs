@@ -27,7 +27,7 @@ use crate::criterion::Plan;
 use crate::error::Result;
 use crate::pattern::{Pattern, PatternInput, Slot};
 use crate::surface::SurfaceSet;
-use crate::topology::Edge;
+use crate::topology::Topology;
 use rayon::prelude::*;
 
 /// Where every vertex and triangle of one tessellation goes (see the module doc).
@@ -141,15 +141,14 @@ impl Layout {
         // Where nothing is culled every edge is seen: its uses are not read (one pass over
         // the visibility row instead of a search of each edge's uses).
         let all_visible = given_edge_counts.is_none() && plan.visible.iter().all(|&v| v != 0);
-        let edge_counts =
-            self.edge_offsets[..edges].par_iter_mut().zip(&topo.edges).enumerate().with_min_len(1024);
+        let edge_counts = self.edge_offsets[..edges].par_iter_mut().enumerate().with_min_len(1024);
         let count_edges = || {
-            edge_counts.for_each(|(e, (count, edge))| {
+            edge_counts.for_each(|(e, count)| {
                 // Without a branch per use: with culling on, about half the patches are
                 // culled in no predictable order, and `any`'s early exit mispredicted.
                 let seen = all_visible
                     || topo.edge_uses(e).iter().fold(0, |seen, u| seen | plan.visible[u.patch as usize]) != 0;
-                *count = edge_samples(edge, seen, plan.segments(e));
+                *count = edge_samples(topo, e, seen, plan.segments(e));
             })
         };
         // The patterns' counts (where the check did not leave them) beside the edges' counts:
@@ -168,7 +167,7 @@ impl Layout {
             Some(given) => {
                 debug_assert!((0..edges).all(|e| {
                     let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
-                    given[e] == edge_samples(&topo.edges[e], seen, plan.segments(e))
+                    given[e] == edge_samples(topo, e, seen, plan.segments(e))
                 }));
                 for (offset, &count) in self.edge_offsets.iter_mut().zip(given) {
                     *offset = total.min(u32::MAX as u64) as u32;
@@ -203,15 +202,20 @@ impl Layout {
             }
             None => &self.counts,
         };
+        let offsets = (&mut self.interior_offsets, &mut self.triangle_offsets);
+        if topo.one_shape.is_some() {
+            // No patch has a repeated corner: every triangle is kept, and the scan's totals
+            // are the size check's (one walk over the counts, not two; the scan writes only
+            // the offsets, nothing of the output's size).
+            let (vertices, triangles) = scan_counts(total, counts.iter().copied(), offsets);
+            check_size(vertices, triangles, options)?;
+            self.collapsed_triangles = 0;
+            return Ok(());
+        }
         let (interior, upper) =
             counts.iter().fold((0u64, 0u64), |(v, t), c| (v + c.0 as u64, t + c.1 as u64));
         check_size(total + interior, upper, options)?;
-        // Scans: both totals fit u32 now (check_size).
-        let offsets = (&mut self.interior_offsets, &mut self.triangle_offsets);
-        let triangles = if topo.one_shape.is_some() {
-            // No patch has a repeated corner: every triangle is kept.
-            scan_counts(total as u32, counts.iter().copied(), offsets)
-        } else {
+        let (_, triangles) = {
             let generation = super::next_generation();
             counts
                 .par_iter()
@@ -228,21 +232,22 @@ impl Layout {
                     })
                 })
                 .collect_into_vec(&mut self.kept);
-            scan_counts(total as u32, counts.iter().zip(&self.kept).map(|(&(v, _), &t)| (v, t)), offsets)
+            scan_counts(total, counts.iter().zip(&self.kept).map(|(&(v, _), &t)| (v, t)), offsets)
         };
-        self.collapsed_triangles = upper - triangles as u64;
+        self.collapsed_triangles = upper - triangles;
         Ok(())
     }
 }
 
-/// The inner samples edge `edge` adds to the output with `segments` segments: one row per
-/// normal variant, none where its curve is collapsed or no visible patch uses it (`seen`;
-/// nothing refers to them). The one rule of the layout's counts and of the planner's
-/// ([`crate::criterion::resolve::edges_counted`]). Segments ≤ `MAX_FACTOR` and ≤ 255 variants:
-/// a count fits u32. Cost: O(1).
+/// The inner samples edge `e` of `topo` adds to the output with `segments` segments: its
+/// rows ([`Topology::edge_rows`]: one per normal variant, none where its curve is collapsed)
+/// of `segments − 1`, none where no visible patch uses it (`seen`; nothing refers to them).
+/// The one rule of the layout's counts and of the planner's
+/// ([`crate::criterion::resolve::edges_counted`]). Segments ≤ `MAX_FACTOR` and ≤ 255
+/// variants: a count fits u32. Cost: O(1).
 #[inline(always)]
-pub(crate) fn edge_samples(edge: &Edge, seen: bool, segments: u32) -> u32 {
-    u32::from(!edge.collapsed && seen) * (segments - 1) * edge.variants as u32
+pub(crate) fn edge_samples(topo: &Topology, e: usize, seen: bool, segments: u32) -> u32 {
+    u32::from(seen) * (segments - 1) * topo.edge_rows(e)
 }
 
 /// Every patch's pattern counts into `counts` (zero for culled patches). Neighbouring patches
@@ -271,26 +276,26 @@ fn count_patterns(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, counts: 
 }
 
 /// The patches' first interior vertex and first triangle (`P + 1` entries each, written
-/// into `interior` and `triangles`, cleared first) from their `(vertices, triangles)`, the
-/// vertices after `start`; returns the triangle total. Precondition: the totals fit `u32`.
-/// Cost: O(P), sequential.
+/// into `interior` and `triangles`, resized) from their `(vertices, triangles)`, the vertices
+/// after `start`; returns the vertex and triangle totals. The offsets are right where the
+/// totals fit `u32` (the caller's size check refuses the others). Cost: O(P), sequential.
 fn scan_counts(
-    start: u32,
-    counts: impl Iterator<Item = (u32, u32)>,
+    start: u64,
+    counts: impl ExactSizeIterator<Item = (u32, u32)>,
     (interior, triangles): (&mut Vec<u32>, &mut Vec<u32>),
-) -> u32 {
-    interior.clear();
-    triangles.clear();
-    let (mut v, mut t) = (start, 0u32);
-    for (vertices, kept) in counts {
-        interior.push(v);
-        triangles.push(t);
-        v += vertices;
-        t += kept;
+) -> (u64, u64) {
+    // Written in place (no `push`, whose capacity test each time kept the loop from
+    // running ahead).
+    interior.resize(counts.len() + 1, 0);
+    triangles.resize(counts.len() + 1, 0);
+    let (mut v, mut t) = (start, 0u64);
+    for ((vertices, kept), (first_vertex, first_triangle)) in counts.zip(interior.iter_mut().zip(triangles.iter_mut())) {
+        (*first_vertex, *first_triangle) = (v as u32, t as u32);
+        v += vertices as u64;
+        t += kept as u64;
     }
-    interior.push(v);
-    triangles.push(t);
-    t
+    (*interior.last_mut().expect("P + 1 entries"), *triangles.last_mut().expect("P + 1 entries")) = (v as u32, t as u32);
+    (v, t)
 }
 
 impl Layout {

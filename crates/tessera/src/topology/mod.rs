@@ -132,6 +132,9 @@ pub struct Topology {
     /// frame's per-edge passes ([`Topology::edge_uses`]) one line in sixteen edges instead of
     /// one in two.
     use_starts: Vec<u32>,
+    /// Each edge's rows of inner samples ([`Topology::edge_rows`]), one byte an edge for the
+    /// same reason.
+    edge_rows: Vec<u8>,
 }
 
 fn canonical(key: [u32; 4]) -> ([u32; 4], bool) {
@@ -309,8 +312,10 @@ impl Topology {
             report,
             patch_pinched: Vec::new(),
             use_starts: Vec::new(),
+            edge_rows: Vec::new(),
         };
         topology.use_starts = topology.edges.iter().map(|e| e.uses.start).collect();
+        topology.edge_rows = topology.edges.iter().map(|e| if e.collapsed { 0 } else { e.variants }).collect();
         topology.use_starts.push(topology.uses.len() as u32);
         debug_assert!(topology
             .edges
@@ -339,6 +344,12 @@ impl Topology {
     /// The uses of edge `e`; the first is the owner.
     pub fn edge_uses(&self, e: usize) -> &[EdgeUse] {
         &self.uses[self.use_starts[e] as usize..self.use_starts[e + 1] as usize]
+    }
+
+    /// How many rows of inner samples edge `e` has in the output: one per normal variant,
+    /// none where its curve is a point (its samples are the corner). Cost: O(1).
+    pub fn edge_rows(&self, e: usize) -> u32 {
+        self.edge_rows[e] as u32
     }
 }
 
