@@ -14,6 +14,7 @@ pub mod bounds;
 pub mod esc;
 pub(crate) mod pattern_shapes;
 pub mod resolve;
+pub(crate) mod rows;
 pub mod screen;
 pub mod sd2;
 pub mod taylor;

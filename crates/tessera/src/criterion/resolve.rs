@@ -262,7 +262,13 @@ pub fn edges_counted(
     // the data `resolve` reads, which it then keeps in registers instead of reading the
     // pointers to it again for every edge.
     #[inline(never)]
-    fn run(first: usize, s: &mut [u32], f: &mut [f32], n: &mut [u32], resolve: &impl Fn(usize) -> (u32, f32, u32)) {
+    fn run(
+        first: usize,
+        s: &mut [u32],
+        f: &mut [f32],
+        n: &mut [u32],
+        resolve: &impl Fn(usize) -> (u32, f32, u32),
+    ) {
         for (i, ((s, f), n)) in s.iter_mut().zip(f).zip(n).enumerate() {
             (*s, *f, *n) = resolve(first + i);
         }

@@ -305,9 +305,7 @@ pub fn tolerances_into(
         return;
     }
     // Culling reads the views; their own boxes serve.
-    out.par_iter_mut().zip(&set.patches).zip(views).for_each(|((o, patch), v)| {
-        *o = v.tolerance(patch, camera, pixels, cull);
-    });
+    super::rows::fill(out, |p, o| *o = views[p].tolerance(&set.patches[p], camera, pixels, cull));
 }
 
 /// The plan's visibility row: 1 for every patch, or, with `cull`, 0 for the patches

@@ -656,7 +656,7 @@ pub(crate) fn plan_limited(
 
     // Each visible patch's proposal per local edge.
     proposals.resize(patches, [0.0; 4]);
-    proposals.par_iter_mut().enumerate().for_each(|(p, out)| {
+    super::rows::fill(proposals, |p, out| {
         // A culled patch wishes nothing, and says so by its sign ([`resolve::CULLED`]).
         let Some(e) = eps[p] else {
             *out = [resolve::CULLED; 4];
@@ -733,14 +733,17 @@ pub(crate) fn plan_limited(
                 CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors, taylor };
             check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, patterns, keep, out)
         };
-    *patterns_fresh = check(&plan.segments, proposals, which, results, false);
+    let (fresh, first_failing) = check(&plan.segments, proposals, which, results, false);
+    *patterns_fresh = fresh;
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
     // Errors shrink as h², hence the square root.
-    for _round in 0..256 {
+    for round in 0..256 {
         failing.clear();
-        failing.extend((0..patches).filter(|&p| results[p].2));
+        if round > 0 || first_failing > 0 {
+            failing.extend((0..patches).filter(|&p| results[p].2));
+        }
         if failing.is_empty() || interior == InteriorRule::Global {
             break;
         }
@@ -956,7 +959,8 @@ struct CheckInputs<'a> {
 /// opens a crack), growing like the square root of the excess since errors shrink as h².
 /// Writes, for each patch of `which`, (interior, guaranteed bound, bound not met) into `out`
 /// (`firsts` and `counts` are its buffers). The first patterns go into `patterns` (after the
-/// ones it holds, with `keep`); returns whether they did.
+/// ones it holds, with `keep`); returns whether they did, and how many patches miss their
+/// bound.
 #[allow(clippy::too_many_arguments)]
 fn check_patches(
     inputs: &CheckInputs<'_>,
@@ -969,7 +973,7 @@ fn check_patches(
     patterns: &mut crate::pattern::cache::PatternCache,
     keep: bool,
     out: &mut Vec<Check>,
-) -> bool {
+) -> (bool, usize) {
     let CheckInputs { set, eps, layout, cap, minimum, errors, taylor } = *inputs;
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
@@ -1018,7 +1022,8 @@ fn check_patches(
     firsts.resize(which.len(), (Domain::Quad, [1; 4], [1; 2]));
     counts.resize(which.len(), 0);
     let count = !limit.unlimited();
-    firsts.par_iter_mut().zip(counts.par_iter_mut()).zip(which).for_each(|((f, c), &p)| {
+    super::rows::fill_pairs(firsts, counts, |i, f, c| {
+        let p = which[i];
         *f = first(p);
         *c = match eps[p] {
             Some(_) if count => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
@@ -1137,8 +1142,12 @@ fn check_patches(
     const RUN: usize = 64;
     const ERRORS_LEAD: usize = 8;
     let runs = out.par_chunks_mut(RUN).zip(which.par_chunks(RUN)).zip(firsts.par_chunks(RUN)).enumerate();
+    // How many patches miss their bound, counted by the runs: where none does, the rounds'
+    // search of every patch's result (one thread's pass over them) is not needed.
+    let failing = std::sync::atomic::AtomicUsize::new(0);
     runs.for_each(|(run, ((outs, patches), firsts))| {
-        super::pattern_shapes::with_pattern_shapes(|table| {
+        let missed = super::pattern_shapes::with_pattern_shapes(|table| {
+            let mut missed = 0;
             for (k, ((o, &p), &f)) in outs.iter_mut().zip(patches).zip(firsts).enumerate() {
                 // The bound's data of a patch a few ahead, asked for in time (96 bytes a
                 // patch: the grid's 8.8 MB are past the core's own cache, and the patches
@@ -1147,10 +1156,15 @@ fn check_patches(
                     crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(ahead));
                 }
                 *o = check_one(run * RUN + k, p, f, table);
+                missed += usize::from(o.2);
             }
+            missed
         });
+        if missed > 0 {
+            failing.fetch_add(missed, Ordering::Relaxed);
+        }
     });
-    filled
+    (filled, failing.into_inner())
 }
 
 #[cfg(test)]

@@ -289,12 +289,15 @@ fn scan_counts(
     interior.resize(counts.len() + 1, 0);
     triangles.resize(counts.len() + 1, 0);
     let (mut v, mut t) = (start, 0u64);
-    for ((vertices, kept), (first_vertex, first_triangle)) in counts.zip(interior.iter_mut().zip(triangles.iter_mut())) {
+    for ((vertices, kept), (first_vertex, first_triangle)) in
+        counts.zip(interior.iter_mut().zip(triangles.iter_mut()))
+    {
         (*first_vertex, *first_triangle) = (v as u32, t as u32);
         v += vertices as u64;
         t += kept as u64;
     }
-    (*interior.last_mut().expect("P + 1 entries"), *triangles.last_mut().expect("P + 1 entries")) = (v as u32, t as u32);
+    (*interior.last_mut().expect("P + 1 entries"), *triangles.last_mut().expect("P + 1 entries")) =
+        (v as u32, t as u32);
     (v, t)
 }
 

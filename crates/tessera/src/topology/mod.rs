@@ -315,7 +315,8 @@ impl Topology {
             edge_rows: Vec::new(),
         };
         topology.use_starts = topology.edges.iter().map(|e| e.uses.start).collect();
-        topology.edge_rows = topology.edges.iter().map(|e| if e.collapsed { 0 } else { e.variants }).collect();
+        topology.edge_rows =
+            topology.edges.iter().map(|e| if e.collapsed { 0 } else { e.variants }).collect();
         topology.use_starts.push(topology.uses.len() as u32);
         debug_assert!(topology
             .edges
