@@ -22,7 +22,7 @@ pub type Proposals = [f64; 4];
 /// ([`edges_counted`]): below every real proposal, so that an edge's largest proposal tells
 /// whether a visible patch uses it, and no wish ([`edge`] takes the largest of 0 and the
 /// proposals).
-pub const CULLED: f64 = -1.0;
+pub(crate) const CULLED: f64 = -1.0;
 
 /// How a resolved real factor becomes an edge sampling.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -234,7 +234,7 @@ pub fn edges(
 /// instead of walking every edge's uses a second time in a pass of its own. Cost: O(E) plus
 /// the edge uses, parallel.
 #[allow(clippy::too_many_arguments)]
-pub fn edges_counted(
+pub(crate) fn edges_counted(
     set: &SurfaceSet,
     proposals: &[Proposals],
     rule: EdgeRule,
