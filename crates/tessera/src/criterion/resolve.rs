@@ -9,7 +9,6 @@
 //! [`InteriorRule`]. Both read only data every patch agrees on, so the plan is crack-free by
 //! construction, and every engine (CPU or GPU) reads the same rows.
 
-use crate::engine::layout;
 use crate::pattern::hardware::{settled_factor, OUTPUT_GAP};
 use crate::sampling::{spacing_segments, Spacing};
 use crate::surface::{Domain, SurfaceSet};
@@ -86,7 +85,7 @@ fn edge(set: &SurfaceSet, proposals: &[Proposals], rule: EdgeRule, caps: &Caps<'
     settle(wanted, rule, caps, e)
 }
 
-/// [`edge`] and the edge's inner samples in the output ([`layout::edge_samples`]), seen
+/// [`edge`] and the edge's inner samples in the output ([`crate::topology::Topology::edge_samples`]), seen
 /// where a patch of `visible` uses it: one walk over its uses for both.
 #[inline(always)]
 fn counted_edge(
@@ -106,9 +105,9 @@ fn counted_edge(
     // all round, or proposed NaN) that would have inner samples asks the visibility row:
     // rarely, so that branch is predicted, where asking for every culled edge mispredicted
     // (culled and visible edges alternate in no order).
-    let ask = (wanted < 0.0) & (layout::edge_samples(topo, e, true, s) != 0);
+    let ask = (wanted < 0.0) & (topo.edge_samples(e, true, s) != 0);
     let seen = if ask { uses.iter().any(|u| visible[u.patch as usize] != 0) } else { wanted >= 0.0 };
-    (s, f, layout::edge_samples(topo, e, seen, s))
+    (s, f, topo.edge_samples(e, seen, s))
 }
 
 /// The rest of [`edge`] from the largest proposal, `wanted`.
@@ -229,8 +228,8 @@ pub fn edges(
 
 /// [`edges`] for an interior rule other than [`InteriorRule::Global`], with each edge's inner
 /// samples in the output written into `counts` (resized) as the layout counts them
-/// ([`layout::edge_samples`]; an edge is seen where a patch `p` with `visible[p] != 0` uses
-/// it). The layout then reads them ([`crate::engine::layout::Layout::build_counted`])
+/// ([`crate::topology::Topology::edge_samples`]; an edge is seen where a patch `p` with `visible[p] != 0` uses
+/// it). The layout then reads them (`engine::layout::Layout::build_counted`)
 /// instead of walking every edge's uses a second time in a pass of its own. Cost: O(E) plus
 /// the edge uses, parallel.
 #[allow(clippy::too_many_arguments)]

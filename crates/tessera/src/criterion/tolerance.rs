@@ -567,7 +567,7 @@ impl Scratch {
     }
 
     /// The last plan's inner samples of every edge in the output
-    /// ([`crate::engine::layout::edge_samples`]), counted as its edges were resolved: the
+    /// ([`crate::topology::Topology::edge_samples`]), counted as its edges were resolved: the
     /// layout's per-edge counts, which it need not find again. None when the last plan was
     /// not made by the check, or had one interior for the whole mesh.
     pub(crate) fn edge_counts(&self) -> Option<&[u32]> {
@@ -778,7 +778,7 @@ pub(crate) fn plan_limited(
             (plan.segments[e], plan.factors[e]) = (s, f);
             if counted {
                 let seen = topo.edge_uses(e).iter().any(|u| plan.visible[u.patch as usize] != 0);
-                edge_counts[e] = crate::engine::layout::edge_samples(topo, e, seen, s);
+                edge_counts[e] = topo.edge_samples(e, seen, s);
             }
         }
         report.rounds += 1;

@@ -27,7 +27,6 @@ use crate::criterion::Plan;
 use crate::error::Result;
 use crate::pattern::{Pattern, PatternInput, Slot};
 use crate::surface::SurfaceSet;
-use crate::topology::Topology;
 use rayon::prelude::*;
 
 /// Where every vertex and triangle of one tessellation goes (see the module doc).
@@ -94,7 +93,7 @@ impl Layout {
     /// found them (`counts[p]`: [`Pattern::counts`] of patch `p`'s pattern input, zero for a
     /// culled patch; the a-posteriori check's, [`crate::criterion::PlanScratch::plan_counts`]),
     /// so that no patch's input is gathered and counted again, and likewise each edge's inner
-    /// samples where the planner counted them (`edge_counts[e]`: [`edge_samples`] of edge `e`,
+    /// samples where the planner counted them (`edge_counts[e]`: `Topology::edge_samples` of edge `e`,
     /// [`crate::criterion::resolve::edges_counted`]).
     pub(crate) fn build_counted(
         &mut self,
@@ -133,7 +132,7 @@ impl Layout {
         given_edge_counts: Option<&[u32]>,
     ) -> Result<()> {
         let topo = &set.topology;
-        // Edges: inner samples per variant ([`edge_samples`]), counted in parallel where the
+        // Edges: inner samples per variant ([`Topology::edge_samples`]), counted in parallel where the
         // planner did not count them, then scanned.
         let edges = topo.edges.len();
         self.edge_offsets.clear();
@@ -148,7 +147,7 @@ impl Layout {
                 // culled in no predictable order, and `any`'s early exit mispredicted.
                 let seen = all_visible
                     || topo.edge_uses(e).iter().fold(0, |seen, u| seen | plan.visible[u.patch as usize]) != 0;
-                *count = edge_samples(topo, e, seen, plan.segments(e));
+                *count = topo.edge_samples(e, seen, plan.segments(e));
             })
         };
         // The patterns' counts (where the check did not leave them) beside the edges' counts:
@@ -167,7 +166,7 @@ impl Layout {
             Some(given) => {
                 debug_assert!((0..edges).all(|e| {
                     let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
-                    given[e] == edge_samples(topo, e, seen, plan.segments(e))
+                    given[e] == topo.edge_samples(e, seen, plan.segments(e))
                 }));
                 for (offset, &count) in self.edge_offsets.iter_mut().zip(given) {
                     *offset = total.min(u32::MAX as u64) as u32;
@@ -237,17 +236,6 @@ impl Layout {
         self.collapsed_triangles = upper - triangles;
         Ok(())
     }
-}
-
-/// The inner samples edge `e` of `topo` adds to the output with `segments` segments: its
-/// rows ([`Topology::edge_rows`]: one per normal variant, none where its curve is collapsed)
-/// of `segments − 1`, none where no visible patch uses it (`seen`; nothing refers to them).
-/// The one rule of the layout's counts and of the planner's
-/// ([`crate::criterion::resolve::edges_counted`]). Segments ≤ `MAX_FACTOR` and ≤ 255
-/// variants: a count fits u32. Cost: O(1).
-#[inline(always)]
-pub(crate) fn edge_samples(topo: &Topology, e: usize, seen: bool, segments: u32) -> u32 {
-    u32::from(seen) * (segments - 1) * topo.edge_rows(e)
 }
 
 /// Every patch's pattern counts into `counts` (zero for culled patches). Neighbouring patches

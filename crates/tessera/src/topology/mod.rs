@@ -352,6 +352,16 @@ impl Topology {
     pub fn edge_rows(&self, e: usize) -> u32 {
         self.edge_rows[e] as u32
     }
+
+    /// The inner samples edge `e` adds to the output with `segments` segments: its rows
+    /// ([`Topology::edge_rows`]) of `segments − 1`, none where no visible patch uses it
+    /// (`seen`; nothing refers to them). The one rule of the layout's counts
+    /// (`engine::layout`) and of the plan's (`criterion::resolve::edges_counted`). Segments
+    /// ≤ `MAX_FACTOR` and ≤ 255 variants: a count fits u32. Cost: O(1).
+    #[inline(always)]
+    pub fn edge_samples(&self, e: usize, seen: bool, segments: u32) -> u32 {
+        u32::from(seen) * (segments - 1) * self.edge_rows(e)
+    }
 }
 
 /// Hand-broken inputs: each defect must be found exactly, so a lenient topology (matching
