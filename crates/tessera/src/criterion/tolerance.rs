@@ -537,6 +537,8 @@ pub(crate) struct Scratch {
     /// `edge_counts_fresh`.
     edge_counts: Vec<u32>,
     edge_counts_fresh: bool,
+    /// Per run of the last check ([`CHECK_RUN`] patches), how many missed their bound.
+    misses: Vec<u32>,
 }
 
 impl Scratch {
@@ -649,6 +651,7 @@ pub(crate) fn plan_limited(
         counts_fresh,
         edge_counts,
         edge_counts_fresh,
+        misses,
     } = scratch;
     *patterns_fresh = false;
     *counts_fresh = false;
@@ -727,23 +730,35 @@ pub(crate) fn plan_limited(
     }
     which.resize(patches, 0);
     which.par_iter_mut().enumerate().for_each(|(i, w)| *w = i);
-    let mut check =
-        |segments: &[u32], proposals: &[[f64; 4]], which: &[usize], out: &mut Vec<Check>, keep| {
-            let inputs =
-                CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors, taylor };
-            check_patches(&inputs, &limit, proposals, segments, which, firsts, counts, patterns, keep, out)
-        };
-    let (fresh, first_failing) = check(&plan.segments, proposals, which, results, false);
-    *patterns_fresh = fresh;
+    let mut check = |segments: &[u32],
+                     proposals: &[[f64; 4]],
+                     which: &[usize],
+                     (out, misses): (&mut Vec<Check>, &mut Vec<u32>),
+                     keep| {
+        let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors, taylor };
+        let rows = (&mut *firsts, &mut *counts, &mut *patterns);
+        check_patches(&inputs, &limit, proposals, segments, which, rows, keep, out, misses)
+    };
+    *patterns_fresh = check(&plan.segments, proposals, which, (results, misses), false);
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
     // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
     // Errors shrink as h², hence the square root.
-    for round in 0..256 {
-        failing.clear();
-        if round > 0 || first_failing > 0 {
-            failing.extend((0..patches).filter(|&p| results[p].2));
-        }
+    // The failing patches: those of the first check's runs that missed, then after each
+    // round those of the patches it checked again (every failing patch is among them, and
+    // no other result changed). In patch order.
+    failing.clear();
+    for (run, _) in misses.iter().enumerate().filter(|&(_, &m)| m > 0) {
+        let run = &which[run * CHECK_RUN..((run + 1) * CHECK_RUN).min(which.len())];
+        failing.extend(run.iter().copied().filter(|&p| results[p].2));
+    }
+    for _round in 0..256 {
+        // (Sorted and distinct, all failing and as many as there are: every failing patch.)
+        debug_assert!(
+            failing.windows(2).all(|w| w[0] < w[1])
+                && failing.iter().all(|&p| results[p].2)
+                && failing.len() == results.iter().filter(|r| r.2).count()
+        );
         if failing.is_empty() || interior == InteriorRule::Global {
             break;
         }
@@ -782,10 +797,12 @@ pub(crate) fn plan_limited(
             }
         }
         report.rounds += 1;
-        check(&plan.segments, proposals, which, rechecked, true);
+        check(&plan.segments, proposals, which, (rechecked, misses), true);
         for (i, &p) in which.iter().enumerate() {
             results[p] = rechecked[i];
         }
+        failing.clear();
+        failing.extend(which.iter().copied().filter(|&p| results[p].2));
     }
     limit.result()?;
     // The plan's interiors, the counts and the report's figures in one parallel pass (the
@@ -954,13 +971,17 @@ struct CheckInputs<'a> {
     taylor: Option<&'a [TaylorBound]>,
 }
 
+/// The patches [`check_patches`] checks as one task (each asks its thread's pattern table
+/// once), and counts the misses of.
+const CHECK_RUN: usize = 64;
+
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
 /// the pattern's own triangles meet the bound (interior vertices are private, so this never
 /// opens a crack), growing like the square root of the excess since errors shrink as h².
 /// Writes, for each patch of `which`, (interior, guaranteed bound, bound not met) into `out`
-/// (`firsts` and `counts` are its buffers). The first patterns go into `patterns` (after the
-/// ones it holds, with `keep`); returns whether they did, and how many patches miss their
-/// bound.
+/// (`firsts` and `counts` are its buffers), and how many of each run of [`CHECK_RUN`]
+/// patches of `which` miss their bound into `misses`. The first patterns go into `patterns`
+/// (after the ones it holds, with `keep`); returns whether they did.
 #[allow(clippy::too_many_arguments)]
 fn check_patches(
     inputs: &CheckInputs<'_>,
@@ -968,12 +989,11 @@ fn check_patches(
     proposals: &[[f64; 4]],
     segments: &[u32],
     which: &[usize],
-    firsts: &mut Vec<First>,
-    counts: &mut Vec<u64>,
-    patterns: &mut crate::pattern::cache::PatternCache,
+    (firsts, counts, patterns): (&mut Vec<First>, &mut Vec<u64>, &mut crate::pattern::cache::PatternCache),
     keep: bool,
     out: &mut Vec<Check>,
-) -> (bool, usize) {
+    misses: &mut Vec<u32>,
+) -> bool {
     let CheckInputs { set, eps, layout, cap, minimum, errors, taylor } = *inputs;
     let topo = &set.topology;
     let global = segments.iter().copied().max().unwrap_or(1);
@@ -1139,14 +1159,14 @@ fn check_patches(
     // thread-local borrow per patch was 2–3 % of the torus grid's frame). Short runs: the
     // torus's 2,048 patches at 0.001 % made 8 runs of 256 of unequal cost, and one thread
     // idled at the end (the runs' part 233 → 187 µs on two threads with runs of 64).
-    const RUN: usize = 64;
+    const RUN: usize = CHECK_RUN;
     const ERRORS_LEAD: usize = 8;
-    let runs = out.par_chunks_mut(RUN).zip(which.par_chunks(RUN)).zip(firsts.par_chunks(RUN)).enumerate();
-    // How many patches miss their bound, counted by the runs: where none does, the rounds'
-    // search of every patch's result (one thread's pass over them) is not needed.
-    let failing = std::sync::atomic::AtomicUsize::new(0);
-    runs.for_each(|(run, ((outs, patches), firsts))| {
-        let missed = super::pattern_shapes::with_pattern_shapes(|table| {
+    // How many patches of each run miss their bound: the rounds look for them only in the
+    // runs that have some (a search of every patch's result was one thread's pass).
+    misses.resize(which.len().div_ceil(RUN), 0);
+    let runs = out.par_chunks_mut(RUN).zip(which.par_chunks(RUN)).zip(firsts.par_chunks(RUN));
+    runs.zip(misses.par_iter_mut()).enumerate().for_each(|(run, (((outs, patches), firsts), misses))| {
+        *misses = super::pattern_shapes::with_pattern_shapes(|table| {
             let mut missed = 0;
             for (k, ((o, &p), &f)) in outs.iter_mut().zip(patches).zip(firsts).enumerate() {
                 // The bound's data of a patch a few ahead, asked for in time (96 bytes a
@@ -1156,15 +1176,12 @@ fn check_patches(
                     crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(ahead));
                 }
                 *o = check_one(run * RUN + k, p, f, table);
-                missed += usize::from(o.2);
+                missed += u32::from(o.2);
             }
             missed
         });
-        if missed > 0 {
-            failing.fetch_add(missed, Ordering::Relaxed);
-        }
     });
-    (filled, failing.into_inner())
+    filled
 }
 
 #[cfg(test)]
