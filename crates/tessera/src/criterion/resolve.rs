@@ -106,7 +106,7 @@ fn counted_edge(
     // rarely, so that branch is predicted, where asking for every culled edge mispredicted
     // (culled and visible edges alternate in no order).
     let ask = (wanted < 0.0) & (topo.edge_samples(e, true, s) != 0);
-    let seen = if ask { uses.iter().any(|u| visible[u.patch as usize] != 0) } else { wanted >= 0.0 };
+    let seen = if ask { topo.edge_seen(e, visible) } else { wanted >= 0.0 };
     (s, f, topo.edge_samples(e, seen, s))
 }
 

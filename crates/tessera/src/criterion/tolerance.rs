@@ -740,10 +740,6 @@ pub(crate) fn plan_limited(
         check_patches(&inputs, &limit, proposals, segments, which, rows, keep, out, misses)
     };
     *patterns_fresh = check(&plan.segments, proposals, which, (results, misses), false);
-    // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
-    // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
-    // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
-    // Errors shrink as h², hence the square root.
     // The failing patches: those of the first check's runs that missed, then after each
     // round those of the patches it checked again (every failing patch is among them, and
     // no other result changed). In patch order.
@@ -752,6 +748,10 @@ pub(crate) fn plan_limited(
         let run = &which[run * CHECK_RUN..((run + 1) * CHECK_RUN).min(which.len())];
         failing.extend(run.iter().copied().filter(|&p| results[p].2));
     }
+    // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
+    // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
+    // problem to a neighbour, so repeat, re-checking only the patches whose edges changed.
+    // Errors shrink as h², hence the square root.
     for _round in 0..256 {
         // (Sorted and distinct, all failing and as many as there are: every failing patch.)
         debug_assert!(
@@ -792,8 +792,7 @@ pub(crate) fn plan_limited(
             let e = e as usize;
             (plan.segments[e], plan.factors[e]) = (s, f);
             if counted {
-                let seen = topo.edge_uses(e).iter().any(|u| plan.visible[u.patch as usize] != 0);
-                edge_counts[e] = topo.edge_samples(e, seen, s);
+                edge_counts[e] = topo.edge_samples(e, topo.edge_seen(e, &plan.visible), s);
             }
         }
         report.rounds += 1;

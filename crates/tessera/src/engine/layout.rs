@@ -143,10 +143,7 @@ impl Layout {
         let edge_counts = self.edge_offsets[..edges].par_iter_mut().enumerate().with_min_len(1024);
         let count_edges = || {
             edge_counts.for_each(|(e, count)| {
-                // Without a branch per use: with culling on, about half the patches are
-                // culled in no predictable order, and `any`'s early exit mispredicted.
-                let seen = all_visible
-                    || topo.edge_uses(e).iter().fold(0, |seen, u| seen | plan.visible[u.patch as usize]) != 0;
+                let seen = all_visible || topo.edge_seen(e, &plan.visible);
                 *count = topo.edge_samples(e, seen, plan.segments(e));
             })
         };
@@ -161,13 +158,14 @@ impl Layout {
                 rayon::join(count_edges, || count_patterns(set, plan, pattern, layout_counts));
             }
         }
+        debug_assert!(given_edge_counts.is_none_or(|given| (0..edges).all(|e| {
+            given[e] == topo.edge_samples(e, topo.edge_seen(e, &plan.visible), plan.segments(e))
+        })));
+        // The scan: from the planner's counts where it gave them (read where they are, not
+        // copied in first: 0.7 MB for the torus grid), else in place.
         let mut total = self.corners as u64;
         match given_edge_counts {
             Some(given) => {
-                debug_assert!((0..edges).all(|e| {
-                    let seen = topo.edge_uses(e).iter().any(|u| plan.is_visible(u.patch as usize));
-                    given[e] == topo.edge_samples(e, seen, plan.segments(e))
-                }));
                 for (offset, &count) in self.edge_offsets.iter_mut().zip(given) {
                     *offset = total.min(u32::MAX as u64) as u32;
                     total += count as u64;
