@@ -728,25 +728,23 @@ pub(crate) fn plan_limited(
         // Only a limit reads them (`Limit::admit`, `Limit::reserve`).
         limit.per_patch.par_iter().for_each(|c| c.store(0, Ordering::Relaxed));
     }
-    which.resize(patches, 0);
-    which.par_iter_mut().enumerate().for_each(|(i, w)| *w = i);
     let mut check = |segments: &[u32],
                      proposals: &[[f64; 4]],
-                     which: &[usize],
+                     which: Patches<'_>,
                      (out, misses): (&mut Vec<Check>, &mut Vec<u32>),
                      keep| {
         let inputs = CheckInputs { set, eps, layout: interior, cap, minimum: minimum_inner, errors, taylor };
         let rows = (&mut *firsts, &mut *counts, &mut *patterns);
         check_patches(&inputs, &limit, proposals, segments, which, rows, keep, out, misses)
     };
-    *patterns_fresh = check(&plan.segments, proposals, which, (results, misses), false);
+    *patterns_fresh = check(&plan.segments, proposals, Patches::All(patches), (results, misses), false);
     // The failing patches: those of the first check's runs that missed, then after each
     // round those of the patches it checked again (every failing patch is among them, and
     // no other result changed). In patch order.
     failing.clear();
     for (run, _) in misses.iter().enumerate().filter(|&(_, &m)| m > 0) {
-        let run = &which[run * CHECK_RUN..((run + 1) * CHECK_RUN).min(which.len())];
-        failing.extend(run.iter().copied().filter(|&p| results[p].2));
+        let run = run * CHECK_RUN..((run + 1) * CHECK_RUN).min(patches);
+        failing.extend(run.filter(|&p| results[p].2));
     }
     // A patch whose bound the interior alone cannot meet (its strip triangles follow coarse
     // edges) asks for finer edges; the maximum rule keeps them consistent. That can move the
@@ -796,7 +794,7 @@ pub(crate) fn plan_limited(
             }
         }
         report.rounds += 1;
-        check(&plan.segments, proposals, which, (rechecked, misses), true);
+        check(&plan.segments, proposals, Patches::Listed(which), (rechecked, misses), true);
         for (i, &p) in which.iter().enumerate() {
             results[p] = rechecked[i];
         }
@@ -923,20 +921,20 @@ impl<'a> Limit<'a> {
     /// [`Limit::admit`] for the patches of `which` at once (`counts[i]` the triangles of
     /// `which[i]`'s pattern, 0 for culled patches), all or none: when their patterns
     /// together would exceed the limit, the whole total is what the refusal reports.
-    fn reserve(&self, which: &[usize], counts: &[u64]) -> bool {
+    fn reserve(&self, which: Patches<'_>, counts: &[u64]) -> bool {
         if self.unlimited() {
             return true;
         }
         let add: u64 = counts.iter().sum();
-        let remove: u64 = which.iter().map(|&p| self.per_patch[p].load(Ordering::Relaxed)).sum();
+        let remove: u64 = (0..which.len()).map(|i| self.per_patch[which.at(i)].load(Ordering::Relaxed)).sum();
         let update = self.used.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |u| {
             let n = u - remove + add;
             (n <= self.max_triangles).then_some(n)
         });
         match update {
             Ok(_) => {
-                for (&p, &t) in which.iter().zip(counts) {
-                    self.per_patch[p].store(t, Ordering::Relaxed);
+                for (i, &t) in counts.iter().enumerate() {
+                    self.per_patch[which.at(i)].store(t, Ordering::Relaxed);
                 }
                 true
             }
@@ -974,6 +972,40 @@ struct CheckInputs<'a> {
 /// once), and counts the misses of.
 const CHECK_RUN: usize = 64;
 
+/// The patches a check runs over: every patch of the set in order (a plan's first check), or
+/// a sorted list of them (a round's re-checks).
+#[derive(Clone, Copy)]
+enum Patches<'a> {
+    All(usize),
+    Listed(&'a [usize]),
+}
+
+impl Patches<'_> {
+    fn len(self) -> usize {
+        match self {
+            Patches::All(n) => n,
+            Patches::Listed(list) => list.len(),
+        }
+    }
+
+    /// The `i`-th patch.
+    #[inline(always)]
+    fn at(self, i: usize) -> usize {
+        match self {
+            Patches::All(_) => i,
+            Patches::Listed(list) => list[i],
+        }
+    }
+}
+
+/// From this many patches up, a check without a triangle limit finds each run's first
+/// patterns in the run ([`check_patches`]); below it a pass of their own costs little.
+const TILED_FROM: usize = 4096;
+
+/// One patch in this many is looked at to decide whether a tiled check's first patterns are
+/// worth building once each ([`check_patches`]).
+const WORTH_SAMPLE: usize = 16;
+
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
 /// the pattern's own triangles meet the bound (interior vertices are private, so this never
 /// opens a crack), growing like the square root of the excess since errors shrink as h².
@@ -981,13 +1013,21 @@ const CHECK_RUN: usize = 64;
 /// (`firsts` and `counts` are its buffers), and how many of each run of [`CHECK_RUN`]
 /// patches of `which` miss their bound into `misses`. The first patterns go into `patterns`
 /// (after the ones it holds, with `keep`); returns whether they did.
+///
+/// Each patch's first pattern comes from its edges' segments, a chain of dependent loads.
+/// With a triangle limit, or when the first patterns are to be built once each, all of them
+/// are found first, in a pass of their own (the limit counts their triangles before any is
+/// built; the table builds from them). Otherwise, on many patches, each run finds its own
+/// patches' first patterns just before checking them: the run's loads overlap one another,
+/// and no row of them is written and read again (a first pattern inside each patch's check
+/// instead, its loads in series with the bound, measured slower than the pass).
 #[allow(clippy::too_many_arguments)]
 fn check_patches(
     inputs: &CheckInputs<'_>,
     limit: &Limit,
     proposals: &[[f64; 4]],
     segments: &[u32],
-    which: &[usize],
+    which: Patches<'_>,
     (firsts, counts, patterns): (&mut Vec<First>, &mut Vec<u64>, &mut crate::pattern::cache::PatternCache),
     keep: bool,
     out: &mut Vec<Check>,
@@ -995,7 +1035,11 @@ fn check_patches(
 ) -> bool {
     let CheckInputs { set, eps, layout, cap, minimum, errors, taylor } = *inputs;
     let topo = &set.topology;
-    let global = segments.iter().copied().max().unwrap_or(1);
+    // Only the global rule reads it (a pass over every edge on one thread).
+    let global = match layout {
+        InteriorRule::Global => segments.iter().copied().max().unwrap_or(1),
+        _ => 1,
+    };
     // The engine's input, collapsed edges included, so the bound is that of the output.
     let input_of = |p: usize, domain, segments, interior| PatternInput {
         collapsed: set.topology.collapsed_sides(p),
@@ -1036,37 +1080,60 @@ fn check_patches(
         }
         (domain, seg, interior)
     };
-    // Interiors only grow, so the first patterns' triangles are a lower bound of the output:
-    // count them all before building any, and build nothing when they already exceed the limit.
-    firsts.resize(which.len(), (Domain::Quad, [1; 4], [1; 2]));
-    counts.resize(which.len(), 0);
-    let count = !limit.unlimited();
-    super::rows::fill_pairs(firsts, counts, |i, f, c| {
-        let p = which[i];
-        *f = first(p);
-        *c = match eps[p] {
-            Some(_) if count => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
-            _ => 0,
-        };
-    });
-    let admitted = limit.reserve(which, counts);
-    // The first patterns (admitted by the reservation above) are built once per distinct
-    // input, with their local-vertex parameters: neighbours share inputs, and most patches
-    // pass on their first pattern. Later rounds of a patch build on the thread instead.
-    // Tiny patterns (a cell or two, as in a distant view) cost about what a lookup costs, and
-    // the lookups run on one thread: there each task reuses its last pattern instead.
-    let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
-    let worth = cells >= crate::pattern::cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * firsts.len() as u64;
-    let filled = admitted && worth && !limit.pattern.depends_on_patch();
+    let n = which.len();
+    let cacheable = !limit.pattern.depends_on_patch();
+    let is_worth = |cells: u64, patches: usize| {
+        cells >= crate::pattern::cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * patches as u64
+    };
+    // Whether the runs find their own first patterns: not with a limit, and not where the
+    // patterns are built once each, which a sample of the first patterns decides (only the
+    // pace depends on that choice, never the plan).
+    let tiled = limit.unlimited()
+        && n >= TILED_FROM
+        && !(cacheable && {
+            let samples = n.div_ceil(WORTH_SAMPLE);
+            let cells: u64 = (0..samples)
+                .into_par_iter()
+                .map(|k| first(which.at(k * WORTH_SAMPLE)).2.iter().map(|&c| c as u64).product::<u64>())
+                .sum();
+            is_worth(cells, samples)
+        });
+    let (admitted, filled) = if tiled {
+        (true, false)
+    } else {
+        // Interiors only grow, so the first patterns' triangles are a lower bound of the
+        // output: count them all before building any, and build nothing when they already
+        // exceed the limit.
+        firsts.resize(n, (Domain::Quad, [1; 4], [1; 2]));
+        counts.resize(n, 0);
+        let count = !limit.unlimited();
+        super::rows::fill_pairs(firsts, counts, |i, f, c| {
+            let p = which.at(i);
+            *f = first(p);
+            *c = match eps[p] {
+                Some(_) if count => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
+                _ => 0,
+            };
+        });
+        let admitted = limit.reserve(which, counts);
+        // The first patterns (admitted by the reservation above) are built once per
+        // distinct input, with their local-vertex parameters: neighbours share inputs, and
+        // most patches pass on their first pattern. Later rounds of a patch build on the
+        // thread instead. Tiny patterns (a cell or two, as in a distant view) cost about
+        // what a lookup costs, and the lookups run on one thread: there each task reuses
+        // its last pattern instead.
+        let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
+        (admitted, admitted && is_worth(cells, n) && cacheable)
+    };
     if filled {
         let first_input = |i: usize| {
-            let (p, (domain, seg, interior)) = (which[i], firsts[i]);
+            let (p, (domain, seg, interior)) = (which.at(i), firsts[i]);
             eps[p].map(|_| input_of(p, domain, seg, interior))
         };
         if keep {
-            patterns.extend_inputs(limit.pattern, which.len(), first_input, true);
+            patterns.extend_inputs(limit.pattern, n, first_input, true);
         } else {
-            patterns.fill_inputs(limit.pattern, which.len(), first_input, true);
+            patterns.fill_inputs(limit.pattern, n, first_input, true);
         }
     } else if keep {
         patterns.forget_items();
@@ -1077,7 +1144,7 @@ fn check_patches(
     // Each thread's pattern buffers are kept from call to call (a per-frame loop then
     // allocates none here).
     let generation = crate::pattern::cache::next_generation();
-    out.resize(which.len(), ([1; 2], 0.0, false, (0, 0)));
+    out.resize(n, ([1; 2], 0.0, false, (0, 0)));
     // One patch's check: its first pattern, then larger interiors until the bound is met,
     // the cap is reached or the bound stops shrinking. `table` is the thread's pattern-shape
     // table (`i` the patch's place in `which`).
@@ -1162,19 +1229,32 @@ fn check_patches(
     const ERRORS_LEAD: usize = 8;
     // How many patches of each run miss their bound: the rounds look for them only in the
     // runs that have some (a search of every patch's result was one thread's pass).
-    misses.resize(which.len().div_ceil(RUN), 0);
-    let runs = out.par_chunks_mut(RUN).zip(which.par_chunks(RUN)).zip(firsts.par_chunks(RUN));
-    runs.zip(misses.par_iter_mut()).enumerate().for_each(|(run, (((outs, patches), firsts), misses))| {
+    misses.resize(n.div_ceil(RUN), 0);
+    let firsts = &firsts[..];
+    out.par_chunks_mut(RUN).zip(misses.par_iter_mut()).enumerate().for_each(|(run, (outs, misses))| {
+        let start = run * RUN;
+        let mut tile = [(Domain::Quad, [1; 4], [1; 2]); RUN];
+        let run_firsts = if tiled {
+            for (k, f) in tile.iter_mut().enumerate().take(outs.len()) {
+                *f = first(which.at(start + k));
+            }
+            &tile[..outs.len()]
+        } else {
+            &firsts[start..start + outs.len()]
+        };
+        let len = outs.len();
         *misses = super::pattern_shapes::with_pattern_shapes(|table| {
             let mut missed = 0;
-            for (k, ((o, &p), &f)) in outs.iter_mut().zip(patches).zip(firsts).enumerate() {
+            for (k, (o, &f)) in outs.iter_mut().zip(run_firsts).enumerate() {
                 // The bound's data of a patch a few ahead, asked for in time (96 bytes a
                 // patch: the grid's 8.8 MB are past the core's own cache, and the patches
                 // in view come in runs between culled ones, which the check skips).
-                if let Some(ahead) = patches.get(k + ERRORS_LEAD).and_then(|&q| errors.get(q)) {
-                    crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(ahead));
+                if k + ERRORS_LEAD < len {
+                    if let Some(ahead) = errors.get(which.at(start + k + ERRORS_LEAD)) {
+                        crate::surface::patch_tree::prefetch_slice(std::slice::from_ref(ahead));
+                    }
                 }
-                *o = check_one(run * RUN + k, p, f, table);
+                *o = check_one(start + k, which.at(start + k), f, table);
                 missed += u32::from(o.2);
             }
             missed
