@@ -919,8 +919,9 @@ impl<'a> Limit<'a> {
     }
 
     /// [`Limit::admit`] for the patches of `which` at once (`counts[i]` the triangles of
-    /// `which[i]`'s pattern, 0 for culled patches), all or none: when their patterns
-    /// together would exceed the limit, the whole total is what the refusal reports.
+    /// `which[i]`'s pattern, 0 for culled patches; not read without a limit), all or none:
+    /// when their patterns together would exceed the limit, the whole total is what the
+    /// refusal reports.
     fn reserve(&self, which: Patches<'_>, counts: &[u64]) -> bool {
         if self.unlimited() {
             return true;
@@ -998,14 +999,6 @@ impl Patches<'_> {
     }
 }
 
-/// From this many patches up, a check without a triangle limit finds each run's first
-/// patterns in the run ([`check_patches`]); below it a pass of their own costs little.
-const TILED_FROM: usize = 4096;
-
-/// One patch in this many is looked at to decide whether a tiled check's first patterns are
-/// worth building once each ([`check_patches`]).
-const WORTH_SAMPLE: usize = 16;
-
 /// Interior factors for every patch and the a-posteriori check: the interior is raised until
 /// the pattern's own triangles meet the bound (interior vertices are private, so this never
 /// opens a crack), growing like the square root of the excess since errors shrink as h².
@@ -1013,14 +1006,6 @@ const WORTH_SAMPLE: usize = 16;
 /// (`firsts` and `counts` are its buffers), and how many of each run of [`CHECK_RUN`]
 /// patches of `which` miss their bound into `misses`. The first patterns go into `patterns`
 /// (after the ones it holds, with `keep`); returns whether they did.
-///
-/// Each patch's first pattern comes from its edges' segments, a chain of dependent loads.
-/// With a triangle limit, or when the first patterns are to be built once each, all of them
-/// are found first, in a pass of their own (the limit counts their triangles before any is
-/// built; the table builds from them). Otherwise, on many patches, each run finds its own
-/// patches' first patterns just before checking them: the run's loads overlap one another,
-/// and no row of them is written and read again (a first pattern inside each patch's check
-/// instead, its loads in series with the bound, measured slower than the pass).
 #[allow(clippy::too_many_arguments)]
 fn check_patches(
     inputs: &CheckInputs<'_>,
@@ -1081,50 +1066,35 @@ fn check_patches(
         (domain, seg, interior)
     };
     let n = which.len();
-    let cacheable = !limit.pattern.depends_on_patch();
-    let is_worth = |cells: u64, patches: usize| {
-        cells >= crate::pattern::cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * patches as u64
-    };
-    // Whether the runs find their own first patterns: not with a limit, and not where the
-    // patterns are built once each, which a sample of the first patterns decides (only the
-    // pace depends on that choice, never the plan).
-    let tiled = limit.unlimited()
-        && n >= TILED_FROM
-        && !(cacheable && {
-            let samples = n.div_ceil(WORTH_SAMPLE);
-            let cells: u64 = (0..samples)
-                .into_par_iter()
-                .map(|k| first(which.at(k * WORTH_SAMPLE)).2.iter().map(|&c| c as u64).product::<u64>())
-                .sum();
-            is_worth(cells, samples)
-        });
-    let (admitted, filled) = if tiled {
-        (true, false)
+    // Interiors only grow, so the first patterns' triangles are a lower bound of the output:
+    // count them all before building any, and build nothing when they already exceed the limit.
+    // (Found in a pass of their own: found in the check's runs instead, a run's at a time
+    // before its checks, the check took as long: the loads of the edges' segments cost the
+    // same wherever they are.)
+    firsts.resize(n, (Domain::Quad, [1; 4], [1; 2]));
+    if limit.unlimited() {
+        // Nothing to count: no row of zeros (8 bytes a patch) written for nothing.
+        super::rows::fill(firsts, |i, f| *f = first(which.at(i)));
     } else {
-        // Interiors only grow, so the first patterns' triangles are a lower bound of the
-        // output: count them all before building any, and build nothing when they already
-        // exceed the limit.
-        firsts.resize(n, (Domain::Quad, [1; 4], [1; 2]));
         counts.resize(n, 0);
-        let count = !limit.unlimited();
         super::rows::fill_pairs(firsts, counts, |i, f, c| {
             let p = which.at(i);
             *f = first(p);
             *c = match eps[p] {
-                Some(_) if count => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
-                _ => 0,
+                Some(_) => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
+                None => 0,
             };
         });
-        let admitted = limit.reserve(which, counts);
-        // The first patterns (admitted by the reservation above) are built once per
-        // distinct input, with their local-vertex parameters: neighbours share inputs, and
-        // most patches pass on their first pattern. Later rounds of a patch build on the
-        // thread instead. Tiny patterns (a cell or two, as in a distant view) cost about
-        // what a lookup costs, and the lookups run on one thread: there each task reuses
-        // its last pattern instead.
-        let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
-        (admitted, admitted && is_worth(cells, n) && cacheable)
-    };
+    }
+    let admitted = limit.reserve(which, counts);
+    // The first patterns (admitted by the reservation above) are built once per distinct
+    // input, with their local-vertex parameters: neighbours share inputs, and most patches
+    // pass on their first pattern. Later rounds of a patch build on the thread instead.
+    // Tiny patterns (a cell or two, as in a distant view) cost about what a lookup costs, and
+    // the lookups run on one thread: there each task reuses its last pattern instead.
+    let cells: u64 = firsts.par_iter().map(|f| f.2[0] as u64 * f.2[1] as u64).sum();
+    let worth = cells >= crate::pattern::cache::MIN_TRIANGLES_PER_PATCH as u64 / 2 * n as u64;
+    let filled = admitted && worth && !limit.pattern.depends_on_patch();
     if filled {
         let first_input = |i: usize| {
             let (p, (domain, seg, interior)) = (which.at(i), firsts[i]);
@@ -1230,19 +1200,9 @@ fn check_patches(
     // How many patches of each run miss their bound: the rounds look for them only in the
     // runs that have some (a search of every patch's result was one thread's pass).
     misses.resize(n.div_ceil(RUN), 0);
-    let firsts = &firsts[..];
-    out.par_chunks_mut(RUN).zip(misses.par_iter_mut()).enumerate().for_each(|(run, (outs, misses))| {
-        let start = run * RUN;
-        let mut tile = [(Domain::Quad, [1; 4], [1; 2]); RUN];
-        let run_firsts = if tiled {
-            for (k, f) in tile.iter_mut().enumerate().take(outs.len()) {
-                *f = first(which.at(start + k));
-            }
-            &tile[..outs.len()]
-        } else {
-            &firsts[start..start + outs.len()]
-        };
-        let len = outs.len();
+    let runs = out.par_chunks_mut(RUN).zip(firsts.par_chunks(RUN)).zip(misses.par_iter_mut());
+    runs.enumerate().for_each(|(run, ((outs, run_firsts), misses))| {
+        let (start, len) = (run * RUN, outs.len());
         *misses = super::pattern_shapes::with_pattern_shapes(|table| {
             let mut missed = 0;
             for (k, (o, &f)) in outs.iter_mut().zip(run_firsts).enumerate() {
