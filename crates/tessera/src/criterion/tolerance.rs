@@ -657,9 +657,12 @@ pub(crate) fn plan_limited(
     *counts_fresh = false;
     *edge_counts_fresh = false;
 
-    // Each visible patch's proposal per local edge.
+    // Each visible patch's proposal per local edge, and the plan's visibility row (a pass of
+    // its own, over the tolerances again, was 20–50 µs on the torus grid).
     proposals.resize(patches, [0.0; 4]);
-    super::rows::fill(proposals, |p, out| {
+    plan.visible.resize(patches, 0);
+    super::rows::fill_pairs(proposals, &mut plan.visible, |p, out, visible| {
+        *visible = u32::from(eps[p].is_some());
         // A culled patch wishes nothing, and says so by its sign ([`resolve::CULLED`]).
         let Some(e) = eps[p] else {
             *out = [resolve::CULLED; 4];
@@ -697,19 +700,6 @@ pub(crate) fn plan_limited(
     plan.depths.clear();
     plan.lattice_offsets.clear();
     plan.lattice.clear();
-    // The per-patch rows are written in parallel, each element once (`resize` keeps a row of
-    // the right length as it is): on two threads a sequential pass over 92,160 patches was
-    // a pass the second core idled through.
-    plan.visible.resize(patches, 0);
-    report.culled = plan
-        .visible
-        .par_iter_mut()
-        .zip(eps)
-        .map(|(v, e)| {
-            *v = u32::from(e.is_some());
-            usize::from(e.is_none())
-        })
-        .sum();
     // The layout's edge counts with the edges (one walk over their uses), except where one
     // interior is the whole mesh's.
     let counted = interior != InteriorRule::Global;
@@ -803,20 +793,22 @@ pub(crate) fn plan_limited(
     }
     limit.result()?;
     // The plan's interiors, the counts and the report's figures in one parallel pass (the
-    // largest of bounds is the same in any order).
+    // largest of bounds is the same in any order). Writing them in the check's runs instead,
+    // while the results were at hand, made the check as much slower as this pass takes.
     plan.interior.resize(patches, [0; 2]);
     plan_counts.resize(patches, (0, 0));
     let rows = plan.interior.par_iter_mut().zip(plan_counts.par_iter_mut()).zip(results.par_iter()).zip(eps);
-    let (worst_bound, worst_ratio, capped) = rows
+    let (worst_bound, worst_ratio, capped, culled) = rows
         .map(|(((interior, counts), r), e)| {
             (*interior, *counts) = (r.0, r.3);
             match e {
-                Some(e) => (r.1, r.1 / e, usize::from(r.2)),
-                None => (0.0, 0.0, 0),
+                Some(e) => (r.1, r.1 / e, usize::from(r.2), 0),
+                None => (0.0, 0.0, 0, 1),
             }
         })
-        .reduce(|| (0.0, 0.0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2 + b.2));
-    (report.worst_bound, report.worst_ratio, report.capped_patches) = (worst_bound, worst_ratio, capped);
+        .reduce(|| (0.0, 0.0, 0, 0), |a, b| (a.0.max(b.0), a.1.max(b.1), a.2 + b.2, a.3 + b.3));
+    (report.worst_bound, report.worst_ratio) = (worst_bound, worst_ratio);
+    (report.capped_patches, report.culled) = (capped, culled);
     // The check's inputs carry the segments as their factors: the engine's, except under a
     // fractional rule, whose patterns read the real factors.
     *counts_fresh = !matches!(rule, EdgeRule::Fractional(_));
