@@ -72,6 +72,7 @@
 //! ```
 
 pub mod camera;
+mod cpu;
 pub mod criterion;
 pub mod domain;
 pub mod engine;

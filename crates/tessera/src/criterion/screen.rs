@@ -49,6 +49,7 @@ impl PatchView {
 
     /// [`patch_tolerance`] with the view-independent data precomputed: no allocation, eight
     /// point transforms ([`box_tolerance`] of the patch's box).
+    #[inline(always)]
     pub fn tolerance(&self, patch: &Patch, view: &View, pixels: f64, cull: bool) -> Option<f64> {
         if cull && self.culled(patch, view) {
             return None;
@@ -64,6 +65,7 @@ impl PatchView {
     /// [`culled`] with the view-independent data precomputed. The bounding sphere decides
     /// each frustum plane it lies wholly inside of; only the planes it reaches test the
     /// control points, so the answer is that of the control-point test.
+    #[inline(always)]
     pub fn culled(&self, patch: &Patch, view: &View) -> bool {
         let t = view.half_tangents;
         let c = view.to_camera(self.centre);
@@ -103,6 +105,7 @@ impl PatchView {
     /// [`back_facing`] with the cone and sphere precomputed. The angle test
     /// `γ > 90° + α + β` is done on cosines (no inverse trigonometry per frame), with a margin
     /// of 1e-12 so that rounding can only keep a patch, never cull it.
+    #[inline(always)]
     pub fn back_facing(&self, eye: DVec3) -> bool {
         let Some((axis, _)) = self.cone else { return false };
         let to_eye = eye - self.centre;
@@ -242,6 +245,7 @@ pub fn normal_cone(patch: &Patch) -> Option<(DVec3, f64)> {
 /// space, the nearest depth and the widest ratios to it bound every point's screen scale.
 /// The rule of [`PatchView::tolerance`] and of [`tolerances_into`]. Cost: 18 products for
 /// the eight corners, sixteen divisions.
+#[inline(always)]
 pub fn box_tolerance(lo: DVec3, hi: DVec3, view: &View, pixels: f64) -> f64 {
     let t = view.half_tangents;
     // Camera-space corners of the world-space box around the control points, one array per
@@ -299,13 +303,22 @@ pub fn tolerances_into(
         // The boxes alone, 48 bytes a patch: the views are 136, and this pass, streaming
         // them from memory, waited on their loads (the Catmull-Clark torus × 1563 at 0.5 px:
         // 1.8 → 1.25 ms, one thread).
-        out.par_iter_mut()
-            .zip(boxes)
-            .for_each(|(o, &[lo, hi])| *o = Some(box_tolerance(lo, hi, camera, pixels)));
+        super::rows::fill(
+            out,
+            #[inline(always)]
+            |p, o| {
+                let [lo, hi] = boxes[p];
+                *o = Some(box_tolerance(lo, hi, camera, pixels));
+            },
+        );
         return;
     }
     // Culling reads the views; their own boxes serve.
-    super::rows::fill(out, |p, o| *o = views[p].tolerance(&set.patches[p], camera, pixels, cull));
+    super::rows::fill(
+        out,
+        #[inline(always)]
+        |p, o| *o = views[p].tolerance(&set.patches[p], camera, pixels, cull),
+    );
 }
 
 /// The plan's visibility row: 1 for every patch, or, with `cull`, 0 for the patches

@@ -661,38 +661,43 @@ pub(crate) fn plan_limited(
     // its own, over the tolerances again, was 20–50 µs on the torus grid).
     proposals.resize(patches, [0.0; 4]);
     plan.visible.resize(patches, 0);
-    super::rows::fill_pairs(proposals, &mut plan.visible, |p, out, visible| {
-        *visible = u32::from(eps[p].is_some());
-        // A culled patch wishes nothing, and says so by its sign ([`resolve::CULLED`]).
-        let Some(e) = eps[p] else {
-            *out = [resolve::CULLED; 4];
-            return;
-        };
-        *out = [0.0; 4];
-        let domain = set.topology.patch_domains[p];
-        let m = &hessians[p];
-        let taylor = taylor.map(|t| &t[p]).filter(|t| t.is_some());
-        match (interior, domain) {
-            (InteriorRule::Core, Domain::Quad) => {
-                let mut grid = quad_grid(m, e, cap).unwrap_or((cap, cap));
-                if let Some(t) = taylor {
-                    grid = taylor_quad_grid(t, &errors[p], grid, e);
+    super::rows::fill_pairs(
+        proposals,
+        &mut plan.visible,
+        #[inline(always)]
+        |p, out, visible| {
+            *visible = u32::from(eps[p].is_some());
+            // A culled patch wishes nothing, and says so by its sign ([`resolve::CULLED`]).
+            let Some(e) = eps[p] else {
+                *out = [resolve::CULLED; 4];
+                return;
+            };
+            *out = [0.0; 4];
+            let domain = set.topology.patch_domains[p];
+            let m = &hessians[p];
+            let taylor = taylor.map(|t| &t[p]).filter(|t| t.is_some());
+            match (interior, domain) {
+                (InteriorRule::Core, Domain::Quad) => {
+                    let mut grid = quad_grid(m, e, cap).unwrap_or((cap, cap));
+                    if let Some(t) = taylor {
+                        grid = taylor_quad_grid(t, &errors[p], grid, e);
+                    }
+                    let (nu, nv) = grid;
+                    *out = [nu as f64, nv as f64, nu as f64, nv as f64];
                 }
-                let (nu, nv) = grid;
-                *out = [nu as f64, nv as f64, nu as f64, nv as f64];
-            }
-            _ => {
-                let mut n = uniform_factor(m, e);
-                if let Some(t) = taylor {
-                    n = taylor_uniform_factor(t, &errors[p], domain, n.min(cap as f64), e);
+                _ => {
+                    let mut n = uniform_factor(m, e);
+                    if let Some(t) = taylor {
+                        n = taylor_uniform_factor(t, &errors[p], domain, n.min(cap as f64), e);
+                    }
+                    out[..domain.corner_count()].fill(n);
                 }
-                out[..domain.corner_count()].fill(n);
             }
-        }
-        for (l, o) in out.iter_mut().enumerate().take(domain.corner_count()) {
-            *o = o.max(curve_factor(curves[p][l], e));
-        }
-    });
+            for (l, o) in out.iter_mut().enumerate().take(domain.corner_count()) {
+                *o = o.max(curve_factor(curves[p][l], e));
+            }
+        },
+    );
 
     let caps = prepared.caps(cap as f64);
     let minimum_inner = &prepared.minimum_interior;
@@ -1066,17 +1071,26 @@ fn check_patches(
     firsts.resize(n, (Domain::Quad, [1; 4], [1; 2]));
     if limit.unlimited() {
         // Nothing to count: no row of zeros (8 bytes a patch) written for nothing.
-        super::rows::fill(firsts, |i, f| *f = first(which.at(i)));
+        super::rows::fill(
+            firsts,
+            #[inline(always)]
+            |i, f| *f = first(which.at(i)),
+        );
     } else {
         counts.resize(n, 0);
-        super::rows::fill_pairs(firsts, counts, |i, f, c| {
-            let p = which.at(i);
-            *f = first(p);
-            *c = match eps[p] {
-                Some(_) => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
-                None => 0,
-            };
-        });
+        super::rows::fill_pairs(
+            firsts,
+            counts,
+            #[inline(always)]
+            |i, f, c| {
+                let p = which.at(i);
+                *f = first(p);
+                *c = match eps[p] {
+                    Some(_) => limit.pattern.counts(&input_of(p, f.0, f.1, f.2)).1 as u64,
+                    None => 0,
+                };
+            },
+        );
     }
     let admitted = limit.reserve(which, counts);
     // The first patterns (admitted by the reservation above) are built once per distinct

@@ -440,15 +440,7 @@ pub(crate) struct PointBlocks {
     avx2_fma: bool,
 }
 
-/// True when the CPU has AVX2 and FMA, so the kernels compiled for them may run.
-pub(crate) fn has_avx2_fma() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    false
-}
+pub(crate) use crate::cpu::has_avx2_fma;
 
 /// `L` points of one patch in structure-of-arrays form.
 pub(crate) struct Block<const L: usize> {
