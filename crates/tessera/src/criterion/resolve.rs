@@ -255,19 +255,12 @@ pub(crate) fn edges_counted(
         const RUN: usize = 4096;
         let runs =
             segments.par_chunks_mut(RUN).zip(factors.par_chunks_mut(RUN)).zip(counts.par_chunks_mut(RUN));
-        let resolve = &resolve;
-        runs.enumerate().for_each(|(c, ((s, f), n))| {
-            crate::cpu::multiversioned(
-                #[inline(always)]
-                move || run(c * RUN, s, f, n, resolve),
-            )
-        })
+        runs.enumerate().for_each(|(c, ((s, f), n))| run(c * RUN, s, f, n, &resolve))
     }
     // A function of its own: its rows, arguments, are known to the compiler not to overlap
     // the data `resolve` reads, which it then keeps in registers instead of reading the
-    // pointers to it again for every edge (inlined, it keeps that knowledge). Compiled for
-    // AVX2 too ([`crate::cpu::multiversioned`]).
-    #[inline(always)]
+    // pointers to it again for every edge.
+    #[inline(never)]
     fn run(
         first: usize,
         s: &mut [u32],
@@ -282,21 +275,9 @@ pub(crate) fn edges_counted(
     let rows = (&mut segments[..], &mut factors[..], &mut counts[..]);
     let edge = |rule, e| counted_edge(set, proposals, visible, rule, caps, e);
     match rule {
-        EdgeRule::Integer => resolve_all(
-            rows,
-            #[inline(always)]
-            |e| edge(EdgeRule::Integer, e),
-        ),
-        EdgeRule::PowerOfTwo => resolve_all(
-            rows,
-            #[inline(always)]
-            |e| edge(EdgeRule::PowerOfTwo, e),
-        ),
-        EdgeRule::Fractional(_) => resolve_all(
-            rows,
-            #[inline(always)]
-            |e| edge(rule, e),
-        ),
+        EdgeRule::Integer => resolve_all(rows, |e| edge(EdgeRule::Integer, e)),
+        EdgeRule::PowerOfTwo => resolve_all(rows, |e| edge(EdgeRule::PowerOfTwo, e)),
+        EdgeRule::Fractional(_) => resolve_all(rows, |e| edge(rule, e)),
     }
 }
 
