@@ -163,23 +163,30 @@ impl Layout {
         })));
         // The scan: from the planner's counts where it gave them (read where they are, not
         // copied in first: 0.7 MB for the torus grid), else in place.
-        let mut total = self.corners as u64;
-        match given_edge_counts {
-            Some(given) => {
-                for (offset, &count) in self.edge_offsets.iter_mut().zip(given) {
-                    *offset = total.min(u32::MAX as u64) as u32;
-                    total += count as u64;
+        let edge_offsets = &mut self.edge_offsets;
+        let total = crate::cpu::multiversioned(
+            #[inline(always)]
+            || {
+                let mut total = self.corners as u64;
+                match given_edge_counts {
+                    Some(given) => {
+                        for (offset, &count) in edge_offsets.iter_mut().zip(given) {
+                            *offset = total.min(u32::MAX as u64) as u32;
+                            total += count as u64;
+                        }
+                        edge_offsets[edges] = total.min(u32::MAX as u64) as u32;
+                    }
+                    None => {
+                        for offset in edge_offsets.iter_mut() {
+                            let count = *offset as u64;
+                            *offset = total.min(u32::MAX as u64) as u32;
+                            total += count;
+                        }
+                    }
                 }
-                self.edge_offsets[edges] = total.min(u32::MAX as u64) as u32;
-            }
-            None => {
-                for offset in self.edge_offsets.iter_mut() {
-                    let count = *offset as u64;
-                    *offset = total.min(u32::MAX as u64) as u32;
-                    total += count;
-                }
-            }
-        }
+                total
+            },
+        );
         // Pattern counts first, without building anything: a triangle count is an upper bound
         // (triangles collapsed at a repeated corner are dropped below), so an output that is
         // too large is refused here, before any pattern or buffer of its size exists.
@@ -204,7 +211,10 @@ impl Layout {
             // No patch has a repeated corner: every triangle is kept, and the scan's totals
             // are the size check's (one walk over the counts, not two; the scan writes only
             // the offsets, nothing of the output's size).
-            let (vertices, triangles) = scan_counts(total, counts.iter().copied(), offsets);
+            let (vertices, triangles) = crate::cpu::multiversioned(
+                #[inline(always)]
+                || scan_counts(total, counts.iter().copied(), offsets),
+            );
             check_size(vertices, triangles, options)?;
             self.collapsed_triangles = 0;
             return Ok(());
@@ -265,6 +275,7 @@ fn count_patterns(set: &SurfaceSet, plan: &Plan, pattern: &dyn Pattern, counts: 
 /// into `interior` and `triangles`, resized) from their `(vertices, triangles)`, the vertices
 /// after `start`; returns the vertex and triangle totals. The offsets are right where the
 /// totals fit `u32` (the caller's size check refuses the others). Cost: O(P), sequential.
+#[inline(always)]
 fn scan_counts(
     start: u64,
     counts: impl ExactSizeIterator<Item = (u32, u32)>,
