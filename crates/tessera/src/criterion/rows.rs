@@ -10,8 +10,8 @@
 //!
 //! Each run loop is compiled twice, for the baseline target and for AVX2 and FMA
 //! ([`crate::cpu::multiversioned`]). A pass's closure is `#[inline(always)]`, and so are the
-//! per-patch functions it calls, so that they are compiled into both: a screen tolerance's
-//! eight box corners then take four-lane vectors.
+//! per-patch functions it calls where the wider build pays (the screen tolerance's), so that
+//! they are compiled into both: a box's eight corners then take four-lane vectors.
 
 use rayon::prelude::*;
 

@@ -6,10 +6,11 @@
 //! to frame.
 
 use super::edge_params::UniformEdgeParams;
-use super::point_blocks::{has_avx2_fma, GridFormKey, GridPatch, PointBlocks, LANES};
+use super::point_blocks::{GridFormKey, GridPatch, PointBlocks, LANES};
 use super::uniform_quads::{store, Basis, Block, EdgePairLanes, GridLanes, GridLine, Line, LocalPatch};
 use super::uniform_triangles::UniformTriangles;
 use super::{CornerRecords, VertexSlices};
+use crate::cpu::has_avx2_fma;
 use crate::criterion::Plan;
 use crate::pattern::cache::PatternCache;
 use crate::pattern::{Pattern, PatternInput};

@@ -29,6 +29,7 @@
 use super::tree_points::{catmark_leaf, eval_sparse, loop_leaf, CatmarkLeaf, LoopLeaf, FORM_LEVEL};
 use super::uniform_quads::LocalPatch;
 use super::VertexSlices;
+use crate::cpu::has_avx2_fma;
 use crate::surface::patch_tree::PatchTree;
 use crate::surface::{BezierTriangle, GregoryPatch, GregoryTriangle, Patch, SurfacePoint, SurfaceSet};
 use glam::{DVec2, DVec3};
@@ -439,8 +440,6 @@ pub(crate) struct PointBlocks {
     /// the `unsafe` calls below rely on it.
     avx2_fma: bool,
 }
-
-pub(crate) use crate::cpu::has_avx2_fma;
 
 /// `L` points of one patch in structure-of-arrays form.
 pub(crate) struct Block<const L: usize> {

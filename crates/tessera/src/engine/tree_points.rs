@@ -662,7 +662,8 @@ const OPEN_BLOCKS: usize = 4;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::point_blocks::{has_avx2_fma, PointBlocks};
+    use crate::cpu::has_avx2_fma;
+    use crate::engine::point_blocks::PointBlocks;
     use crate::surface::Patch;
     use glam::Vec3;
 

@@ -278,7 +278,7 @@ impl Block {
                 (pos.split_first_chunk_mut::<LANES>(), nrm.split_first_chunk_mut::<LANES>())
             {
                 // SAFETY: `AVX` is only set in code compiled for AVX2 and FMA, which only
-                // runs where the CPU has them (`point_blocks::has_avx2_fma`).
+                // runs where the CPU has them (`cpu::has_avx2_fma`).
                 unsafe {
                     store_points(&self.pos, pos.as_flattened_mut().try_into().expect("LANES points"));
                     store_points(&self.nrm, nrm.as_flattened_mut().try_into().expect("LANES points"));
@@ -788,7 +788,7 @@ mod tests {
     /// lane) is written lane by lane either way, nothing past its points.
     #[test]
     fn whole_blocks_store_the_points_that_lane_stores_store() {
-        let avx = super::super::point_blocks::has_avx2_fma();
+        let avx = crate::cpu::has_avx2_fma();
         #[cfg(target_arch = "x86_64")]
         assert!(avx, "the x86-64 machines tessera is tested on have AVX2 and FMA");
         // Distinct bits in every slot, with a negative zero, a subnormal and an infinity.
